@@ -1,0 +1,58 @@
+/* Private to app/: subcommands and the small helpers they share. The app
+ * only parses arguments and wires the libraries together. */
+#ifndef MR_APP_H
+#define MR_APP_H
+
+#include "mr_core.h"
+#include "mr_render.h"
+#include "mr_scene.h"
+
+/* A declared option table: name, whether it takes a value, help text. */
+typedef struct app_opt {
+    const char *name;   /* without the leading "--" */
+    const char *arg;    /* value placeholder, or NULL for a flag */
+    const char *help;
+    const char *value;  /* filled by app_parse: the value, "1" for a set flag, or NULL */
+} app_opt;
+
+/* Parses argv[first..argc) into opts (terminated by a NULL name); positional
+ * arguments go to *pos (up to max_pos). --help prints usage and returns 0 via
+ * *done. Returns false (after printing one line) on a bad argument. */
+bool app_parse(int argc, char **argv, int first, app_opt *opts, const char **pos, int max_pos, int *npos,
+               const char *usage, bool *help_shown);
+const char *app_get(const app_opt *opts, const char *name);
+bool app_flag(const app_opt *opts, const char *name);
+/* Number parsing with range checks; print one line and return false on error. */
+bool app_double(const char *opt, const char *s, double lo, double hi, double *out);
+bool app_int(const char *opt, const char *s, long lo, long hi, long *out);
+bool app_size(const char *opt, const char *s, int *w, int *h);
+/* Prints "mrcheck: <cmd>: <message>" on stderr and returns 1. */
+int app_error(const char *cmd, const mr_error *err);
+int app_errorf(const char *cmd, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Sets the log level from --verbose / --quiet. */
+void app_log_level(const app_opt *opts);
+
+/* AprilTag images for the demo (tag36h11, ids 0..count-1), gray8 with the
+ * white border; *border gets its width in pixels. In tags.c. */
+bool app_tag_images(int count, mr_image **out, int *border, mr_error *err);
+void app_tag_images_free(mr_image *imgs, int count);
+
+/* A headless GPU, a renderer and (optionally) a scene set on it. */
+typedef struct app_gfx {
+    mr_gpu *gpu;
+    mr_renderer *renderer;
+} app_gfx;
+bool app_gfx_open(app_gfx *g, mr_error *err);
+void app_gfx_close(app_gfx *g);
+/* Writes what --aux asks for: depth.pfm, normal.pfm into dir. */
+bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err);
+
+int cmd_demo(int argc, char **argv);
+int cmd_render(int argc, char **argv);
+int cmd_bench(int argc, char **argv);
+
+#endif

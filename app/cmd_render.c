@@ -1,0 +1,125 @@
+/* mrcheck render: one headless frame. */
+#include "app.h"
+
+#include <string.h>
+
+bool app_gfx_open(app_gfx *g, mr_error *err) {
+    memset(g, 0, sizeof *g);
+    mr_gpu_params gp = MR_GPU_DEFAULTS;
+    gp.debug = mr_log_get_level() >= MR_LOG_DEBUG;
+    g->gpu = mr_gpu_create_headless(&gp, err);
+    if (!g->gpu) return false;
+    g->renderer = mr_renderer_create(g->gpu, err);
+    if (!g->renderer) {
+        mr_gpu_destroy(&g->gpu);
+        return false;
+    }
+    return true;
+}
+
+void app_gfx_close(app_gfx *g) {
+    mr_renderer_destroy(&g->renderer);
+    mr_gpu_destroy(&g->gpu);
+}
+
+bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err) {
+    char path[4096];
+    if (!mr_mkdirs(dir, err)) return false;
+    if (res->depth.data) {
+        mr_path_join(dir, "depth.pfm", path, sizeof path);
+        if (!mr_image_save_pfm(path, &res->depth, err)) return false;
+    }
+    if (res->normal.data) {
+        mr_path_join(dir, "normal.pfm", path, sizeof path);
+        if (!mr_image_save_pfm(path, &res->normal, err)) return false;
+    }
+    return true;
+}
+
+int cmd_render(int argc, char **argv) {
+    static const char *cmd = "render";
+    app_opt opts[] = {
+        {"scene", "FILE", "glTF/GLB file or scene config JSON (required)", NULL},
+        {"view", "VIEW.json", "camera + world_from_camera (required)", NULL},
+        {"out", "OUT.png", "output image (required)", NULL},
+        {"size", "WxH", "output size (default: the camera's)", NULL},
+        {"video", "IMG", "camera frame to overlay (raw, distorted)", NULL},
+        {"alpha", "A", "video transparency in [0,1]: 0 virtual only, 1 video only (default 0.5)", NULL},
+        {"aux", "DIR", "also write depth.pfm (linear view depth) and normal.pfm", NULL},
+        {"hidden", "GLOB", "extra node-name glob for the hidden layer", NULL},
+        {"hide-hidden", NULL, "leave the hidden layer out", NULL},
+        {"ao", "METHOD", "ambient occlusion (only 'none' in this build)", NULL},
+        {"ghost", "MODE", "ghosted views (only 'off' in this build)", NULL},
+        {"verbose", NULL, "print the passes that ran and more", NULL},
+        {"quiet", NULL, "errors only", NULL},
+        {NULL, NULL, NULL, NULL},
+    };
+    bool help;
+    if (!app_parse(argc, argv, 2, opts, NULL, 0, NULL,
+                   "usage: mrcheck render --scene FILE --view VIEW.json --out OUT.png [--size WxH] "
+                   "[--video IMG --alpha A] [--aux DIR]",
+                   &help))
+        return 2;
+    if (help) return 0;
+    app_log_level(opts);
+    const char *scene_path = app_get(opts, "scene"), *view_path = app_get(opts, "view"), *out = app_get(opts, "out");
+    if (!scene_path || !view_path || !out) return app_errorf(cmd, "--scene, --view and --out are required"), 2;
+    const char *ao = app_get(opts, "ao"), *ghost = app_get(opts, "ghost");
+    if (ao && strcmp(ao, "none") != 0) return app_errorf(cmd, "--ao %s: no AO method is available in this build (only 'none')", ao);
+    if (ghost && strcmp(ghost, "off") != 0) return app_errorf(cmd, "--ghost %s: ghosting is not available in this build (only 'off')", ghost);
+
+    mr_frame_params fp = MR_FRAME_DEFAULTS;
+    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &fp.width, &fp.height)) return 2;
+    double alpha = 0.5;
+    if (app_get(opts, "alpha") && !app_double("alpha", app_get(opts, "alpha"), 0, 1, &alpha)) return 2;
+    fp.alpha = (float)alpha;
+    fp.hide_hidden_layer = app_flag(opts, "hide-hidden");
+    const char *aux = app_get(opts, "aux");
+    fp.want_depth = fp.want_normals = aux != NULL;
+
+    /* Everything that can be checked without a GPU is checked first, so a
+     * bad input never costs a context. */
+    mr_error err = {0};
+    mr_view view;
+    if (!mr_view_load(view_path, &view, &err)) return app_error(cmd, &err);
+    mr_image video = {0};
+    if (app_get(opts, "video")) {
+        if (!mr_image_load(app_get(opts, "video"), 3, &video, &err)) return app_error(cmd, &err);
+        fp.video = &video;
+    }
+    const char *globs[1] = {app_get(opts, "hidden")};
+    mr_scene_params sp = MR_SCENE_DEFAULTS;
+    sp.hidden_globs = globs;
+    sp.hidden_glob_count = globs[0] ? 1 : 0;
+    double t0 = mr_time_now();
+    mr_scene *scene = mr_scene_load(scene_path, &sp, &err);
+    if (!scene) {
+        mr_image_free(&video);
+        return app_error(cmd, &err);
+    }
+    mr_log(MR_LOG_INFO, "loaded %s: %d nodes, %d meshes, %llu triangles in %.1f ms", scene_path, (int)scene->node_count,
+           (int)scene->mesh_count, (unsigned long long)mr_scene_triangle_count(scene), (mr_time_now() - t0) * 1e3);
+
+    int rc = 0;
+    app_gfx gfx;
+    mr_frame_result res = {0};
+    if (!app_gfx_open(&gfx, &err)) {
+        rc = app_error(cmd, &err);
+    } else {
+        if (!mr_renderer_set_scene(gfx.renderer, scene, &err) || !mr_render_frame(gfx.renderer, &view, &fp, &res, &err))
+            rc = app_error(cmd, &err);
+        else if (!mr_image_save_png(out, &res.color, &err) || (aux && !app_write_aux(aux, &res, &err)))
+            rc = app_error(cmd, &err);
+        if (rc == 0 && app_flag(opts, "verbose")) {
+            char passes[256];
+            mr_frame_result_passes(&res, passes, sizeof passes);
+            fprintf(stderr, "mrcheck: render: passes: %s; %u draw calls, %llu triangles, near plane %g\n", passes,
+                    res.draw_calls, (unsigned long long)res.triangles, res.near_plane);
+        }
+        mr_frame_result_free(&res);
+        app_gfx_close(&gfx);
+    }
+    mr_scene_destroy(&scene);
+    mr_image_free(&video);
+    return rc;
+}

@@ -1,0 +1,39 @@
+/* mrcheck — mixed-reality discrepancy checks for factory planning. */
+#include "app.h"
+
+#include <string.h>
+
+static const struct {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *help;
+} k_commands[] = {
+    {"demo", cmd_demo, "build the demo hall (as planned / as built), render camera frames and overlays"},
+    {"render", cmd_render, "render one headless frame of a scene from a view"},
+    {"bench", cmd_bench, "measure run time: bench frame"},
+};
+
+static void usage(FILE *f) {
+    fprintf(f, "usage: mrcheck <command> [options]   (mrcheck <command> --help for details)\n\ncommands:\n");
+    for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)
+        fprintf(f, "  %-10s %s\n", k_commands[i].name, k_commands[i].help);
+}
+
+int main(int argc, char **argv) {
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "help") == 0) {
+        usage(stdout);
+        return 0;
+    }
+    if (strcmp(argv[1], "--version") == 0) {
+        printf("mrcheck 0.1.0\n");
+        return 0;
+    }
+    for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)
+        if (strcmp(argv[1], k_commands[i].name) == 0) return k_commands[i].run(argc, argv);
+    fprintf(stderr, "mrcheck: unknown command '%s' (see mrcheck --help)\n", argv[1]);
+    return 2;
+}

@@ -1,0 +1,226 @@
+/* mr_core.h — the bottom layer of mrcheck: errors, logging, double-precision
+ * math and poses, camera model and view files (JSON through cJSON), image
+ * buffers and image files, atomic file writes, clocks, a deterministic RNG.
+ *
+ * Conventions used everywhere (see shared DESIGN.md §2):
+ *  - matrices are 4x4, row-major, double: m[r*4 + c]; points are column
+ *    vectors, so p' = M p, and a_from_c = a_from_b * b_from_c;
+ *  - a pose is world_from_camera with OpenCV camera axes (x right, y down,
+ *    z forward);
+ *  - pixel coordinates follow OpenCV: the centre of the top-left pixel is
+ *    (0,0), x to the right, y down.
+ *
+ * Functions that can fail return bool (or NULL) and fill an mr_error; nothing
+ * in lib/ calls exit() or keeps global state except the log level.
+ */
+#ifndef MR_CORE_H
+#define MR_CORE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include <cjson/cJSON.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------- errors */
+
+typedef enum mr_err_code {
+    MR_OK = 0,
+    MR_ERR_IO,          /* file missing, unreadable or unwritable */
+    MR_ERR_PARSE,       /* malformed content (JSON, glTF, image) */
+    MR_ERR_INVALID,     /* well-formed but meaningless values */
+    MR_ERR_NOMEM,       /* allocation failed or input too large */
+    MR_ERR_UNSUPPORTED, /* valid but not handled by this build */
+    MR_ERR_NODEVICE,    /* no EGL/GL device or context */
+    MR_ERR_GL,          /* a GL call or shader failed */
+} mr_err_code;
+
+/* An error: a stable code and one human-readable line (no newline). */
+typedef struct mr_error {
+    mr_err_code code;
+    char msg[512];
+} mr_error;
+
+/* Sets *err (if err is non-NULL) and returns false, so callers can write
+ * `return mr_fail(err, MR_ERR_IO, "cannot open %s", path);`. */
+bool mr_fail(mr_error *err, mr_err_code code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* Prefixes an existing message with context ("loading x.glb: ..."). */
+void mr_error_prefix(mr_error *err, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+const char *mr_err_name(mr_err_code code);
+
+/* --------------------------------------------------------------- logging */
+
+typedef enum mr_log_level { MR_LOG_ERROR = 0, MR_LOG_WARN, MR_LOG_INFO, MR_LOG_DEBUG } mr_log_level;
+void mr_log_set_level(mr_log_level level); /* default MR_LOG_WARN */
+mr_log_level mr_log_get_level(void);
+void mr_log(mr_log_level level, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* ----------------------------------------------------------------- clock */
+
+double mr_time_now(void); /* monotonic seconds */
+/* Peak resident set size of this process in bytes (0 where unknown). */
+size_t mr_peak_rss_bytes(void);
+
+/* ------------------------------------------------------------------ math */
+
+typedef struct mr_dvec3 { double x, y, z; } mr_dvec3;
+typedef struct mr_dmat4 { double m[16]; } mr_dmat4; /* row-major */
+
+static inline mr_dvec3 mr_v3(double x, double y, double z) { mr_dvec3 v = {x, y, z}; return v; }
+mr_dvec3 mr_v3_add(mr_dvec3 a, mr_dvec3 b);
+mr_dvec3 mr_v3_sub(mr_dvec3 a, mr_dvec3 b);
+mr_dvec3 mr_v3_scale(mr_dvec3 a, double s);
+double mr_v3_dot(mr_dvec3 a, mr_dvec3 b);
+mr_dvec3 mr_v3_cross(mr_dvec3 a, mr_dvec3 b);
+double mr_v3_len(mr_dvec3 a);
+mr_dvec3 mr_v3_normalize(mr_dvec3 a); /* zero vector stays zero */
+
+mr_dmat4 mr_m4_identity(void);
+mr_dmat4 mr_m4_mul(const mr_dmat4 *a, const mr_dmat4 *b); /* a * b */
+mr_dmat4 mr_m4_translate(double x, double y, double z);
+mr_dmat4 mr_m4_scale(double x, double y, double z);
+/* Rotation from a unit quaternion (x, y, z, w) as glTF stores it. */
+mr_dmat4 mr_m4_from_quat(double x, double y, double z, double w);
+mr_dmat4 mr_m4_rotate_axis(mr_dvec3 axis, double radians);
+/* glTF node: T * R * S. */
+mr_dmat4 mr_m4_from_trs(const double t[3], const double q[4], const double s[3]);
+/* General inverse; false if singular (|det| tiny relative to the scale). */
+bool mr_m4_invert(const mr_dmat4 *a, mr_dmat4 *out);
+/* Inverse of a rigid transform (rotation + translation). */
+mr_dmat4 mr_m4_invert_rigid(const mr_dmat4 *a);
+mr_dvec3 mr_m4_point(const mr_dmat4 *a, mr_dvec3 p);
+mr_dvec3 mr_m4_dir(const mr_dmat4 *a, mr_dvec3 d);
+/* True if the upper 3x3 is orthonormal with det +1 (within tol) and the
+ * last row is 0 0 0 1 and all entries are finite. */
+bool mr_m4_is_rigid(const mr_dmat4 *a, double tol);
+bool mr_m4_is_finite(const mr_dmat4 *a);
+/* Column-major float copy for GL (caller composes camera-relative first). */
+void mr_m4_to_gl(const mr_dmat4 *a, float out[16]);
+/* world_from_camera (OpenCV axes) of a camera at eye looking at target;
+ * up is the world's up direction (the image's y axis points against it). */
+mr_dmat4 mr_m4_look_at_cv(mr_dvec3 eye, mr_dvec3 target, mr_dvec3 up);
+
+/* ---------------------------------------------------------------- camera */
+
+/* Pinhole camera with OpenCV's 5-coefficient distortion (k1 k2 p1 p2 k3).
+ * Units: pixels. */
+typedef struct mr_camera {
+    int width, height;    /* image size in pixels */
+    double fx, fy;        /* focal lengths in pixels */
+    double cx, cy;        /* principal point in pixels (OpenCV convention) */
+    double dist[5];       /* k1 k2 p1 p2 k3 */
+} mr_camera;
+
+bool mr_camera_validate(const mr_camera *cam, mr_error *err);
+bool mr_camera_has_distortion(const mr_camera *cam);
+/* Normalised undistorted (x,y) -> normalised distorted (OpenCV model). */
+void mr_camera_distort(const mr_camera *cam, double x, double y, double *xd, double *yd);
+/* Inverse of mr_camera_distort by fixed-point iteration; false if it did not
+ * converge (far outside the valid field of view). */
+bool mr_camera_undistort(const mr_camera *cam, double xd, double yd, double *x, double *y);
+/* The same camera for another image size (intrinsics scaled). */
+mr_camera mr_camera_resized(const mr_camera *cam, int width, int height);
+
+/* ------------------------------------------------------------------ JSON */
+
+/* Reads and parses a JSON file; NULL + err on failure. */
+cJSON *mr_json_load(const char *path, mr_error *err);
+/* Writes JSON atomically (temp file + rename), pretty-printed. */
+bool mr_json_save(const char *path, const cJSON *json, mr_error *err);
+/* Field readers: false + err if missing (when required) or wrong type.
+ * `what` names the object in error messages. */
+bool mr_json_number(const cJSON *obj, const char *key, double *out, bool required, mr_error *err);
+bool mr_json_numbers(const cJSON *obj, const char *key, double *out, int n, mr_error *err);
+bool mr_json_dmat4(const cJSON *obj, const char *key, mr_dmat4 *out, mr_error *err);
+cJSON *mr_json_from_dmat4(const mr_dmat4 *m);
+cJSON *mr_json_from_doubles(const double *v, int n);
+
+bool mr_camera_from_json(const cJSON *obj, mr_camera *cam, mr_error *err);
+cJSON *mr_camera_to_json(const mr_camera *cam);
+bool mr_camera_load(const char *path, mr_camera *cam, mr_error *err);
+
+/* A view for headless rendering: a camera plus its pose. */
+typedef struct mr_view {
+    mr_camera camera;
+    mr_dmat4 world_from_camera; /* rigid, OpenCV camera axes */
+} mr_view;
+
+/* View JSON: {"camera": {...} or "path/to/camera.json",
+ *             "world_from_camera": [16 numbers, row-major]}.
+ * Relative camera paths are resolved against the view file's folder. */
+bool mr_view_load(const char *path, mr_view *view, mr_error *err);
+bool mr_view_from_json(const cJSON *obj, const char *base_dir, mr_view *view, mr_error *err);
+cJSON *mr_view_to_json(const mr_view *view);
+
+/* ----------------------------------------------------------------- files */
+
+/* Reads a whole file; the buffer is NUL-terminated (not counted in *size).
+ * Files over max_bytes (0 = 4 GiB) are refused. Free with free(). */
+void *mr_file_read(const char *path, size_t *size, size_t max_bytes, mr_error *err);
+/* Writes data to path.tmp.<pid> then renames over path, so a reader never
+ * sees a half-written file. */
+bool mr_file_write_atomic(const char *path, const void *data, size_t size, mr_error *err);
+bool mr_file_exists(const char *path);
+bool mr_mkdirs(const char *path, mr_error *err); /* mkdir -p */
+/* Directory part of a path ("." if none), into out (size n). */
+void mr_path_dir(const char *path, char *out, size_t n);
+/* Joins dir and rel unless rel is absolute. */
+void mr_path_join(const char *dir, const char *rel, char *out, size_t n);
+
+/* ---------------------------------------------------------------- images */
+
+typedef enum mr_pixel_type { MR_PIX_U8 = 0, MR_PIX_F32 = 1 } mr_pixel_type;
+
+/* A tightly packed image, rows top to bottom. */
+typedef struct mr_image {
+    int width, height;
+    int channels;       /* 1..4 */
+    mr_pixel_type type;
+    void *data;         /* width*height*channels elements */
+} mr_image;
+
+bool mr_image_alloc(mr_image *img, int width, int height, int channels, mr_pixel_type type, mr_error *err);
+void mr_image_free(mr_image *img); /* frees data, zeroes the struct */
+size_t mr_image_bytes(const mr_image *img);
+/* Loads PNG/JPEG/etc. (stb_image) as 8-bit with `channels` channels (0 =
+ * as stored). */
+bool mr_image_load(const char *path, int channels, mr_image *img, mr_error *err);
+/* PNG (8-bit only) and PFM (float, 1 or 3 channels), written atomically. */
+bool mr_image_save_png(const char *path, const mr_image *img, mr_error *err);
+bool mr_image_save_pfm(const char *path, const mr_image *img, mr_error *err);
+bool mr_image_load_pfm(const char *path, mr_image *img, mr_error *err);
+/* Bilinear sample of an 8-bit image at OpenCV pixel coordinates; out gets
+ * img->channels values in [0,255]; false if outside. */
+bool mr_image_sample_bilinear(const mr_image *img, double x, double y, float *out);
+
+/* ------------------------------------------------------------------- RNG */
+
+/* Deterministic generator (splitmix64 seeded xoshiro256**), so that demo
+ * data and tests are the same on every machine. */
+typedef struct mr_rng { uint64_t s[4]; } mr_rng;
+void mr_rng_seed(mr_rng *r, uint64_t seed);
+uint64_t mr_rng_u64(mr_rng *r);
+double mr_rng_uniform(mr_rng *r);  /* [0,1) */
+double mr_rng_normal(mr_rng *r);   /* standard normal */
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,426 @@
+/* Scene building: meshes, materials, textures, nodes, bounds, globs.
+ * glTF import/export lives in gltf_io.cc; the demo hall in demo.c. */
+#include "mr_scene.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+mr_scene *mr_scene_create(void) {
+    mr_scene *s = calloc(1, sizeof *s);
+    if (!s) return NULL;
+    s->ambient = 0.35f;
+    return s;
+}
+
+static void mesh_free(mr_mesh *m) {
+    free(m->positions);
+    free(m->normals);
+    free(m->uvs);
+    free(m->indices);
+}
+
+void mr_scene_destroy(mr_scene **scene) {
+    if (!scene || !*scene) return;
+    mr_scene *s = *scene;
+    for (int32_t i = 0; i < s->mesh_count; i++) mesh_free(&s->meshes[i]);
+    for (int32_t i = 0; i < s->texture_count; i++) mr_image_free(&s->textures[i].image);
+    free(s->meshes);
+    free(s->materials);
+    free(s->textures);
+    free(s->nodes);
+    free(s);
+    *scene = NULL;
+}
+
+/* Makes room for one more element of `elem` bytes; capacity doubles. */
+static bool grow(void **arr, int32_t count, int32_t *cap, size_t elem) {
+    if (count < *cap) return true;
+    if (*cap >= INT32_MAX / 2) return false;
+    int32_t ncap = *cap ? *cap * 2 : 8;
+    void *p = realloc(*arr, (size_t)ncap * elem);
+    if (!p) return false;
+    *arr = p;
+    *cap = ncap;
+    return true;
+}
+
+static const float k_fallback_normal[3] = {0.0f, 1.0f, 0.0f};
+
+/* Unit vector from double components; degenerate or non-finite input gets
+ * the fallback so that shading never sees NaN. */
+static void store_unit(double x, double y, double z, float *out) {
+    double len = sqrt(x * x + y * y + z * z);
+    if (!(len > 1e-300) || !isfinite(len)) {
+        memcpy(out, k_fallback_normal, sizeof k_fallback_normal);
+        return;
+    }
+    out[0] = (float)(x / len);
+    out[1] = (float)(y / len);
+    out[2] = (float)(z / len);
+}
+
+void mr_mesh_generate_normals(const float *positions, uint32_t vertex_count,
+                              const uint32_t *indices, uint32_t index_count, float *normals) {
+    if (!normals || vertex_count == 0) return;
+    /* Accumulate in double: cross products of huge or tiny triangles stay
+     * representable, and many small faces do not lose precision. */
+    double *acc = calloc((size_t)vertex_count * 3, sizeof *acc);
+    if (acc && positions && indices) {
+        for (uint32_t t = 0; t + 2 < index_count; t += 3) {
+            uint32_t i0 = indices[t], i1 = indices[t + 1], i2 = indices[t + 2];
+            if (i0 >= vertex_count || i1 >= vertex_count || i2 >= vertex_count) continue;
+            const float *a = positions + 3 * (size_t)i0;
+            const float *b = positions + 3 * (size_t)i1;
+            const float *c = positions + 3 * (size_t)i2;
+            double e1[3] = {(double)b[0] - a[0], (double)b[1] - a[1], (double)b[2] - a[2]};
+            double e2[3] = {(double)c[0] - a[0], (double)c[1] - a[1], (double)c[2] - a[2]};
+            /* |e1 x e2| = 2 * area, so the sum is area-weighted. */
+            double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                           e1[0] * e2[1] - e1[1] * e2[0]};
+            if (!isfinite(n[0]) || !isfinite(n[1]) || !isfinite(n[2])) continue;
+            const uint32_t tri[3] = {i0, i1, i2};
+            for (int k = 0; k < 3; k++) {
+                double *d = acc + 3 * (size_t)tri[k];
+                d[0] += n[0];
+                d[1] += n[1];
+                d[2] += n[2];
+            }
+        }
+    }
+    for (uint32_t v = 0; v < vertex_count; v++) {
+        if (acc) store_unit(acc[3 * (size_t)v], acc[3 * (size_t)v + 1], acc[3 * (size_t)v + 2], normals + 3 * (size_t)v);
+        else memcpy(normals + 3 * (size_t)v, k_fallback_normal, sizeof k_fallback_normal);
+    }
+    free(acc);
+}
+
+static bool all_finite(const float *v, size_t n) {
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(v[i])) return false;
+    return true;
+}
+
+/* On failure nothing is freed or changed: the caller keeps ownership of the
+ * arrays in *mesh. On success the arrays belong to the scene and the pointers
+ * in *mesh are set to NULL (so a caller's cleanup cannot double-free), while
+ * origin, bounds and vertex data there reflect the stored mesh. */
+int32_t mr_scene_add_mesh(mr_scene *s, mr_mesh *mesh, mr_error *err) {
+    if (!s || !mesh) {
+        mr_fail(err, MR_ERR_INVALID, "mr_scene_add_mesh: NULL argument");
+        return -1;
+    }
+    char name[80];
+    snprintf(name, sizeof name, "%.*s", (int)sizeof mesh->name, mesh->name[0] ? mesh->name : "(unnamed)");
+    size_t nv = mesh->vertex_count;
+    if (nv == 0 || !mesh->positions) {
+        mr_fail(err, MR_ERR_INVALID, "mesh '%s' has no vertices", name);
+        return -1;
+    }
+    if (mesh->index_count % 3 != 0) {
+        mr_fail(err, MR_ERR_INVALID, "mesh '%s' has %u indices, not a multiple of 3", name, mesh->index_count);
+        return -1;
+    }
+    if (mesh->index_count > 0 && !mesh->indices) {
+        mr_fail(err, MR_ERR_INVALID, "mesh '%s' has an index count but no indices", name);
+        return -1;
+    }
+    for (uint32_t i = 0; i < mesh->index_count; i++) {
+        if (mesh->indices[i] >= mesh->vertex_count) {
+            mr_fail(err, MR_ERR_INVALID, "mesh '%s': index %u (at %u) is out of range (%u vertices)", name,
+                    mesh->indices[i], i, mesh->vertex_count);
+            return -1;
+        }
+    }
+    if (!all_finite(mesh->positions, 3 * nv)) {
+        mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
+        return -1;
+    }
+    if (mesh->normals && !all_finite(mesh->normals, 3 * nv)) {
+        mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite normal", name);
+        return -1;
+    }
+    if (mesh->uvs && !all_finite(mesh->uvs, 2 * nv)) {
+        mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite texture coordinate", name);
+        return -1;
+    }
+    for (int k = 0; k < 3; k++) {
+        if (!isfinite(mesh->origin[k])) {
+            mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite origin", name);
+            return -1;
+        }
+    }
+    if (mesh->material < -1 || mesh->material >= s->material_count) {
+        mr_fail(err, MR_ERR_INVALID, "mesh '%s' refers to material %d (scene has %d)", name, mesh->material,
+                s->material_count);
+        return -1;
+    }
+    /* Allocate everything before changing anything, so failure leaves the
+     * caller's mesh untouched. */
+    if (!grow((void **)&s->meshes, s->mesh_count, &s->mesh_cap, sizeof *s->meshes)) {
+        mr_fail(err, MR_ERR_NOMEM, "out of memory adding mesh '%s'", name);
+        return -1;
+    }
+    float *gen_normals = NULL;
+    if (!mesh->normals) {
+        gen_normals = malloc(3 * nv * sizeof *gen_normals);
+        if (!gen_normals) {
+            mr_fail(err, MR_ERR_NOMEM, "out of memory generating normals for mesh '%s'", name);
+            return -1;
+        }
+    }
+
+    /* Recentre on the bounds centre, computed in double. */
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t v = 0; v < nv; v++)
+        for (int k = 0; k < 3; k++) {
+            double p = mesh->positions[3 * v + (size_t)k];
+            if (p < lo[k]) lo[k] = p;
+            if (p > hi[k]) hi[k] = p;
+        }
+    double centre[3];
+    for (int k = 0; k < 3; k++) {
+        centre[k] = 0.5 * lo[k] + 0.5 * hi[k]; /* halves first: no overflow near FLT_MAX */
+        mesh->origin[k] += centre[k];
+    }
+    for (size_t v = 0; v < nv; v++)
+        for (int k = 0; k < 3; k++) {
+            float *p = &mesh->positions[3 * v + (size_t)k];
+            *p = (float)((double)*p - centre[k]);
+        }
+    for (int k = 0; k < 3; k++) {
+        mesh->bounds_min[k] = INFINITY;
+        mesh->bounds_max[k] = -INFINITY;
+    }
+    for (size_t v = 0; v < nv; v++)
+        for (int k = 0; k < 3; k++) {
+            float p = mesh->positions[3 * v + (size_t)k];
+            if (p < mesh->bounds_min[k]) mesh->bounds_min[k] = p;
+            if (p > mesh->bounds_max[k]) mesh->bounds_max[k] = p;
+        }
+
+    if (gen_normals) {
+        mr_mesh_generate_normals(mesh->positions, mesh->vertex_count, mesh->indices, mesh->index_count, gen_normals);
+        mesh->normals = gen_normals;
+    } else {
+        for (size_t v = 0; v < nv; v++) {
+            float *n = mesh->normals + 3 * v;
+            store_unit(n[0], n[1], n[2], n);
+        }
+    }
+    mesh->name[sizeof mesh->name - 1] = 0;
+
+    int32_t idx = s->mesh_count++;
+    s->meshes[idx] = *mesh;
+    mesh->positions = NULL;
+    mesh->normals = NULL;
+    mesh->uvs = NULL;
+    mesh->indices = NULL;
+    return idx;
+}
+
+int32_t mr_scene_add_material(mr_scene *s, const mr_material *mat) {
+    if (!s || !mat) return -1;
+    if (mat->base_color_texture < -1 || mat->base_color_texture >= s->texture_count) {
+        mr_log(MR_LOG_WARN, "material '%.64s': texture %d out of range", mat->name, mat->base_color_texture);
+        return -1;
+    }
+    if (!grow((void **)&s->materials, s->material_count, &s->material_cap, sizeof *s->materials)) return -1;
+    int32_t idx = s->material_count++;
+    s->materials[idx] = *mat;
+    s->materials[idx].name[sizeof mat->name - 1] = 0;
+    return idx;
+}
+
+/* Any 8-bit image with 1..4 channels becomes RGBA8 (gray -> rgb, alpha 255). */
+static bool to_rgba8(mr_image *img) {
+    if (img->channels == 4) return true;
+    size_t n = (size_t)img->width * (size_t)img->height;
+    uint8_t *dst = malloc(n * 4);
+    if (!dst) return false;
+    const uint8_t *src = img->data;
+    int c = img->channels;
+    for (size_t i = 0; i < n; i++) {
+        const uint8_t *p = src + i * (size_t)c;
+        uint8_t *q = dst + i * 4;
+        if (c <= 2) {
+            q[0] = q[1] = q[2] = p[0];
+            q[3] = c == 2 ? p[1] : 255;
+        } else {
+            q[0] = p[0];
+            q[1] = p[1];
+            q[2] = p[2];
+            q[3] = 255;
+        }
+    }
+    free(img->data);
+    img->data = dst;
+    img->channels = 4;
+    return true;
+}
+
+/* Takes ownership of tex->image.data on success (the caller's pointer is
+ * NULLed); 8-bit images with fewer channels are expanded to RGBA8. */
+int32_t mr_scene_add_texture(mr_scene *s, mr_texture *tex) {
+    if (!s || !tex) return -1;
+    const mr_image *im = &tex->image;
+    if (!im->data || im->width <= 0 || im->height <= 0 || im->channels < 1 || im->channels > 4 ||
+        im->type != MR_PIX_U8) {
+        mr_log(MR_LOG_WARN, "texture rejected: needs an 8-bit image with 1-4 channels");
+        return -1;
+    }
+    if (!grow((void **)&s->textures, s->texture_count, &s->texture_cap, sizeof *s->textures)) return -1;
+    mr_texture t = *tex;
+    if (!to_rgba8(&t.image)) return -1;
+    int32_t idx = s->texture_count++;
+    s->textures[idx] = t;
+    memset(&tex->image, 0, sizeof tex->image);
+    return idx;
+}
+
+int32_t mr_scene_add_node(mr_scene *s, const mr_node *node) {
+    if (!s || !node) return -1;
+    /* Parents come first so that a node's parent index is always valid. */
+    if (node->parent < -1 || node->parent >= s->node_count) {
+        mr_log(MR_LOG_WARN, "node '%.96s': parent %d out of range", node->name, node->parent);
+        return -1;
+    }
+    if (node->mesh_first >= 0 &&
+        (node->mesh_count < 0 || node->mesh_first > s->mesh_count - node->mesh_count)) {
+        mr_log(MR_LOG_WARN, "node '%.96s': meshes %d+%d out of range", node->name, node->mesh_first,
+               node->mesh_count);
+        return -1;
+    }
+    if (node->layer >= MR_LAYER_COUNT || !mr_m4_is_finite(&node->world)) {
+        mr_log(MR_LOG_WARN, "node '%.96s': bad layer or non-finite transform", node->name);
+        return -1;
+    }
+    if (!grow((void **)&s->nodes, s->node_count, &s->node_cap, sizeof *s->nodes)) return -1;
+    int32_t idx = s->node_count++;
+    s->nodes[idx] = *node;
+    s->nodes[idx].name[sizeof node->name - 1] = 0;
+    if (node->mesh_first < 0) {
+        s->nodes[idx].mesh_first = -1;
+        s->nodes[idx].mesh_count = 0;
+    }
+    return idx;
+}
+
+/* Meshes a node draws, clamped to what exists. */
+static bool node_meshes(const mr_scene *s, const mr_node *n, int32_t *first, int32_t *count) {
+    if (n->mesh_first < 0 || n->mesh_count <= 0 || n->mesh_first >= s->mesh_count) return false;
+    *first = n->mesh_first;
+    *count = n->mesh_count;
+    if (*count > s->mesh_count - *first) *count = s->mesh_count - *first;
+    return true;
+}
+
+void mr_scene_update_bounds(mr_scene *s) {
+    if (!s) return;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t i = 0; i < s->node_count; i++) {
+        const mr_node *n = &s->nodes[i];
+        int32_t first, count;
+        if (!node_meshes(s, n, &first, &count)) continue;
+        for (int32_t j = first; j < first + count; j++) {
+            const mr_mesh *m = &s->meshes[j];
+            if (m->vertex_count == 0) continue;
+            mr_dmat4 t = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
+            mr_dmat4 model = mr_m4_mul(&n->world, &t);
+            for (int c = 0; c < 8; c++) {
+                mr_dvec3 p = mr_v3((c & 1) ? m->bounds_max[0] : m->bounds_min[0],
+                                   (c & 2) ? m->bounds_max[1] : m->bounds_min[1],
+                                   (c & 4) ? m->bounds_max[2] : m->bounds_min[2]);
+                mr_dvec3 w = mr_m4_point(&model, p);
+                double wv[3] = {w.x, w.y, w.z};
+                for (int k = 0; k < 3; k++) {
+                    if (wv[k] < lo[k]) lo[k] = wv[k];
+                    if (wv[k] > hi[k]) hi[k] = wv[k];
+                }
+            }
+        }
+    }
+    for (int k = 0; k < 3; k++) {
+        if (!(lo[k] <= hi[k])) lo[k] = hi[k] = 0.0; /* nothing drawn */
+        s->bounds_min[k] = lo[k];
+        s->bounds_max[k] = hi[k];
+    }
+}
+
+uint64_t mr_scene_triangle_count(const mr_scene *s) {
+    if (!s) return 0;
+    uint64_t total = 0;
+    for (int32_t i = 0; i < s->node_count; i++) {
+        int32_t first, count;
+        if (!node_meshes(s, &s->nodes[i], &first, &count)) continue;
+        for (int32_t j = first; j < first + count; j++) total += s->meshes[j].index_count / 3;
+    }
+    return total;
+}
+
+/* Matches one bracket expression at *pp against c; advances *pp past it.
+ * Returns -1 if the bracket is unterminated (then '[' is a literal). */
+static int glob_class(const char **pp, unsigned char c) {
+    const char *p = *pp + 1;
+    bool negate = false, match = false;
+    if (*p == '!' || *p == '^') {
+        negate = true;
+        p++;
+    }
+    bool first = true;
+    while (*p && (*p != ']' || first)) {
+        unsigned char lo = (unsigned char)*p, hi = lo;
+        if (p[1] == '-' && p[2] && p[2] != ']') {
+            hi = (unsigned char)p[2];
+            p += 3;
+        } else {
+            p++;
+        }
+        if (c >= lo && c <= hi) match = true;
+        first = false;
+    }
+    if (*p != ']') return -1;
+    *pp = p + 1;
+    return match != negate;
+}
+
+bool mr_glob_match(const char *pattern, const char *text) {
+    if (!pattern || !text) return false;
+    const char *p = pattern, *t = text;
+    const char *star_p = NULL, *star_t = NULL; /* backtrack point of the last '*' */
+    while (*t) {
+        if (*p == '*') {
+            while (*p == '*') p++;
+            if (!*p) return true;
+            star_p = p;
+            star_t = t;
+            continue;
+        }
+        bool ok = false;
+        const char *next = p + 1;
+        if (*p == '?') {
+            ok = true;
+        } else if (*p == '[') {
+            const char *q = p;
+            int r = glob_class(&q, (unsigned char)*t);
+            if (r < 0) ok = (*t == '[');
+            else {
+                ok = r == 1;
+                next = q;
+            }
+        } else if (*p) {
+            ok = (*p == *t);
+        }
+        if (ok) {
+            p = next;
+            t++;
+        } else if (star_p) {
+            p = star_p;
+            t = ++star_t;
+        } else {
+            return false;
+        }
+    }
+    while (*p == '*') p++;
+    return *p == 0;
+}

@@ -1,0 +1,25 @@
+in vec3 v_pos;
+in vec3 v_normal;
+in vec2 v_uv;
+
+layout(location = 3) uniform vec4 u_base_color;   // linear RGBA
+layout(location = 4) uniform int u_has_texture;
+layout(location = 5) uniform uvec2 u_ids;         // node index + 1, layer
+layout(binding = 0) uniform sampler2D u_base_tex; // sRGB texture: sampled linear
+
+layout(location = 0) out vec4 o_albedo;  // sRGB8 target: linear in, encoded on write
+layout(location = 1) out vec4 o_normal;  // xyz view normal, w = 1 where geometry
+layout(location = 2) out uvec2 o_ids;
+
+void main() {
+    vec4 c = u_base_color;
+    if (u_has_texture != 0) c *= texture(u_base_tex, v_uv);
+    vec3 n = normalize(v_normal);
+    // CAD exports have arbitrary winding and open shells: light both sides
+    // by turning the normal towards the camera (which sits at the origin).
+    if (dot(n, v_pos) > 0.0) n = -n;
+    if (any(isnan(n))) n = normalize(-v_pos);
+    o_albedo = vec4(c.rgb, 1.0);
+    o_normal = vec4(n, 1.0);
+    o_ids = u_ids;
+}

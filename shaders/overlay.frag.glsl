@@ -1,0 +1,34 @@
+// Video overlay: the raw (distorted) camera frame is undistorted on the fly
+// by mapping every pixel of the ideal pinhole image through the OpenCV
+// distortion model, then blended with the virtual image:
+//   out = mix(virtual, video, alpha)   (alpha 0 = virtual only, 1 = video only)
+// Blending happens in linear light; both inputs are sRGB textures.
+#include "common.glsl"
+
+layout(location = 0) uniform vec4 u_intr;        // fx fy cx cy of the output image
+layout(location = 1) uniform vec4 u_video_intr;  // fx fy cx cy of the video frame
+layout(location = 2) uniform vec2 u_video_size;  // pixels
+layout(location = 3) uniform float u_dist[5];    // k1 k2 p1 p2 k3
+layout(location = 8) uniform float u_alpha;
+
+layout(binding = 0) uniform sampler2D u_virtual;
+layout(binding = 1) uniform sampler2D u_video;
+
+layout(location = 0) out vec4 o_color; // sRGB8 target
+
+void main() {
+    vec2 px = cv_pixel();
+    vec2 xy = (px - u_intr.zw) / u_intr.xy;
+    float r2 = dot(xy, xy);
+    float k1 = u_dist[0], k2 = u_dist[1], p1 = u_dist[2], p2 = u_dist[3], k3 = u_dist[4];
+    float radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    vec2 d = xy * radial + vec2(2.0 * p1 * xy.x * xy.y + p2 * (r2 + 2.0 * xy.x * xy.x),
+                                p1 * (r2 + 2.0 * xy.y * xy.y) + 2.0 * p2 * xy.x * xy.y);
+    vec2 vp = d * u_video_intr.xy + u_video_intr.zw;          // raw video pixel
+    vec2 uv = (vp + 0.5) / u_video_size;
+    vec3 video = vec3(0.0);                                   // black outside the frame
+    if (all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))))
+        video = texture(u_video, uv).rgb;
+    vec3 virt = texelFetch(u_virtual, ivec2(gl_FragCoord.xy), 0).rgb;
+    o_color = vec4(mix(virt, video, u_alpha), 1.0);
+}
