@@ -51,6 +51,13 @@ void app_gfx_close(app_gfx *g);
 /* Writes what --aux asks for: depth.pfm, normal.pfm into dir. */
 bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err);
 
+/* The demo hall built in memory (tag images included), its camera and its
+ * standing viewpoints. In cmd_demo.c. */
+bool app_demo_hall(mr_demo_hall *hall, mr_error *err);
+mr_camera app_demo_camera(void);
+int app_demo_view_count(void);
+mr_view app_demo_view(int i);
+
 int cmd_demo(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_bench(int argc, char **argv);

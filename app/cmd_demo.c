@@ -13,7 +13,7 @@
 
 /* The demo tablet camera: 640x480, ~65 degrees horizontal, mild barrel
  * distortion as a real tablet lens has. */
-static mr_camera demo_camera(void) {
+mr_camera app_demo_camera(void) {
     mr_camera c = {640, 480, 500.0, 500.0, 319.5, 239.5, {-0.10, 0.04, 0.0005, -0.0005, 0.0}};
     return c;
 }
@@ -28,6 +28,31 @@ static const double k_views[][6] = {
     {-18.0, 6.5, 11.0, 4.0, 0.0, -4.0},
 };
 #define DEMO_VIEWS (int)(sizeof k_views / sizeof k_views[0])
+
+int app_demo_view_count(void) { return DEMO_VIEWS; }
+
+mr_view app_demo_view(int i) {
+    mr_view v;
+    v.camera = app_demo_camera();
+    i = i < 0 ? 0 : i >= DEMO_VIEWS ? DEMO_VIEWS - 1 : i;
+    v.world_from_camera = mr_m4_look_at_cv(mr_v3(k_views[i][0], k_views[i][1], k_views[i][2]),
+                                           mr_v3(k_views[i][3], k_views[i][4], k_views[i][5]), mr_v3(0, 1, 0));
+    return v;
+}
+
+bool app_demo_hall(mr_demo_hall *hall, mr_error *err) {
+    mr_image *tags = NULL;
+    int border = 1;
+    memset(hall, 0, sizeof *hall);
+    if (!app_tag_images(DEMO_TAGS, &tags, &border, err)) return false;
+    mr_demo_params dp = MR_DEMO_DEFAULTS;
+    dp.tag_images = tags;
+    dp.tag_image_count = DEMO_TAGS;
+    dp.tag_border_px = border;
+    bool ok = mr_demo_build(&dp, hall, err);
+    app_tag_images_free(tags, DEMO_TAGS);
+    return ok;
+}
 
 static bool write_markers(const char *path, const mr_demo_hall *hall, mr_error *err) {
     cJSON *j = cJSON_CreateObject();
@@ -128,22 +153,13 @@ static bool run_demo(const char *dir, mr_error *err) {
         if (!mr_mkdirs(sub, err)) return false;
     }
 
-    mr_image *tags = NULL;
-    int border = 1;
-    if (!app_tag_images(DEMO_TAGS, &tags, &border, err)) return false;
-    mr_demo_params dp = MR_DEMO_DEFAULTS;
-    dp.tag_images = tags;
-    dp.tag_image_count = DEMO_TAGS;
-    dp.tag_border_px = border;
     mr_demo_hall hall;
-    memset(&hall, 0, sizeof hall);
-    bool ok = mr_demo_build(&dp, &hall, err);
-    app_tag_images_free(tags, DEMO_TAGS);
-    if (!ok) return false;
+    if (!app_demo_hall(&hall, err)) return false;
+    bool ok;
 
     /* Files: both halls as .glb through tinygltf, configs, markers, the
      * list of discrepancies, the camera and the views. */
-    mr_camera cam = demo_camera();
+    mr_camera cam = app_demo_camera();
     mr_path_join(dir, "hall_planned.glb", path, sizeof path);
     ok = mr_scene_save_glb(hall.planned, path, err);
     mr_path_join(dir, "hall_built.glb", path, sizeof path);
@@ -162,10 +178,7 @@ static bool run_demo(const char *dir, mr_error *err) {
     cJSON_Delete(cj);
     mr_view views[DEMO_VIEWS];
     for (int i = 0; ok && i < DEMO_VIEWS; i++) {
-        views[i].camera = cam;
-        views[i].world_from_camera = mr_m4_look_at_cv(mr_v3(k_views[i][0], k_views[i][1], k_views[i][2]),
-                                                      mr_v3(k_views[i][3], k_views[i][4], k_views[i][5]),
-                                                      mr_v3(0, 1, 0));
+        views[i] = app_demo_view(i);
         cJSON *vj = mr_view_to_json(&views[i]);
         snprintf(sub, sizeof sub, "views/view_%03d.json", i);
         mr_path_join(dir, sub, path, sizeof path);

@@ -22,7 +22,7 @@
 #define COL_HALF 0.2
 #define TAG_GAP 0.005 /* plate in front of its surface: no z-fighting */
 
-/* Column grid: every 8 m, row r at z = COL_Z[r], column c at x = COL_X[c]. */
+/* Column grid, every 8 m: Column_r_c stands at x = k_col_x[c], z = k_col_z[r]. */
 static const double k_col_x[4] = {-12.0, -4.0, 4.0, 12.0};
 static const double k_col_z[2] = {-4.0, 4.0};
 
@@ -706,8 +706,10 @@ static mr_scene *build_scene(const demo_plan *plan, const mr_demo_params *p, dou
 
 /* ---------------------------------------------------------- discrepancies */
 
+/* built_delta NULL: the part is missing. The delta is stored as given (not
+ * re-derived from rounded positions). */
 static bool add_discrepancy(cJSON *arr, int id, const char *kind, const char *node, const char *desc,
-                            const double planned[3], const double *built) {
+                            const double planned[3], const double *built_delta) {
     cJSON *o = cJSON_CreateObject();
     if (!o) return false;
     cJSON_AddItemToArray(arr, o);
@@ -716,11 +718,11 @@ static bool add_discrepancy(cJSON *arr, int id, const char *kind, const char *no
     cJSON *pp = mr_json_from_doubles(planned, 3);
     ok = ok && pp && cJSON_AddItemToObject(o, "planned_position", pp);
     if (!ok) return false;
-    if (!built) return cJSON_AddNullToObject(o, "built_position") != NULL;
-    double d[3] = {built[0] - planned[0], built[1] - planned[1], built[2] - planned[2]};
-    cJSON *bp = mr_json_from_doubles(built, 3);
+    if (!built_delta) return cJSON_AddNullToObject(o, "built_position") != NULL;
+    double b[3] = {planned[0] + built_delta[0], planned[1] + built_delta[1], planned[2] + built_delta[2]};
+    cJSON *bp = mr_json_from_doubles(b, 3);
     if (!bp || !cJSON_AddItemToObject(o, "built_position", bp)) return false;
-    cJSON *dp = mr_json_from_doubles(d, 3);
+    cJSON *dp = mr_json_from_doubles(built_delta, 3);
     return dp && cJSON_AddItemToObject(o, "delta", dp);
 }
 
@@ -731,10 +733,10 @@ static cJSON *make_discrepancies(const demo_plan *plan) {
     bool ok = true;
 
     const machine_plan *m = &plan->machines[MOVED_MACHINE];
-    double mp[3] = {m->x, 0.0, m->z}, mb[3] = {m->x + MOVED_DX, 0.0, m->z};
+    double mp[3] = {m->x, 0.0, m->z}, md[3] = {MOVED_DX, 0.0, 0.0};
     snprintf(node, sizeof node, "Machine_%d", MOVED_MACHINE);
     snprintf(desc, sizeof desc, "%s was installed %.2f m further along +x than planned", node, MOVED_DX);
-    ok = ok && add_discrepancy(arr, 1, "moved", node, desc, mp, mb);
+    ok = ok && add_discrepancy(arr, 1, "moved", node, desc, mp, md);
 
     double cp[3] = {k_col_x[MISSING_COL_C], 0.0, k_col_z[MISSING_COL_R]};
     snprintf(node, sizeof node, "Column_%d_%d", MISSING_COL_R, MISSING_COL_C);
@@ -743,10 +745,10 @@ static cJSON *make_discrepancies(const demo_plan *plan) {
 
     const pipe_plan *pp = &k_pipes[RAISED_PIPE];
     double pz = PART_Z + 0.5 * PART_T + 0.12 + pp->radius;
-    double ppl[3] = {PART_CX, pp->y, pz}, pbu[3] = {PART_CX, pp->y + RAISED_DY, pz};
+    double ppl[3] = {PART_CX, pp->y, pz}, pd[3] = {0.0, RAISED_DY, 0.0};
     snprintf(node, sizeof node, "Pipe_%d", RAISED_PIPE);
     snprintf(desc, sizeof desc, "%s (behind the partition) runs %.2f m higher than planned", node, RAISED_DY);
-    ok = ok && add_discrepancy(arr, 3, "height", node, desc, ppl, pbu);
+    ok = ok && add_discrepancy(arr, 3, "height", node, desc, ppl, pd);
 
     if (!ok) {
         cJSON_Delete(arr);
