@@ -21,11 +21,11 @@ mr_camera app_demo_camera(void) {
 /* Standing viewpoints at eye height, looking at different parts of the
  * hall (tags, machines, the partition with the pipes behind it). */
 static const double k_views[][6] = {
-    {-17.0, 1.6, 9.0, 4.0, 1.8, -6.0},
-    {12.0, 1.7, 9.0, -4.0, 1.6, -9.0},
-    {0.0, 1.6, 10.0, 0.0, 2.2, -12.0},
-    {16.0, 1.6, -9.0, -8.0, 1.5, 6.0},
-    {-18.0, 6.5, 11.0, 4.0, 0.0, -4.0},
+    {-4.0, 1.6, -2.0, -14.0, 2.0, 8.0},  /* the partition: pipes hidden behind it */
+    {12.0, 1.7, 9.0, -4.0, 1.6, -9.0},   /* down the hall from the south-east */
+    {0.0, 1.6, 6.0, 0.0, 2.2, -12.0},    /* the north wall and its tags */
+    {16.0, 1.6, -9.0, -8.0, 1.5, 6.0},   /* under the suspended ceiling */
+    {-2.0, 7.5, -11.0, -8.0, 0.0, 6.0},  /* overview from high up */
 };
 #define DEMO_VIEWS (int)(sizeof k_views / sizeof k_views[0])
 

@@ -57,6 +57,7 @@ std::string one_line(const std::string &s) {
         }
     }
     while (!out.empty() && (out.back() == ' ' || out.back() == ';')) out.pop_back();
+    if (out.size() > 1000) out = out.substr(0, 1000) + "...";  // e.g. a data: URI quoted back at us
     return out;
 }
 
@@ -362,7 +363,8 @@ struct Loader {
             const std::vector<double> &f = gm.pbrMetallicRoughness.baseColorFactor;
             for (int k = 0; k < 4; k++) {
                 double v = f.size() == 4 ? f[(size_t)k] : 1.0;
-                mat.base_color[k] = std::isfinite(v) ? (float)v : 1.0f;
+                // glTF's range; also keeps the float cast defined.
+                mat.base_color[k] = std::isfinite(v) ? (float)std::min(1.0, std::max(0.0, v)) : 1.0f;
             }
             mat.base_color_texture = texture(gm.pbrMetallicRoughness.baseColorTexture.index);
             if (mr_scene_add_material(s, &mat) < 0) throw std::bad_alloc();
@@ -625,11 +627,20 @@ struct Loader {
     }
 };
 
+// Required extensions that change nothing we read.
+bool extension_ok(const std::string &e) {
+    return e == "KHR_materials_unlit" || e == "KHR_materials_emissive_strength";
+}
+
 mr_scene *load_memory(const void *data, size_t size, const char *base_dir, const mr_scene_params *params,
-                      const std::vector<std::string> &extra_globs) {
+                      const std::vector<std::string> &extra_globs, const char *label) {
     if (!data || size == 0) fail(MR_ERR_PARSE, "empty glTF data");
     if (size > UINT_MAX) fail(MR_ERR_NOMEM, "glTF data too large (%zu bytes)", size);
     const unsigned char *bytes = static_cast<const unsigned char *>(data);
+    if (size >= 3 && bytes[0] == 0xEF && bytes[1] == 0xBB && bytes[2] == 0xBF) {  // UTF-8 BOM
+        bytes += 3;
+        size -= 3;
+    }
     bool binary = size >= 4 && std::memcmp(bytes, "glTF", 4) == 0;
 
     tinygltf::TinyGLTF gltf;
@@ -648,6 +659,8 @@ mr_scene *load_memory(const void *data, size_t size, const char *base_dir, const
         std::string msg = one_line(terr.empty() ? twarn : terr);
         fail(MR_ERR_PARSE, "invalid %s: %s", binary ? "GLB" : "glTF", msg.empty() ? "parse error" : msg.c_str());
     }
+    for (const std::string &e : model.extensionsRequired)
+        if (!extension_ok(e)) fail(MR_ERR_UNSUPPORTED, "requires glTF extension %s (not supported)", e.c_str());
     mr_scene *scene = mr_scene_create();
     if (!scene) throw std::bad_alloc();
     SceneGuard guard(scene);
@@ -658,7 +671,7 @@ mr_scene *load_memory(const void *data, size_t size, const char *base_dir, const
     for (const std::string &g : extra_globs) L.globs.push_back(g.c_str());
     L.run();
     std::string all = one_line(twarn + (terr.empty() ? "" : "\n" + terr) + "\n" + L.warn);
-    if (!all.empty()) mr_log(MR_LOG_WARN, "glTF: %s", all.c_str());
+    if (!all.empty()) mr_log(MR_LOG_WARN, "%s: %s", label, all.c_str());
     return guard.release();
 }
 
@@ -711,7 +724,7 @@ mr_scene *load_config(const cJSON *cfg, const char *path, const mr_scene_params 
             if (!(len > 0) || !std::isfinite(len)) fail(MR_ERR_INVALID, "%s: a light direction is zero", path);
             if (cJSON_GetObjectItemCaseSensitive(l, "color")) json_vec3(l, "color", c, path);
             for (int k = 0; k < 3; k++) {
-                if (c[k] < 0) fail(MR_ERR_INVALID, "%s: a light colour is negative", path);
+                if (c[k] < 0 || c[k] > 1e6) fail(MR_ERR_INVALID, "%s: a light colour is out of range", path);
                 L.direction[k] = d[k] / len;
                 L.color[k] = (float)c[k];
             }
@@ -750,14 +763,15 @@ mr_scene *load_path(const char *path, const mr_scene_params *params, const std::
     mr_scene *s = nullptr;
     try {
         if (size >= 4 && std::memcmp(data, "glTF", 4) == 0) {
-            s = load_memory(data, size, dir, params, extra_globs);
+            s = load_memory(data, size, dir, params, extra_globs, path);
         } else {
-            JsonGuard j{cJSON_ParseWithLength(static_cast<const char *>(data), size)};
+            size_t bom = size >= 3 && std::memcmp(data, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
+        JsonGuard j{cJSON_ParseWithLength(static_cast<const char *>(data) + bom, size - bom)};
             if (!j.j || !cJSON_IsObject(j.j))
                 fail(MR_ERR_PARSE, "%s: not a glTF file or scene config (neither GLB nor a JSON object)", path);
             const cJSON *g = cJSON_GetObjectItemCaseSensitive(j.j, "gltf");
             if (cJSON_GetObjectItemCaseSensitive(j.j, "asset")) {
-                s = load_memory(data, size, dir, params, extra_globs);
+                s = load_memory(data, size, dir, params, extra_globs, path);
             } else if (cJSON_IsString(g)) {
                 if (!allow_config) fail(MR_ERR_INVALID, "%s: a scene config cannot point to another scene config", path);
                 s = load_config(j.j, path, params, extra_globs);
@@ -847,7 +861,10 @@ struct Writer {
             std::vector<double> lo(3, INFINITY), hi(3, -INFINITY);
             for (size_t v = 0; v < nv; v++)
                 for (int c = 0; c < 3; c++) {
-                    float f = (float)((double)mm.positions[v * 3 + (size_t)c] + d[c]);
+                    double x = (double)mm.positions[v * 3 + (size_t)c] + d[c];
+                    if (!(std::fabs(x) <= 3.0e38))
+                        fail(MR_ERR_INVALID, "mesh '%s' lies too far from the first mesh of its node", mm.name);
+                    float f = (float)x;
                     pos[v * 3 + (size_t)c] = f;
                     lo[(size_t)c] = std::min(lo[(size_t)c], (double)f);
                     hi[(size_t)c] = std::max(hi[(size_t)c], (double)f);
@@ -949,7 +966,7 @@ bool report(mr_error *err, mr_err_code code, const std::string &msg) {
 mr_scene *mr_scene_load_gltf_memory(const void *data, size_t size, const char *base_dir,
                                     const mr_scene_params *params, mr_error *err) {
     try {
-        return load_memory(data, size, base_dir, params, std::vector<std::string>());
+        return load_memory(data, size, base_dir, params, std::vector<std::string>(), "glTF");
     } catch (const Fail &f) {
         report(err, f.code, f.msg);
     } catch (const std::bad_alloc &) {

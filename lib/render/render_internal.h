@@ -1,0 +1,78 @@
+/* Private to lib/render: the renderer's state, the per-frame context and the
+ * pass interface. A pass lives in its own file (passes.c, later pass_ao.c,
+ * pass_ghost.c, ...) and is listed in k_passes in renderer.c with a predicate
+ * saying when a frame needs it. Geometry (scene upload and drawing) lives in
+ * geometry.c. */
+#ifndef MR_RENDER_INTERNAL_H
+#define MR_RENDER_INTERNAL_H
+
+#include "gpu_internal.h"
+
+typedef struct gl_mesh {
+    GLuint vao, vbo[3], ibo; /* positions, normals, uvs */
+    uint32_t index_count;
+} gl_mesh;
+
+/* A framebuffer with up to 3 colour textures and an optional depth texture. */
+typedef struct target {
+    GLuint fbo, color[3], depth;
+} target;
+
+struct mr_renderer {
+    mr_gpu *gpu;
+    const mr_scene *scene;
+    gl_mesh *meshes;
+    int32_t mesh_count;
+    GLuint *textures;
+    int32_t texture_count;
+    GLuint prog_gbuffer, prog_shade, prog_overlay;
+    GLuint empty_vao;
+    int w, h;              /* current target size */
+    target gbuf;           /* albedo (sRGB8), normal (RGBA16F), ids (RG32UI), depth (32F) */
+    target shaded;         /* sRGB8: the virtual image */
+    target composed;       /* sRGB8: virtual + video */
+    GLuint video_tex;
+    int video_w, video_h;
+    GLuint queries[MR_MAX_PASSES];
+};
+
+typedef struct frame {
+    mr_renderer *r;
+    const mr_view *view;
+    const mr_frame_params *p;
+    mr_camera cam;          /* the view's camera at the output size */
+    mr_dmat4 cam_from_world;
+    double near_plane;
+    mr_frame_result *out;
+    GLuint final_tex;       /* the texture holding the finished image */
+} frame;
+
+typedef struct pass_desc {
+    const char *name;
+    bool (*needed)(frame *f);
+    void (*run)(frame *f);
+} pass_desc;
+
+/* Helpers (renderer.c). */
+GLuint mr_gl_make_tex(GLenum fmt, int w, int h, GLenum filter);
+bool mr_gl_target_make(target *t, int w, int h, const GLenum *fmts, int n, bool depth, mr_error *err);
+void mr_gl_target_free(target *t);
+/* Reversed-Z infinite projection for OpenCV intrinsics (column-major). */
+void mr_gl_projection(const mr_camera *c, double near_plane, float out[16]);
+
+/* Geometry (geometry.c). */
+bool mr_geometry_upload(mr_renderer *r, const mr_scene *s, mr_error *err);
+void mr_geometry_free(mr_renderer *r);
+/* Draws the nodes whose layer bit (1 << layer) is in layer_mask with the
+ * G-buffer program into the currently bound framebuffer, counting triangles
+ * and draw calls into the frame result. */
+void mr_geometry_draw(frame *f, uint32_t layer_mask);
+
+/* Passes (passes.c). */
+bool mr_pass_need_always(frame *f);
+bool mr_pass_need_overlay(frame *f);
+void mr_pass_gbuffer(frame *f);
+void mr_pass_shade(frame *f);
+void mr_pass_overlay(frame *f);
+
+#endif
