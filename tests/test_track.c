@@ -137,6 +137,17 @@ static void test_detect_exact(void) {
     memset(img.data, 255, (size_t)W * W);
     for (int y = 0; y < tb.w * S; y++)
         for (int x = 0; x < tb.w * S; x++) ((unsigned char *)img.data)[(y + off) * W + x + off] = tb.px[(y / S) * tb.w + x / S];
+    /* A symmetric [1 2 1]/4 blur both ways, as a lens gives: it does not
+     * move the edges, and gradient-based edge refinement needs a ramp. */
+    unsigned char *p = img.data, tmp[320 * 320];
+    for (int pass = 0; pass < 2; pass++) {
+        memcpy(tmp, p, sizeof tmp);
+        for (int y = 1; y < W - 1; y++)
+            for (int x = 1; x < W - 1; x++) {
+                int a = pass ? tmp[(y - 1) * W + x] : tmp[y * W + x - 1], b = pass ? tmp[(y + 1) * W + x] : tmp[y * W + x + 1];
+                p[y * W + x] = (unsigned char)((a + 2 * tmp[y * W + x] + b + 2) / 4);
+            }
+    }
     mr_error err = {0};
     for (int refine = -1; refine <= 1; refine += 2) {
         mr_detector_params dp = MR_DETECTOR_DEFAULTS;
@@ -154,11 +165,12 @@ static void test_detect_exact(void) {
              * (-s/2,+s/2) first = bottom-left in the image. */
             const double lo = off + S - 0.5, hi = off + (tb.w - 1) * S - 0.5;
             const double want[4][2] = {{lo, hi}, {hi, hi}, {hi, lo}, {lo, lo}};
-            /* Without edge refinement the quad fit is coarser. */
-            double tol = refine > 0 ? 0.1 : 0.3;
+            /* apriltag 3.3 samples edges at integer pixels (no interpolation),
+             * so even on this ideal image it is off by up to ~0.2 px; a wrong
+             * pixel convention would be off by 0.5. */
+            double tol = 0.25;
             for (int k = 0; k < 4; k++) {
-                CHECK_NEAR(det[0].corners[k][0], want[k][0], tol);
-                CHECK_NEAR(det[0].corners[k][1], want[k][1], tol);
+                CHECK_MSG(fabs(det[0].corners[k][0] - want[k][0]) <= tol && fabs(det[0].corners[k][1] - want[k][1]) <= tol, "refine %d corner %d: (%.3f, %.3f) want (%.1f, %.1f)", refine, k, det[0].corners[k][0], det[0].corners[k][1], want[k][0], want[k][1]);
             }
         }
         mr_detector_destroy(&d);
