@@ -99,11 +99,13 @@ typedef struct mr_pose_params {
                                 default 3.0 px */
     double max_rms_px;       /* no pose when the final RMS exceeds this,
                                 default 4.0 px */
-    double ambiguity_px;     /* single tag: IPPE solutions within this RMS of
-                                the best count as ambiguous, default 1.0 px */
+    double ambiguity_ratio;  /* candidate poses whose RMS is within this factor
+                                of the best count as ambiguous (then the one
+                                nearest the previous pose wins), default 2.5 */
+    double ambiguity_px;     /* ... or within this many px of it, default 0.1 */
     double min_tag_px;       /* tags with a shorter edge are ignored, default 8 px */
 } mr_pose_params;
-#define MR_POSE_DEFAULTS {0.0, 0.0, 0.0, 0.0}
+#define MR_POSE_DEFAULTS {0.0, 0.0, 0.0, 0.0, 0.0}
 
 #define MR_POSE_MAX_IDS 32
 
