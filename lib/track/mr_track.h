@@ -253,6 +253,17 @@ typedef struct mr_calib_view {
 bool mr_calibrate(const mr_calib_view *views, int nviews, int width, int height, mr_camera *out, double *rms_px,
                   double *per_view_rms, mr_error *err);
 
+/* ------------------------------------------------------- video writing */
+
+/* Motion-JPEG AVI through OpenCV, written to a temporary file and renamed
+ * over `path` by mr_video_writer_close (so no half-written video is ever
+ * seen under that name); mr_video_writer_abort removes it instead. */
+typedef struct mr_video_writer mr_video_writer;
+mr_video_writer *mr_video_writer_open(const char *path, int width, int height, double fps, mr_error *err);
+bool mr_video_writer_add(mr_video_writer *w, const mr_image *img, mr_error *err); /* 8-bit grey or RGB */
+bool mr_video_writer_close(mr_video_writer **w, mr_error *err);
+void mr_video_writer_abort(mr_video_writer **w);
+
 /* ------------------------------------------------------- image coding */
 
 /* JPEG / PNG encoding and decoding through OpenCV (used for recordings and
