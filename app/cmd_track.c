@@ -56,7 +56,8 @@ int cmd_track(int argc, char **argv) {
 
     mr_error err = {0};
     mr_recording *rec = NULL;
-    mr_source *src = app_open_input(input, true, &rec, &err);
+    mr_source *src = NULL;
+    if (!app_open_input_opts(cmd, opts, true, &rec, &src, &err)) return 2;
     if (!src) return app_error(cmd, &err);
     app_tracker t;
     bool ok = app_tracker_init(&t, cmd, opts, rec);
