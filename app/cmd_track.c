@@ -107,6 +107,8 @@ int cmd_track(int argc, char **argv) {
             cJSON *o = cJSON_CreateObject();
             cJSON_AddNumberToObject(o, "frame", (double)f.index);
             cJSON_AddItemToObject(o, "detections", app_detections_json(r.dets, r.count));
+            /* with camera and markers the line also carries the pose */
+            if (want_pose) cJSON_AddItemToObject(o, "pose", app_pose_line(f.index, f.timestamp, &r));
             char *s = cJSON_PrintUnformatted(o);
             cJSON_Delete(o);
             if (s) puts(s);
