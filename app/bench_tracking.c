@@ -77,7 +77,7 @@ static void jitter_segment(const mr_dmat4 *p, int n, jitter_acc *acc) {
 }
 
 static bool run_setting(const setting *s, const mr_recording *rec, const mr_image *imgs, const int *fidx, int nf,
-                        result *res, mr_error *err) {
+                        const mr_filter_params *fparams, result *res, mr_error *err) {
     memset(res, 0, sizeof *res);
     mr_detector *det = NULL;
     mr_aruco *ar = NULL;
@@ -93,7 +93,7 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
         det = mr_detector_create(&dp, err);
         if (!det) return false;
     }
-    mr_pose_filter *filt = mr_pose_filter_create(NULL, err);
+    mr_pose_filter *filt = mr_pose_filter_create(fparams, err);
     double *ms = calloc((size_t)nf, sizeof *ms), *dms = calloc((size_t)nf, sizeof *dms);
     double *te = calloc((size_t)nf, sizeof *te), *tp = calloc((size_t)nf, sizeof *tp), *re = calloc((size_t)nf, sizeof *re);
     double *rm = calloc((size_t)nf, sizeof *rm);
@@ -272,6 +272,8 @@ int bench_tracking(int argc, char **argv) {
         {"out", "DIR", "write bench_tracking.csv and .svg there (default bench-out)", NULL},
         {"frames", "N", "use at most N frames (default all)", NULL},
         {"quick", NULL, "a few settings only", NULL},
+        {"min-cutoff", "HZ", "One Euro filter cutoff at rest (default 0.5)", NULL},
+        {"beta", "B", "One Euro filter speed coefficient (default 2)", NULL},
         {NULL, NULL, NULL, NULL},
     };
     bool help;
@@ -287,6 +289,10 @@ int bench_tracking(int argc, char **argv) {
     const char *out = app_get(opts, "out") ? app_get(opts, "out") : "bench-out";
     long max_frames = 1L << 30;
     if (app_get(opts, "frames") && !app_int("frames", app_get(opts, "frames"), 1, 1L << 30, &max_frames)) return 2;
+    mr_filter_params fparams = MR_FILTER_DEFAULTS;
+    if (app_get(opts, "min-cutoff") && !app_double("min-cutoff", app_get(opts, "min-cutoff"), 1e-3, 100, &fparams.min_cutoff)) return 2;
+    if (app_get(opts, "beta") && !app_double("beta", app_get(opts, "beta"), 1e-6, 1000, &fparams.beta)) return 2;
+    fparams.rot_min_cutoff = fparams.min_cutoff;
     mr_error err = {0};
     mr_recording *rec = mr_recording_open(dir, &err);
     if (!rec) return app_error(cmd, &err);
@@ -346,7 +352,7 @@ int bench_tracking(int argc, char **argv) {
                "t err %", "r err", "rms px", "det", "det56", "pose", "flip", "jitter raw", "jitter filt");
     }
     for (int i = 0; ok && i < ns; i++) {
-        ok = run_setting(&set[i], rec, imgs, fidx, nf, &res[i], &err);
+        ok = run_setting(&set[i], rec, imgs, fidx, nf, &fparams, &res[i], &err);
         if (!ok) break;
         const result *r = &res[i];
         printf("%-22s %7.2f %7.2f %8.1f %7.2f %7.3f %6.3f %5.1f%% %5.1f%% %5.1f%% %5.1f%% %5.2fmm/%.3f° %5.2fmm/%.3f°\n",
