@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* ------------------------------------------------------------ the path */
 
@@ -227,7 +228,9 @@ bool app_synth_recording(const char *dir, const app_synth_params *params, mr_err
         mr_image_free(&frame);
         mr_image_free(&gray);
         if (ok && i % 10 == 0) mr_log(MR_LOG_INFO, "synth: frame %d/%d, %d tags", i, p.frames, n);
+        if (ok && isatty(2) && mr_log_get_level() < MR_LOG_INFO) fprintf(stderr, "\rsynth: frame %d/%d", i + 1, p.frames);
     }
+    if (isatty(2) && mr_log_get_level() < MR_LOG_INFO) fprintf(stderr, "\r\033[K");
     for (int k = 0; k < 16; k++) mr_image_free(&ideal[k]);
     if (ok) mr_log(MR_LOG_INFO, "synth: %d frames, %d with a pose", p.frames, with_pose);
     mr_recorder_close(&rec);
