@@ -58,6 +58,10 @@ mr_camera app_demo_camera(void);
 int app_demo_view_count(void);
 mr_view app_demo_view(int i);
 
+/* Fills gp from the --ghost, --ghost-importance, --ghost-saliency and
+ * --ghost-* number options present in opts; one line + false if bad. */
+bool app_ghost_options(const app_opt *opts, mr_ghost_params *gp);
+
 int cmd_demo(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_bench(int argc, char **argv);

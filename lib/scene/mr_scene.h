@@ -156,6 +156,19 @@ typedef struct mr_demo_hall {
 bool mr_demo_build(const mr_demo_params *params, mr_demo_hall *out, mr_error *err);
 void mr_demo_free(mr_demo_hall *hall);
 
+/* ------------------------------------------------------------ curvature */
+
+/* Per-vertex maximum principal curvature magnitude |kappa_max| of a mesh in
+ * 1/scene units (out: vertex_count floats), estimated from the normal
+ * variation along the edges that share the vertex: for an edge e = p_j - p_i,
+ * the normal curvature is (n_j - n_i).e / |e|^2 (exact for a sphere). Only
+ * edges of the same smooth patch count (shared vertex indices): at a crease
+ * (split vertices, as CAD exports flat faces) the curvature is a line
+ * singularity that the renderer finds in screen space from the normals.
+ * Degenerate edges are skipped; the result is finite and >= 0. Linear time
+ * in index_count. Scale: kappa(s * mesh) = kappa(mesh) / s. */
+void mr_mesh_curvature(const mr_mesh *mesh, float *out);
+
 #ifdef __cplusplus
 }
 #endif
