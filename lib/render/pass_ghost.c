@@ -41,7 +41,8 @@ typedef struct mr_ghost_state {
     target hid;          /* D's G-buffer: albedo, normal, ids, depth */
     target hid_shaded;   /* D shaded (sRGB8) */
     target curv;         /* R32F curvature + depth */
-    GLuint lab;          /* rgba32f with SAL_LEVELS mips: L*a*b* pyramid */
+    GLuint lab;          /* rgba32f with lab_levels (<= SAL_LEVELS) mips: L*a*b* pyramid */
+    int lab_levels;
     GLuint tmp, gpos, gneg, sal_o, sal_g0, sal_final;
     GLuint mask, key, label[2];
     GLuint g0, c, gkc, dgk, oa, ga;
@@ -138,8 +139,11 @@ static bool ensure_size(mr_ghost_state *g, int w, int h, mr_error *err) {
     if (!mr_gl_target_make(&g->hid, w, h, gfmt, 3, true, err) || !mr_gl_target_make(&g->hid_shaded, w, h, cfmt, 1, false, err) ||
         !mr_gl_target_make(&g->curv, w, h, kfmt, 1, true, err))
         return false;
+    /* Small images have fewer levels; the shader clamps to the last one. */
+    g->lab_levels = 1;
+    while (g->lab_levels < SAL_LEVELS && ((w >> g->lab_levels) > 0 || (h >> g->lab_levels) > 0)) g->lab_levels++;
     glCreateTextures(GL_TEXTURE_2D, 1, &g->lab);
-    glTextureStorage2D(g->lab, SAL_LEVELS, GL_RGBA32F, w, h);
+    glTextureStorage2D(g->lab, g->lab_levels, GL_RGBA32F, w, h);
     /* Level n is sampled bilinearly inside the level (eq. 10's pyramid). */
     glTextureParameteri(g->lab, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
     glTextureParameteri(g->lab, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -241,9 +245,7 @@ static void saliency(mr_ghost_state *g, GLuint src, GLuint dst, mr_saliency_impl
         glBindTextureUnit(1, g->lab);
     }
     glUniform1f(1, gain);
-    int levels = 1;
-    while (levels < SAL_LEVELS && ((g->w >> levels) > 0 || (g->h >> levels) > 0)) levels++;
-    glUniform1i(2, levels - 1);
+    glUniform1i(2, g->lab_levels - 1);
     glBindImageTexture(0, dst, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     dispatch(g->w, g->h);
 }
