@@ -1,5 +1,5 @@
 // Legibility measure for the bench: over the region, the important pixels
-// (IM > 0.5) whose saliency in the final image reaches
+// (IM > 0.3, above the flat-wall bias) whose saliency in the final image reaches
 // C_desired = max(tc_minimal, gamma * IM) (+ tc_silhouette on silhouettes),
 // and the mean |L*(O_A) - L*(O)|. Sums in fixed point (1/256; 1/16 for L*).
 #include "ghost_lab.glsl"
@@ -23,7 +23,7 @@ void main() {
     atomicAdd(c_sum, uint(clamp(texelFetch(u_c, p, 0).r, 0.0, 4.0) * 256.0 + 0.5));
     float dl = abs(rgb_to_lab(texelFetch(u_oa, p, 0).rgb).x - rgb_to_lab(texelFetch(u_o, p, 0).rgb).x);
     atomicAdd(dl_sum, uint(min(dl, 100.0) * 16.0 + 0.5)); // 1/16 L*: no overflow at 4K
-    if (m.x > 0.5) {
+    if (m.x > 0.3) {
         atomicAdd(important, 1u);
         float want = max(u_tc_min, u_gamma * m.x) + (m.z > 0.5 ? u_tc_sil : 0.0);
         if (texelFetch(u_sal, p, 0).r >= want) atomicAdd(legible, 1u);

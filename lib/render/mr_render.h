@@ -82,24 +82,26 @@ typedef struct mr_ghost_params {
     mr_saliency_impl saliency;   /* default mip-map pyramid */
     float t;                     /* user transparency: alpha = t * IM, in [0,1]; default 1 */
     float curv_scale;            /* IM = curv_scale * curvature (radians per pixel) + curv_bias; default 2 */
-    float curv_bias;             /* default 0.15 (higher: denser occluder) */
+    float curv_bias;             /* default 0.35 (higher: denser occluder, lower: sparser) */
     float saliency_gain;         /* saliency S = gain * |centre-surround| / 100 L* units; default 4 */
-    float tc_minimal;            /* minimal desired contrast where 0 < alpha < 1; default 0.15 */
-    float gamma;                 /* multiplier of IM in C_desired; default 1 */
-    float tc_silhouette;         /* added to C_desired on the hidden structure's silhouette; default 0.25 */
-    float emphasis_gain;         /* L* units per unit of GK(C); default 100 */
+    float tc_minimal;            /* minimal desired contrast where 0 < alpha < 1; default 0.1 */
+    float gamma;                 /* multiplier of IM in C_desired; default 0.5 (curvature IM
+                                    reaches 1 on edges where saliency rarely does) */
+    float tc_silhouette;         /* added to C_desired on the hidden structure's silhouette; default 0.15 */
+    float emphasis_gain;         /* L* units per unit of GK(C); default 200 (O_A is seen through
+                                    alpha, so its change must be larger than the contrast wanted) */
     float sigma_c;               /* Gaussian GK on C, pixels; default 3 */
     float sigma_d;               /* Gaussian GK on D, pixels; default 3 */
     bool stats;                  /* fill mr_frame_result.ghost (extra GPU work and a read-back) */
 } mr_ghost_params;
-#define MR_GHOST_DEFAULTS {MR_GHOST_OFF, MR_GHOST_IMP_AUTO, MR_SALIENCY_MIPMAP, 1.0f, 2.0f, 0.15f, 4.0f, 0.15f, 1.0f, 0.25f, 100.0f, 3.0f, 3.0f, false}
+#define MR_GHOST_DEFAULTS {MR_GHOST_OFF, MR_GHOST_IMP_AUTO, MR_SALIENCY_MIPMAP, 1.0f, 2.0f, 0.35f, 4.0f, 0.1f, 0.5f, 0.15f, 200.0f, 3.0f, 3.0f, false}
 
 /* Legibility of a ghosted frame (when mr_ghost_params.stats). */
 typedef struct mr_ghost_stats {
     bool valid;
     double region_fraction;    /* fraction of the image where hidden structure lies behind an occluder */
     double mean_importance;    /* mean IM over that region */
-    double legibility;         /* fraction of important pixels (IM > 0.5 in the region) whose saliency
+    double legibility;         /* fraction of important pixels (IM > 0.3 in the region) whose saliency
                                   in the final image is >= C_desired */
     double mean_abs_dL;        /* mean |L*(O_A) - L*(O)| over the region (0 unless adaptive) */
     double mean_contrast_missing; /* mean C over the region (after G0) */

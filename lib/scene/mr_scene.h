@@ -134,8 +134,10 @@ typedef struct mr_demo_params {
                                    white border), tag i has id i; may be NULL */
     int tag_image_count;
     int tag_border_px;        /* white border width in those images (px), default 1 */
+    bool pipes_like_partition; /* ghosting conflict case: the hidden pipes get the
+                                  partition's colour; default false */
 } mr_demo_params;
-#define MR_DEMO_DEFAULTS {1, 0.4, NULL, 0, 1}
+#define MR_DEMO_DEFAULTS {1, 0.4, NULL, 0, 1, false}
 
 /* One AprilTag plate of the demo hall. */
 typedef struct mr_demo_tag {
