@@ -102,7 +102,8 @@ typedef struct mr_ghost_stats {
     double region_fraction;    /* fraction of the image where hidden structure lies behind an occluder */
     double mean_importance;    /* mean IM over that region */
     double legibility;         /* fraction of important pixels (IM > 0.3 in the region) whose saliency
-                                  in the final image is >= C_desired */
+                                  in the final image is >= C_desired; always measured
+                                  with the two-Gaussian saliency; NaN if no pixel is important */
     double mean_abs_dL;        /* mean |L*(O_A) - L*(O)| over the region (0 unless adaptive) */
     double mean_contrast_missing; /* mean C over the region (after G0) */
 } mr_ghost_stats;

@@ -280,10 +280,13 @@ static void stage_analysis(mr_ghost_state *g, const mr_ghost_params *gp) {
 
 /* key_base: the first vote slot of the video's connected regions (object
  * ids of the model lie below it). */
-static void stage_emphasis(mr_ghost_state *g, GLuint o, GLuint d, const mr_ghost_params *gp, uint32_t key_base) {
+static void stage_emphasis(mr_ghost_state *g, GLuint o, GLuint d, const mr_ghost_params *gp, uint32_t key_base,
+                           bool regions) {
     blur(g, g->c, g->gkc, gp->sigma_c, radius_of(gp->sigma_c));
     blur(g, d, g->dgk, gp->sigma_d, radius_of(gp->sigma_d));
-    /* Connected regions of the video occluder. */
+    /* Connected regions of the video occluder: only where some occluder
+     * has no object id (video without a model in front); otherwise the
+     * single init step writes zeros. */
     glUseProgram(g->prog_label);
     glBindTextureUnit(0, g->mask);
     glBindTextureUnit(1, g->key);
@@ -293,7 +296,7 @@ static void stage_emphasis(mr_ghost_state *g, GLuint o, GLuint d, const mr_ghost
     glBindImageTexture(0, g->label[0], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
     dispatch(g->w, g->h);
     glUniform1i(0, 0);
-    for (int i = 0; i < LABEL_STEPS; i++) {
+    for (int i = 0; regions && i < LABEL_STEPS; i++) {
         glBindTextureUnit(2, g->label[cur]);
         glBindImageTexture(0, g->label[1 - cur], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
         dispatch(g->w, g->h);
@@ -327,7 +330,9 @@ static void stage_emphasis(mr_ghost_state *g, GLuint o, GLuint d, const mr_ghost
 
 /* Legibility and lightness change of the finished ghosted view. */
 static void stage_stats(mr_ghost_state *g, GLuint o, bool adaptive, const mr_ghost_params *gp, mr_ghost_stats *st) {
-    saliency(g, adaptive ? g->ga : g->g0, g->sal_final, gp->saliency, gp->saliency_gain);
+    /* One yardstick for every configuration: the measure always uses the
+     * two-Gaussian saliency, whichever pyramid the analysis used. */
+    saliency(g, adaptive ? g->ga : g->g0, g->sal_final, MR_SALIENCY_GAUSS, gp->saliency_gain);
     static const GLuint zero = 0;
     glClearNamedBufferData(g->ssbo_sums, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glUseProgram(g->prog_stats);
@@ -347,7 +352,7 @@ static void stage_stats(mr_ghost_state *g, GLuint o, bool adaptive, const mr_gho
     st->valid = true;
     st->region_fraction = s[0] / npx;
     st->mean_importance = s[3] / 256.0 / reg;
-    st->legibility = s[1] > 0 ? (double)s[2] / s[1] : 1.0;
+    st->legibility = s[1] > 0 ? (double)s[2] / s[1] : NAN; /* no important pixel: undefined */
     st->mean_abs_dL = s[4] / 16.0 / reg;
     st->mean_contrast_missing = adaptive ? s[5] / 256.0 / reg : 0.0;
 }
@@ -533,7 +538,7 @@ void mr_pass_ghost_analysis(frame *f) { stage_analysis(f->r->ghost, &f->p->ghost
 void mr_pass_ghost_emphasis(frame *f) {
     mr_ghost_state *g = f->r->ghost;
     uint32_t key_base = (uint32_t)(f->r->scene ? f->r->scene->node_count : 0) + 1;
-    stage_emphasis(g, g->o_tex, g->hid_shaded.color[0], &f->p->ghost, key_base);
+    stage_emphasis(g, g->o_tex, g->hid_shaded.color[0], &f->p->ghost, key_base, f->p->video != NULL);
     f->final_tex = g->out_view;
     if (f->p->ghost.stats) stage_stats(g, g->o_tex, true, &f->p->ghost, &f->out->ghost);
 }
@@ -665,7 +670,7 @@ bool mr_ghost_compose(mr_renderer *r, const mr_ghost_images *in, const mr_ghost_
     upload_rgba(g->in_d, in->occludee);
     stage_g0(g, g->in_o, g->in_d, &gp);
     stage_analysis(g, &gp);
-    stage_emphasis(g, g->in_o, g->in_d, &gp, key_base);
+    stage_emphasis(g, g->in_o, g->in_d, &gp, key_base, in->objects == NULL);
     mr_image rgba = {0};
     bool ok = read_tex(g->g0, w, h, 3, &out->g0, err) && read_tex(g->ga, w, h, 3, &out->ga, err) &&
               read_tex(g->oa, w, h, 3, &out->occluder_a, err) && read_tex(g->c, w, h, 1, &out->contrast, err) &&
