@@ -496,6 +496,17 @@ static void test_frame(void) {
         }
         mr_frame_result_free(&off2);
     }
+    /* Bad parameters fail the frame with one clear error. */
+    {
+        mr_frame_params bad = p;
+        bad.ghost.t = 2;
+        mr_view v = {{96, 72, 80, 80, 47.5, 35.5, {0}}, mr_m4_identity()};
+        mr_error err = {0};
+        CHECK(!mr_render_frame(g_r, &v, &bad, &res, &err) && err.code == MR_ERR_INVALID);
+        bad.ghost.t = 1;
+        bad.ghost.sigma_c = NAN;
+        CHECK(!mr_render_frame(g_r, &v, &bad, &res, &err) && err.code == MR_ERR_INVALID);
+    }
     p.hide_hidden_layer = true;
     if (render(in_view, &p, &res, passes, sizeof passes)) {
         CHECK_MSG(strcmp(passes, "gbuffer shade") == 0, "hidden layer hidden: %s", passes);

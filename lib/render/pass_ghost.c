@@ -391,18 +391,30 @@ static bool hidden_in_view(frame *f) {
     return false;
 }
 
+static bool finite_in(float v, float lo, float hi) { return v >= lo && v <= hi; }
+
+bool mr_ghost_prepare(mr_renderer *r, const mr_ghost_params *gp, int w, int h, mr_error *err) {
+    if (gp->mode == MR_GHOST_OFF) return true;
+    if ((unsigned)gp->mode > MR_GHOST_ADAPTIVE || (unsigned)gp->importance > MR_GHOST_IMP_SALIENCY ||
+        (unsigned)gp->saliency > MR_SALIENCY_GAUSS)
+        return mr_fail(err, MR_ERR_INVALID, "ghost: unknown mode, importance source or saliency implementation");
+    if (!finite_in(gp->t, 0, 1)) return mr_fail(err, MR_ERR_INVALID, "ghost: t must be in [0,1]");
+    if (!finite_in(gp->curv_scale, 0, 1e6f) || !finite_in(gp->curv_bias, -1e6f, 1e6f) ||
+        !finite_in(gp->saliency_gain, 0, 1e6f) || !finite_in(gp->tc_minimal, 0, 1e6f) || !finite_in(gp->gamma, 0, 1e6f) ||
+        !finite_in(gp->tc_silhouette, 0, 1e6f) || !finite_in(gp->emphasis_gain, 0, 1e6f))
+        return mr_fail(err, MR_ERR_INVALID, "ghost: parameters must be finite and not negative");
+    if (!finite_in(gp->sigma_c, 0.1f, 64) || !finite_in(gp->sigma_d, 0.1f, 64))
+        return mr_fail(err, MR_ERR_INVALID, "ghost: sigma_c and sigma_d must be in [0.1, 64] pixels");
+    mr_ghost_state *g = state(r, err);
+    return g && ensure_size(g, w, h, err);
+}
+
 bool mr_ghost_active(frame *f) {
     if (f->ghost == 0) {
         const mr_frame_params *p = f->p;
-        bool on = p->ghost.mode != MR_GHOST_OFF && !p->hide_hidden_layer && hidden_in_view(f);
-        if (on) {
-            mr_error err = {0};
-            mr_ghost_state *g = state(f->r, &err);
-            if (!g || !ensure_size(g, f->r->w, f->r->h, &err)) {
-                mr_log(MR_LOG_ERROR, "ghosting disabled for this frame: %s", err.msg);
-                on = false;
-            }
-        }
+        /* mr_ghost_prepare ran at the start of the frame (programs, targets). */
+        bool on = p->ghost.mode != MR_GHOST_OFF && !p->hide_hidden_layer && f->r->ghost && f->r->ghost->w == f->r->w &&
+                  f->r->ghost->h == f->r->h && hidden_in_view(f);
         f->ghost = on ? 1 : -1;
     }
     return f->ghost > 0;

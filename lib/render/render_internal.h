@@ -94,6 +94,9 @@ void mr_pass_ghost_importance(frame *f);
 void mr_pass_ghost_g0(frame *f);
 void mr_pass_ghost_analysis(frame *f);
 void mr_pass_ghost_emphasis(frame *f);
+/* Checks the ghost parameters and builds programs and targets, before the
+ * frame's passes run (so a failure fails the frame). */
+bool mr_ghost_prepare(mr_renderer *r, const mr_ghost_params *gp, int w, int h, mr_error *err);
 /* Drops what was derived from the scene (per-mesh curvature buffers). */
 void mr_ghost_scene_changed(mr_renderer *r);
 void mr_ghost_free(mr_renderer *r);

@@ -205,6 +205,7 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
     int h = p->height > 0 ? p->height : view->camera.height;
     if (w > 16384 || h > 16384) return mr_fail(err, MR_ERR_INVALID, "output size %dx%d too large", w, h);
     if (!ensure_targets(r, w, h, err)) return false;
+    if (!mr_ghost_prepare(r, &p->ghost, w, h, err)) return false;
 
     frame f;
     memset(&f, 0, sizeof f);
