@@ -88,6 +88,44 @@ static void test_curvature(void) {
     CHECK(isfinite(k[2]) && isfinite(k[3]));
 }
 
+/* The demo's conflict case: the hidden pipes take the partition's colour;
+ * the default hall keeps its coloured pipes and the same geometry. */
+static const mr_material *node_material(const mr_scene *s, const char *name) {
+    for (int32_t i = 0; i < s->node_count; i++)
+        if (strcmp(s->nodes[i].name, name) == 0 && s->nodes[i].mesh_first >= 0) {
+            int32_t m = s->meshes[s->nodes[i].mesh_first].material;
+            return m >= 0 ? &s->materials[m] : NULL;
+        }
+    return NULL;
+}
+
+static void test_demo_conflict(void) {
+    mr_demo_params dp = MR_DEMO_DEFAULTS;
+    mr_demo_hall plain, conflict;
+    mr_error err = {0};
+    CHECK_MSG(mr_demo_build(&dp, &plain, &err), "%s", err.msg);
+    dp.pipes_like_partition = true;
+    CHECK_MSG(mr_demo_build(&dp, &conflict, &err), "%s", err.msg);
+    if (plain.planned && conflict.planned) {
+        const mr_material *wall = node_material(conflict.planned, "Wall_Partition");
+        const mr_material *wall0 = node_material(plain.planned, "Wall_Partition");
+        CHECK(conflict.planned->node_count == plain.planned->node_count);
+        CHECK(cJSON_GetArraySize(conflict.discrepancies) == cJSON_GetArraySize(plain.discrepancies));
+        for (int k = 0; k < 4; k++) {
+            char name[16];
+            snprintf(name, sizeof name, "Pipe_%d", k);
+            const mr_material *pc = node_material(conflict.planned, name), *pp = node_material(plain.planned, name);
+            CHECK(pc && pp && wall && wall0);
+            if (pc && pp && wall && wall0) {
+                CHECK(memcmp(pc->base_color, wall->base_color, sizeof pc->base_color) == 0);
+                CHECK(memcmp(pp->base_color, wall0->base_color, sizeof pp->base_color) != 0);
+            }
+        }
+    }
+    mr_demo_free(&plain);
+    mr_demo_free(&conflict);
+}
+
 /* ------------------------------------------------------------- helpers */
 
 static mr_image img(int w, int h, int ch, float v) {
@@ -581,6 +619,7 @@ static void test_frame_importance(void) {
 
 int main(void) {
     test_curvature();
+    test_demo_conflict();
     mr_error err = {0};
     g_gpu = mr_gpu_create_headless(NULL, &err);
     if (!g_gpu) {
