@@ -95,6 +95,7 @@ mr_renderer *mr_renderer_create(mr_gpu *gpu, mr_error *err) {
 void mr_renderer_destroy(mr_renderer **rp) {
     if (!rp || !*rp) return;
     mr_renderer *r = *rp;
+    mr_ghost_free(r);
     mr_geometry_free(r);
     mr_gl_target_free(&r->gbuf);
     mr_gl_target_free(&r->shaded);
@@ -111,6 +112,7 @@ void mr_renderer_destroy(mr_renderer **rp) {
 
 
 bool mr_renderer_set_scene(mr_renderer *r, const mr_scene *s, mr_error *err) {
+    mr_ghost_scene_changed(r);
     mr_geometry_free(r);
     if (!s) return true;
     return mr_geometry_upload(r, s, err);
@@ -153,8 +155,16 @@ void mr_gl_projection(const mr_camera *c, double near_plane, float out[16]) {
 
 static const pass_desc k_passes[] = {
     {"gbuffer", mr_pass_need_always, mr_pass_gbuffer},
+    {"ghost_hidden", mr_pass_need_ghost, mr_pass_ghost_hidden},
     {"shade", mr_pass_need_always, mr_pass_shade},
     {"overlay", mr_pass_need_overlay, mr_pass_overlay},
+    /* Ghosting after the overlay: with video, the occluder O is what the
+     * user sees in front of the hidden structure (the real wall). */
+    {"ghost_curvature", mr_pass_need_ghost_curvature, mr_pass_ghost_curvature},
+    {"ghost_importance", mr_pass_need_ghost, mr_pass_ghost_importance},
+    {"ghost_g0", mr_pass_need_ghost, mr_pass_ghost_g0},
+    {"ghost_analysis", mr_pass_need_ghost_adaptive, mr_pass_ghost_analysis},
+    {"ghost_emphasis", mr_pass_need_ghost_adaptive, mr_pass_ghost_emphasis},
 };
 
 static bool read_back(frame *f, mr_error *err) {
@@ -195,6 +205,7 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
     int h = p->height > 0 ? p->height : view->camera.height;
     if (w > 16384 || h > 16384) return mr_fail(err, MR_ERR_INVALID, "output size %dx%d too large", w, h);
     if (!ensure_targets(r, w, h, err)) return false;
+    if (!mr_ghost_prepare(r, &p->ghost, w, h, err)) return false;
 
     frame f;
     memset(&f, 0, sizeof f);

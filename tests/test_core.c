@@ -1,0 +1,255 @@
+/* Unit tests for lib/core: double math and poses, the camera model, the
+ * camera/view JSON formats, atomic files, image files, the RNG. */
+#include "mr_core.h"
+#include "mr_test.h"
+
+#include <string.h>
+#include <unistd.h>
+
+static char g_tmp[1024];
+
+static double max_abs_diff(const mr_dmat4 *a, const mr_dmat4 *b) {
+    double m = 0;
+    for (int i = 0; i < 16; i++) {
+        double d = fabs(a->m[i] - b->m[i]);
+        if (d > m) m = d;
+    }
+    return m;
+}
+
+static void test_math(void) {
+    mr_dmat4 I = mr_m4_identity();
+    double t[3] = {1e7, -2.5, 3e6}, q[4] = {0.1, -0.3, 0.2, 0.9}, s[3] = {2, 3, 0.5};
+    mr_dmat4 M = mr_m4_from_trs(t, q, s), Mi;
+    CHECK(mr_m4_invert(&M, &Mi));
+    mr_dmat4 P = mr_m4_mul(&M, &Mi);
+    CHECK(max_abs_diff(&P, &I) < 1e-9);
+    /* Quaternions are normalised: the rotation part of TRS with unit scale
+     * is rigid even for a non-unit quaternion. */
+    double one[3] = {1, 1, 1};
+    mr_dmat4 R = mr_m4_from_trs(t, q, one);
+    CHECK(mr_m4_is_rigid(&R, 1e-12));
+    mr_dmat4 Ri = mr_m4_invert_rigid(&R), Rg;
+    CHECK(mr_m4_invert(&R, &Rg));
+    CHECK(max_abs_diff(&Ri, &Rg) < 1e-8);
+    /* A point 1e7 away survives the round trip to the millimetre's millionth. */
+    mr_dvec3 p = mr_v3(1e7 + 0.123456, 5, -1e7), pr = mr_m4_point(&Ri, mr_m4_point(&R, p));
+    CHECK(mr_v3_len(mr_v3_sub(p, pr)) < 1e-8);
+    CHECK(!mr_m4_is_rigid(&M, 1e-6)); /* scaled */
+    mr_dmat4 Z;
+    memset(&Z, 0, sizeof Z);
+    CHECK(!mr_m4_invert(&Z, &Mi));
+    mr_dmat4 N = I;
+    N.m[5] = NAN;
+    CHECK(!mr_m4_is_rigid(&N, 1e-6) && !mr_m4_is_finite(&N));
+    mr_dmat4 mirror = mr_m4_scale(-1, 1, 1);
+    CHECK(!mr_m4_is_rigid(&mirror, 1e-6)); /* det -1 is not a pose */
+    /* Axis-angle matches the quaternion path. */
+    mr_dmat4 Ra = mr_m4_rotate_axis(mr_v3(0, 0, 1), 3.14159265358979323846 / 2);
+    mr_dvec3 x = mr_m4_dir(&Ra, mr_v3(1, 0, 0));
+    CHECK_NEAR(x.x, 0, 1e-12);
+    CHECK_NEAR(x.y, 1, 1e-12);
+    /* look_at: OpenCV axes (z forward, y down), rigid, eye is the origin. */
+    mr_dvec3 eye = mr_v3(3, 1.6, -2), at = mr_v3(-5, 0.5, 7);
+    mr_dmat4 L = mr_m4_look_at_cv(eye, at, mr_v3(0, 1, 0));
+    CHECK(mr_m4_is_rigid(&L, 1e-12));
+    mr_dvec3 fwd = mr_m4_dir(&L, mr_v3(0, 0, 1)), down = mr_m4_dir(&L, mr_v3(0, 1, 0));
+    mr_dvec3 want = mr_v3_normalize(mr_v3_sub(at, eye));
+    CHECK(mr_v3_dot(fwd, want) > 1 - 1e-12);
+    CHECK(down.y < 0);
+    mr_dvec3 o = mr_m4_point(&L, mr_v3(0, 0, 0));
+    CHECK(mr_v3_len(mr_v3_sub(o, eye)) < 1e-12);
+    /* Looking straight down the up axis still gives a rigid pose. */
+    mr_dmat4 D = mr_m4_look_at_cv(mr_v3(0, 10, 0), mr_v3(0, 0, 0), mr_v3(0, 1, 0));
+    CHECK(mr_m4_is_rigid(&D, 1e-12));
+    /* GL export is column-major. */
+    float gl[16];
+    mr_m4_to_gl(&M, gl);
+    CHECK(gl[12] == (float)M.m[3] && gl[1] == (float)M.m[4]);
+    CHECK(mr_v3_len(mr_v3_normalize(mr_v3(0, 0, 0))) == 0);
+}
+
+static void test_camera(void) {
+    mr_camera c = {640, 480, 500, 505, 319.5, 239.5, {-0.12, 0.05, 0.001, -0.0007, 0.01}};
+    mr_error err = {0};
+    CHECK(mr_camera_validate(&c, &err));
+    CHECK(mr_camera_has_distortion(&c));
+    /* Undistort inverts distort across the image, corners included. */
+    double worst = 0;
+    for (int v = 0; v <= 480; v += 40)
+        for (int u = 0; u <= 640; u += 40) {
+            double xd = (u - c.cx) / c.fx, yd = (v - c.cy) / c.fy, x, y, x2, y2;
+            CHECK(mr_camera_undistort(&c, xd, yd, &x, &y));
+            mr_camera_distort(&c, x, y, &x2, &y2);
+            double e = fabs(x2 - xd) + fabs(y2 - yd);
+            if (e > worst) worst = e;
+        }
+    CHECK(worst < 1e-9);
+    /* Far outside the field of view the inversion reports failure instead
+     * of returning garbage, and never NaN. */
+    double x = 0, y = 0;
+    bool ok = mr_camera_undistort(&c, 50, 50, &x, &y);
+    CHECK(!ok || (isfinite(x) && isfinite(y)));
+    mr_camera r = mr_camera_resized(&c, 320, 240);
+    CHECK_NEAR(r.fx, 250, 1e-12);
+    CHECK_NEAR(r.cx, 159.5, 1e-12); /* pixel centres stay centres */
+    mr_camera bad = c;
+    bad.fx = 0;
+    CHECK(!mr_camera_validate(&bad, &err) && err.code == MR_ERR_INVALID);
+    bad = c;
+    bad.dist[1] = NAN;
+    CHECK(!mr_camera_validate(&bad, &err));
+    bad = c;
+    bad.width = 0;
+    CHECK(!mr_camera_validate(&bad, &err));
+}
+
+static bool parse_camera(const char *text, mr_camera *c, mr_error *err) {
+    cJSON *j = cJSON_Parse(text);
+    bool ok = j && mr_camera_from_json(j, c, err);
+    cJSON_Delete(j);
+    return ok;
+}
+
+static void test_json(void) {
+    mr_camera c;
+    mr_error err = {0};
+    CHECK(parse_camera("{\"width\":64,\"height\":48,\"fx\":50,\"fy\":51,\"cx\":31.5,\"cy\":23.5,\"dist\":[0.1,0,0,0]}", &c, &err));
+    CHECK(c.width == 64 && c.fy == 51 && c.dist[0] == 0.1 && c.dist[4] == 0);
+    CHECK(parse_camera("{\"width\":64,\"height\":48,\"fx\":50,\"fy\":51,\"cx\":31.5,\"cy\":23.5,\"dist\":[0,0,0,0,0,0,0,0]}", &c, &err));
+    CHECK(!parse_camera("{\"width\":64,\"height\":48,\"fx\":50,\"fy\":51,\"cx\":31.5,\"cy\":23.5,\"dist\":[0,0,0,0,0,0.2,0,0]}", &c, &err) &&
+          err.code == MR_ERR_UNSUPPORTED);
+    CHECK(!parse_camera("{\"width\":64,\"height\":48,\"fx\":-50,\"fy\":51,\"cx\":31.5,\"cy\":23.5}", &c, &err));
+    CHECK(!parse_camera("{\"width\":64.5,\"height\":48,\"fx\":50,\"fy\":51,\"cx\":31.5,\"cy\":23.5}", &c, &err));
+    CHECK(!parse_camera("{\"width\":64,\"height\":48,\"fx\":50,\"cx\":31.5,\"cy\":23.5}", &c, &err));
+    CHECK(strstr(err.msg, "fy") != NULL && strchr(err.msg, '\n') == NULL);
+    CHECK(!parse_camera("{\"width\":\"64\",\"height\":48,\"fx\":50,\"fy\":50,\"cx\":31.5,\"cy\":23.5}", &c, &err));
+
+    /* Camera round trip through a file, then a view referring to it. */
+    CHECK(parse_camera("{\"width\":64,\"height\":48,\"fx\":50,\"fy\":51,\"cx\":31.5,\"cy\":23.5,\"dist\":[0.1,-0.01,0.001,0.002,0.003]}", &c, &err));
+    char path[1200], vpath[1200];
+    snprintf(path, sizeof path, "%s/cam.json", g_tmp);
+    cJSON *cj = mr_camera_to_json(&c);
+    CHECK(mr_json_save(path, cj, &err));
+    cJSON_Delete(cj);
+    mr_camera c2;
+    CHECK(mr_camera_load(path, &c2, &err) && memcmp(&c, &c2, sizeof c) == 0);
+    snprintf(vpath, sizeof vpath, "%s/view.json", g_tmp);
+    const char *vtext = "{\"camera\":\"cam.json\",\"world_from_camera\":[0,0,1,10000000,  -1,0,0,2,  0,-1,0,3,  0,0,0,1]}";
+    CHECK(mr_file_write_atomic(vpath, vtext, strlen(vtext), &err));
+    mr_view v;
+    CHECK_MSG(mr_view_load(vpath, &v, &err), "%s", err.msg);
+    CHECK(v.camera.width == 64 && v.world_from_camera.m[3] == 1e7);
+    /* View written and read back is identical. */
+    cJSON *vj = mr_view_to_json(&v);
+    mr_view v2;
+    CHECK(mr_view_from_json(vj, ".", &v2, &err) && memcmp(&v, &v2, sizeof v) == 0);
+    cJSON_Delete(vj);
+    const char *bad = "{\"camera\":\"cam.json\",\"world_from_camera\":[1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,1,1]}";
+    CHECK(mr_file_write_atomic(vpath, bad, strlen(bad), &err));
+    CHECK(!mr_view_load(vpath, &v, &err) && err.code == MR_ERR_INVALID);
+    const char *garbage = "{\"camera\": ";
+    CHECK(mr_file_write_atomic(vpath, garbage, strlen(garbage), &err));
+    CHECK(!mr_view_load(vpath, &v, &err) && err.code == MR_ERR_PARSE);
+    CHECK(strstr(err.msg, "view.json") != NULL);
+}
+
+static void test_files(void) {
+    mr_error err = {0};
+    char path[1200], dir[1200];
+    snprintf(path, sizeof path, "%s/a/b/c", g_tmp);
+    CHECK(mr_mkdirs(path, &err) && mr_mkdirs(path, &err));
+    snprintf(path, sizeof path, "%s/a/file.txt", g_tmp);
+    CHECK(mr_file_write_atomic(path, "hello", 5, &err));
+    CHECK(mr_file_write_atomic(path, "bye", 3, &err)); /* replaces */
+    size_t n = 0;
+    char *s = mr_file_read(path, &n, 0, &err);
+    CHECK(s && n == 3 && strcmp(s, "bye") == 0);
+    free(s);
+    CHECK(mr_file_read(path, &n, 2, &err) == NULL && err.code == MR_ERR_NOMEM); /* over the limit */
+    snprintf(dir, sizeof dir, "%s/a", g_tmp);
+    CHECK(mr_file_read(dir, &n, 0, &err) == NULL && err.code == MR_ERR_IO);     /* a folder */
+    snprintf(path, sizeof path, "%s/missing/x.txt", g_tmp);
+    CHECK(!mr_file_write_atomic(path, "x", 1, &err) && err.code == MR_ERR_IO);
+    CHECK(!mr_file_exists(path));
+    char out[64];
+    mr_path_dir("a/b/c.json", out, sizeof out);
+    CHECK(strcmp(out, "a/b") == 0);
+    mr_path_dir("c.json", out, sizeof out);
+    CHECK(strcmp(out, ".") == 0);
+    mr_path_join("a/b", "/abs", out, sizeof out);
+    CHECK(strcmp(out, "/abs") == 0);
+    mr_path_join("a/b", "rel.glb", out, sizeof out);
+    CHECK(strcmp(out, "a/b/rel.glb") == 0);
+}
+
+static void test_images(void) {
+    mr_error err = {0};
+    mr_image f;
+    CHECK(mr_image_alloc(&f, 7, 5, 3, MR_PIX_F32, &err));
+    float *d = f.data;
+    for (int i = 0; i < 7 * 5 * 3; i++) d[i] = (float)i * 0.25f - 3.0f;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/x.pfm", g_tmp);
+    CHECK(mr_image_save_pfm(path, &f, &err));
+    mr_image g;
+    CHECK(mr_image_load_pfm(path, &g, &err) && g.width == 7 && g.height == 5 && g.channels == 3);
+    CHECK(g.data && memcmp(f.data, g.data, mr_image_bytes(&f)) == 0); /* rows flipped on disk and back */
+    mr_image_free(&g);
+    mr_image_free(&f);
+    mr_image p;
+    CHECK(mr_image_alloc(&p, 9, 4, 3, MR_PIX_U8, &err));
+    for (size_t i = 0; i < mr_image_bytes(&p); i++) ((unsigned char *)p.data)[i] = (unsigned char)(i * 7);
+    snprintf(path, sizeof path, "%s/x.png", g_tmp);
+    CHECK(mr_image_save_png(path, &p, &err));
+    CHECK(mr_image_load(path, 3, &g, &err) && memcmp(p.data, g.data, mr_image_bytes(&p)) == 0);
+    float px[3];
+    CHECK(mr_image_sample_bilinear(&p, 0, 0, px) && px[0] == ((unsigned char *)p.data)[0]);
+    CHECK(!mr_image_sample_bilinear(&p, -1, 0, px));
+    mr_image_free(&g);
+    mr_image_free(&p);
+    CHECK(!mr_image_alloc(&p, 0, 4, 3, MR_PIX_U8, &err));
+    CHECK(!mr_image_load_pfm(path, &g, &err)); /* a PNG is not a PFM */
+}
+
+static void test_rng_and_errors(void) {
+    mr_rng a, b;
+    mr_rng_seed(&a, 42);
+    mr_rng_seed(&b, 42);
+    bool same = true;
+    double sum = 0, sum2 = 0;
+    for (int i = 0; i < 1000; i++) same = same && mr_rng_u64(&a) == mr_rng_u64(&b);
+    for (int i = 0; i < 20000; i++) {
+        double z = mr_rng_normal(&a);
+        sum += z;
+        sum2 += z * z;
+        double u = mr_rng_uniform(&a);
+        CHECK(u >= 0 && u < 1);
+    }
+    CHECK(same);
+    CHECK(fabs(sum / 20000) < 0.05 && fabs(sum2 / 20000 - 1) < 0.05);
+    mr_error err = {0};
+    CHECK(!mr_fail(&err, MR_ERR_PARSE, "line one\nline two"));
+    CHECK(strchr(err.msg, '\n') == NULL && err.code == MR_ERR_PARSE);
+    mr_error_prefix(&err, "file.glb");
+    CHECK(strncmp(err.msg, "file.glb: line one", 18) == 0);
+    CHECK(strcmp(mr_err_name(MR_ERR_NODEVICE), "nodevice") == 0);
+    CHECK(!mr_fail(NULL, MR_ERR_IO, "ignored")); /* NULL err is allowed */
+}
+
+int main(void) {
+    const char *tmp = getenv("MR_TEST_TMP");
+    snprintf(g_tmp, sizeof g_tmp, "%s/core", tmp ? tmp : "/tmp/mrcheck-test");
+    mr_error err = {0};
+    if (!mr_mkdirs(g_tmp, &err)) {
+        fprintf(stderr, "%s\n", err.msg);
+        return 1;
+    }
+    test_math();
+    test_camera();
+    test_json();
+    test_files();
+    test_images();
+    test_rng_and_errors();
+    return mr_test_finish("test_core");
+}
