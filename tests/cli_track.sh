@@ -24,6 +24,10 @@ grep -q '^{"frame":0,"detections":\[{"id":2,"hamming":0,"corners":\[\[' "$tmp/de
 grep -q '"world_from_camera":\[' "$tmp/poses.jsonl" && grep -q '"filtered":\[' "$tmp/poses.jsonl" && ok || bad "pose lines lack matrices"
 # Same input, same output.
 "$mr" track --input "$rec" --out "$tmp/poses2.jsonl" 2>/dev/null && cmp -s "$tmp/poses.jsonl" "$tmp/poses2.jsonl" && ok || bad "track is not deterministic"
+# --freeze: one filtered pose for the whole run (a still-image check).
+"$mr" track --input "$rec" --freeze --out "$tmp/frozen.jsonl" 2>/dev/null && ok || bad "track --freeze failed"
+[ "$(grep -o '"filtered":\[[^]]*\]' "$tmp/frozen.jsonl" | sort -u | wc -l)" -eq 1 ] && ok || bad "--freeze: the filtered pose changed"
+[ "$(grep -c '"filtered"' "$tmp/frozen.jsonl")" -gt "$(grep -c '"valid":true' "$tmp/frozen.jsonl")" ] && ok || bad "--freeze: no held pose on frames without tags"
 # Explicit camera and markers from the recording's meta, on an image folder.
 "$mr" track --input "$rec/frames" --camera "$src/configs/cameras/demo_640x480.json" --markers "$src/configs/markers/demo_hall.json" \
   --decimate 1 --threads 2 --refine-edges 0 --family tag36h11 --max-frames 5 >"$tmp/folder.jsonl" 2>"$tmp/folder.err" \
