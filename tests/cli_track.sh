@@ -130,6 +130,8 @@ if "$mr" demo --out "$tmp/demo" >"$tmp/demo.log" 2>&1; then
   done
   [ $n -eq 3 ] && ok || bad "replay wrote $n images, expected 3 (frames 20, 60, 100)"
   cmp -s "$tmp/rp1/replay.jsonl" "$tmp/rp2/replay.jsonl" && ok || bad "replay.jsonl differs"
+  "$mr" replay "$rec" --scene "$scene" --out "$tmp/rp5" --from 40 --to 50 --video "$tmp/rp5.avi" >/dev/null 2>"$tmp/rp5.err" \
+    && [ "$("$mr" track --input "$tmp/rp5.avi" --print-detections 2>/dev/null | wc -l)" -eq 11 ] && ok || bad "replay --video: $(cat "$tmp/rp5.err")"
   expect_fail replay_not_recording "" -- "$mr" replay "$tmp" --scene "$scene" --out "$tmp/rp3"
   expect_fail replay_bad_range "" -- "$mr" replay "$rec" --scene "$scene" --out "$tmp/rp4" --from 50 --to 10
   "$mr" synth --out "$tmp/syn" --frames 3 --motion-blur 1 >/dev/null 2>"$tmp/syn.err" && [ "$(wc -l <"$tmp/syn/groundtruth.jsonl")" -eq 3 ] \
