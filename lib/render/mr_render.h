@@ -115,9 +115,11 @@ typedef struct mr_ao_params {
     bool want_ao;                 /* fill mr_frame_result.ao */
     bool no_reuse;                /* recompute even if camera and settings are unchanged
                                      (benchmarks) */
+    const mr_image *external;     /* F32x1 AO at the output size to shade with instead of
+                                     computing one (e.g. ray-traced ground truth); NULL */
 } mr_ao_params;
 #define MR_AO_DEFAULTS {MR_AO_NONE, MR_AO_RADIUS_SCREEN, 0.0, 0.05, 16, MR_AO_KERNEL_UNIFORM, 0.8f, 1.0f, 1, \
-                        1.0f, 0.05f, 1.0f, 4, false, false, MR_AO_MASK_OFF, false, false}
+                        1.0f, 0.05f, 1.0f, 4, false, false, MR_AO_MASK_OFF, false, false, NULL}
 
 /* Names used on the command line ("none", "scheer", ...); NULL if out of range. */
 const char *mr_ao_method_name(mr_ao_method m);

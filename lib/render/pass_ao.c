@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { AO_PLAN_UNDECIDED = 0, AO_PLAN_OFF, AO_PLAN_REUSE, AO_PLAN_RUN };
+enum { AO_PLAN_UNDECIDED = 0, AO_PLAN_OFF, AO_PLAN_REUSE, AO_PLAN_RUN, AO_PLAN_EXTERNAL };
 
 /* Everything that makes an AO buffer what it is; equal keys mean the last
  * buffer can be shown again. */
@@ -304,6 +304,7 @@ static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
     if ((int)p.radius_mode < 0 || p.radius_mode > MR_AO_RADIUS_VIEW) p.radius_mode = MR_AO_RADIUS_SCREEN;
     p.want_ao = false;
     p.no_reuse = false;
+    p.external = NULL;
     return p;
 }
 
@@ -312,6 +313,19 @@ static int plan(frame *f) {
     mr_renderer *r = f->r;
     const mr_ao_params *in = &f->p->ao;
     f->ao_plan = AO_PLAN_OFF;
+    const mr_image *ext = in->external;
+    if (ext && ext->data && ext->type == MR_PIX_F32 && ext->channels == 1 && ext->width == r->w && ext->height == r->h) {
+        /* An AO image from outside (ground truth): upload, no AO pass runs. */
+        if (!r->ao && !(r->ao = calloc(1, sizeof *r->ao))) return f->ao_plan;
+        mr_ao_state *s = r->ao;
+        ensure_targets(s, r->w, r->h, s->step > 0 ? s->step : 1);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glTextureSubImage2D(s->tex_full, 0, 0, 0, r->w, r->h, GL_RED, GL_FLOAT, ext->data);
+        s->result = s->tex_full;
+        s->valid = false; /* the next computed AO must not mistake this for its own */
+        s->p.mask = MR_AO_MASK_OFF;
+        return f->ao_plan = AO_PLAN_EXTERNAL;
+    }
     if (in->method <= MR_AO_NONE || in->method >= MR_AO_METHOD_COUNT) return f->ao_plan;
     if (!r->ao && !(r->ao = calloc(1, sizeof *r->ao))) return f->ao_plan;
     mr_ao_state *s = r->ao;
@@ -355,7 +369,7 @@ static int plan(frame *f) {
 
 GLuint mr_pass_ao_texture(frame *f) {
     int pl = plan(f);
-    return pl == AO_PLAN_RUN || pl == AO_PLAN_REUSE ? f->r->ao->result : 0;
+    return pl == AO_PLAN_RUN || pl == AO_PLAN_REUSE || pl == AO_PLAN_EXTERNAL ? f->r->ao->result : 0;
 }
 
 bool mr_pass_need_ao(frame *f) { return plan(f) == AO_PLAN_RUN; }
@@ -563,7 +577,7 @@ bool mr_pass_ao_read_back(frame *f, mr_error *err) {
         if (!mr_image_alloc(&o->ao, r->w, r->h, 1, MR_PIX_F32, err)) return false;
         float *a = o->ao.data;
         size_t n = (size_t)r->w * r->h;
-        if (pl == AO_PLAN_RUN || pl == AO_PLAN_REUSE) {
+        if (pl == AO_PLAN_RUN || pl == AO_PLAN_REUSE || pl == AO_PLAN_EXTERNAL) {
             glPixelStorei(GL_PACK_ALIGNMENT, 4);
             glGetTextureImage(r->ao->result, 0, GL_RED, GL_FLOAT, (GLsizei)(n * sizeof *a), a);
         } else {
