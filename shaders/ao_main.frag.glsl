@@ -83,8 +83,9 @@ float occ_scheer(vec3 P, vec3 n, float r, vec3 plane) {
 }
 
 // Mittring (Crysis): sphere samples, occluded when the depth buffer is in
-// front of the sample (within a range check of r). Half the sphere is
-// behind any flat surface, so the ratio is remapped: flat = 0 occlusion.
+// front of the sample. Failing the range check (the occluder more than r in
+// front) counts as half occluded, neutral under the remap: half the sphere
+// is behind any flat surface, so the ratio is remapped to flat = 0.
 float occ_crytek(vec3 P, vec3 n, float r, vec3 plane) {
     float hits = 0.0, used = 0.0;
     for (int i = 0; i < u_samples; i++) {
@@ -95,7 +96,7 @@ float occ_crytek(vec3 P, vec3 n, float r, vec3 plane) {
         used += 1.0;
         if (!fetch_pos(q, Q)) continue;
         float dz = s.z - Q.z;
-        if (dz > u_bias * r && dz < r) hits += 1.0;
+        if (dz > u_bias * r) hits += dz < r ? 1.0 : 0.5;
     }
     return used > 0.0 ? max(0.0, 2.0 * hits / used - 1.0) : 0.0;
 }
@@ -174,7 +175,7 @@ float occ_alchemy(vec3 P, vec3 n, float r, vec3 rnd, vec2 px) {
         if (!(vv < 1.0)) continue;                   // only occluders inside the ball of radius r
         sum += max(0.0, dot(v, n) - u_bias) / (vv + 0.01);
     }
-    return 2.0 * sum / float(u_samples) * 0.1;       // 0.1: a full-strength sigma that keeps A in range
+    return sum / float(u_samples);                   // 2 sigma / s with sigma = 0.5
 }
 
 void main() {

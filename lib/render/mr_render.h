@@ -127,8 +127,11 @@ const char *mr_ao_method_name(mr_ao_method m);
 bool mr_ao_method_parse(const char *name, mr_ao_method *out);
 const char *mr_ao_kernel_name(mr_ao_kernel k);
 bool mr_ao_kernel_parse(const char *name, mr_ao_kernel *out);
-/* Fills `out` (n x 3 floats, points of the unit ball shell [r_min, r_max])
- * with the kernel the AO pass uses: deterministic for given arguments. */
+/* The kernels the AO pass uses, deterministic for given arguments: out3
+ * (n x 3 floats) in the unit ball shell [r_min, r_max] for the view-space
+ * methods, out2 (n x 2) in the unit disk of radius r_max for the screen-space
+ * disk (alchemy: there only surface points within the radius count, so an
+ * inner hole would only lose samples). Either may be NULL. */
 void mr_ao_kernel_generate(mr_ao_kernel kind, int n, float r_min, float r_max, uint64_t seed, float *out3,
                            float *out2);
 

@@ -158,7 +158,7 @@ void mr_ao_kernel_generate(mr_ao_kernel kind, int n, float r_min, float r_max, u
     mr_rng_seed(&rng, seed);
     if (kind == MR_AO_KERNEL_POISSON) {
         if (out3) poisson(&rng, n, 3, rmin, rmax, out3, 3);
-        if (out2) poisson(&rng, n, 2, rmin, rmax, out2, 2);
+        if (out2) poisson(&rng, n, 2, 0.0, rmax, out2, 2);
         return;
     }
     int p1[MR_AO_MAX_SAMPLES], p2[MR_AO_MAX_SAMPLES], p3[MR_AO_MAX_SAMPLES];
@@ -185,7 +185,7 @@ void mr_ao_kernel_generate(mr_ao_kernel kind, int n, float r_min, float r_max, u
             u3 = mr_rng_uniform(&rng);
         }
         if (out3) to_ball(u1, u2, u3, rmin, rmax, out3 + 3 * i);
-        if (out2) to_disk(u1, u2, rmin, rmax, out2 + 2 * i);
+        if (out2) to_disk(u1, u2, 0.0, rmax, out2 + 2 * i);
     }
 }
 
@@ -407,7 +407,11 @@ static void fullscreen(frame *f, GLuint fbo, int w, int h) {
 void mr_pass_ao_positions(frame *f) {
     mr_ao_state *s = f->r->ao;
     glUseProgram(s->prog_pos);
-    common_uniforms(f);
+    /* Only the uniforms this shader declares: setting another location is
+     * an error. */
+    glUniform4f(0, (float)f->cam.fx, (float)f->cam.fy, (float)f->cam.cx, (float)f->cam.cy);
+    glUniform1f(3, (float)f->near_plane);
+    glBindTextureUnit(0, f->r->gbuf.depth);
     glBindTextureUnit(2, 0); /* the target itself must not be bound for reading */
     fullscreen(f, s->fbo_pos, s->w, s->h);
 }
