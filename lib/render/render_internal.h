@@ -34,6 +34,7 @@ struct mr_renderer {
     GLuint video_tex;
     int video_w, video_h;
     GLuint queries[MR_MAX_PASSES];
+    struct mr_ao_state *ao; /* pass_ao.c: AO targets, programs, kernel, reuse cache */
     struct mr_ghost_state *ghost; /* pass_ghost.c: targets, programs, caches; NULL until first used */
 };
 
@@ -46,6 +47,7 @@ typedef struct frame {
     double near_plane;
     mr_frame_result *out;
     GLuint final_tex;       /* the texture holding the finished image */
+    int ao_plan;            /* pass_ao.c: decided once per frame (off / reuse / run) */
     int ghost;              /* pass_ghost.c: 0 not decided yet, 1 ghosting runs, -1 it does not */
 } frame;
 
@@ -100,5 +102,24 @@ bool mr_ghost_prepare(mr_renderer *r, const mr_ghost_params *gp, int w, int h, m
 /* Drops what was derived from the scene (per-mesh curvature buffers). */
 void mr_ghost_scene_changed(mr_renderer *r);
 void mr_ghost_free(mr_renderer *r);
+
+/* Ambient occlusion (pass_ao.c). */
+typedef struct mr_ao_state mr_ao_state;
+bool mr_pass_need_ao_positions(frame *f);
+bool mr_pass_need_ao_mask(frame *f);
+bool mr_pass_need_ao(frame *f);
+bool mr_pass_need_ao_blur(frame *f);
+bool mr_pass_need_ao_upsample(frame *f);
+void mr_pass_ao_positions(frame *f);
+void mr_pass_ao_mask(frame *f);
+void mr_pass_ao(frame *f);
+void mr_pass_ao_blur(frame *f);
+void mr_pass_ao_upsample(frame *f);
+/* The finished AO texture of this frame (computed or reused), or 0. */
+GLuint mr_pass_ao_texture(frame *f);
+/* Fills out->ao (if asked) and the mask statistics; reports a failed AO shader. */
+bool mr_pass_ao_read_back(frame *f, mr_error *err);
+void mr_pass_ao_scene_changed(mr_renderer *r);
+void mr_pass_ao_free(mr_renderer *r);
 
 #endif
