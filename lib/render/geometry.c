@@ -482,6 +482,8 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
             if (gm->count[0] == 0) continue;
             int level = use_lod && gm->level_count > 1 && isfinite(ppu) ? choose_level(gm, g->node_scale[ni], ppu, tol, pix) : 0;
             lod_inst += level > 0;
+            if (level > 0 && gm->error[level] * g->node_scale[ni] > r->stats.lod_max_error)
+                r->stats.lod_max_error = gm->error[level] * g->node_scale[ni];
             tri_full += gm->count[0] / 3;
             uint32_t key = (uint32_t)g->rank[mi] * LEVELS + (uint32_t)level;
             g->recs[nrec++] = (geo_rec){ni, mi, key};

@@ -122,6 +122,8 @@ typedef struct mr_draw_stats {
     uint64_t triangles;        /* submitted */
     uint64_t triangles_full;   /* the same instances at full detail */
     uint32_t lod_instances;    /* instances drawn with a simplified level */
+    double lod_max_error;      /* largest error bound (scene units, node
+                                  stretch included) of a level drawn */
 } mr_draw_stats;
 
 /* Sets how geometry is submitted from the next frame on (NULL: defaults). */

@@ -104,6 +104,11 @@ void mr_mesh_generate_normals(const float *positions, uint32_t vertex_count,
 typedef struct mr_scene_params {
     const char *const *hidden_globs; /* node-name globs for the hidden layer */
     int hidden_glob_count;
+    /* Called now and then during a load with the stage ("read", "parse",
+     * "nodes": meshes are read when a node first uses them) and its fraction
+     * done in [0,1]; NULL: none. */
+    void (*progress)(void *user, const char *stage, double fraction);
+    void *progress_user;
 } mr_scene_params;
 #define MR_SCENE_DEFAULTS {0}
 
@@ -266,6 +271,30 @@ void mr_lod_cache_path(const char *scene_path, char *out, size_t n);
  * lies farther than `limit` from the other surface. */
 double mr_lod_hausdorff_bound(const float *positions, uint32_t vertex_count, const uint32_t *a, uint32_t a_count,
                               const uint32_t *b, uint32_t b_count, double resolution, double limit);
+
+/* ------------------------------------ synthetic factories (synth.c) */
+
+typedef struct mr_synth_params {
+    uint64_t seed;           /* default 1 */
+    int halls;               /* halls in a grid, about 1M drawn triangles
+                                and 3000 nodes each; 0 = 1 */
+    double hall_width;       /* metres, 0 = 60 */
+    double hall_depth;       /* metres, 0 = 30 */
+    double origin[3];        /* offset of the whole plant (x and z), metres */
+} mr_synth_params;
+#define MR_SYNTH_DEFAULTS {1, 1, 0.0, 0.0, {0.0, 0.0, 0.0}}
+
+/* A factory of `halls` halls whose parts (machines, motors, valves, bolts,
+ * racks, boxes, pipes, trays, lamps) are shared meshes placed by many
+ * nodes; pipes and trays below the roof form the hidden layer. */
+mr_scene *mr_synth_build(const mr_synth_params *params, mr_error *err);
+/* The hall count whose drawn triangles come closest to the target. */
+int mr_synth_halls_for(uint64_t target_triangles);
+enum { MR_SYNTH_VIEW_FLOOR = 0, MR_SYNTH_VIEW_AISLE = 1, MR_SYNTH_VIEW_OVERVIEW = 2, MR_SYNTH_VIEW_COUNT = 3 };
+/* world_from_camera of a fixed viewpoint: standing on the floor of the
+ * first hall, looking down an aisle through the row of halls, or an
+ * overview from above. */
+mr_dmat4 mr_synth_viewpoint(const mr_synth_params *params, int which);
 
 #ifdef __cplusplus
 }
