@@ -78,11 +78,15 @@ mr_lod *app_load_lod(const mr_scene *s, const char *scene_path, bool use_cache, 
  * --lod-tolerance and --lod-pixels; prints one line and returns false on a
  * bad value. */
 bool app_draw_params(const app_opt *opts, mr_draw_params *dp);
+/* --lod auto (the default): levels only for scenes that draw at least
+ * APP_LOD_AUTO_TRIANGLES, where simplifying pays for its one-off cost. */
+bool app_lod_auto(const app_opt *opts);
+#define APP_LOD_AUTO_TRIANGLES 500000u
 #define APP_DRAW_OPTS                                                                                          \
     {"cull", "on|off", "BVH frustum culling (default on)", NULL},                                              \
     {"batch", "on|off", "multi-draw-indirect batching (default on)", NULL},                                   \
     {"instancing", "on|off", "one command per mesh instead of per node (default on)", NULL},                   \
-    {"lod", "on|off", "simplified levels within the tolerance, cached next to the scene (default on)", NULL},   \
+    {"lod", "auto|on|off", "simplified levels within the tolerance, cached next to the scene (default auto: on for scenes over 500k triangles)", NULL}, \
     {"lod-tolerance", "UNITS", "largest geometric error of a level in scene units (default 0.005)", NULL},     \
     {"lod-pixels", "PX", "largest projected error of a level in pixels (default 1)", NULL},                    \
     {"occlusion", "on|off", "occlusion culling (default off)", NULL}

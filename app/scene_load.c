@@ -76,8 +76,13 @@ static bool on_off(const char *opt, const char *v, bool *off) {
     if (!v) return true;
     if (strcmp(v, "on") == 0) *off = false;
     else if (strcmp(v, "off") == 0) *off = true;
-    else return app_errorf("render", "--%s must be 'on' or 'off', not '%s'", opt, v), false;
+    else return app_errorf("render", "--%s must be 'on' or 'off'%s, not '%s'", opt, strcmp(opt, "lod") ? "" : " or 'auto'", v), false;
     return true;
+}
+
+bool app_lod_auto(const app_opt *opts) {
+    const char *v = app_get(opts, "lod");
+    return !v || strcmp(v, "auto") == 0;
 }
 
 bool app_draw_params(const app_opt *opts, mr_draw_params *dp) {
@@ -85,7 +90,7 @@ bool app_draw_params(const app_opt *opts, mr_draw_params *dp) {
     bool occl_off = true;
     if (!on_off("cull", app_get(opts, "cull"), &d.no_cull) || !on_off("batch", app_get(opts, "batch"), &d.no_batch) ||
         !on_off("instancing", app_get(opts, "instancing"), &d.no_instancing) ||
-        !on_off("lod", app_get(opts, "lod"), &d.no_lod) || !on_off("occlusion", app_get(opts, "occlusion"), &occl_off))
+        !on_off("lod", app_lod_auto(opts) ? NULL : app_get(opts, "lod"), &d.no_lod) || !on_off("occlusion", app_get(opts, "occlusion"), &occl_off))
         return false;
     d.occlusion = !occl_off;
     if (app_get(opts, "lod-tolerance") && !app_double("lod-tolerance", app_get(opts, "lod-tolerance"), 1e-12, 1e12, &d.lod_tolerance))

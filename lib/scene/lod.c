@@ -100,6 +100,7 @@ typedef struct tri_grid {
     uint32_t *partner; /* 3 per triangle: the neighbour across each edge if
                           both are coplanar and their union is convex, else
                           UINT32_MAX (see convex_partners) */
+    double ptol;       /* coplanarity tolerance used for partner */
 } tri_grid;
 
 static dv vtx(const float *pos, uint32_t i) {
@@ -205,6 +206,7 @@ static bool convex_pair(dv a, dv b, dv c, dv d, double tol) {
 }
 
 static bool convex_partners(tri_grid *g, double tol) {
+    g->ptol = tol;
     size_t ne = (size_t)g->tri_count * 3;
     g->partner = malloc((ne + 1) * sizeof *g->partner);
     edge_rec *e = malloc((ne + 1) * sizeof *e);
@@ -319,8 +321,10 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
             for (int j = 0; j < 3 && o->partner; j++) {
                 uint32_t q = o->partner[3 * (size_t)t + (size_t)j];
                 if (q == UINT32_MAX) continue;
+                /* + 2 ptol: "coplanar" allows float rounding, so the union
+                 * is convex only up to that distance. */
                 double mq = fmax(fmin(ta_, dist_to_tri(o, a, q)),
-                                 fmax(fmin(tb_, dist_to_tri(o, b, q)), fmin(tc_, dist_to_tri(o, c, q))));
+                                 fmax(fmin(tb_, dist_to_tri(o, b, q)), fmin(tc_, dist_to_tri(o, c, q)))) + 2 * o->ptol;
                 if (mq < ub) ub = mq;
             }
         }
@@ -331,7 +335,9 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
         double longest = sqrt(fmax(lab, fmax(lbc, lca)));
         double lip = fmax(da, fmax(db, dc)) + longest / sqrt(3.0);
         if (lip < ub) ub = lip;
-        if (ub <= x->lower + x->resolution || depth >= 40 || longest <= x->resolution || x->work > 20000000ull) {
+        /* Past the work cap a piece keeps the bound it has: still a bound,
+         * only looser, so a pathological mesh costs seconds, not hours. */
+        if (ub <= x->lower + x->resolution || depth >= 40 || longest <= x->resolution || x->work > 4000000ull) {
             if (ub > x->upper) x->upper = ub;
             return;
         }
@@ -407,7 +413,8 @@ double mr_lod_hausdorff_bound(const float *positions, uint32_t vertex_count, con
     if (!(resolution > 0)) resolution = 1e-12;
     if (!(limit > 0)) limit = INFINITY;
     tri_grid ga, gb;
-    double ptol = 1e-9 * fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    /* Positions are float: a few ulps of the extent. */
+    double ptol = 1e-6 * fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
     bool ok = grid_build(&ga, positions, a, a_count, lo, hi) && grid_build(&gb, positions, b, b_count, lo, hi);
     if (!ok || !convex_partners(&ga, ptol) || !convex_partners(&gb, ptol)) {
         grid_free(&ga);
@@ -496,7 +503,7 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
         }
         /* Resolution: far below the errors that matter, coarse enough to
          * keep the bisection cheap; it only ever adds to the bound. */
-        double res = fmax(0.25 * est * scale, fmax(0.05 * p->max_error, 1e-6 * scale));
+        double res = fmax(0.1 * est * scale, fmax(0.01 * p->max_error, 1e-6 * scale));
         double e = mr_lod_hausdorff_bound(m->positions, m->vertex_count, m->indices, m->index_count, dst, (uint32_t)n,
                                           res, 2 * p->max_error);
         if (!(e <= p->max_error)) break; /* coarser levels only get worse */
