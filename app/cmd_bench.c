@@ -182,6 +182,7 @@ static int bench_frame(int argc, char **argv) {
 
 int cmd_bench(int argc, char **argv) {
     if (argc >= 3 && strcmp(argv[2], "frame") == 0) return bench_frame(argc, argv);
+    if (argc >= 3 && strcmp(argv[2], "scene") == 0) return bench_scene(argc, argv);
     if (argc >= 3 && (strcmp(argv[2], "--help") == 0 || strcmp(argv[2], "-h") == 0)) {
         printf("usage: mrcheck bench frame [options]   (mrcheck bench frame --help)\n");
         return 0;

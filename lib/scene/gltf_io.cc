@@ -1033,3 +1033,28 @@ bool mr_scene_save_glb(const mr_scene *s, const char *path, mr_error *err) {
     }
     return mr_file_write_atomic(path, out.data(), out.size(), err);
 }
+
+// Only tinygltf's parse of a .glb/.gltf in memory, nothing converted: the
+// reference speed the loader is measured against (bench scene).
+bool mr_gltf_parse_only(const void *data, size_t size, mr_error *err) {
+    try {
+        if (!data || size < 4 || size > UINT_MAX) return mr_fail(err, MR_ERR_PARSE, "no glTF data");
+        tinygltf::TinyGLTF gltf;
+        gltf.SetImageLoader(image_loader, nullptr);
+        tinygltf::FsCallbacks fs = {fs_no_exists, fs_no_expand, fs_no_read, fs_no_write, nullptr};
+        gltf.SetFsCallbacks(fs);
+        tinygltf::Model model;
+        std::string terr, twarn;
+        const unsigned char *bytes = static_cast<const unsigned char *>(data);
+        bool ok = std::memcmp(bytes, "glTF", 4) == 0
+                      ? gltf.LoadBinaryFromMemory(&model, &terr, &twarn, bytes, (unsigned)size, "")
+                      : gltf.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char *>(bytes),
+                                                 (unsigned)size, "");
+        if (!ok) return mr_fail(err, MR_ERR_PARSE, "invalid glTF: %s", one_line(terr).c_str());
+        return true;
+    } catch (const std::bad_alloc &) {
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory parsing glTF");
+    } catch (...) {
+        return mr_fail(err, MR_ERR_PARSE, "glTF parse error");
+    }
+}

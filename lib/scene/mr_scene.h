@@ -127,6 +127,10 @@ mr_scene *mr_scene_load_gltf_memory(const void *data, size_t size, const char *b
  * extras.mrcheck_layer = "hidden". */
 bool mr_scene_save_glb(const mr_scene *s, const char *path, mr_error *err);
 
+/* tinygltf's parse alone (no conversion, no external files): the reference
+ * the loader's speed is compared with. */
+bool mr_gltf_parse_only(const void *data, size_t size, mr_error *err);
+
 /* Shell-style glob: '*' any run, '?' one char, '[abc]' a set. */
 bool mr_glob_match(const char *pattern, const char *text);
 
