@@ -11,6 +11,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 static const char *tmp_dir(void) {
     const char *t = getenv("MR_TEST_TMP");
@@ -440,6 +441,32 @@ static void test_100k_and_truncation(void) {
         mr_scene_destroy(&l);
     }
     printf("100k nodes: load %.2f s, peak RSS %.0f MB\n", dt, mr_peak_rss_bytes() / 1048576.0);
+    /* The same load on a thread: polls return at once while it runs. */
+    mr_scene_loader *ld = mr_scene_load_async(path, NULL, &err);
+    CHECK(ld != NULL);
+    int polls = 0;
+    double worst_poll = 0, last_fraction = 0;
+    bool monotone = true;
+    for (;;) {
+        const char *stage;
+        double fr, tp = mr_time_now();
+        bool done = mr_scene_loader_poll(ld, &stage, &fr);
+        worst_poll = fmax(worst_poll, mr_time_now() - tp);
+        polls++;
+        if (done) break;
+        if (strcmp(stage, "nodes") == 0) {
+            monotone = monotone && fr >= last_fraction;
+            last_fraction = fr;
+        }
+        struct timespec ts = {0, 2000000};
+        nanosleep(&ts, NULL);
+    }
+    l = mr_scene_loader_finish(&ld, &err);
+    CHECK(l && l->node_count == 100000 && ld == NULL && monotone && worst_poll < 0.01 && polls > 1);
+    mr_scene_destroy(&l);
+    mr_scene_loader *bad = mr_scene_load_async("/nonexistent/x.glb", NULL, &err);
+    mr_error e4 = {0};
+    CHECK(bad && !mr_scene_loader_finish(&bad, &e4) && e4.code == MR_ERR_IO);
     CHECK(mr_peak_rss_bytes() < (size_t)2 << 30);
     size_t size = 0;
     unsigned char *data = mr_file_read(path, &size, 0, &err);

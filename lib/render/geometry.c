@@ -12,19 +12,20 @@
  * are bucketed by (draw group, mesh, level) with a counting sort. One bucket
  * is one indirect command whose instances read their camera-relative
  * matrices (composed in double per instance, then cast to float), colour
- * and ids from an SSBO; all commands of a group (layout + texture) go out in
+ * and ids as per-instance attributes; all commands of a group (layout + texture) go out in
  * one glMultiDrawElementsIndirect. GL calls therefore grow with the number
  * of textures, not with the number of nodes, and a culled node costs nothing
  * on the GPU. */
 #include "render_internal.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define LEVELS (MR_LOD_MAX_LEVELS + 1) /* full detail + simplified levels */
 
-/* One instance as the G-buffer vertex shader reads it (std430). */
+/* One instance as the G-buffer vertex shader reads it (attributes 3..11). */
 typedef struct gpu_instance {
     float modelview[16]; /* camera (OpenCV axes) from mesh, column-major */
     float normal[12];    /* inverse transpose of its 3x3: 3 columns padded to vec4 */
@@ -57,9 +58,9 @@ typedef struct geo_rec {
 
 struct mr_geo {
     GLuint vao[2], vbo[2], ibo;
-    GLuint inst_ids;               /* 0, 1, 2, ... as a per-instance attribute */
-    uint32_t inst_ids_cap;
-    GLuint inst_ssbo, cmd_buf;
+    GLuint inst_buf;               /* instance records (per-instance attributes) */
+    uint32_t inst_cap;
+    GLuint cmd_buf;
     geo_mesh *meshes;
     int32_t mesh_count;
     int32_t *rank;                 /* mesh -> position in group order */
@@ -111,8 +112,7 @@ void mr_geometry_free(mr_renderer *r) {
         glDeleteVertexArrays(2, g->vao);
         glDeleteBuffers(2, g->vbo);
         glDeleteBuffers(1, &g->ibo);
-        glDeleteBuffers(1, &g->inst_ids);
-        glDeleteBuffers(1, &g->inst_ssbo);
+        glDeleteBuffers(1, &g->inst_buf);
         glDeleteBuffers(1, &g->cmd_buf);
         free(g->meshes);
         free(g->rank);
@@ -180,20 +180,18 @@ static bool upload_textures(mr_renderer *r, const mr_scene *s, mr_error *err) {
     return true;
 }
 
-/* Makes the buffer of instance ids 0..cap-1 at least `need` long. */
-static void ensure_inst_ids(struct mr_geo *g, uint32_t need) {
-    if (need <= g->inst_ids_cap && g->inst_ids) return;
-    uint32_t cap = g->inst_ids_cap ? g->inst_ids_cap : 1024;
+/* Makes the instance buffer hold at least `need` records; the VAOs keep
+ * pointing at it (binding 1). */
+static bool ensure_instances(struct mr_geo *g, uint32_t need) {
+    if (need <= g->inst_cap && g->inst_buf) return true;
+    uint32_t cap = g->inst_cap ? g->inst_cap : 1024;
     while (cap < need) cap *= 2;
-    uint32_t *ids = malloc((size_t)cap * sizeof *ids);
-    if (!ids) return; /* the caller checks inst_ids_cap */
-    for (uint32_t i = 0; i < cap; i++) ids[i] = i;
-    glDeleteBuffers(1, &g->inst_ids);
-    glCreateBuffers(1, &g->inst_ids);
-    glNamedBufferStorage(g->inst_ids, (GLsizeiptr)cap * 4, ids, 0);
-    free(ids);
-    g->inst_ids_cap = cap;
-    for (int p = 0; p < 2; p++) glVertexArrayVertexBuffer(g->vao[p], 3, g->inst_ids, 0, 4);
+    glDeleteBuffers(1, &g->inst_buf);
+    glCreateBuffers(1, &g->inst_buf);
+    glNamedBufferStorage(g->inst_buf, (GLsizeiptr)cap * (GLsizeiptr)sizeof(gpu_instance), NULL, GL_DYNAMIC_STORAGE_BIT);
+    g->inst_cap = cap;
+    for (int p = 0; p < 2; p++) glVertexArrayVertexBuffer(g->vao[p], 1, g->inst_buf, 0, sizeof(gpu_instance));
+    return glGetError() == GL_NO_ERROR;
 }
 
 static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_error *err) {
@@ -276,13 +274,17 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
             glVertexArrayAttribFormat(g->vao[p], 2, 2, GL_FLOAT, GL_FALSE, 24);
             glVertexArrayAttribBinding(g->vao[p], 2, 0);
         }
-        /* Attribute 3: the instance's index into the SSBO; with the
-         * command's baseInstance this works on plain GL 4.5 (no
-         * gl_BaseInstance / ARB_shader_draw_parameters needed). */
-        glEnableVertexArrayAttrib(g->vao[p], 3);
-        glVertexArrayAttribIFormat(g->vao[p], 3, 1, GL_UNSIGNED_INT, 0);
-        glVertexArrayAttribBinding(g->vao[p], 3, 3);
-        glVertexArrayBindingDivisor(g->vao[p], 3, 1);
+        /* Attributes 3..11: the instance record, one per instance (divisor
+         * 1); the command's baseInstance offsets into it, so this works on
+         * plain GL 4.5 (no gl_BaseInstance needed), and llvmpipe fetches
+         * attributes much faster than it loads from an SSBO per vertex. */
+        for (GLuint a = 0; a < 9; a++) {
+            glEnableVertexArrayAttrib(g->vao[p], 3 + a);
+            if (a == 8) glVertexArrayAttribIFormat(g->vao[p], 3 + a, 4, GL_UNSIGNED_INT, (GLuint)offsetof(gpu_instance, ids));
+            else glVertexArrayAttribFormat(g->vao[p], 3 + a, 4, GL_FLOAT, GL_FALSE, a * 16);
+            glVertexArrayAttribBinding(g->vao[p], 3 + a, 1);
+        }
+        glVertexArrayBindingDivisor(g->vao[p], 1, 1);
     }
     glCreateBuffers(1, &g->ibo);
     glNamedBufferStorage(g->ibo, (GLsizeiptr)(indices ? indices : 1) * 4, NULL, GL_DYNAMIC_STORAGE_BIT);
@@ -345,9 +347,8 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     g->cmds = malloc((recs + 1) * sizeof *g->cmds);
     if (!g->visible || !g->recs || !g->sorted || !g->key_count || !g->inst || !g->cmds)
         return mr_fail(err, MR_ERR_NOMEM, "out of memory for %zu mesh instances", recs);
-    glCreateBuffers(1, &g->inst_ssbo);
     glCreateBuffers(1, &g->cmd_buf);
-    ensure_inst_ids(g, 1024);
+    ensure_instances(g, 1024);
     r->scene = s;
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x while uploading the scene", e);
@@ -522,7 +523,7 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
         tris += gm->count[level] / 3;
         ninst++;
     }
-    ensure_inst_ids(g, ninst);
+    bool have_room = ensure_instances(g, ninst);
     r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
     r->stats.nodes_drawable += ndrawable;
     r->stats.nodes_visible += (uint32_t)nvis;
@@ -531,16 +532,15 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
     r->stats.triangles += tris;
     r->stats.triangles_full += tri_full;
     r->stats.lod_instances += lod_inst;
-    if (ninst == 0 || g->inst_ids_cap < ninst) return; /* nothing to draw costs nothing */
+    if (ninst == 0 || !have_room) return; /* nothing to draw costs nothing */
 
     /* 4. Submission. */
-    glNamedBufferData(g->inst_ssbo, (GLsizeiptr)ninst * (GLsizeiptr)sizeof(gpu_instance), g->inst, GL_STREAM_DRAW);
+    glNamedBufferSubData(g->inst_buf, 0, (GLsizeiptr)ninst * (GLsizeiptr)sizeof(gpu_instance), g->inst);
     glNamedBufferData(g->cmd_buf, (GLsizeiptr)ncmd * (GLsizeiptr)sizeof(draw_cmd), g->cmds, GL_STREAM_DRAW);
     glUseProgram(r->prog_gbuffer);
     float proj[16];
     mr_gl_projection(&f->cam, f->near_plane, proj);
     glUniformMatrix4fv(2, 1, GL_FALSE, proj);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, g->inst_ssbo);
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, g->cmd_buf);
     uint32_t calls = 0;
     for (int32_t grp = 0; grp < g->group_count; grp++) {

@@ -112,6 +112,17 @@ typedef struct mr_scene_params {
 } mr_scene_params;
 #define MR_SCENE_DEFAULTS {0}
 
+/* Loading on a thread of its own (scene_async.c), so a window's event loop
+ * never blocks: start, poll once per frame (non-blocking; true when done,
+ * with the stage and fraction for a progress bar), then finish (waits, and
+ * returns the scene or NULL + err; frees the loader). The glob strings in
+ * params must stay valid until finish; params->progress, if set, is called
+ * on the loader's thread. */
+typedef struct mr_scene_loader mr_scene_loader;
+mr_scene_loader *mr_scene_load_async(const char *path, const mr_scene_params *params, mr_error *err);
+bool mr_scene_loader_poll(mr_scene_loader *loader, const char **stage, double *fraction);
+mr_scene *mr_scene_loader_finish(mr_scene_loader **loader, mr_error *err);
+
 /* Loads a scene from a .gltf/.glb (recognised by content, not extension)
  * or a scene config JSON: {"gltf": "rel/path.glb", "hidden": ["Pipe*"],
  * "lights": [{"direction": [x,y,z], "color": [r,g,b]}], "ambient": 0.35}.
