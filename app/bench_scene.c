@@ -5,7 +5,7 @@
  * viewpoints (standing on the floor, down an aisle, overview) the frame time
  * and its parts (CPU culling, GPU geometry pass), triangles submitted, draw
  * calls and visible nodes, with culling, batching and LOD each switched
- * off in turn. CSV + an SVG plot of frame time against scene size. Never
+ * off in turn, and occlusion culling switched on. CSV + an SVG plot of frame time against scene size. Never
  * pass/fail. */
 #include "app.h"
 
@@ -15,15 +15,16 @@
 
 typedef struct bench_config {
     const char *name;
-    bool no_cull, no_batch, no_instancing, no_lod;
+    bool no_cull, no_batch, no_instancing, no_lod, occlusion;
 } bench_config;
 
 static const bench_config k_configs[] = {
-    {"all", false, false, false, false},
-    {"no-cull", true, false, false, false},
-    {"no-batch", false, true, true, false},
-    {"no-lod", false, false, false, true},
-    {"none", true, true, true, true},
+    {"all", false, false, false, false, false},
+    {"no-cull", true, false, false, false, false},
+    {"no-batch", false, true, true, false, false},
+    {"no-lod", false, false, false, true, false},
+    {"none", true, true, true, true, false},
+    {"all+occl", false, false, false, false, true},
 };
 #define N_CONFIGS (int)(sizeof k_configs / sizeof k_configs[0])
 
@@ -48,7 +49,7 @@ typedef struct row {
 /* Frame time (floor view, and overview dashed) against drawn scene
  * triangles, log-log, one colour per configuration. */
 static bool write_plot(const char *path, const row *rows, int n, const double *sizes, int nsizes, mr_error *err) {
-    static const char *const colours[N_CONFIGS] = {"#1b7837", "#c51b7d", "#e08214", "#4575b4", "#555555"};
+    static const char *const colours[N_CONFIGS] = {"#1b7837", "#c51b7d", "#e08214", "#4575b4", "#555555", "#8c510a"};
     double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
     for (int i = 0; i < n; i++) {
         if (rows[i].view == MR_SYNTH_VIEW_AISLE) continue;
@@ -171,10 +172,11 @@ int bench_scene(int argc, char **argv) {
     int len = snprintf(csv, csv_cap,
                        "scene_triangles,stored_triangles,nodes,file_mb,raw_parse_s,load_s,upload_s,load_upload_mb_s,raw_parse_mb_s,"
                        "lod_s,lod_from_cache,peak_rss_mb,view,config,frame_ms,cull_ms,gpu_geometry_ms,triangles_submitted,"
-                       "draw_calls,commands,nodes_visible,nodes_drawable,lod_instances\n");
+                       "draw_calls,commands,nodes_visible,nodes_drawable,nodes_occluded,lod_instances\n");
     printf("bench scene: %s, %dx%d, median of %ld frames\n", mr_gpu_description(gfx.gpu), w, h, frames);
-    printf("%10s %8s %9s %6s %6s %7s %8s %-9s %-9s %9s %8s %8s %11s %6s %7s\n", "triangles", "nodes", "file MB", "parse",
-           "load", "upload", "RSS MB", "view", "config", "frame ms", "cull ms", "GPU ms", "submitted", "calls", "visible");
+    printf("%10s %8s %9s %6s %6s %7s %8s %-9s %-9s %9s %8s %8s %11s %6s %7s %7s\n", "triangles", "nodes", "file MB", "parse",
+           "load", "upload", "RSS MB", "view", "config", "frame ms", "cull ms", "GPU ms", "submitted", "calls", "visible",
+           "occl");
     char lod_cache[4096];
     mr_path_join(out_dir, "synth.glb.mrlod", lod_cache, sizeof lod_cache); /* same parts at every size */
     for (int si = 0; si < nsizes; si++) {
@@ -235,6 +237,7 @@ int bench_scene(int argc, char **argv) {
                 dp.no_batch = k_configs[c].no_batch;
                 dp.no_instancing = k_configs[c].no_instancing;
                 dp.no_lod = k_configs[c].no_lod;
+                dp.occlusion = k_configs[c].occlusion;
                 mr_frame_params fp = MR_FRAME_DEFAULTS;
                 fp.width = w;
                 fp.height = h;
@@ -266,10 +269,10 @@ int bench_scene(int argc, char **argv) {
                 r->cull_ms = med(ct, (int)frames);
                 r->gpu_ms = med(gt, (int)frames);
                 double rss = mr_peak_rss_bytes() / 1048576.0;
-                printf("%10llu %8d %9.1f %6.2f %6.2f %7.2f %8.0f %-9s %-9s %9.1f %8.2f %8.1f %11llu %6u %7u\n",
+                printf("%10llu %8d %9.1f %6.2f %6.2f %7.2f %8.0f %-9s %-9s %9.1f %8.2f %8.1f %11llu %6u %7u %7u\n",
                        (unsigned long long)li.triangles, (int)s->node_count, mb, parse_s, li.load_s, upload_s, rss,
                        k_view_names[v], k_configs[c].name, r->frame_ms, r->cull_ms, r->gpu_ms,
-                       (unsigned long long)st.triangles, st.gl_draw_calls, st.nodes_visible);
+                       (unsigned long long)st.triangles, st.gl_draw_calls, st.nodes_visible, st.nodes_occluded);
                 fflush(stdout);
                 if ((size_t)len + 1024 > csv_cap) {
                     char *bigger = realloc(csv, csv_cap * 2);
@@ -278,12 +281,12 @@ int bench_scene(int argc, char **argv) {
                     csv_cap *= 2;
                 }
                 len += snprintf(csv + len, csv_cap - (size_t)len,
-                                "%llu,%llu,%d,%.2f,%.4f,%.4f,%.4f,%.1f,%.1f,%.3f,%d,%.0f,%s,%s,%.3f,%.3f,%.3f,%llu,%u,%u,%u,%u,%u\n",
+                                "%llu,%llu,%d,%.2f,%.4f,%.4f,%.4f,%.1f,%.1f,%.3f,%d,%.0f,%s,%s,%.3f,%.3f,%.3f,%llu,%u,%u,%u,%u,%u,%u\n",
                                 (unsigned long long)li.triangles, (unsigned long long)li.unique_triangles, (int)s->node_count,
                                 mb, parse_s, li.load_s, upload_s, mb / (li.load_s + upload_s), mb / parse_s, lod_s,
                                 linfo.from_cache, rss, k_view_names[v], k_configs[c].name, r->frame_ms, r->cull_ms, r->gpu_ms,
                                 (unsigned long long)st.triangles, st.gl_draw_calls, st.commands, st.nodes_visible,
-                                st.nodes_drawable, st.lod_instances);
+                                st.nodes_drawable, st.nodes_occluded, st.lod_instances);
             }
         }
         printf("  load %.2f s + upload %.2f s = %.0f MB/s; tinygltf raw parse %.2f s = %.0f MB/s; LOD %.2f s (%s)\n",

@@ -109,6 +109,9 @@ static void test_submission_modes_same_image(void) {
     mr_rng rng;
     mr_rng_seed(&rng, 5);
     mr_draw_params on = MR_DRAW_DEFAULTS, off = MR_DRAW_DEFAULTS, nobatch = MR_DRAW_DEFAULTS, noinst = MR_DRAW_DEFAULTS;
+    mr_draw_params occl = MR_DRAW_DEFAULTS;
+    occl.occlusion = true;
+    uint32_t occluded = 0;
     off.no_cull = off.no_batch = off.no_instancing = off.no_lod = true;
     nobatch.no_batch = true;
     noinst.no_instancing = true;
@@ -145,9 +148,17 @@ static void test_submission_modes_same_image(void) {
             if (m > worst) worst = m;
             mr_frame_result_free(&d);
         }
+        mr_draw_stats so;
+        if (frame(&view, &occl, 200, 150, &d, &so)) {
+            double m = mismatch(&a.color, &d.color, 2);
+            if (m > worst) worst = m;
+            occluded += so.nodes_occluded;
+            mr_frame_result_free(&d);
+        }
         mr_frame_result_free(&a);
     }
-    printf("submission modes: worst mismatch %.5f, %u node draws culled\n", worst, culled);
+    printf("submission modes: worst mismatch %.5f, %u node draws culled, %u occluded\n", worst, culled, occluded);
+    CHECK(occluded > 0);
     CHECK_MSG(worst <= 0.002, "images differ: %.4f of pixels", worst);
     CHECK(culled > 0);
     CHECK(calls_flat);

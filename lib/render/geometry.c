@@ -78,6 +78,11 @@ struct mr_geo {
     gpu_instance *inst;
     draw_cmd *cmds;
     int32_t *group_first, *group_cmds;
+    /* occlusion culling scratch */
+    int32_t *occ_rest;
+    float *depth, *hz;
+    size_t depth_cap, hz_cap, hz_off[24];
+    int hz_w[24], hz_h[24];
 };
 
 /* ------------------------------------------------------------- params */
@@ -87,8 +92,6 @@ bool mr_renderer_set_draw_params(mr_renderer *r, const mr_draw_params *params, m
     if (params) d = *params;
     if (!isfinite(d.lod_tolerance) || !isfinite(d.lod_pixels) || d.lod_pixels < 0)
         return mr_fail(err, MR_ERR_INVALID, "LOD tolerance and pixel error must be finite, pixels >= 0");
-    if (d.occlusion)
-        return mr_fail(err, MR_ERR_UNSUPPORTED, "occlusion culling is not available in this build");
     r->draw = d;
     return true;
 }
@@ -127,6 +130,9 @@ void mr_geometry_free(mr_renderer *r) {
         free(g->cmds);
         free(g->group_first);
         free(g->group_cmds);
+        free(g->occ_rest);
+        free(g->depth);
+        free(g->hz);
         free(g);
         r->geo = NULL;
     }
@@ -340,12 +346,13 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     g->bvh = mr_bvh_build(s, err);
     if (!g->bvh) return false;
     g->visible = malloc((nn + 1) * sizeof *g->visible);
+    g->occ_rest = malloc((nn + 1) * sizeof *g->occ_rest);
     g->recs = malloc((recs + 1) * sizeof *g->recs);
     g->sorted = malloc((recs + 1) * sizeof *g->sorted);
     g->key_count = malloc((nm * LEVELS + 1) * sizeof *g->key_count);
     g->inst = malloc((recs + 1) * sizeof *g->inst);
     g->cmds = malloc((recs + 1) * sizeof *g->cmds);
-    if (!g->visible || !g->recs || !g->sorted || !g->key_count || !g->inst || !g->cmds)
+    if (!g->visible || !g->occ_rest || !g->recs || !g->sorted || !g->key_count || !g->inst || !g->cmds)
         return mr_fail(err, MR_ERR_NOMEM, "out of memory for %zu mesh instances", recs);
     glCreateBuffers(1, &g->cmd_buf);
     ensure_instances(g, 1024);
@@ -440,21 +447,14 @@ static bool fill_instance(const frame *f, const mr_node *n, const mr_mesh *m, co
     return true;
 }
 
-void mr_geometry_draw(frame *f, uint32_t layer_mask) {
+/* Steps 2-4 for a list of visible nodes: LOD choice, bucketing, instance
+ * records and commands, submission. Adds to the frame's statistics. */
+static void submit_nodes(frame *f, const int32_t *nodes, int32_t nvis) {
     mr_renderer *r = f->r;
     const mr_scene *s = r->scene;
     struct mr_geo *g = r->geo;
-    if (!s || !g) return;
     const mr_draw_params *dp = &r->draw;
     double t0 = mr_time_now();
-
-    /* 1. Culling. */
-    mr_frustum fr = mr_frustum_from_camera(&f->cam, &f->view->world_from_camera, f->near_plane, 1.0);
-    mr_bvh_stats bst;
-    int32_t nvis = mr_bvh_cull(g->bvh, dp->no_cull ? NULL : &fr, layer_mask, g->visible, &bst);
-    uint32_t ndrawable = 0;
-    for (int l = 0; l < MR_LAYER_COUNT; l++)
-        if (layer_mask & (1u << l)) ndrawable += g->drawable[l];
 
     /* 2. LOD choice and bucketing of (node, mesh) pairs. */
     double tol = dp->lod_tolerance == 0 ? 0.005 : dp->lod_tolerance;
@@ -473,7 +473,7 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
     uint64_t tri_full = 0;
     uint32_t lod_inst = 0;
     for (int32_t vi = 0; vi < nvis; vi++) {
-        int32_t ni = g->visible[vi];
+        int32_t ni = nodes[vi];
         const mr_node *n = &s->nodes[ni];
         int32_t last = n->mesh_first + n->mesh_count;
         if (last > g->mesh_count) last = g->mesh_count;
@@ -525,8 +525,6 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
     }
     bool have_room = ensure_instances(g, ninst);
     r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
-    r->stats.nodes_drawable += ndrawable;
-    r->stats.nodes_visible += (uint32_t)nvis;
     r->stats.instances += ninst;
     r->stats.commands += ncmd;
     r->stats.triangles += tris;
@@ -568,4 +566,192 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
     r->stats.gl_draw_calls += calls;
     f->out->triangles += tris;
     f->out->draw_calls += calls;
+}
+
+/* ---------------------------------------------------- occlusion culling
+ *
+ * Within the frame, so it is exact and needs no previous frame: the nodes
+ * whose boxes cover a good part of the image (floors, walls, big machines)
+ * are drawn first; their depth is read back and reduced to a pyramid of the
+ * farthest depth per tile (reversed Z: the smallest value); every other
+ * visible node whose box lies wholly behind that depth over the tiles its
+ * projection touches is skipped. The tiles cover the box's pixels and the
+ * box encloses the geometry, so no visible node is dropped: the image is
+ * the same with and without (the tests check it). The read-back is a sync
+ * point: a win when much is hidden (a hall seen from its floor), a cost in
+ * open views, hence behind a flag. */
+
+#define HZ_TILE 8
+
+static bool box_screen(const frame *f, const double *bb, double rect[4], double *near_depth) {
+    const double *M = f->cam_from_world.m;
+    double zmin = INFINITY;
+    rect[0] = rect[1] = INFINITY;
+    rect[2] = rect[3] = -INFINITY;
+    for (int c = 0; c < 8; c++) {
+        double p[3] = {(c & 1) ? bb[3] : bb[0], (c & 2) ? bb[4] : bb[1], (c & 4) ? bb[5] : bb[2]};
+        double x = M[0] * p[0] + M[1] * p[1] + M[2] * p[2] + M[3];
+        double y = M[4] * p[0] + M[5] * p[1] + M[6] * p[2] + M[7];
+        double z = M[8] * p[0] + M[9] * p[1] + M[10] * p[2] + M[11];
+        if (!(z > f->near_plane)) return false; /* reaches the camera: cannot be tested */
+        double u = f->cam.fx * x / z + f->cam.cx, v = f->cam.fy * y / z + f->cam.cy;
+        rect[0] = fmin(rect[0], u);
+        rect[1] = fmin(rect[1], v);
+        rect[2] = fmax(rect[2], u);
+        rect[3] = fmax(rect[3], v);
+        zmin = fmin(zmin, z);
+    }
+    *near_depth = f->near_plane / zmin; /* reversed Z: the box's nearest depth */
+    return true;
+}
+
+/* Level 0: the farthest (smallest) depth per HZ_TILE^2 tile; level k+1
+ * halves each side. Returns the level count (0 if out of memory). */
+static int build_pyramid(struct mr_geo *g, const float *depth, int w, int h) {
+    int tw = (w + HZ_TILE - 1) / HZ_TILE, th = (h + HZ_TILE - 1) / HZ_TILE;
+    size_t need = 0;
+    for (int lw = tw, lh = th;; lw = (lw + 1) / 2, lh = (lh + 1) / 2) {
+        need += (size_t)lw * lh;
+        if (lw == 1 && lh == 1) break;
+    }
+    if (need > g->hz_cap) {
+        float *p = realloc(g->hz, need * sizeof *p);
+        if (!p) return 0;
+        g->hz = p;
+        g->hz_cap = need;
+    }
+    float *lvl = g->hz;
+    for (int ty = 0; ty < th; ty++)
+        for (int tx = 0; tx < tw; tx++) {
+            float m = INFINITY;
+            for (int y = ty * HZ_TILE; y < ty * HZ_TILE + HZ_TILE && y < h; y++)
+                for (int x = tx * HZ_TILE; x < tx * HZ_TILE + HZ_TILE && x < w; x++) m = fminf(m, depth[(size_t)y * w + x]);
+            lvl[(size_t)ty * tw + tx] = m;
+        }
+    int levels = 1;
+    g->hz_w[0] = tw;
+    g->hz_h[0] = th;
+    g->hz_off[0] = 0;
+    size_t off = (size_t)tw * th;
+    while ((tw > 1 || th > 1) && levels < 24) {
+        int nw = (tw + 1) / 2, nh = (th + 1) / 2;
+        const float *src = g->hz + g->hz_off[levels - 1];
+        float *dst = g->hz + off;
+        for (int y = 0; y < nh; y++)
+            for (int x = 0; x < nw; x++) {
+                float m = INFINITY;
+                for (int dy = 0; dy < 2; dy++)
+                    for (int dx = 0; dx < 2; dx++) {
+                        int sx = 2 * x + dx, sy = 2 * y + dy;
+                        if (sx < tw && sy < th) m = fminf(m, src[(size_t)sy * tw + sx]);
+                    }
+                dst[(size_t)y * nw + x] = m;
+            }
+        g->hz_off[levels] = off;
+        g->hz_w[levels] = nw;
+        g->hz_h[levels] = nh;
+        off += (size_t)nw * nh;
+        tw = nw;
+        th = nh;
+        levels++;
+    }
+    return levels;
+}
+
+static bool occluded(const struct mr_geo *g, int levels, const double rect[4], double near_depth, int w, int h) {
+    /* Pixels the projection can touch (pixel centres at integers), widened
+     * by a pixel for rasterisation rounding. */
+    double x0 = floor(rect[0] - 1), y0 = floor(rect[1] - 1), x1 = ceil(rect[2] + 1), y1 = ceil(rect[3] + 1);
+    if (x1 < 0 || y1 < 0 || x0 > w - 1 || y0 > h - 1) return false; /* the frustum's business */
+    x0 = fmax(x0, 0);
+    y0 = fmax(y0, 0);
+    x1 = fmin(x1, w - 1);
+    y1 = fmin(y1, h - 1);
+    int tx0 = (int)x0 / HZ_TILE, ty0 = (int)y0 / HZ_TILE, tx1 = (int)x1 / HZ_TILE, ty1 = (int)y1 / HZ_TILE;
+    int lv = 0;
+    while (lv + 1 < levels && (tx1 - tx0 > 3 || ty1 - ty0 > 3)) {
+        tx0 >>= 1;
+        ty0 >>= 1;
+        tx1 >>= 1;
+        ty1 >>= 1;
+        lv++;
+    }
+    const float *t = g->hz + g->hz_off[lv];
+    for (int y = ty0; y <= ty1 && y < g->hz_h[lv]; y++)
+        for (int x = tx0; x <= tx1 && x < g->hz_w[lv]; x++)
+            if (!(near_depth < (double)t[(size_t)y * g->hz_w[lv] + x])) return false;
+    return true;
+}
+
+void mr_geometry_draw(frame *f, uint32_t layer_mask) {
+    mr_renderer *r = f->r;
+    const mr_scene *s = r->scene;
+    struct mr_geo *g = r->geo;
+    if (!s || !g) return;
+    const mr_draw_params *dp = &r->draw;
+    double t0 = mr_time_now();
+
+    /* 1. Frustum culling. */
+    mr_frustum fr = mr_frustum_from_camera(&f->cam, &f->view->world_from_camera, f->near_plane, 1.0);
+    mr_bvh_stats bst;
+    int32_t nvis = mr_bvh_cull(g->bvh, dp->no_cull ? NULL : &fr, layer_mask, g->visible, &bst);
+    uint32_t ndrawable = 0;
+    for (int l = 0; l < MR_LAYER_COUNT; l++)
+        if (layer_mask & (1u << l)) ndrawable += g->drawable[l];
+    r->stats.nodes_drawable += ndrawable;
+    r->stats.nodes_visible += (uint32_t)nvis;
+    r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
+    GLint vp[4];
+    glGetIntegerv(GL_VIEWPORT, vp);
+    int w = vp[2], h = vp[3];
+    if (!dp->occlusion || dp->no_cull || nvis < 64 || w != f->cam.width || h != f->cam.height) {
+        submit_nodes(f, g->visible, nvis);
+        return;
+    }
+
+    /* 2. Occluders first: boxes covering at least 1/256 of the image (or
+     * reaching the camera). */
+    t0 = mr_time_now();
+    int32_t nocc = 0, nrest = 0;
+    int32_t *rest = g->occ_rest;
+    double min_area = (double)w * h / 256.0;
+    for (int32_t i = 0; i < nvis; i++) {
+        double rect[4], nd;
+        const double *bb = mr_bvh_bounds(g->bvh, g->visible[i]);
+        bool big = !box_screen(f, bb, rect, &nd) ||
+                   (fmin(rect[2], w) - fmax(rect[0], 0)) * (fmin(rect[3], h) - fmax(rect[1], 0)) >= min_area;
+        if (big) g->visible[nocc++] = g->visible[i];
+        else rest[nrest++] = g->visible[i];
+    }
+    r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
+    submit_nodes(f, g->visible, nocc);
+
+    /* 3. Their depth as a pyramid; the rest tested against it. */
+    t0 = mr_time_now();
+    size_t npx = (size_t)w * h;
+    if (npx > g->depth_cap) {
+        float *d = realloc(g->depth, npx * sizeof *d);
+        if (!d) {
+            submit_nodes(f, rest, nrest);
+            return;
+        }
+        g->depth = d;
+        g->depth_cap = npx;
+    }
+    GLint draw_fbo = 0;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &draw_fbo);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, (GLuint)draw_fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, g->depth);
+    int levels = build_pyramid(g, g->depth, w, h);
+    int32_t nkeep = 0;
+    for (int32_t i = 0; i < nrest; i++) {
+        double rect[4], nd;
+        const double *bb = mr_bvh_bounds(g->bvh, rest[i]);
+        if (levels > 0 && box_screen(f, bb, rect, &nd) && occluded(g, levels, rect, nd, w, h)) continue;
+        rest[nkeep++] = rest[i];
+    }
+    r->stats.nodes_occluded += (uint32_t)(nrest - nkeep);
+    r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
+    submit_nodes(f, rest, nkeep);
 }
