@@ -22,8 +22,10 @@
 #include "mr_scene.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <meshoptimizer.h>
 
 /* ------------------------------------------------------- distance math */
@@ -525,6 +527,41 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
     return true;
 }
 
+/* Meshes are independent: workers take the next mesh from a shared
+ * counter, largest meshes first so the last one does not run alone. */
+typedef struct build_job {
+    const mr_scene *s;
+    const mr_lod_params *p;
+    mr_lod *l;
+    const int32_t *order;
+    pthread_mutex_t lock;
+    int32_t next, done;
+    int32_t failed;          /* mesh that ran out of memory, or -1 */
+    double t0;
+    bool shown;
+} build_job;
+
+static void *build_worker(void *arg) {
+    build_job *j = arg;
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        int32_t k = j->failed < 0 && j->next < j->s->mesh_count ? j->next++ : -1;
+        pthread_mutex_unlock(&j->lock);
+        if (k < 0) return NULL;
+        int32_t i = j->order[k];
+        bool ok = build_mesh(&j->s->meshes[i], j->p, &j->l->meshes[i]);
+        pthread_mutex_lock(&j->lock);
+        if (!ok && j->failed < 0) j->failed = i;
+        j->done++;
+        if (j->p->progress && mr_time_now() - j->t0 > 1.0) {
+            fprintf(stderr, "\rLOD: mesh %d of %d   ", (int)j->done, (int)j->s->mesh_count);
+            fflush(stderr);
+            j->shown = true;
+        }
+        pthread_mutex_unlock(&j->lock);
+    }
+}
+
 mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *err) {
     if (!s) {
         mr_fail(err, MR_ERR_INVALID, "no scene");
@@ -534,28 +571,52 @@ mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *e
     resolve(params, &p);
     mr_lod *l = calloc(1, sizeof *l);
     if (l) l->meshes = calloc((size_t)s->mesh_count + 1, sizeof *l->meshes);
-    if (!l || !l->meshes) {
+    int32_t *order = malloc(((size_t)s->mesh_count + 1) * sizeof *order);
+    if (!l || !l->meshes || !order) {
+        free(order);
         mr_lod_destroy(&l);
         mr_fail(err, MR_ERR_NOMEM, "out of memory for LOD levels");
         return NULL;
     }
     l->mesh_count = s->mesh_count;
     l->scene_hash = mr_lod_scene_hash(s);
-    double t0 = mr_time_now();
-    bool shown = false;
-    for (int32_t i = 0; i < s->mesh_count; i++) {
-        if (p.progress && mr_time_now() - t0 > 1.0) {
-            fprintf(stderr, "\rLOD: mesh %d of %d   ", (int)i + 1, (int)s->mesh_count);
-            fflush(stderr);
-            shown = true;
+    /* Largest first (insertion sort: mesh counts are small; very large
+     * counts keep file order). */
+    for (int32_t i = 0; i < s->mesh_count; i++) order[i] = i;
+    for (int32_t i = 1; i < s->mesh_count && s->mesh_count <= 4096; i++) {
+        int32_t v = order[i], k = i;
+        while (k > 0 && s->meshes[order[k - 1]].index_count < s->meshes[v].index_count) {
+            order[k] = order[k - 1];
+            k--;
         }
-        if (!build_mesh(&s->meshes[i], &p, &l->meshes[i])) {
-            mr_lod_destroy(&l);
-            mr_fail(err, MR_ERR_NOMEM, "out of memory simplifying mesh '%s'", s->meshes[i].name);
-            return NULL;
-        }
+        order[k] = v;
     }
-    if (shown) fprintf(stderr, "\r%40s\r", "");
+    build_job j;
+    memset(&j, 0, sizeof j);
+    j.s = s;
+    j.p = &p;
+    j.l = l;
+    j.order = order;
+    j.failed = -1;
+    j.t0 = mr_time_now();
+    pthread_mutex_init(&j.lock, NULL);
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    int nthreads = ncpu < 1 ? 1 : ncpu > 16 ? 16 : (int)ncpu;
+    if (nthreads > s->mesh_count) nthreads = s->mesh_count > 0 ? s->mesh_count : 1;
+    pthread_t threads[16];
+    int started = 0;
+    for (int t = 1; t < nthreads; t++)
+        if (pthread_create(&threads[started], NULL, build_worker, &j) == 0) started++;
+    build_worker(&j); /* this thread works too */
+    for (int t = 0; t < started; t++) pthread_join(threads[t], NULL);
+    pthread_mutex_destroy(&j.lock);
+    free(order);
+    if (j.shown) fprintf(stderr, "\r%40s\r", "");
+    if (j.failed >= 0) {
+        mr_fail(err, MR_ERR_NOMEM, "out of memory simplifying mesh '%s'", s->meshes[j.failed].name);
+        mr_lod_destroy(&l);
+        return NULL;
+    }
     return l;
 }
 
