@@ -157,6 +157,23 @@ static void test_submission_modes_same_image(void) {
         }
         mr_frame_result_free(&a);
     }
+    /* Layer masks: with the hidden layer left out, only visible-layer
+     * nodes are drawable. */
+    {
+        uint32_t vis_nodes = 0;
+        for (int32_t i = 0; i < s->node_count; i++)
+            vis_nodes += s->nodes[i].layer == MR_LAYER_VISIBLE && s->nodes[i].mesh_first >= 0;
+        mr_view view = {cam, mr_synth_viewpoint(&sp, MR_SYNTH_VIEW_OVERVIEW)};
+        mr_frame_params fp = MR_FRAME_DEFAULTS;
+        fp.hide_hidden_layer = true;
+        mr_frame_result res;
+        mr_draw_stats st;
+        if (mr_renderer_set_draw_params(g_r, &on, &err) && mr_render_frame(g_r, &view, &fp, &res, &err)) {
+            mr_renderer_draw_stats(g_r, &st);
+            CHECK_MSG(st.nodes_drawable == vis_nodes && vis_nodes < (uint32_t)s->node_count, "%u vs %u", st.nodes_drawable, vis_nodes);
+            mr_frame_result_free(&res);
+        }
+    }
     printf("submission modes: worst mismatch %.5f, %u node draws culled, %u occluded\n", worst, culled, occluded);
     CHECK(occluded > 0);
     CHECK_MSG(worst <= 0.002, "images differ: %.4f of pixels", worst);

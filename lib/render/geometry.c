@@ -704,7 +704,22 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
     GLint vp[4];
     glGetIntegerv(GL_VIEWPORT, vp);
     int w = vp[2], h = vp[3];
-    if (!dp->occlusion || dp->no_cull || nvis < 64 || w != f->cam.width || h != f->cam.height) {
+    /* Occlusion needs a depth buffer that this draw tests and writes with
+     * reversed Z (a pass drawing without depth, e.g. an x-ray view of the
+     * hidden layer, gets plain frustum culling). */
+    bool depth_ok = false;
+    if (dp->occlusion && !dp->no_cull && nvis >= 64 && w == f->cam.width && h == f->cam.height) {
+        GLint fbo = 0, type = GL_NONE, func = 0;
+        GLboolean mask = GL_FALSE;
+        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fbo);
+        if (fbo != 0)
+            glGetNamedFramebufferAttachmentParameteriv((GLuint)fbo, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+        glGetIntegerv(GL_DEPTH_FUNC, &func);
+        glGetBooleanv(GL_DEPTH_WRITEMASK, &mask);
+        depth_ok = fbo != 0 && type != GL_NONE && glIsEnabled(GL_DEPTH_TEST) && mask &&
+                   (func == GL_GREATER || func == GL_GEQUAL);
+    }
+    if (!depth_ok) {
         submit_nodes(f, g->visible, nvis);
         return;
     }
