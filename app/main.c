@@ -10,7 +10,7 @@ static const struct {
 } k_commands[] = {
     {"demo", cmd_demo, "build the demo hall (as planned / as built), render camera frames and overlays"},
     {"render", cmd_render, "render one headless frame of a scene from a view"},
-    {"bench", cmd_bench, "measure run time: bench frame"},
+    {"bench", cmd_bench, "measure run time: bench frame, bench scene"},
     {"synth", cmd_synth, "write a big synthetic factory (1M..20M triangles) as .glb"},
 };
 
