@@ -299,6 +299,56 @@ static void test_lod_tolerance(void) {
     mr_scene_destroy(&s);
 }
 
+/* A node with a degenerate (zero-scale) transform draws nothing and does
+ * not disturb the batching of the others. */
+static void test_degenerate_instance(void) {
+    mr_error err = {0};
+    mr_scene *s[2];
+    for (int k = 0; k < 2; k++) {
+        s[k] = mr_scene_create();
+        mr_mesh a = sphere(0.5, 12, 6), b = sphere(0.3, 5, 3);
+        mr_scene_add_mesh(s[k], &a, &err);
+        mr_scene_add_mesh(s[k], &b, &err);
+        const double xs[3] = {-1, 0.5, 1.2};
+        const int32_t mesh[3] = {0, 1, 1};
+        for (int i = 0; i < 3; i++) {
+            mr_node n;
+            memset(&n, 0, sizeof n);
+            snprintf(n.name, sizeof n.name, "n%d", i);
+            n.parent = -1;
+            n.world = mr_m4_translate(xs[i], 0, 4);
+            if (k == 1 && i == 1) n.world = mr_m4_scale(0, 0, 0); /* degenerate, before a sibling of mesh 1 */
+            n.mesh_first = mesh[i];
+            n.mesh_count = 1;
+            mr_scene_add_node(s[k], &n);
+        }
+        mr_scene_update_bounds(s[k]);
+    }
+    mr_view view = {{96, 64, 70, 70, 47.5, 31.5, {0}}, mr_m4_identity()};
+    mr_frame_result r0, r1;
+    mr_draw_params dp = MR_DRAW_DEFAULTS;
+    dp.no_cull = true; /* keep the degenerate node in the list */
+    bool ok0 = mr_renderer_set_scene(g_r, s[0], &err) && frame(&view, &dp, 96, 64, &r0, NULL);
+    bool ok1 = ok0 && mr_renderer_set_scene(g_r, s[1], &err) && frame(&view, &dp, 96, 64, &r1, NULL);
+    CHECK_MSG(ok0 && ok1, "%s", err.msg);
+    if (ok1) {
+        /* Without node 1 the pictures differ only where node 1 was. */
+        const unsigned char *a = r0.color.data, *b = r1.color.data;
+        int differ_left = 0;
+        for (int y = 0; y < 64; y++)
+            for (int x = 0; x < 96; x++)
+                if (x < 40 || x >= 64) differ_left += a[3 * (y * 96 + x)] != b[3 * (y * 96 + x)];
+        CHECK_MSG(differ_left == 0, "%d pixels changed away from the removed node", differ_left);
+        /* and where it was, it is gone */
+        CHECK(memcmp(a, b, 96 * 64 * 3) != 0);
+        mr_frame_result_free(&r1);
+    }
+    if (ok0) mr_frame_result_free(&r0);
+    mr_renderer_set_scene(g_r, NULL, &err);
+    mr_scene_destroy(&s[0]);
+    mr_scene_destroy(&s[1]);
+}
+
 static void test_100k_nodes_frame(void) {
     mr_scene *s = mr_scene_create();
     mr_error err = {0};
@@ -364,6 +414,7 @@ int main(void) {
         RUN(test_submission_modes_same_image);
         RUN(test_far_plant);
         RUN(test_lod_tolerance);
+        RUN(test_degenerate_instance);
         RUN(test_100k_nodes_frame);
     }
     mr_renderer_destroy(&g_r);

@@ -88,6 +88,7 @@ struct mr_geo {
 /* ------------------------------------------------------------- params */
 
 bool mr_renderer_set_draw_params(mr_renderer *r, const mr_draw_params *params, mr_error *err) {
+    if (!r) return mr_fail(err, MR_ERR_INVALID, "no renderer");
     mr_draw_params d = MR_DRAW_DEFAULTS;
     if (params) d = *params;
     if (!isfinite(d.lod_tolerance) || !isfinite(d.lod_pixels) || d.lod_pixels < 0)
@@ -501,7 +502,7 @@ static void submit_nodes(frame *f, const int32_t *nodes, int32_t nvis) {
     for (size_t i = 0; i < nrec; i++) g->sorted[g->key_count[g->recs[i].key]++] = g->recs[i];
 
     /* 3. Instance data and commands, one per bucket (or per instance). */
-    uint32_t ninst = 0, ncmd = 0;
+    uint32_t ninst = 0, ncmd = 0, last_key = UINT32_MAX;
     uint64_t tris = 0;
     memset(g->group_cmds, 0, (size_t)g->group_count * sizeof *g->group_cmds);
     for (int32_t k = 0; k < g->group_count; k++) g->group_first[k] = -1;
@@ -510,8 +511,10 @@ static void submit_nodes(frame *f, const int32_t *nodes, int32_t nvis) {
         const geo_mesh *gm = &g->meshes[rc->mesh];
         if (!fill_instance(f, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, rc->node, &g->inst[ninst])) continue;
         int level = (int)(rc->key % LEVELS);
-        bool extend = !dp->no_instancing && ncmd > 0 && i > 0 && g->sorted[i - 1].key == rc->key &&
-                      g->cmds[ncmd - 1].base_instance + g->cmds[ncmd - 1].instance_count == ninst;
+        /* Same bucket as the last command (records skipped as degenerate
+         * leave no gap: the command's instances stay contiguous). */
+        bool extend = !dp->no_instancing && ncmd > 0 && last_key == rc->key;
+        last_key = rc->key;
         if (extend) {
             g->cmds[ncmd - 1].instance_count++;
         } else {
