@@ -104,8 +104,10 @@ typedef struct mr_draw_params {
                               (5 mm in a metre scene); < 0: no LOD at all */
     double lod_pixels;     /* largest projected error of a chosen level, pixels;
                               0 = 1.0 */
-    bool occlusion;        /* occlusion culling against the previous frame's
-                              depth (hierarchical Z); default off */
+    bool occlusion;        /* occlusion culling within the frame: big
+                              occluders first, then a hierarchical-Z test
+                              of the rest on the CPU; exact (same image),
+                              costs a depth read-back; default off */
 } mr_draw_params;
 #define MR_DRAW_DEFAULTS {false, false, false, false, 0.0, 0.0, false}
 

@@ -280,7 +280,7 @@ int32_t mr_bvh_cull(const mr_bvh *b, const mr_frustum *f, uint32_t layer_mask, i
                     }
                     out[n++] = node;
                 }
-            } else if (sp + 2 <= 128) {
+            } else if (sp + 2 <= 128) { /* depth is ~log2(n / LEAF_SIZE) (median splits): never full */
                 stack[sp] = box->left + 1;
                 inside_stack[sp++] = inside;
                 stack[sp] = box->left;

@@ -249,10 +249,11 @@ typedef struct mr_lod {
 } mr_lod;
 
 typedef struct mr_lod_params {
-    double max_error;         /* largest certified error worth keeping, scene
-                                 units; 0 = 0.02 (levels coarser than this are
-                                 never usable under the default 5 mm tolerance
-                                 with some headroom for --lod-tolerance) */
+    double max_error;         /* largest certified error worth keeping, in
+                                 mesh units (scene units for unscaled nodes);
+                                 0 = 0.02: coarser levels are never usable
+                                 under the default 5 mm tolerance, with
+                                 headroom for a larger --lod-tolerance */
     uint32_t min_triangles;   /* meshes with fewer triangles get no levels; 0 = 64 */
     bool progress;            /* progress line on stderr (caller decides on a tty) */
 } mr_lod_params;
