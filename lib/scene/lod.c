@@ -103,6 +103,7 @@ typedef struct tri_grid {
                           both are coplanar and their union is convex, else
                           UINT32_MAX (see convex_partners) */
     double ptol;       /* coplanarity tolerance used for partner */
+    uint32_t *vt_start, *vt_items; /* triangles around each vertex (CSR) */
 } tri_grid;
 
 static dv vtx(const float *pos, uint32_t i) {
@@ -121,6 +122,8 @@ static void grid_free(tri_grid *g) {
     free(g->start);
     free(g->items);
     free(g->partner);
+    free(g->vt_start);
+    free(g->vt_items);
     memset(g, 0, sizeof *g);
 }
 
@@ -207,8 +210,15 @@ static bool convex_pair(dv a, dv b, dv c, dv d, double tol) {
     return dv_dot(y1, y2) <= 0;
 }
 
-static bool convex_partners(tri_grid *g, double tol) {
+static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
     g->ptol = tol;
+    /* Triangles around each vertex, for fan bounds. */
+    g->vt_start = calloc((size_t)vertex_count + 2, sizeof *g->vt_start);
+    g->vt_items = malloc(((size_t)g->tri_count * 3 + 1) * sizeof *g->vt_items);
+    if (!g->vt_start || !g->vt_items) return false;
+    for (size_t i = 0; i < (size_t)g->tri_count * 3; i++) g->vt_start[g->idx[i] + 2]++;
+    for (uint32_t v = 0; v < vertex_count; v++) g->vt_start[v + 2] += g->vt_start[v + 1];
+    for (size_t i = 0; i < (size_t)g->tri_count * 3; i++) g->vt_items[g->vt_start[g->idx[i] + 1]++] = (uint32_t)(i / 3);
     size_t ne = (size_t)g->tri_count * 3;
     g->partner = malloc((ne + 1) * sizeof *g->partner);
     edge_rec *e = malloc((ne + 1) * sizeof *e);
@@ -291,6 +301,105 @@ static double dist_to_tri(const tri_grid *g, dv p, uint32_t t) {
     return sqrt(dist2_point_tri(p, vtx(g->pos, g->idx[3 * t]), vtx(g->pos, g->idx[3 * t + 1]), vtx(g->pos, g->idx[3 * t + 2])));
 }
 
+/* 2D cross of (b - a) x (c - a). */
+static double cross2(const double *a, const double *b, const double *c) {
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+static int cmp_pt2(const void *x, const void *y) {
+    const double *p = x, *q = y;
+    if (p[0] != q[0]) return p[0] < q[0] ? -1 : 1;
+    return p[1] < q[1] ? -1 : p[1] > q[1];
+}
+
+/* Bound over the piece (a, b, c) from the fan of triangles around vertex v
+ * that lie in the plane of triangle `ref`: if their union is a convex
+ * polygon (it equals its convex hull: same orientation, angles at v within
+ * a full turn, and area sum equal to the hull's area), the distance to it
+ * is convex, so its largest value over the piece is at a corner. Planar
+ * regions split into many triangles (cylinder strips, box faces, caps)
+ * then need no subdivision around their vertices. INFINITY if it does not
+ * apply. */
+static double fan_bound(const tri_grid *o, uint32_t v, uint32_t ref, dv a, dv b, dv c) {
+    dv r0 = vtx(o->pos, o->idx[3 * ref]), r1 = vtx(o->pos, o->idx[3 * ref + 1]), r2 = vtx(o->pos, o->idx[3 * ref + 2]);
+    dv e1 = dv_sub(r1, r0), e2 = dv_sub(r2, r0);
+    dv n = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
+    double nl = sqrt(dv_dot(n, n));
+    if (!(nl > 0)) return INFINITY;
+    n = (dv){n.x / nl, n.y / nl, n.z / nl};
+    dv u = dv_mad(e1, n, 0);
+    double ul = sqrt(dv_dot(u, u));
+    u = (dv){u.x / ul, u.y / ul, u.z / ul};
+    dv w = {n.y * u.z - n.z * u.y, n.z * u.x - n.x * u.z, n.x * u.y - n.y * u.x};
+    uint32_t fan[16];
+    int nf = 0;
+    double area = 0, angle = 0;
+    double pts[48][2];
+    int np = 0;
+    for (uint32_t k = o->vt_start[v]; k < o->vt_start[v + 1]; k++) {
+        uint32_t t = o->vt_items[k];
+        dv p[3];
+        bool in_plane = true;
+        for (int j = 0; j < 3; j++) {
+            p[j] = vtx(o->pos, o->idx[3 * t + (uint32_t)j]);
+            if (fabs(dv_dot(dv_sub(p[j], r0), n)) > o->ptol) in_plane = false;
+        }
+        if (!in_plane) continue;
+        dv f1 = dv_sub(p[1], p[0]), f2 = dv_sub(p[2], p[0]);
+        dv fn = {f1.y * f2.z - f1.z * f2.y, f1.z * f2.x - f1.x * f2.z, f1.x * f2.y - f1.y * f2.x};
+        if (!(dv_dot(fn, n) > 0)) return INFINITY; /* flipped or degenerate: no claim */
+        if (nf == 16) return INFINITY;
+        fan[nf++] = t;
+        area += 0.5 * sqrt(dv_dot(fn, fn));
+        /* angle at v */
+        int iv = o->idx[3 * t] == v ? 0 : o->idx[3 * t + 1] == v ? 1 : 2;
+        dv x1 = dv_sub(p[(iv + 1) % 3], p[iv]), x2 = dv_sub(p[(iv + 2) % 3], p[iv]);
+        double cs = dv_dot(x1, x2) / sqrt(dv_dot(x1, x1) * dv_dot(x2, x2));
+        angle += acos(cs < -1 ? -1 : cs > 1 ? 1 : cs);
+        for (int j = 0; j < 3; j++) {
+            dv d = dv_sub(p[j], r0);
+            pts[np][0] = dv_dot(d, u);
+            pts[np][1] = dv_dot(d, w);
+            np++;
+        }
+    }
+    if (nf < 2 || angle > 2 * 3.14159265358979323846 + 1e-9) return INFINITY;
+    /* Convex hull (monotone chain) of the fan's points, its area and
+     * perimeter. */
+    qsort(pts, (size_t)np, sizeof pts[0], cmp_pt2);
+    double hull[97][2];
+    int h = 0;
+    for (int i = 0; i < np; i++) {
+        while (h >= 2 && cross2(hull[h - 2], hull[h - 1], pts[i]) <= 0) h--;
+        hull[h][0] = pts[i][0];
+        hull[h][1] = pts[i][1];
+        h++;
+    }
+    for (int i = np - 2, lo = h + 1; i >= 0; i--) {
+        while (h >= lo && cross2(hull[h - 2], hull[h - 1], pts[i]) <= 0) h--;
+        hull[h][0] = pts[i][0];
+        hull[h][1] = pts[i][1];
+        h++;
+    }
+    double harea = 0, perim = 0;
+    for (int i = 0; i + 1 < h; i++) {
+        harea += 0.5 * (hull[i][0] * hull[i + 1][1] - hull[i + 1][0] * hull[i][1]);
+        perim += hypot(hull[i + 1][0] - hull[i][0], hull[i + 1][1] - hull[i][1]);
+    }
+    if (!(harea > 0) || !(fabs(harea - area) <= 1e-6 * harea)) return INFINITY;
+    /* What float rounding may leave uncovered: a sliver of the area
+     * mismatch is at most 2 * area / perimeter wide; plus the plane slack. */
+    double slack = 2 * fabs(harea - area) / perim + 2 * o->ptol;
+    double m = 0;
+    const dv q[3] = {a, b, c};
+    for (int j = 0; j < 3; j++) {
+        double best = INFINITY;
+        for (int k = 0; k < nf; k++) best = fmin(best, dist_to_tri(o, q[j], fan[k]));
+        m = fmax(m, best);
+    }
+    return m + slack;
+}
+
 typedef struct bb_ctx {
     const tri_grid *other;
     double lower;      /* largest exact point distance seen */
@@ -328,6 +437,15 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
                 double mq = fmax(fmin(ta_, dist_to_tri(o, a, q)),
                                  fmax(fmin(tb_, dist_to_tri(o, b, q)), fmin(tc_, dist_to_tri(o, c, q)))) + 2 * o->ptol;
                 if (mq < ub) ub = mq;
+            }
+        }
+        /* Planar fans around the candidates' vertices, where still needed. */
+        for (int k = 0; k < 3 && ub > x->lower + x->resolution && o->vt_start; k++) {
+            uint32_t t = cand[k];
+            if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
+            for (int j = 0; j < 3 && ub > x->lower + x->resolution; j++) {
+                double fb = fan_bound(o, o->idx[3 * t + (uint32_t)j], t, a, b, c);
+                if (fb < ub) ub = fb;
             }
         }
         /* Lipschitz: every point is within the covering radius (at most the
@@ -418,7 +536,7 @@ double mr_lod_hausdorff_bound(const float *positions, uint32_t vertex_count, con
     /* Positions are float: a few ulps of the extent. */
     double ptol = 1e-6 * fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
     bool ok = grid_build(&ga, positions, a, a_count, lo, hi) && grid_build(&gb, positions, b, b_count, lo, hi);
-    if (!ok || !convex_partners(&ga, ptol) || !convex_partners(&gb, ptol)) {
+    if (!ok || !convex_partners(&ga, ptol, vertex_count) || !convex_partners(&gb, ptol, vertex_count)) {
         grid_free(&ga);
         grid_free(&gb);
         return INFINITY;
