@@ -99,4 +99,37 @@ int cmd_render(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
 int bench_ao(int argc, char **argv);
 
+/* Big scenes (scene_load.c): load with progress on a terminal and report
+ * time and memory; LOD levels through the cache next to the scene; the
+ * shared draw options. */
+typedef struct app_load_info {
+    double load_s;             /* wall-clock seconds for mr_scene_load */
+    uint64_t file_bytes;
+    uint64_t triangles;        /* drawn (instances counted each time) */
+    uint64_t unique_triangles; /* stored */
+    size_t peak_rss;           /* bytes, after the load */
+} app_load_info;
+mr_scene *app_load_scene(const char *path, const mr_scene_params *params, app_load_info *info, mr_error *err);
+mr_lod *app_load_lod(const mr_scene *s, const char *scene_path, bool use_cache, mr_error *err);
+/* Reads --cull --batch --instancing --lod --occlusion (on|off),
+ * --lod-tolerance and --lod-pixels; prints one line and returns false on a
+ * bad value. */
+bool app_draw_params(const app_opt *opts, mr_draw_params *dp);
+/* --lod auto (the default): levels only for scenes that draw at least
+ * APP_LOD_AUTO_TRIANGLES, where simplifying pays for its one-off cost. */
+bool app_lod_auto(const app_opt *opts);
+#define APP_LOD_AUTO_TRIANGLES 500000u
+#define APP_DRAW_OPTS                                                                                          \
+    {"cull", "on|off", "BVH frustum culling (default on)", NULL},                                              \
+    {"batch", "on|off", "multi-draw-indirect batching (default on)", NULL},                                   \
+    {"instancing", "on|off", "one command per mesh instead of per node (default on)", NULL},                   \
+    {"lod", "auto|on|off", "simplified levels within the tolerance, cached next to the scene (default auto: on for scenes over 500k triangles)", NULL}, \
+    {"lod-tolerance", "UNITS", "largest geometric error of a level in scene units (default 0.005)", NULL},     \
+    {"lod-pixels", "PX", "largest projected error of a level in pixels (default 1)", NULL},                    \
+    {"occlusion", "on|off", "occlusion culling (default off)", NULL}
+
+int cmd_synth(int argc, char **argv);
+int cmd_factory(int argc, char **argv);
+int bench_scene(int argc, char **argv);
+
 #endif

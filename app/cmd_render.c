@@ -128,6 +128,8 @@ int cmd_render(int argc, char **argv) {
         {"ghost-tc-min", "C", "minimal desired contrast tc_minimal (default 0.1)", NULL},
         {"ghost-gamma", "G", "multiplier of IM in C_desired (default 0.5)", NULL},
         {"ghost-tc-sil", "C", "extra desired contrast on hidden silhouettes (default 0.15)", NULL},
+        APP_DRAW_OPTS,
+        {"lod-cache", "on|off", "read/write LOD levels in <scene>.mrlod (default on)", NULL},
         {"verbose", NULL, "print the passes that ran and more", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -150,6 +152,11 @@ int cmd_render(int argc, char **argv) {
     if (app_get(opts, "alpha") && !app_double("alpha", app_get(opts, "alpha"), 0, 1, &alpha)) return 2;
     fp.alpha = (float)alpha;
     fp.hide_hidden_layer = app_flag(opts, "hide-hidden");
+    mr_draw_params dp;
+    if (!app_draw_params(opts, &dp)) return 2;
+    const char *lod_cache = app_get(opts, "lod-cache");
+    if (lod_cache && strcmp(lod_cache, "on") != 0 && strcmp(lod_cache, "off") != 0)
+        return app_errorf(cmd, "--lod-cache must be 'on' or 'off'"), 2;
     const char *aux = app_get(opts, "aux");
     fp.want_depth = fp.want_normals = aux != NULL;
     bool groundtruth = false;
@@ -171,14 +178,18 @@ int cmd_render(int argc, char **argv) {
     mr_scene_params sp = MR_SCENE_DEFAULTS;
     sp.hidden_globs = globs;
     sp.hidden_glob_count = globs[0] ? 1 : 0;
-    double t0 = mr_time_now();
-    mr_scene *scene = mr_scene_load(scene_path, &sp, &err);
+    mr_scene *scene = app_load_scene(scene_path, &sp, NULL, &err);
     if (!scene) {
         mr_image_free(&video);
         return app_error(cmd, &err);
     }
-    mr_log(MR_LOG_INFO, "loaded %s: %d nodes, %d meshes, %llu triangles in %.1f ms", scene_path, (int)scene->node_count,
-           (int)scene->mesh_count, (unsigned long long)mr_scene_triangle_count(scene), (mr_time_now() - t0) * 1e3);
+    mr_lod *lod = NULL;
+    if (app_lod_auto(opts) && mr_scene_triangle_count(scene) < APP_LOD_AUTO_TRIANGLES) dp.no_lod = true;
+    if (!dp.no_lod && !(lod = app_load_lod(scene, scene->source, !lod_cache || strcmp(lod_cache, "on") == 0, &err))) {
+        mr_scene_destroy(&scene);
+        mr_image_free(&video);
+        return app_error(cmd, &err);
+    }
 
     int rc = 0;
     app_gfx gfx;
@@ -186,7 +197,8 @@ int cmd_render(int argc, char **argv) {
     if (!app_gfx_open(&gfx, &err)) {
         rc = app_error(cmd, &err);
     } else {
-        if (!mr_renderer_set_scene(gfx.renderer, scene, &err) || !mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||
+        if (!mr_renderer_set_draw_params(gfx.renderer, &dp, &err) || !mr_renderer_set_scene(gfx.renderer, scene, &err) ||
+            !mr_renderer_set_lod(gfx.renderer, lod, &err) || !mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||
             (groundtruth && !render_groundtruth(gfx.renderer, scene, &view, &fp, &gtp, &res, &err)))
             rc = app_error(cmd, &err);
         else if (!mr_image_save_png(out, &res.color, &err) || (aux && !app_write_aux(aux, &res, &err)))
@@ -196,10 +208,17 @@ int cmd_render(int argc, char **argv) {
             mr_frame_result_passes(&res, passes, sizeof passes);
             fprintf(stderr, "mrcheck: render: passes: %s; %u draw calls, %llu triangles, near plane %g\n", passes,
                     res.draw_calls, (unsigned long long)res.triangles, res.near_plane);
+            mr_draw_stats ds;
+            mr_renderer_draw_stats(gfx.renderer, &ds);
+            fprintf(stderr, "mrcheck: render: geometry: %u of %u nodes visible, %u instances (%u at a simplified level) in %u "
+                    "commands, %llu of %llu triangles, culling %.2f ms; peak RSS %.0f MB\n", ds.nodes_visible,
+                    ds.nodes_drawable, ds.instances, ds.lod_instances, ds.commands, (unsigned long long)ds.triangles,
+                    (unsigned long long)ds.triangles_full, ds.cull_ms, mr_peak_rss_bytes() / 1048576.0);
         }
         mr_frame_result_free(&res);
         app_gfx_close(&gfx);
     }
+    mr_lod_destroy(&lod);
     mr_scene_destroy(&scene);
     mr_image_free(&video);
     return rc;

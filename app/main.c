@@ -11,12 +11,13 @@ static const struct {
 } k_commands[] = {
     {"demo", cmd_demo, "build the demo hall (as planned / as built), render camera frames and overlays"},
     {"render", cmd_render, "render one headless frame of a scene from a view"},
-    {"bench", cmd_bench, "measure run time: bench frame, ao, ghost, tracking"},
+    {"bench", cmd_bench, "measure run time: bench frame, ao, ghost, tracking, scene"},
     {"synth", cmd_synth, "synthetic recording of the demo hall with ground truth (or a calibration set)"},
     {"track", cmd_track, "AprilTag detection and camera pose per frame (V4L2, video, images, recording)"},
     {"record", cmd_record, "track a camera or video and write a crash-safe recording as it goes"},
     {"calibrate", cmd_calibrate, "camera intrinsics from images of an AprilTag grid board (OpenCV)"},
     {"replay", cmd_replay, "render the overlay of a recording's frames headless (deterministic)"},
+    {"factory", cmd_factory, "write a big synthetic factory (1M..20M triangles) as .glb"},
 };
 
 static void usage(FILE *f) {

@@ -4,7 +4,7 @@
 set -euo pipefail
 pkgs=(
   cmake make gcc g++ pkg-config
-  libcjson-dev libstb-dev libtinygltf-dev libapriltag-dev
+  libcjson-dev libstb-dev libtinygltf-dev libapriltag-dev libmeshoptimizer-dev
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   libopencv-dev libopencv-contrib-dev
   libembree-dev

@@ -1,10 +1,9 @@
 in vec3 v_pos;
 in vec3 v_normal;
 in vec2 v_uv;
+flat in vec4 v_color;   // linear RGBA
+flat in uvec3 v_ids;    // node index + 1, layer, has texture
 
-layout(location = 3) uniform vec4 u_base_color;   // linear RGBA
-layout(location = 4) uniform int u_has_texture;
-layout(location = 5) uniform uvec2 u_ids;         // node index + 1, layer
 layout(binding = 0) uniform sampler2D u_base_tex; // sRGB texture: sampled linear
 
 layout(location = 0) out vec4 o_albedo;  // sRGB8 target: linear in, encoded on write
@@ -12,8 +11,8 @@ layout(location = 1) out vec4 o_normal;  // xyz view normal, w = 1 where geometr
 layout(location = 2) out uvec2 o_ids;
 
 void main() {
-    vec4 c = u_base_color;
-    if (u_has_texture != 0) c *= texture(u_base_tex, v_uv);
+    vec4 c = v_color;
+    if (v_ids.z != 0u) c *= texture(u_base_tex, v_uv);
     vec3 n = normalize(v_normal);
     // CAD exports have arbitrary winding and open shells: light both sides
     // by turning the normal towards the camera (which sits at the origin).
@@ -21,5 +20,5 @@ void main() {
     if (any(isnan(n))) n = normalize(-v_pos);
     o_albedo = vec4(c.rgb, 1.0);
     o_normal = vec4(n, 1.0);
-    o_ids = u_ids;
+    o_ids = v_ids.xy;
 }

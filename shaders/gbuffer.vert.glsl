@@ -1,22 +1,33 @@
-// G-buffer geometry pass. Positions arrive relative to their mesh origin;
-// u_modelview is camera-relative (composed in double on the CPU), so the
-// float values here stay small however far the scene is from the origin.
+// G-buffer geometry pass, instanced. Positions arrive relative to their mesh
+// origin; each instance's model-view is camera-relative (composed in double
+// on the CPU per instance, then cast to float), so the float values here stay
+// small however far the scene is from the origin. The instance record comes
+// in as per-instance attributes (the indirect command's baseInstance selects
+// it), so one multi-draw covers many meshes and nodes.
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
+layout(location = 3) in mat4 a_modelview;   // camera (OpenCV axes) from mesh; 3..6
+layout(location = 7) in vec4 a_normal0;     // columns of the inverse transpose
+layout(location = 8) in vec4 a_normal1;     // of the model-view's 3x3
+layout(location = 9) in vec4 a_normal2;
+layout(location = 10) in vec4 a_color;      // linear RGBA base colour
+layout(location = 11) in uvec4 a_ids;       // node index + 1, layer, has texture
 
-layout(location = 0) uniform mat4 u_modelview;  // camera (OpenCV axes) from mesh
-layout(location = 1) uniform mat3 u_normal_mat; // inverse transpose of its 3x3
-layout(location = 2) uniform mat4 u_proj;       // reversed-Z, infinite far
+layout(location = 2) uniform mat4 u_proj;   // reversed-Z, infinite far
 
 out vec3 v_pos;     // view space, OpenCV axes
 out vec3 v_normal;  // view space
 out vec2 v_uv;
+flat out vec4 v_color;
+flat out uvec3 v_ids;
 
 void main() {
-    vec4 p = u_modelview * vec4(a_position, 1.0);
+    vec4 p = a_modelview * vec4(a_position, 1.0);
     v_pos = p.xyz;
-    v_normal = u_normal_mat * a_normal;
+    v_normal = mat3(a_normal0.xyz, a_normal1.xyz, a_normal2.xyz) * a_normal;
     v_uv = a_uv;
+    v_color = a_color;
+    v_ids = a_ids.xyz;
     gl_Position = u_proj * p;
 }

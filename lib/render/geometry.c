@@ -1,27 +1,142 @@
-/* Geometry: the scene's meshes and textures on the GPU, and drawing them
- * into the G-buffer layout with camera-relative matrices. */
+/* Geometry: the scene on the GPU and its submission into the G-buffer.
+ *
+ * Upload: all meshes share a few large buffers, one interleaved vertex
+ * buffer per vertex layout (position + normal; position + normal + uv for
+ * textured meshes, so UVs cost nothing where no texture is sampled) and one
+ * index buffer holding every mesh's full index list followed by its LOD
+ * levels. A mesh is (layout, base vertex, first index, count) into them, so
+ * a glTF mesh used by many nodes is stored once and drawn as instances.
+ *
+ * Per draw: the BVH (double precision, world space) culls nodes against the
+ * frustum; each visible (node, mesh) pair picks a LOD level, and the pairs
+ * are bucketed by (draw group, mesh, level) with a counting sort. One bucket
+ * is one indirect command whose instances read their camera-relative
+ * matrices (composed in double per instance, then cast to float), colour
+ * and ids as per-instance attributes; all commands of a group (layout + texture) go out in
+ * one glMultiDrawElementsIndirect. GL calls therefore grow with the number
+ * of textures, not with the number of nodes, and a culled node costs nothing
+ * on the GPU. */
 #include "render_internal.h"
 
+#include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
-static GLuint upload_buffer(const void *data, size_t bytes) {
-    GLuint b;
-    glCreateBuffers(1, &b);
-    glNamedBufferStorage(b, (GLsizeiptr)bytes, data, 0);
-    return b;
+#define LEVELS (MR_LOD_MAX_LEVELS + 1) /* full detail + simplified levels */
+
+/* One instance as the G-buffer vertex shader reads it (attributes 3..11). */
+typedef struct gpu_instance {
+    float modelview[16]; /* camera (OpenCV axes) from mesh, column-major */
+    float normal[12];    /* inverse transpose of its 3x3: 3 columns padded to vec4 */
+    float color[4];      /* linear RGBA base colour */
+    uint32_t ids[4];     /* node index + 1, layer, has texture, unused */
+} gpu_instance;
+
+/* glMultiDrawElementsIndirect's command layout. */
+typedef struct draw_cmd {
+    uint32_t count, instance_count, first_index;
+    int32_t base_vertex;
+    uint32_t base_instance;
+} draw_cmd;
+
+typedef struct geo_mesh {
+    int32_t group;                 /* draw group: 0 untextured, 1 + t for texture t */
+    int32_t pool;                  /* vertex layout: 0 pos+normal, 1 pos+normal+uv */
+    int32_t base_vertex;
+    int32_t level_count;           /* 1 + simplified levels */
+    uint32_t first[LEVELS], count[LEVELS];
+    double error[LEVELS];          /* certified error of each level, mesh units */
+    float color[4];
+    uint32_t has_tex;
+} geo_mesh;
+
+typedef struct geo_rec {
+    int32_t node, mesh;
+    uint32_t key;                  /* rank(mesh) * LEVELS + level */
+} geo_rec;
+
+struct mr_geo {
+    GLuint vao[2], vbo[2], ibo;
+    GLuint inst_buf;               /* instance records (per-instance attributes) */
+    uint32_t inst_cap;
+    GLuint cmd_buf;
+    geo_mesh *meshes;
+    int32_t mesh_count;
+    int32_t *rank;                 /* mesh -> position in group order */
+    int32_t *by_rank;              /* position -> mesh */
+    int32_t group_count;
+    double *node_scale;            /* upper bound of each node's linear stretch */
+    mr_bvh *bvh;
+    const mr_lod *lod;
+    size_t max_recs;               /* (node, mesh) pairs over all nodes */
+    uint32_t drawable[MR_LAYER_COUNT]; /* nodes that draw something, per layer */
+    /* per-draw scratch, sized at upload */
+    int32_t *visible;
+    geo_rec *recs, *sorted;
+    uint32_t *key_count;           /* mesh_count * LEVELS + 1 */
+    gpu_instance *inst;
+    draw_cmd *cmds;
+    int32_t *group_first, *group_cmds;
+    /* occlusion culling scratch */
+    int32_t *occ_rest;
+    float *depth, *hz;
+    size_t depth_cap, hz_cap, hz_off[24];
+    int hz_w[24], hz_h[24];
+};
+
+/* ------------------------------------------------------------- params */
+
+bool mr_renderer_set_draw_params(mr_renderer *r, const mr_draw_params *params, mr_error *err) {
+    if (!r) return mr_fail(err, MR_ERR_INVALID, "no renderer");
+    mr_draw_params d = MR_DRAW_DEFAULTS;
+    if (params) d = *params;
+    if (!isfinite(d.lod_tolerance) || !isfinite(d.lod_pixels) || d.lod_pixels < 0)
+        return mr_fail(err, MR_ERR_INVALID, "LOD tolerance and pixel error must be finite, pixels >= 0");
+    r->draw = d;
+    return true;
 }
 
+void mr_renderer_draw_stats(const mr_renderer *r, mr_draw_stats *out) {
+    if (!out) return;
+    if (!r) {
+        memset(out, 0, sizeof *out);
+        return;
+    }
+    *out = r->stats;
+}
+
+void mr_geometry_begin_frame(mr_renderer *r) { memset(&r->stats, 0, sizeof r->stats); }
+
+/* ------------------------------------------------------------- upload */
 
 void mr_geometry_free(mr_renderer *r) {
-    for (int32_t i = 0; i < r->mesh_count; i++) {
-        glDeleteVertexArrays(1, &r->meshes[i].vao);
-        glDeleteBuffers(3, r->meshes[i].vbo);
-        glDeleteBuffers(1, &r->meshes[i].ibo);
+    struct mr_geo *g = r->geo;
+    if (g) {
+        glDeleteVertexArrays(2, g->vao);
+        glDeleteBuffers(2, g->vbo);
+        glDeleteBuffers(1, &g->ibo);
+        glDeleteBuffers(1, &g->inst_buf);
+        glDeleteBuffers(1, &g->cmd_buf);
+        free(g->meshes);
+        free(g->rank);
+        free(g->by_rank);
+        free(g->node_scale);
+        mr_bvh_destroy(&g->bvh);
+        free(g->visible);
+        free(g->recs);
+        free(g->sorted);
+        free(g->key_count);
+        free(g->inst);
+        free(g->cmds);
+        free(g->group_first);
+        free(g->group_cmds);
+        free(g->occ_rest);
+        free(g->depth);
+        free(g->hz);
+        free(g);
+        r->geo = NULL;
     }
-    free(r->meshes);
-    r->meshes = NULL;
-    r->mesh_count = 0;
     if (r->textures) glDeleteTextures(r->texture_count, r->textures);
     free(r->textures);
     r->textures = NULL;
@@ -29,48 +144,33 @@ void mr_geometry_free(mr_renderer *r) {
     r->scene = NULL;
 }
 
+/* Upper bound of the largest singular value of the node's 3x3: the square
+ * root of Gershgorin's bound on the largest eigenvalue of M^T M. Exact for
+ * rotations and (rotated) axis scales, conservative for shears; LOD errors
+ * in mesh units are multiplied by it. */
+static double stretch_bound(const mr_dmat4 *w) {
+    double mtm[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double acc = 0;
+            for (int k = 0; k < 3; k++) acc += w->m[k * 4 + i] * w->m[k * 4 + j];
+            mtm[i][j] = acc;
+        }
+    double best = 0;
+    for (int i = 0; i < 3; i++) {
+        double row = fabs(mtm[i][0]) + fabs(mtm[i][1]) + fabs(mtm[i][2]);
+        if (row > best) best = row;
+    }
+    return sqrt(best);
+}
 
-bool mr_geometry_upload(mr_renderer *r, const mr_scene *s, mr_error *err) {
-    r->meshes = calloc((size_t)s->mesh_count + 1, sizeof *r->meshes);
+static bool upload_textures(mr_renderer *r, const mr_scene *s, mr_error *err) {
     r->textures = calloc((size_t)s->texture_count + 1, sizeof *r->textures);
-    if (!r->meshes || !r->textures) {
-        mr_geometry_free(r);
-        return mr_fail(err, MR_ERR_NOMEM, "out of memory uploading the scene");
-    }
-    /* UVs are uploaded only for meshes whose material samples a texture. */
-    for (int32_t i = 0; i < s->mesh_count; i++) {
-        const mr_mesh *m = &s->meshes[i];
-        gl_mesh *g = &r->meshes[i];
-        bool textured = m->uvs && m->material >= 0 && m->material < s->material_count &&
-                        s->materials[m->material].base_color_texture >= 0;
-        glCreateVertexArrays(1, &g->vao);
-        g->vbo[0] = upload_buffer(m->positions, (size_t)m->vertex_count * 12);
-        g->vbo[1] = upload_buffer(m->normals, (size_t)m->vertex_count * 12);
-        glVertexArrayVertexBuffer(g->vao, 0, g->vbo[0], 0, 12);
-        glVertexArrayVertexBuffer(g->vao, 1, g->vbo[1], 0, 12);
-        for (GLuint a = 0; a < 2; a++) {
-            glEnableVertexArrayAttrib(g->vao, a);
-            glVertexArrayAttribFormat(g->vao, a, 3, GL_FLOAT, GL_FALSE, 0);
-            glVertexArrayAttribBinding(g->vao, a, a);
-        }
-        if (textured) {
-            g->vbo[2] = upload_buffer(m->uvs, (size_t)m->vertex_count * 8);
-            glVertexArrayVertexBuffer(g->vao, 2, g->vbo[2], 0, 8);
-            glEnableVertexArrayAttrib(g->vao, 2);
-            glVertexArrayAttribFormat(g->vao, 2, 2, GL_FLOAT, GL_FALSE, 0);
-            glVertexArrayAttribBinding(g->vao, 2, 2);
-        }
-        g->ibo = upload_buffer(m->indices, (size_t)m->index_count * 4);
-        glVertexArrayElementBuffer(g->vao, g->ibo);
-        g->index_count = m->index_count;
-    }
-    r->mesh_count = s->mesh_count;
+    if (!r->textures) return mr_fail(err, MR_ERR_NOMEM, "out of memory uploading textures");
     for (int32_t i = 0; i < s->texture_count; i++) {
         const mr_texture *t = &s->textures[i];
-        if (!t->image.data || t->image.channels != 4 || t->image.type != MR_PIX_U8) {
-            mr_geometry_free(r);
+        if (!t->image.data || t->image.channels != 4 || t->image.type != MR_PIX_U8)
             return mr_fail(err, MR_ERR_INVALID, "texture %d is not RGBA8", (int)i);
-        }
         int w = t->image.width, h = t->image.height, levels = 1;
         while ((w >> levels) > 0 || (h >> levels) > 0) levels++;
         GLuint tex;
@@ -82,66 +182,675 @@ bool mr_geometry_upload(mr_renderer *r, const mr_scene *s, mr_error *err) {
         glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
         glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, t->nearest ? GL_NEAREST : GL_LINEAR);
         r->textures[i] = tex;
-    }
-    r->texture_count = s->texture_count;
-    r->scene = s;
-    GLenum e = glGetError();
-    if (e != GL_NO_ERROR) {
-        mr_geometry_free(r);
-        return mr_fail(err, MR_ERR_GL, "GL error 0x%x while uploading the scene", e);
+        r->texture_count = i + 1;
     }
     return true;
 }
 
+/* Makes the instance buffer hold at least `need` records; the VAOs keep
+ * pointing at it (binding 1). */
+static bool ensure_instances(struct mr_geo *g, uint32_t need) {
+    if (need <= g->inst_cap && g->inst_buf) return true;
+    uint32_t cap = g->inst_cap ? g->inst_cap : 1024;
+    while (cap < need) cap *= 2;
+    glDeleteBuffers(1, &g->inst_buf);
+    glCreateBuffers(1, &g->inst_buf);
+    glNamedBufferStorage(g->inst_buf, (GLsizeiptr)cap * (GLsizeiptr)sizeof(gpu_instance), NULL, GL_DYNAMIC_STORAGE_BIT);
+    g->inst_cap = cap;
+    for (int p = 0; p < 2; p++) glVertexArrayVertexBuffer(g->vao[p], 1, g->inst_buf, 0, sizeof(gpu_instance));
+    return glGetError() == GL_NO_ERROR;
+}
 
-void mr_geometry_draw(frame *f, uint32_t layer_mask) {
+static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_error *err) {
+    if (lod && lod->mesh_count != s->mesh_count) lod = NULL;
+    if (!upload_textures(r, s, err)) return false;
+    struct mr_geo *g = calloc(1, sizeof *g);
+    if (!g) return mr_fail(err, MR_ERR_NOMEM, "out of memory uploading the scene");
+    r->geo = g;
+    g->lod = lod;
+    size_t nm = (size_t)s->mesh_count, nn = (size_t)s->node_count;
+    g->mesh_count = s->mesh_count;
+    g->meshes = calloc(nm + 1, sizeof *g->meshes);
+    g->rank = calloc(nm + 1, sizeof *g->rank);
+    g->by_rank = calloc(nm + 1, sizeof *g->by_rank);
+    g->node_scale = calloc(nn + 1, sizeof *g->node_scale);
+    g->group_count = 1 + s->texture_count;
+    g->group_first = calloc((size_t)g->group_count, sizeof *g->group_first);
+    g->group_cmds = calloc((size_t)g->group_count, sizeof *g->group_cmds);
+    if (!g->meshes || !g->rank || !g->by_rank || !g->node_scale || !g->group_first || !g->group_cmds)
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory uploading the scene");
+
+    /* Layout, group and place of each mesh in the shared buffers. */
+    uint64_t verts[2] = {0, 0}, indices = 0;
+    for (size_t i = 0; i < nm; i++) {
+        const mr_mesh *m = &s->meshes[i];
+        geo_mesh *gm = &g->meshes[i];
+        const mr_material *mat = m->material >= 0 && m->material < s->material_count ? &s->materials[m->material] : NULL;
+        bool textured = m->uvs && mat && mat->base_color_texture >= 0 && mat->base_color_texture < r->texture_count;
+        gm->pool = textured ? 1 : 0;
+        gm->group = textured ? 1 + mat->base_color_texture : 0;
+        gm->has_tex = textured;
+        static const float grey[4] = {0.7f, 0.7f, 0.7f, 1.0f};
+        memcpy(gm->color, mat ? mat->base_color : grey, sizeof gm->color);
+        gm->base_vertex = (int32_t)verts[gm->pool];
+        verts[gm->pool] += m->vertex_count;
+        gm->level_count = 1;
+        gm->first[0] = (uint32_t)indices;
+        gm->count[0] = m->index_count;
+        gm->error[0] = 0;
+        indices += m->index_count;
+        const mr_mesh_lods *ml = lod ? &lod->meshes[i] : NULL;
+        for (int32_t k = 0; ml && k < ml->level_count && k < MR_LOD_MAX_LEVELS; k++) {
+            if (!ml->levels[k].indices || ml->levels[k].index_count == 0) continue;
+            int32_t l = gm->level_count++;
+            gm->first[l] = (uint32_t)indices;
+            gm->count[l] = ml->levels[k].index_count;
+            gm->error[l] = ml->levels[k].error;
+            indices += ml->levels[k].index_count;
+        }
+        if (verts[0] > INT32_MAX || verts[1] > INT32_MAX || indices > UINT32_MAX / 4)
+            return mr_fail(err, MR_ERR_NOMEM, "scene too large for one upload (%llu vertices, %llu indices)",
+                           (unsigned long long)(verts[0] + verts[1]), (unsigned long long)indices);
+    }
+    /* Meshes in group order, so that a group's commands are contiguous. */
+    {
+        int32_t pos = 0;
+        for (int32_t grp = 0; grp < g->group_count; grp++)
+            for (size_t i = 0; i < nm; i++)
+                if (g->meshes[i].group == grp) {
+                    g->rank[i] = pos;
+                    g->by_rank[pos++] = (int32_t)i;
+                }
+    }
+
+    /* The shared buffers, filled mesh by mesh (no scene-sized staging copy). */
+    static const GLsizei stride[2] = {24, 32};
+    for (int p = 0; p < 2; p++) {
+        glCreateVertexArrays(1, &g->vao[p]);
+        glCreateBuffers(1, &g->vbo[p]);
+        glNamedBufferStorage(g->vbo[p], (GLsizeiptr)(verts[p] ? verts[p] : 1) * stride[p], NULL, GL_DYNAMIC_STORAGE_BIT);
+        glVertexArrayVertexBuffer(g->vao[p], 0, g->vbo[p], 0, stride[p]);
+        glEnableVertexArrayAttrib(g->vao[p], 0);
+        glVertexArrayAttribFormat(g->vao[p], 0, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(g->vao[p], 0, 0);
+        glEnableVertexArrayAttrib(g->vao[p], 1);
+        glVertexArrayAttribFormat(g->vao[p], 1, 3, GL_FLOAT, GL_FALSE, 12);
+        glVertexArrayAttribBinding(g->vao[p], 1, 0);
+        if (p == 1) {
+            glEnableVertexArrayAttrib(g->vao[p], 2);
+            glVertexArrayAttribFormat(g->vao[p], 2, 2, GL_FLOAT, GL_FALSE, 24);
+            glVertexArrayAttribBinding(g->vao[p], 2, 0);
+        }
+        /* Attributes 3..11: the instance record, one per instance (divisor
+         * 1); the command's baseInstance offsets into it, so this works on
+         * plain GL 4.5 (no gl_BaseInstance needed), and llvmpipe fetches
+         * attributes much faster than it loads from an SSBO per vertex. */
+        for (GLuint a = 0; a < 9; a++) {
+            glEnableVertexArrayAttrib(g->vao[p], 3 + a);
+            if (a == 8) glVertexArrayAttribIFormat(g->vao[p], 3 + a, 4, GL_UNSIGNED_INT, (GLuint)offsetof(gpu_instance, ids));
+            else glVertexArrayAttribFormat(g->vao[p], 3 + a, 4, GL_FLOAT, GL_FALSE, a * 16);
+            glVertexArrayAttribBinding(g->vao[p], 3 + a, 1);
+        }
+        glVertexArrayBindingDivisor(g->vao[p], 1, 1);
+    }
+    glCreateBuffers(1, &g->ibo);
+    glNamedBufferStorage(g->ibo, (GLsizeiptr)(indices ? indices : 1) * 4, NULL, GL_DYNAMIC_STORAGE_BIT);
+    for (int p = 0; p < 2; p++) glVertexArrayElementBuffer(g->vao[p], g->ibo);
+    float *tmp = NULL;
+    size_t tmp_cap = 0;
+    for (size_t i = 0; i < nm; i++) {
+        const mr_mesh *m = &s->meshes[i];
+        const geo_mesh *gm = &g->meshes[i];
+        size_t fl = gm->pool ? 8 : 6, need = (size_t)m->vertex_count * fl;
+        if (need > tmp_cap) {
+            float *t = realloc(tmp, need * sizeof *t);
+            if (!t) {
+                free(tmp);
+                return mr_fail(err, MR_ERR_NOMEM, "out of memory uploading mesh '%s'", m->name);
+            }
+            tmp = t;
+            tmp_cap = need;
+        }
+        for (size_t v = 0; v < m->vertex_count; v++) {
+            float *d = tmp + v * fl;
+            memcpy(d, m->positions + 3 * v, 12);
+            memcpy(d + 3, m->normals + 3 * v, 12);
+            if (gm->pool) memcpy(d + 6, m->uvs + 2 * v, 8);
+        }
+        if (m->vertex_count)
+            glNamedBufferSubData(g->vbo[gm->pool], (GLintptr)gm->base_vertex * stride[gm->pool],
+                                 (GLsizeiptr)(need * sizeof *tmp), tmp);
+        if (m->index_count) glNamedBufferSubData(g->ibo, (GLintptr)gm->first[0] * 4, (GLsizeiptr)m->index_count * 4, m->indices);
+        const mr_mesh_lods *ml = lod ? &lod->meshes[i] : NULL;
+        for (int32_t k = 0, l = 1; ml && k < ml->level_count && k < MR_LOD_MAX_LEVELS; k++) {
+            if (!ml->levels[k].indices || ml->levels[k].index_count == 0) continue;
+            glNamedBufferSubData(g->ibo, (GLintptr)gm->first[l] * 4, (GLsizeiptr)gm->count[l] * 4, ml->levels[k].indices);
+            l++;
+        }
+    }
+    free(tmp);
+
+    /* Per node: stretch bound; count of (node, mesh) pairs for scratch. */
+    size_t recs = 0;
+    for (size_t i = 0; i < nn; i++) {
+        const mr_node *n = &s->nodes[i];
+        g->node_scale[i] = stretch_bound(&n->world);
+        double lo[3], hi[3];
+        if (n->layer < MR_LAYER_COUNT && mr_scene_node_bounds(s, (int32_t)i, lo, hi)) g->drawable[n->layer]++;
+        if (n->mesh_first >= 0 && n->mesh_count > 0 && n->mesh_first < s->mesh_count) {
+            int32_t c = n->mesh_count;
+            if (c > s->mesh_count - n->mesh_first) c = s->mesh_count - n->mesh_first;
+            recs += (size_t)c;
+        }
+    }
+    g->max_recs = recs;
+    g->bvh = mr_bvh_build(s, err);
+    if (!g->bvh) return false;
+    g->visible = malloc((nn + 1) * sizeof *g->visible);
+    g->occ_rest = malloc((nn + 1) * sizeof *g->occ_rest);
+    g->recs = malloc((recs + 1) * sizeof *g->recs);
+    g->sorted = malloc((recs + 1) * sizeof *g->sorted);
+    g->key_count = malloc((nm * LEVELS + 1) * sizeof *g->key_count);
+    g->inst = malloc((recs + 1) * sizeof *g->inst);
+    g->cmds = malloc((recs + 1) * sizeof *g->cmds);
+    if (!g->visible || !g->occ_rest || !g->recs || !g->sorted || !g->key_count || !g->inst || !g->cmds)
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory for %zu mesh instances", recs);
+    glCreateBuffers(1, &g->cmd_buf);
+    ensure_instances(g, 1024);
+    r->scene = s;
+    GLenum e = glGetError();
+    if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x while uploading the scene", e);
+    return true;
+}
+
+bool mr_geometry_upload(mr_renderer *r, const mr_scene *s, mr_error *err) {
+    if (!upload(r, s, NULL, err)) {
+        mr_geometry_free(r);
+        return false;
+    }
+    return true;
+}
+
+bool mr_renderer_set_lod(mr_renderer *r, const mr_lod *lod, mr_error *err) {
+    if (!r) return mr_fail(err, MR_ERR_INVALID, "no renderer");
+    const mr_scene *s = r->scene;
+    if (!s) return lod ? mr_fail(err, MR_ERR_INVALID, "set a scene before its LOD levels") : true;
+    if (lod && lod->mesh_count != s->mesh_count)
+        return mr_fail(err, MR_ERR_INVALID, "LOD levels are for %d meshes, the scene has %d", lod->mesh_count, s->mesh_count);
+    mr_geometry_free(r);
+    if (!upload(r, s, lod, err)) {
+        mr_geometry_free(r);
+        return false;
+    }
+    return true;
+}
+
+/* --------------------------------------------------------------- draw */
+
+/* Projected-error factor for a node box: pixels per scene unit of error at
+ * the box's nearest depth. A displacement e at depth z moves the image point
+ * by at most f e sqrt(1 + t^2) / z, where t bounds |(x, y) / z| inside the
+ * view. Returns INFINITY where the box reaches the near plane. */
+static double pixels_per_unit(const frame *f, const double *bb, double fmax_t) {
+    const double *M = f->cam_from_world.m;
+    double c = M[11], e = 0;
+    for (int k = 0; k < 3; k++) {
+        double mid = 0.5 * bb[k] + 0.5 * bb[3 + k], half = 0.5 * bb[3 + k] - 0.5 * bb[k];
+        c += M[8 + k] * mid;
+        e += fabs(M[8 + k]) * half;
+    }
+    double zmin = c - e;
+    if (!(zmin > f->near_plane)) return INFINITY;
+    return fmax_t / zmin;
+}
+
+static int choose_level(const geo_mesh *gm, double scale, double ppu, double tol, double pix) {
+    int best = 0;
+    for (int l = 1; l < gm->level_count; l++) {
+        double e = gm->error[l] * scale; /* scene units */
+        if (!(e <= tol)) break;          /* never beyond the tolerance: errors increase */
+        if (!(e * ppu <= pix)) break;
+        best = l;
+    }
+    return best;
+}
+
+/* Camera-relative model-view of one instance, in double, then float. */
+static bool fill_instance(const frame *f, const mr_node *n, const mr_mesh *m, const geo_mesh *gm, int32_t node,
+                          gpu_instance *out) {
+    mr_dmat4 cn = mr_m4_mul(&f->cam_from_world, &n->world);
+    mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
+    mr_dmat4 mv = mr_m4_mul(&cn, &T);
+    const double *a = mv.m;
+    /* Cofactors of the 3x3 = det * inverse transpose; normals are
+     * renormalised in the shader, the sign keeps det's orientation. */
+    double c00 = a[5] * a[10] - a[6] * a[9], c01 = a[6] * a[8] - a[4] * a[10], c02 = a[4] * a[9] - a[5] * a[8];
+    double c10 = a[2] * a[9] - a[1] * a[10], c11 = a[0] * a[10] - a[2] * a[8], c12 = a[1] * a[8] - a[0] * a[9];
+    double c20 = a[1] * a[6] - a[2] * a[5], c21 = a[2] * a[4] - a[0] * a[6], c22 = a[0] * a[5] - a[1] * a[4];
+    double det = a[0] * c00 + a[1] * c01 + a[2] * c02, mx = 0;
+    for (int k = 0; k < 12; k++)
+        if (k % 4 != 3 && fabs(a[k]) > mx) mx = fabs(a[k]);
+    if (!(fabs(det) > 1e-14 * mx * mx * mx) || !isfinite(det)) return false; /* degenerate: nothing to draw */
+    mr_m4_to_gl(&mv, out->modelview);
+    double inv = 1.0 / det;
+    /* Column j of the normal matrix = row j of the cofactor matrix / det
+     * transposed: N = (A^-1)^T = C / det with C[i][j] = cofactor(i, j). */
+    const double C[3][3] = {{c00, c01, c02}, {c10, c11, c12}, {c20, c21, c22}};
+    for (int col = 0; col < 3; col++) {
+        for (int row = 0; row < 3; row++) out->normal[col * 4 + row] = (float)(C[row][col] * inv);
+        out->normal[col * 4 + 3] = 0;
+    }
+    memcpy(out->color, gm->color, sizeof out->color);
+    out->ids[0] = (uint32_t)node + 1;
+    out->ids[1] = n->layer;
+    out->ids[2] = gm->has_tex;
+    out->ids[3] = 0;
+    return true;
+}
+
+/* Steps 2-4 for a list of visible nodes: LOD choice, bucketing, instance
+ * records and commands, submission. Adds to the frame's statistics. */
+static void submit_nodes(frame *f, const int32_t *nodes, int32_t nvis) {
     mr_renderer *r = f->r;
     const mr_scene *s = r->scene;
-    if (!s) return;
+    struct mr_geo *g = r->geo;
+    const mr_draw_params *dp = &r->draw;
+    double t0 = mr_time_now();
+
+    /* 2. LOD choice and bucketing of (node, mesh) pairs. */
+    double tol = dp->lod_tolerance == 0 ? 0.005 : dp->lod_tolerance;
+    double pix = dp->lod_pixels == 0 ? 1.0 : dp->lod_pixels;
+    bool use_lod = g->lod && !dp->no_lod && tol > 0;
+    double fmax_t = 0;
+    if (use_lod) {
+        /* Largest |x/z|, |y/z| over the image corners (with the margin). */
+        double ax = fmax(fabs((-1.5 - f->cam.cx) / f->cam.fx), fabs((f->cam.width + 0.5 - f->cam.cx) / f->cam.fx));
+        double ay = fmax(fabs((-1.5 - f->cam.cy) / f->cam.fy), fabs((f->cam.height + 0.5 - f->cam.cy) / f->cam.fy));
+        fmax_t = fmax(f->cam.fx, f->cam.fy) * sqrt(1 + ax * ax + ay * ay);
+    }
+    size_t nkeys = (size_t)g->mesh_count * LEVELS;
+    memset(g->key_count, 0, (nkeys + 1) * sizeof *g->key_count);
+    size_t nrec = 0;
+    uint64_t tri_full = 0;
+    uint32_t lod_inst = 0;
+    for (int32_t vi = 0; vi < nvis; vi++) {
+        int32_t ni = nodes[vi];
+        const mr_node *n = &s->nodes[ni];
+        int32_t last = n->mesh_first + n->mesh_count;
+        if (last > g->mesh_count) last = g->mesh_count;
+        double ppu = use_lod ? pixels_per_unit(f, mr_bvh_bounds(g->bvh, ni), fmax_t) : INFINITY;
+        for (int32_t mi = n->mesh_first; mi < last; mi++) {
+            const geo_mesh *gm = &g->meshes[mi];
+            if (gm->count[0] == 0) continue;
+            int level = use_lod && gm->level_count > 1 && isfinite(ppu) ? choose_level(gm, g->node_scale[ni], ppu, tol, pix) : 0;
+            lod_inst += level > 0;
+            if (level > 0 && gm->error[level] * g->node_scale[ni] > r->stats.lod_max_error)
+                r->stats.lod_max_error = gm->error[level] * g->node_scale[ni];
+            tri_full += gm->count[0] / 3;
+            uint32_t key = (uint32_t)g->rank[mi] * LEVELS + (uint32_t)level;
+            g->recs[nrec++] = (geo_rec){ni, mi, key};
+            g->key_count[key]++;
+        }
+    }
+    /* Counting sort by key: stable, so instances keep node order. */
+    uint32_t sum = 0;
+    for (size_t k = 0; k < nkeys; k++) {
+        uint32_t c = g->key_count[k];
+        g->key_count[k] = sum;
+        sum += c;
+    }
+    for (size_t i = 0; i < nrec; i++) g->sorted[g->key_count[g->recs[i].key]++] = g->recs[i];
+
+    /* 3. Instance data and commands, one per bucket (or per instance). */
+    uint32_t ninst = 0, ncmd = 0, last_key = UINT32_MAX;
+    uint64_t tris = 0;
+    memset(g->group_cmds, 0, (size_t)g->group_count * sizeof *g->group_cmds);
+    for (int32_t k = 0; k < g->group_count; k++) g->group_first[k] = -1;
+    for (size_t i = 0; i < nrec; i++) {
+        const geo_rec *rc = &g->sorted[i];
+        const geo_mesh *gm = &g->meshes[rc->mesh];
+        if (!fill_instance(f, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, rc->node, &g->inst[ninst])) continue;
+        int level = (int)(rc->key % LEVELS);
+        /* Same bucket as the last command (records skipped as degenerate
+         * leave no gap: the command's instances stay contiguous). */
+        bool extend = !dp->no_instancing && ncmd > 0 && last_key == rc->key;
+        last_key = rc->key;
+        if (extend) {
+            g->cmds[ncmd - 1].instance_count++;
+        } else {
+            g->cmds[ncmd] = (draw_cmd){gm->count[level], 1, gm->first[level], gm->base_vertex, ninst};
+            if (g->group_first[gm->group] < 0) g->group_first[gm->group] = (int32_t)ncmd;
+            g->group_cmds[gm->group]++;
+            ncmd++;
+        }
+        tris += gm->count[level] / 3;
+        ninst++;
+    }
+    bool have_room = ensure_instances(g, ninst);
+    r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
+    r->stats.instances += ninst;
+    r->stats.commands += ncmd;
+    r->stats.triangles += tris;
+    r->stats.triangles_full += tri_full;
+    r->stats.lod_instances += lod_inst;
+    if (ninst == 0 || !have_room) return; /* nothing to draw costs nothing */
+
+    /* 4. Submission. */
+    glNamedBufferSubData(g->inst_buf, 0, (GLsizeiptr)ninst * (GLsizeiptr)sizeof(gpu_instance), g->inst);
+    glNamedBufferData(g->cmd_buf, (GLsizeiptr)ncmd * (GLsizeiptr)sizeof(draw_cmd), g->cmds, GL_STREAM_DRAW);
     glUseProgram(r->prog_gbuffer);
     float proj[16];
     mr_gl_projection(&f->cam, f->near_plane, proj);
     glUniformMatrix4fv(2, 1, GL_FALSE, proj);
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, g->cmd_buf);
+    uint32_t calls = 0;
+    for (int32_t grp = 0; grp < g->group_count; grp++) {
+        int32_t first = g->group_first[grp], count = g->group_cmds[grp];
+        if (first < 0 || count == 0) continue;
+        glBindVertexArray(g->vao[grp > 0 ? 1 : 0]);
+        if (grp > 0) glBindTextureUnit(0, r->textures[grp - 1]);
+        if (!dp->no_batch) {
+            glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, (const void *)((size_t)first * sizeof(draw_cmd)),
+                                        count, 0);
+            calls++;
+        } else {
+            for (int32_t c = first; c < first + count; c++) {
+                const draw_cmd *dc = &g->cmds[c];
+                glDrawElementsInstancedBaseVertexBaseInstance(GL_TRIANGLES, (GLsizei)dc->count, GL_UNSIGNED_INT,
+                                                              (const void *)((size_t)dc->first_index * 4),
+                                                              (GLsizei)dc->instance_count, dc->base_vertex,
+                                                              dc->base_instance);
+                calls++;
+            }
+        }
+    }
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+    glBindVertexArray(0);
+    r->stats.gl_draw_calls += calls;
+    f->out->triangles += tris;
+    f->out->draw_calls += calls;
+}
+
+/* ---------------------------------------------------- occlusion culling
+ *
+ * Within the frame, so it is exact and needs no previous frame: the nodes
+ * whose boxes cover a good part of the image (floors, walls, big machines)
+ * are drawn first; their depth is read back and reduced to a pyramid of the
+ * farthest depth per tile (reversed Z: the smallest value); every other
+ * visible node whose box lies wholly behind that depth over the tiles its
+ * projection touches is skipped. The tiles cover the box's pixels and the
+ * box encloses the geometry, so no visible node is dropped: the image is
+ * the same with and without (the tests check it). The read-back is a sync
+ * point: a win when much is hidden (a hall seen from its floor), a cost in
+ * open views, hence behind a flag. */
+
+#define HZ_TILE 8
+
+static bool box_screen(const frame *f, const double *bb, double rect[4], double *near_depth) {
+    const double *M = f->cam_from_world.m;
+    double zmin = INFINITY;
+    rect[0] = rect[1] = INFINITY;
+    rect[2] = rect[3] = -INFINITY;
+    for (int c = 0; c < 8; c++) {
+        double p[3] = {(c & 1) ? bb[3] : bb[0], (c & 2) ? bb[4] : bb[1], (c & 4) ? bb[5] : bb[2]};
+        double x = M[0] * p[0] + M[1] * p[1] + M[2] * p[2] + M[3];
+        double y = M[4] * p[0] + M[5] * p[1] + M[6] * p[2] + M[7];
+        double z = M[8] * p[0] + M[9] * p[1] + M[10] * p[2] + M[11];
+        if (!(z > f->near_plane)) return false; /* reaches the camera: cannot be tested */
+        double u = f->cam.fx * x / z + f->cam.cx, v = f->cam.fy * y / z + f->cam.cy;
+        rect[0] = fmin(rect[0], u);
+        rect[1] = fmin(rect[1], v);
+        rect[2] = fmax(rect[2], u);
+        rect[3] = fmax(rect[3], v);
+        zmin = fmin(zmin, z);
+    }
+    *near_depth = f->near_plane / zmin; /* reversed Z: the box's nearest depth */
+    return true;
+}
+
+/* Level 0: the farthest (smallest) depth per HZ_TILE^2 tile; level k+1
+ * halves each side. Returns the level count (0 if out of memory). */
+static int build_pyramid(struct mr_geo *g, const float *depth, int w, int h) {
+    int tw = (w + HZ_TILE - 1) / HZ_TILE, th = (h + HZ_TILE - 1) / HZ_TILE;
+    size_t need = 0;
+    for (int lw = tw, lh = th;; lw = (lw + 1) / 2, lh = (lh + 1) / 2) {
+        need += (size_t)lw * lh;
+        if (lw == 1 && lh == 1) break;
+    }
+    if (need > g->hz_cap) {
+        float *p = realloc(g->hz, need * sizeof *p);
+        if (!p) return 0;
+        g->hz = p;
+        g->hz_cap = need;
+    }
+    float *lvl = g->hz;
+    for (int ty = 0; ty < th; ty++)
+        for (int tx = 0; tx < tw; tx++) {
+            float m = INFINITY;
+            for (int y = ty * HZ_TILE; y < ty * HZ_TILE + HZ_TILE && y < h; y++)
+                for (int x = tx * HZ_TILE; x < tx * HZ_TILE + HZ_TILE && x < w; x++) m = fminf(m, depth[(size_t)y * w + x]);
+            lvl[(size_t)ty * tw + tx] = m;
+        }
+    int levels = 1;
+    g->hz_w[0] = tw;
+    g->hz_h[0] = th;
+    g->hz_off[0] = 0;
+    size_t off = (size_t)tw * th;
+    while ((tw > 1 || th > 1) && levels < 24) {
+        int nw = (tw + 1) / 2, nh = (th + 1) / 2;
+        const float *src = g->hz + g->hz_off[levels - 1];
+        float *dst = g->hz + off;
+        for (int y = 0; y < nh; y++)
+            for (int x = 0; x < nw; x++) {
+                float m = INFINITY;
+                for (int dy = 0; dy < 2; dy++)
+                    for (int dx = 0; dx < 2; dx++) {
+                        int sx = 2 * x + dx, sy = 2 * y + dy;
+                        if (sx < tw && sy < th) m = fminf(m, src[(size_t)sy * tw + sx]);
+                    }
+                dst[(size_t)y * nw + x] = m;
+            }
+        g->hz_off[levels] = off;
+        g->hz_w[levels] = nw;
+        g->hz_h[levels] = nh;
+        off += (size_t)nw * nh;
+        tw = nw;
+        th = nh;
+        levels++;
+    }
+    return levels;
+}
+
+static bool occluded(const struct mr_geo *g, int levels, const double rect[4], double near_depth, int w, int h) {
+    /* Pixels the projection can touch (pixel centres at integers), widened
+     * by a pixel for rasterisation rounding. */
+    double x0 = floor(rect[0] - 1), y0 = floor(rect[1] - 1), x1 = ceil(rect[2] + 1), y1 = ceil(rect[3] + 1);
+    if (x1 < 0 || y1 < 0 || x0 > w - 1 || y0 > h - 1) return false; /* the frustum's business */
+    x0 = fmax(x0, 0);
+    y0 = fmax(y0, 0);
+    x1 = fmin(x1, w - 1);
+    y1 = fmin(y1, h - 1);
+    int tx0 = (int)x0 / HZ_TILE, ty0 = (int)y0 / HZ_TILE, tx1 = (int)x1 / HZ_TILE, ty1 = (int)y1 / HZ_TILE;
+    int lv = 0;
+    while (lv + 1 < levels && (tx1 - tx0 > 3 || ty1 - ty0 > 3)) {
+        tx0 >>= 1;
+        ty0 >>= 1;
+        tx1 >>= 1;
+        ty1 >>= 1;
+        lv++;
+    }
+    const float *t = g->hz + g->hz_off[lv];
+    for (int y = ty0; y <= ty1 && y < g->hz_h[lv]; y++)
+        for (int x = tx0; x <= tx1 && x < g->hz_w[lv]; x++)
+            if (!(near_depth < (double)t[(size_t)y * g->hz_w[lv] + x])) return false;
+    return true;
+}
+
+void mr_geometry_draw(frame *f, uint32_t layer_mask) {
+    mr_renderer *r = f->r;
+    const mr_scene *s = r->scene;
+    struct mr_geo *g = r->geo;
+    if (!s || !g) return;
+    const mr_draw_params *dp = &r->draw;
+    double t0 = mr_time_now();
+
+    /* 1. Frustum culling. */
+    mr_frustum fr = mr_frustum_from_camera(&f->cam, &f->view->world_from_camera, f->near_plane, 1.0);
+    mr_bvh_stats bst;
+    int32_t nvis = mr_bvh_cull(g->bvh, dp->no_cull ? NULL : &fr, layer_mask, g->visible, &bst);
+    uint32_t ndrawable = 0;
+    for (int l = 0; l < MR_LAYER_COUNT; l++)
+        if (layer_mask & (1u << l)) ndrawable += g->drawable[l];
+    r->stats.nodes_drawable += ndrawable;
+    r->stats.nodes_visible += (uint32_t)nvis;
+    r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
+    GLint vp[4];
+    glGetIntegerv(GL_VIEWPORT, vp);
+    int w = vp[2], h = vp[3];
+    /* Occlusion needs a depth buffer that this draw tests and writes with
+     * reversed Z (a pass drawing without depth, e.g. an x-ray view of the
+     * hidden layer, gets plain frustum culling). */
+    bool depth_ok = false;
+    if (dp->occlusion && !dp->no_cull && nvis >= 64 && w == f->cam.width && h == f->cam.height) {
+        GLint fbo = 0, type = GL_NONE, func = 0;
+        GLboolean mask = GL_FALSE;
+        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fbo);
+        if (fbo != 0)
+            glGetNamedFramebufferAttachmentParameteriv((GLuint)fbo, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+        glGetIntegerv(GL_DEPTH_FUNC, &func);
+        glGetBooleanv(GL_DEPTH_WRITEMASK, &mask);
+        depth_ok = fbo != 0 && type != GL_NONE && glIsEnabled(GL_DEPTH_TEST) && mask &&
+                   (func == GL_GREATER || func == GL_GEQUAL);
+    }
+    if (!depth_ok) {
+        submit_nodes(f, g->visible, nvis);
+        return;
+    }
+
+    /* 2. Occluders first: boxes covering at least 1/256 of the image (or
+     * reaching the camera). */
+    t0 = mr_time_now();
+    int32_t nocc = 0, nrest = 0;
+    int32_t *rest = g->occ_rest;
+    double min_area = (double)w * h / 256.0;
+    for (int32_t i = 0; i < nvis; i++) {
+        double rect[4], nd;
+        const double *bb = mr_bvh_bounds(g->bvh, g->visible[i]);
+        bool big = !box_screen(f, bb, rect, &nd) ||
+                   (fmin(rect[2], w) - fmax(rect[0], 0)) * (fmin(rect[3], h) - fmax(rect[1], 0)) >= min_area;
+        if (big) g->visible[nocc++] = g->visible[i];
+        else rest[nrest++] = g->visible[i];
+    }
+    r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
+    submit_nodes(f, g->visible, nocc);
+
+    /* 3. Their depth as a pyramid; the rest tested against it. */
+    t0 = mr_time_now();
+    size_t npx = (size_t)w * h;
+    if (npx > g->depth_cap) {
+        float *d = realloc(g->depth, npx * sizeof *d);
+        if (!d) {
+            submit_nodes(f, rest, nrest);
+            return;
+        }
+        g->depth = d;
+        g->depth_cap = npx;
+    }
+    GLint draw_fbo = 0;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &draw_fbo);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, (GLuint)draw_fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, g->depth);
+    int levels = build_pyramid(g, g->depth, w, h);
+    int32_t nkeep = 0;
+    for (int32_t i = 0; i < nrest; i++) {
+        double rect[4], nd;
+        const double *bb = mr_bvh_bounds(g->bvh, rest[i]);
+        if (levels > 0 && box_screen(f, bb, rect, &nd) && occluded(g, levels, rect, nd, w, h)) continue;
+        rest[nkeep++] = rest[i];
+    }
+    r->stats.nodes_occluded += (uint32_t)(nrest - nkeep);
+    r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
+    submit_nodes(f, rest, nkeep);
+}
+
+/* ------------------------------------------------------ auxiliary streams */
+
+bool mr_geometry_aux_create(mr_renderer *r, float *const *per_mesh, int comps, GLuint attrib, mr_geo_aux *aux) {
+    memset(aux, 0, sizeof *aux);
+    struct mr_geo *g = r->geo;
+    const mr_scene *s = r->scene;
+    if (!g || !s || comps < 1 || comps > 4) return false;
+    static const GLsizei stride[2] = {24, 32};
+    size_t verts[2] = {0, 0};
+    for (int32_t i = 0; i < g->mesh_count && i < s->mesh_count; i++) {
+        size_t end = (size_t)g->meshes[i].base_vertex + s->meshes[i].vertex_count;
+        if (end > verts[g->meshes[i].pool]) verts[g->meshes[i].pool] = end;
+    }
+    for (int p = 0; p < 2; p++) {
+        size_t n = (verts[p] ? verts[p] : 1) * (size_t)comps;
+        float *buf = calloc(n, sizeof *buf);
+        if (!buf) {
+            mr_geometry_aux_free(aux);
+            return false;
+        }
+        for (int32_t i = 0; i < g->mesh_count && i < s->mesh_count; i++)
+            if (g->meshes[i].pool == p && per_mesh[i])
+                memcpy(buf + (size_t)g->meshes[i].base_vertex * comps, per_mesh[i],
+                       (size_t)s->meshes[i].vertex_count * comps * sizeof *buf);
+        glCreateBuffers(1, &aux->vbo[p]);
+        glNamedBufferStorage(aux->vbo[p], (GLsizeiptr)(n * sizeof *buf), buf, 0);
+        free(buf);
+        glCreateVertexArrays(1, &aux->vao[p]);
+        glVertexArrayVertexBuffer(aux->vao[p], 0, g->vbo[p], 0, stride[p]);
+        glEnableVertexArrayAttrib(aux->vao[p], 0);
+        glVertexArrayAttribFormat(aux->vao[p], 0, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(aux->vao[p], 0, 0);
+        glVertexArrayVertexBuffer(aux->vao[p], 1, aux->vbo[p], 0, comps * (GLsizei)sizeof(float));
+        glEnableVertexArrayAttrib(aux->vao[p], attrib);
+        glVertexArrayAttribFormat(aux->vao[p], attrib, comps, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(aux->vao[p], attrib, 1);
+        glVertexArrayElementBuffer(aux->vao[p], g->ibo);
+    }
+    aux->valid = true;
+    return true;
+}
+
+void mr_geometry_aux_free(mr_geo_aux *aux) {
+    if (!aux) return;
+    glDeleteVertexArrays(2, aux->vao);
+    glDeleteBuffers(2, aux->vbo);
+    memset(aux, 0, sizeof *aux);
+}
+
+void mr_geometry_aux_draw(frame *f, const mr_geo_aux *aux, uint32_t layer_mask) {
+    mr_renderer *r = f->r;
+    struct mr_geo *g = r->geo;
+    const mr_scene *s = r->scene;
+    if (!g || !s || !aux->valid) return;
     for (int32_t ni = 0; ni < s->node_count; ni++) {
         const mr_node *n = &s->nodes[ni];
-        if (n->mesh_first < 0 || n->mesh_count <= 0) continue;
-        if (!(layer_mask & (1u << n->layer))) continue;
+        if (n->mesh_first < 0 || n->mesh_count <= 0 || !(layer_mask & (1u << n->layer))) continue;
         mr_dmat4 cam_from_node = mr_m4_mul(&f->cam_from_world, &n->world);
-        glUniform2ui(5, (GLuint)ni + 1, n->layer);
         for (int32_t k = 0; k < n->mesh_count; k++) {
             int32_t mi = n->mesh_first + k;
-            if (mi >= r->mesh_count) break;
+            if (mi >= g->mesh_count || mi >= s->mesh_count) break;
             const mr_mesh *m = &s->meshes[mi];
-            /* Camera-relative in double, then float: this is what keeps a
-             * scene 1e7 units from the origin as sharp as one at it. */
+            const geo_mesh *gm = &g->meshes[mi];
+            /* Camera-relative in double, then float, as the main path. */
             mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
-            mr_dmat4 mv = mr_m4_mul(&cam_from_node, &T);
-            mr_dmat4 inv;
+            mr_dmat4 mv = mr_m4_mul(&cam_from_node, &T), inv;
+            if (!mr_m4_invert(&mv, &inv)) continue;
             float mvf[16], nm[9];
             mr_m4_to_gl(&mv, mvf);
-            if (!mr_m4_invert(&mv, &inv)) continue; /* degenerate (zero scale): nothing to draw */
             for (int rr = 0; rr < 3; rr++)
-                for (int cc = 0; cc < 3; cc++) nm[cc * 3 + rr] = (float)inv.m[cc * 4 + rr]; /* transpose */
+                for (int cc = 0; cc < 3; cc++) nm[cc * 3 + rr] = (float)inv.m[cc * 4 + rr];
             glUniformMatrix4fv(0, 1, GL_FALSE, mvf);
             glUniformMatrix3fv(1, 1, GL_FALSE, nm);
-            float color[4] = {0.7f, 0.7f, 0.7f, 1.0f};
-            int has_tex = 0;
-            if (m->material >= 0 && m->material < s->material_count) {
-                const mr_material *mat = &s->materials[m->material];
-                memcpy(color, mat->base_color, sizeof color);
-                if (mat->base_color_texture >= 0 && mat->base_color_texture < r->texture_count && m->uvs) {
-                    glBindTextureUnit(0, r->textures[mat->base_color_texture]);
-                    has_tex = 1;
-                }
-            }
-            glUniform4fv(3, 1, color);
-            glUniform1i(4, has_tex);
-            glBindVertexArray(r->meshes[mi].vao);
-            glDrawElements(GL_TRIANGLES, (GLsizei)r->meshes[mi].index_count, GL_UNSIGNED_INT, NULL);
-            f->out->triangles += r->meshes[mi].index_count / 3;
-            f->out->draw_calls++;
+            glBindVertexArray(aux->vao[gm->pool]);
+            glDrawElementsBaseVertex(GL_TRIANGLES, (GLsizei)gm->count[0], GL_UNSIGNED_INT,
+                                     (const void *)((size_t)gm->first[0] * 4), gm->base_vertex);
         }
     }
     glBindVertexArray(0);
 }
-

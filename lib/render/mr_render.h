@@ -277,6 +277,55 @@ bool mr_ghost_compose(mr_renderer *r, const mr_ghost_images *in, const mr_ghost_
                       mr_error *err);
 void mr_ghost_output_free(mr_ghost_output *out);
 
+/* -------------------------------------------------- drawing the scene */
+
+/* How the scene's geometry is submitted. Zero means default; every switch
+ * turns a saving off, so the plain path stays available for comparison
+ * (the images are the same either way, up to rasterisation order). */
+typedef struct mr_draw_params {
+    bool no_cull;          /* draw every node: no BVH frustum culling; default off */
+    bool no_batch;         /* one GL draw call per command instead of one
+                              glMultiDrawElementsIndirect per group; default off */
+    bool no_instancing;    /* one command per node and mesh instead of one per
+                              mesh (and LOD level); default off */
+    bool no_lod;           /* always full detail; default off */
+    double lod_tolerance;  /* largest geometric error (scene units) a LOD level
+                              may have, whatever its projected size; 0 = 0.005
+                              (5 mm in a metre scene); < 0: no LOD at all */
+    double lod_pixels;     /* largest projected error of a chosen level, pixels;
+                              0 = 1.0 */
+    bool occlusion;        /* occlusion culling within the frame: big
+                              occluders first, then a hierarchical-Z test
+                              of the rest on the CPU; exact (same image),
+                              costs a depth read-back; default off */
+} mr_draw_params;
+#define MR_DRAW_DEFAULTS {false, false, false, false, 0.0, 0.0, false}
+
+/* What the last frame's geometry submission did (summed over the passes
+ * that drew geometry). */
+typedef struct mr_draw_stats {
+    double cull_ms;            /* CPU: culling, LOD choice, instance data */
+    uint32_t nodes_drawable;   /* nodes of the drawn layers that draw something */
+    uint32_t nodes_visible;    /* of those, not culled */
+    uint32_t nodes_occluded;   /* culled by occlusion (when enabled) */
+    uint32_t instances;        /* mesh instances submitted */
+    uint32_t commands;         /* indirect draw commands */
+    uint32_t gl_draw_calls;    /* GL draw calls issued */
+    uint64_t triangles;        /* submitted */
+    uint64_t triangles_full;   /* the same instances at full detail */
+    uint32_t lod_instances;    /* instances drawn with a simplified level */
+    double lod_max_error;      /* largest error bound (scene units, node
+                                  stretch included) of a level drawn */
+} mr_draw_stats;
+
+/* Sets how geometry is submitted from the next frame on (NULL: defaults). */
+bool mr_renderer_set_draw_params(mr_renderer *r, const mr_draw_params *params, mr_error *err);
+void mr_renderer_draw_stats(const mr_renderer *r, mr_draw_stats *out);
+/* Draws simplified levels from `lod` (built for the scene that is set; it
+ * must stay alive while set; NULL: full detail only). Re-uploads the
+ * scene's geometry; setting another scene drops the levels. */
+bool mr_renderer_set_lod(mr_renderer *r, const mr_lod *lod, mr_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -47,8 +47,8 @@ struct mr_ao_state {
     ao_key last;
     uint64_t scene_gen;
     /* outline meshes, per scene mesh: integrated-normal directions */
-    GLuint *outline_vbo, *outline_vao;
-    int32_t outline_count;
+    mr_geo_aux outline;          /* outline directions as attribute 1, aligned with the geometry */
+    bool outline_built;
     uint64_t outline_gen;
     /* this frame */
     mr_ao_params p; /* resolved */
@@ -207,12 +207,8 @@ static void free_targets(mr_ao_state *s) {
 }
 
 static void free_outlines(mr_ao_state *s) {
-    if (s->outline_vao) glDeleteVertexArrays(s->outline_count, s->outline_vao);
-    if (s->outline_vbo) glDeleteBuffers(s->outline_count, s->outline_vbo);
-    free(s->outline_vao);
-    free(s->outline_vbo);
-    s->outline_vao = s->outline_vbo = NULL;
-    s->outline_count = 0;
+    mr_geometry_aux_free(&s->outline);
+    s->outline_built = false;
 }
 
 void mr_pass_ao_free(mr_renderer *r) {
@@ -425,41 +421,25 @@ void mr_pass_ao_positions(frame *f) {
 static bool ensure_outlines(mr_renderer *r, mr_ao_state *s) {
     const mr_scene *sc = r->scene;
     if (!sc) return false;
-    if (s->outline_vao && s->outline_gen == s->scene_gen && s->outline_count == sc->mesh_count) return true;
+    if (s->outline_built && s->outline_gen == s->scene_gen) return s->outline.valid;
     free_outlines(s);
-    s->outline_vao = calloc((size_t)sc->mesh_count + 1, sizeof *s->outline_vao);
-    s->outline_vbo = calloc((size_t)sc->mesh_count + 1, sizeof *s->outline_vbo);
-    if (!s->outline_vao || !s->outline_vbo) {
-        free_outlines(s);
-        return false;
-    }
-    s->outline_count = sc->mesh_count;
+    s->outline_built = true;
     s->outline_gen = s->scene_gen;
-    for (int32_t i = 0; i < sc->mesh_count && i < r->mesh_count; i++) {
+    float **dirs = calloc((size_t)sc->mesh_count + 1, sizeof *dirs);
+    if (!dirs) return false;
+    for (int32_t i = 0; i < sc->mesh_count; i++) {
         const mr_mesh *m = &sc->meshes[i];
-        float *dirs = malloc((size_t)m->vertex_count * 3 * sizeof *dirs + 1);
         mr_error err = {0};
-        if (!dirs || !mr_mesh_outline_dirs(m, dirs, &err)) {
-            free(dirs);
-            continue;
+        dirs[i] = malloc((size_t)m->vertex_count * 3 * sizeof **dirs + 1);
+        if (dirs[i] && !mr_mesh_outline_dirs(m, dirs[i], &err)) {
+            free(dirs[i]);
+            dirs[i] = NULL; /* no outline: the mesh never masks */
         }
-        glCreateBuffers(1, &s->outline_vbo[i]);
-        glNamedBufferStorage(s->outline_vbo[i], (GLsizeiptr)m->vertex_count * 12 + 12, NULL, GL_DYNAMIC_STORAGE_BIT);
-        glNamedBufferSubData(s->outline_vbo[i], 0, (GLsizeiptr)m->vertex_count * 12, dirs);
-        free(dirs);
-        GLuint vao;
-        glCreateVertexArrays(1, &vao);
-        glVertexArrayVertexBuffer(vao, 0, r->meshes[i].vbo[0], 0, 12); /* positions shared with the scene */
-        glVertexArrayVertexBuffer(vao, 1, s->outline_vbo[i], 0, 12);
-        for (GLuint a = 0; a < 2; a++) {
-            glEnableVertexArrayAttrib(vao, a);
-            glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, 0);
-            glVertexArrayAttribBinding(vao, a, a);
-        }
-        glVertexArrayElementBuffer(vao, r->meshes[i].ibo);
-        s->outline_vao[i] = vao;
     }
-    return true;
+    bool ok = mr_geometry_aux_create(r, dirs, 3, 1, &s->outline);
+    for (int32_t i = 0; i < sc->mesh_count; i++) free(dirs[i]);
+    free(dirs);
+    return ok;
 }
 
 /* Park & Baek: draw every outline volume with additive blending into a
@@ -490,31 +470,9 @@ void mr_pass_ao_mask(frame *f) {
     glUniform1i(3, s->p.radius_mode == MR_AO_RADIUS_SCREEN ? 0 : 1);
     glUniform1f(4, (float)s->p.radius);
     glUniform1f(5, s->screen_k);
-    const mr_scene *sc = r->scene;
     uint32_t mask = 1u << MR_LAYER_VISIBLE;
     if (!f->p->hide_hidden_layer) mask |= 1u << MR_LAYER_HIDDEN;
-    for (int32_t ni = 0; ni < sc->node_count; ni++) {
-        const mr_node *n = &sc->nodes[ni];
-        if (n->mesh_first < 0 || n->mesh_count <= 0 || !(mask & (1u << n->layer))) continue;
-        mr_dmat4 cam_from_node = mr_m4_mul(&f->cam_from_world, &n->world);
-        for (int32_t k = 0; k < n->mesh_count; k++) {
-            int32_t mi = n->mesh_first + k;
-            if (mi >= s->outline_count || !s->outline_vao[mi]) continue;
-            const mr_mesh *m = &sc->meshes[mi];
-            mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
-            mr_dmat4 mv = mr_m4_mul(&cam_from_node, &T), inv;
-            if (!mr_m4_invert(&mv, &inv)) continue;
-            float mvf[16], nm[9];
-            mr_m4_to_gl(&mv, mvf);
-            for (int rr = 0; rr < 3; rr++)
-                for (int cc = 0; cc < 3; cc++) nm[cc * 3 + rr] = (float)inv.m[cc * 4 + rr];
-            glUniformMatrix4fv(0, 1, GL_FALSE, mvf);
-            glUniformMatrix3fv(1, 1, GL_FALSE, nm);
-            glBindVertexArray(s->outline_vao[mi]);
-            glDrawElements(GL_TRIANGLES, (GLsizei)m->index_count, GL_UNSIGNED_INT, NULL);
-        }
-    }
-    glBindVertexArray(0);
+    mr_geometry_aux_draw(f, &s->outline, mask);
     glDisable(GL_BLEND);
     glDisable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);

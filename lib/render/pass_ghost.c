@@ -50,8 +50,8 @@ typedef struct mr_ghost_state {
     GLuint out_store, out_view; /* RGBA8 storage and its sRGB view */
     GLuint ssbo_stats, ssbo_votes, ssbo_sums;
     size_t votes_cap;    /* ints */
-    GLuint *curv_vbo;    /* per mesh, computed once per scene (cache) */
-    int32_t curv_count;
+    mr_geo_aux curv_aux; /* per-vertex curvature as attribute 3, once per scene (cache) */
+    bool curv_built;
     /* per frame */
     GLuint o_tex;        /* the occluder image of this frame (linear when sampled) */
 } mr_ghost_state;
@@ -73,10 +73,8 @@ static void free_targets(mr_ghost_state *g) {
 void mr_ghost_scene_changed(mr_renderer *r) {
     mr_ghost_state *g = r ? r->ghost : NULL;
     if (!g) return;
-    if (g->curv_vbo) glDeleteBuffers(g->curv_count, g->curv_vbo);
-    free(g->curv_vbo);
-    g->curv_vbo = NULL;
-    g->curv_count = 0;
+    mr_geometry_aux_free(&g->curv_aux);
+    g->curv_built = false;
 }
 
 void mr_ghost_free(mr_renderer *r) {
@@ -449,28 +447,22 @@ void mr_pass_ghost_hidden(frame *f) {
     f->final_tex = keep;
 }
 
-/* Per-mesh curvature as vertex attribute 3 of the meshes' vertex arrays,
- * computed once per scene. */
+/* Per-vertex curvature as attribute 3 of the curvature program, laid out
+ * like the shared geometry; computed once per scene. */
 static void ensure_curvature(mr_renderer *r, mr_ghost_state *g) {
     const mr_scene *s = r->scene;
-    if (!s || g->curv_vbo || r->mesh_count <= 0) return;
-    g->curv_vbo = calloc((size_t)r->mesh_count, sizeof *g->curv_vbo);
-    if (!g->curv_vbo) return;
-    g->curv_count = r->mesh_count;
-    glCreateBuffers(r->mesh_count, g->curv_vbo);
-    for (int32_t i = 0; i < r->mesh_count; i++) {
+    if (!s || g->curv_built) return;
+    g->curv_built = true;
+    float **k = calloc((size_t)s->mesh_count + 1, sizeof *k);
+    if (!k) return;
+    for (int32_t i = 0; i < s->mesh_count; i++) {
         const mr_mesh *m = &s->meshes[i];
-        float *k = malloc((size_t)(m->vertex_count ? m->vertex_count : 1) * sizeof *k);
-        if (!k) continue;
-        mr_mesh_curvature(m, k);
-        glNamedBufferStorage(g->curv_vbo[i], (GLsizeiptr)((m->vertex_count ? m->vertex_count : 1) * sizeof *k), k, 0);
-        free(k);
-        GLuint vao = r->meshes[i].vao;
-        glVertexArrayVertexBuffer(vao, 3, g->curv_vbo[i], 0, sizeof(float));
-        glEnableVertexArrayAttrib(vao, 3);
-        glVertexArrayAttribFormat(vao, 3, 1, GL_FLOAT, GL_FALSE, 0);
-        glVertexArrayAttribBinding(vao, 3, 3);
+        k[i] = malloc((size_t)(m->vertex_count ? m->vertex_count : 1) * sizeof **k);
+        if (k[i]) mr_mesh_curvature(m, k[i]);
     }
+    mr_geometry_aux_create(r, k, 1, 3, &g->curv_aux);
+    for (int32_t i = 0; i < s->mesh_count; i++) free(k[i]);
+    free(k);
 }
 
 void mr_pass_ghost_curvature(frame *f) {
@@ -487,12 +479,11 @@ void mr_pass_ghost_curvature(frame *f) {
     static const float depth0 = 0.0f;
     glClearNamedFramebufferfv(g->curv.fbo, GL_COLOR, 0, zero4);
     glClearNamedFramebufferfv(g->curv.fbo, GL_DEPTH, 0, &depth0);
-    /* mr_geometry_draw draws with r->prog_gbuffer; the curvature program
-     * has the same uniform interface, so it stands in for this one draw. */
-    GLuint keep = r->prog_gbuffer;
-    r->prog_gbuffer = g->prog_curv;
-    mr_geometry_draw(f, 1u << MR_LAYER_VISIBLE);
-    r->prog_gbuffer = keep;
+    glUseProgram(g->prog_curv);
+    float proj[16];
+    mr_gl_projection(&f->cam, f->near_plane, proj);
+    glUniformMatrix4fv(2, 1, GL_FALSE, proj);
+    mr_geometry_aux_draw(f, &g->curv_aux, 1u << MR_LAYER_VISIBLE);
     glDisable(GL_DEPTH_TEST);
 }
 

@@ -8,11 +8,6 @@
 
 #include "gpu_internal.h"
 
-typedef struct gl_mesh {
-    GLuint vao, vbo[3], ibo; /* positions, normals, uvs */
-    uint32_t index_count;
-} gl_mesh;
-
 /* A framebuffer with up to 3 colour textures and an optional depth texture. */
 typedef struct target {
     GLuint fbo, color[3], depth;
@@ -21,8 +16,9 @@ typedef struct target {
 struct mr_renderer {
     mr_gpu *gpu;
     const mr_scene *scene;
-    gl_mesh *meshes;
-    int32_t mesh_count;
+    struct mr_geo *geo;    /* geometry.c: buffers, BVH, per-frame scratch */
+    mr_draw_params draw;   /* how geometry is submitted */
+    mr_draw_stats stats;   /* of the current / last frame */
     GLuint *textures;
     int32_t texture_count;
     GLuint prog_gbuffer, prog_shade, prog_overlay;
@@ -71,6 +67,24 @@ void mr_geometry_free(mr_renderer *r);
  * G-buffer program into the currently bound framebuffer, counting triangles
  * and draw calls into the frame result. */
 void mr_geometry_draw(frame *f, uint32_t layer_mask);
+/* Resets the frame's draw statistics (called by mr_render_frame). */
+void mr_geometry_begin_frame(mr_renderer *r);
+
+/* Extra per-vertex streams for passes that draw the scene with their own
+ * program (AO outline volumes, ghost curvature): one buffer per vertex pool,
+ * laid out like the shared geometry, paired with the pools' positions
+ * (attribute 0) in VAOs of their own; `attrib` receives the stream. */
+typedef struct mr_geo_aux {
+    GLuint vao[2], vbo[2];
+    bool valid;
+} mr_geo_aux;
+/* per_mesh[i]: comps floats per vertex of scene mesh i (NULL: zeros). */
+bool mr_geometry_aux_create(mr_renderer *r, float *const *per_mesh, int comps, GLuint attrib, mr_geo_aux *aux);
+void mr_geometry_aux_free(mr_geo_aux *aux);
+/* Draws every node of the layers at full detail, no culling, through the aux
+ * VAOs with the bound program; sets uniform location 0 (model-view, camera
+ * relative, composed in double) and 1 (its normal matrix) per instance. */
+void mr_geometry_aux_draw(frame *f, const mr_geo_aux *aux, uint32_t layer_mask);
 
 /* Passes (passes.c). */
 bool mr_pass_need_always(frame *f);

@@ -216,6 +216,7 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
 
     frame f;
     memset(&f, 0, sizeof f);
+    mr_geometry_begin_frame(r);
     f.r = r;
     f.view = view;
     f.p = p;

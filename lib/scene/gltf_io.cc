@@ -259,7 +259,14 @@ struct Loader {
     std::vector<int32_t> tex_map;                        // glTF texture -> scene texture; -2: not yet
     std::string warn;
 
+    void (*progress)(void *, const char *, double) = nullptr;
+    void *progress_user = nullptr;
+
     Loader(const tinygltf::Model &model, mr_scene *scene) : m(model), s(scene) {}
+
+    void report(const char *stage, size_t done, size_t total) {
+        if (progress && total > 0) progress(progress_user, stage, (double)done / (double)total);
+    }
 
     void warning(const std::string &w) { warn += w + "\n"; }
 
@@ -584,7 +591,9 @@ struct Loader {
         std::vector<char> seen(m.nodes.size(), 0);
         std::vector<Item> stack;  // explicit stack: deep hierarchies cannot overflow the C stack
         for (size_t i = roots.size(); i-- > 0;) stack.push_back(Item{roots[i], -1});
+        size_t visited = 0;
         while (!stack.empty()) {
+            if ((++visited & 4095) == 0) report("nodes", visited, m.nodes.size());
             Item it = stack.back();
             stack.pop_back();
             if (it.node < 0 || (size_t)it.node >= m.nodes.size())
@@ -623,6 +632,7 @@ struct Loader {
         tex_map.assign(m.textures.size(), -2);
         materials();
         nodes();
+        report("nodes", 1, 1);
         mr_scene_update_bounds(s);
     }
 };
@@ -649,6 +659,7 @@ mr_scene *load_memory(const void *data, size_t size, const char *base_dir, const
         tinygltf::FsCallbacks fs = {fs_no_exists, fs_no_expand, fs_no_read, fs_no_write, nullptr};
         gltf.SetFsCallbacks(fs);
     }
+    if (params && params->progress) params->progress(params->progress_user, "parse", 0.0);
     tinygltf::Model model;
     std::string terr, twarn;
     std::string dir = base_dir ? base_dir : "";
@@ -665,6 +676,10 @@ mr_scene *load_memory(const void *data, size_t size, const char *base_dir, const
     if (!scene) throw std::bad_alloc();
     SceneGuard guard(scene);
     Loader L(model, scene);
+    if (params) {
+        L.progress = params->progress;
+        L.progress_user = params->progress_user;
+    }
     if (params)
         for (int i = 0; i < params->hidden_glob_count; i++)
             if (params->hidden_globs) L.globs.push_back(params->hidden_globs[i]);
@@ -751,6 +766,7 @@ mr_scene *load_path(const char *path, const mr_scene_params *params, const std::
                     bool allow_config) {
     mr_error e;
     size_t size = 0;
+    if (params && params->progress) params->progress(params->progress_user, "read", 0.0);
     void *data = mr_file_read(path, &size, (size_t)2 << 30, &e);
     if (!data) throw Fail{e.code, e.msg};
     struct Free {
@@ -1016,4 +1032,29 @@ bool mr_scene_save_glb(const mr_scene *s, const char *path, mr_error *err) {
         return mr_fail(err, MR_ERR_IO, "saving %s: unknown error", path);
     }
     return mr_file_write_atomic(path, out.data(), out.size(), err);
+}
+
+// Only tinygltf's parse of a .glb/.gltf in memory, nothing converted: the
+// reference speed the loader is measured against (bench scene).
+bool mr_gltf_parse_only(const void *data, size_t size, mr_error *err) {
+    try {
+        if (!data || size < 4 || size > UINT_MAX) return mr_fail(err, MR_ERR_PARSE, "no glTF data");
+        tinygltf::TinyGLTF gltf;
+        gltf.SetImageLoader(image_loader, nullptr);
+        tinygltf::FsCallbacks fs = {fs_no_exists, fs_no_expand, fs_no_read, fs_no_write, nullptr};
+        gltf.SetFsCallbacks(fs);
+        tinygltf::Model model;
+        std::string terr, twarn;
+        const unsigned char *bytes = static_cast<const unsigned char *>(data);
+        bool ok = std::memcmp(bytes, "glTF", 4) == 0
+                      ? gltf.LoadBinaryFromMemory(&model, &terr, &twarn, bytes, (unsigned)size, "")
+                      : gltf.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char *>(bytes),
+                                                 (unsigned)size, "");
+        if (!ok) return mr_fail(err, MR_ERR_PARSE, "invalid glTF: %s", one_line(terr).c_str());
+        return true;
+    } catch (const std::bad_alloc &) {
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory parsing glTF");
+    } catch (...) {
+        return mr_fail(err, MR_ERR_PARSE, "glTF parse error");
+    }
 }

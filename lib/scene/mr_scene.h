@@ -104,8 +104,24 @@ void mr_mesh_generate_normals(const float *positions, uint32_t vertex_count,
 typedef struct mr_scene_params {
     const char *const *hidden_globs; /* node-name globs for the hidden layer */
     int hidden_glob_count;
+    /* Called now and then during a load with the stage ("read", "parse",
+     * "nodes": meshes are read when a node first uses them) and its fraction
+     * done in [0,1]; NULL: none. */
+    void (*progress)(void *user, const char *stage, double fraction);
+    void *progress_user;
 } mr_scene_params;
 #define MR_SCENE_DEFAULTS {0}
+
+/* Loading on a thread of its own (scene_async.c), so a window's event loop
+ * never blocks: start, poll once per frame (non-blocking; true when done,
+ * with the stage and fraction for a progress bar), then finish (waits, and
+ * returns the scene or NULL + err; frees the loader). The glob strings in
+ * params must stay valid until finish; params->progress, if set, is called
+ * on the loader's thread. */
+typedef struct mr_scene_loader mr_scene_loader;
+mr_scene_loader *mr_scene_load_async(const char *path, const mr_scene_params *params, mr_error *err);
+bool mr_scene_loader_poll(mr_scene_loader *loader, const char **stage, double *fraction);
+mr_scene *mr_scene_loader_finish(mr_scene_loader **loader, mr_error *err);
 
 /* Loads a scene from a .gltf/.glb (recognised by content, not extension)
  * or a scene config JSON: {"gltf": "rel/path.glb", "hidden": ["Pipe*"],
@@ -121,6 +137,10 @@ mr_scene *mr_scene_load_gltf_memory(const void *data, size_t size, const char *b
  * flat (world transforms as matrices); hidden nodes get
  * extras.mrcheck_layer = "hidden". */
 bool mr_scene_save_glb(const mr_scene *s, const char *path, mr_error *err);
+
+/* tinygltf's parse alone (no conversion, no external files): the reference
+ * the loader's speed is compared with. */
+bool mr_gltf_parse_only(const void *data, size_t size, mr_error *err);
 
 /* Shell-style glob: '*' any run, '?' one char, '[abc]' a set. */
 bool mr_glob_match(const char *pattern, const char *text);
@@ -179,6 +199,142 @@ void mr_demo_free(mr_demo_hall *hall);
  * Degenerate edges are skipped; the result is finite and >= 0. Linear time
  * in index_count. Scale: kappa(s * mesh) = kappa(mesh) / s. */
 void mr_mesh_curvature(const mr_mesh *mesh, float *out);
+
+/* ------------------------------------------------- culling (bvh.c) */
+
+/* A convex view volume: points x with n.x + d >= 0 for every plane are
+ * inside. World space, double precision. */
+typedef struct mr_frustum {
+    double planes[6][4];  /* nx ny nz d */
+    int plane_count;
+} mr_frustum;
+
+/* The pinhole frustum of an OpenCV camera at world_from_camera: the image
+ * rectangle widened by margin_px pixels on each side (so rounding in the
+ * rasteriser can never show a culled node), and the near plane z >= near
+ * (infinite far). Lens distortion is ignored: the renderer draws the
+ * undistorted image. */
+mr_frustum mr_frustum_from_camera(const mr_camera *cam, const mr_dmat4 *world_from_camera, double near_plane,
+                                  double margin_px);
+/* -1: the box lies outside, 0: it straddles, 1: it lies inside. */
+int mr_frustum_test_box(const mr_frustum *f, const double lo[3], const double hi[3]);
+
+/* World-space bounds of what node n draws (its meshes through its world
+ * transform, in double); false if it draws nothing. */
+bool mr_scene_node_bounds(const mr_scene *s, int32_t node, double lo[3], double hi[3]);
+
+/* A bounding-volume hierarchy over the world bounds of the nodes that draw
+ * something, built once per scene (the scene is static while it is set). */
+typedef struct mr_bvh mr_bvh;
+
+typedef struct mr_bvh_stats {
+    uint32_t boxes_tested;   /* BVH boxes tested against the frustum */
+    uint32_t nodes_visible;  /* scene nodes returned */
+} mr_bvh_stats;
+
+mr_bvh *mr_bvh_build(const mr_scene *s, mr_error *err);
+void mr_bvh_destroy(mr_bvh **bvh); /* NULLs, accepts NULL */
+/* Number of scene nodes the BVH holds (those that draw something). */
+int32_t mr_bvh_node_count(const mr_bvh *bvh);
+/* Writes the indices of the scene nodes whose bounds touch the frustum and
+ * whose layer bit (1 << layer) is in layer_mask into out (room for
+ * mr_bvh_node_count entries), in BVH order; returns the count.
+ * frustum NULL: every node of those layers. */
+int32_t mr_bvh_cull(const mr_bvh *bvh, const mr_frustum *frustum, uint32_t layer_mask, int32_t *out,
+                    mr_bvh_stats *stats);
+/* World bounds of scene node `node` as stored in the BVH (6 doubles: lo, hi),
+ * or NULL if the node draws nothing. */
+const double *mr_bvh_bounds(const mr_bvh *bvh, int32_t node);
+
+/* ------------------------------------------ level of detail (lod.c) */
+
+/* Simplified index lists of a mesh (meshoptimizer, edge collapses onto
+ * existing vertices, so a level indexes the mesh's own vertex arrays).
+ * `error` is a certified upper bound, in the mesh's units (before the node
+ * transform), of the two-sided Hausdorff distance between the level and the
+ * full mesh: measured, not the simplifier's estimate (see lod.c). */
+typedef struct mr_lod_level {
+    uint32_t index_count;
+    uint32_t *indices;
+    double error;
+} mr_lod_level;
+
+#define MR_LOD_MAX_LEVELS 6
+
+typedef struct mr_mesh_lods {
+    int32_t level_count;                    /* 0: the mesh is drawn at full detail only */
+    mr_lod_level levels[MR_LOD_MAX_LEVELS]; /* finest first, errors increasing */
+} mr_mesh_lods;
+
+typedef struct mr_lod {
+    int32_t mesh_count;       /* == the scene's */
+    mr_mesh_lods *meshes;
+    uint64_t scene_hash;      /* of the geometry the levels were built for */
+} mr_lod;
+
+typedef struct mr_lod_params {
+    double max_error;         /* largest certified error worth keeping, in
+                                 mesh units (scene units for unscaled nodes);
+                                 0 = 0.02: coarser levels are never usable
+                                 under the default 5 mm tolerance, with
+                                 headroom for a larger --lod-tolerance */
+    uint32_t min_triangles;   /* meshes with fewer triangles get no levels; 0 = 64 */
+    bool progress;            /* progress line on stderr (caller decides on a tty) */
+} mr_lod_params;
+#define MR_LOD_DEFAULTS {0.0, 0, false}
+
+typedef struct mr_lod_info {
+    bool from_cache;          /* the cache was valid and used */
+    bool cache_written;
+    double build_s;           /* seconds spent simplifying and certifying */
+    uint64_t levels;          /* levels kept over all meshes */
+} mr_lod_info;
+
+/* Builds the levels of every mesh. */
+mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *err);
+void mr_lod_destroy(mr_lod **lod); /* NULLs, accepts NULL */
+/* Hash of the scene's mesh geometry (positions, indices, origins): a cache
+ * for another geometry is never used. */
+uint64_t mr_lod_scene_hash(const mr_scene *s);
+/* Reads levels from cache_path if it holds levels for exactly this scene
+ * and these params (checked by hash and a checksum; anything else is
+ * ignored, never trusted), else builds them and writes the cache atomically
+ * (a failed write is only a warning). cache_path NULL: no cache. */
+mr_lod *mr_lod_load_or_build(const mr_scene *s, const char *cache_path, const mr_lod_params *params,
+                             mr_lod_info *info, mr_error *err);
+/* The default cache path next to a scene file: "<scene>.mrlod". */
+void mr_lod_cache_path(const char *scene_path, char *out, size_t n);
+/* Certified upper bound of the two-sided Hausdorff distance between the
+ * triangle lists a and b over the same vertex positions (3 floats each),
+ * found by branch and bound on subdivided triangles down to `resolution`
+ * (the bound is exact to within resolution). Returns INFINITY where a point
+ * lies farther than `limit` from the other surface. */
+double mr_lod_hausdorff_bound(const float *positions, uint32_t vertex_count, const uint32_t *a, uint32_t a_count,
+                              const uint32_t *b, uint32_t b_count, double resolution, double limit);
+
+/* ------------------------------------ synthetic factories (synth.c) */
+
+typedef struct mr_synth_params {
+    uint64_t seed;           /* default 1 */
+    int halls;               /* halls in a grid, about 1M drawn triangles
+                                and 3000 nodes each; 0 = 1 */
+    double hall_width;       /* metres, 0 = 60 */
+    double hall_depth;       /* metres, 0 = 30 */
+    double origin[3];        /* offset of the whole plant (x and z), metres */
+} mr_synth_params;
+#define MR_SYNTH_DEFAULTS {1, 1, 0.0, 0.0, {0.0, 0.0, 0.0}}
+
+/* A factory of `halls` halls whose parts (machines, motors, valves, bolts,
+ * racks, boxes, pipes, trays, lamps) are shared meshes placed by many
+ * nodes; pipes and trays below the roof form the hidden layer. */
+mr_scene *mr_synth_build(const mr_synth_params *params, mr_error *err);
+/* The hall count whose drawn triangles come closest to the target. */
+int mr_synth_halls_for(uint64_t target_triangles);
+enum { MR_SYNTH_VIEW_FLOOR = 0, MR_SYNTH_VIEW_AISLE = 1, MR_SYNTH_VIEW_OVERVIEW = 2, MR_SYNTH_VIEW_COUNT = 3 };
+/* world_from_camera of a fixed viewpoint: standing on the floor of the
+ * first hall, looking down an aisle through the row of halls, or an
+ * overview from above. */
+mr_dmat4 mr_synth_viewpoint(const mr_synth_params *params, int which);
 
 #ifdef __cplusplus
 }

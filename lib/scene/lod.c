@@ -1,0 +1,906 @@
+/* Levels of detail with a certified error bound, and their disk cache.
+ *
+ * meshoptimizer simplifies each mesh once (edge collapses onto existing
+ * vertices, so every level indexes the mesh's own vertex arrays). Its
+ * result_error is an estimate from quadrics, not a bound, so a level's error
+ * here is measured: an upper bound of the two-sided Hausdorff distance
+ * between the level and the full mesh, found by branch and bound:
+ *
+ *  - every vertex of each surface is queried exactly against the other
+ *    surface (a uniform grid of triangles, exact point-triangle distance);
+ *    the largest distance L is a lower bound of the Hausdorff distance;
+ *  - a triangle T is then bounded without sampling: the distance to one
+ *    triangle t is a convex function, so over all of T it is at most the
+ *    largest distance of T's corners to t, and the distance to the whole
+ *    surface is at most that (min over a few candidate t: the corners'
+ *    nearest triangles). Where that bound exceeds L + resolution, T is
+ *    bisected along its longest edge and the halves are bounded again.
+ *
+ * The result is a true upper bound, within `resolution` of the truth, which
+ * tests check against dense brute-force sampling; the renderer never uses a
+ * level whose bound (times the node's stretch) exceeds the tolerance. */
+#include "mr_scene.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <meshoptimizer.h>
+
+/* ------------------------------------------------------- distance math */
+
+typedef struct dv { double x, y, z; } dv;
+
+static dv dv_sub(dv a, dv b) { return (dv){a.x - b.x, a.y - b.y, a.z - b.z}; }
+static double dv_dot(dv a, dv b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static dv dv_mad(dv a, dv b, double s) { return (dv){a.x + b.x * s, a.y + b.y * s, a.z + b.z * s}; }
+
+/* Squared distance from p to triangle abc (Ericson, Real-Time Collision
+ * Detection 5.1.5), in double; degenerate triangles fall back to edges. */
+static double dist2_point_tri(dv p, dv a, dv b, dv c) {
+    dv ab = dv_sub(b, a), ac = dv_sub(c, a), ap = dv_sub(p, a);
+    double d1 = dv_dot(ab, ap), d2 = dv_dot(ac, ap);
+    dv q;
+    if (d1 <= 0 && d2 <= 0) q = a;
+    else {
+        dv bp = dv_sub(p, b);
+        double d3 = dv_dot(ab, bp), d4 = dv_dot(ac, bp);
+        if (d3 >= 0 && d4 <= d3) q = b;
+        else {
+            double vc = d1 * d4 - d3 * d2;
+            if (vc <= 0 && d1 >= 0 && d3 <= 0) q = dv_mad(a, ab, d1 / (d1 - d3));
+            else {
+                dv cp = dv_sub(p, c);
+                double d5 = dv_dot(ab, cp), d6 = dv_dot(ac, cp);
+                if (d6 >= 0 && d5 <= d6) q = c;
+                else {
+                    double vb = d5 * d2 - d1 * d6;
+                    if (vb <= 0 && d2 >= 0 && d6 <= 0) q = dv_mad(a, ac, d2 / (d2 - d6));
+                    else {
+                        double va = d3 * d6 - d5 * d4;
+                        if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+                            dv bc = dv_sub(c, b);
+                            q = dv_mad(b, bc, (d4 - d3) / ((d4 - d3) + (d5 - d6)));
+                        } else {
+                            double den = va + vb + vc;
+                            if (!(fabs(den) > 0) || !isfinite(1.0 / den)) {
+                                /* Degenerate (collinear): nearest of the edges. */
+                                double best = INFINITY;
+                                const dv e0[3] = {a, b, c}, e1[3] = {b, c, a};
+                                for (int k = 0; k < 3; k++) {
+                                    dv d = dv_sub(e1[k], e0[k]);
+                                    double dd = dv_dot(d, d), t = dd > 0 ? dv_dot(dv_sub(p, e0[k]), d) / dd : 0;
+                                    t = t < 0 ? 0 : t > 1 ? 1 : t;
+                                    dv r = dv_sub(p, dv_mad(e0[k], d, t));
+                                    double r2 = dv_dot(r, r);
+                                    if (r2 < best) best = r2;
+                                }
+                                return best;
+                            }
+                            double v = vb / den, w = vc / den;
+                            q = dv_mad(dv_mad(a, ab, v), ac, w);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    dv d = dv_sub(p, q);
+    return dv_dot(d, d);
+}
+
+/* A uniform grid over the triangles of one surface. */
+typedef struct tri_grid {
+    const float *pos;
+    const uint32_t *idx;
+    uint32_t tri_count;
+    double lo[3], cell;
+    int n[3];
+    uint32_t *start;   /* n0*n1*n2 + 1 offsets into items */
+    uint32_t *items;   /* triangle ids */
+    uint32_t *partner; /* 3 per triangle: the neighbour across each edge if
+                          both are coplanar and their union is convex, else
+                          UINT32_MAX (see convex_partners) */
+    double ptol;       /* coplanarity tolerance used for partner */
+    uint32_t *vt_start, *vt_items; /* triangles around each vertex (CSR) */
+} tri_grid;
+
+static dv vtx(const float *pos, uint32_t i) {
+    return (dv){pos[3 * (size_t)i], pos[3 * (size_t)i + 1], pos[3 * (size_t)i + 2]};
+}
+
+static void cell_of(const tri_grid *g, dv p, int c[3]) {
+    const double q[3] = {p.x, p.y, p.z};
+    for (int k = 0; k < 3; k++) {
+        double f = floor((q[k] - g->lo[k]) / g->cell);
+        c[k] = f < 0 ? 0 : f >= g->n[k] ? g->n[k] - 1 : (int)f;
+    }
+}
+
+static void grid_free(tri_grid *g) {
+    free(g->start);
+    free(g->items);
+    free(g->partner);
+    free(g->vt_start);
+    free(g->vt_items);
+    memset(g, 0, sizeof *g);
+}
+
+/* bounds: of all vertices (both surfaces share them), so every query point
+ * lies inside the grid's box. */
+static bool grid_build(tri_grid *g, const float *pos, const uint32_t *idx, uint32_t index_count, const double lo[3],
+                       const double hi[3]) {
+    memset(g, 0, sizeof *g);
+    g->pos = pos;
+    g->idx = idx;
+    g->tri_count = index_count / 3;
+    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    if (!(ext > 0)) ext = 1;
+    /* A few cells per triangle (most are empty: surfaces are thin), at most
+     * 128 per axis. */
+    double per_axis = cbrt((double)g->tri_count + 1) * 2.5;
+    if (per_axis > 128) per_axis = 128;
+    if (per_axis < 1) per_axis = 1;
+    g->cell = ext / per_axis * 1.0000001;
+    for (int k = 0; k < 3; k++) {
+        g->lo[k] = lo[k];
+        g->n[k] = (int)ceil((hi[k] - lo[k]) / g->cell);
+        if (g->n[k] < 1) g->n[k] = 1;
+    }
+    size_t cells = (size_t)g->n[0] * g->n[1] * g->n[2];
+    g->start = calloc(cells + 1, sizeof *g->start);
+    if (!g->start) return false;
+    /* Two passes: count, then fill (triangle AABB against cells). */
+    for (int pass = 0; pass < 2; pass++) {
+        for (uint32_t t = 0; t < g->tri_count; t++) {
+            dv a = vtx(pos, idx[3 * t]), b = vtx(pos, idx[3 * t + 1]), c = vtx(pos, idx[3 * t + 2]);
+            dv mn = {fmin(a.x, fmin(b.x, c.x)), fmin(a.y, fmin(b.y, c.y)), fmin(a.z, fmin(b.z, c.z))};
+            dv mx = {fmax(a.x, fmax(b.x, c.x)), fmax(a.y, fmax(b.y, c.y)), fmax(a.z, fmax(b.z, c.z))};
+            int c0[3], c1[3];
+            cell_of(g, mn, c0);
+            cell_of(g, mx, c1);
+            for (int z = c0[2]; z <= c1[2]; z++)
+                for (int y = c0[1]; y <= c1[1]; y++)
+                    for (int x = c0[0]; x <= c1[0]; x++) {
+                        size_t ci = ((size_t)z * g->n[1] + y) * g->n[0] + x;
+                        if (pass == 0) g->start[ci + 1]++;
+                        else g->items[g->start[ci]++] = t;
+                    }
+        }
+        if (pass == 0) {
+            for (size_t i = 0; i < cells; i++) g->start[i + 1] += g->start[i];
+            g->items = malloc(((size_t)g->start[cells] + 1) * sizeof *g->items);
+            if (!g->items) return false;
+        } else {
+            /* start[i] now holds the end of cell i: shift back. */
+            for (size_t i = cells; i > 0; i--) g->start[i] = g->start[i - 1];
+            g->start[0] = 0;
+        }
+    }
+    return true;
+}
+
+typedef struct edge_rec { uint32_t a, b, tri, slot; } edge_rec;
+
+static int cmp_edge(const void *x, const void *y) {
+    const edge_rec *p = x, *q = y;
+    if (p->a != q->a) return p->a < q->a ? -1 : 1;
+    if (p->b != q->b) return p->b < q->b ? -1 : 1;
+    return 0;
+}
+
+/* Two triangles sharing edge ab with opposite corners c and d form a convex
+ * planar quad iff they are coplanar and segment cd crosses ab: then the
+ * distance to their union is convex too, and a piece straddling their
+ * common edge needs no subdivision (planar faces split into triangles are
+ * the common case in CAD meshes). */
+static bool convex_pair(dv a, dv b, dv c, dv d, double tol) {
+    dv ab = dv_sub(b, a), ac = dv_sub(c, a), ad = dv_sub(d, a);
+    dv n = {ab.y * ac.z - ab.z * ac.y, ab.z * ac.x - ab.x * ac.z, ab.x * ac.y - ab.y * ac.x};
+    double nl = sqrt(dv_dot(n, n));
+    if (!(nl > 0)) return false;
+    if (fabs(dv_dot(ad, n)) / nl > tol) return false; /* not coplanar */
+    /* c and d on opposite sides of ab, a and b on opposite sides of cd. */
+    dv x1 = {ab.y * ad.z - ab.z * ad.y, ab.z * ad.x - ab.x * ad.z, ab.x * ad.y - ab.y * ad.x};
+    if (dv_dot(x1, n) >= 0) return false;
+    dv cd = dv_sub(d, c), ca = dv_sub(a, c), cb = dv_sub(b, c);
+    dv y1 = {cd.y * ca.z - cd.z * ca.y, cd.z * ca.x - cd.x * ca.z, cd.x * ca.y - cd.y * ca.x};
+    dv y2 = {cd.y * cb.z - cd.z * cb.y, cd.z * cb.x - cd.x * cb.z, cd.x * cb.y - cd.y * cb.x};
+    return dv_dot(y1, y2) <= 0;
+}
+
+static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
+    g->ptol = tol;
+    /* Triangles around each vertex, for fan bounds. */
+    g->vt_start = calloc((size_t)vertex_count + 2, sizeof *g->vt_start);
+    g->vt_items = malloc(((size_t)g->tri_count * 3 + 1) * sizeof *g->vt_items);
+    if (!g->vt_start || !g->vt_items) return false;
+    for (size_t i = 0; i < (size_t)g->tri_count * 3; i++) g->vt_start[g->idx[i] + 2]++;
+    for (uint32_t v = 0; v < vertex_count; v++) g->vt_start[v + 2] += g->vt_start[v + 1];
+    for (size_t i = 0; i < (size_t)g->tri_count * 3; i++) g->vt_items[g->vt_start[g->idx[i] + 1]++] = (uint32_t)(i / 3);
+    size_t ne = (size_t)g->tri_count * 3;
+    g->partner = malloc((ne + 1) * sizeof *g->partner);
+    edge_rec *e = malloc((ne + 1) * sizeof *e);
+    if (!g->partner || !e) {
+        free(e);
+        return false;
+    }
+    for (size_t i = 0; i < ne; i++) {
+        uint32_t t = (uint32_t)(i / 3), k = (uint32_t)(i % 3);
+        uint32_t a = g->idx[3 * t + k], b = g->idx[3 * t + (k + 1) % 3];
+        e[i] = (edge_rec){a < b ? a : b, a < b ? b : a, t, k};
+        g->partner[i] = UINT32_MAX;
+    }
+    qsort(e, ne, sizeof *e, cmp_edge);
+    for (size_t i = 0; i + 1 < ne; i++) {
+        if (e[i].a != e[i + 1].a || e[i].b != e[i + 1].b) continue;
+        if (i + 2 < ne && e[i + 2].a == e[i].a && e[i + 2].b == e[i].b) continue; /* non-manifold edge */
+        uint32_t t1 = e[i].tri, t2 = e[i + 1].tri;
+        uint32_t c = g->idx[3 * t1 + (e[i].slot + 2) % 3], d = g->idx[3 * t2 + (e[i + 1].slot + 2) % 3];
+        if (convex_pair(vtx(g->pos, e[i].a), vtx(g->pos, e[i].b), vtx(g->pos, c), vtx(g->pos, d), tol)) {
+            g->partner[3 * (size_t)t1 + e[i].slot] = t2;
+            g->partner[3 * (size_t)t2 + e[i + 1].slot] = t1;
+        }
+    }
+    free(e);
+    return true;
+}
+
+/* Distance from p to the surface, searched out to `limit` (beyond it:
+ * INFINITY); *tri gets the nearest triangle (or UINT32_MAX). */
+static double grid_nearest(const tri_grid *g, dv p, double limit, uint32_t *tri) {
+    int c[3];
+    cell_of(g, p, c);
+    double best2 = INFINITY;
+    uint32_t bt = UINT32_MAX;
+    int maxr = g->n[0] + g->n[1] + g->n[2];
+    for (int r = 0; r <= maxr; r++) {
+        /* Every cell of ring r+1 and beyond is at least r cells away. */
+        double ring_min = (r - 1) * g->cell;
+        if (r > 0 && ring_min * ring_min > best2) break;
+        if (r > 0 && ring_min > limit) break;
+        for (int z = c[2] - r; z <= c[2] + r; z++) {
+            if (z < 0 || z >= g->n[2]) continue;
+            for (int y = c[1] - r; y <= c[1] + r; y++) {
+                if (y < 0 || y >= g->n[1]) continue;
+                bool shell_yz = z == c[2] - r || z == c[2] + r || y == c[1] - r || y == c[1] + r;
+                for (int x = c[0] - r; x <= c[0] + r; x += (shell_yz || r == 0) ? 1 : 2 * r) {
+                    if (x < 0 || x >= g->n[0]) continue;
+                    size_t ci = ((size_t)z * g->n[1] + y) * g->n[0] + x;
+                    if (g->start[ci] == g->start[ci + 1]) continue;
+                    /* Skip cells whose box is farther than the best so far. */
+                    const int cc[3] = {x, y, z};
+                    const double q[3] = {p.x, p.y, p.z};
+                    double box2 = 0;
+                    for (int k = 0; k < 3; k++) {
+                        double lo = g->lo[k] + cc[k] * g->cell, hi = lo + g->cell;
+                        double d = q[k] < lo ? lo - q[k] : q[k] > hi ? q[k] - hi : 0;
+                        box2 += d * d;
+                    }
+                    if (box2 >= best2) continue;
+                    for (uint32_t k = g->start[ci]; k < g->start[ci + 1]; k++) {
+                        uint32_t t = g->items[k];
+                        double d2 = dist2_point_tri(p, vtx(g->pos, g->idx[3 * t]), vtx(g->pos, g->idx[3 * t + 1]),
+                                                    vtx(g->pos, g->idx[3 * t + 2]));
+                        if (d2 < best2) {
+                            best2 = d2;
+                            bt = t;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    if (tri) *tri = bt;
+    double d = sqrt(best2);
+    return d <= limit ? d : INFINITY;
+}
+
+static double dist_to_tri(const tri_grid *g, dv p, uint32_t t) {
+    return sqrt(dist2_point_tri(p, vtx(g->pos, g->idx[3 * t]), vtx(g->pos, g->idx[3 * t + 1]), vtx(g->pos, g->idx[3 * t + 2])));
+}
+
+/* 2D cross of (b - a) x (c - a). */
+static double cross2(const double *a, const double *b, const double *c) {
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+static int cmp_pt2(const void *x, const void *y) {
+    const double *p = x, *q = y;
+    if (p[0] != q[0]) return p[0] < q[0] ? -1 : 1;
+    return p[1] < q[1] ? -1 : p[1] > q[1];
+}
+
+/* Bound over the piece (a, b, c) from the fan of triangles around vertex v
+ * that lie in the plane of triangle `ref`: if their union is a convex
+ * polygon (it equals its convex hull: same orientation, angles at v within
+ * a full turn, and area sum equal to the hull's area), the distance to it
+ * is convex, so its largest value over the piece is at a corner. Planar
+ * regions split into many triangles (cylinder strips, box faces, caps)
+ * then need no subdivision around their vertices. INFINITY if it does not
+ * apply. */
+static double fan_bound(const tri_grid *o, uint32_t v, uint32_t ref, dv a, dv b, dv c) {
+    dv r0 = vtx(o->pos, o->idx[3 * ref]), r1 = vtx(o->pos, o->idx[3 * ref + 1]), r2 = vtx(o->pos, o->idx[3 * ref + 2]);
+    dv e1 = dv_sub(r1, r0), e2 = dv_sub(r2, r0);
+    dv n = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
+    double nl = sqrt(dv_dot(n, n));
+    if (!(nl > 0)) return INFINITY;
+    n = (dv){n.x / nl, n.y / nl, n.z / nl};
+    dv u = dv_mad(e1, n, 0);
+    double ul = sqrt(dv_dot(u, u));
+    u = (dv){u.x / ul, u.y / ul, u.z / ul};
+    dv w = {n.y * u.z - n.z * u.y, n.z * u.x - n.x * u.z, n.x * u.y - n.y * u.x};
+    uint32_t fan[16];
+    int nf = 0;
+    double area = 0, angle = 0;
+    double pts[48][2];
+    int np = 0;
+    for (uint32_t k = o->vt_start[v]; k < o->vt_start[v + 1]; k++) {
+        uint32_t t = o->vt_items[k];
+        dv p[3];
+        bool in_plane = true;
+        for (int j = 0; j < 3; j++) {
+            p[j] = vtx(o->pos, o->idx[3 * t + (uint32_t)j]);
+            if (fabs(dv_dot(dv_sub(p[j], r0), n)) > o->ptol) in_plane = false;
+        }
+        if (!in_plane) continue;
+        dv f1 = dv_sub(p[1], p[0]), f2 = dv_sub(p[2], p[0]);
+        dv fn = {f1.y * f2.z - f1.z * f2.y, f1.z * f2.x - f1.x * f2.z, f1.x * f2.y - f1.y * f2.x};
+        if (!(dv_dot(fn, n) > 0)) return INFINITY; /* flipped or degenerate: no claim */
+        if (nf == 16) return INFINITY;
+        fan[nf++] = t;
+        area += 0.5 * sqrt(dv_dot(fn, fn));
+        /* angle at v */
+        int iv = o->idx[3 * t] == v ? 0 : o->idx[3 * t + 1] == v ? 1 : 2;
+        dv x1 = dv_sub(p[(iv + 1) % 3], p[iv]), x2 = dv_sub(p[(iv + 2) % 3], p[iv]);
+        double cs = dv_dot(x1, x2) / sqrt(dv_dot(x1, x1) * dv_dot(x2, x2));
+        angle += acos(cs < -1 ? -1 : cs > 1 ? 1 : cs);
+        for (int j = 0; j < 3; j++) {
+            dv d = dv_sub(p[j], r0);
+            pts[np][0] = dv_dot(d, u);
+            pts[np][1] = dv_dot(d, w);
+            np++;
+        }
+    }
+    if (nf < 2 || angle > 2 * 3.14159265358979323846 + 1e-9) return INFINITY;
+    /* Convex hull (monotone chain) of the fan's points, its area and
+     * perimeter. */
+    qsort(pts, (size_t)np, sizeof pts[0], cmp_pt2);
+    double hull[97][2];
+    int h = 0;
+    for (int i = 0; i < np; i++) {
+        while (h >= 2 && cross2(hull[h - 2], hull[h - 1], pts[i]) <= 0) h--;
+        hull[h][0] = pts[i][0];
+        hull[h][1] = pts[i][1];
+        h++;
+    }
+    for (int i = np - 2, lo = h + 1; i >= 0; i--) {
+        while (h >= lo && cross2(hull[h - 2], hull[h - 1], pts[i]) <= 0) h--;
+        hull[h][0] = pts[i][0];
+        hull[h][1] = pts[i][1];
+        h++;
+    }
+    double harea = 0, perim = 0;
+    for (int i = 0; i + 1 < h; i++) {
+        harea += 0.5 * (hull[i][0] * hull[i + 1][1] - hull[i + 1][0] * hull[i][1]);
+        perim += hypot(hull[i + 1][0] - hull[i][0], hull[i + 1][1] - hull[i][1]);
+    }
+    if (!(harea > 0) || !(fabs(harea - area) <= 1e-6 * harea)) return INFINITY;
+    /* What float rounding may leave uncovered: a sliver of the area
+     * mismatch is at most 2 * area / perimeter wide; plus the plane slack. */
+    double slack = 2 * fabs(harea - area) / perim + 2 * o->ptol;
+    double m = 0;
+    const dv q[3] = {a, b, c};
+    for (int j = 0; j < 3; j++) {
+        double best = INFINITY;
+        for (int k = 0; k < nf; k++) best = fmin(best, dist_to_tri(o, q[j], fan[k]));
+        m = fmax(m, best);
+    }
+    return m + slack;
+}
+
+typedef struct bb_ctx {
+    const tri_grid *other;
+    double lower;      /* largest exact point distance seen */
+    double upper;      /* largest accepted bound */
+    double resolution, limit;
+    uint64_t work;
+} bb_ctx;
+
+/* Bound of the distance from triangle (a, b, c) to the other surface. */
+static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double dc, uint32_t ta, uint32_t tb,
+                      uint32_t tc, int depth) {
+    for (;;) {
+        x->work++;
+        if (!isfinite(da) || !isfinite(db) || !isfinite(dc)) {
+            x->upper = INFINITY;
+            return;
+        }
+        /* Convexity: over the triangle, distance to one triangle t is at
+         * most the largest corner distance to t. */
+        double ub = INFINITY;
+        const uint32_t cand[3] = {ta, tb, tc};
+        const tri_grid *o = x->other;
+        for (int k = 0; k < 3; k++) {
+            uint32_t t = cand[k];
+            if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
+            double ta_ = dist_to_tri(o, a, t), tb_ = dist_to_tri(o, b, t), tc_ = dist_to_tri(o, c, t);
+            double m = fmax(ta_, fmax(tb_, tc_));
+            if (m < ub) ub = m;
+            /* The convex union with a coplanar neighbour. */
+            for (int j = 0; j < 3 && o->partner; j++) {
+                uint32_t q = o->partner[3 * (size_t)t + (size_t)j];
+                if (q == UINT32_MAX) continue;
+                /* + 2 ptol: "coplanar" allows float rounding, so the union
+                 * is convex only up to that distance. */
+                double mq = fmax(fmin(ta_, dist_to_tri(o, a, q)),
+                                 fmax(fmin(tb_, dist_to_tri(o, b, q)), fmin(tc_, dist_to_tri(o, c, q)))) + 2 * o->ptol;
+                if (mq < ub) ub = mq;
+            }
+        }
+        /* Planar fans around the candidates' vertices, where still needed. */
+        for (int k = 0; k < 3 && ub > x->lower + x->resolution && o->vt_start; k++) {
+            uint32_t t = cand[k];
+            if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
+            for (int j = 0; j < 3 && ub > x->lower + x->resolution; j++) {
+                double fb = fan_bound(o, o->idx[3 * t + (uint32_t)j], t, a, b, c);
+                if (fb < ub) ub = fb;
+            }
+        }
+        /* Lipschitz: every point is within the covering radius (at most the
+         * longest edge / sqrt 3) of a corner. */
+        dv ab = dv_sub(b, a), bc = dv_sub(c, b), ca = dv_sub(a, c);
+        double lab = dv_dot(ab, ab), lbc = dv_dot(bc, bc), lca = dv_dot(ca, ca);
+        double longest = sqrt(fmax(lab, fmax(lbc, lca)));
+        double lip = fmax(da, fmax(db, dc)) + longest / sqrt(3.0);
+        if (lip < ub) ub = lip;
+        /* Past the work cap a piece keeps the bound it has: still a bound,
+         * only looser, so a pathological mesh costs seconds, not hours. */
+        if (ub <= x->lower + x->resolution || depth >= 40 || longest <= x->resolution || x->work > 4000000ull) {
+            if (ub > x->upper) x->upper = ub;
+            return;
+        }
+        /* Bisect the longest edge: query the midpoint exactly. */
+        dv m;
+        uint32_t tm;
+        if (lab >= lbc && lab >= lca) {
+            m = dv_mad(a, ab, 0.5);
+            double dm = grid_nearest(x->other, m, x->limit, &tm);
+            if (dm > x->lower) x->lower = dm;
+            bound_tri(x, a, m, c, da, dm, dc, ta, tm, tc, depth + 1);
+            a = m; da = dm; ta = tm; /* second half: m, b, c */
+        } else if (lbc >= lca) {
+            m = dv_mad(b, bc, 0.5);
+            double dm = grid_nearest(x->other, m, x->limit, &tm);
+            if (dm > x->lower) x->lower = dm;
+            bound_tri(x, a, b, m, da, db, dm, ta, tb, tm, depth + 1);
+            b = m; db = dm; tb = tm; /* a, m, c */
+        } else {
+            m = dv_mad(c, ca, 0.5);
+            double dm = grid_nearest(x->other, m, x->limit, &tm);
+            if (dm > x->lower) x->lower = dm;
+            bound_tri(x, a, b, m, da, db, dm, ta, tb, tm, depth + 1);
+            a = m; da = dm; ta = tm; /* m, b, c */
+        }
+        depth++;
+    }
+}
+
+/* One direction: from surface `from` to the grid's surface. */
+static double directed_bound(const float *pos, uint32_t nv, const uint32_t *from, uint32_t from_count,
+                             const tri_grid *to, double resolution, double limit) {
+    bb_ctx x = {to, 0, 0, resolution, limit, 0};
+    double *d = malloc((size_t)nv * sizeof *d);
+    uint32_t *near = malloc((size_t)nv * sizeof *near);
+    if (!d || !near) {
+        free(d);
+        free(near);
+        return INFINITY;
+    }
+    for (uint32_t v = 0; v < nv; v++) d[v] = -1;
+    for (uint32_t i = 0; i < from_count; i++) {
+        uint32_t v = from[i];
+        if (d[v] >= 0) continue;
+        d[v] = grid_nearest(to, vtx(pos, v), limit, &near[v]);
+        if (d[v] > x.lower) x.lower = d[v];
+    }
+    x.upper = x.lower;
+    for (uint32_t t = 0; t + 2 < from_count && isfinite(x.upper); t += 3) {
+        uint32_t i0 = from[t], i1 = from[t + 1], i2 = from[t + 2];
+        bound_tri(&x, vtx(pos, i0), vtx(pos, i1), vtx(pos, i2), d[i0], d[i1], d[i2], near[i0], near[i1], near[i2], 0);
+    }
+    free(d);
+    free(near);
+    return x.upper;
+}
+
+double mr_lod_hausdorff_bound(const float *positions, uint32_t vertex_count, const uint32_t *a, uint32_t a_count,
+                              const uint32_t *b, uint32_t b_count, double resolution, double limit) {
+    if (!positions || vertex_count == 0 || !a || !b || a_count < 3 || b_count < 3) return INFINITY;
+    for (uint32_t i = 0; i < a_count; i++)
+        if (a[i] >= vertex_count) return INFINITY;
+    for (uint32_t i = 0; i < b_count; i++)
+        if (b[i] >= vertex_count) return INFINITY;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t v = 0; v < vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            double p = positions[3 * (size_t)v + (size_t)k];
+            if (p < lo[k]) lo[k] = p;
+            if (p > hi[k]) hi[k] = p;
+        }
+    if (!(resolution > 0)) resolution = 1e-6 * fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    if (!(resolution > 0)) resolution = 1e-12;
+    if (!(limit > 0)) limit = INFINITY;
+    tri_grid ga, gb;
+    /* Positions are float: a few ulps of the extent. */
+    double ptol = 1e-6 * fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    bool ok = grid_build(&ga, positions, a, a_count, lo, hi) && grid_build(&gb, positions, b, b_count, lo, hi);
+    if (!ok || !convex_partners(&ga, ptol, vertex_count) || !convex_partners(&gb, ptol, vertex_count)) {
+        grid_free(&ga);
+        grid_free(&gb);
+        return INFINITY;
+    }
+    double ab = directed_bound(positions, vertex_count, a, a_count, &gb, resolution, limit);
+    double ba = isfinite(ab) ? directed_bound(positions, vertex_count, b, b_count, &ga, resolution, limit) : INFINITY;
+    grid_free(&ga);
+    grid_free(&gb);
+    return fmax(ab, ba);
+}
+
+/* ---------------------------------------------------------- building */
+
+void mr_lod_destroy(mr_lod **lp) {
+    if (!lp || !*lp) return;
+    mr_lod *l = *lp;
+    for (int32_t i = 0; l->meshes && i < l->mesh_count; i++)
+        for (int32_t k = 0; k < l->meshes[i].level_count; k++) free(l->meshes[i].levels[k].indices);
+    free(l->meshes);
+    free(l);
+    *lp = NULL;
+}
+
+/* 64-bit hash (FNV-1a over 8-byte words, then a final mix): fast enough
+ * for hundreds of MB, and any change of geometry changes it. */
+static uint64_t hash_bytes(uint64_t h, const void *data, size_t n) {
+    const unsigned char *p = data;
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        uint64_t w;
+        memcpy(&w, p + i, 8);
+        h = (h ^ w) * 0x100000001b3ull;
+        h ^= h >> 29;
+    }
+    for (; i < n; i++) h = (h ^ p[i]) * 0x100000001b3ull;
+    return h;
+}
+
+uint64_t mr_lod_scene_hash(const mr_scene *s) {
+    uint64_t h = 0xcbf29ce484222325ull;
+    if (!s) return h;
+    h = hash_bytes(h, &s->mesh_count, sizeof s->mesh_count);
+    for (int32_t i = 0; i < s->mesh_count; i++) {
+        const mr_mesh *m = &s->meshes[i];
+        h = hash_bytes(h, &m->vertex_count, sizeof m->vertex_count);
+        h = hash_bytes(h, &m->index_count, sizeof m->index_count);
+        h = hash_bytes(h, m->positions, (size_t)m->vertex_count * 12);
+        h = hash_bytes(h, m->indices, (size_t)m->index_count * 4);
+    }
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdull;
+    h ^= h >> 33;
+    return h;
+}
+
+static void resolve(const mr_lod_params *in, mr_lod_params *p) {
+    mr_lod_params d = MR_LOD_DEFAULTS;
+    *p = in ? *in : d;
+    if (!(p->max_error > 0)) p->max_error = 0.02;
+    if (p->min_triangles == 0) p->min_triangles = 64;
+}
+
+/* Levels of one mesh: halving triangle targets from the full mesh, each
+ * certified; a level is kept if it saves triangles and its bound stays
+ * within max_error. */
+static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *out) {
+    memset(out, 0, sizeof *out);
+    if (m->index_count / 3 < p->min_triangles || m->vertex_count == 0) return true;
+    float scale = meshopt_simplifyScale(m->positions, m->vertex_count, 12);
+    if (!(scale > 0)) return true;
+    uint32_t *dst = malloc((size_t)m->index_count * sizeof *dst);
+    if (!dst) return false;
+    uint32_t prev = m->index_count;
+    double prev_err = 0;
+    for (int k = 1; k <= 12 && out->level_count < MR_LOD_MAX_LEVELS; k++) {
+        size_t target = (size_t)((double)m->index_count / (double)(1u << k)) / 3 * 3;
+        if (target < 12) break;
+        float est = 0;
+        size_t n = meshopt_simplify(dst, m->indices, m->index_count, m->positions, m->vertex_count, 12, target,
+                                    (float)(p->max_error / scale), 0, &est);
+        if (n < 3 || n > (size_t)(prev * 0.85)) {
+            if (n >= prev) break; /* the error cap stops it: coarser targets cannot do better */
+            continue;
+        }
+        /* Resolution: far below the errors that matter, coarse enough to
+         * keep the bisection cheap; it only ever adds to the bound. */
+        double res = fmax(0.1 * est * scale, fmax(0.01 * p->max_error, 1e-6 * scale));
+        double e = mr_lod_hausdorff_bound(m->positions, m->vertex_count, m->indices, m->index_count, dst, (uint32_t)n,
+                                          res, 2 * p->max_error);
+        if (!(e <= p->max_error)) break; /* coarser levels only get worse */
+        mr_lod_level *l = &out->levels[out->level_count];
+        l->indices = malloc(n * sizeof *l->indices);
+        if (!l->indices) {
+            free(dst);
+            return false;
+        }
+        memcpy(l->indices, dst, n * sizeof *dst);
+        l->index_count = (uint32_t)n;
+        /* Bounds only ever overstate: keep them increasing for the renderer. */
+        l->error = e > prev_err ? e : prev_err;
+        prev_err = l->error;
+        prev = (uint32_t)n;
+        out->level_count++;
+    }
+    free(dst);
+    return true;
+}
+
+/* Meshes are independent: workers take the next mesh from a shared
+ * counter, largest meshes first so the last one does not run alone. */
+typedef struct build_job {
+    const mr_scene *s;
+    const mr_lod_params *p;
+    mr_lod *l;
+    const int32_t *order;
+    pthread_mutex_t lock;
+    int32_t next, done;
+    int32_t failed;          /* mesh that ran out of memory, or -1 */
+    double t0;
+    bool shown;
+} build_job;
+
+static void *build_worker(void *arg) {
+    build_job *j = arg;
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        int32_t k = j->failed < 0 && j->next < j->s->mesh_count ? j->next++ : -1;
+        pthread_mutex_unlock(&j->lock);
+        if (k < 0) return NULL;
+        int32_t i = j->order[k];
+        bool ok = build_mesh(&j->s->meshes[i], j->p, &j->l->meshes[i]);
+        pthread_mutex_lock(&j->lock);
+        if (!ok && j->failed < 0) j->failed = i;
+        j->done++;
+        if (j->p->progress && mr_time_now() - j->t0 > 1.0) {
+            fprintf(stderr, "\rLOD: mesh %d of %d   ", (int)j->done, (int)j->s->mesh_count);
+            fflush(stderr);
+            j->shown = true;
+        }
+        pthread_mutex_unlock(&j->lock);
+    }
+}
+
+mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *err) {
+    if (!s) {
+        mr_fail(err, MR_ERR_INVALID, "no scene");
+        return NULL;
+    }
+    mr_lod_params p;
+    resolve(params, &p);
+    mr_lod *l = calloc(1, sizeof *l);
+    if (l) l->meshes = calloc((size_t)s->mesh_count + 1, sizeof *l->meshes);
+    int32_t *order = malloc(((size_t)s->mesh_count + 1) * sizeof *order);
+    if (!l || !l->meshes || !order) {
+        free(order);
+        mr_lod_destroy(&l);
+        mr_fail(err, MR_ERR_NOMEM, "out of memory for LOD levels");
+        return NULL;
+    }
+    l->mesh_count = s->mesh_count;
+    l->scene_hash = mr_lod_scene_hash(s);
+    /* Largest first (insertion sort: mesh counts are small; very large
+     * counts keep file order). */
+    for (int32_t i = 0; i < s->mesh_count; i++) order[i] = i;
+    for (int32_t i = 1; i < s->mesh_count && s->mesh_count <= 4096; i++) {
+        int32_t v = order[i], k = i;
+        while (k > 0 && s->meshes[order[k - 1]].index_count < s->meshes[v].index_count) {
+            order[k] = order[k - 1];
+            k--;
+        }
+        order[k] = v;
+    }
+    build_job j;
+    memset(&j, 0, sizeof j);
+    j.s = s;
+    j.p = &p;
+    j.l = l;
+    j.order = order;
+    j.failed = -1;
+    j.t0 = mr_time_now();
+    pthread_mutex_init(&j.lock, NULL);
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    int nthreads = ncpu < 1 ? 1 : ncpu > 16 ? 16 : (int)ncpu;
+    if (nthreads > s->mesh_count) nthreads = s->mesh_count > 0 ? s->mesh_count : 1;
+    pthread_t threads[16];
+    int started = 0;
+    for (int t = 1; t < nthreads; t++)
+        if (pthread_create(&threads[started], NULL, build_worker, &j) == 0) started++;
+    build_worker(&j); /* this thread works too */
+    for (int t = 0; t < started; t++) pthread_join(threads[t], NULL);
+    pthread_mutex_destroy(&j.lock);
+    free(order);
+    if (j.shown) fprintf(stderr, "\r%40s\r", "");
+    if (j.failed >= 0) {
+        mr_fail(err, MR_ERR_NOMEM, "out of memory simplifying mesh '%s'", s->meshes[j.failed].name);
+        mr_lod_destroy(&l);
+        return NULL;
+    }
+    return l;
+}
+
+/* -------------------------------------------------------------- cache */
+
+#define CACHE_MAGIC "MRLOD\r\n\x1a"
+#define CACHE_VERSION 1u /* bump whenever simplification or certification changes */
+
+void mr_lod_cache_path(const char *scene_path, char *out, size_t n) {
+    snprintf(out, n, "%s.mrlod", scene_path ? scene_path : "scene");
+}
+
+typedef struct wbuf {
+    unsigned char *p;
+    size_t n, cap;
+    bool oom;
+} wbuf;
+
+static void put(wbuf *b, const void *d, size_t n) {
+    if (b->oom) return;
+    if (b->n + n > b->cap) {
+        size_t c = b->cap ? b->cap : 4096;
+        while (c < b->n + n) c *= 2;
+        unsigned char *q = realloc(b->p, c);
+        if (!q) { b->oom = true; return; }
+        b->p = q;
+        b->cap = c;
+    }
+    memcpy(b->p + b->n, d, n);
+    b->n += n;
+}
+
+static bool cache_write(const mr_lod *l, const mr_lod_params *p, const char *path, mr_error *err) {
+    wbuf b = {0};
+    uint32_t ver = CACHE_VERSION, mc = (uint32_t)l->mesh_count, mt = p->min_triangles;
+    put(&b, CACHE_MAGIC, 8);
+    put(&b, &ver, 4);
+    put(&b, &mc, 4);
+    put(&b, &l->scene_hash, 8);
+    put(&b, &p->max_error, 8);
+    put(&b, &mt, 4);
+    for (int32_t i = 0; i < l->mesh_count; i++) {
+        uint32_t lc = (uint32_t)l->meshes[i].level_count;
+        put(&b, &lc, 4);
+        for (uint32_t k = 0; k < lc; k++) {
+            const mr_lod_level *lv = &l->meshes[i].levels[k];
+            put(&b, &lv->index_count, 4);
+            put(&b, &lv->error, 8);
+            put(&b, lv->indices, (size_t)lv->index_count * 4);
+        }
+    }
+    uint64_t sum = b.oom ? 0 : hash_bytes(0x9e3779b97f4a7c15ull, b.p, b.n);
+    put(&b, &sum, 8);
+    bool ok = !b.oom && mr_file_write_atomic(path, b.p, b.n, err);
+    if (b.oom) mr_fail(err, MR_ERR_NOMEM, "out of memory writing %s", path);
+    free(b.p);
+    return ok;
+}
+
+typedef struct rbuf {
+    const unsigned char *p;
+    size_t n, at;
+} rbuf;
+
+static bool get(rbuf *r, void *d, size_t n) {
+    if (n > r->n - r->at) return false;
+    memcpy(d, r->p + r->at, n);
+    r->at += n;
+    return true;
+}
+
+/* NULL (with the reason in *why) unless the file holds levels for exactly
+ * this geometry and these params, intact and in range. */
+static mr_lod *cache_read(const mr_scene *s, const mr_lod_params *p, const char *path, const char **why) {
+    size_t size = 0;
+    mr_error e;
+    unsigned char *data = mr_file_read(path, &size, 0, &e);
+    if (!data) {
+        *why = "no cache";
+        return NULL;
+    }
+    rbuf r = {data, size, 0};
+    char magic[8];
+    uint32_t ver, mc, mt;
+    uint64_t hash, sum;
+    double maxe;
+    mr_lod *l = NULL;
+    *why = "not a LOD cache";
+    if (size < 8 + 8 || !get(&r, magic, 8) || memcmp(magic, CACHE_MAGIC, 8) != 0) goto out;
+    memcpy(&sum, data + size - 8, 8);
+    *why = "checksum mismatch (truncated or damaged)";
+    if (hash_bytes(0x9e3779b97f4a7c15ull, data, size - 8) != sum) goto out;
+    r.n = size - 8;
+    *why = "written for another scene or other settings";
+    if (!get(&r, &ver, 4) || ver != CACHE_VERSION || !get(&r, &mc, 4) || mc != (uint32_t)s->mesh_count ||
+        !get(&r, &hash, 8) || hash != mr_lod_scene_hash(s) || !get(&r, &maxe, 8) || maxe != p->max_error ||
+        !get(&r, &mt, 4) || mt != p->min_triangles)
+        goto out;
+    l = calloc(1, sizeof *l);
+    if (!l || !(l->meshes = calloc((size_t)mc + 1, sizeof *l->meshes))) {
+        *why = "out of memory";
+        goto fail;
+    }
+    l->mesh_count = (int32_t)mc;
+    l->scene_hash = hash;
+    *why = "malformed";
+    for (uint32_t i = 0; i < mc; i++) {
+        const mr_mesh *m = &s->meshes[i];
+        uint32_t lc;
+        if (!get(&r, &lc, 4) || lc > MR_LOD_MAX_LEVELS) goto fail;
+        double prev = 0;
+        for (uint32_t k = 0; k < lc; k++) {
+            mr_lod_level *lv = &l->meshes[i].levels[k];
+            if (!get(&r, &lv->index_count, 4) || !get(&r, &lv->error, 8)) goto fail;
+            if (lv->index_count == 0 || lv->index_count % 3 || lv->index_count > m->index_count ||
+                !(lv->error >= prev) || !isfinite(lv->error) || (size_t)lv->index_count * 4 > r.n - r.at)
+                goto fail;
+            prev = lv->error;
+            lv->indices = malloc((size_t)lv->index_count * 4);
+            if (!lv->indices) goto fail;
+            l->meshes[i].level_count = (int32_t)k + 1;
+            get(&r, lv->indices, (size_t)lv->index_count * 4);
+            for (uint32_t j = 0; j < lv->index_count; j++)
+                if (lv->indices[j] >= m->vertex_count) goto fail;
+        }
+    }
+    if (r.at != r.n) goto fail;
+    *why = NULL;
+    goto out;
+fail:
+    mr_lod_destroy(&l);
+out:
+    free(data);
+    return l;
+}
+
+mr_lod *mr_lod_load_or_build(const mr_scene *s, const char *cache_path, const mr_lod_params *params,
+                             mr_lod_info *info, mr_error *err) {
+    mr_lod_info li;
+    memset(&li, 0, sizeof li);
+    if (!s) {
+        mr_fail(err, MR_ERR_INVALID, "no scene");
+        return NULL;
+    }
+    mr_lod_params p;
+    resolve(params, &p);
+    mr_lod *l = NULL;
+    if (cache_path) {
+        const char *why = NULL;
+        l = cache_read(s, &p, cache_path, &why);
+        if (l) li.from_cache = true;
+        else if (why && strcmp(why, "no cache") != 0)
+            mr_log(MR_LOG_WARN, "%s: ignored (%s); rebuilding the LOD levels", cache_path, why);
+    }
+    if (!l) {
+        double t0 = mr_time_now();
+        l = mr_lod_build(s, &p, err);
+        if (!l) return NULL;
+        li.build_s = mr_time_now() - t0;
+        if (cache_path) {
+            mr_error we = {0};
+            li.cache_written = cache_write(l, &p, cache_path, &we);
+            if (!li.cache_written) mr_log(MR_LOG_WARN, "LOD cache not written: %s", we.msg);
+        }
+    }
+    for (int32_t i = 0; i < l->mesh_count; i++) li.levels += (uint64_t)l->meshes[i].level_count;
+    if (info) *info = li;
+    return l;
+}
