@@ -34,6 +34,14 @@ struct mr_renderer {
     GLuint video_tex;
     int video_w, video_h;
     GLuint queries[MR_MAX_PASSES];
+    /* The last finished frame, for showing it in a window and for picking. */
+    struct {
+        bool valid;
+        GLuint tex;            /* texture holding the finished image */
+        mr_camera cam;         /* at the output size */
+        mr_dmat4 world_from_camera;
+        double near_plane;
+    } last;
 };
 
 typedef struct frame {
