@@ -1,0 +1,1 @@
+#include "mr_session.h"

@@ -1,0 +1,232 @@
+/* mr_track.h — the tracked camera: marker map, AprilTag detection, camera
+ * pose from all seen tags (PnP through OpenCV, behind pnp.cc), the One Euro
+ * pose filter, and frame sources (V4L2, video files, image files and
+ * sequences; recordings plug in through mr_source_ops).
+ *
+ * Conventions (shared DESIGN.md §2):
+ *  - pixel coordinates follow OpenCV: the centre of the top-left pixel is
+ *    (0,0), x right, y down. Detected corners are reported in this
+ *    convention (the apriltag library's own +0.5 offset is removed);
+ *  - a tag's frame has its origin at the tag centre, x right, y down as seen
+ *    facing the tag, z into the surface; the four corners, in the apriltag
+ *    library's order, are (-s/2,+s/2), (+s/2,+s/2), (+s/2,-s/2), (-s/2,-s/2)
+ *    with s the edge of the black square (`tag_size`, scene units);
+ *  - a pose is world_from_camera (row-major double 4x4, OpenCV camera axes).
+ *
+ * No OpenCV or C++ type crosses this header.
+ */
+#ifndef MR_TRACK_H
+#define MR_TRACK_H
+
+#include "mr_core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------ marker map */
+
+typedef struct mr_marker {
+    int id;                  /* tag id in the family */
+    mr_dmat4 world_from_tag; /* rigid */
+} mr_marker;
+
+typedef struct mr_marker_map {
+    char family[32];         /* "tag36h11", ... */
+    double tag_size;         /* black-square edge, scene units, > 0 */
+    mr_marker *tags;         /* count tags, unique ids */
+    int count;
+} mr_marker_map;
+
+/* {"family": "tag36h11", "tag_size": 0.4, "tags": [{"id": 0,
+ *   "world_from_tag": [16]}, ...]}. Refuses duplicate ids, a tag size <= 0,
+ * non-rigid transforms and unknown families. */
+bool mr_marker_map_from_json(const cJSON *obj, mr_marker_map *map, mr_error *err);
+bool mr_marker_map_parse(const char *text, size_t size, mr_marker_map *map, mr_error *err);
+bool mr_marker_map_load(const char *path, mr_marker_map *map, mr_error *err);
+cJSON *mr_marker_map_to_json(const mr_marker_map *map);
+void mr_marker_map_free(mr_marker_map *map); /* zeroes the struct */
+const mr_marker *mr_marker_map_find(const mr_marker_map *map, int id);
+/* World positions of the four corners of tag m, apriltag order. */
+void mr_marker_corners_world(const mr_marker_map *map, const mr_marker *m, mr_dvec3 out[4]);
+/* Corners in the tag frame (z = 0), apriltag order. */
+void mr_marker_corners_tag(double tag_size, mr_dvec3 out[4]);
+
+/* Camera JSON from memory (the reader behind mr_camera_load; fuzzed). */
+bool mr_camera_parse(const char *text, size_t size, mr_camera *cam, mr_error *err);
+
+/* Is `name` a tag family the detector knows? */
+bool mr_tag_family_known(const char *name);
+
+/* ------------------------------------------------------------- detection */
+
+typedef struct mr_detection {
+    int id;
+    int hamming;             /* bits corrected */
+    double decision_margin;  /* apriltag's decode confidence */
+    double corners[4][2];    /* pixels, OpenCV convention, apriltag order */
+} mr_detection;
+
+typedef struct mr_detector_params {
+    const char *family;      /* default "tag36h11" */
+    double decimate;         /* quad_decimate >= 1; 0 = default 2.0 */
+    int threads;             /* worker threads; 0 = default 1 */
+    int refine_edges;        /* 1 on, -1 off, 0 = default (on) */
+    double sharpening;       /* decode_sharpening; 0 = default 0.25, < 0 = none */
+    double blur;             /* quad_sigma in px (Gaussian before quads); 0 = none */
+    int max_hamming;         /* detections with more corrected bits are dropped;
+                                0 = default 1, < 0 = 0 */
+} mr_detector_params;
+#define MR_DETECTOR_DEFAULTS {NULL, 0.0, 0, 0, 0.0, 0.0, 0}
+
+/* Frames smaller than this on either side are refused: the apriltag 3.3
+ * library crashes on 1x1 images, and no tag fits in fewer pixels anyway. */
+#define MR_DETECTOR_MIN_SIDE 16
+
+typedef struct mr_detector mr_detector;
+mr_detector *mr_detector_create(const mr_detector_params *params, mr_error *err);
+void mr_detector_destroy(mr_detector **det);
+/* Detects tags in an 8-bit image (1, 3 or 4 channels; colour is converted to
+ * grey). Returns an array of *count detections sorted by id, owned by the
+ * detector and valid until the next call; NULL + err on failure (a frame
+ * that is too small, a bad image). Zero detections is success. */
+const mr_detection *mr_detector_detect(mr_detector *det, const mr_image *img, int *count, mr_error *err);
+
+/* ------------------------------------------------------------------ pose */
+
+typedef struct mr_pose_params {
+    double outlier_px;       /* a tag whose corner RMS exceeds this is dropped,
+                                default 3.0 px */
+    double max_rms_px;       /* no pose when the final RMS exceeds this,
+                                default 4.0 px */
+    double ambiguity_px;     /* single tag: IPPE solutions within this RMS of
+                                the best count as ambiguous, default 1.0 px */
+    double min_tag_px;       /* tags with a shorter edge are ignored, default 8 px */
+} mr_pose_params;
+#define MR_POSE_DEFAULTS {0.0, 0.0, 0.0, 0.0}
+
+#define MR_POSE_MAX_IDS 32
+
+typedef struct mr_pose {
+    bool valid;
+    mr_dmat4 world_from_camera;
+    int tags_seen;           /* detections that are in the map */
+    int tags_used;           /* after outlier rejection */
+    int ids_used[MR_POSE_MAX_IDS];
+    double rms_px;           /* reprojection RMS over used corners, pixels */
+    bool ambiguous;          /* single tag with two plausible IPPE solutions;
+                                the one nearest the previous pose was kept */
+} mr_pose;
+
+/* Camera pose from the detections: corners undistorted, candidate poses from
+ * each tag's two IPPE solutions, the candidate that most tags agree with
+ * (ties: nearest the previous pose, then lowest error), Levenberg-Marquardt
+ * refinement over all inlier corners, outlier tags dropped. `prev` (may be
+ * NULL or invalid) keeps a single tag from flipping. Returns false + err only
+ * on bad arguments; "no pose" is out->valid == false. */
+bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_detection *dets, int count,
+                   const mr_pose *prev, const mr_pose_params *params, mr_pose *out, mr_error *err);
+
+/* Projects a world point with the camera model; false if behind the camera. */
+bool mr_project_point(const mr_camera *cam, const mr_dmat4 *world_from_camera, mr_dvec3 p, double *u, double *v);
+
+/* Pose differences: translation distance (scene units) and rotation angle
+ * (degrees) between two rigid transforms. */
+double mr_pose_dist(const mr_dmat4 *a, const mr_dmat4 *b);
+double mr_pose_angle_deg(const mr_dmat4 *a, const mr_dmat4 *b);
+
+/* Rotation vector (axis * angle, radians) <-> rotation matrix (3x3 row-major). */
+void mr_rotvec_to_mat(const double rv[3], double R[9]);
+void mr_mat_to_rotvec(const double R[9], double rv[3]);
+
+/* ---------------------------------------------------------------- filter */
+
+typedef struct mr_filter_params {
+    double min_cutoff;       /* One Euro cutoff at rest, Hz; default 0.5 */
+    double beta;             /* cutoff increase per unit speed (1/scene unit for
+                                translation); default 2.0 */
+    double d_cutoff;         /* cutoff for the speed estimate, Hz; default 1.0 */
+    double rot_min_cutoff;   /* for rotation, Hz; default 0.5 */
+    double rot_beta;         /* per rad/s; default 1.0 */
+    double jump_dist;        /* reset when the raw pose moves more than this
+                                between frames, scene units; default 0.5 */
+    double jump_deg;         /* ... or turns more than this; default 20 */
+    double max_gap_s;        /* reset after a gap longer than this; default 0.5 s */
+} mr_filter_params;
+#define MR_FILTER_DEFAULTS {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}
+
+typedef struct mr_pose_filter mr_pose_filter;
+mr_pose_filter *mr_pose_filter_create(const mr_filter_params *params, mr_error *err);
+void mr_pose_filter_destroy(mr_pose_filter **f);
+void mr_pose_filter_reset(mr_pose_filter *f);
+/* While frozen the output stays at the last filtered pose whatever comes in
+ * (a check on a still image); unfreezing resets the filter. */
+void mr_pose_filter_freeze(mr_pose_filter *f, bool frozen);
+bool mr_pose_filter_frozen(const mr_pose_filter *f);
+/* Feeds a raw pose at time t (seconds, increasing). *out gets the filtered
+ * pose. Returns true if the filter reset on this sample (first sample, jump,
+ * gap or time going backwards). */
+bool mr_pose_filter_update(mr_pose_filter *f, double t, const mr_dmat4 *raw, mr_dmat4 *out);
+/* The last output (identity before the first sample); false if none yet. */
+bool mr_pose_filter_last(const mr_pose_filter *f, mr_dmat4 *out);
+
+/* ---------------------------------------------------------- frame sources */
+
+typedef struct mr_frame {
+    mr_image image;          /* 8-bit, 1 or 3 channels; owned by the source,
+                                valid until the next read */
+    double timestamp;        /* seconds (source clock; sequences: index / fps) */
+    int64_t index;           /* 0-based, in source order */
+    char name[256];          /* file name for image sequences, else "" */
+} mr_frame;
+
+typedef enum mr_read_status { MR_READ_FRAME = 0, MR_READ_END = 1, MR_READ_ERROR = 2 } mr_read_status;
+
+typedef struct mr_source_params {
+    int width, height;       /* V4L2: requested size; 0 = default 1280x720 */
+    double fps;              /* V4L2: requested rate; image sequences: the
+                                timestamp step; 0 = default 30 */
+    const char *pixel_format;/* V4L2: "YUYV" or "MJPG"; NULL = try YUYV, then MJPG */
+    int retries;             /* V4L2: reopen attempts after the device vanished,
+                                default 5 (< 0 = none) */
+    double retry_s;          /* seconds between attempts, default 1.0 */
+    bool gray;               /* deliver grey frames (cheaper for tracking) */
+} mr_source_params;
+#define MR_SOURCE_DEFAULTS {0, 0, 0.0, NULL, 0, 0.0, false}
+
+/* A source kind implemented elsewhere (e.g. recordings in lib/session). */
+typedef struct mr_source_ops {
+    const char *kind;
+    mr_read_status (*read)(void *impl, mr_frame *frame, mr_error *err);
+    void (*close)(void *impl);
+} mr_source_ops;
+
+typedef struct mr_source mr_source;
+/* Opens /dev/videoN (V4L2), a folder of images (sorted by name), a single
+ * image file, or a video file (anything else, through OpenCV). */
+mr_source *mr_source_open(const char *uri, const mr_source_params *params, mr_error *err);
+mr_source *mr_source_from_ops(const mr_source_ops *ops, void *impl, mr_error *err);
+void mr_source_close(mr_source **src);
+const char *mr_source_kind(const mr_source *src); /* "v4l2", "images", "video", ... */
+/* MR_READ_FRAME: *frame is filled. MR_READ_END: no more frames. MR_READ_ERROR:
+ * err says why; for live devices the source already retried. Frames that
+ * cannot be decoded are skipped with a warning on the log. */
+mr_read_status mr_source_read(mr_source *src, mr_frame *frame, mr_error *err);
+
+/* V4L2 directly (mr_source_open uses it for /dev/... paths). */
+mr_source *mr_source_open_v4l2(const char *device, const mr_source_params *params, mr_error *err);
+
+/* ------------------------------------------------------- image coding */
+
+/* JPEG / PNG encoding and decoding through OpenCV (used for recordings and
+ * MJPEG). encode: *data is malloc'd. quality 1..100 for JPEG. */
+bool mr_image_encode(const mr_image *img, const char *ext, int quality, void **data, size_t *size, mr_error *err);
+bool mr_image_decode(const void *data, size_t size, int channels, mr_image *img, mr_error *err);
+
+/* Grey conversion (Rec. 601 luma) of an 8-bit image with 1, 3 or 4 channels. */
+bool mr_image_to_gray(const mr_image *src, mr_image *dst, mr_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

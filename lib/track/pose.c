@@ -1,0 +1,307 @@
+/* Camera pose from AprilTag detections against the marker map. */
+#include "track_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_TAGS 64
+#define MAX_CAND (2 * MAX_TAGS + 1)
+
+void mr_rotvec_to_mat(const double rv[3], double R[9]) {
+    double th = sqrt(rv[0] * rv[0] + rv[1] * rv[1] + rv[2] * rv[2]);
+    double x = 0, y = 0, z = 0, s = sin(th), c = cos(th), C = 1 - c;
+    if (th > 1e-12) {
+        x = rv[0] / th;
+        y = rv[1] / th;
+        z = rv[2] / th;
+    } else {
+        /* First order: R = I + [rv]x. */
+        R[0] = 1; R[1] = -rv[2]; R[2] = rv[1];
+        R[3] = rv[2]; R[4] = 1; R[5] = -rv[0];
+        R[6] = -rv[1]; R[7] = rv[0]; R[8] = 1;
+        return;
+    }
+    R[0] = c + x * x * C;     R[1] = x * y * C - z * s; R[2] = x * z * C + y * s;
+    R[3] = y * x * C + z * s; R[4] = c + y * y * C;     R[5] = y * z * C - x * s;
+    R[6] = z * x * C - y * s; R[7] = z * y * C + x * s; R[8] = c + z * z * C;
+}
+
+void mr_mat_to_rotvec(const double R[9], double rv[3]) {
+    double tr = R[0] + R[4] + R[8];
+    double c = 0.5 * (tr - 1);
+    c = c > 1 ? 1 : c < -1 ? -1 : c;
+    double th = acos(c);
+    double v[3] = {R[7] - R[5], R[2] - R[6], R[3] - R[1]};
+    double s2 = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); /* = 2 sin(th) */
+    if (th < 1e-9) {
+        rv[0] = 0.5 * v[0];
+        rv[1] = 0.5 * v[1];
+        rv[2] = 0.5 * v[2];
+        return;
+    }
+    if (th > M_PI - 1e-4 || s2 < 1e-9) {
+        /* Near pi the antisymmetric part vanishes: take the axis from the
+         * largest diagonal of (R + I) / 2 = a a^T. */
+        double a[3];
+        int k = R[0] >= R[4] && R[0] >= R[8] ? 0 : R[4] >= R[8] ? 1 : 2;
+        double d = sqrt(fmax(0.0, 0.5 * (R[4 * k] + 1)));
+        a[k] = d;
+        for (int j = 0; j < 3; j++)
+            if (j != k) a[j] = d > 1e-12 ? 0.5 * (R[3 * k + j] + R[3 * j + k]) / (2 * d) : 0;
+        /* Sign from the (small) antisymmetric part, if any. */
+        if (a[0] * v[0] + a[1] * v[1] + a[2] * v[2] < 0) { a[0] = -a[0]; a[1] = -a[1]; a[2] = -a[2]; }
+        double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        for (int j = 0; j < 3; j++) rv[j] = n > 0 ? a[j] / n * th : 0;
+        return;
+    }
+    for (int j = 0; j < 3; j++) rv[j] = v[j] / s2 * th;
+}
+
+double mr_pose_dist(const mr_dmat4 *a, const mr_dmat4 *b) {
+    return mr_v3_len(mr_v3(a->m[3] - b->m[3], a->m[7] - b->m[7], a->m[11] - b->m[11]));
+}
+
+double mr_pose_angle_deg(const mr_dmat4 *a, const mr_dmat4 *b) {
+    /* angle of Ra^T Rb from its trace */
+    double tr = 0;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) tr += a->m[r * 4 + c] * b->m[r * 4 + c];
+    double c = 0.5 * (tr - 1);
+    c = c > 1 ? 1 : c < -1 ? -1 : c;
+    return acos(c) * 180.0 / M_PI;
+}
+
+bool mr_project_point(const mr_camera *cam, const mr_dmat4 *wfc, mr_dvec3 p, double *u, double *v) {
+    mr_dmat4 cfw = mr_m4_invert_rigid(wfc);
+    mr_dvec3 q = mr_m4_point(&cfw, p);
+    if (!(q.z > 1e-12 * (fabs(q.x) + fabs(q.y) + 1e-300))) return false;
+    double xd, yd;
+    mr_camera_distort(cam, q.x / q.z, q.y / q.z, &xd, &yd);
+    *u = cam->fx * xd + cam->cx;
+    *v = cam->fy * yd + cam->cy;
+    return true;
+}
+
+/* camera_from_world as R (row-major 3x3) + t. */
+typedef struct rt { double R[9], t[3]; } rt;
+
+static mr_dmat4 rt_to_m4(const rt *x) {
+    mr_dmat4 m = mr_m4_identity();
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 3; c++) m.m[r * 4 + c] = x->R[r * 3 + c];
+        m.m[r * 4 + 3] = x->t[r];
+    }
+    return m;
+}
+
+static rt m4_to_rt(const mr_dmat4 *m) {
+    rt x;
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 3; c++) x.R[r * 3 + c] = m->m[r * 4 + c];
+        x.t[r] = m->m[r * 4 + 3];
+    }
+    return x;
+}
+
+typedef struct tag_obs {
+    int id;
+    double world[4][3];  /* corners in the world */
+    double norm[4][2];   /* undistorted normalised image points */
+} tag_obs;
+
+/* RMS reprojection error of one tag under camera_from_world x, in pixels
+ * (normalised residuals scaled by the focal lengths); INFINITY if a corner
+ * is behind the camera. */
+static double tag_rms(const mr_camera *cam, const rt *x, const tag_obs *o) {
+    double s = 0;
+    for (int k = 0; k < 4; k++) {
+        const double *p = o->world[k];
+        double q[3];
+        for (int r = 0; r < 3; r++) q[r] = x->R[3 * r] * p[0] + x->R[3 * r + 1] * p[1] + x->R[3 * r + 2] * p[2] + x->t[r];
+        if (!(q[2] > 0)) return INFINITY;
+        double du = cam->fx * (q[0] / q[2] - o->norm[k][0]), dv = cam->fy * (q[1] / q[2] - o->norm[k][1]);
+        s += du * du + dv * dv;
+    }
+    return sqrt(s / 4);
+}
+
+typedef struct cand {
+    rt x;
+    int inliers;
+    double sse;      /* sum of squared per-tag RMS over inliers */
+    double rms;      /* RMS over inlier corners */
+} cand;
+
+static void score(const mr_camera *cam, const tag_obs *obs, int n, double outlier_px, cand *c) {
+    c->inliers = 0;
+    c->sse = 0;
+    for (int i = 0; i < n; i++) {
+        double e = tag_rms(cam, &c->x, &obs[i]);
+        if (e <= outlier_px) {
+            c->inliers++;
+            c->sse += e * e;
+        }
+    }
+    c->rms = c->inliers ? sqrt(c->sse / c->inliers) : INFINITY;
+}
+
+static bool refine(const tag_obs *obs, const bool *use, int n, rt *x) {
+    double o[MAX_TAGS * 12], p[MAX_TAGS * 8];
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        if (!use[i]) continue;
+        for (int k = 0; k < 4; k++) {
+            memcpy(&o[3 * m], obs[i].world[k], 3 * sizeof(double));
+            memcpy(&p[2 * m], obs[i].norm[k], 2 * sizeof(double));
+            m++;
+        }
+    }
+    return m >= 4 && mr_cv_refine_lm(o, p, m, x->R, x->t);
+}
+
+bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_detection *dets, int count,
+                   const mr_pose *prev, const mr_pose_params *params, mr_pose *out, mr_error *err) {
+    memset(out, 0, sizeof *out);
+    out->world_from_camera = mr_m4_identity();
+    if (!cam || !map || (count > 0 && !dets) || count < 0) return mr_fail(err, MR_ERR_INVALID, "pose: bad arguments");
+    if (!mr_camera_validate(cam, err)) return false;
+    mr_pose_params p = params ? *params : (mr_pose_params)MR_POSE_DEFAULTS;
+    double outlier_px = p.outlier_px > 0 ? p.outlier_px : 3.0;
+    double max_rms = p.max_rms_px > 0 ? p.max_rms_px : 4.0;
+    double amb_px = p.ambiguity_px > 0 ? p.ambiguity_px : 1.0;
+    double min_tag = p.min_tag_px > 0 ? p.min_tag_px : 8.0;
+
+    tag_obs obs[MAX_TAGS];
+    int n = 0;
+    for (int i = 0; i < count && n < MAX_TAGS; i++) {
+        const mr_marker *m = mr_marker_map_find(map, dets[i].id);
+        if (!m) continue;
+        /* One detection per id: the detector sorts by id, best first. */
+        if (n > 0 && obs[n - 1].id == dets[i].id) continue;
+        out->tags_seen++;
+        double edge = INFINITY;
+        bool ok = true;
+        for (int k = 0; k < 4; k++) {
+            const double *a = dets[i].corners[k], *b = dets[i].corners[(k + 1) % 4];
+            if (!isfinite(a[0]) || !isfinite(a[1])) ok = false;
+            edge = fmin(edge, hypot(b[0] - a[0], b[1] - a[1]));
+        }
+        if (!ok || edge < min_tag) continue;
+        tag_obs *o = &obs[n];
+        o->id = dets[i].id;
+        mr_dvec3 w[4];
+        mr_marker_corners_world(map, m, w);
+        for (int k = 0; k < 4 && ok; k++) {
+            o->world[k][0] = w[k].x;
+            o->world[k][1] = w[k].y;
+            o->world[k][2] = w[k].z;
+            ok = mr_camera_undistort(cam, (dets[i].corners[k][0] - cam->cx) / cam->fx,
+                                     (dets[i].corners[k][1] - cam->cy) / cam->fy, &o->norm[k][0], &o->norm[k][1]);
+        }
+        if (ok) n++;
+    }
+    if (n == 0) return true;
+
+    /* Candidates: both IPPE solutions of every tag, in world terms. */
+    cand cands[MAX_CAND];
+    int nc = 0;
+    mr_dvec3 tc[4];
+    mr_marker_corners_tag(map->tag_size, tc);
+    double objt[12];
+    for (int k = 0; k < 4; k++) {
+        objt[3 * k] = tc[k].x;
+        objt[3 * k + 1] = tc[k].y;
+        objt[3 * k + 2] = tc[k].z;
+    }
+    for (int i = 0; i < n; i++) {
+        double R[2][9], t[2][3];
+        double img8[8];
+        memcpy(img8, obs[i].norm, sizeof img8);
+        int ns = mr_cv_ippe_square(objt, img8, R, t);
+        const mr_marker *m = mr_marker_map_find(map, obs[i].id);
+        mr_dmat4 tfw = mr_m4_invert_rigid(&m->world_from_tag);
+        for (int s = 0; s < ns; s++) {
+            rt ct;
+            memcpy(ct.R, R[s], sizeof ct.R);
+            memcpy(ct.t, t[s], sizeof ct.t);
+            mr_dmat4 cft = rt_to_m4(&ct);
+            mr_dmat4 cfw = mr_m4_mul(&cft, &tfw);
+            cands[nc].x = m4_to_rt(&cfw);
+            score(cam, obs, n, outlier_px, &cands[nc]);
+            nc++;
+        }
+    }
+    /* And, with several tags, one global SQPnP start over all corners
+     * (it may beat every single-tag start when the tags are small). */
+    if (n >= 2) {
+        double o[MAX_TAGS * 12], q[MAX_TAGS * 8];
+        for (int i = 0; i < n; i++) {
+            memcpy(&o[12 * i], obs[i].world, sizeof obs[i].world);
+            memcpy(&q[8 * i], obs[i].norm, sizeof obs[i].norm);
+        }
+        if (mr_cv_sqpnp(o, q, 4 * n, cands[nc].x.R, cands[nc].x.t)) {
+            score(cam, obs, n, outlier_px, &cands[nc]);
+            nc++;
+        }
+    }
+    int best = -1;
+    for (int c = 0; c < nc; c++)
+        if (cands[c].inliers > 0 &&
+            (best < 0 || cands[c].inliers > cands[best].inliers ||
+             (cands[c].inliers == cands[best].inliers && cands[c].rms < cands[best].rms)))
+            best = c;
+    if (best < 0) return true;
+    /* Plausible alternatives: as many inlier tags and an error within the
+     * ambiguity margin. If they differ in rotation, prefer the previous
+     * pose's neighbour, so a single tag seen head-on does not flip. */
+    bool have_prev = prev && prev->valid;
+    mr_dmat4 prev_cfw = have_prev ? mr_m4_invert_rigid(&prev->world_from_camera) : mr_m4_identity();
+    mr_dmat4 best_m = rt_to_m4(&cands[best].x);
+    int pick = best;
+    double pick_angle = have_prev ? mr_pose_angle_deg(&best_m, &prev_cfw) : 0;
+    for (int c = 0; c < nc; c++) {
+        if (c == best || cands[c].inliers != cands[best].inliers || cands[c].rms > cands[best].rms + amb_px) continue;
+        mr_dmat4 cm = rt_to_m4(&cands[c].x);
+        if (mr_pose_angle_deg(&cm, &best_m) < 2.0) continue;
+        out->ambiguous = true;
+        if (have_prev) {
+            double a = mr_pose_angle_deg(&cm, &prev_cfw);
+            if (a < pick_angle) {
+                pick_angle = a;
+                pick = c;
+            }
+        }
+    }
+    /* Refine over the inlier tags; drop tags that still do not fit and
+     * refine once more. */
+    rt x = cands[pick].x;
+    bool use[MAX_TAGS];
+    /* A lone ambiguous tag: IPPE's solution is already the local optimum,
+     * and the error valley between the two mirror poses is so flat that LM
+     * may slide into the other one; keep the chosen branch as it is. */
+    bool lone = cands[pick].inliers == 1 && out->ambiguous;
+    for (int round = 0; round < 2 && !lone; round++) {
+        int nu = 0;
+        for (int i = 0; i < n; i++) nu += use[i] = tag_rms(cam, &x, &obs[i]) <= outlier_px * (round ? 1.0 : 1.5);
+        if (nu == 0) return true;
+        rt y = x;
+        if (refine(obs, use, n, &y)) x = y;
+    }
+    double sse = 0;
+    int used = 0;
+    for (int i = 0; i < n; i++) {
+        double e = tag_rms(cam, &x, &obs[i]);
+        if (e > outlier_px) continue;
+        sse += e * e;
+        if (used < MR_POSE_MAX_IDS) out->ids_used[used] = obs[i].id;
+        used++;
+    }
+    if (used == 0) return true;
+    out->tags_used = used;
+    out->rms_px = sqrt(sse / used);
+    mr_dmat4 cfw = rt_to_m4(&x);
+    out->world_from_camera = mr_m4_invert_rigid(&cfw);
+    out->valid = out->rms_px <= max_rms && mr_m4_is_finite(&out->world_from_camera);
+    return true;
+}
