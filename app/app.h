@@ -61,5 +61,6 @@ mr_view app_demo_view(int i);
 int cmd_demo(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
+int cmd_view(int argc, char **argv);
 
 #endif

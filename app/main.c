@@ -10,6 +10,7 @@ static const struct {
 } k_commands[] = {
     {"demo", cmd_demo, "build the demo hall (as planned / as built), render camera frames and overlays"},
     {"render", cmd_render, "render one headless frame of a scene from a view"},
+    {"view", cmd_view, "the interactive check: overlay window with a touch UI, live or replayed"},
     {"bench", cmd_bench, "measure run time: bench frame"},
 };
 
