@@ -237,7 +237,7 @@ static void set_frozen(view_app *a, bool on) {
 
 static void toggle_play(view_app *a) {
     if (!a->cap || !vw_capture_seekable(a->cap)) return;
-    if (a->frozen) set_frozen(a, false);
+    /* Playing does not unfreeze: the still stays until Freeze is undone. */
     vw_capture_play(a->cap, !vw_capture_playing(a->cap));
 }
 
@@ -939,6 +939,13 @@ static void write_state(view_app *a, const mr_image *screen) {
                                                : st == VW_ENDED ? "ended" : "starting");
     cJSON_AddStringToObject(j, "source_message", msg);
     cJSON_AddStringToObject(j, "scene_message", a->scene_msg);
+    /* Where each widget is (framebuffer pixels x y w h), for tests that
+     * drive the window with real X input (xdotool). */
+    cJSON *wd = cJSON_AddObjectToObject(j, "widgets");
+    for (int i = 0; i < a->named_count; i++) {
+        double r[4] = {a->named[i].r.x, a->named[i].r.y, a->named[i].r.w, a->named[i].r.h};
+        cJSON_AddItemToObject(wd, a->named[i].name, mr_json_from_doubles(r, 4));
+    }
     if (screen && screen->data) {
         /* Spread of the screen's pixel values: a blank window has none. */
         const uint8_t *p = screen->data;

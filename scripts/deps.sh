@@ -6,6 +6,7 @@ pkgs=(
   cmake make gcc g++ pkg-config
   libcjson-dev libstb-dev libtinygltf-dev libapriltag-dev
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
+  libglfw3-dev xvfb xauth xdotool fonts-dejavu-core
 )
 missing=()
 for p in "${pkgs[@]}"; do
