@@ -8,6 +8,7 @@
  * Wiring only: widgets come from lib/ui, drawing from lib/render. */
 #include "view.h"
 
+#include "mr_session.h"
 #include "mr_ui.h"
 
 #include <math.h>
@@ -1072,6 +1073,20 @@ static void frame_tick(view_app *a) {
 static bool load_replay_meta(const char *dir, mr_camera *cam, bool have_cam, mr_marker_map *map, bool *have_map,
                              mr_error *err) {
     char path[4096], sub[8192];
+    if (mr_is_recording(dir)) {
+        mr_recording *rec = mr_recording_open(dir, err);
+        if (!rec) return false;
+        if (!have_cam) *cam = rec->camera;
+        if (!*have_map && rec->has_markers) {
+            /* Take the map over; the recording is closed right after. */
+            *map = rec->markers;
+            memset(&rec->markers, 0, sizeof rec->markers);
+            rec->has_markers = false;
+            *have_map = true;
+        }
+        mr_recording_close(&rec);
+        return true;
+    }
     mr_path_join(dir, "meta.json", path, sizeof path);
     cJSON *meta = mr_file_exists(path) ? mr_json_load(path, err) : NULL;
     if (mr_file_exists(path) && !meta) return false;
@@ -1132,6 +1147,7 @@ int cmd_view(int argc, char **argv) {
         {"fullscreen", NULL, "start fullscreen (F11 toggles)", NULL},
         {"ui-scale", "S", "scale the UI beyond the screen's density (default 1)", NULL},
         {"paused", NULL, "replay: start paused", NULL},
+        {"retrack", NULL, "replay: track the frames again instead of using the recorded poses", NULL},
         {"script", "FILE", "timed input events (tests, demos): see cmd_view.c", NULL},
         {"stats", NULL, "print the frame-time split on exit", NULL},
         {"verbose", NULL, "more log output", NULL},
@@ -1244,6 +1260,8 @@ int cmd_view(int argc, char **argv) {
     cp.markers = a->have_markers ? &a->markers : NULL;
     cp.fixed_pose = a->have_fixed_pose ? &a->fixed_pose : NULL;
     cp.retry_s = 1.0;
+    cp.retrack = app_flag(opts, "retrack");
+    if (cp.retrack && !a->have_markers) { rc = app_errorf(k_cmd, "--retrack needs a marker map"); goto done; }
     cp.wake = wake_window;
     cp.wake_ctx = a->win;
     a->cap = vw_capture_start(&cp, &err);

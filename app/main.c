@@ -1,5 +1,6 @@
 /* mrcheck — mixed-reality discrepancy checks for factory planning. */
 #include "app.h"
+#include "app_track.h"
 
 #include <string.h>
 
@@ -12,6 +13,11 @@ static const struct {
     {"render", cmd_render, "render one headless frame of a scene from a view"},
     {"view", cmd_view, "the interactive check: overlay window with a touch UI, live or replayed"},
     {"bench", cmd_bench, "measure run time: bench frame"},
+    {"synth", cmd_synth, "synthetic recording of the demo hall with ground truth (or a calibration set)"},
+    {"track", cmd_track, "AprilTag detection and camera pose per frame (V4L2, video, images, recording)"},
+    {"record", cmd_record, "track a camera or video and write a crash-safe recording as it goes"},
+    {"calibrate", cmd_calibrate, "camera intrinsics from images of an AprilTag grid board (OpenCV)"},
+    {"replay", cmd_replay, "render the overlay of a recording's frames headless (deterministic)"},
 };
 
 static void usage(FILE *f) {

@@ -35,6 +35,8 @@ typedef struct vw_capture_params {
     const mr_marker_map *markers; /* for tracking; NULL: poses must come from
                                      the recording or fixed_pose */
     const mr_dmat4 *fixed_pose; /* a still with a known view: no tracking */
+    bool retrack;             /* replay: detect and solve again instead of
+                                 using the recorded poses */
     double retry_s;           /* between attempts to reopen a lost camera */
     void (*wake)(void *ctx);  /* called after a new frame is published */
     void *wake_ctx;

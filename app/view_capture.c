@@ -7,6 +7,8 @@
  * render thread only ever swaps pointers, so it never waits for either. */
 #include "view.h"
 
+#include "mr_session.h"
+
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -29,6 +31,8 @@ typedef struct replay_index {
     mr_dmat4 *pose;           /* recorded world_from_camera per frame */
     int *tags;                /* recorded tags seen, -1 unknown */
     double *rms;
+    mr_recording *rec;        /* a recording (lib/session), or NULL: a plain
+                                 folder of frames */
 } replay_index;
 
 struct vw_capture {
@@ -180,7 +184,8 @@ static void read_frames_jsonl(replay_index *r, const char *path) {
 }
 
 static void replay_free(replay_index *r) {
-    for (int64_t i = 0; i < r->count; i++) free(r->names[i]);
+    mr_recording_close(&r->rec);
+    for (int64_t i = 0; r->names && i < r->count; i++) free(r->names[i]);
     free(r->names);
     free(r->t);
     free(r->has_pose);
@@ -192,9 +197,20 @@ static void replay_free(replay_index *r) {
 
 static bool replay_open(replay_index *r, const char *dir, mr_error *err) {
     char sub[4096];
-    mr_path_join(dir, "frames", sub, sizeof sub);
-    if (!list_images(r, sub) && !list_images(r, dir))
-        return mr_fail(err, MR_ERR_IO, "%s holds no frames (expected images in %s/frames/)", dir, dir);
+    if (mr_is_recording(dir)) {
+        r->rec = mr_recording_open(dir, err);
+        if (!r->rec) return false;
+        r->count = r->rec->frame_count;
+        if (r->count <= 0) {
+            replay_free(r);
+            return mr_fail(err, MR_ERR_IO, "recording %s has no frames", dir);
+        }
+    } else {
+        mr_path_join(dir, "frames", sub, sizeof sub);
+        if (!list_images(r, sub) && !list_images(r, dir))
+            return mr_fail(err, MR_ERR_IO, "%s holds no frames (expected a recording or images in %s/frames/)", dir,
+                           dir);
+    }
     r->t = calloc((size_t)r->count, sizeof *r->t);
     r->has_pose = calloc((size_t)r->count, sizeof *r->has_pose);
     r->pose = calloc((size_t)r->count, sizeof *r->pose);
@@ -208,6 +224,21 @@ static bool replay_open(replay_index *r, const char *dir, mr_error *err) {
         r->t[i] = (double)i / 30.0; /* without timestamps: 30 fps */
         r->tags[i] = -1;
         r->rms[i] = -1;
+    }
+    if (r->rec) {
+        /* The recording's own poses: the filtered one where recorded, as
+         * the live view showed it, else the raw pose. */
+        for (int64_t i = 0; i < r->count; i++) {
+            const mr_rec_frame *f = &r->rec->frames[i];
+            r->t[i] = f->t;
+            r->tags[i] = f->pose.tags_seen;
+            r->rms[i] = f->pose.valid ? f->pose.rms_px : -1;
+            if (f->pose.valid) {
+                r->has_pose[i] = true;
+                r->pose[i] = f->has_filtered ? f->filtered : f->pose.world_from_camera;
+            }
+        }
+        return true;
     }
     mr_path_join(dir, "frames.jsonl", sub, sizeof sub);
     read_frames_jsonl(r, sub);
@@ -279,11 +310,17 @@ static void *replay_reader(void *arg) {
             c->msg[0] = 0;
         }
         pthread_mutex_unlock(&c->mu);
-        char path[8192];
-        mr_path_join(r->dir, r->names[next], path, sizeof path);
         mr_image img = {0};
         mr_error e = {0};
-        if (mr_image_load(path, 3, &img, &e)) put_raw(c, &img, r->t[next], next);
+        bool loaded;
+        if (r->rec) {
+            loaded = mr_recording_load_image(r->rec, (int)next, false, &img, &e);
+        } else {
+            char path[8192];
+            mr_path_join(r->dir, r->names[next], path, sizeof path);
+            loaded = mr_image_load(path, 3, &img, &e);
+        }
+        if (loaded) put_raw(c, &img, r->t[next], next);
         else mr_log(MR_LOG_WARN, "replay: skipping frame %lld: %s", (long long)next, e.msg);
         pthread_mutex_lock(&c->mu);
     }
@@ -397,7 +434,7 @@ static void *tracker(void *arg) {
         if (c->p.fixed_pose) {
             f.pose_valid = true;
             last_pose = *c->p.fixed_pose;
-        } else if (c->seekable && index >= 0 && index < c->rp.count && c->rp.has_pose[index]) {
+        } else if (c->seekable && !c->p.retrack && index >= 0 && index < c->rp.count && c->rp.has_pose[index]) {
             /* A recording's own poses: the replay shows what was seen. */
             f.pose_valid = true;
             last_pose = c->rp.pose[index];

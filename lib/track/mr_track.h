@@ -216,6 +216,41 @@ mr_read_status mr_source_read(mr_source *src, mr_frame *frame, mr_error *err);
 /* V4L2 directly (mr_source_open uses it for /dev/... paths). */
 mr_source *mr_source_open_v4l2(const char *device, const mr_source_params *params, mr_error *err);
 
+/* ------------------------------------------------- OpenCV aruco (peer) */
+
+/* OpenCV's aruco detector with DICT_APRILTAG_36h11, for comparison in
+ * `mrcheck bench tracking`. Corners are converted to the apriltag order
+ * above, so the same pose code runs on both. */
+typedef enum mr_aruco_refine {
+    MR_ARUCO_REFINE_NONE = 0,
+    MR_ARUCO_REFINE_SUBPIX,
+    MR_ARUCO_REFINE_CONTOUR,
+    MR_ARUCO_REFINE_APRILTAG,
+} mr_aruco_refine;
+
+typedef struct mr_aruco mr_aruco;
+mr_aruco *mr_aruco_create(mr_aruco_refine refine, mr_error *err);
+void mr_aruco_destroy(mr_aruco **a);
+/* As mr_detector_detect: results owned by a, valid until the next call. */
+const mr_detection *mr_aruco_detect(mr_aruco *a, const mr_image *img, int *count, mr_error *err);
+const char *mr_aruco_refine_name(mr_aruco_refine refine);
+
+/* ------------------------------------------------------- calibration */
+
+/* One image's correspondences: n board points (board frame, z = 0) and
+ * their detected pixels (OpenCV convention). */
+typedef struct mr_calib_view {
+    const double *object; /* 3n */
+    const double *image;  /* 2n */
+    int n;
+} mr_calib_view;
+
+/* OpenCV calibrateCamera (k1 k2 p1 p2, k3 fixed at 0: a few board views do
+ * not constrain it) over >= 3 views. *rms_px gets the RMS reprojection
+ * error; per_view_rms (may be NULL) one value per view. */
+bool mr_calibrate(const mr_calib_view *views, int nviews, int width, int height, mr_camera *out, double *rms_px,
+                  double *per_view_rms, mr_error *err);
+
 /* ------------------------------------------------------- image coding */
 
 /* JPEG / PNG encoding and decoding through OpenCV (used for recordings and

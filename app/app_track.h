@@ -1,0 +1,88 @@
+/* Private to app/: the tracking commands (track, record, replay, synth,
+ * calibrate, bench tracking) and what they share. Kept apart from app.h so
+ * the tracking work merges without touching the foundation's header. */
+#ifndef MR_APP_TRACK_H
+#define MR_APP_TRACK_H
+
+#include "app.h"
+#include "mr_session.h"
+#include "mr_track.h"
+
+/* The detector / pose / filter options every tracking command takes. */
+#define APP_TRACK_OPTS                                                                                  \
+    {"camera", "CAMERA.json", "camera intrinsics (default: the recording's, if the input is one)", NULL}, \
+    {"markers", "MARKERS.json", "marker map (default: the recording's, if the input is one)", NULL},      \
+    {"family", "F", "tag family (default: the marker map's, else tag36h11)", NULL},                       \
+    {"decimate", "D", "detector decimation >= 1 (default 2)", NULL},                                      \
+    {"threads", "N", "detector threads (default 1)", NULL},                                               \
+    {"refine-edges", "0|1", "edge refinement (default 1)", NULL},                                         \
+    {"sharpening", "S", "decode sharpening (default 0.25)", NULL},                                        \
+    {"no-filter", NULL, "no One Euro filtering of the pose", NULL},                                       \
+    {"freeze", NULL, "freeze the filtered pose at the first valid one (still-image check)", NULL}
+
+typedef struct app_tracker {
+    mr_detector *det;
+    bool has_camera, has_markers;
+    mr_camera camera;
+    mr_marker_map markers;
+    mr_pose_filter *filter;   /* NULL with --no-filter */
+    bool freeze;
+    mr_pose prev;             /* previous raw pose (for single-tag disambiguation) */
+    double prev_t;
+} app_tracker;
+
+/* The input: a recording folder (its camera and markers become defaults),
+ * /dev/videoN, a video file, an image or a folder of images. */
+mr_source *app_open_input(const char *uri, bool gray, mr_recording **rec_info, mr_error *err);
+
+/* Sets up detector, camera, markers and filter from the options; rec (may
+ * be NULL) supplies defaults. Prints one line and returns false on error. */
+bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, const mr_recording *rec);
+void app_tracker_free(app_tracker *t);
+
+typedef struct app_track_result {
+    const mr_detection *dets;
+    int count;
+    mr_pose pose;             /* raw */
+    bool has_filtered;
+    mr_dmat4 filtered;
+} app_track_result;
+
+/* Detects and (with camera and markers) solves and filters one frame. */
+bool app_tracker_frame(app_tracker *t, const mr_frame *f, app_track_result *r, mr_error *err);
+
+/* JSON helpers for the line formats. */
+cJSON *app_detections_json(const mr_detection *d, int n);
+cJSON *app_pose_line(int64_t frame, double t, const app_track_result *r);
+
+/* Synthetic recordings of the demo hall (demo_track.c). */
+typedef struct app_synth_params {
+    int frames;          /* spread over the path; default 120 (one per step) */
+    int width, height;   /* default 640x480 (the demo camera) */
+    double noise;        /* sensor noise sigma in grey levels, default 2.0 */
+    int motion_blur;     /* sub-frames averaged per frame (1 = none), default 3 */
+    double exposure;     /* relative exposure swing along the path, default 0.25 */
+    int jpeg_quality;    /* default 90 */
+    uint64_t seed;       /* default 1 */
+    double fps;          /* default 10 */
+} app_synth_params;
+#define APP_SYNTH_DEFAULTS {120, 640, 480, 2.0, 3, 0.25, 90, 1, 10.0}
+
+bool app_synth_recording(const char *dir, const app_synth_params *p, mr_error *err);
+/* The calibration board (tag grid) and images of it rendered on the CPU. */
+bool app_synth_calibration(const char *dir, int images, mr_error *err);
+/* Called once by `mrcheck demo`: writes DIR/recording and DIR/calib. */
+bool app_demo_track(const char *dir, mr_error *err);
+
+int cmd_track(int argc, char **argv);
+int cmd_record(int argc, char **argv);
+int cmd_replay(int argc, char **argv);
+int cmd_synth(int argc, char **argv);
+int cmd_calibrate(int argc, char **argv);
+int bench_tracking(int argc, char **argv);
+
+/* Set by SIGINT/SIGTERM while a long command runs (app/track_util.c). */
+void app_catch_signals(void);
+bool app_interrupted(void);
+
+#endif

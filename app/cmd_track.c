@@ -1,0 +1,130 @@
+/* mrcheck track: detection and pose per frame. */
+#include "app_track.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* A growing text buffer for the poses file, written atomically at the end. */
+typedef struct strbuf { char *s; size_t len, cap; } strbuf;
+
+static bool sb_add(strbuf *b, const char *s) {
+    size_t n = strlen(s);
+    if (b->len + n + 2 > b->cap) {
+        size_t cap = b->cap ? b->cap * 2 : 65536;
+        while (cap < b->len + n + 2) cap *= 2;
+        char *ns = realloc(b->s, cap);
+        if (!ns) return false;
+        b->s = ns;
+        b->cap = cap;
+    }
+    memcpy(b->s + b->len, s, n);
+    b->len += n;
+    b->s[b->len++] = '\n';
+    b->s[b->len] = 0;
+    return true;
+}
+
+int cmd_track(int argc, char **argv) {
+    static const char *cmd = "track";
+    app_opt opts[] = {
+        {"input", "PATH", "recording folder, /dev/videoN, video file, image or folder of images", NULL},
+        APP_TRACK_OPTS,
+        {"out", "POSES.jsonl", "write one pose line per frame there (written when the run ends)", NULL},
+        {"print-detections", NULL, "print {\"frame\",\"detections\"} per frame on stdout", NULL},
+        {"max-frames", "N", "stop after N frames", NULL},
+        {"verbose", NULL, "more output", NULL},
+        {"quiet", NULL, "errors only", NULL},
+        {NULL, NULL, NULL, NULL},
+    };
+    bool help;
+    if (!app_parse(argc, argv, 2, opts, NULL, 0, NULL,
+                   "usage: mrcheck track --input PATH|/dev/videoN [--camera C] [--markers M] [--family F] [--decimate D]\n"
+                   "                     [--threads N] [--refine-edges 0|1] [--out poses.jsonl] [--print-detections]\n"
+                   "Detects AprilTags per frame (corners in pixels, OpenCV convention: centre of the top-left pixel\n"
+                   "is (0,0)); with a camera and a marker map also the pose world_from_camera (OpenCV axes).",
+                   &help))
+        return 2;
+    if (help) return 0;
+    app_log_level(opts);
+    const char *input = app_get(opts, "input");
+    if (!input) return app_errorf(cmd, "--input is required (see --help)"), 2;
+    long max_frames = -1;
+    if (app_get(opts, "max-frames") && !app_int("max-frames", app_get(opts, "max-frames"), 1, 1L << 40, &max_frames))
+        return 2;
+    const char *out = app_get(opts, "out");
+    bool print_det = app_flag(opts, "print-detections");
+
+    mr_error err = {0};
+    mr_recording *rec = NULL;
+    mr_source *src = app_open_input(input, true, &rec, &err);
+    if (!src) return app_error(cmd, &err);
+    app_tracker t;
+    bool ok = app_tracker_init(&t, cmd, opts, rec);
+    mr_recording_close(&rec);
+    if (!ok) {
+        mr_source_close(&src);
+        return 1;
+    }
+    bool want_pose = t.has_camera && t.has_markers;
+    if (out && !want_pose) {
+        app_tracker_free(&t);
+        mr_source_close(&src);
+        return app_errorf(cmd, "--out needs --camera and --markers (or a recording as input)");
+    }
+    app_catch_signals();
+    strbuf poses = {0};
+    long frames = 0, failed = 0, with_tags = 0, with_pose = 0;
+    int rc = 0;
+    while (!app_interrupted() && (max_frames < 0 || frames < max_frames)) {
+        mr_frame f;
+        mr_read_status st = mr_source_read(src, &f, &err);
+        if (st == MR_READ_END) break;
+        if (st == MR_READ_ERROR) {
+            rc = app_error(cmd, &err);
+            break;
+        }
+        frames++;
+        app_track_result r;
+        mr_error fe = {0};
+        if (!app_tracker_frame(&t, &f, &r, &fe)) {
+            /* One bad frame (too small, broken) does not end the run. */
+            fprintf(stderr, "mrcheck: track: warning: frame %lld: %s\n", (long long)f.index, fe.msg);
+            failed++;
+            continue;
+        }
+        with_tags += r.count > 0;
+        with_pose += r.pose.valid;
+        if (print_det) {
+            cJSON *o = cJSON_CreateObject();
+            cJSON_AddNumberToObject(o, "frame", (double)f.index);
+            cJSON_AddItemToObject(o, "detections", app_detections_json(r.dets, r.count));
+            char *s = cJSON_PrintUnformatted(o);
+            cJSON_Delete(o);
+            if (s) puts(s);
+            free(s);
+        }
+        if (want_pose) {
+            cJSON *o = app_pose_line(f.index, f.timestamp, &r);
+            char *s = cJSON_PrintUnformatted(o);
+            cJSON_Delete(o);
+            if (!s || (out && !sb_add(&poses, s))) {
+                free(s);
+                rc = app_errorf(cmd, "out of memory");
+                break;
+            }
+            if (!out && !print_det) puts(s);
+            free(s);
+        }
+        fflush(stdout);
+    }
+    if (rc == 0 && frames == 0) rc = app_errorf(cmd, "%s: no frames", input);
+    else if (rc == 0 && failed == frames) rc = app_errorf(cmd, "no frame could be processed (%ld failed)", failed);
+    if (rc == 0 && out && !mr_file_write_atomic(out, poses.s ? poses.s : "", poses.len, &err)) rc = app_error(cmd, &err);
+    if (rc == 0 && mr_log_get_level() >= MR_LOG_INFO)
+        fprintf(stderr, "track: %ld frames, %ld with tags, %ld with a pose, %ld failed\n", frames, with_tags, with_pose,
+                failed);
+    free(poses.s);
+    app_tracker_free(&t);
+    mr_source_close(&src);
+    return rc;
+}

@@ -1,0 +1,173 @@
+/* Shared wiring of the tracking commands: input, tracker, line formats. */
+#include "app_track.h"
+
+#include <math.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+
+static volatile sig_atomic_t g_interrupted = 0; /* app only: signal flag */
+
+static void on_signal(int sig) {
+    (void)sig;
+    g_interrupted = 1;
+}
+
+void app_catch_signals(void) {
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+bool app_interrupted(void) { return g_interrupted != 0; }
+
+mr_source *app_open_input(const char *uri, bool gray, mr_recording **rec_info, mr_error *err) {
+    if (rec_info) *rec_info = NULL;
+    if (uri && mr_is_recording(uri)) {
+        mr_recording *rec = mr_recording_open(uri, err);
+        if (!rec) return NULL;
+        if (rec_info) {
+            /* A second, read-only copy for the caller's defaults. */
+            *rec_info = mr_recording_open(uri, err);
+            if (!*rec_info) {
+                mr_recording_close(&rec);
+                return NULL;
+            }
+        }
+        return mr_recording_source(rec, gray, err);
+    }
+    mr_source_params sp = MR_SOURCE_DEFAULTS;
+    sp.gray = gray;
+    return mr_source_open(uri, &sp, err);
+}
+
+bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, const mr_recording *rec) {
+    memset(t, 0, sizeof *t);
+    mr_error err = {0};
+    const char *cam = app_get(opts, "camera"), *mk = app_get(opts, "markers");
+    if (cam) {
+        if (!mr_camera_load(cam, &t->camera, &err)) return app_error(cmd, &err), false;
+        t->has_camera = true;
+    } else if (rec) {
+        t->camera = rec->camera;
+        t->has_camera = true;
+    }
+    if (mk) {
+        if (!mr_marker_map_load(mk, &t->markers, &err)) return app_error(cmd, &err), false;
+        t->has_markers = true;
+    } else if (rec && rec->has_markers) {
+        t->markers = rec->markers;
+        t->markers.tags = malloc((size_t)rec->markers.count * sizeof *t->markers.tags);
+        if (!t->markers.tags) return app_errorf(cmd, "out of memory"), false;
+        memcpy(t->markers.tags, rec->markers.tags, (size_t)rec->markers.count * sizeof *t->markers.tags);
+        t->has_markers = true;
+    }
+    mr_detector_params dp = MR_DETECTOR_DEFAULTS;
+    dp.family = app_get(opts, "family") ? app_get(opts, "family") : t->has_markers ? t->markers.family : NULL;
+    double v;
+    long l;
+    if (app_get(opts, "decimate")) {
+        if (!app_double("decimate", app_get(opts, "decimate"), 1, 16, &v)) goto fail;
+        dp.decimate = v;
+    }
+    if (app_get(opts, "threads")) {
+        if (!app_int("threads", app_get(opts, "threads"), 1, 64, &l)) goto fail;
+        dp.threads = (int)l;
+    }
+    if (app_get(opts, "refine-edges")) {
+        if (!app_int("refine-edges", app_get(opts, "refine-edges"), 0, 1, &l)) goto fail;
+        dp.refine_edges = l ? 1 : -1;
+    }
+    if (app_get(opts, "sharpening")) {
+        if (!app_double("sharpening", app_get(opts, "sharpening"), 0, 10, &v)) goto fail;
+        dp.sharpening = v > 0 ? v : -1;
+    }
+    if (t->has_markers && app_get(opts, "family") && strcmp(app_get(opts, "family"), t->markers.family) != 0)
+        mr_log(MR_LOG_WARN, "--family %s differs from the marker map's %s", app_get(opts, "family"), t->markers.family);
+    t->det = mr_detector_create(&dp, &err);
+    if (!t->det) {
+        app_error(cmd, &err);
+        goto fail;
+    }
+    if (!app_flag(opts, "no-filter")) {
+        t->filter = mr_pose_filter_create(NULL, &err);
+        if (!t->filter) {
+            app_error(cmd, &err);
+            goto fail;
+        }
+    }
+    t->freeze = app_flag(opts, "freeze");
+    return true;
+fail:
+    app_tracker_free(t);
+    return false;
+}
+
+void app_tracker_free(app_tracker *t) {
+    mr_detector_destroy(&t->det);
+    mr_pose_filter_destroy(&t->filter);
+    mr_marker_map_free(&t->markers);
+}
+
+bool app_tracker_frame(app_tracker *t, const mr_frame *f, app_track_result *r, mr_error *err) {
+    memset(r, 0, sizeof *r);
+    r->dets = mr_detector_detect(t->det, &f->image, &r->count, err);
+    if (!r->dets) return false;
+    if (!t->has_camera || !t->has_markers) return true;
+    mr_camera cam = t->camera;
+    if (f->image.width != cam.width || f->image.height != cam.height) {
+        /* Same lens, other resolution (e.g. a camera delivering 640x480
+         * for a 1280x960 calibration): scale the intrinsics. */
+        cam = mr_camera_resized(&t->camera, f->image.width, f->image.height);
+    }
+    /* The previous pose only helps if it is recent. */
+    const mr_pose *prev = t->prev.valid && f->timestamp - t->prev_t < 0.5 && f->timestamp >= t->prev_t ? &t->prev : NULL;
+    if (!mr_pose_solve(&cam, &t->markers, r->dets, r->count, prev, NULL, &r->pose, err)) return false;
+    if (r->pose.valid) {
+        t->prev = r->pose;
+        t->prev_t = f->timestamp;
+        if (t->filter) {
+            mr_pose_filter_update(t->filter, f->timestamp, &r->pose.world_from_camera, &r->filtered);
+            if (t->freeze && !mr_pose_filter_frozen(t->filter)) mr_pose_filter_freeze(t->filter, true);
+            r->has_filtered = true;
+        }
+    } else if (t->filter && mr_pose_filter_frozen(t->filter)) {
+        /* Frozen: the held pose stands even when the tags are lost. */
+        r->has_filtered = mr_pose_filter_last(t->filter, &r->filtered);
+    }
+    return true;
+}
+
+cJSON *app_detections_json(const mr_detection *d, int n) {
+    cJSON *a = cJSON_CreateArray();
+    for (int i = 0; i < n; i++) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "id", d[i].id);
+        cJSON_AddNumberToObject(o, "hamming", d[i].hamming);
+        cJSON *c = cJSON_AddArrayToObject(o, "corners");
+        for (int k = 0; k < 4; k++) {
+            /* 1/1000 px is far below the detector's accuracy. */
+            double p[2] = {round(d[i].corners[k][0] * 1e3) / 1e3, round(d[i].corners[k][1] * 1e3) / 1e3};
+            cJSON_AddItemToArray(c, mr_json_from_doubles(p, 2));
+        }
+        cJSON_AddItemToArray(a, o);
+    }
+    return a;
+}
+
+cJSON *app_pose_line(int64_t frame, double t, const app_track_result *r) {
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "frame", (double)frame);
+    cJSON_AddNumberToObject(o, "t", t);
+    cJSON_AddBoolToObject(o, "valid", r->pose.valid);
+    if (r->pose.valid) cJSON_AddItemToObject(o, "world_from_camera", mr_json_from_dmat4(&r->pose.world_from_camera));
+    if (r->has_filtered) cJSON_AddItemToObject(o, "filtered", mr_json_from_dmat4(&r->filtered));
+    cJSON_AddNumberToObject(o, "tags_seen", r->pose.tags_seen);
+    cJSON_AddNumberToObject(o, "tags_used", r->pose.tags_used);
+    cJSON_AddNumberToObject(o, "rms_px", r->pose.rms_px);
+    cJSON_AddBoolToObject(o, "ambiguous", r->pose.ambiguous);
+    return o;
+}
