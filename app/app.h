@@ -4,6 +4,7 @@
 #define MR_APP_H
 
 #include "mr_core.h"
+#include "mr_eval.h"
 #include "mr_render.h"
 #include "mr_scene.h"
 
@@ -48,7 +49,30 @@ typedef struct app_gfx {
 } app_gfx;
 bool app_gfx_open(app_gfx *g, mr_error *err);
 void app_gfx_close(app_gfx *g);
-/* Writes what --aux asks for: depth.pfm, normal.pfm into dir. */
+/* The AO option rows, to splice into a command's option table. */
+#define APP_AO_OPTS                                                                                                 \
+    {"ao", "METHOD", "ambient occlusion: none, scheer, crytek, filion, hbao, alchemy, groundtruth (default none)", NULL}, \
+    {"ao-radius-mode", "MODE", "screen (radius grows with depth, default) or view (constant radius)", NULL},              \
+    {"ao-radius", "R", "view-space radius in scene units (implies --ao-radius-mode view; default 2% of the scene)", NULL}, \
+    {"ao-screen-radius", "F", "screen mode: projected radius as a fraction of the image height (default 0.05)", NULL},  \
+    {"ao-samples", "N", "samples per pixel, 1..64 (default 16)", NULL},                                                  \
+    {"ao-kernel", "K", "sample kernel: uniform, stratified, latin, poisson (default uniform)", NULL},                    \
+    {"ao-rmin", "F", "kernel inner radius as a fraction of the radius (default 0.8)", NULL},                              \
+    {"ao-rmax", "F", "kernel outer radius as a fraction of the radius (default 1)", NULL},                                \
+    {"ao-radii", "K", "multi-radius: K radii R, R/2, ..; the darkest wins (default 1)", NULL},                            \
+    {"ao-c", "C", "scheer attenuation c in [0,1e7] (default 1)", NULL},                                                    \
+    {"ao-bias", "B", "bias (cosine / depth fraction of the radius, default 0.05)", NULL},                                  \
+    {"ao-strength", "S", "AO = 1 - S * occlusion (default 1)", NULL},                                                      \
+    {"ao-blur", "PX", "bilateral blur half-width in AO pixels, 0 = off (default 4)", NULL},                              \
+    {"ao-half", NULL, "AO at half resolution with a joint bilateral upsample", NULL},                                    \
+    {"ao-positions", NULL, "AO from a view-space positions texture", NULL},                                              \
+    {"ao-mask", "M", "corner masking: off, on, standalone (default off)", NULL},                                          \
+    {"ao-rays", "N", "groundtruth: rays per pixel (default 256)", NULL}
+/* Reads the APP_AO_OPTS values into ao (and gt for --ao groundtruth);
+ * prints one line and returns false on a bad value. */
+bool app_ao_parse(const char *cmd, const app_opt *opts, mr_ao_params *ao, bool *groundtruth, mr_gt_params *gt);
+
+/* Writes what --aux asks for: depth.pfm, normal.pfm, ao.pfm into dir. */
 bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err);
 
 /* The demo hall built in memory (tag images included), its camera and its
@@ -62,5 +86,6 @@ int cmd_demo(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
 int cmd_view(int argc, char **argv);
+int bench_ao(int argc, char **argv);
 
 #endif

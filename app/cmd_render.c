@@ -33,7 +33,36 @@ bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err) {
         mr_path_join(dir, "normal.pfm", path, sizeof path);
         if (!mr_image_save_pfm(path, &res->normal, err)) return false;
     }
+    if (res->ao.data) {
+        mr_path_join(dir, "ao.pfm", path, sizeof path);
+        if (!mr_image_save_pfm(path, &res->ao, err)) return false;
+    }
     return true;
+}
+
+/* --ao groundtruth: ray-trace the AO of the surface points the first frame
+ * saw, then render again shading with it (no AO pass runs). */
+static bool render_groundtruth(mr_renderer *r, const mr_scene *scene, const mr_view *view, mr_frame_params *fp,
+                               const mr_gt_params *gtp, mr_frame_result *res, mr_error *err) {
+    mr_frame_params gp = *fp;
+    gp.want_depth = gp.want_normals = true;
+    mr_frame_result g = {0};
+    mr_image ao = {0};
+    mr_eval_gt *gt = NULL;
+    double t0 = mr_time_now();
+    bool ok = mr_render_frame(r, view, &gp, &g, err) && (gt = mr_eval_gt_create(scene, fp->hide_hidden_layer, err)) &&
+              mr_eval_ao_groundtruth(gt, view, &g.depth, &g.normal, gtp, &ao, err);
+    mr_frame_result_free(&g);
+    mr_eval_gt_destroy(&gt);
+    if (ok) {
+        mr_log(MR_LOG_INFO, "ground truth: %d rays per pixel in %.0f ms", gtp->rays, (mr_time_now() - t0) * 1e3);
+        mr_frame_result_free(res);
+        fp->ao.external = &ao;
+        ok = mr_render_frame(r, view, fp, res, err);
+        fp->ao.external = NULL;
+    }
+    mr_image_free(&ao);
+    return ok;
 }
 
 int cmd_render(int argc, char **argv) {
@@ -45,10 +74,10 @@ int cmd_render(int argc, char **argv) {
         {"size", "WxH", "output size (default: the camera's)", NULL},
         {"video", "IMG", "camera frame to overlay (raw, distorted)", NULL},
         {"alpha", "A", "video transparency in [0,1]: 0 virtual only, 1 video only (default 0.5)", NULL},
-        {"aux", "DIR", "also write depth.pfm (linear view depth) and normal.pfm", NULL},
+        {"aux", "DIR", "also write depth.pfm (linear view depth), normal.pfm and ao.pfm (1 = unoccluded)", NULL},
         {"hidden", "GLOB", "extra node-name glob for the hidden layer", NULL},
         {"hide-hidden", NULL, "leave the hidden layer out", NULL},
-        {"ao", "METHOD", "ambient occlusion (only 'none' in this build)", NULL},
+        APP_AO_OPTS,
         {"ghost", "MODE", "ghosted views (only 'off' in this build)", NULL},
         {"verbose", NULL, "print the passes that ran and more", NULL},
         {"quiet", NULL, "errors only", NULL},
@@ -57,15 +86,14 @@ int cmd_render(int argc, char **argv) {
     bool help;
     if (!app_parse(argc, argv, 2, opts, NULL, 0, NULL,
                    "usage: mrcheck render --scene FILE --view VIEW.json --out OUT.png [--size WxH] "
-                   "[--video IMG --alpha A] [--aux DIR]",
+                   "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...]",
                    &help))
         return 2;
     if (help) return 0;
     app_log_level(opts);
     const char *scene_path = app_get(opts, "scene"), *view_path = app_get(opts, "view"), *out = app_get(opts, "out");
     if (!scene_path || !view_path || !out) return app_errorf(cmd, "--scene, --view and --out are required"), 2;
-    const char *ao = app_get(opts, "ao"), *ghost = app_get(opts, "ghost");
-    if (ao && strcmp(ao, "none") != 0) return app_errorf(cmd, "--ao %s: no AO method is available in this build (only 'none')", ao);
+    const char *ghost = app_get(opts, "ghost");
     if (ghost && strcmp(ghost, "off") != 0) return app_errorf(cmd, "--ghost %s: ghosting is not available in this build (only 'off')", ghost);
 
     mr_frame_params fp = MR_FRAME_DEFAULTS;
@@ -76,6 +104,10 @@ int cmd_render(int argc, char **argv) {
     fp.hide_hidden_layer = app_flag(opts, "hide-hidden");
     const char *aux = app_get(opts, "aux");
     fp.want_depth = fp.want_normals = aux != NULL;
+    bool groundtruth = false;
+    mr_gt_params gtp = MR_GT_DEFAULTS;
+    if (!app_ao_parse(cmd, opts, &fp.ao, &groundtruth, &gtp)) return 2;
+    fp.ao.want_ao = aux != NULL;
 
     /* Everything that can be checked without a GPU is checked first, so a
      * bad input never costs a context. */
@@ -106,7 +138,8 @@ int cmd_render(int argc, char **argv) {
     if (!app_gfx_open(&gfx, &err)) {
         rc = app_error(cmd, &err);
     } else {
-        if (!mr_renderer_set_scene(gfx.renderer, scene, &err) || !mr_render_frame(gfx.renderer, &view, &fp, &res, &err))
+        if (!mr_renderer_set_scene(gfx.renderer, scene, &err) || !mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||
+            (groundtruth && !render_groundtruth(gfx.renderer, scene, &view, &fp, &gtp, &res, &err)))
             rc = app_error(cmd, &err);
         else if (!mr_image_save_png(out, &res.color, &err) || (aux && !app_write_aux(aux, &res, &err)))
             rc = app_error(cmd, &err);

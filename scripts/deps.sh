@@ -7,6 +7,7 @@ pkgs=(
   libcjson-dev libstb-dev libtinygltf-dev libapriltag-dev
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   libglfw3-dev xvfb xauth xdotool fonts-dejavu-core
+  libembree-dev
 )
 missing=()
 for p in "${pkgs[@]}"; do

@@ -7,9 +7,11 @@ layout(location = 1) uniform vec3 u_light_dir[MAX_LIGHTS];   // view space, towa
 layout(location = 9) uniform vec3 u_light_color[MAX_LIGHTS];
 layout(location = 17) uniform float u_ambient;
 layout(location = 18) uniform vec3 u_background;              // linear
+layout(location = 19) uniform int u_use_ao;                    // AO texture bound at 2
 
 layout(binding = 0) uniform sampler2D u_albedo;
 layout(binding = 1) uniform sampler2D u_normal;
+layout(binding = 2) uniform sampler2D u_ao;      // ambient visibility, 1 = unoccluded
 
 layout(location = 0) out vec4 o_color; // sRGB8 target
 
@@ -19,7 +21,10 @@ void main() {
     if (nn.w == 0.0) { o_color = vec4(u_background, 1.0); return; }
     vec3 albedo = texelFetch(u_albedo, px, 0).rgb;
     vec3 n = nn.xyz;
-    vec3 light = vec3(u_ambient);
+    // AO is the visibility of the ambient (sky) light, so it scales only
+    // the ambient term; direct light has its own (shadow) visibility.
+    float ao = u_use_ao != 0 ? texelFetch(u_ao, px, 0).r : 1.0;
+    vec3 light = vec3(u_ambient * ao);
     for (int i = 0; i < u_light_count; i++)
         light += u_light_color[i] * max(dot(n, u_light_dir[i]), 0.0);
     o_color = vec4(albedo * light, 1.0);

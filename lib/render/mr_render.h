@@ -49,6 +49,92 @@ void mr_renderer_destroy(mr_renderer **r);
  * NULL removes the scene. */
 bool mr_renderer_set_scene(mr_renderer *r, const mr_scene *scene, mr_error *err);
 
+/* ------------------------------------------------------ ambient occlusion */
+
+/* Screen-space ambient occlusion methods (pass_ao.c, shaders/ao_*.glsl).
+ * AO is a visibility factor in [0,1]: 1 = unoccluded. It multiplies the
+ * ambient term of the shading. */
+typedef enum mr_ao_method {
+    MR_AO_NONE = 0,    /* plain shading (Scheer & Keutel's D1): no AO pass runs */
+    MR_AO_SCHEER,      /* occlusion vectors, depth-scaled radius (D2; D3 with radius_mode view) */
+    MR_AO_CRYTEK,      /* Mittring 2007: ratio of sphere samples behind the depth buffer */
+    MR_AO_FILION,      /* Filion & McNaughton 2008: hemisphere samples, depth-difference falloff */
+    MR_AO_HBAO,        /* Bavoil et al. 2008: horizon search along image-space directions */
+    MR_AO_ALCHEMY,     /* McGuire et al. 2011: obscurance estimator on a screen-space disk */
+    MR_AO_METHOD_COUNT
+} mr_ao_method;
+
+typedef enum mr_ao_radius_mode {
+    MR_AO_RADIUS_SCREEN = 0, /* r_S = screen_radius * Z_p * height / fy: the projected
+                                radius is constant (Scheer & Keutel); scale-free */
+    MR_AO_RADIUS_VIEW = 1,   /* constant view-space radius `radius` (scene units) */
+} mr_ao_radius_mode;
+
+/* How the sample kernel is generated (Doronin et al.). */
+typedef enum mr_ao_kernel {
+    MR_AO_KERNEL_UNIFORM = 0, /* independent uniform samples */
+    MR_AO_KERNEL_STRATIFIED,  /* jittered grid over direction, shuffled radius strata */
+    MR_AO_KERNEL_LATIN,       /* Latin hypercube: one sample per stratum in each dimension */
+    MR_AO_KERNEL_POISSON,     /* Poisson disk: dart throwing with a shrinking minimum distance */
+} mr_ao_kernel;
+
+/* Corner masking (Park & Baek's OdSSAO). */
+typedef enum mr_ao_mask {
+    MR_AO_MASK_OFF = 0,
+    MR_AO_MASK_ON,         /* AO only where >= 2 outline volumes contain the surface */
+    MR_AO_MASK_STANDALONE, /* the blurred mask itself is the AO (no sampling) */
+} mr_ao_mask;
+
+#define MR_AO_MAX_SAMPLES 64
+#define MR_AO_MAX_RADII 4
+
+typedef struct mr_ao_params {
+    mr_ao_method method;          /* default MR_AO_NONE */
+    mr_ao_radius_mode radius_mode;/* default screen (scheer's D2) */
+    double radius;                /* view mode: radius in scene units; 0 = 2% of the
+                                     scene's bounding-box diagonal */
+    double screen_radius;         /* screen mode: projected radius as a fraction of the
+                                     image height; 0 = 0.05 */
+    int samples;                  /* samples per pixel per radius, 1..64; 0 = 16 */
+    mr_ao_kernel kernel;          /* default uniform */
+    float r_min, r_max;           /* kernel shell as fractions of the radius;
+                                     default 0.8 and 1.0 (Doronin et al.) */
+    int radii;                    /* multi-radius: K radii R, R/2, .. R/2^(K-1), the AO is
+                                     the darkest of them; 0 = 1 */
+    float c;                      /* scheer's attenuation 1/(1 + c |v|'^2); any value in
+                                     [0,1e7]; default 1 */
+    float bias;                   /* per-method bias (cosine / depth, as a fraction of
+                                     the radius); default 0.05 */
+    float strength;               /* AO = 1 - strength * occlusion; <= 0 means 1 */
+    int blur_radius;              /* bilateral blur half-width in AO pixels; 0 = off;
+                                     default 4 */
+    bool half_res;                /* AO at half resolution + joint bilateral upsample */
+    bool positions;               /* read view-space positions from a positions texture
+                                     instead of un-projecting depth */
+    mr_ao_mask mask;              /* corner masking; default off */
+    bool want_ao;                 /* fill mr_frame_result.ao */
+    bool no_reuse;                /* recompute even if camera and settings are unchanged
+                                     (benchmarks) */
+    const mr_image *external;     /* F32x1 AO at the output size to shade with instead of
+                                     computing one (e.g. ray-traced ground truth); NULL */
+} mr_ao_params;
+#define MR_AO_DEFAULTS {MR_AO_NONE, MR_AO_RADIUS_SCREEN, 0.0, 0.05, 16, MR_AO_KERNEL_UNIFORM, 0.8f, 1.0f, 1, \
+                        1.0f, 0.05f, 1.0f, 4, false, false, MR_AO_MASK_OFF, false, false, NULL}
+
+/* Names used on the command line ("none", "scheer", ...); NULL if out of range. */
+const char *mr_ao_method_name(mr_ao_method m);
+/* Parses a method name; false if unknown. */
+bool mr_ao_method_parse(const char *name, mr_ao_method *out);
+const char *mr_ao_kernel_name(mr_ao_kernel k);
+bool mr_ao_kernel_parse(const char *name, mr_ao_kernel *out);
+/* The kernels the AO pass uses, deterministic for given arguments: out3
+ * (n x 3 floats) in the unit ball shell [r_min, r_max] for the view-space
+ * methods, out2 (n x 2) in the unit disk of radius r_max for the screen-space
+ * disk (alchemy: there only surface points within the radius count, so an
+ * inner hole would only lose samples). Either may be NULL. */
+void mr_ao_kernel_generate(mr_ao_kernel kind, int n, float r_min, float r_max, uint64_t seed, float *out3,
+                           float *out2);
+
 typedef struct mr_frame_params {
     int width, height;         /* output size in pixels; 0 = the camera's */
     const mr_image *video;     /* camera frame (8-bit, 1/3/4 channels, raw
@@ -60,8 +146,9 @@ typedef struct mr_frame_params {
     bool want_depth;           /* fill result.depth (linear view depth) */
     bool want_normals;         /* fill result.normal (view-space normals) */
     bool timing;               /* GPU timer queries per pass (adds a sync) */
+    mr_ao_params ao;           /* ambient occlusion; default none */
 } mr_frame_params;
-#define MR_FRAME_DEFAULTS {0, 0, NULL, 0.5f, false, {0.62f, 0.66f, 0.70f}, false, false, false}
+#define MR_FRAME_DEFAULTS {0, 0, NULL, 0.5f, false, {0.62f, 0.66f, 0.70f}, false, false, false, MR_AO_DEFAULTS}
 
 #define MR_MAX_PASSES 32
 
@@ -78,6 +165,11 @@ typedef struct mr_frame_result {
     uint64_t triangles;        /* submitted this frame */
     uint32_t draw_calls;
     double near_plane;         /* the near plane used (scene units) */
+    mr_image ao;               /* F32x1 ambient visibility in [0,1] at the output size
+                                  (1 = unoccluded, 1 where nothing), when ao.want_ao */
+    double ao_masked_fraction; /* corner masking: fraction of geometry pixels in the
+                                  mask (-1 when masking is off) */
+    bool ao_reused;            /* AO of the previous frame was reused (frozen camera) */
 } mr_frame_result;
 
 /* Renders one frame of the current scene seen through `view`. */

@@ -65,8 +65,11 @@ void mr_pass_shade(frame *f) {
         bg[i] = c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
     }
     glUniform3fv(18, 1, bg);
+    GLuint ao = mr_pass_ao_texture(f); /* 0 when the frame has no AO */
+    glUniform1i(19, ao != 0);
     glBindTextureUnit(0, r->gbuf.color[0]);
     glBindTextureUnit(1, r->gbuf.color[1]);
+    glBindTextureUnit(2, ao);
     glBindVertexArray(r->empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     f->final_tex = r->shaded.color[0];

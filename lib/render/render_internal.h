@@ -42,6 +42,7 @@ struct mr_renderer {
         mr_dmat4 world_from_camera;
         double near_plane;
     } last;
+    struct mr_ao_state *ao; /* pass_ao.c: AO targets, programs, kernel, reuse cache */
 };
 
 typedef struct frame {
@@ -53,6 +54,7 @@ typedef struct frame {
     double near_plane;
     mr_frame_result *out;
     GLuint final_tex;       /* the texture holding the finished image */
+    int ao_plan;            /* pass_ao.c: decided once per frame (off / reuse / run) */
 } frame;
 
 typedef struct pass_desc {
@@ -82,5 +84,24 @@ bool mr_pass_need_overlay(frame *f);
 void mr_pass_gbuffer(frame *f);
 void mr_pass_shade(frame *f);
 void mr_pass_overlay(frame *f);
+
+/* Ambient occlusion (pass_ao.c). */
+typedef struct mr_ao_state mr_ao_state;
+bool mr_pass_need_ao_positions(frame *f);
+bool mr_pass_need_ao_mask(frame *f);
+bool mr_pass_need_ao(frame *f);
+bool mr_pass_need_ao_blur(frame *f);
+bool mr_pass_need_ao_upsample(frame *f);
+void mr_pass_ao_positions(frame *f);
+void mr_pass_ao_mask(frame *f);
+void mr_pass_ao(frame *f);
+void mr_pass_ao_blur(frame *f);
+void mr_pass_ao_upsample(frame *f);
+/* The finished AO texture of this frame (computed or reused), or 0. */
+GLuint mr_pass_ao_texture(frame *f);
+/* Fills out->ao (if asked) and the mask statistics; reports a failed AO shader. */
+bool mr_pass_ao_read_back(frame *f, mr_error *err);
+void mr_pass_ao_scene_changed(mr_renderer *r);
+void mr_pass_ao_free(mr_renderer *r);
 
 #endif

@@ -95,6 +95,7 @@ mr_renderer *mr_renderer_create(mr_gpu *gpu, mr_error *err) {
 void mr_renderer_destroy(mr_renderer **rp) {
     if (!rp || !*rp) return;
     mr_renderer *r = *rp;
+    mr_pass_ao_free(r);
     mr_geometry_free(r);
     mr_gl_target_free(&r->gbuf);
     mr_gl_target_free(&r->shaded);
@@ -112,6 +113,7 @@ void mr_renderer_destroy(mr_renderer **rp) {
 
 bool mr_renderer_set_scene(mr_renderer *r, const mr_scene *s, mr_error *err) {
     mr_geometry_free(r);
+    mr_pass_ao_scene_changed(r);
     if (!s) return true;
     return mr_geometry_upload(r, s, err);
 }
@@ -153,6 +155,11 @@ void mr_gl_projection(const mr_camera *c, double near_plane, float out[16]) {
 
 static const pass_desc k_passes[] = {
     {"gbuffer", mr_pass_need_always, mr_pass_gbuffer},
+    {"ao_positions", mr_pass_need_ao_positions, mr_pass_ao_positions},
+    {"ao_mask", mr_pass_need_ao_mask, mr_pass_ao_mask},
+    {"ao", mr_pass_need_ao, mr_pass_ao},
+    {"ao_blur", mr_pass_need_ao_blur, mr_pass_ao_blur},
+    {"ao_upsample", mr_pass_need_ao_upsample, mr_pass_ao_upsample},
     {"shade", mr_pass_need_always, mr_pass_shade},
     {"overlay", mr_pass_need_overlay, mr_pass_overlay},
 };
@@ -175,7 +182,7 @@ static bool read_back(frame *f, mr_error *err) {
         if (!mr_image_alloc(&o->normal, r->w, r->h, 3, MR_PIX_F32, err)) return false;
         glGetTextureImage(r->gbuf.color[1], 0, GL_RGB, GL_FLOAT, (GLsizei)mr_image_bytes(&o->normal), o->normal.data);
     }
-    return true;
+    return mr_pass_ao_read_back(f, err);
 }
 
 
@@ -245,6 +252,7 @@ void mr_frame_result_free(mr_frame_result *res) {
     mr_image_free(&res->color);
     mr_image_free(&res->depth);
     mr_image_free(&res->normal);
+    mr_image_free(&res->ao);
 }
 
 

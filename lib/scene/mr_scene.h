@@ -153,6 +153,15 @@ typedef struct mr_demo_hall {
     const char *const *hidden_globs; int hidden_glob_count; /* for configs */
 } mr_demo_hall;
 
+/* ------------------------------------------------------ outline meshes */
+
+/* Corner masking (Park & Baek): the integrated-normal extrusion direction of
+ * every vertex of mesh m (unit length, mesh space) into out (3 *
+ * vertex_count floats): vertices welded by position, the distinct face
+ * normals around each averaged. An outline mesh is the mesh with each vertex
+ * moved by radius * out[v]. Computed once per mesh by the renderer. */
+bool mr_mesh_outline_dirs(const mr_mesh *m, float *out, mr_error *err);
+
 bool mr_demo_build(const mr_demo_params *params, mr_demo_hall *out, mr_error *err);
 void mr_demo_free(mr_demo_hall *hall);
 

@@ -1,0 +1,239 @@
+/* Ray-traced ambient-occlusion ground truth with Embree 3: cosine-weighted
+ * hemisphere rays of length R from each visible surface point; the result
+ * is the fraction that escapes. */
+#include "mr_eval.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <embree3/rtcore.h>
+
+struct mr_eval_gt {
+    RTCDevice device;
+    RTCScene scene;
+    double origin[3]; /* world position of the Embree frame's origin */
+    double diag;      /* bounding-box diagonal of the scene */
+};
+
+static void gt_error(void *user, enum RTCError code, const char *str) {
+    (void)user;
+    mr_log(MR_LOG_ERROR, "embree: error %d: %s", (int)code, str ? str : "");
+}
+
+mr_eval_gt *mr_eval_gt_create(const mr_scene *s, bool skip_hidden, mr_error *err) {
+    mr_eval_gt *g = calloc(1, sizeof *g);
+    if (!g) {
+        mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    g->device = rtcNewDevice(NULL);
+    if (!g->device) {
+        free(g);
+        mr_fail(err, MR_ERR_UNSUPPORTED, "embree: cannot create a device (error %d)", (int)rtcGetDeviceError(NULL));
+        return NULL;
+    }
+    rtcSetDeviceErrorFunction(g->device, gt_error, NULL);
+    g->scene = rtcNewScene(g->device);
+    rtcSetSceneBuildQuality(g->scene, RTC_BUILD_QUALITY_HIGH);
+    double d2 = 0;
+    for (int i = 0; i < 3; i++) {
+        g->origin[i] = 0.5 * (s->bounds_min[i] + s->bounds_max[i]);
+        if (!isfinite(g->origin[i])) g->origin[i] = 0;
+        d2 += (s->bounds_max[i] - s->bounds_min[i]) * (s->bounds_max[i] - s->bounds_min[i]);
+    }
+    g->diag = isfinite(d2) && d2 > 0 ? sqrt(d2) : 1.0;
+    mr_dmat4 shift = mr_m4_translate(-g->origin[0], -g->origin[1], -g->origin[2]);
+    for (int32_t ni = 0; ni < s->node_count; ni++) {
+        const mr_node *n = &s->nodes[ni];
+        if (n->mesh_first < 0 || n->mesh_count <= 0) continue;
+        if (skip_hidden && n->layer == MR_LAYER_HIDDEN) continue;
+        mr_dmat4 rel = mr_m4_mul(&shift, &n->world);
+        for (int32_t k = 0; k < n->mesh_count; k++) {
+            int32_t mi = n->mesh_first + k;
+            if (mi < 0 || mi >= s->mesh_count) continue;
+            const mr_mesh *m = &s->meshes[mi];
+            if (m->index_count < 3 || m->vertex_count == 0) continue;
+            mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
+            mr_dmat4 M = mr_m4_mul(&rel, &T);
+            RTCGeometry geom = rtcNewGeometry(g->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+            float *v = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                               m->vertex_count);
+            unsigned *idx = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                    3 * sizeof(unsigned), m->index_count / 3);
+            if (!v || !idx) {
+                rtcReleaseGeometry(geom);
+                mr_eval_gt_destroy(&g);
+                mr_fail(err, MR_ERR_NOMEM, "embree: out of memory for mesh %s", m->name);
+                return NULL;
+            }
+            for (uint32_t i = 0; i < m->vertex_count; i++) {
+                mr_dvec3 p = mr_m4_point(&M, mr_v3(m->positions[3 * i], m->positions[3 * i + 1], m->positions[3 * i + 2]));
+                v[3 * i] = (float)p.x;
+                v[3 * i + 1] = (float)p.y;
+                v[3 * i + 2] = (float)p.z;
+            }
+            memcpy(idx, m->indices, (size_t)(m->index_count / 3) * 3 * sizeof(unsigned));
+            rtcCommitGeometry(geom);
+            rtcAttachGeometry(g->scene, geom);
+            rtcReleaseGeometry(geom);
+        }
+    }
+    rtcCommitScene(g->scene);
+    if (rtcGetDeviceError(g->device) != RTC_ERROR_NONE) {
+        mr_eval_gt_destroy(&g);
+        mr_fail(err, MR_ERR_UNSUPPORTED, "embree: building the scene failed");
+        return NULL;
+    }
+    return g;
+}
+
+void mr_eval_gt_destroy(mr_eval_gt **gp) {
+    if (!gp || !*gp) return;
+    mr_eval_gt *g = *gp;
+    if (g->scene) rtcReleaseScene(g->scene);
+    if (g->device) rtcReleaseDevice(g->device);
+    free(g);
+    *gp = NULL;
+}
+
+double mr_eval_ao_wall_analytic(double d, double radius) {
+    if (!(radius > 0)) return 1.0;
+    double a = d / radius;
+    if (a >= 1) return 1.0;
+    if (a < 0) a = 0;
+    return 1.0 - (acos(a) - a * sqrt(1 - a * a)) / 3.14159265358979323846;
+}
+
+/* Visibility at p (Embree frame, double) with unit normal n: `rays`
+ * cosine-weighted directions, stratified on a jittered grid (the square
+ * part of `rays`), the rest independent. */
+static double visibility(const mr_eval_gt *g, const double p[3], const double n[3], double radius, int rays,
+                         mr_rng *rng) {
+    if (!(radius > 0) || rays <= 0) return 1.0;
+    /* Orthonormal basis around n (Duff et al. 2017). */
+    double sign = n[2] >= 0 ? 1.0 : -1.0, a = -1.0 / (sign + n[2]), b = n[0] * n[1] * a;
+    double t[3] = {1 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]};
+    double bt[3] = {b, sign + n[1] * n[1] * a, -n[1]};
+    int grid = (int)floor(sqrt((double)rays));
+    int escaped = 0;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    for (int i = 0; i < rays; i++) {
+        double u1 = mr_rng_uniform(rng), u2 = mr_rng_uniform(rng);
+        if (i < grid * grid) {
+            u1 = ((i % grid) + u1) / grid;
+            u2 = ((i / grid) + u2) / grid;
+        }
+        double r = sqrt(u1), phi = 2 * 3.14159265358979323846 * u2;
+        double lx = r * cos(phi), ly = r * sin(phi), lz = sqrt(fmax(0.0, 1 - u1));
+        struct RTCRay ray;
+        ray.org_x = (float)p[0];
+        ray.org_y = (float)p[1];
+        ray.org_z = (float)p[2];
+        ray.dir_x = (float)(lx * t[0] + ly * bt[0] + lz * n[0]);
+        ray.dir_y = (float)(lx * t[1] + ly * bt[1] + lz * n[1]);
+        ray.dir_z = (float)(lx * t[2] + ly * bt[2] + lz * n[2]);
+        ray.tnear = 0.0f;
+        ray.tfar = (float)radius;
+        ray.time = 0.0f;
+        ray.mask = 0xFFFFFFFFu;
+        ray.id = 0;
+        ray.flags = 0;
+        rtcOccluded1(g->scene, &ctx, &ray);
+        if (ray.tfar >= 0.0f) escaped++;
+    }
+    return (double)escaped / rays;
+}
+
+double mr_eval_ao_point(const mr_eval_gt *g, mr_dvec3 p, mr_dvec3 n, double radius, int rays, uint64_t seed) {
+    mr_dvec3 nn = mr_v3_normalize(n);
+    if (mr_v3_len(nn) == 0) return 1.0;
+    double q[3] = {p.x - g->origin[0], p.y - g->origin[1], p.z - g->origin[2]}, nv[3] = {nn.x, nn.y, nn.z};
+    mr_rng rng;
+    mr_rng_seed(&rng, seed ? seed : 1);
+    return visibility(g, q, nv, radius, rays, &rng);
+}
+
+typedef struct gt_job {
+    const mr_eval_gt *g;
+    const mr_image *depth, *normal;
+    mr_image *out;
+    mr_camera cam;
+    mr_dmat4 rel_from_camera; /* Embree frame from camera */
+    mr_gt_params p;
+    int next_row;
+    pthread_mutex_t lock;
+} gt_job;
+
+static void *gt_worker(void *arg) {
+    gt_job *j = arg;
+    int w = j->depth->width, h = j->depth->height;
+    const float *dep = j->depth->data, *nor = j->normal->data;
+    float *out = j->out->data;
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        int y = j->next_row++;
+        pthread_mutex_unlock(&j->lock);
+        if (y >= h) break;
+        for (int x = 0; x < w; x++) {
+            size_t i = (size_t)y * w + x;
+            float z = dep[i];
+            out[i] = 1.0f;
+            if (!(z > 0) || !isfinite(z)) continue;
+            mr_dvec3 nc = mr_v3(nor[3 * i], nor[3 * i + 1], nor[3 * i + 2]);
+            mr_dvec3 pc = mr_v3((x - j->cam.cx) / j->cam.fx * z, (y - j->cam.cy) / j->cam.fy * z, z);
+            nc = mr_v3_normalize(nc);
+            if (mr_v3_len(nc) == 0) nc = mr_v3_normalize(mr_v3_scale(pc, -1));
+            double R = j->p.radius_mode == MR_AO_RADIUS_SCREEN ? j->p.screen_radius * z * j->cam.height / j->cam.fy
+                                                               : j->p.radius;
+            /* Lift the origin off the surface by a little more than the
+             * depth buffer's error so rays do not hit their own triangle. */
+            pc = mr_v3_add(pc, mr_v3_scale(nc, 2e-4 * z));
+            mr_dvec3 pw = mr_m4_point(&j->rel_from_camera, pc), nw = mr_m4_dir(&j->rel_from_camera, nc);
+            double q[3] = {pw.x, pw.y, pw.z}, nv[3] = {nw.x, nw.y, nw.z};
+            mr_rng rng;
+            mr_rng_seed(&rng, j->p.seed * 0x9E3779B97F4A7C15ull + i);
+            out[i] = (float)visibility(j->g, q, nv, R, j->p.rays, &rng);
+        }
+    }
+    return NULL;
+}
+
+bool mr_eval_ao_groundtruth(const mr_eval_gt *g, const mr_view *view, const mr_image *depth, const mr_image *normal,
+                            const mr_gt_params *params, mr_image *out, mr_error *err) {
+    mr_gt_params p = MR_GT_DEFAULTS;
+    if (params) p = *params;
+    if (!depth || !normal || !depth->data || !normal->data || depth->type != MR_PIX_F32 || normal->type != MR_PIX_F32 ||
+        depth->channels != 1 || normal->channels != 3 || depth->width != normal->width || depth->height != normal->height)
+        return mr_fail(err, MR_ERR_INVALID, "ground truth needs an F32 depth image and an F32x3 normal image of one size");
+    if (p.rays <= 0) p.rays = 256;
+    if (p.seed == 0) p.seed = 1;
+    if (!(p.radius > 0) || !isfinite(p.radius)) p.radius = 0.02 * g->diag;
+    if (!(p.screen_radius > 0) || !isfinite(p.screen_radius)) p.screen_radius = 0.05;
+    if (!mr_image_alloc(out, depth->width, depth->height, 1, MR_PIX_F32, err)) return false;
+    gt_job j;
+    memset(&j, 0, sizeof j);
+    j.g = g;
+    j.depth = depth;
+    j.normal = normal;
+    j.out = out;
+    j.cam = mr_camera_resized(&view->camera, depth->width, depth->height);
+    j.p = p;
+    mr_dmat4 shift = mr_m4_translate(-g->origin[0], -g->origin[1], -g->origin[2]);
+    j.rel_from_camera = mr_m4_mul(&shift, &view->world_from_camera);
+    pthread_mutex_init(&j.lock, NULL);
+    int nt = p.threads > 0 ? p.threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    if (nt < 1) nt = 1;
+    if (nt > 64) nt = 64;
+    pthread_t th[64];
+    int started = 0;
+    for (int i = 1; i < nt; i++)
+        if (pthread_create(&th[started], NULL, gt_worker, &j) == 0) started++;
+    gt_worker(&j);
+    for (int i = 0; i < started; i++) pthread_join(th[i], NULL);
+    pthread_mutex_destroy(&j.lock);
+    return true;
+}

@@ -1,0 +1,98 @@
+/* mr_eval.h — measuring the renderer: ray-traced ambient-occlusion ground
+ * truth (Embree), image metrics (RMSE, SSIM, signed bias), and small report
+ * helpers (SVG line plots, PNG montages). Used by `mrcheck bench`, by
+ * `render --ao groundtruth` and by the tests.
+ *
+ * Precision: the Embree scene is built in float relative to the centre of
+ * the scene's bounds (composed in double), so scenes far from the origin
+ * trace as accurately as scenes at it.
+ */
+#ifndef MR_EVAL_H
+#define MR_EVAL_H
+
+#include "mr_core.h"
+#include "mr_render.h"
+#include "mr_scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------- ground truth */
+
+typedef struct mr_eval_gt mr_eval_gt;
+
+/* Builds the ray-tracing scene of every drawn node (the hidden layer too
+ * unless skip_hidden). NULL + err on failure (MR_ERR_NOMEM, MR_ERR_UNSUPPORTED). */
+mr_eval_gt *mr_eval_gt_create(const mr_scene *scene, bool skip_hidden, mr_error *err);
+void mr_eval_gt_destroy(mr_eval_gt **gt); /* NULLs, accepts NULL */
+
+typedef struct mr_gt_params {
+    mr_ao_radius_mode radius_mode; /* view (default): fixed R; screen: R grows with
+                                      depth exactly like the SSAO radius */
+    double radius;                 /* R in scene units (view mode); 0 = 2% of the
+                                      scene's bounding-box diagonal (as the renderer) */
+    double screen_radius;          /* screen mode: R = screen_radius * z * height / fy;
+                                      0 = 0.05 (as the renderer) */
+    int rays;                      /* cosine-weighted rays per pixel; 0 = 256 */
+    uint64_t seed;                 /* 0 = 1 */
+    int threads;                   /* 0 = one per online CPU */
+} mr_gt_params;
+#define MR_GT_DEFAULTS {MR_AO_RADIUS_VIEW, 0.0, 0.05, 256, 1, 0}
+
+/* Ambient visibility (fraction of cosine-weighted rays of length R that
+ * escape; 1 = unoccluded, 1 where depth is 0) for each pixel of a rendered
+ * frame, from the surface point and normal the G-buffer saw there: `depth`
+ * (F32x1, linear view z) and `normal` (F32x3, camera axes) as
+ * mr_render_frame returns them; `view`'s camera is resized to their size.
+ * out is allocated (F32x1). */
+bool mr_eval_ao_groundtruth(const mr_eval_gt *gt, const mr_view *view, const mr_image *depth, const mr_image *normal,
+                            const mr_gt_params *params, mr_image *out, mr_error *err);
+
+/* The same for one world-space point p with unit normal n: fraction of
+ * `rays` cosine-weighted rays of length `radius` that escape. */
+double mr_eval_ao_point(const mr_eval_gt *gt, mr_dvec3 p, mr_dvec3 n, double radius, int rays, uint64_t seed);
+
+/* Closed form for a point on a floor at distance d from an infinite wall
+ * standing on it, rays of length R: V = 1 - (acos a - a sqrt(1 - a^2)) / pi,
+ * a = d / R, and V = 1 for d >= R. */
+double mr_eval_ao_wall_analytic(double d, double radius);
+
+/* ------------------------------------------------------------ metrics */
+
+typedef struct mr_image_metrics {
+    double rmse;     /* root mean square of (a - ref) */
+    double ssim;     /* mean SSIM (Gaussian window 11, sigma 1.5, data range 1) */
+    double bias;     /* mean of (a - ref): > 0 brighter than the reference */
+    double max_abs;  /* largest |a - ref| */
+    long long count; /* pixels compared */
+} mr_image_metrics;
+
+/* Compares two F32x1 images of equal size over the pixels where `mask`
+ * (F32x1, e.g. a depth image) is > 0, or all pixels if mask is NULL.
+ * Non-finite values count as an error of 1. */
+bool mr_image_compare(const mr_image *a, const mr_image *ref, const mr_image *mask, mr_image_metrics *out,
+                      mr_error *err);
+
+/* ------------------------------------------------------------ reports */
+
+typedef struct mr_plot_series {
+    const char *name;
+    const double *x, *y;
+    int count;
+} mr_plot_series;
+
+/* A line plot (one polyline with markers per series, legend), written
+ * atomically as SVG. log_x: logarithmic x axis. */
+bool mr_plot_svg(const char *path, const char *title, const char *xlabel, const char *ylabel,
+                 const mr_plot_series *series, int nseries, bool log_x, mr_error *err);
+
+/* Tiles F32x1 images (values in [0,1], each resized by nearest neighbour to
+ * tile_w x tile_h) into a grey PNG, cols tiles per row, row-major. */
+bool mr_montage_png(const char *path, const mr_image *const *images, int count, int cols, int tile_w, int tile_h,
+                    mr_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,611 @@
+/* Ambient occlusion passes: positions texture, corner mask (Park & Baek),
+ * the SSAO methods (Scheer & Keutel and its baselines), bilateral blur and
+ * joint bilateral upsampling (Doronin et al.). The shaders are
+ * shaders/ao_*.glsl.
+ *
+ * A frame decides once (ao_plan) whether AO is off, reused (the camera,
+ * the size, the scene and the settings are those of the last computed AO)
+ * or computed; the k_passes rows ask that plan, so a frame that does not
+ * need AO runs none of these passes and a frozen camera runs only shading. */
+#include "render_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { AO_PLAN_UNDECIDED = 0, AO_PLAN_OFF, AO_PLAN_REUSE, AO_PLAN_RUN, AO_PLAN_EXTERNAL };
+
+/* Everything that makes an AO buffer what it is; equal keys mean the last
+ * buffer can be shown again. */
+typedef struct ao_key {
+    mr_dmat4 pose;
+    mr_camera cam;
+    int w, h;
+    bool hide_hidden;
+    uint64_t scene_gen;
+    mr_ao_params p; /* resolved, with want_ao / no_reuse cleared */
+} ao_key;
+
+struct mr_ao_state {
+    bool broken;          /* a shader failed: AO stays off, the error is reported */
+    mr_error error;
+    GLuint prog_main, prog_blur, prog_up, prog_pos, prog_outline;
+    int w, h, aw, ah, step; /* G-buffer size, AO size, G-buffer pixels per AO pixel */
+    GLuint tex_ao[2], fbo_ao[2]; /* AO resolution, ping-pong */
+    GLuint tex_full, fbo_full;   /* upsampled result */
+    GLuint tex_pos, fbo_pos;     /* view-space positions */
+    GLuint tex_mask, fbo_mask;   /* outline counts, depth-tested against the G-buffer */
+    GLuint result;               /* texture with the finished AO (full resolution) */
+    int cur;                     /* which tex_ao holds the latest AO */
+    /* kernel */
+    int k_n;
+    mr_ao_kernel k_kind;
+    float k_rmin, k_rmax;
+    float kernel3[MR_AO_MAX_SAMPLES * 4], kernel2[MR_AO_MAX_SAMPLES * 4];
+    /* reuse */
+    bool valid;
+    ao_key last;
+    uint64_t scene_gen;
+    /* outline meshes, per scene mesh: integrated-normal directions */
+    GLuint *outline_vbo, *outline_vao;
+    int32_t outline_count;
+    uint64_t outline_gen;
+    /* this frame */
+    mr_ao_params p; /* resolved */
+    float screen_k;
+};
+
+/* ------------------------------------------------------------ names */
+
+static const char *const k_method_names[MR_AO_METHOD_COUNT] = {"none", "scheer", "crytek", "filion", "hbao", "alchemy"};
+static const char *const k_kernel_names[4] = {"uniform", "stratified", "latin", "poisson"};
+
+const char *mr_ao_method_name(mr_ao_method m) {
+    return (int)m >= 0 && m < MR_AO_METHOD_COUNT ? k_method_names[m] : NULL;
+}
+
+bool mr_ao_method_parse(const char *name, mr_ao_method *out) {
+    for (int i = 0; i < MR_AO_METHOD_COUNT; i++)
+        if (name && strcmp(name, k_method_names[i]) == 0) {
+            *out = (mr_ao_method)i;
+            return true;
+        }
+    return false;
+}
+
+const char *mr_ao_kernel_name(mr_ao_kernel k) { return (int)k >= 0 && k < 4 ? k_kernel_names[k] : NULL; }
+
+bool mr_ao_kernel_parse(const char *name, mr_ao_kernel *out) {
+    for (int i = 0; i < 4; i++)
+        if (name && strcmp(name, k_kernel_names[i]) == 0) {
+            *out = (mr_ao_kernel)i;
+            return true;
+        }
+    return false;
+}
+
+/* ------------------------------------------------------------ kernels */
+
+static void shuffle(mr_rng *rng, int *perm, int n) {
+    for (int i = 0; i < n; i++) perm[i] = i;
+    for (int i = n - 1; i > 0; i--) {
+        int j = (int)(mr_rng_uniform(rng) * (i + 1));
+        if (j > i) j = i;
+        int t = perm[i]; perm[i] = perm[j]; perm[j] = t;
+    }
+}
+
+/* Unit-cube coordinates (u1,u2,u3) to the ball shell [rmin, rmax] with
+ * uniform volume density, and (u1,u2) to the disk annulus with uniform
+ * area density. */
+static void to_ball(double u1, double u2, double u3, double rmin, double rmax, float *o) {
+    double z = 1 - 2 * u1, phi = 2 * 3.14159265358979323846 * u2, s = sqrt(fmax(0, 1 - z * z));
+    double r = cbrt(rmin * rmin * rmin + u3 * (rmax * rmax * rmax - rmin * rmin * rmin));
+    o[0] = (float)(r * s * cos(phi));
+    o[1] = (float)(r * s * sin(phi));
+    o[2] = (float)(r * z);
+}
+
+static void to_disk(double u1, double u2, double rmin, double rmax, float *o) {
+    double r = sqrt(rmin * rmin + u1 * (rmax * rmax - rmin * rmin)), a = 2 * 3.14159265358979323846 * u2;
+    o[0] = (float)(r * cos(a));
+    o[1] = (float)(r * sin(a));
+}
+
+/* Poisson disk by dart throwing in the shell (dim 3) or annulus (dim 2):
+ * candidates closer than dmin to an accepted point are rejected; dmin
+ * shrinks by 10% whenever 64 candidates in a row fail, so n points are
+ * always found. */
+static void poisson(mr_rng *rng, int n, int dim, double rmin, double rmax, float *out, int stride) {
+    double d;
+    if (dim == 3) {
+        double vol = 4.0 / 3.0 * 3.14159265358979323846 * (rmax * rmax * rmax - rmin * rmin * rmin);
+        double area = 4 * 3.14159265358979323846 * rmax * rmax;
+        d = rmax - rmin > 0.05 ? 0.85 * cbrt(vol / n) : 0.85 * sqrt(area / n);
+    } else {
+        double area = 3.14159265358979323846 * (rmax * rmax - rmin * rmin);
+        d = rmax - rmin > 0.05 ? 0.85 * sqrt(area / n) : 0.85 * 2 * 3.14159265358979323846 * rmax / n;
+    }
+    int have = 0, fails = 0;
+    while (have < n) {
+        float c[3] = {0, 0, 0};
+        if (dim == 3) to_ball(mr_rng_uniform(rng), mr_rng_uniform(rng), mr_rng_uniform(rng), rmin, rmax, c);
+        else to_disk(mr_rng_uniform(rng), mr_rng_uniform(rng), rmin, rmax, c);
+        bool ok = true;
+        for (int j = 0; j < have && ok; j++) {
+            double s = 0;
+            for (int k = 0; k < dim; k++) s += (c[k] - out[j * stride + k]) * (c[k] - out[j * stride + k]);
+            ok = s >= d * d;
+        }
+        if (ok) {
+            for (int k = 0; k < dim; k++) out[have * stride + k] = c[k];
+            have++;
+            fails = 0;
+        } else if (++fails >= 64) {
+            d *= 0.9;
+            fails = 0;
+        }
+    }
+}
+
+void mr_ao_kernel_generate(mr_ao_kernel kind, int n, float r_min, float r_max, uint64_t seed, float *out3, float *out2) {
+    if (n <= 0) return;
+    if (n > MR_AO_MAX_SAMPLES) n = MR_AO_MAX_SAMPLES;
+    double rmax = r_max > 0 && r_max <= 1 ? r_max : 1.0;
+    double rmin = r_min >= 0 ? r_min : 0.0;
+    if (rmin > rmax) rmin = rmax;
+    mr_rng rng;
+    mr_rng_seed(&rng, seed);
+    if (kind == MR_AO_KERNEL_POISSON) {
+        if (out3) poisson(&rng, n, 3, rmin, rmax, out3, 3);
+        if (out2) poisson(&rng, n, 2, 0.0, rmax, out2, 2);
+        return;
+    }
+    int p1[MR_AO_MAX_SAMPLES], p2[MR_AO_MAX_SAMPLES], p3[MR_AO_MAX_SAMPLES];
+    shuffle(&rng, p1, n);
+    shuffle(&rng, p2, n);
+    shuffle(&rng, p3, n);
+    int nx = 1; /* stratified: an nx x ny grid over the two direction coordinates */
+    for (int k = 1; k * k <= n; k++)
+        if (n % k == 0) nx = k;
+    int ny = n / nx;
+    for (int i = 0; i < n; i++) {
+        double u1, u2, u3;
+        if (kind == MR_AO_KERNEL_STRATIFIED) {
+            u1 = ((i % nx) + mr_rng_uniform(&rng)) / nx;
+            u2 = ((i / nx) + mr_rng_uniform(&rng)) / ny;
+            u3 = (p3[i] + mr_rng_uniform(&rng)) / n;
+        } else if (kind == MR_AO_KERNEL_LATIN) {
+            u1 = (p1[i] + mr_rng_uniform(&rng)) / n;
+            u2 = (p2[i] + mr_rng_uniform(&rng)) / n;
+            u3 = (p3[i] + mr_rng_uniform(&rng)) / n;
+        } else {
+            u1 = mr_rng_uniform(&rng);
+            u2 = mr_rng_uniform(&rng);
+            u3 = mr_rng_uniform(&rng);
+        }
+        if (out3) to_ball(u1, u2, u3, rmin, rmax, out3 + 3 * i);
+        if (out2) to_disk(u1, u2, 0.0, rmax, out2 + 2 * i);
+    }
+}
+
+/* ------------------------------------------------------------ state */
+
+static void free_targets(mr_ao_state *s) {
+    glDeleteFramebuffers(2, s->fbo_ao);
+    glDeleteTextures(2, s->tex_ao);
+    glDeleteFramebuffers(1, &s->fbo_full);
+    glDeleteTextures(1, &s->tex_full);
+    glDeleteFramebuffers(1, &s->fbo_pos);
+    glDeleteTextures(1, &s->tex_pos);
+    glDeleteFramebuffers(1, &s->fbo_mask);
+    glDeleteTextures(1, &s->tex_mask);
+    s->fbo_ao[0] = s->fbo_ao[1] = s->tex_ao[0] = s->tex_ao[1] = 0;
+    s->fbo_full = s->tex_full = s->fbo_pos = s->tex_pos = s->fbo_mask = s->tex_mask = 0;
+    s->w = s->h = s->aw = s->ah = 0;
+    s->valid = false;
+}
+
+static void free_outlines(mr_ao_state *s) {
+    if (s->outline_vao) glDeleteVertexArrays(s->outline_count, s->outline_vao);
+    if (s->outline_vbo) glDeleteBuffers(s->outline_count, s->outline_vbo);
+    free(s->outline_vao);
+    free(s->outline_vbo);
+    s->outline_vao = s->outline_vbo = NULL;
+    s->outline_count = 0;
+}
+
+void mr_pass_ao_free(mr_renderer *r) {
+    mr_ao_state *s = r->ao;
+    if (!s) return;
+    free_targets(s);
+    free_outlines(s);
+    glDeleteProgram(s->prog_main);
+    glDeleteProgram(s->prog_blur);
+    glDeleteProgram(s->prog_up);
+    glDeleteProgram(s->prog_pos);
+    glDeleteProgram(s->prog_outline);
+    free(s);
+    r->ao = NULL;
+}
+
+void mr_pass_ao_scene_changed(mr_renderer *r) {
+    if (!r->ao) return;
+    r->ao->scene_gen++;
+    r->ao->valid = false;
+    free_outlines(r->ao);
+}
+
+static GLuint fbo_for(GLuint tex) {
+    GLuint fbo;
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, tex, 0);
+    return fbo;
+}
+
+static bool ensure_programs(mr_ao_state *s) {
+    if (s->prog_main) return true;
+    static const char *const m[] = {"fullscreen.vert.glsl", "ao_main.frag.glsl", NULL};
+    static const char *const b[] = {"fullscreen.vert.glsl", "ao_blur.frag.glsl", NULL};
+    static const char *const u[] = {"fullscreen.vert.glsl", "ao_upsample.frag.glsl", NULL};
+    static const char *const p[] = {"fullscreen.vert.glsl", "ao_positions.frag.glsl", NULL};
+    static const char *const o[] = {"ao_outline.vert.glsl", "ao_outline.frag.glsl", NULL};
+    if ((s->prog_main = mr_gl_program(m, &s->error)) && (s->prog_blur = mr_gl_program(b, &s->error)) &&
+        (s->prog_up = mr_gl_program(u, &s->error)) && (s->prog_pos = mr_gl_program(p, &s->error)) &&
+        (s->prog_outline = mr_gl_program(o, &s->error)))
+        return true;
+    s->broken = true;
+    return false;
+}
+
+static void ensure_targets(mr_ao_state *s, int w, int h, int step) {
+    int aw = (w + step - 1) / step, ah = (h + step - 1) / step;
+    if (s->w == w && s->h == h && s->aw == aw && s->ah == ah) return;
+    free_targets(s);
+    for (int i = 0; i < 2; i++) {
+        s->tex_ao[i] = mr_gl_make_tex(GL_R32F, aw, ah, GL_NEAREST);
+        s->fbo_ao[i] = fbo_for(s->tex_ao[i]);
+    }
+    s->tex_full = mr_gl_make_tex(GL_R32F, w, h, GL_NEAREST);
+    s->fbo_full = fbo_for(s->tex_full);
+    s->tex_pos = mr_gl_make_tex(GL_RGBA32F, w, h, GL_NEAREST);
+    s->fbo_pos = fbo_for(s->tex_pos);
+    s->tex_mask = mr_gl_make_tex(GL_R16F, w, h, GL_NEAREST);
+    s->fbo_mask = fbo_for(s->tex_mask);
+    s->w = w; s->h = h; s->aw = aw; s->ah = ah;
+}
+
+/* Defaults and ranges applied, so that the shaders never see a value that
+ * can make them divide by zero or loop without end. */
+static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
+    mr_ao_params p = *in;
+    if (p.samples <= 0) p.samples = 16;
+    if (p.samples > MR_AO_MAX_SAMPLES) p.samples = MR_AO_MAX_SAMPLES;
+    if (p.radii <= 0) p.radii = 1;
+    if (p.radii > MR_AO_MAX_RADII) p.radii = MR_AO_MAX_RADII;
+    if (!(p.screen_radius > 0) || !isfinite(p.screen_radius)) p.screen_radius = 0.05;
+    if (!(p.radius > 0) || !isfinite(p.radius)) {
+        double diag = 0;
+        if (scene)
+            for (int i = 0; i < 3; i++) diag += (scene->bounds_max[i] - scene->bounds_min[i]) * (scene->bounds_max[i] - scene->bounds_min[i]);
+        diag = sqrt(diag);
+        p.radius = diag > 0 && isfinite(diag) ? 0.02 * diag : 1.0;
+    }
+    if (!(p.strength > 0) || !isfinite(p.strength)) p.strength = 1.0f;
+    if (!(p.c >= 0) || !isfinite(p.c)) p.c = 1.0f;
+    if (!(p.bias >= 0) || !(p.bias < 0.9f)) p.bias = 0.05f;
+    if (!(p.r_max > 0 && p.r_max <= 1)) p.r_max = 1.0f;
+    if (!(p.r_min >= 0)) p.r_min = 0.0f;
+    if (p.r_min > p.r_max) p.r_min = p.r_max;
+    if (p.blur_radius < 0) p.blur_radius = 0;
+    if (p.blur_radius > 32) p.blur_radius = 32;
+    if ((int)p.kernel < 0 || p.kernel > MR_AO_KERNEL_POISSON) p.kernel = MR_AO_KERNEL_UNIFORM;
+    if ((int)p.mask < 0 || p.mask > MR_AO_MASK_STANDALONE) p.mask = MR_AO_MASK_OFF;
+    if ((int)p.radius_mode < 0 || p.radius_mode > MR_AO_RADIUS_VIEW) p.radius_mode = MR_AO_RADIUS_SCREEN;
+    p.want_ao = false;
+    p.no_reuse = false;
+    p.external = NULL;
+    return p;
+}
+
+static int plan(frame *f) {
+    if (f->ao_plan != AO_PLAN_UNDECIDED) return f->ao_plan;
+    mr_renderer *r = f->r;
+    const mr_ao_params *in = &f->p->ao;
+    f->ao_plan = AO_PLAN_OFF;
+    const mr_image *ext = in->external;
+    if (ext && ext->data && ext->type == MR_PIX_F32 && ext->channels == 1 && ext->width == r->w && ext->height == r->h) {
+        /* An AO image from outside (ground truth): upload, no AO pass runs. */
+        if (!r->ao && !(r->ao = calloc(1, sizeof *r->ao))) return f->ao_plan;
+        mr_ao_state *s = r->ao;
+        ensure_targets(s, r->w, r->h, s->step > 0 ? s->step : 1);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glTextureSubImage2D(s->tex_full, 0, 0, 0, r->w, r->h, GL_RED, GL_FLOAT, ext->data);
+        s->result = s->tex_full;
+        s->valid = false; /* the next computed AO must not mistake this for its own */
+        s->p.mask = MR_AO_MASK_OFF;
+        return f->ao_plan = AO_PLAN_EXTERNAL;
+    }
+    if (in->method <= MR_AO_NONE || in->method >= MR_AO_METHOD_COUNT) return f->ao_plan;
+    if (!r->ao && !(r->ao = calloc(1, sizeof *r->ao))) return f->ao_plan;
+    mr_ao_state *s = r->ao;
+    if (s->broken || !ensure_programs(s)) return f->ao_plan;
+    s->p = resolve(in, r->scene);
+    s->step = s->p.half_res ? 2 : 1;
+    ensure_targets(s, r->w, r->h, s->step);
+    s->screen_k = (float)(s->p.screen_radius * f->cam.height / f->cam.fy);
+    if (s->k_n != s->p.samples || s->k_kind != s->p.kernel || s->k_rmin != s->p.r_min || s->k_rmax != s->p.r_max) {
+        float k3[MR_AO_MAX_SAMPLES * 3], k2[MR_AO_MAX_SAMPLES * 2];
+        mr_ao_kernel_generate(s->p.kernel, s->p.samples, s->p.r_min, s->p.r_max, 0x5eedu, k3, k2);
+        memset(s->kernel3, 0, sizeof s->kernel3);
+        memset(s->kernel2, 0, sizeof s->kernel2);
+        for (int i = 0; i < s->p.samples; i++) {
+            memcpy(s->kernel3 + 4 * i, k3 + 3 * i, 3 * sizeof(float));
+            memcpy(s->kernel2 + 4 * i, k2 + 2 * i, 2 * sizeof(float));
+        }
+        s->k_n = s->p.samples;
+        s->k_kind = s->p.kernel;
+        s->k_rmin = s->p.r_min;
+        s->k_rmax = s->p.r_max;
+    }
+    ao_key key;
+    memset(&key, 0, sizeof key);
+    key.pose = f->view->world_from_camera;
+    key.cam = f->cam;
+    key.w = r->w;
+    key.h = r->h;
+    key.hide_hidden = f->p->hide_hidden_layer;
+    key.scene_gen = s->scene_gen;
+    key.p = s->p;
+    if (s->valid && !in->no_reuse && memcmp(&key, &s->last, sizeof key) == 0) {
+        f->ao_plan = AO_PLAN_REUSE;
+    } else {
+        f->ao_plan = AO_PLAN_RUN;
+        s->last = key;
+        s->valid = false; /* until the passes below have run */
+    }
+    return f->ao_plan;
+}
+
+GLuint mr_pass_ao_texture(frame *f) {
+    int pl = plan(f);
+    return pl == AO_PLAN_RUN || pl == AO_PLAN_REUSE || pl == AO_PLAN_EXTERNAL ? f->r->ao->result : 0;
+}
+
+bool mr_pass_need_ao(frame *f) { return plan(f) == AO_PLAN_RUN; }
+bool mr_pass_need_ao_positions(frame *f) { return plan(f) == AO_PLAN_RUN && f->r->ao->p.positions && f->r->ao->p.mask != MR_AO_MASK_STANDALONE; }
+bool mr_pass_need_ao_mask(frame *f) { return plan(f) == AO_PLAN_RUN && f->r->ao->p.mask != MR_AO_MASK_OFF; }
+bool mr_pass_need_ao_blur(frame *f) {
+    /* The standalone mask is a hard 0/1 stencil: it needs the blur to be AO. */
+    return plan(f) == AO_PLAN_RUN && (f->r->ao->p.blur_radius > 0 || f->r->ao->p.mask == MR_AO_MASK_STANDALONE);
+}
+bool mr_pass_need_ao_upsample(frame *f) { return plan(f) == AO_PLAN_RUN && f->r->ao->step > 1; }
+
+/* The uniforms the full-screen AO shaders share (locations 0..3). */
+static void common_uniforms(frame *f) {
+    mr_ao_state *s = f->r->ao;
+    glUniform4f(0, (float)f->cam.fx, (float)f->cam.fy, (float)f->cam.cx, (float)f->cam.cy);
+    glUniform2i(1, f->r->w, f->r->h);
+    glUniform1i(2, s->step);
+    glUniform1f(3, (float)f->near_plane);
+    glBindTextureUnit(0, f->r->gbuf.depth);
+    glBindTextureUnit(1, f->r->gbuf.color[1]);
+    glBindTextureUnit(2, s->tex_pos);
+    glBindTextureUnit(3, s->tex_mask);
+}
+
+static void fullscreen(frame *f, GLuint fbo, int w, int h) {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glViewport(0, 0, w, h);
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glBindVertexArray(f->r->empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+void mr_pass_ao_positions(frame *f) {
+    mr_ao_state *s = f->r->ao;
+    glUseProgram(s->prog_pos);
+    /* Only the uniforms this shader declares: setting another location is
+     * an error. */
+    glUniform4f(0, (float)f->cam.fx, (float)f->cam.fy, (float)f->cam.cx, (float)f->cam.cy);
+    glUniform1f(3, (float)f->near_plane);
+    glBindTextureUnit(0, f->r->gbuf.depth);
+    glBindTextureUnit(2, 0); /* the target itself must not be bound for reading */
+    fullscreen(f, s->fbo_pos, s->w, s->h);
+}
+
+static bool ensure_outlines(mr_renderer *r, mr_ao_state *s) {
+    const mr_scene *sc = r->scene;
+    if (!sc) return false;
+    if (s->outline_vao && s->outline_gen == s->scene_gen && s->outline_count == sc->mesh_count) return true;
+    free_outlines(s);
+    s->outline_vao = calloc((size_t)sc->mesh_count + 1, sizeof *s->outline_vao);
+    s->outline_vbo = calloc((size_t)sc->mesh_count + 1, sizeof *s->outline_vbo);
+    if (!s->outline_vao || !s->outline_vbo) {
+        free_outlines(s);
+        return false;
+    }
+    s->outline_count = sc->mesh_count;
+    s->outline_gen = s->scene_gen;
+    for (int32_t i = 0; i < sc->mesh_count && i < r->mesh_count; i++) {
+        const mr_mesh *m = &sc->meshes[i];
+        float *dirs = malloc((size_t)m->vertex_count * 3 * sizeof *dirs + 1);
+        mr_error err = {0};
+        if (!dirs || !mr_mesh_outline_dirs(m, dirs, &err)) {
+            free(dirs);
+            continue;
+        }
+        glCreateBuffers(1, &s->outline_vbo[i]);
+        glNamedBufferStorage(s->outline_vbo[i], (GLsizeiptr)m->vertex_count * 12 + 12, NULL, GL_DYNAMIC_STORAGE_BIT);
+        glNamedBufferSubData(s->outline_vbo[i], 0, (GLsizeiptr)m->vertex_count * 12, dirs);
+        free(dirs);
+        GLuint vao;
+        glCreateVertexArrays(1, &vao);
+        glVertexArrayVertexBuffer(vao, 0, r->meshes[i].vbo[0], 0, 12); /* positions shared with the scene */
+        glVertexArrayVertexBuffer(vao, 1, s->outline_vbo[i], 0, 12);
+        for (GLuint a = 0; a < 2; a++) {
+            glEnableVertexArrayAttrib(vao, a);
+            glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, 0);
+            glVertexArrayAttribBinding(vao, a, a);
+        }
+        glVertexArrayElementBuffer(vao, r->meshes[i].ibo);
+        s->outline_vao[i] = vao;
+    }
+    return true;
+}
+
+/* Park & Baek: draw every outline volume with additive blending into a
+ * float target, +1 on entering faces and -1 on leaving ones, depth-tested
+ * against the G-buffer without writing depth; a count >= 2 marks a pixel
+ * where two volumes overlap at the visible surface: a corner. */
+void mr_pass_ao_mask(frame *f) {
+    mr_renderer *r = f->r;
+    mr_ao_state *s = r->ao;
+    static const float zero[4] = {0, 0, 0, 0};
+    glNamedFramebufferTexture(s->fbo_mask, GL_DEPTH_ATTACHMENT, r->gbuf.depth, 0);
+    glClearNamedFramebufferfv(s->fbo_mask, GL_COLOR, 0, zero);
+    if (!ensure_outlines(r, s)) return;
+    glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_mask);
+    glViewport(0, 0, s->w, s->h);
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER); /* reversed Z: in front of the visible surface */
+    glDepthMask(GL_FALSE);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glUseProgram(s->prog_outline);
+    float proj[16];
+    mr_gl_projection(&f->cam, f->near_plane, proj);
+    glUniformMatrix4fv(2, 1, GL_FALSE, proj);
+    glUniform1i(3, s->p.radius_mode == MR_AO_RADIUS_SCREEN ? 0 : 1);
+    glUniform1f(4, (float)s->p.radius);
+    glUniform1f(5, s->screen_k);
+    const mr_scene *sc = r->scene;
+    uint32_t mask = 1u << MR_LAYER_VISIBLE;
+    if (!f->p->hide_hidden_layer) mask |= 1u << MR_LAYER_HIDDEN;
+    for (int32_t ni = 0; ni < sc->node_count; ni++) {
+        const mr_node *n = &sc->nodes[ni];
+        if (n->mesh_first < 0 || n->mesh_count <= 0 || !(mask & (1u << n->layer))) continue;
+        mr_dmat4 cam_from_node = mr_m4_mul(&f->cam_from_world, &n->world);
+        for (int32_t k = 0; k < n->mesh_count; k++) {
+            int32_t mi = n->mesh_first + k;
+            if (mi >= s->outline_count || !s->outline_vao[mi]) continue;
+            const mr_mesh *m = &sc->meshes[mi];
+            mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
+            mr_dmat4 mv = mr_m4_mul(&cam_from_node, &T), inv;
+            if (!mr_m4_invert(&mv, &inv)) continue;
+            float mvf[16], nm[9];
+            mr_m4_to_gl(&mv, mvf);
+            for (int rr = 0; rr < 3; rr++)
+                for (int cc = 0; cc < 3; cc++) nm[cc * 3 + rr] = (float)inv.m[cc * 4 + rr];
+            glUniformMatrix4fv(0, 1, GL_FALSE, mvf);
+            glUniformMatrix3fv(1, 1, GL_FALSE, nm);
+            glBindVertexArray(s->outline_vao[mi]);
+            glDrawElements(GL_TRIANGLES, (GLsizei)m->index_count, GL_UNSIGNED_INT, NULL);
+        }
+    }
+    glBindVertexArray(0);
+    glDisable(GL_BLEND);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+}
+
+void mr_pass_ao(frame *f) {
+    mr_ao_state *s = f->r->ao;
+    const mr_ao_params *p = &s->p;
+    glUseProgram(s->prog_main);
+    common_uniforms(f);
+    glUniform1i(4, p->mask == MR_AO_MASK_STANDALONE ? 100 : (int)p->method);
+    glUniform1i(5, p->samples);
+    glUniform1i(6, p->radius_mode == MR_AO_RADIUS_SCREEN ? 0 : 1);
+    glUniform1f(7, (float)p->radius);
+    glUniform1f(8, s->screen_k);
+    glUniform1f(9, p->c);
+    glUniform1f(10, p->bias);
+    glUniform1f(11, p->strength);
+    glUniform1i(12, p->radii);
+    glUniform1i(13, p->positions ? 1 : 0);
+    glUniform1i(14, p->mask == MR_AO_MASK_ON ? 1 : 0);
+    glUniform4fv(16, MR_AO_MAX_SAMPLES, s->kernel3);
+    glUniform4fv(80, MR_AO_MAX_SAMPLES, s->kernel2);
+    fullscreen(f, s->fbo_ao[0], s->aw, s->ah);
+    s->cur = 0;
+    s->result = s->tex_ao[0];
+    s->valid = true;
+}
+
+void mr_pass_ao_blur(frame *f) {
+    mr_ao_state *s = f->r->ao;
+    int radius = s->p.blur_radius > 0 ? s->p.blur_radius : 4;
+    glUseProgram(s->prog_blur);
+    common_uniforms(f);
+    glUniform1i(5, radius);
+    glUniform2i(6, s->aw, s->ah);
+    for (int pass = 0; pass < 2; pass++) {
+        glUniform2i(4, pass == 0, pass == 1);
+        glBindTextureUnit(4, s->tex_ao[s->cur]);
+        fullscreen(f, s->fbo_ao[1 - s->cur], s->aw, s->ah);
+        s->cur = 1 - s->cur;
+    }
+    glBindTextureUnit(4, 0);
+    s->result = s->tex_ao[s->cur];
+}
+
+void mr_pass_ao_upsample(frame *f) {
+    mr_ao_state *s = f->r->ao;
+    glUseProgram(s->prog_up);
+    common_uniforms(f);
+    glUniform2i(6, s->aw, s->ah);
+    glBindTextureUnit(4, s->tex_ao[s->cur]);
+    fullscreen(f, s->fbo_full, s->w, s->h);
+    glBindTextureUnit(4, 0);
+    s->result = s->tex_full;
+}
+
+bool mr_pass_ao_read_back(frame *f, mr_error *err) {
+    mr_renderer *r = f->r;
+    mr_frame_result *o = f->out;
+    int pl = plan(f);
+    o->ao_masked_fraction = -1;
+    o->ao_reused = pl == AO_PLAN_REUSE;
+    if (r->ao && r->ao->broken && f->p->ao.method != MR_AO_NONE) {
+        *err = r->ao->error;
+        mr_error_prefix(err, "ambient occlusion: ");
+        return false;
+    }
+    if (f->p->ao.want_ao) {
+        if (!mr_image_alloc(&o->ao, r->w, r->h, 1, MR_PIX_F32, err)) return false;
+        float *a = o->ao.data;
+        size_t n = (size_t)r->w * r->h;
+        if (pl == AO_PLAN_RUN || pl == AO_PLAN_REUSE || pl == AO_PLAN_EXTERNAL) {
+            glPixelStorei(GL_PACK_ALIGNMENT, 4);
+            glGetTextureImage(r->ao->result, 0, GL_RED, GL_FLOAT, (GLsizei)(n * sizeof *a), a);
+        } else {
+            for (size_t i = 0; i < n; i++) a[i] = 1.0f;
+        }
+    }
+    if ((pl == AO_PLAN_RUN || pl == AO_PLAN_REUSE) && r->ao->p.mask != MR_AO_MASK_OFF) {
+        size_t n = (size_t)r->w * r->h;
+        float *cnt = malloc(n * sizeof *cnt), *dep = malloc(n * sizeof *dep);
+        if (!cnt || !dep) {
+            free(cnt); free(dep);
+            return mr_fail(err, MR_ERR_NOMEM, "out of memory reading the AO mask");
+        }
+        glGetTextureImage(r->ao->tex_mask, 0, GL_RED, GL_FLOAT, (GLsizei)(n * sizeof *cnt), cnt);
+        glGetTextureImage(r->gbuf.depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, (GLsizei)(n * sizeof *dep), dep);
+        size_t geo = 0, in = 0;
+        for (size_t i = 0; i < n; i++)
+            if (dep[i] > 0) {
+                geo++;
+                in += cnt[i] > 1.5f;
+            }
+        o->ao_masked_fraction = geo ? (double)in / (double)geo : 0.0;
+        free(cnt);
+        free(dep);
+    }
+    return true;
+}

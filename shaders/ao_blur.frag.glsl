@@ -1,0 +1,44 @@
+// Separable depth- and normal-aware bilateral blur of the AO buffer. A tap
+// counts by a Gaussian in pixels times how close it lies to the centre's
+// tangent plane (relative to the centre's depth, so any scene scale and
+// grazing planes blur alike) times the agreement of the normals.
+#include "ao_common.glsl"
+
+layout(location = 0) uniform vec4 u_intr;    // G-buffer intrinsics
+layout(location = 1) uniform ivec2 u_full;   // G-buffer size
+layout(location = 2) uniform int u_step;     // G-buffer pixels per AO pixel
+layout(location = 3) uniform float u_near;
+layout(location = 4) uniform ivec2 u_dir;    // (1,0) or (0,1)
+layout(location = 5) uniform int u_radius;   // taps each side
+layout(location = 6) uniform ivec2 u_ao_size;
+
+layout(binding = 0) uniform sampler2D u_depth;
+layout(binding = 1) uniform sampler2D u_normal;
+layout(binding = 2) uniform sampler2D u_pos;  // unused here
+layout(binding = 4) uniform sampler2D u_ao;
+
+layout(location = 0) out float o_ao;
+
+void main() {
+    ivec2 ap = ivec2(gl_FragCoord.xy);
+    vec3 P;
+    if (!ao_view_pos(u_depth, u_pos, false, u_near, u_intr, ap * u_step, P)) { o_ao = 1.0; return; }
+    vec3 n = ao_normal(u_normal, ap * u_step, P);
+    float sigma = 0.5 * float(u_radius) + 0.5;
+    float tol = 0.02 * P.z * float(u_step);
+    float sum = 0.0, wsum = 0.0;
+    for (int i = -u_radius; i <= u_radius; i++) {
+        ivec2 q = ap + u_dir * i;
+        if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, u_ao_size))) continue;
+        vec3 Q;
+        if (!ao_view_pos(u_depth, u_pos, false, u_near, u_intr, q * u_step, Q)) continue;
+        vec3 nq = ao_normal(u_normal, q * u_step, Q);
+        float dp = dot(Q - P, n) / tol;
+        float w = exp(-float(i * i) / (2.0 * sigma * sigma)) * exp(-dp * dp) * pow(max(dot(n, nq), 0.0), 8.0);
+        float a = texelFetch(u_ao, q, 0).r;
+        if (!(w > 0.0) || isnan(a)) continue;
+        sum += w * a;
+        wsum += w;
+    }
+    o_ao = wsum > 1e-6 ? clamp(sum / wsum, 0.0, 1.0) : texelFetch(u_ao, ap, 0).r;
+}

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# End-to-end checks of `mrcheck render --ao ...`: every method writes ao.pfm
+# through --aux, the pass list shows the AO passes (none when --ao none),
+# the ground truth works, and bad AO options fail with one line on stderr.
+# Usage: cli_ao.sh MRCHECK TMPDIR. Exit 77 = skipped (no EGL device).
+set -u
+mr=$1
+tmp=$2
+rm -rf "$tmp" && mkdir -p "$tmp"
+pass=0 fail=0
+ok() { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
+
+if ! "$mr" demo --out "$tmp/demo" >"$tmp/demo.log" 2>&1; then
+  if grep -q "EGL" "$tmp/demo.log"; then echo "cli_ao: SKIPPED: no EGL device"; exit 77; fi
+  cat "$tmp/demo.log"; echo "0 passed, 1 failed"; exit 1
+fi
+d=$tmp/demo
+r() { "$mr" render --scene "$d/scene_planned.json" --view "$d/views/view_001.json" --size 96x72 "$@"; }
+
+for m in scheer crytek filion hbao alchemy; do
+  rm -rf "$tmp/aux_$m"
+  if r --out "$tmp/$m.png" --ao "$m" --ao-samples 8 --aux "$tmp/aux_$m" --verbose 2>"$tmp/$m.err"; then
+    [ -s "$tmp/aux_$m/ao.pfm" ] && ok || bad "--ao $m wrote no ao.pfm"
+    grep -q "passes: gbuffer ao ao_blur shade" "$tmp/$m.err" && ok || bad "--ao $m pass list: $(cat "$tmp/$m.err")"
+  else
+    bad "--ao $m failed: $(cat "$tmp/$m.err")"
+  fi
+done
+# No AO pass when AO is off; ao.pfm is then all ones (still written).
+if r --out "$tmp/none.png" --ao none --aux "$tmp/aux_none" --verbose 2>"$tmp/none.err"; then
+  grep -q "passes: gbuffer shade;" "$tmp/none.err" && ok || bad "--ao none ran AO: $(cat "$tmp/none.err")"
+  [ -s "$tmp/aux_none/ao.pfm" ] && ok || bad "--ao none wrote no ao.pfm"
+else
+  bad "--ao none failed"
+fi
+# Options: half resolution, positions, masking, kernels, view radius.
+if r --out "$tmp/opts.png" --ao scheer --ao-half --ao-positions --ao-mask on --ao-kernel poisson --ao-radii 2 \
+     --ao-radius-mode view --ao-radius 0.5 --ao-c 1e7 --aux "$tmp/aux_opts" --verbose 2>"$tmp/opts.err"; then
+  grep -q "passes: gbuffer ao_positions ao_mask ao ao_blur ao_upsample shade" "$tmp/opts.err" && ok || bad "options pass list: $(cat "$tmp/opts.err")"
+else
+  bad "AO options failed: $(cat "$tmp/opts.err")"
+fi
+# Ground truth (few rays: this is about the plumbing).
+if r --out "$tmp/gt.png" --ao groundtruth --ao-radius 1 --ao-rays 8 --aux "$tmp/aux_gt" 2>"$tmp/gt.err"; then
+  [ -s "$tmp/aux_gt/ao.pfm" ] && [ -s "$tmp/gt.png" ] && ok || bad "groundtruth wrote no ao.pfm"
+  cmp -s "$tmp/gt.png" "$tmp/none.png" && bad "groundtruth AO did not change the shading" || ok
+else
+  bad "groundtruth failed: $(cat "$tmp/gt.err")"
+fi
+# Bad values: one line on stderr, non-zero exit, no output.
+for args in "--ao ssao" "--ao scheer --ao-samples 0" "--ao scheer --ao-samples 65" "--ao scheer --ao-radius-mode far" \
+            "--ao scheer --ao-mask maybe" "--ao scheer --ao-kernel sobol" "--ao scheer --ao-c -1" "--ao scheer --ao-radius 0" \
+            "--ao scheer --ao-rmin 0.9 --ao-rmax 0.5"; do
+  rm -f "$tmp/bad.png"
+  # shellcheck disable=SC2086
+  if r --out "$tmp/bad.png" $args 2>"$tmp/bad.err"; then
+    bad "accepted: $args"
+  else
+    [ "$(wc -l <"$tmp/bad.err")" -eq 1 ] && ok || bad "$args: not one line: $(cat "$tmp/bad.err")"
+    [ ! -e "$tmp/bad.png" ] && ok || bad "$args: wrote an output"
+  fi
+done
+echo "cli_ao: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]

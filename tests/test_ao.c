@@ -1,0 +1,554 @@
+/* Ambient occlusion: sample kernels and outline directions (CPU), the
+ * Embree ground truth against the closed form beside a wall (CPU), and
+ * through EGL: scheer on a flat plane and in a concave corner, every method
+ * darker in the corner, the pixel path of the ground truth against the
+ * closed form, scale invariance (1e-3 .. 1e4 and a 1e7 offset), finite
+ * output on extreme inputs (c in [0,1e7], depth near 0, sky, zero normals),
+ * the pass list (no AO pass when off, reuse while the camera is frozen,
+ * half resolution, corner masking). GPU parts skip where EGL is missing. */
+#include "mr_eval.h"
+#include "mr_render.h"
+#include "mr_test.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* --------------------------------------------------------- scene helpers */
+
+/* An axis-aligned box sx x sy x sz centred on its node origin, 24 vertices
+ * (split at the edges, as CAD exports come). */
+static int32_t add_box(mr_scene *s, double sx, double sy, double sz) {
+    mr_mesh m;
+    memset(&m, 0, sizeof m);
+    snprintf(m.name, sizeof m.name, "box");
+    m.vertex_count = 24;
+    m.index_count = 36;
+    m.positions = malloc(72 * sizeof(float));
+    m.indices = malloc(36 * sizeof(uint32_t));
+    static const int faces[6][4][3] = {
+        {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}},     {{-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, -1}},
+        {{-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}},     {{-1, -1, 1}, {-1, -1, -1}, {1, -1, -1}, {1, -1, 1}},
+        {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},     {{1, -1, -1}, {-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}},
+    };
+    for (int f = 0; f < 6; f++) {
+        for (int v = 0; v < 4; v++) {
+            m.positions[(f * 4 + v) * 3 + 0] = (float)(faces[f][v][0] * sx / 2);
+            m.positions[(f * 4 + v) * 3 + 1] = (float)(faces[f][v][1] * sy / 2);
+            m.positions[(f * 4 + v) * 3 + 2] = (float)(faces[f][v][2] * sz / 2);
+        }
+        const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
+        for (int k = 0; k < 6; k++) m.indices[f * 6 + k] = (uint32_t)(f * 4) + q[k];
+    }
+    m.material = -1;
+    mr_error err = {0};
+    int32_t id = mr_scene_add_mesh(s, &m, &err);
+    CHECK_MSG(id >= 0, "%s", err.msg);
+    return id;
+}
+
+static void add_node(mr_scene *s, mr_dmat4 world, int32_t mesh) {
+    mr_node n;
+    memset(&n, 0, sizeof n);
+    snprintf(n.name, sizeof n.name, "n%d", (int)s->node_count);
+    n.parent = -1;
+    n.world = world;
+    n.mesh_first = mesh;
+    n.mesh_count = 1;
+    mr_scene_add_node(s, &n);
+}
+
+static void place(mr_scene *s, int32_t mesh, double k, mr_dvec3 off, double x, double y, double z) {
+    add_node(s, mr_m4_translate(off.x + x * k, off.y + y * k, off.z + z * k), mesh);
+}
+
+/* Floor (top at y = 0), a wall whose face is the plane z = 2.9 standing on
+ * it (a concave corner), and a cube; all lengths times k, moved by off. */
+static mr_scene *corner_scene(double k, mr_dvec3 off, bool with_wall) {
+    mr_scene *s = mr_scene_create();
+    place(s, add_box(s, 20 * k, 0.2 * k, 20 * k), k, off, 0, -0.1, 0);
+    if (with_wall) {
+        place(s, add_box(s, 20 * k, 6 * k, 0.2 * k), k, off, 0, 3, 3.0);
+        place(s, add_box(s, 1 * k, 1 * k, 1 * k), k, off, -1.5, 0.5, 1.0);
+    }
+    mr_scene_update_bounds(s);
+    return s;
+}
+
+static mr_view corner_view(double k, mr_dvec3 off, int w, int h) {
+    mr_view v;
+    mr_camera c = {w, h, 0.8 * w, 0.8 * w, (w - 1) / 2.0, (h - 1) / 2.0, {0, 0, 0, 0, 0}};
+    v.camera = c;
+    v.world_from_camera = mr_m4_look_at_cv(mr_v3(off.x + 0.7 * k, off.y + 2.2 * k, off.z - 2.5 * k),
+                                           mr_v3(off.x + 0.2 * k, off.y + 0.2 * k, off.z + 2.5 * k), mr_v3(0, 1, 0));
+    return v;
+}
+
+/* World point of pixel i of a rendered frame (depth > 0). */
+static mr_dvec3 pixel_world(const mr_view *v, const mr_image *depth, int x, int y) {
+    mr_camera c = mr_camera_resized(&v->camera, depth->width, depth->height);
+    double z = ((const float *)depth->data)[(size_t)y * depth->width + x];
+    return mr_m4_point(&v->world_from_camera, mr_v3((x - c.cx) / c.fx * z, (y - c.cy) / c.fy * z, z));
+}
+
+/* ------------------------------------------------------------ CPU tests */
+
+static void test_kernels(void) {
+    for (int kind = 0; kind < 4; kind++) {
+        for (int n = 8; n <= 64; n *= 2) {
+            float k3[64 * 3], k2[64 * 2];
+            mr_ao_kernel_generate((mr_ao_kernel)kind, n, 0.8f, 1.0f, 42, k3, k2);
+            int bad = 0;
+            double mind = 1e9;
+            int strata[64] = {0};
+            for (int i = 0; i < n; i++) {
+                double r = sqrt(k3[3 * i] * k3[3 * i] + k3[3 * i + 1] * k3[3 * i + 1] + k3[3 * i + 2] * k3[3 * i + 2]);
+                double r2 = sqrt(k2[2 * i] * k2[2 * i] + k2[2 * i + 1] * k2[2 * i + 1]);
+                if (!(r >= 0.8 - 1e-5 && r <= 1.0 + 1e-5) || !(r2 <= 1 + 1e-5)) bad++;
+                double u3 = (r * r * r - 0.512) / (1 - 0.512);
+                int st = (int)(u3 * n);
+                if (st >= 0 && st < n) strata[st]++;
+                for (int j = 0; j < i; j++) {
+                    double dx = k3[3 * i] - k3[3 * j], dy = k3[3 * i + 1] - k3[3 * j + 1], dz = k3[3 * i + 2] - k3[3 * j + 2];
+                    double d = sqrt(dx * dx + dy * dy + dz * dz);
+                    if (d < mind) mind = d;
+                }
+            }
+            CHECK_MSG(bad == 0, "kernel %s n=%d: %d samples outside the shell", mr_ao_kernel_name((mr_ao_kernel)kind), n, bad);
+            if (kind == MR_AO_KERNEL_LATIN || kind == MR_AO_KERNEL_STRATIFIED) {
+                /* One sample per radius stratum: the Latin property. */
+                int empty = 0;
+                for (int i = 0; i < n; i++) empty += strata[i] != 1;
+                CHECK_MSG(empty == 0, "kernel %s n=%d: radius strata not filled once each", mr_ao_kernel_name((mr_ao_kernel)kind), n);
+            }
+            if (kind == MR_AO_KERNEL_POISSON) {
+                /* Dart throwing keeps points apart: far more than random
+                 * points of the same count would be. */
+                double expect = 0.85 * 0.5 * cbrt(4.0 / 3.0 * 3.14159 * (1 - 0.512) / n);
+                CHECK_MSG(mind > expect, "poisson n=%d: min distance %g <= %g", n, mind, expect);
+            }
+        }
+    }
+    float a[48], b[48];
+    mr_ao_kernel_generate(MR_AO_KERNEL_LATIN, 16, 0.5f, 1.0f, 7, a, NULL);
+    mr_ao_kernel_generate(MR_AO_KERNEL_LATIN, 16, 0.5f, 1.0f, 7, b, NULL);
+    CHECK(memcmp(a, b, sizeof a) == 0); /* deterministic */
+    mr_ao_method m;
+    CHECK(mr_ao_method_parse("scheer", &m) && m == MR_AO_SCHEER);
+    CHECK(!mr_ao_method_parse("ssao", &m));
+}
+
+static void test_outline_dirs(void) {
+    mr_scene *s = mr_scene_create();
+    int32_t b = add_box(s, 2, 1, 4);
+    const mr_mesh *m = &s->meshes[b];
+    float dirs[72];
+    mr_error err = {0};
+    CHECK(mr_mesh_outline_dirs(m, dirs, &err));
+    int bad = 0;
+    for (uint32_t i = 0; i < m->vertex_count; i++) {
+        /* Each corner: the average of its three face normals, (+-1,+-1,+-1)/sqrt 3
+         * pointing away from the centre, the same for all split copies. */
+        for (int k = 0; k < 3; k++) {
+            double want = (m->positions[3 * i + k] > 0 ? 1 : -1) / sqrt(3.0);
+            if (fabs(dirs[3 * i + k] - want) > 1e-5) bad++;
+        }
+    }
+    CHECK_MSG(bad == 0, "%d outline direction components off", bad);
+    mr_scene_destroy(&s);
+}
+
+/* Floor y = 0 (normal up) and a wall face x = 0 standing on it; a point on
+ * the floor at distance d from the wall, rays of length R. */
+static void test_groundtruth_wall(void) {
+    for (int far = 0; far < 2; far++) {
+        double off = far ? 1e7 : 0;
+        mr_scene *s = mr_scene_create();
+        add_node(s, mr_m4_translate(off, -0.5, off), add_box(s, 400, 1, 400));
+        add_node(s, mr_m4_translate(off + 0.5, 0, off), add_box(s, 1, 400, 400));
+        mr_scene_update_bounds(s);
+        mr_error err = {0};
+        mr_eval_gt *gt = mr_eval_gt_create(s, false, &err);
+        CHECK_MSG(gt != NULL, "%s", err.msg);
+        if (gt) {
+            const double as[] = {0.01, 0.1, 0.3, 0.5, 0.8, 0.99, 1.3};
+            for (size_t i = 0; i < sizeof as / sizeof as[0]; i++) {
+                double R = 1.0, d = as[i] * R;
+                double v = mr_eval_ao_point(gt, mr_v3(off - d, 1e-5, off), mr_v3(0, 1, 0), R, 16384, 3 + i);
+                double want = mr_eval_ao_wall_analytic(d, R);
+                /* 16384 stratified rays: the error is well below 0.01. */
+                CHECK_MSG(fabs(v - want) < 0.01, "offset %g a=%g: traced %.4f, analytic %.4f", off, as[i], v, want);
+            }
+            /* Same with R = 40 (scale does not matter to the closed form). */
+            double v = mr_eval_ao_point(gt, mr_v3(off - 20, 1e-4, off), mr_v3(0, 1, 0), 40, 16384, 9);
+            CHECK_NEAR(v, mr_eval_ao_wall_analytic(20, 40), 0.01);
+        }
+        mr_eval_gt_destroy(&gt);
+        mr_scene_destroy(&s);
+    }
+    CHECK_NEAR(mr_eval_ao_wall_analytic(0, 1), 0.5, 1e-12); /* a point at the wall sees half the sky */
+    CHECK_NEAR(mr_eval_ao_wall_analytic(2, 1), 1.0, 1e-12);
+}
+
+static void test_metrics(void) {
+    mr_image a = {0}, b = {0};
+    mr_image_alloc(&a, 32, 24, 1, MR_PIX_F32, NULL);
+    mr_image_alloc(&b, 32, 24, 1, MR_PIX_F32, NULL);
+    float *pa = a.data, *pb = b.data;
+    for (int i = 0; i < 32 * 24; i++) {
+        pb[i] = (float)((i % 32) / 31.0);
+        pa[i] = pb[i] + 0.1f;
+    }
+    mr_image_metrics m;
+    CHECK(mr_image_compare(&a, &b, NULL, &m, NULL));
+    CHECK_NEAR(m.rmse, 0.1, 1e-6);
+    CHECK_NEAR(m.bias, 0.1, 1e-6);
+    CHECK(m.ssim < 1.0 && m.ssim > 0.5);
+    CHECK(mr_image_compare(&b, &b, NULL, &m, NULL));
+    CHECK_NEAR(m.ssim, 1.0, 1e-9);
+    CHECK_NEAR(m.rmse, 0.0, 1e-12);
+    pa[5] = NAN;
+    CHECK(mr_image_compare(&a, &b, NULL, &m, NULL));
+    CHECK_NEAR(m.max_abs, 1.0, 1e-12); /* NaN counts as the worst error */
+    mr_image_free(&a);
+    mr_image_free(&b);
+}
+
+/* ------------------------------------------------------------ GPU tests */
+
+static mr_gpu *g_gpu;
+static mr_renderer *g_r;
+
+static bool render_ao(const mr_scene *s, const mr_view *v, const mr_ao_params *ao, mr_frame_result *res) {
+    mr_frame_params p = MR_FRAME_DEFAULTS;
+    p.ao = *ao;
+    p.ao.want_ao = true;
+    p.want_depth = p.want_normals = true;
+    mr_error err = {0};
+    bool ok = mr_renderer_set_scene(g_r, s, &err) && mr_render_frame(g_r, v, &p, res, &err);
+    CHECK_MSG(ok, "%s", err.msg);
+    return ok;
+}
+
+static int count_bad(const mr_image *ao) {
+    int bad = 0;
+    const float *a = ao->data;
+    for (int i = 0; i < ao->width * ao->height; i++) bad += !(a[i] >= 0 && a[i] <= 1);
+    return bad;
+}
+
+static void test_flat_plane(void) {
+    mr_scene *s = corner_scene(1, mr_v3(0, 0, 0), false);
+    mr_view v = corner_view(1, mr_v3(0, 0, 0), 128, 96);
+    for (int mode = 0; mode < 2; mode++) {
+        mr_ao_params ao = MR_AO_DEFAULTS;
+        ao.method = MR_AO_SCHEER;
+        ao.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
+        ao.radius = 0.5;
+        mr_frame_result res;
+        if (!render_ao(s, &v, &ao, &res)) continue;
+        const float *a = res.ao.data, *d = res.depth.data;
+        double sum = 0;
+        int n = 0;
+        for (int i = 0; i < 128 * 96; i++)
+            if (d[i] > 0) { sum += a[i]; n++; }
+        CHECK(n > 1000);
+        CHECK_MSG(n && sum / n >= 0.98, "flat plane, %s radius: mean AO %.4f < 0.98", mode ? "view" : "screen", n ? sum / n : 0);
+        CHECK(count_bad(&res.ao) == 0);
+        mr_frame_result_free(&res);
+    }
+    mr_scene_destroy(&s);
+}
+
+/* Mean AO over floor pixels at distance [d0, d1) in front of the wall. */
+static double floor_band(const mr_view *v, const mr_frame_result *res, const mr_image *ao, double d0, double d1, double k,
+                         mr_dvec3 off, int *count) {
+    double sum = 0;
+    int n = 0;
+    const float *d = res->depth.data, *a = ao->data;
+    for (int y = 0; y < res->depth.height; y++)
+        for (int x = 0; x < res->depth.width; x++) {
+            size_t i = (size_t)y * res->depth.width + x;
+            if (!(d[i] > 0)) continue;
+            mr_dvec3 p = pixel_world(v, &res->depth, x, y);
+            double py = (p.y - off.y) / k, dist = 2.9 - (p.z - off.z) / k, px = (p.x - off.x) / k;
+            if (fabs(py) > 0.01 || dist < d0 || dist >= d1 || px < -0.5 || px > 5) continue;
+            sum += a[i];
+            n++;
+        }
+    if (count) *count = n;
+    return n ? sum / n : NAN;
+}
+
+static void test_corner_all_methods(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    mr_view v = corner_view(1, o, 128, 96);
+    for (int m = MR_AO_SCHEER; m < MR_AO_METHOD_COUNT; m++) {
+        for (int mode = 0; mode < 2; mode++) {
+            mr_ao_params ao = MR_AO_DEFAULTS;
+            ao.method = (mr_ao_method)m;
+            ao.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
+            ao.radius = 0.5;
+            mr_frame_result res;
+            if (!render_ao(s, &v, &ao, &res)) continue;
+            int nc = 0, no = 0;
+            double corner = floor_band(&v, &res, &res.ao, 0.0, 0.12, 1, o, &nc);
+            double open = floor_band(&v, &res, &res.ao, 1.5, 2.5, 1, o, &no);
+            CHECK_MSG(nc > 5 && no > 20, "%s: too few pixels (%d corner, %d open)", mr_ao_method_name(ao.method), nc, no);
+            /* scheer must show the corner clearly; the baselines at least darker. */
+            double margin = m == MR_AO_SCHEER ? 0.1 : 0.02;
+            if (getenv("MR_TEST_VERBOSE"))
+                printf("%s %s: corner %.3f open %.3f\n", mr_ao_method_name(ao.method), mode ? "view" : "screen", corner, open);
+            CHECK_MSG(corner < open - margin, "%s %s: corner %.3f not darker than open floor %.3f", mr_ao_method_name(ao.method),
+                      mode ? "view" : "screen", corner, open);
+            CHECK(count_bad(&res.ao) == 0);
+            mr_frame_result_free(&res);
+        }
+    }
+    mr_scene_destroy(&s);
+}
+
+/* The ground truth through the renderer's depth and normals, against the
+ * closed form for floor pixels in front of the wall (away from its ends). */
+static void test_groundtruth_pixels(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    mr_view v = corner_view(1, o, 96, 72);
+    mr_ao_params none = MR_AO_DEFAULTS;
+    mr_frame_result res;
+    if (render_ao(s, &v, &none, &res)) {
+        mr_error err = {0};
+        mr_eval_gt *gt = mr_eval_gt_create(s, false, &err);
+        mr_gt_params gp = MR_GT_DEFAULTS;
+        gp.radius = 0.6;
+        gp.rays = 1024;
+        mr_image ao = {0};
+        CHECK_MSG(gt && mr_eval_ao_groundtruth(gt, &v, &res.depth, &res.normal, &gp, &ao, &err), "%s", err.msg);
+        if (ao.data) {
+            CHECK(count_bad(&ao) == 0);
+            double se = 0;
+            int n = 0;
+            const float *a = ao.data, *d = res.depth.data;
+            for (int y = 0; y < 72; y++)
+                for (int x = 0; x < 96; x++) {
+                    size_t i = (size_t)y * 96 + x;
+                    if (!(d[i] > 0)) continue;
+                    mr_dvec3 p = pixel_world(&v, &res.depth, x, y);
+                    double dist = 2.9 - p.z;
+                    /* Floor, in front of the wall, away from the cube (x < -0.9). */
+                    if (fabs(p.y) > 0.01 || dist < 0 || dist > 1.0 || p.x < -0.5 || p.x > 5) continue;
+                    double e = a[i] - mr_eval_ao_wall_analytic(dist, gp.radius);
+                    se += e * e;
+                    n++;
+                }
+            CHECK_MSG(n > 30, "only %d floor pixels in front of the wall", n);
+            CHECK_MSG(n && sqrt(se / n) < 0.03, "pixel ground truth vs closed form: RMSE %.4f over %d pixels",
+                      n ? sqrt(se / n) : 0, n);
+            int nc = 0, no = 0;
+            double corner = floor_band(&v, &res, &ao, 0, 0.12, 1, o, &nc), open = floor_band(&v, &res, &ao, 1.5, 2.5, 1, o, &no);
+            CHECK(corner < 0.7 && open > 0.97);
+        }
+        mr_image_free(&ao);
+        mr_eval_gt_destroy(&gt);
+        mr_frame_result_free(&res);
+    }
+    mr_scene_destroy(&s);
+}
+
+static double rmse(const mr_image *a, const mr_image *b) {
+    mr_image_metrics m;
+    if (!mr_image_compare(a, b, NULL, &m, NULL)) return 1e9;
+    return m.rmse;
+}
+
+static void test_scale_invariance(void) {
+    const double scales[] = {1, 1e-3, 1e4, 1};
+    const mr_dvec3 offs[] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {1e7, 0, -1e7}};
+    for (int half = 0; half < 2; half++) {
+        mr_image ref = {0};
+        for (int i = 0; i < 4; i++) {
+            mr_scene *s = corner_scene(scales[i], offs[i], true);
+            mr_view v = corner_view(scales[i], offs[i], 128, 96);
+            mr_ao_params ao = MR_AO_DEFAULTS;
+            ao.method = MR_AO_SCHEER;
+            ao.half_res = half;
+            mr_frame_result res;
+            if (render_ao(s, &v, &ao, &res)) {
+                CHECK(count_bad(&res.ao) == 0);
+                if (i == 0) {
+                    ref = res.ao;
+                    res.ao.data = NULL;
+                } else {
+                    double e = rmse(&res.ao, &ref);
+                    CHECK_MSG(e < 0.01, "scheer%s at scale %g offset %g: RMSE %.5f vs scale 1", half ? " half-res" : "",
+                              scales[i], offs[i].x, e);
+                }
+                mr_frame_result_free(&res);
+            }
+            mr_scene_destroy(&s);
+        }
+        mr_image_free(&ref);
+    }
+}
+
+/* Extreme inputs: every method and option stays finite and in [0,1]. */
+static void test_finite(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    /* Zero-length normals on the cube (the G-buffer must cope). */
+    memset(s->meshes[2].normals, 0, s->meshes[2].vertex_count * 3 * sizeof(float));
+    mr_view views[3];
+    views[0] = corner_view(1, o, 96, 72);
+    /* Half the image is sky. */
+    views[1] = views[0];
+    views[1].world_from_camera = mr_m4_look_at_cv(mr_v3(0, 0.5, -2), mr_v3(0, 0.6, -30), mr_v3(0, 1, 0));
+    /* The camera a hair in front of the wall: depth close to the near plane. */
+    views[2] = views[0];
+    views[2].world_from_camera = mr_m4_look_at_cv(mr_v3(0.3, 1.0, 2.9 - 1e-5), mr_v3(0.3, 1.0, 3.5), mr_v3(0, 1, 0));
+    const float cs[] = {0.0f, 1.0f, 1e7f};
+    int bad_total = 0, frames = 0;
+    for (int vi = 0; vi < 3; vi++)
+        for (int m = MR_AO_SCHEER; m < MR_AO_METHOD_COUNT; m++)
+            for (int variant = 0; variant < 4; variant++) {
+                mr_ao_params ao = MR_AO_DEFAULTS;
+                ao.method = (mr_ao_method)m;
+                ao.c = cs[variant % 3];
+                ao.half_res = variant == 1;
+                ao.mask = variant == 2 ? MR_AO_MASK_ON : variant == 3 ? MR_AO_MASK_STANDALONE : MR_AO_MASK_OFF;
+                ao.positions = variant == 3;
+                ao.radii = variant == 1 ? 3 : 1;
+                ao.radius_mode = variant == 2 ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
+                ao.samples = 8;
+                mr_frame_result res;
+                if (!render_ao(s, &views[vi], &ao, &res)) continue;
+                int bad = count_bad(&res.ao);
+                const unsigned char *c = res.color.data;
+                (void)c;
+                CHECK_MSG(bad == 0, "view %d %s variant %d: %d non-finite or out-of-range AO values", vi,
+                          mr_ao_method_name(ao.method), variant, bad);
+                bad_total += bad;
+                /* Sky pixels are unoccluded. */
+                const float *d = res.depth.data, *a = res.ao.data;
+                int sky_bad = 0;
+                for (int i = 0; i < res.ao.width * res.ao.height; i++) sky_bad += d[i] == 0 && a[i] != 1.0f;
+                CHECK_MSG(sky_bad == 0, "view %d %s: %d sky pixels with AO != 1", vi, mr_ao_method_name(ao.method), sky_bad);
+                frames++;
+                mr_frame_result_free(&res);
+            }
+    CHECK(frames == 3 * 5 * 4 && bad_total == 0);
+    mr_scene_destroy(&s);
+}
+
+static void passes_of(const mr_frame_result *r, char *buf, size_t n) { mr_frame_result_passes(r, buf, n); }
+
+static void test_pass_list(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    mr_view v = corner_view(1, o, 96, 72);
+    mr_error err = {0};
+    CHECK(mr_renderer_set_scene(g_r, s, &err));
+    mr_frame_params p = MR_FRAME_DEFAULTS;
+    p.ao.want_ao = true;
+    mr_frame_result r1, r2, r3;
+    char buf[256];
+    /* Off: no AO pass, AO image is all ones. */
+    CHECK(mr_render_frame(g_r, &v, &p, &r1, &err));
+    passes_of(&r1, buf, sizeof buf);
+    CHECK_MSG(strcmp(buf, "gbuffer shade") == 0, "passes with AO off: %s", buf);
+    CHECK(((float *)r1.ao.data)[0] == 1.0f && r1.ao_masked_fraction == -1);
+    mr_frame_result_free(&r1);
+    /* On, then the same frame again: reused, identical, no AO pass. */
+    p.ao.method = MR_AO_SCHEER;
+    CHECK(mr_render_frame(g_r, &v, &p, &r1, &err));
+    passes_of(&r1, buf, sizeof buf);
+    CHECK_MSG(strcmp(buf, "gbuffer ao ao_blur shade") == 0, "passes with scheer: %s", buf);
+    CHECK(mr_render_frame(g_r, &v, &p, &r2, &err));
+    passes_of(&r2, buf, sizeof buf);
+    CHECK_MSG(strcmp(buf, "gbuffer shade") == 0 && r2.ao_reused, "frozen camera: %s", buf);
+    CHECK(memcmp(r1.ao.data, r2.ao.data, mr_image_bytes(&r1.ao)) == 0);
+    CHECK(memcmp(r1.color.data, r2.color.data, mr_image_bytes(&r1.color)) == 0);
+    /* AO darkens the shading somewhere, never brightens. */
+    mr_frame_params p0 = p;
+    p0.ao.method = MR_AO_NONE;
+    CHECK(mr_render_frame(g_r, &v, &p0, &r3, &err));
+    int darker = 0, brighter = 0;
+    for (size_t i = 0; i < mr_image_bytes(&r3.color); i++) {
+        int a = ((unsigned char *)r1.color.data)[i], b = ((unsigned char *)r3.color.data)[i];
+        darker += a < b - 2;
+        brighter += a > b + 1;
+    }
+    CHECK(darker > 50 && brighter == 0);
+    mr_frame_result_free(&r3);
+    mr_frame_result_free(&r2);
+    /* The camera moves: computed again. */
+    mr_view v2 = v;
+    v2.world_from_camera.m[3] += 0.01;
+    CHECK(mr_render_frame(g_r, &v2, &p, &r2, &err));
+    passes_of(&r2, buf, sizeof buf);
+    CHECK(strstr(buf, "ao ") != NULL && !r2.ao_reused);
+    mr_frame_result_free(&r2);
+    mr_frame_result_free(&r1);
+    /* Half resolution, positions, masking. */
+    p.ao.half_res = true;
+    p.ao.positions = true;
+    p.ao.mask = MR_AO_MASK_ON;
+    CHECK_MSG(mr_render_frame(g_r, &v, &p, &r1, &err), "%s", err.msg);
+    passes_of(&r1, buf, sizeof buf);
+    CHECK_MSG(strcmp(buf, "gbuffer ao_positions ao_mask ao ao_blur ao_upsample shade") == 0, "passes: %s", buf);
+    CHECK_MSG(r1.ao_masked_fraction > 0.02 && r1.ao_masked_fraction < 0.9, "masked fraction %g", r1.ao_masked_fraction);
+    mr_frame_result_free(&r1);
+    mr_scene_destroy(&s);
+    mr_renderer_set_scene(g_r, NULL, NULL);
+}
+
+/* Corner masking keeps the corner and skips the open floor, whose AO is
+ * then exactly 1; the standalone mask darkens the corner by itself. */
+static void test_mask(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    mr_view v = corner_view(1, o, 128, 96);
+    for (int mm = MR_AO_MASK_ON; mm <= MR_AO_MASK_STANDALONE; mm++) {
+        mr_ao_params ao = MR_AO_DEFAULTS;
+        ao.method = MR_AO_SCHEER;
+        ao.mask = (mr_ao_mask)mm;
+        ao.blur_radius = 0;
+        mr_frame_result res;
+        if (!render_ao(s, &v, &ao, &res)) continue;
+        int nc = 0, no = 0;
+        double corner = floor_band(&v, &res, &res.ao, 0.0, 0.1, 1, o, &nc);
+        double open = floor_band(&v, &res, &res.ao, 2.0, 2.5, 1, o, &no);
+        CHECK_MSG(corner < 0.9, "mask %d: corner %.3f", mm, corner);
+        if (mm == MR_AO_MASK_ON) CHECK_MSG(open == 1.0, "mask on: open floor AO %.4f, not skipped", open);
+        CHECK(res.ao_masked_fraction > 0 && res.ao_masked_fraction < 0.8);
+        mr_frame_result_free(&res);
+    }
+    mr_scene_destroy(&s);
+}
+
+int main(void) {
+    test_kernels();
+    test_outline_dirs();
+    test_groundtruth_wall();
+    test_metrics();
+    mr_error err = {0};
+    g_gpu = mr_gpu_create_headless(NULL, &err);
+    if (!g_gpu) {
+        fprintf(stderr, "test_ao: GPU tests SKIPPED: %s\n", err.msg);
+        int rc = mr_test_finish("test_ao (CPU part)");
+        return rc ? rc : MR_TEST_SKIP;
+    }
+    g_r = mr_renderer_create(g_gpu, &err);
+    CHECK_MSG(g_r != NULL, "%s", err.msg);
+    if (g_r) {
+        test_flat_plane();
+        test_corner_all_methods();
+        test_groundtruth_pixels();
+        test_scale_invariance();
+        test_finite();
+        test_pass_list();
+        test_mask();
+    }
+    mr_renderer_destroy(&g_r);
+    mr_gpu_destroy(&g_gpu);
+    return mr_test_finish("test_ao");
+}
