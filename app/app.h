@@ -82,6 +82,18 @@ mr_camera app_demo_camera(void);
 int app_demo_view_count(void);
 mr_view app_demo_view(int i);
 
+/* Fills gp from the --ghost, --ghost-importance, --ghost-saliency and
+ * --ghost-* number options present in opts; one line + false if bad. */
+bool app_ghost_options(const app_opt *opts, mr_ghost_params *gp);
+
+/* The demo hall with (conflict) or without the hidden pipes coloured like
+ * the partition, and the ghosting triptychs of `mrcheck demo`. In
+ * demo_ghost.c. */
+bool app_demo_ghost_hall(bool conflict, mr_demo_hall *hall, mr_error *err);
+bool app_demo_ghost(const char *dir, mr_error *err);
+/* mrcheck bench ghost (bench_ghost.c). */
+int app_bench_ghost(int argc, char **argv);
+
 int cmd_demo(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_bench(int argc, char **argv);

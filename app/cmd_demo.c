@@ -242,6 +242,7 @@ static bool run_demo(const char *dir, mr_error *err) {
     mr_scene_destroy(&built);
     mr_scene_destroy(&planned);
     if (!ok) return false;
+    if (!app_demo_ghost(dir, err)) return false;
     printf("demo hall: %llu triangles as planned, %d known discrepancies (%.1f s to build)\n", (unsigned long long)tri,
            discrepancy_count, t_build);
     printf("wrote %s/: hall_planned.glb hall_built.glb scene_*.json markers.json discrepancies.json camera.json\n", dir);

@@ -1,6 +1,7 @@
 /* mrcheck render: one headless frame. */
 #include "app.h"
 
+#include <stddef.h>
 #include <string.h>
 
 bool app_gfx_open(app_gfx *g, mr_error *err) {
@@ -65,6 +66,46 @@ static bool render_groundtruth(mr_renderer *r, const mr_scene *scene, const mr_v
     return ok;
 }
 
+/* Reads the --ghost* options (declared by the caller's option table). */
+bool app_ghost_options(const app_opt *opts, mr_ghost_params *gp) {
+    const char *m = app_get(opts, "ghost"), *im = app_get(opts, "ghost-importance"), *sal = app_get(opts, "ghost-saliency");
+    if (m) {
+        static const char *const names[] = {"off", "alpha", "g0", "adaptive"};
+        int k = -1;
+        for (int i = 0; i < 4; i++)
+            if (strcmp(m, names[i]) == 0) k = i;
+        if (k < 0) return app_errorf("render", "--ghost must be off, alpha, g0 or adaptive, got '%s'", m), false;
+        gp->mode = (mr_ghost_mode)k;
+    }
+    if (im) {
+        if (strcmp(im, "auto") == 0) gp->importance = MR_GHOST_IMP_AUTO;
+        else if (strcmp(im, "curvature") == 0) gp->importance = MR_GHOST_IMP_CURVATURE;
+        else if (strcmp(im, "saliency") == 0) gp->importance = MR_GHOST_IMP_SALIENCY;
+        else return app_errorf("render", "--ghost-importance must be curvature, saliency or auto, got '%s'", im), false;
+    }
+    if (sal) {
+        if (strcmp(sal, "mipmap") == 0) gp->saliency = MR_SALIENCY_MIPMAP;
+        else if (strcmp(sal, "gauss") == 0) gp->saliency = MR_SALIENCY_GAUSS;
+        else return app_errorf("render", "--ghost-saliency must be mipmap or gauss, got '%s'", sal), false;
+    }
+    static const struct { const char *name; double lo, hi; size_t off; } nums[] = {
+        {"ghost-t", 0, 1, offsetof(mr_ghost_params, t)},
+        {"ghost-curv-scale", 0, 1e3, offsetof(mr_ghost_params, curv_scale)},
+        {"ghost-curv-bias", -1, 1, offsetof(mr_ghost_params, curv_bias)},
+        {"ghost-tc-min", 0, 4, offsetof(mr_ghost_params, tc_minimal)},
+        {"ghost-gamma", 0, 100, offsetof(mr_ghost_params, gamma)},
+        {"ghost-tc-sil", 0, 4, offsetof(mr_ghost_params, tc_silhouette)},
+    };
+    for (size_t i = 0; i < sizeof nums / sizeof nums[0]; i++) {
+        const char *v = app_get(opts, nums[i].name);
+        double d;
+        if (!v) continue;
+        if (!app_double(nums[i].name, v, nums[i].lo, nums[i].hi, &d)) return false;
+        *(float *)((char *)gp + nums[i].off) = (float)d;
+    }
+    return true;
+}
+
 int cmd_render(int argc, char **argv) {
     static const char *cmd = "render";
     app_opt opts[] = {
@@ -78,7 +119,15 @@ int cmd_render(int argc, char **argv) {
         {"hidden", "GLOB", "extra node-name glob for the hidden layer", NULL},
         {"hide-hidden", NULL, "leave the hidden layer out", NULL},
         APP_AO_OPTS,
-        {"ghost", "MODE", "ghosted views (only 'off' in this build)", NULL},
+        {"ghost", "MODE", "ghosted views of the hidden layer: off|alpha|g0|adaptive (default off)", NULL},
+        {"ghost-importance", "SRC", "importance map: curvature|saliency|auto (default auto)", NULL},
+        {"ghost-saliency", "IMPL", "saliency pyramid: mipmap|gauss (default mipmap)", NULL},
+        {"ghost-t", "T", "user transparency t in [0,1]: alpha = t * IM (default 1)", NULL},
+        {"ghost-curv-scale", "S", "curvature (rad/px) to importance scale (default 2)", NULL},
+        {"ghost-curv-bias", "B", "importance bias: higher = denser occluder (default 0.35)", NULL},
+        {"ghost-tc-min", "C", "minimal desired contrast tc_minimal (default 0.1)", NULL},
+        {"ghost-gamma", "G", "multiplier of IM in C_desired (default 0.5)", NULL},
+        {"ghost-tc-sil", "C", "extra desired contrast on hidden silhouettes (default 0.15)", NULL},
         {"verbose", NULL, "print the passes that ran and more", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -86,17 +135,16 @@ int cmd_render(int argc, char **argv) {
     bool help;
     if (!app_parse(argc, argv, 2, opts, NULL, 0, NULL,
                    "usage: mrcheck render --scene FILE --view VIEW.json --out OUT.png [--size WxH] "
-                   "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...]",
+                   "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive]",
                    &help))
         return 2;
     if (help) return 0;
     app_log_level(opts);
     const char *scene_path = app_get(opts, "scene"), *view_path = app_get(opts, "view"), *out = app_get(opts, "out");
     if (!scene_path || !view_path || !out) return app_errorf(cmd, "--scene, --view and --out are required"), 2;
-    const char *ghost = app_get(opts, "ghost");
-    if (ghost && strcmp(ghost, "off") != 0) return app_errorf(cmd, "--ghost %s: ghosting is not available in this build (only 'off')", ghost);
 
     mr_frame_params fp = MR_FRAME_DEFAULTS;
+    if (!app_ghost_options(opts, &fp.ghost)) return 2;
     if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &fp.width, &fp.height)) return 2;
     double alpha = 0.5;
     if (app_get(opts, "alpha") && !app_double("alpha", app_get(opts, "alpha"), 0, 1, &alpha)) return 2;

@@ -134,6 +134,64 @@ bool mr_ao_kernel_parse(const char *name, mr_ao_kernel *out);
  * inner hole would only lose samples). Either may be NULL. */
 void mr_ao_kernel_generate(mr_ao_kernel kind, int n, float r_min, float r_max, uint64_t seed, float *out3,
                            float *out2);
+/* Adaptive ghosted views of hidden structure (Kalkofen et al., "Adaptive
+ * Ghosted Views for Augmented Reality"). The hidden layer D is rendered into
+ * its own target; the occluder O is the image in front of it (the shaded
+ * visible layer, with the video blended in when there is video). An
+ * importance map IM (curvature of the occluder's mesh, or saliency of O)
+ * gives the occluder's opacity alpha = t * IM; G0 = O*alpha + D*(1-alpha).
+ * The analysis compares the saliency of G0 with the desired contrast and the
+ * emphasis changes the occluder's L* where contrast was lost, one sign per
+ * occluder object. */
+typedef enum mr_ghost_mode {
+    MR_GHOST_OFF = 0,      /* hidden layer depth-tested like the rest */
+    MR_GHOST_ALPHA,        /* uniform alpha = t * mean(IM) over the occludee */
+    MR_GHOST_G0,           /* importance-driven alpha: the initial ghosted view */
+    MR_GHOST_ADAPTIVE,     /* G0 + analysis + emphasis: G_A */
+} mr_ghost_mode;
+
+typedef enum mr_ghost_importance {
+    MR_GHOST_IMP_AUTO = 0,   /* curvature where a registered model occludes, saliency of the video elsewhere */
+    MR_GHOST_IMP_CURVATURE,  /* principal curvature of the occluder's mesh */
+    MR_GHOST_IMP_SALIENCY,   /* centre-surround saliency of O */
+} mr_ghost_importance;
+
+typedef enum mr_saliency_impl {
+    MR_SALIENCY_MIPMAP = 0,  /* mip-mapped box pyramid (paper eq. 9-10 with a box f_p) */
+    MR_SALIENCY_GAUSS,       /* two separable Gaussians approximating eq. 9 */
+} mr_saliency_impl;
+
+typedef struct mr_ghost_params {
+    mr_ghost_mode mode;          /* default MR_GHOST_OFF */
+    mr_ghost_importance importance; /* default auto */
+    mr_saliency_impl saliency;   /* default mip-map pyramid */
+    float t;                     /* user transparency: alpha = t * IM, in [0,1]; default 1 */
+    float curv_scale;            /* IM = curv_scale * curvature (radians per pixel) + curv_bias; default 2 */
+    float curv_bias;             /* default 0.35 (higher: denser occluder, lower: sparser) */
+    float saliency_gain;         /* saliency S = gain * |centre-surround| / 100 L* units; default 4 */
+    float tc_minimal;            /* minimal desired contrast where 0 < alpha < 1; default 0.1 */
+    float gamma;                 /* multiplier of IM in C_desired; default 0.5 (curvature IM
+                                    reaches 1 on edges where saliency rarely does) */
+    float tc_silhouette;         /* added to C_desired on the hidden structure's silhouette; default 0.15 */
+    float emphasis_gain;         /* L* units per unit of GK(C); default 200 (O_A is seen through
+                                    alpha, so its change must be larger than the contrast wanted) */
+    float sigma_c;               /* Gaussian GK on C, pixels; default 3 */
+    float sigma_d;               /* Gaussian GK on D, pixels; default 3 */
+    bool stats;                  /* fill mr_frame_result.ghost (extra GPU work and a read-back) */
+} mr_ghost_params;
+#define MR_GHOST_DEFAULTS {MR_GHOST_OFF, MR_GHOST_IMP_AUTO, MR_SALIENCY_MIPMAP, 1.0f, 2.0f, 0.35f, 4.0f, 0.1f, 0.5f, 0.15f, 200.0f, 3.0f, 3.0f, false}
+
+/* Legibility of a ghosted frame (when mr_ghost_params.stats). */
+typedef struct mr_ghost_stats {
+    bool valid;
+    double region_fraction;    /* fraction of the image where hidden structure lies behind an occluder */
+    double mean_importance;    /* mean IM over that region */
+    double legibility;         /* fraction of important pixels (IM > 0.3 in the region) whose saliency
+                                  in the final image is >= C_desired; always measured
+                                  with the two-Gaussian saliency; NaN if no pixel is important */
+    double mean_abs_dL;        /* mean |L*(O_A) - L*(O)| over the region (0 unless adaptive) */
+    double mean_contrast_missing; /* mean C over the region (after G0) */
+} mr_ghost_stats;
 
 typedef struct mr_frame_params {
     int width, height;         /* output size in pixels; 0 = the camera's */
@@ -147,8 +205,10 @@ typedef struct mr_frame_params {
     bool want_normals;         /* fill result.normal (view-space normals) */
     bool timing;               /* GPU timer queries per pass (adds a sync) */
     mr_ao_params ao;           /* ambient occlusion; default none */
+    mr_ghost_params ghost;     /* ghosted views of the hidden layer; default off */
 } mr_frame_params;
-#define MR_FRAME_DEFAULTS {0, 0, NULL, 0.5f, false, {0.62f, 0.66f, 0.70f}, false, false, false, MR_AO_DEFAULTS}
+#define MR_FRAME_DEFAULTS {0, 0, NULL, 0.5f, false, {0.62f, 0.66f, 0.70f}, false, false, false, MR_AO_DEFAULTS, \
+                           MR_GHOST_DEFAULTS}
 
 #define MR_MAX_PASSES 32
 
@@ -170,6 +230,7 @@ typedef struct mr_frame_result {
     double ao_masked_fraction; /* corner masking: fraction of geometry pixels in the
                                   mask (-1 when masking is off) */
     bool ao_reused;            /* AO of the previous frame was reused (frozen camera) */
+    mr_ghost_stats ghost;      /* when params.ghost.stats and ghosting ran */
 } mr_frame_result;
 
 /* Renders one frame of the current scene seen through `view`. */
@@ -285,6 +346,39 @@ bool mr_draw2d_frame(mr_draw2d *d, mr_renderer *r, float x, float y, float w, fl
 bool mr_draw2d_list_draw(mr_draw2d *d, const mr_draw2d_list *list, mr_error *err);
 /* What is in the framebuffer now (before the swap), RGB8, top row first. */
 bool mr_draw2d_read(mr_draw2d *d, mr_image *out, mr_error *err);
+/* ------------------------------------------------- ghosting, image level
+ * The stages of the ghosting passes on plain images, with the same shaders
+ * the frame uses: for tests, benches and tools. Colour images are F32 with 3
+ * channels in linear RGB (not sRGB-encoded); maps are F32 x1. */
+
+/* Linear RGB -> CIE L*a*b* (D65, as OpenCV's cvtColor) or back (inverse). */
+bool mr_ghost_lab(mr_renderer *r, const mr_image *in, bool inverse, mr_image *out, mr_error *err);
+/* Saliency S of a linear RGB image (F32x1, scaled by saliency_gain). */
+bool mr_ghost_saliency(mr_renderer *r, const mr_image *rgb, mr_saliency_impl impl, float saliency_gain,
+                       mr_image *out, mr_error *err);
+
+typedef struct mr_ghost_images {
+    const mr_image *occluder;   /* O, F32x3 linear RGB */
+    const mr_image *occludee;   /* D, F32x3 linear RGB */
+    const mr_image *importance; /* IM in [0,1], F32x1 */
+    const mr_image *region;     /* F32x1: 1 where hidden structure lies behind the occluder */
+    const mr_image *silhouette; /* F32x1: 1 on the hidden structure's silhouette, or NULL */
+    const mr_image *objects;    /* F32x1 occluder object id (> 0) per pixel, or NULL: connected regions */
+} mr_ghost_images;
+
+typedef struct mr_ghost_output {
+    mr_image g0;          /* F32x3 linear: the initial ghosted view (mode alpha or g0 rules) */
+    mr_image ga;          /* F32x3 linear: the adaptive ghosted view */
+    mr_image occluder_a;  /* F32x3 linear: O_A, the emphasised occluder */
+    mr_image contrast;    /* F32x1: C = max(0, C_desired - S(G0)) */
+    mr_image alpha;       /* F32x1: the alpha used */
+} mr_ghost_output;
+
+/* Runs G0, analysis and emphasis on the images (mode alpha uses the uniform
+ * alpha, other modes the importance). */
+bool mr_ghost_compose(mr_renderer *r, const mr_ghost_images *in, const mr_ghost_params *params, mr_ghost_output *out,
+                      mr_error *err);
+void mr_ghost_output_free(mr_ghost_output *out);
 
 #ifdef __cplusplus
 }

@@ -25,14 +25,20 @@ void mr_pass_gbuffer(frame *f) {
     glClearNamedFramebufferuiv(r->gbuf.fbo, GL_COLOR, 2, zero_u);
     glClearNamedFramebufferfv(r->gbuf.fbo, GL_DEPTH, 0, &depth0);
     uint32_t mask = 1u << MR_LAYER_VISIBLE;
-    if (!f->p->hide_hidden_layer) mask |= 1u << MR_LAYER_HIDDEN;
+    /* With ghosting, the hidden layer goes to its own target D (pass_ghost.c). */
+    if (!f->p->hide_hidden_layer && !mr_ghost_active(f)) mask |= 1u << MR_LAYER_HIDDEN;
     mr_geometry_draw(f, mask);
     glDisable(GL_DEPTH_TEST);
 }
 
 void mr_pass_shade(frame *f) {
+    mr_shade_draw(f, &f->r->gbuf, &f->r->shaded);
+    f->final_tex = f->r->shaded.color[0];
+}
+
+void mr_shade_draw(frame *f, const target *src, const target *dst) {
     mr_renderer *r = f->r;
-    glBindFramebuffer(GL_FRAMEBUFFER, r->shaded.fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, dst->fbo);
     glViewport(0, 0, r->w, r->h);
     glEnable(GL_FRAMEBUFFER_SRGB);
     glUseProgram(r->prog_shade);
@@ -65,14 +71,15 @@ void mr_pass_shade(frame *f) {
         bg[i] = c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
     }
     glUniform3fv(18, 1, bg);
-    GLuint ao = mr_pass_ao_texture(f); /* 0 when the frame has no AO */
+    /* AO belongs to the main G-buffer; the ghosting's hidden-layer target
+     * is shaded without it. */
+    GLuint ao = src == &r->gbuf ? mr_pass_ao_texture(f) : 0; /* 0 when the frame has no AO */
     glUniform1i(19, ao != 0);
-    glBindTextureUnit(0, r->gbuf.color[0]);
-    glBindTextureUnit(1, r->gbuf.color[1]);
+    glBindTextureUnit(0, src->color[0]);
+    glBindTextureUnit(1, src->color[1]);
     glBindTextureUnit(2, ao);
     glBindVertexArray(r->empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
-    f->final_tex = r->shaded.color[0];
 }
 
 

@@ -43,6 +43,7 @@ struct mr_renderer {
         double near_plane;
     } last;
     struct mr_ao_state *ao; /* pass_ao.c: AO targets, programs, kernel, reuse cache */
+    struct mr_ghost_state *ghost; /* pass_ghost.c: targets, programs, caches; NULL until first used */
 };
 
 typedef struct frame {
@@ -55,6 +56,7 @@ typedef struct frame {
     mr_frame_result *out;
     GLuint final_tex;       /* the texture holding the finished image */
     int ao_plan;            /* pass_ao.c: decided once per frame (off / reuse / run) */
+    int ghost;              /* pass_ghost.c: 0 not decided yet, 1 ghosting runs, -1 it does not */
 } frame;
 
 typedef struct pass_desc {
@@ -84,6 +86,30 @@ bool mr_pass_need_overlay(frame *f);
 void mr_pass_gbuffer(frame *f);
 void mr_pass_shade(frame *f);
 void mr_pass_overlay(frame *f);
+/* Shades G-buffer `src` (albedo, normal) into `dst`'s first colour target
+ * with the scene's lights (used for the main image and for the hidden
+ * layer D of ghosted views). */
+void mr_shade_draw(frame *f, const target *src, const target *dst);
+
+/* Ghosted views (pass_ghost.c). mr_ghost_active: this frame ghosts (a mode
+ * other than off, the hidden layer drawn, and hidden structure in view);
+ * then the G-buffer pass leaves the hidden layer to the ghost passes. */
+bool mr_ghost_active(frame *f);
+bool mr_pass_need_ghost(frame *f);
+bool mr_pass_need_ghost_curvature(frame *f);
+bool mr_pass_need_ghost_adaptive(frame *f);
+void mr_pass_ghost_hidden(frame *f);
+void mr_pass_ghost_curvature(frame *f);
+void mr_pass_ghost_importance(frame *f);
+void mr_pass_ghost_g0(frame *f);
+void mr_pass_ghost_analysis(frame *f);
+void mr_pass_ghost_emphasis(frame *f);
+/* Checks the ghost parameters and builds programs and targets, before the
+ * frame's passes run (so a failure fails the frame). */
+bool mr_ghost_prepare(mr_renderer *r, const mr_ghost_params *gp, int w, int h, mr_error *err);
+/* Drops what was derived from the scene (per-mesh curvature buffers). */
+void mr_ghost_scene_changed(mr_renderer *r);
+void mr_ghost_free(mr_renderer *r);
 
 /* Ambient occlusion (pass_ao.c). */
 typedef struct mr_ao_state mr_ao_state;

@@ -96,6 +96,7 @@ void mr_renderer_destroy(mr_renderer **rp) {
     if (!rp || !*rp) return;
     mr_renderer *r = *rp;
     mr_pass_ao_free(r);
+    mr_ghost_free(r);
     mr_geometry_free(r);
     mr_gl_target_free(&r->gbuf);
     mr_gl_target_free(&r->shaded);
@@ -112,6 +113,7 @@ void mr_renderer_destroy(mr_renderer **rp) {
 
 
 bool mr_renderer_set_scene(mr_renderer *r, const mr_scene *s, mr_error *err) {
+    mr_ghost_scene_changed(r);
     mr_geometry_free(r);
     mr_pass_ao_scene_changed(r);
     if (!s) return true;
@@ -160,8 +162,16 @@ static const pass_desc k_passes[] = {
     {"ao", mr_pass_need_ao, mr_pass_ao},
     {"ao_blur", mr_pass_need_ao_blur, mr_pass_ao_blur},
     {"ao_upsample", mr_pass_need_ao_upsample, mr_pass_ao_upsample},
+    {"ghost_hidden", mr_pass_need_ghost, mr_pass_ghost_hidden},
     {"shade", mr_pass_need_always, mr_pass_shade},
     {"overlay", mr_pass_need_overlay, mr_pass_overlay},
+    /* Ghosting after the overlay: with video, the occluder O is what the
+     * user sees in front of the hidden structure (the real wall). */
+    {"ghost_curvature", mr_pass_need_ghost_curvature, mr_pass_ghost_curvature},
+    {"ghost_importance", mr_pass_need_ghost, mr_pass_ghost_importance},
+    {"ghost_g0", mr_pass_need_ghost, mr_pass_ghost_g0},
+    {"ghost_analysis", mr_pass_need_ghost_adaptive, mr_pass_ghost_analysis},
+    {"ghost_emphasis", mr_pass_need_ghost_adaptive, mr_pass_ghost_emphasis},
 };
 
 static bool read_back(frame *f, mr_error *err) {
@@ -203,6 +213,7 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
     int h = p->height > 0 ? p->height : view->camera.height;
     if (w > 16384 || h > 16384) return mr_fail(err, MR_ERR_INVALID, "output size %dx%d too large", w, h);
     if (!ensure_targets(r, w, h, err)) return false;
+    if (!mr_ghost_prepare(r, &p->ghost, w, h, err)) return false;
 
     frame f;
     memset(&f, 0, sizeof f);

@@ -412,8 +412,14 @@ static void build_materials(hall_ctx *h) {
     };
     for (int i = 0; i < MAT_PIPE0; i++) h->mat[i] = add_material(h, k[i].name, k[i].r, k[i].g, k[i].b, -1);
     static const char *const pipe_names[3] = {"PipeWater", "PipeSprinkler", "PipeGas"};
-    for (int i = 0; i < 3; i++)
-        h->mat[MAT_PIPE0 + i] = add_material(h, pipe_names[i], k_pipe_rgb[i][0], k_pipe_rgb[i][1], k_pipe_rgb[i][2], -1);
+    /* The ghosting conflict case: the hidden pipes take the colour of the
+     * partition in front of them, so plain ghosting loses them. */
+    const bool conflict = h->params && h->params->pipes_like_partition;
+    for (int i = 0; i < 3; i++) {
+        float r = k_pipe_rgb[i][0], g = k_pipe_rgb[i][1], b = k_pipe_rgb[i][2];
+        if (conflict) r = k[MAT_PARTITION].r, g = k[MAT_PARTITION].g, b = k[MAT_PARTITION].b;
+        h->mat[MAT_PIPE0 + i] = add_material(h, pipe_names[i], r, g, b, -1);
+    }
 }
 
 static void build_shell(hall_ctx *h) {

@@ -134,8 +134,10 @@ typedef struct mr_demo_params {
                                    white border), tag i has id i; may be NULL */
     int tag_image_count;
     int tag_border_px;        /* white border width in those images (px), default 1 */
+    bool pipes_like_partition; /* ghosting conflict case: the hidden pipes get the
+                                  partition's colour; default false */
 } mr_demo_params;
-#define MR_DEMO_DEFAULTS {1, 0.4, NULL, 0, 1}
+#define MR_DEMO_DEFAULTS {1, 0.4, NULL, 0, 1, false}
 
 /* One AprilTag plate of the demo hall. */
 typedef struct mr_demo_tag {
@@ -164,6 +166,19 @@ bool mr_mesh_outline_dirs(const mr_mesh *m, float *out, mr_error *err);
 
 bool mr_demo_build(const mr_demo_params *params, mr_demo_hall *out, mr_error *err);
 void mr_demo_free(mr_demo_hall *hall);
+
+/* ------------------------------------------------------------ curvature */
+
+/* Per-vertex maximum principal curvature magnitude |kappa_max| of a mesh in
+ * 1/scene units (out: vertex_count floats), estimated from the normal
+ * variation along the edges that share the vertex: for an edge e = p_j - p_i,
+ * the normal curvature is (n_j - n_i).e / |e|^2 (exact for a sphere). Only
+ * edges of the same smooth patch count (shared vertex indices): at a crease
+ * (split vertices, as CAD exports flat faces) the curvature is a line
+ * singularity that the renderer finds in screen space from the normals.
+ * Degenerate edges are skipped; the result is finite and >= 0. Linear time
+ * in index_count. Scale: kappa(s * mesh) = kappa(mesh) / s. */
+void mr_mesh_curvature(const mr_mesh *mesh, float *out);
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,58 @@
+// Emphasis (paper section 3.3 with the "lightness only" and "unified sign"
+// rules of section 3.4).
+//  u_stage 0 (vote): per pixel the lightness direction that raises contrast
+//    to the smoothed occludee, eq. 5-6 restricted to L*:
+//      L_max = 50 + sgn(50 - L*(GK(D))) * 50,  dir = sgn(L_max - L*(O)),
+//    added, weighted by GK(C), to its occluder object's vote.
+//  u_stage 1 (apply): each object takes the sign of its vote, so it is
+//    either lightened or darkened, never both:
+//      L*(O_A) = L*(O) + gain * GK(C) * sign,  G_A = LAB^-1(O_A)*alpha + D*(1-alpha).
+#include "ghost_lab.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(location = 0) uniform int u_stage;
+layout(location = 1) uniform uint u_key_base;  // first key of the video regions
+layout(location = 2) uniform float u_gain;
+layout(binding = 0) uniform sampler2D u_o;
+layout(binding = 1) uniform sampler2D u_d;
+layout(binding = 2) uniform sampler2D u_dgk;   // GK(D), linear
+layout(binding = 3) uniform sampler2D u_gkc;   // GK(C) in .r
+layout(binding = 4) uniform sampler2D u_mask;
+layout(binding = 5) uniform sampler2D u_g0;
+layout(binding = 6) uniform usampler2D u_key;
+layout(binding = 7) uniform usampler2D u_label;
+layout(binding = 0, rgba8) uniform writeonly image2D u_out;
+layout(binding = 1, rgba32f) uniform writeonly image2D u_oa;
+layout(binding = 2, rgba32f) uniform writeonly image2D u_ga;
+layout(std430, binding = 1) buffer Votes { int votes[]; };
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy), n = textureSize(u_mask, 0);
+    if (p.x >= n.x || p.y >= n.y) return;
+    vec4 m = texelFetch(u_mask, p, 0);
+    float gkc = texelFetch(u_gkc, p, 0).r;
+    vec3 o = texelFetch(u_o, p, 0).rgb;
+    bool act = m.y > 0.5 && gkc > 1e-4;
+    uint key = texelFetch(u_key, p, 0).x;
+    if (key == 0u) key = u_key_base + texelFetch(u_label, p, 0).x;
+    vec3 lab = rgb_to_lab(o);
+    float ld = rgb_to_lab(texelFetch(u_dgk, p, 0).rgb).x;
+    float lmax = 50.0 + sign(50.0 - ld) * 50.0;
+    float dir = sign(lmax - lab.x);
+    if (u_stage == 0) {
+        if (act) atomicAdd(votes[key], int(round(clamp(gkc, 0.0, 4.0) * dir * 1024.0)));
+        return;
+    }
+    vec4 g0 = texelFetch(u_g0, p, 0);
+    vec3 ga = g0.rgb, oa = o;
+    if (act) {
+        int v = votes[key];
+        float s = v > 0 ? 1.0 : v < 0 ? -1.0 : dir;
+        lab.x = clamp(lab.x + u_gain * gkc * s, 0.0, 100.0);
+        oa = clamp(lab_to_rgb(lab), 0.0, 1.0);
+        vec3 d = texelFetch(u_d, p, 0).rgb;
+        ga = oa * g0.a + d * (1.0 - g0.a);
+    }
+    imageStore(u_out, p, vec4(ghost_linear_to_srgb(ga), 1.0));
+    imageStore(u_oa, p, vec4(oa, 1.0));
+    imageStore(u_ga, p, vec4(ga, 1.0));
+}

@@ -1,0 +1,542 @@
+/* Ghosted views: mesh curvature (CPU), then through EGL the L*a*b*
+ * conversion (round trip, black/white/out-of-gamut), saliency of analytic
+ * patterns for both pyramids, G_A = G0 where C = 0, contrast raised on a
+ * constructed conflict, one lightness sign per object (ids and connected
+ * regions), and the frame's pass list (no ghosting pass without hidden
+ * structure in view). The comparison against OpenCV's cvtColor is in
+ * test_ghost_opencv.cc. Skips the GPU part (77) without an EGL device. */
+#include "mr_render.h"
+#include "mr_test.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static mr_gpu *g_gpu;
+static mr_renderer *g_r;
+
+/* ------------------------------------------------------------ curvature */
+
+/* UV sphere of radius r with shared vertices (smooth normals). */
+static void sphere(mr_mesh *m, double r, int seg, int rings) {
+    memset(m, 0, sizeof *m);
+    m->vertex_count = (uint32_t)((rings + 1) * seg);
+    m->index_count = (uint32_t)(rings * seg * 6);
+    m->positions = malloc(m->vertex_count * 12);
+    m->normals = malloc(m->vertex_count * 12);
+    m->indices = malloc(m->index_count * 4);
+    uint32_t k = 0;
+    for (int j = 0; j <= rings; j++) {
+        double th = 3.14159265358979 * (0.1 + 0.8 * j / rings); /* poles left out */
+        for (int i = 0; i < seg; i++, k++) {
+            double ph = 2 * 3.14159265358979 * i / seg;
+            double n[3] = {sin(th) * cos(ph), cos(th), sin(th) * sin(ph)};
+            for (int c = 0; c < 3; c++) {
+                m->normals[k * 3 + c] = (float)n[c];
+                m->positions[k * 3 + c] = (float)(r * n[c]);
+            }
+        }
+    }
+    k = 0;
+    for (int j = 0; j < rings; j++)
+        for (int i = 0; i < seg; i++) {
+            uint32_t a = (uint32_t)(j * seg + i), b = (uint32_t)(j * seg + (i + 1) % seg);
+            uint32_t idx[6] = {a, a + (uint32_t)seg, b + (uint32_t)seg, a, b + (uint32_t)seg, b};
+            memcpy(&m->indices[k], idx, sizeof idx);
+            k += 6;
+        }
+}
+
+static void free_mesh(mr_mesh *m) {
+    free(m->positions);
+    free(m->normals);
+    free(m->indices);
+}
+
+static void test_curvature(void) {
+    static const double radii[] = {1e-3, 1.0, 1e6};
+    for (int t = 0; t < 3; t++) {
+        mr_mesh m;
+        sphere(&m, radii[t], 48, 24);
+        float *k = malloc(m.vertex_count * sizeof *k);
+        mr_mesh_curvature(&m, k);
+        double lo = 1e30, hi = 0;
+        for (uint32_t i = 0; i < m.vertex_count; i++) {
+            double v = k[i] * radii[t];
+            lo = v < lo ? v : lo;
+            hi = v > hi ? v : hi;
+        }
+        /* A sphere: kappa = 1/r everywhere (scale-invariant estimate). */
+        CHECK_MSG(lo > 0.97 && hi < 1.03, "sphere r=%g: kappa*r in [%g, %g]", radii[t], lo, hi);
+        free(k);
+        free_mesh(&m);
+    }
+    /* A flat grid: zero; a degenerate (zero-length) edge: finite. */
+    mr_mesh m;
+    memset(&m, 0, sizeof m);
+    float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 1, 1, 0}, nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    m.positions = pos;
+    m.normals = nrm;
+    m.indices = idx;
+    m.vertex_count = 4;
+    m.index_count = 6;
+    float k[4];
+    mr_mesh_curvature(&m, k);
+    CHECK(k[0] == 0 && k[1] == 0 && k[2] == 0 && k[3] == 0);
+    nrm[11] = -1; /* coincident vertices 2 and 3 with opposite normals */
+    mr_mesh_curvature(&m, k);
+    CHECK(isfinite(k[2]) && isfinite(k[3]));
+}
+
+/* ------------------------------------------------------------- helpers */
+
+static mr_image img(int w, int h, int ch, float v) {
+    mr_image im;
+    mr_image_alloc(&im, w, h, ch, MR_PIX_F32, NULL);
+    float *p = im.data;
+    for (size_t i = 0; i < (size_t)w * h * ch; i++) p[i] = v;
+    return im;
+}
+
+static float *px(mr_image *im, int x, int y) { return (float *)im->data + ((size_t)y * im->width + x) * im->channels; }
+
+/* L* of a linear RGB value (CPU, for checks only). */
+static double lightness(const float *rgb) {
+    double y = 0.212671 * rgb[0] + 0.715160 * rgb[1] + 0.072169 * rgb[2];
+    return y > 0.008856 ? 116 * cbrt(y) - 16 : 903.3 * y;
+}
+
+/* Linear value with L* = L for a neutral grey. */
+static float grey_of(double L) {
+    double fy = (L + 16) / 116;
+    return (float)(fy > 6.0 / 29 ? fy * fy * fy : 3 * (6.0 / 29) * (6.0 / 29) * (fy - 4.0 / 29));
+}
+
+/* ----------------------------------------------------------------- lab */
+
+static void test_lab(void) {
+    const int w = 16, h = 8;
+    mr_image in = img(w, h, 3, 0);
+    mr_rng rng;
+    mr_rng_seed(&rng, 5);
+    float *p = in.data;
+    for (int i = 0; i < w * h * 3; i++) p[i] = (float)mr_rng_uniform(&rng);
+    /* black, white, pure primaries, out of gamut */
+    const float special[][3] = {{0, 0, 0}, {1, 1, 1}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {2, -0.5f, 0}, {-1, -1, -1}, {1e3f, 1e3f, 1e3f}};
+    for (int i = 0; i < 8; i++) memcpy(&p[i * 3], special[i], sizeof special[i]);
+    mr_image lab, back;
+    mr_error err = {0};
+    if (!mr_ghost_lab(g_r, &in, false, &lab, &err)) {
+        CHECK_MSG(false, "%s", err.msg);
+        mr_image_free(&in);
+        return;
+    }
+    const float *L = lab.data;
+    bool finite = true;
+    for (int i = 0; i < w * h * 3; i++) finite = finite && isfinite(L[i]);
+    CHECK(finite);
+    CHECK_NEAR(L[0], 0, 1e-4);                                   /* black */
+    CHECK_NEAR(L[3], 100, 1e-3);                                 /* white */
+    CHECK(fabs(L[4]) < 1e-3 && fabs(L[5]) < 1e-3);
+    CHECK_NEAR(L[6], 53.24, 0.05);                               /* sRGB red: L* 53.24 a* 80.09 b* 67.20 */
+    CHECK_NEAR(L[7], 80.09, 0.1);
+    CHECK_NEAR(L[8], 67.20, 0.1);
+    if (mr_ghost_lab(g_r, &lab, true, &back, &err)) {
+        const float *b = back.data;
+        double worst = 0;
+        /* In-gamut (and the mildly out-of-gamut ones) round trip to 1e-3. */
+        for (int i = 0; i < w * h; i++) {
+            if (i == 7) continue; /* 1e3: checked relative below */
+            for (int c = 0; c < 3; c++) {
+                double d = fabs(b[i * 3 + c] - p[i * 3 + c]);
+                worst = d > worst ? d : worst;
+            }
+        }
+        CHECK_MSG(worst < 1e-3, "round trip error %g", worst);
+        CHECK(fabs(b[21] - 1e3) < 1.0 && isfinite(b[22]) && isfinite(b[23]));
+        mr_image_free(&back);
+    } else {
+        CHECK_MSG(false, "%s", err.msg);
+    }
+    mr_image_free(&lab);
+    mr_image_free(&in);
+}
+
+/* ------------------------------------------------------------ saliency */
+
+static void test_saliency(void) {
+    const int w = 96, h = 72;
+    for (int impl = 0; impl < 2; impl++) {
+        mr_error err = {0};
+        mr_image flat = img(w, h, 3, 0.3f), dot = img(w, h, 3, 0.02f), s;
+        if (mr_ghost_saliency(g_r, &flat, (mr_saliency_impl)impl, 4.0f, &s, &err)) {
+            float mx = 0;
+            for (int i = 0; i < w * h; i++) mx = fmaxf(mx, fabsf(((float *)s.data)[i]));
+            CHECK_MSG(mx < 1e-4f, "impl %d: flat image saliency %g", impl, mx);
+            mr_image_free(&s);
+        } else {
+            CHECK_MSG(false, "%s", err.msg);
+        }
+        /* A 2x2 bright dot off-centre: the saliency maximum sits on it. */
+        for (int y = 30; y < 32; y++)
+            for (int x = 57; x < 59; x++) {
+                float *q = px(&dot, x, y);
+                q[0] = q[1] = q[2] = 1.0f;
+            }
+        if (mr_ghost_saliency(g_r, &dot, (mr_saliency_impl)impl, 4.0f, &s, &err)) {
+            const float *v = s.data;
+            int best = 0;
+            for (int i = 1; i < w * h; i++)
+                if (v[i] > v[best]) best = i;
+            int bx = best % w, by = best / w;
+            CHECK_MSG(bx >= 56 && bx <= 59 && by >= 29 && by <= 32, "impl %d: maximum at (%d,%d)", impl, bx, by);
+            /* ... and falls off away from it. */
+            CHECK(v[best] > 4 * v[10 * w + 10]);
+            mr_image_free(&s);
+        } else {
+            CHECK_MSG(false, "%s", err.msg);
+        }
+        mr_image_free(&flat);
+        mr_image_free(&dot);
+    }
+}
+
+/* ------------------------------------------------------------- compose */
+
+typedef struct scene_imgs {
+    mr_image o, d, im, region, objects;
+} scene_imgs;
+
+static void free_imgs(scene_imgs *s) {
+    mr_image_free(&s->o);
+    mr_image_free(&s->d);
+    mr_image_free(&s->im);
+    mr_image_free(&s->region);
+    mr_image_free(&s->objects);
+}
+
+/* A conflict: a grey wall O (L* 55) with important vertical ribs (IM 0.8),
+ * over a hidden box D of the same grey (L* 55) in the middle; elsewhere
+ * IM 0.2. */
+static scene_imgs conflict(int w, int h) {
+    scene_imgs s;
+    s.o = img(w, h, 3, grey_of(55));
+    s.d = img(w, h, 3, grey_of(55));
+    s.im = img(w, h, 1, 0.2f);
+    s.region = img(w, h, 1, 0);
+    s.objects = img(w, h, 1, 1);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            if (x % 12 < 3) *px(&s.im, x, y) = 0.8f;
+            if (x % 12 < 3) {
+                float *q = px(&s.o, x, y);
+                q[0] = q[1] = q[2] = grey_of(40); /* the ribs are a little darker */
+            }
+            if (x >= w / 4 && x < 3 * w / 4 && y >= h / 4 && y < 3 * h / 4) *px(&s.region, x, y) = 1;
+        }
+    return s;
+}
+
+static bool compose(scene_imgs *s, const mr_ghost_params *gp, mr_ghost_output *out, bool with_objects) {
+    mr_ghost_images in = {&s->o, &s->d, &s->im, &s->region, NULL, with_objects ? &s->objects : NULL};
+    mr_error err = {0};
+    bool ok = mr_ghost_compose(g_r, &in, gp, out, &err);
+    CHECK_MSG(ok, "%s", err.msg);
+    return ok;
+}
+
+/* Mean saliency over the important region pixels. */
+static double mean_sal(const mr_image *rgb, const scene_imgs *s) {
+    mr_image sal;
+    mr_error err = {0};
+    if (!mr_ghost_saliency(g_r, rgb, MR_SALIENCY_MIPMAP, 4.0f, &sal, &err)) {
+        CHECK_MSG(false, "%s", err.msg);
+        return 0;
+    }
+    double sum = 0;
+    int n = 0;
+    for (int i = 0; i < sal.width * sal.height; i++)
+        if (((float *)s->region.data)[i] > 0.5f && ((float *)s->im.data)[i] > 0.5f) {
+            sum += ((float *)sal.data)[i];
+            n++;
+        }
+    mr_image_free(&sal);
+    return n ? sum / n : 0;
+}
+
+static void test_compose(void) {
+    const int w = 96, h = 72;
+    scene_imgs s = conflict(w, h);
+    mr_ghost_params gp = MR_GHOST_DEFAULTS;
+    gp.mode = MR_GHOST_ADAPTIVE;
+    gp.t = 0.6f;
+    mr_ghost_output out;
+    /* Nothing desired: C = 0 everywhere and G_A is G0 exactly. */
+    mr_ghost_params none = gp;
+    none.tc_minimal = none.gamma = none.tc_silhouette = 0;
+    if (compose(&s, &none, &out, true)) {
+        double worst = 0, cmax = 0;
+        for (int i = 0; i < w * h * 3; i++) worst = fmax(worst, fabs(((float *)out.ga.data)[i] - ((float *)out.g0.data)[i]));
+        for (int i = 0; i < w * h; i++) cmax = fmax(cmax, ((float *)out.contrast.data)[i]);
+        CHECK_NEAR(cmax, 0, 0);
+        CHECK_MSG(worst < 1e-6, "G_A differs from G0 by %g where C = 0", worst);
+        /* G0 follows eq. 2 with alpha = t * IM. */
+        float *g0 = px(&out.g0, 48, 36), *o = px(&s.o, 48, 36), *d = px(&s.d, 48, 36);
+        float a = gp.t * *px(&s.im, 48, 36);
+        CHECK_NEAR(*px(&out.alpha, 48, 36), a, 1e-6);
+        CHECK_NEAR(g0[0], o[0] * a + d[0] * (1 - a), 1e-5);
+        /* Outside the region: O unchanged. */
+        CHECK_NEAR(px(&out.g0, 2, 2)[1], px(&s.o, 2, 2)[1], 1e-6);
+        mr_ghost_output_free(&out);
+    }
+    /* The conflict: G_A is more salient than G0 on the important pixels,
+     * and where C = 0 far from any C > 0 (beyond the Gaussian) G_A = G0. */
+    if (compose(&s, &gp, &out, true)) {
+        double s0 = mean_sal(&out.g0, &s), sa = mean_sal(&out.ga, &s);
+        CHECK_MSG(sa > 1.3 * s0 && sa > s0 + 0.05, "conflict: saliency of G_A %.4f vs G0 %.4f", sa, s0);
+        double far = 0;
+        int r = (int)ceilf(3 * gp.sigma_c) + 1;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                bool near_c = false;
+                for (int dy = -r; dy <= r && !near_c; dy++)
+                    for (int dx = -r; dx <= r && !near_c; dx++) {
+                        int xx = x + dx, yy = y + dy;
+                        if (xx >= 0 && yy >= 0 && xx < w && yy < h && *px(&out.contrast, xx, yy) > 0) near_c = true;
+                    }
+                if (near_c) continue;
+                for (int c = 0; c < 3; c++) far = fmax(far, fabs(px(&out.ga, x, y)[c] - px(&out.g0, x, y)[c]));
+            }
+        CHECK_MSG(far < 1e-6, "G_A differs from G0 by %g away from C > 0", far);
+        mr_ghost_output_free(&out);
+    }
+    /* Mode alpha: one alpha, t * mean(IM) over the region. */
+    mr_ghost_params ap = gp;
+    ap.mode = MR_GHOST_ALPHA;
+    if (compose(&s, &ap, &out, true)) {
+        double sum = 0;
+        int n = 0;
+        for (int i = 0; i < w * h; i++)
+            if (((float *)s.region.data)[i] > 0.5f) {
+                sum += ((float *)s.im.data)[i];
+                n++;
+            }
+        CHECK_NEAR(*px(&out.alpha, 30, 30), ap.t * sum / n, 2e-3);
+        CHECK_NEAR(*px(&out.alpha, 31, 30), *px(&out.alpha, 40, 40), 0);
+        mr_ghost_output_free(&out);
+    }
+    free_imgs(&s);
+}
+
+/* Per-pixel directions disagree inside one object: D is dark on the left
+ * (L* 15: lighten) and light on the right (L* 85: darken) under a uniform
+ * grey occluder. One object: one sign. Two objects (or two separate
+ * connected regions): each its own sign. */
+static void test_unified_sign(void) {
+    const int w = 96, h = 72;
+    scene_imgs s;
+    s.o = img(w, h, 3, grey_of(50));
+    s.d = img(w, h, 3, 0);
+    s.im = img(w, h, 1, 0.9f);
+    s.region = img(w, h, 1, 0);
+    s.objects = img(w, h, 1, 7);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            float *q = px(&s.d, x, y);
+            q[0] = q[1] = q[2] = grey_of(x < w / 2 ? 15 : 85);
+            /* Two blobs, left bigger than right, separated by a gap. */
+            bool left = x >= 8 && x < 44 && y >= 12 && y < 60, right = x >= 56 && x < 80 && y >= 20 && y < 52;
+            if (left || right) *px(&s.region, x, y) = 1;
+            if (x >= w / 2) *px(&s.objects, x, y) = 9;
+        }
+    mr_ghost_params gp = MR_GHOST_DEFAULTS;
+    gp.mode = MR_GHOST_ADAPTIVE;
+    gp.t = 0.5f;
+    gp.tc_minimal = 0.6f;
+    /* variant 0: one object id everywhere; 1: two ids; 2: connected regions */
+    for (int variant = 0; variant < 3; variant++) {
+        if (variant == 0) {
+            for (int i = 0; i < w * h; i++) ((float *)s.objects.data)[i] = 7;
+        }
+        if (variant == 1)
+            for (int y = 0; y < h; y++)
+                for (int x = 0; x < w; x++) *px(&s.objects, x, y) = x < w / 2 ? 7 : 9;
+        mr_ghost_output out;
+        if (!compose(&s, &gp, &out, variant < 2)) continue;
+        int up[2] = {0, 0}, down[2] = {0, 0};
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                if (*px(&s.region, x, y) < 0.5f) continue;
+                double dl = lightness(px(&out.occluder_a, x, y)) - lightness(px(&s.o, x, y));
+                int side = x < w / 2 ? 0 : 1;
+                if (dl > 0.05) up[side]++;
+                if (dl < -0.05) down[side]++;
+            }
+        int changed = up[0] + up[1] + down[0] + down[1];
+        CHECK_MSG(changed > 500, "variant %d: only %d pixels emphasised", variant, changed);
+        if (variant == 0) {
+            /* One object: never both lightened and darkened. */
+            CHECK_MSG((up[0] + up[1] == 0) != (down[0] + down[1] == 0), "one object: %d lightened, %d darkened",
+                      up[0] + up[1], down[0] + down[1]);
+        } else {
+            /* Two objects / regions: left lightens (dark D), right darkens. */
+            CHECK_MSG(up[0] > 0 && down[0] == 0, "variant %d left: %d up %d down", variant, up[0], down[0]);
+            CHECK_MSG(down[1] > 0 && up[1] == 0, "variant %d right: %d up %d down", variant, up[1], down[1]);
+        }
+        mr_ghost_output_free(&out);
+    }
+    free_imgs(&s);
+}
+
+/* ---------------------------------------------------------------- frame */
+
+static int32_t add_box(mr_scene *s, double sx, double sy, double sz, int32_t material) {
+    mr_mesh m;
+    memset(&m, 0, sizeof m);
+    m.vertex_count = 24;
+    m.index_count = 36;
+    m.positions = malloc(72 * sizeof(float));
+    m.indices = malloc(36 * sizeof(uint32_t));
+    static const int faces[6][4][3] = {
+        {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}},     {{-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, -1}},
+        {{-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}},     {{-1, -1, 1}, {-1, -1, -1}, {1, -1, -1}, {1, -1, 1}},
+        {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},     {{1, -1, -1}, {-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}},
+    };
+    for (int f = 0; f < 6; f++) {
+        for (int v = 0; v < 4; v++) {
+            m.positions[(f * 4 + v) * 3 + 0] = (float)(faces[f][v][0] * sx / 2);
+            m.positions[(f * 4 + v) * 3 + 1] = (float)(faces[f][v][1] * sy / 2);
+            m.positions[(f * 4 + v) * 3 + 2] = (float)(faces[f][v][2] * sz / 2);
+        }
+        const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
+        for (int k = 0; k < 6; k++) m.indices[f * 6 + k] = (uint32_t)(f * 4) + q[k];
+    }
+    m.material = material;
+    mr_error err = {0};
+    int32_t id = mr_scene_add_mesh(s, &m, &err);
+    CHECK_MSG(id >= 0, "%s", err.msg);
+    return id;
+}
+
+static void add_node(mr_scene *s, const char *name, mr_dmat4 world, int32_t mesh, uint8_t layer) {
+    mr_node n;
+    memset(&n, 0, sizeof n);
+    snprintf(n.name, sizeof n.name, "%s", name);
+    n.parent = -1;
+    n.world = world;
+    n.mesh_first = mesh;
+    n.mesh_count = 1;
+    n.layer = layer;
+    mr_scene_add_node(s, &n);
+}
+
+/* A wall at z = 5 in front of the camera, a hidden bar behind it at z = 6,
+ * and (optionally) a hidden box far off to the side, out of view. */
+static mr_scene *wall_scene(bool bar_in_view) {
+    mr_scene *s = mr_scene_create();
+    mr_material a = {"wall", {0.5f, 0.5f, 0.45f, 1}, -1}, b = {"pipe", {0.7f, 0.05f, 0.05f, 1}, -1};
+    int32_t ma = mr_scene_add_material(s, &a), mb = mr_scene_add_material(s, &b);
+    add_node(s, "Wall", mr_m4_translate(0, 0, 5), add_box(s, 6, 4, 0.1, ma), MR_LAYER_VISIBLE);
+    add_node(s, "Pipe", mr_m4_translate(bar_in_view ? 0 : 500, 0, 6), add_box(s, 3, 0.4, 0.4, mb), MR_LAYER_HIDDEN);
+    mr_scene_update_bounds(s);
+    return s;
+}
+
+static bool render(const mr_scene *s, const mr_frame_params *p, mr_frame_result *res, char *passes, size_t n) {
+    mr_view v = {{96, 72, 80, 80, 47.5, 35.5, {0}}, mr_m4_identity()};
+    mr_error err = {0};
+    bool ok = mr_renderer_set_scene(g_r, s, &err) && mr_render_frame(g_r, &v, p, res, &err);
+    CHECK_MSG(ok, "%s", err.msg);
+    if (ok) mr_frame_result_passes(res, passes, n);
+    return ok;
+}
+
+static void test_frame(void) {
+    mr_scene *in_view = wall_scene(true), *out_of_view = wall_scene(false);
+    char passes[512];
+    mr_frame_result off, res;
+    mr_frame_params p = MR_FRAME_DEFAULTS;
+    if (!render(in_view, &p, &off, passes, sizeof passes)) goto done;
+    CHECK(strcmp(passes, "gbuffer shade") == 0);
+    p.ghost.mode = MR_GHOST_ADAPTIVE;
+    p.ghost.importance = MR_GHOST_IMP_CURVATURE;
+    p.ghost.stats = true;
+    if (render(in_view, &p, &res, passes, sizeof passes)) {
+        CHECK_MSG(strcmp(passes, "gbuffer ghost_hidden shade ghost_curvature ghost_importance ghost_g0 ghost_analysis "
+                                 "ghost_emphasis") == 0, "%s", passes);
+        CHECK(res.ghost.valid && res.ghost.region_fraction > 0.02 && res.ghost.region_fraction < 0.3);
+        /* The red bar shows through the wall in the middle; the wall's
+         * corner pixels (no hidden structure) are unchanged. */
+        const unsigned char *a = off.color.data, *b = res.color.data;
+        int c = (36 * 96 + 48) * 3;
+        CHECK_MSG(b[c] > b[c + 1] + 40 && abs(a[c] - a[c + 1]) < 10, "centre: off %d %d %d, ghost %d %d %d", a[c],
+                  a[c + 1], a[c + 2], b[c], b[c + 1], b[c + 2]);
+        int corner = (5 * 96 + 5) * 3;
+        CHECK(memcmp(a + corner, b + corner, 3) == 0);
+        mr_frame_result_free(&res);
+    }
+    /* Other modes: fewer passes. */
+    p.ghost.mode = MR_GHOST_G0;
+    p.ghost.importance = MR_GHOST_IMP_SALIENCY;
+    if (render(in_view, &p, &res, passes, sizeof passes)) {
+        CHECK_MSG(strcmp(passes, "gbuffer ghost_hidden shade ghost_importance ghost_g0") == 0, "%s", passes);
+        mr_frame_result_free(&res);
+    }
+    /* Hidden structure out of view, or the hidden layer hidden: no
+     * ghosting pass at all, and the same picture as without ghosting. */
+    p.ghost.mode = MR_GHOST_ADAPTIVE;
+    mr_frame_result off2;
+    mr_frame_params p_off = MR_FRAME_DEFAULTS;
+    if (render(out_of_view, &p_off, &off2, passes, sizeof passes)) {
+        if (render(out_of_view, &p, &res, passes, sizeof passes)) {
+            CHECK_MSG(strcmp(passes, "gbuffer shade") == 0, "out of view: %s", passes);
+            CHECK(memcmp(off2.color.data, res.color.data, mr_image_bytes(&res.color)) == 0);
+            CHECK(!res.ghost.valid);
+            mr_frame_result_free(&res);
+        }
+        mr_frame_result_free(&off2);
+    }
+    /* Bad parameters fail the frame with one clear error. */
+    {
+        mr_frame_params bad = p;
+        bad.ghost.t = 2;
+        mr_view v = {{96, 72, 80, 80, 47.5, 35.5, {0}}, mr_m4_identity()};
+        mr_error err = {0};
+        CHECK(!mr_render_frame(g_r, &v, &bad, &res, &err) && err.code == MR_ERR_INVALID);
+        bad.ghost.t = 1;
+        bad.ghost.sigma_c = NAN;
+        CHECK(!mr_render_frame(g_r, &v, &bad, &res, &err) && err.code == MR_ERR_INVALID);
+    }
+    p.hide_hidden_layer = true;
+    if (render(in_view, &p, &res, passes, sizeof passes)) {
+        CHECK_MSG(strcmp(passes, "gbuffer shade") == 0, "hidden layer hidden: %s", passes);
+        mr_frame_result_free(&res);
+    }
+    mr_frame_result_free(&off);
+done:
+    mr_renderer_set_scene(g_r, NULL, NULL);
+    mr_scene_destroy(&in_view);
+    mr_scene_destroy(&out_of_view);
+}
+
+int main(void) {
+    test_curvature();
+    mr_error err = {0};
+    g_gpu = mr_gpu_create_headless(NULL, &err);
+    if (!g_gpu) {
+        printf("test_ghost: SKIPPED (GPU part): no EGL device (%s)\n", err.msg);
+        return mr_test_failures ? mr_test_finish("test_ghost") : MR_TEST_SKIP;
+    }
+    g_r = mr_renderer_create(g_gpu, &err);
+    CHECK_MSG(g_r != NULL, "%s", err.msg);
+    if (g_r) {
+        test_lab();
+        test_saliency();
+        test_compose();
+        test_unified_sign();
+        test_frame();
+    }
+    mr_renderer_destroy(&g_r);
+    mr_gpu_destroy(&g_gpu);
+    return mr_test_finish("test_ghost");
+}
