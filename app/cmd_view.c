@@ -47,6 +47,8 @@ static const struct {
     {"1..6", "choose a note / Esc cancels"},
     {"v", "video on/off"},
     {"h", "hidden layer on/off"},
+    {"a", "next ambient occlusion method"},
+    {"g", "next ghosting mode"},
     {"space", "replay: play / pause"},
     {". / Right", "replay: step forward"},
     {", / Left", "replay: step back"},
@@ -62,7 +64,12 @@ typedef struct settings {
     bool show_video;
     bool hide_hidden;
     int rate_i;          /* index into k_rates */
+    mr_ao_method ao;     /* ambient occlusion method, default none */
+    mr_ghost_mode ghost; /* ghosted views of the hidden layer, default off */
 } settings;
+
+static const char *const k_ghost_names[] = {"off", "alpha", "g0", "adaptive"};
+#define GHOST_COUNT 4
 
 typedef struct named_rect {
     char name[24];
@@ -155,6 +162,8 @@ static void settings_default(settings *s) {
     s->show_video = true;
     s->hide_hidden = false;
     s->rate_i = 2;
+    s->ao = MR_AO_NONE;
+    s->ghost = MR_GHOST_OFF;
 }
 
 static void settings_load(view_app *a) {
@@ -175,6 +184,12 @@ static void settings_load(view_app *a) {
     if (cJSON_IsBool(b)) a->s.show_video = cJSON_IsTrue(b);
     b = cJSON_GetObjectItemCaseSensitive(j, "hide_hidden_layer");
     if (cJSON_IsBool(b)) a->s.hide_hidden = cJSON_IsTrue(b);
+    b = cJSON_GetObjectItemCaseSensitive(j, "ao");
+    mr_ao_method m;
+    if (cJSON_IsString(b) && mr_ao_method_parse(b->valuestring, &m)) a->s.ao = m;
+    b = cJSON_GetObjectItemCaseSensitive(j, "ghost");
+    for (int i = 0; cJSON_IsString(b) && i < GHOST_COUNT; i++)
+        if (strcmp(b->valuestring, k_ghost_names[i]) == 0) a->s.ghost = (mr_ghost_mode)i;
     cJSON_Delete(j);
 }
 
@@ -188,6 +203,8 @@ static void settings_save(view_app *a) {
     cJSON_AddBoolToObject(j, "show_video", a->s.show_video);
     cJSON_AddBoolToObject(j, "hide_hidden_layer", a->s.hide_hidden);
     cJSON_AddNumberToObject(j, "rate", k_rates[a->s.rate_i]);
+    cJSON_AddStringToObject(j, "ao", mr_ao_method_name(a->s.ao));
+    cJSON_AddStringToObject(j, "ghost", k_ghost_names[a->s.ghost]);
     /* mr_json_save writes a temporary file and renames it: a crash never
      * leaves a half-written config. */
     if (!mr_mkdirs(dir, &err) || !mr_json_save(a->config_path, j, &err))
@@ -246,6 +263,16 @@ static void step(view_app *a, int d) {
     if (!a->cap || !vw_capture_seekable(a->cap)) return;
     if (a->frozen) set_frozen(a, false);
     vw_capture_step(a->cap, d);
+}
+
+static void next_ao(view_app *a) {
+    a->s.ao = (mr_ao_method)((a->s.ao + 1) % MR_AO_METHOD_COUNT);
+    changed(a);
+}
+
+static void next_ghost(view_app *a) {
+    a->s.ghost = (mr_ghost_mode)((a->s.ghost + 1) % GHOST_COUNT);
+    changed(a);
 }
 
 static void set_rate(view_app *a, int i) {
@@ -429,6 +456,8 @@ static void on_key(view_app *a, int k) {
         break;
     case 'v': a->s.show_video = !a->s.show_video; changed(a); break;
     case 'h': a->s.hide_hidden = !a->s.hide_hidden; changed(a); break;
+    case 'a': next_ao(a); break;
+    case 'g': next_ghost(a); break;
     case ' ': toggle_play(a); break;
     case '.': case MR_KEY_RIGHT: step(a, 1); break;
     case ',': case MR_KEY_LEFT: step(a, -1); break;
@@ -679,6 +708,8 @@ static void render_3d(view_app *a) {
     fp.video = a->s.show_video ? &a->frame.image : NULL;
     fp.alpha = a->s.alpha;
     fp.hide_hidden_layer = a->s.hide_hidden;
+    fp.ao.method = a->s.ao;
+    fp.ghost.mode = a->s.ghost;
     /* Tracking lost: keep the last good pose but let the video through, so
      * a stale model never passes for the truth. No pose yet: video only. */
     a->dimmed = false;
@@ -704,6 +735,8 @@ static void render_3d(view_app *a) {
     a->rh = rh;
     a->image_rect = fit;
     mr_frame_result_passes(&a->res, a->passes, sizeof a->passes);
+    /* A still camera reuses the last AO: say so, or AO seems to be off. */
+    if (a->res.ao_reused) strncat(a->passes, " (ao reused)", sizeof a->passes - strlen(a->passes) - 1);
 }
 
 static void build_ui(view_app *a) {
@@ -778,7 +811,10 @@ static void build_ui(view_app *a) {
 
     /* Right column: the toggles and actions, wrapping into a second column
      * when the screen is too short. */
-    float colw = fmaxf(T * 2.4f, mr_ui_text_width(mr_ui_get_font(ui), "Snapshot", th) + 3 * g);
+    float colw = fmaxf(T * 2.4f, mr_ui_text_width(mr_ui_get_font(ui), "AO alchemy", th) + 3 * g);
+    char ao_label[32], ghost_label[32];
+    snprintf(ao_label, sizeof ao_label, "AO %s", mr_ao_method_name(a->s.ao));
+    snprintf(ghost_label, sizeof ghost_label, "Ghost %s", k_ghost_names[a->s.ghost]);
     struct {
         const char *name, *label;
         int kind; /* 0 button, 1 toggle state shown */
@@ -789,6 +825,8 @@ static void build_ui(view_app *a) {
         {"mark", "Mark", 1, a->mark_mode},
         {"video", "Video", 1, a->s.show_video},
         {"hidden", "Hidden", 1, !a->s.hide_hidden},
+        {"ao", ao_label, 1, a->s.ao != MR_AO_NONE},
+        {"ghost", ghost_label, 1, a->s.ghost != MR_GHOST_OFF},
         {"help", "?", 1, a->help},
     };
     int n = (int)(sizeof items / sizeof items[0]);
@@ -810,6 +848,8 @@ static void build_ui(view_app *a) {
         else if (!strcmp(items[i].name, "video")) { a->s.show_video = !a->s.show_video; changed(a); }
         else if (!strcmp(items[i].name, "hidden")) { a->s.hide_hidden = !a->s.hide_hidden; changed(a); }
         else if (!strcmp(items[i].name, "help")) a->help = !a->help;
+        else if (!strcmp(items[i].name, "ao")) next_ao(a);
+        else if (!strcmp(items[i].name, "ghost")) next_ghost(a);
     }
 
     /* Messages over the picture: failures first. */
@@ -920,6 +960,8 @@ static void write_state(view_app *a, const mr_image *screen) {
     cJSON_AddNumberToObject(j, "alpha", a->s.alpha);
     cJSON_AddBoolToObject(j, "show_video", a->s.show_video);
     cJSON_AddBoolToObject(j, "hide_hidden_layer", a->s.hide_hidden);
+    cJSON_AddStringToObject(j, "ao", mr_ao_method_name(a->s.ao));
+    cJSON_AddStringToObject(j, "ghost", k_ghost_names[a->s.ghost]);
     cJSON_AddBoolToObject(j, "frozen", a->frozen);
     cJSON_AddBoolToObject(j, "mark_mode", a->mark_mode);
     cJSON_AddBoolToObject(j, "help", a->help);
@@ -974,6 +1016,8 @@ static void write_state(view_app *a, const mr_image *screen) {
             fp.video = &a->frame.image;
             fp.alpha = (float)k;
             fp.hide_hidden_layer = a->s.hide_hidden;
+            fp.ao.method = a->s.ao;
+            fp.ghost.mode = a->s.ghost;
             mr_frame_result r;
             mr_error err = {0};
             if (mr_render_frame(a->rend, &view, &fp, &r, &err)) {

@@ -58,11 +58,13 @@ if view main "0.2 key .
 3.1 tap @video
 3.5 state $tmp/s_novideo.json
 3.6 tap @video
-3.7 key f
-3.9 key space
-4.8 state $tmp/s_frozen.json
-4.9 key s
-5.4 quit" --stats; then
+3.65 tap @ao
+3.95 state $tmp/s_ao.json
+4.0 key f
+4.2 key space
+5.0 state $tmp/s_frozen.json
+5.1 key s
+5.6 quit" --stats; then
   ok
   if [ -s "$tmp/s_start.json" ]; then
     [ "$(jget "$tmp/s_start.json" pose_valid)" = true ] && ok || bad "no pose on the demo's frame 2"
@@ -82,6 +84,9 @@ if view main "0.2 key .
     && ok || bad "dragging right did not move the picture towards the video"
   # Video toggle: no video, no overlay pass.
   [ "$(jget "$tmp/s_novideo.json" passes)" = "gbuffer shade" ] && ok || bad "video toggle: passes $(jget "$tmp/s_novideo.json" passes)"
+  # AO toggle: an AO pass joins the list.
+  jget "$tmp/s_ao.json" passes | grep -q " ao" && [ "$(jget "$tmp/s_ao.json" ao)" != none ] \
+    && ok || bad "AO toggle: passes $(jget "$tmp/s_ao.json" passes)"
   # Frozen: play does not advance the frame.
   [ "$(jget "$tmp/s_frozen.json" frozen)" = true ] && [ "$(jget "$tmp/s_frozen.json" frame_index)" = 2 ] \
     && ok || bad "freeze: frozen=$(jget "$tmp/s_frozen.json" frozen) frame=$(jget "$tmp/s_frozen.json" frame_index)"
