@@ -106,6 +106,23 @@ if view persist "0.5 state $tmp/s_persist.json
   [ "$(jget "$tmp/s_persist.json" alpha)" = "$a" ] && ok || bad "alpha not restored: $(jget "$tmp/s_persist.json" alpha) vs $a"
 else bad "second run failed: $(tail -3 "$tmp/persist.err")"; fi
 
+# 1b. The shipped demo recording (recordings/demo, lib/session's format):
+#     recorded poses, play advances, the seek bar and step move the frame.
+rec=$(cd "$(dirname "$0")/.." && pwd)/recordings/demo
+if [ -f "$rec/meta.json" ]; then
+  printf '%s\n' "0.3 state $tmp/r0.json" "0.4 key space" "1.5 key space" "1.7 state $tmp/r1.json" \
+    "1.8 drag @seek 0.2 0.9" "2.6 state $tmp/r2.json" "2.7 key ," "3.3 state $tmp/r3.json" "3.4 quit" >"$tmp/rec.script"
+  if timeout 120 "$mr" view --scene "$d/scene_planned.json" --replay "$rec" --out "$tmp/recsession" --config "$tmp/cfgr.json" \
+       --size 480x360 --paused --script "$tmp/rec.script" >/dev/null 2>"$tmp/rec.err"; then
+    [ "$(jget "$tmp/r0.json" pose_valid)" = true ] && [ "$(jget "$tmp/r0.json" frame_index)" = 0 ] && ok || bad "recording: no pose at frame 0"
+    lt 20 "$(jget "$tmp/r0.json" screen_std)" && ok || bad "recording: blank window"
+    jget "$tmp/r0.json" passes | grep -q overlay && ok || bad "recording: no overlay pass"
+    f1=$(jget "$tmp/r1.json" frame_index); lt 3 "$f1" && ok || bad "recording: play did not advance ($f1)"
+    f2=$(jget "$tmp/r2.json" frame_index); lt 90 "$f2" && ok || bad "recording: seek bar to 90% gave frame $f2"
+    f3=$(jget "$tmp/r3.json" frame_index); [ "$f3" = $((f2 - 1)) ] && ok || bad "recording: step back from $f2 gave $f3"
+  else bad "recording replay failed: $(tail -3 "$tmp/rec.err")"; fi
+fi
+
 # 2. A mark: tap in the picture, choose a note; the line must be in
 #    annotations.jsonl at once, whole, and survive kill -9 right after.
 rm -f "$tmp/session/annotations.jsonl"
