@@ -149,7 +149,7 @@ typedef struct view_app {
     /* stats */
     bool stats;
     double t_start;
-    int64_t frames_drawn, renders;
+    int64_t frames_drawn, renders, frames_skipped;
     double sum_render_ms, sum_present_ms, sum_ui_cpu_ms, sum_ui_draw_ms, sum_loop_ms;
     double fps, fps_t0;
     int64_t fps_frames;
@@ -1046,7 +1046,10 @@ static void frame_tick(view_app *a) {
     double ppmm = mr_window_px_per_mm(a->win) * a->ui_scale;
     if (fabs(ppmm - mr_ui_px_per_mm(a->ui)) > 1e-6) mr_ui_set_density(a->ui, ppmm);
 
+    uint64_t old_seq = a->frame.seq;
     if (a->cap && !a->frozen && !a->note_open && vw_capture_latest(a->cap, &a->frame)) {
+        /* Newest wins: frames that arrived while we were busy are skipped. */
+        if (old_seq > 0 && a->frame.seq > old_seq + 1) a->frames_skipped += (int64_t)(a->frame.seq - old_seq - 1);
         a->have_frame = true;
         a->need_render = true;
     }
@@ -1165,9 +1168,9 @@ static void print_stats(view_app *a) {
     if (a->cap) vw_capture_counts(a->cap, &nread, &ntracked, &ndropped, &track_sum);
     int64_t nf = a->frames_drawn > 0 ? a->frames_drawn : 1;
     printf("mrcheck view --stats: %lld frames drawn in %.1f s (%.1f fps), %lld 3D renders; "
-           "%lld camera frames read, %lld tracked, %lld dropped (newest wins)\n",
+           "%lld camera frames read, %lld tracked, newest wins: %lld skipped before tracking, %lld before drawing\n",
            (long long)a->frames_drawn, wall, a->frames_drawn / (wall > 0 ? wall : 1), (long long)a->renders,
-           (long long)nread, (long long)ntracked, (long long)ndropped);
+           (long long)nread, (long long)ntracked, (long long)ndropped, (long long)a->frames_skipped);
     printf("  tracking (capture thread)  %8.2f ms per camera frame\n", ntracked ? track_sum / ntracked : 0.0);
     printf("  render (3D frame)          %8.2f ms per render, %.2f ms per drawn frame\n",
            a->renders ? a->sum_render_ms / a->renders : 0.0, a->sum_render_ms / nf);

@@ -22,11 +22,12 @@ bool mr_renderer_pick(mr_renderer *r, double x, double y, mr_pick *out, mr_error
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x reading the pick pixel", e);
     if (!(d > 0)) return true; /* reversed Z: 0 is infinity, nothing there */
-    /* depth = near / z (see mr_gl_projection); the ray through the pixel
-     * centre of the ideal pinhole camera the frame was rendered with. */
+    /* depth = near / z (see mr_gl_projection); the ray through (x, y)
+     * itself, not the pixel centre, of the ideal pinhole camera the frame
+     * was rendered with, so a tap lands where it was made. */
     const mr_camera *c = &r->last.cam;
     double z = r->last.near_plane / d;
-    mr_dvec3 pc = mr_v3((px - c->cx) / c->fx * z, (py - c->cy) / c->fy * z, z);
+    mr_dvec3 pc = mr_v3((x - c->cx) / c->fx * z, (y - c->cy) / c->fy * z, z);
     out->hit = true;
     out->depth = z;
     out->world = mr_m4_point(&r->last.world_from_camera, pc);
