@@ -1,5 +1,6 @@
 /* mrcheck bench: measurements (CSV + SVG plot), never pass/fail. */
 #include "app.h"
+#include "app_track.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -184,11 +185,12 @@ int cmd_bench(int argc, char **argv) {
     if (argc >= 3 && strcmp(argv[2], "frame") == 0) return bench_frame(argc, argv);
     if (argc >= 3 && strcmp(argv[2], "ao") == 0) return bench_ao(argc, argv);
     if (argc >= 3 && strcmp(argv[2], "ghost") == 0) return app_bench_ghost(argc, argv);
+    if (argc >= 3 && strcmp(argv[2], "tracking") == 0) return bench_tracking(argc, argv);
     if (argc >= 3 && (strcmp(argv[2], "--help") == 0 || strcmp(argv[2], "-h") == 0)) {
-        printf("usage: mrcheck bench {frame,ao,ghost} [options]   (mrcheck bench frame --help, ...)\n");
+        printf("usage: mrcheck bench {frame,ao,ghost,tracking} [options]   (mrcheck bench frame --help, ...)\n");
         return 0;
     }
-    fprintf(stderr, "mrcheck: bench: unknown or missing benchmark%s%s (available: frame, ao, ghost)\n", argc >= 3 ? " " : "",
+    fprintf(stderr, "mrcheck: bench: unknown or missing benchmark%s%s (available: frame, ao, ghost, tracking)\n", argc >= 3 ? " " : "",
             argc >= 3 ? argv[2] : "");
     return 2;
 }

@@ -4,6 +4,7 @@
  * distortion, slight blur, sensor noise) and overlays the as-planned model on
  * them at alpha = 0.5. */
 #include "app.h"
+#include "app_track.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -249,6 +250,7 @@ static bool run_demo(const char *dir, mr_error *err) {
     printf("  camera frames (as built):     %s/frames/frame_000..%03d.png\n", dir, DEMO_VIEWS - 1);
     printf("  overlays (planned, alpha 0.5): %s/overlay/overlay_000..%03d.png\n", dir, DEMO_VIEWS - 1);
     printf("  virtual only (planned):        %s/virtual/virtual_000..%03d.png\n", dir, DEMO_VIEWS - 1);
+    if (!app_demo_track(dir, err)) return false; /* tracking: recording + calibration set (demo_track.c) */
     printf("done in %.1f s\n", mr_time_now() - t0);
     return true;
 }

@@ -75,6 +75,9 @@ int cmd_track(int argc, char **argv) {
     strbuf poses = {0};
     long frames = 0, failed = 0, with_tags = 0, with_pose = 0;
     int rc = 0;
+    /* The first bad frame's message is held back: if no frame at all can be
+     * processed (a single tiny image, say) it becomes the one error line. */
+    char held[600] = "";
     while (!app_interrupted() && (max_frames < 0 || frames < max_frames)) {
         mr_frame f;
         mr_read_status st = mr_source_read(src, &f, &err);
@@ -88,9 +91,14 @@ int cmd_track(int argc, char **argv) {
         mr_error fe = {0};
         if (!app_tracker_frame(&t, &f, &r, &fe)) {
             /* One bad frame (too small, broken) does not end the run. */
-            fprintf(stderr, "mrcheck: track: warning: frame %lld: %s\n", (long long)f.index, fe.msg);
+            if (failed == 0 && frames == 1) snprintf(held, sizeof held, "frame %lld: %s", (long long)f.index, fe.msg);
+            else fprintf(stderr, "mrcheck: track: warning: frame %lld: %s\n", (long long)f.index, fe.msg);
             failed++;
             continue;
+        }
+        if (held[0]) {
+            fprintf(stderr, "mrcheck: track: warning: %s\n", held);
+            held[0] = 0;
         }
         with_tags += r.count > 0;
         with_pose += r.pose.valid;
@@ -118,7 +126,8 @@ int cmd_track(int argc, char **argv) {
         fflush(stdout);
     }
     if (rc == 0 && frames == 0) rc = app_errorf(cmd, "%s: no frames", input);
-    else if (rc == 0 && failed == frames) rc = app_errorf(cmd, "no frame could be processed (%ld failed)", failed);
+    else if (rc == 0 && failed == frames)
+        rc = app_errorf(cmd, "no frame could be processed (%ld failed; %s)", failed, held[0] ? held : "see above");
     if (rc == 0 && out && !mr_file_write_atomic(out, poses.s ? poses.s : "", poses.len, &err)) rc = app_error(cmd, &err);
     if (rc == 0 && mr_log_get_level() >= MR_LOG_INFO)
         fprintf(stderr, "track: %ld frames, %ld with tags, %ld with a pose, %ld failed\n", frames, with_tags, with_pose,

@@ -85,13 +85,13 @@ bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, cons
         if (!app_double("sharpening", app_get(opts, "sharpening"), 0, 10, &v)) goto fail;
         dp.sharpening = v > 0 ? v : -1;
     }
-    if (t->has_markers && app_get(opts, "family") && strcmp(app_get(opts, "family"), t->markers.family) != 0)
-        mr_log(MR_LOG_WARN, "--family %s differs from the marker map's %s", app_get(opts, "family"), t->markers.family);
     t->det = mr_detector_create(&dp, &err);
     if (!t->det) {
         app_error(cmd, &err);
         goto fail;
     }
+    if (t->has_markers && app_get(opts, "family") && strcmp(app_get(opts, "family"), t->markers.family) != 0)
+        mr_log(MR_LOG_WARN, "--family %s differs from the marker map's %s", app_get(opts, "family"), t->markers.family);
     if (!app_flag(opts, "no-filter")) {
         t->filter = mr_pose_filter_create(NULL, &err);
         if (!t->filter) {

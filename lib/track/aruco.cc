@@ -66,12 +66,12 @@ extern "C" const mr_detection *mr_aruco_detect(mr_aruco *a, const mr_image *img,
             d.id = ids[i];
             d.hamming = 0;
             d.decision_margin = 0;
-            // aruco: top-left, top-right, bottom-right, bottom-left (as the
-            // marker is printed); apriltag order starts bottom-left and
-            // turns the other way.
+            // OpenCV's DICT_APRILTAG_36h11 starts at another corner and turns
+            // the other way than the apriltag library (checked on the demo
+            // recording: apriltag corner k = aruco corner (5 - k) mod 4).
             for (int k = 0; k < 4; k++) {
-                d.corners[k][0] = corners[i][(size_t)(3 - k)].x;
-                d.corners[k][1] = corners[i][(size_t)(3 - k)].y;
+                d.corners[k][0] = corners[i][(size_t)((5 - k) % 4)].x;
+                d.corners[k][1] = corners[i][(size_t)((5 - k) % 4)].y;
             }
         }
         std::sort(a->dets.begin(), a->dets.begin() + (long)ids.size(),

@@ -99,11 +99,13 @@ typedef struct mr_pose_params {
                                 default 3.0 px */
     double max_rms_px;       /* no pose when the final RMS exceeds this,
                                 default 4.0 px */
-    double ambiguity_px;     /* single tag: IPPE solutions within this RMS of
-                                the best count as ambiguous, default 1.0 px */
+    double ambiguity_ratio;  /* candidate poses whose RMS is within this factor
+                                of the best count as ambiguous (then the one
+                                nearest the previous pose wins), default 2.5 */
+    double ambiguity_px;     /* ... or within this many px of it, default 0.1 */
     double min_tag_px;       /* tags with a shorter edge are ignored, default 8 px */
 } mr_pose_params;
-#define MR_POSE_DEFAULTS {0.0, 0.0, 0.0, 0.0}
+#define MR_POSE_DEFAULTS {0.0, 0.0, 0.0, 0.0, 0.0}
 
 #define MR_POSE_MAX_IDS 32
 
@@ -250,6 +252,17 @@ typedef struct mr_calib_view {
  * error; per_view_rms (may be NULL) one value per view. */
 bool mr_calibrate(const mr_calib_view *views, int nviews, int width, int height, mr_camera *out, double *rms_px,
                   double *per_view_rms, mr_error *err);
+
+/* ------------------------------------------------------- video writing */
+
+/* Motion-JPEG AVI through OpenCV, written to a temporary file and renamed
+ * over `path` by mr_video_writer_close (so no half-written video is ever
+ * seen under that name); mr_video_writer_abort removes it instead. */
+typedef struct mr_video_writer mr_video_writer;
+mr_video_writer *mr_video_writer_open(const char *path, int width, int height, double fps, mr_error *err);
+bool mr_video_writer_add(mr_video_writer *w, const mr_image *img, mr_error *err); /* 8-bit grey or RGB */
+bool mr_video_writer_close(mr_video_writer **w, mr_error *err);
+void mr_video_writer_abort(mr_video_writer **w);
 
 /* ------------------------------------------------------- image coding */
 

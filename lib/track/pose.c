@@ -169,7 +169,8 @@ bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_dete
     mr_pose_params p = params ? *params : (mr_pose_params)MR_POSE_DEFAULTS;
     double outlier_px = p.outlier_px > 0 ? p.outlier_px : 3.0;
     double max_rms = p.max_rms_px > 0 ? p.max_rms_px : 4.0;
-    double amb_px = p.ambiguity_px > 0 ? p.ambiguity_px : 1.0;
+    double amb_px = p.ambiguity_px > 0 ? p.ambiguity_px : 0.1;
+    double amb_ratio = p.ambiguity_ratio > 1 ? p.ambiguity_ratio : 2.5;
     double min_tag = p.min_tag_px > 0 ? p.min_tag_px : 8.0;
 
     tag_obs obs[MAX_TAGS];
@@ -253,15 +254,20 @@ bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_dete
             best = c;
     if (best < 0) return true;
     /* Plausible alternatives: as many inlier tags and an error within the
-     * ambiguity margin. If they differ in rotation, prefer the previous
-     * pose's neighbour, so a single tag seen head-on does not flip. */
+     * ambiguity margin (ratio and slack: the wrong branch of a single tag
+     * typically fits 2-4 times worse, a truly ambiguous one about as well).
+     * If they differ in rotation, prefer the previous pose's neighbour, so a
+     * tag seen head-on does not flip; a clearly better fit still wins, so a
+     * wrong start does not stick. */
     bool have_prev = prev && prev->valid;
     mr_dmat4 prev_cfw = have_prev ? mr_m4_invert_rigid(&prev->world_from_camera) : mr_m4_identity();
     mr_dmat4 best_m = rt_to_m4(&cands[best].x);
     int pick = best;
     double pick_angle = have_prev ? mr_pose_angle_deg(&best_m, &prev_cfw) : 0;
     for (int c = 0; c < nc; c++) {
-        if (c == best || cands[c].inliers != cands[best].inliers || cands[c].rms > cands[best].rms + amb_px) continue;
+        if (c == best || cands[c].inliers != cands[best].inliers ||
+            cands[c].rms > fmax(amb_ratio * cands[best].rms, cands[best].rms + amb_px))
+            continue;
         mr_dmat4 cm = rt_to_m4(&cands[c].x);
         if (mr_pose_angle_deg(&cm, &best_m) < 2.0) continue;
         out->ambiguous = true;

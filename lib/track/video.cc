@@ -7,7 +7,9 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include <cstdio>
 #include <cstdlib>
+#include <unistd.h>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -18,6 +20,10 @@ struct mr_cv_video {
 };
 
 extern "C" mr_cv_video *mr_cv_video_open(const char *path, mr_error *err) {
+    // FFmpeg logs its own complaints ("moov atom not found") on stderr,
+    // which breaks the one-line-per-error rule; OpenCV reads this variable
+    // once, when its FFmpeg backend starts. A user's own setting is kept.
+    setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
     try {
         mr_cv_video *v = new mr_cv_video;
         // FFmpeg explicitly: the "any" backend would also try V4L2 and
@@ -61,6 +67,73 @@ extern "C" int mr_cv_video_read(mr_cv_video *v, bool gray, mr_image *img, double
 }
 
 extern "C" void mr_cv_video_close(mr_cv_video *v) { delete v; }
+
+struct mr_video_writer {
+    cv::VideoWriter vw;
+    std::string path, tmp;
+    int width, height;
+    cv::Mat bgr;
+};
+
+extern "C" mr_video_writer *mr_video_writer_open(const char *path, int width, int height, double fps, mr_error *err) {
+    if (width < 1 || height < 1 || !(fps > 0)) {
+        mr_fail(err, MR_ERR_INVALID, "video: bad size or rate");
+        return nullptr;
+    }
+    try {
+        mr_video_writer *w = new mr_video_writer;
+        w->path = path;
+        w->tmp = w->path + ".tmp." + std::to_string((long)getpid()) + ".avi";
+        w->width = width;
+        w->height = height;
+        if (!w->vw.open(w->tmp, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
+                        cv::Size(width, height), true)) {
+            delete w;
+            mr_fail(err, MR_ERR_IO, "%s: cannot create the video", path);
+            return nullptr;
+        }
+        return w;
+    } catch (const std::exception &e) {
+        mr_fail(err, MR_ERR_IO, "%s: cannot create the video (%.200s)", path, e.what());
+        return nullptr;
+    }
+}
+
+extern "C" bool mr_video_writer_add(mr_video_writer *w, const mr_image *img, mr_error *err) {
+    if (!img || !img->data || img->type != MR_PIX_U8 || (img->channels != 1 && img->channels != 3) ||
+        img->width != w->width || img->height != w->height)
+        return mr_fail(err, MR_ERR_INVALID, "video: frame must be 8-bit grey/RGB %dx%d", w->width, w->height);
+    try {
+        cv::Mat m(img->height, img->width, img->channels == 1 ? CV_8UC1 : CV_8UC3, img->data);
+        cv::cvtColor(m, w->bgr, img->channels == 1 ? cv::COLOR_GRAY2BGR : cv::COLOR_RGB2BGR);
+        w->vw.write(w->bgr);
+        return true;
+    } catch (const std::exception &e) {
+        return mr_fail(err, MR_ERR_IO, "video: cannot write a frame (%.200s)", e.what());
+    }
+}
+
+extern "C" bool mr_video_writer_close(mr_video_writer **pw, mr_error *err) {
+    if (!pw || !*pw) return true;
+    mr_video_writer *w = *pw;
+    *pw = nullptr;
+    w->vw.release();
+    bool ok = std::rename(w->tmp.c_str(), w->path.c_str()) == 0;
+    if (!ok) {
+        mr_fail(err, MR_ERR_IO, "%s: cannot rename the finished video into place", w->path.c_str());
+        std::remove(w->tmp.c_str());
+    }
+    delete w;
+    return ok;
+}
+
+extern "C" void mr_video_writer_abort(mr_video_writer **pw) {
+    if (!pw || !*pw) return;
+    (*pw)->vw.release();
+    std::remove((*pw)->tmp.c_str());
+    delete *pw;
+    *pw = nullptr;
+}
 
 extern "C" bool mr_image_encode(const mr_image *img, const char *ext, int quality, void **data, size_t *size,
                                 mr_error *err) {

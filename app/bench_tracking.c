@@ -1,0 +1,385 @@
+/* mrcheck bench tracking: error against run time of the tag detector
+ * settings (and OpenCV's aruco detector as the peer) on a recording with
+ * ground truth. CSV + SVG; measures, never asserts. */
+#include "app_track.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct setting {
+    char name[48];
+    bool aruco;
+    double decimate;
+    int threads;
+    int refine;                 /* apriltag: edge refinement 0/1; aruco: mr_aruco_refine */
+} setting;
+
+typedef struct result {
+    double ms_med, ms_p95, det_ms_med;
+    double t_err_mm, t_err_pct, r_err_deg, rms_px;
+    double det_rate, det_rate56, pose_rate, flip_rate;
+    double jit_raw_mm, jit_raw_deg, jit_filt_mm, jit_filt_deg;
+    int frames;
+} result;
+
+static int cmp_d(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double quantile(double *v, int n, double q) {
+    if (n <= 0) return NAN;
+    qsort(v, (size_t)n, sizeof *v, cmp_d);
+    double pos = q * (n - 1);
+    int i = (int)pos;
+    return i + 1 < n ? v[i] + (pos - i) * (v[i + 1] - v[i]) : v[i];
+}
+
+/* Which tags the ground-truth camera sees: all corners in the image (2 px
+ * margin), the tag facing the camera; shortest projected edge in *edge. */
+static bool gt_visible(const mr_camera *cam, const mr_marker_map *map, const mr_marker *m, const mr_dmat4 *gt, double *edge) {
+    mr_dvec3 w[4];
+    mr_marker_corners_world(map, m, w);
+    double uv[4][2];
+    for (int k = 0; k < 4; k++) {
+        if (!mr_project_point(cam, gt, w[k], &uv[k][0], &uv[k][1])) return false;
+        if (uv[k][0] < 2 || uv[k][1] < 2 || uv[k][0] > cam->width - 3 || uv[k][1] > cam->height - 3) return false;
+    }
+    /* facing: the tag's -z (its outward normal) points towards the camera */
+    mr_dvec3 n = mr_v3(-m->world_from_tag.m[2], -m->world_from_tag.m[6], -m->world_from_tag.m[10]);
+    mr_dvec3 c = mr_v3(m->world_from_tag.m[3], m->world_from_tag.m[7], m->world_from_tag.m[11]);
+    mr_dvec3 to_cam = mr_v3_sub(mr_v3(gt->m[3], gt->m[7], gt->m[11]), c);
+    if (mr_v3_dot(n, to_cam) <= 0) return false;
+    *edge = INFINITY;
+    for (int k = 0; k < 4; k++) *edge = fmin(*edge, hypot(uv[(k + 1) % 4][0] - uv[k][0], uv[(k + 1) % 4][1] - uv[k][1]));
+    return true;
+}
+
+/* Standard deviation of poses over each pause (a run of still ground-truth
+ * frames), combined as an RMS over pauses. */
+typedef struct jitter_acc { double sum_t2, sum_r2; int n; } jitter_acc;
+
+static void jitter_segment(const mr_dmat4 *p, int n, jitter_acc *acc) {
+    if (n < 3) return;
+    mr_dvec3 mean = mr_v3(0, 0, 0);
+    for (int i = 0; i < n; i++) mean = mr_v3_add(mean, mr_v3(p[i].m[3], p[i].m[7], p[i].m[11]));
+    mean = mr_v3_scale(mean, 1.0 / n);
+    /* rotation spread about the middle sample */
+    const mr_dmat4 *ref = &p[n / 2];
+    for (int i = 0; i < n; i++) {
+        double d = mr_v3_len(mr_v3_sub(mr_v3(p[i].m[3], p[i].m[7], p[i].m[11]), mean));
+        double a = mr_pose_angle_deg(&p[i], ref);
+        acc->sum_t2 += d * d;
+        acc->sum_r2 += a * a;
+        acc->n++;
+    }
+}
+
+static bool run_setting(const setting *s, const mr_recording *rec, const mr_image *imgs, const int *fidx, int nf,
+                        result *res, mr_error *err) {
+    memset(res, 0, sizeof *res);
+    mr_detector *det = NULL;
+    mr_aruco *ar = NULL;
+    if (s->aruco) {
+        ar = mr_aruco_create((mr_aruco_refine)s->refine, err);
+        if (!ar) return false;
+    } else {
+        mr_detector_params dp = MR_DETECTOR_DEFAULTS;
+        dp.family = rec->markers.family;
+        dp.decimate = s->decimate;
+        dp.threads = s->threads;
+        dp.refine_edges = s->refine ? 1 : -1;
+        det = mr_detector_create(&dp, err);
+        if (!det) return false;
+    }
+    mr_pose_filter *filt = mr_pose_filter_create(NULL, err);
+    double *ms = calloc((size_t)nf, sizeof *ms), *dms = calloc((size_t)nf, sizeof *dms);
+    double *te = calloc((size_t)nf, sizeof *te), *tp = calloc((size_t)nf, sizeof *tp), *re = calloc((size_t)nf, sizeof *re);
+    double *rm = calloc((size_t)nf, sizeof *rm);
+    mr_dmat4 *seg_raw = calloc((size_t)nf, sizeof *seg_raw), *seg_f = calloc((size_t)nf, sizeof *seg_f);
+    bool ok = filt && ms && dms && te && tp && re && rm && seg_raw && seg_f;
+    if (!ok) mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    int nposes = 0, nflip = 0, vis = 0, vis_hit = 0, vis56 = 0, vis56_hit = 0, seg_n = 0;
+    jitter_acc jr = {0}, jf = {0};
+    mr_pose prev = {0};
+    /* one untimed warm-up frame: thread pools, first allocations */
+    int wn;
+    if (ok && nf > 0) {
+        if (ar) mr_aruco_detect(ar, &imgs[0], &wn, NULL);
+        else mr_detector_detect(det, &imgs[0], &wn, NULL);
+    }
+    for (int i = 0; ok && i < nf; i++) {
+        const mr_rec_frame *f = &rec->frames[fidx[i]];
+        mr_camera cam = mr_camera_resized(&rec->camera, imgs[i].width, imgs[i].height);
+        double t0 = mr_time_now();
+        int n = 0;
+        const mr_detection *d = ar ? mr_aruco_detect(ar, &imgs[i], &n, err) : mr_detector_detect(det, &imgs[i], &n, err);
+        double t1 = mr_time_now();
+        if (!d) {
+            ok = false;
+            break;
+        }
+        mr_pose pose;
+        ok = mr_pose_solve(&cam, &rec->markers, d, n, prev.valid ? &prev : NULL, NULL, &pose, err);
+        double t2 = mr_time_now();
+        ms[i] = (t2 - t0) * 1e3;
+        dms[i] = (t1 - t0) * 1e3;
+        /* detection rate against the tags the ground truth sees */
+        double dist_sum = 0;
+        int dist_n = 0;
+        for (int m = 0; m < rec->markers.count; m++) {
+            double edge;
+            if (!gt_visible(&cam, &rec->markers, &rec->markers.tags[m], &f->gt, &edge) || edge < 10) continue;
+            bool hit = false;
+            for (int k = 0; k < n; k++) hit = hit || d[k].id == rec->markers.tags[m].id;
+            vis++;
+            vis_hit += hit;
+            if (edge >= 56) {
+                vis56++;
+                vis56_hit += hit;
+            }
+        }
+        mr_dmat4 filtered = pose.world_from_camera;
+        if (pose.valid) {
+            prev = pose;
+            mr_pose_filter_update(filt, f->t, &pose.world_from_camera, &filtered);
+            for (int k = 0; k < pose.tags_used && k < MR_POSE_MAX_IDS; k++) {
+                const mr_marker *mk = mr_marker_map_find(&rec->markers, pose.ids_used[k]);
+                if (!mk) continue;
+                dist_sum += mr_v3_len(mr_v3(f->gt.m[3] - mk->world_from_tag.m[3], f->gt.m[7] - mk->world_from_tag.m[7],
+                                            f->gt.m[11] - mk->world_from_tag.m[11]));
+                dist_n++;
+            }
+            double e = mr_pose_dist(&pose.world_from_camera, &f->gt), a = mr_pose_angle_deg(&pose.world_from_camera, &f->gt);
+            te[nposes] = e * 1e3;
+            tp[nposes] = dist_n ? 100.0 * e / (dist_sum / dist_n) : NAN;
+            re[nposes] = a;
+            rm[nposes] = pose.rms_px;
+            nflip += a > 5.0;
+            nposes++;
+        }
+        /* pauses: consecutive still frames with a pose */
+        bool in_pause = f->still && pose.valid;
+        if (in_pause) {
+            seg_raw[seg_n] = pose.world_from_camera;
+            seg_f[seg_n] = filtered;
+            seg_n++;
+        }
+        bool next_still = i + 1 < nf && rec->frames[fidx[i + 1]].still;
+        if (!in_pause || !next_still || i + 1 == nf) {
+            /* the filter needs a few frames to settle after the walk */
+            if (seg_n > 4) {
+                jitter_segment(seg_raw + 2, seg_n - 2, &jr);
+                jitter_segment(seg_f + 2, seg_n - 2, &jf);
+            }
+            seg_n = 0;
+        }
+    }
+    if (ok) {
+        res->frames = nf;
+        res->det_ms_med = quantile(dms, nf, 0.5);
+        res->ms_med = quantile(ms, nf, 0.5);
+        res->ms_p95 = quantile(ms, nf, 0.95);
+        res->t_err_mm = quantile(te, nposes, 0.5);
+        int np = 0;
+        for (int i = 0; i < nposes; i++)
+            if (isfinite(tp[i])) tp[np++] = tp[i];
+        res->t_err_pct = quantile(tp, np, 0.5);
+        res->r_err_deg = quantile(re, nposes, 0.5);
+        res->rms_px = quantile(rm, nposes, 0.5);
+        res->det_rate = vis ? (double)vis_hit / vis : NAN;
+        res->det_rate56 = vis56 ? (double)vis56_hit / vis56 : NAN;
+        res->pose_rate = nf ? (double)nposes / nf : 0;
+        res->flip_rate = nposes ? (double)nflip / nposes : NAN;
+        res->jit_raw_mm = jr.n ? 1e3 * sqrt(jr.sum_t2 / jr.n) : NAN;
+        res->jit_raw_deg = jr.n ? sqrt(jr.sum_r2 / jr.n) : NAN;
+        res->jit_filt_mm = jf.n ? 1e3 * sqrt(jf.sum_t2 / jf.n) : NAN;
+        res->jit_filt_deg = jf.n ? sqrt(jf.sum_r2 / jf.n) : NAN;
+    }
+    free(ms);
+    free(dms);
+    free(te);
+    free(tp);
+    free(re);
+    free(rm);
+    free(seg_raw);
+    free(seg_f);
+    mr_pose_filter_destroy(&filt);
+    mr_detector_destroy(&det);
+    mr_aruco_destroy(&ar);
+    return ok;
+}
+
+/* Error against run time: median ms per frame (x, log scale) against median
+ * translation error (y), one point per setting. */
+static bool write_svg(const char *path, const char *title, const setting *s, const result *r, int n, mr_error *err) {
+    double xmin = 1e9, xmax = 0, ymax = 0;
+    for (int i = 0; i < n; i++) {
+        if (!isfinite(r[i].ms_med) || !isfinite(r[i].t_err_mm)) continue;
+        xmin = fmin(xmin, r[i].ms_med);
+        xmax = fmax(xmax, r[i].ms_med);
+        ymax = fmax(ymax, r[i].t_err_mm);
+    }
+    if (xmax <= 0) xmin = 0.1, xmax = 1;
+    xmin = pow(10, floor(log10(fmax(xmin, 1e-3))));
+    xmax = pow(10, ceil(log10(fmax(xmax, xmin * 10))));
+    ymax = ymax > 0 ? ymax * 1.15 : 1;
+    const int W = 900, H = 560, L = 80, R = 260, T = 50, B = 60;
+    size_t cap = 16384 + (size_t)n * 512;
+    char *o = malloc(cap);
+    if (!o) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    int len = snprintf(o, cap,
+                       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" font-family=\"sans-serif\" font-size=\"12\">\n"
+                       "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n<text x=\"%d\" y=\"24\" font-size=\"15\">%s</text>\n"
+                       "<line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"black\"/><line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"black\"/>\n"
+                       "<text x=\"%d\" y=\"%d\">median ms per frame (detection + pose, log scale)</text>\n"
+                       "<text x=\"16\" y=\"%d\" transform=\"rotate(-90 16 %d)\">median translation error (mm)</text>\n",
+                       W, H, L, title, L, H - B, W - R, H - B, L, T, L, H - B, L + 150, H - 20, (H) / 2 + 60, (H) / 2 + 60);
+    for (double x = xmin; x <= xmax * 1.001; x *= 10) {
+        double px = L + (W - R - L) * log10(x / xmin) / log10(xmax / xmin);
+        len += snprintf(o + len, cap - (size_t)len, "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#ccc\"/><text x=\"%.1f\" y=\"%d\">%g</text>\n",
+                        px, T, px, H - B, px - 8, H - B + 16, x);
+    }
+    for (int k = 0; k <= 4; k++) {
+        double y = ymax * k / 4, py = H - B - (H - B - T) * k / 4.0;
+        len += snprintf(o + len, cap - (size_t)len, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#ccc\"/><text x=\"%d\" y=\"%.1f\">%.1f</text>\n",
+                        L, py, W - R, py, L - 40, py + 4, y);
+    }
+    for (int i = 0; i < n; i++) {
+        if (!isfinite(r[i].ms_med) || !isfinite(r[i].t_err_mm)) continue;
+        double px = L + (W - R - L) * log10(fmax(r[i].ms_med, xmin) / xmin) / log10(xmax / xmin);
+        double py = H - B - (H - B - T) * r[i].t_err_mm / ymax;
+        const char *col = s[i].aruco ? "#e08a2c" : s[i].threads > 1 ? "#2c8a3b" : "#3b6fb6";
+        len += snprintf(o + len, cap - (size_t)len, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"><title>%s: %.2f ms, %.1f mm</title></circle>\n",
+                        px, py, col, s[i].name, r[i].ms_med, r[i].t_err_mm);
+        len += snprintf(o + len, cap - (size_t)len, "<text x=\"%d\" y=\"%d\" fill=\"%s\" font-size=\"10\">%s: %.2f ms, %.1f mm, det %.0f%%</text>\n",
+                        W - R + 10, T + 12 * i, col, s[i].name, r[i].ms_med, r[i].t_err_mm, 100 * r[i].det_rate);
+    }
+    len += snprintf(o + len, cap - (size_t)len,
+                    "<text x=\"%d\" y=\"%d\" fill=\"#3b6fb6\">apriltag, 1 thread</text><text x=\"%d\" y=\"%d\" fill=\"#2c8a3b\">apriltag, 2 threads</text>"
+                    "<text x=\"%d\" y=\"%d\" fill=\"#e08a2c\">OpenCV aruco APRILTAG_36h11</text>\n</svg>\n",
+                    L + 10, T + 14, L + 160, T + 14, L + 310, T + 14);
+    bool ok = mr_file_write_atomic(path, o, (size_t)len, err);
+    free(o);
+    return ok;
+}
+
+int bench_tracking(int argc, char **argv) {
+    static const char *cmd = "bench tracking";
+    app_opt opts[] = {
+        {"recording", "DIR", "recording with groundtruth.jsonl (default recordings/demo)", NULL},
+        {"out", "DIR", "write bench_tracking.csv and .svg there (default bench-out)", NULL},
+        {"frames", "N", "use at most N frames (default all)", NULL},
+        {"quick", NULL, "a few settings only", NULL},
+        {NULL, NULL, NULL, NULL},
+    };
+    bool help;
+    if (!app_parse(argc, argv, 3, opts, NULL, 0, NULL,
+                   "usage: mrcheck bench tracking [--recording DIR] [--out DIR]\n"
+                   "Per detector setting (decimation 1 1.5 2 3 4 x threads 1 2 x edge refinement) and OpenCV aruco\n"
+                   "(DICT_APRILTAG_36h11, 4 corner refinements): ms per frame against pose error, detection rate,\n"
+                   "flip rate and jitter during the recording's pauses.",
+                   &help))
+        return 2;
+    if (help) return 0;
+    const char *dir = app_get(opts, "recording") ? app_get(opts, "recording") : "recordings/demo";
+    const char *out = app_get(opts, "out") ? app_get(opts, "out") : "bench-out";
+    long max_frames = 1L << 30;
+    if (app_get(opts, "frames") && !app_int("frames", app_get(opts, "frames"), 1, 1L << 30, &max_frames)) return 2;
+    mr_error err = {0};
+    mr_recording *rec = mr_recording_open(dir, &err);
+    if (!rec) return app_error(cmd, &err);
+    if (!rec->has_markers) {
+        mr_recording_close(&rec);
+        return app_errorf(cmd, "%s: the recording has no marker map", dir);
+    }
+    /* Decode every frame with ground truth once, up front (not timed). */
+    int nf = 0;
+    mr_image *imgs = calloc((size_t)rec->frame_count + 1, sizeof *imgs);
+    int *fidx = calloc((size_t)rec->frame_count + 1, sizeof *fidx);
+    bool ok = imgs && fidx;
+    for (int i = 0; ok && i < rec->frame_count && nf < max_frames; i++) {
+        if (!rec->frames[i].has_gt) continue;
+        mr_error fe = {0};
+        if (!mr_recording_load_image(rec, i, true, &imgs[nf], &fe)) {
+            fprintf(stderr, "mrcheck: bench tracking: warning: %s\n", fe.msg);
+            continue;
+        }
+        fidx[nf++] = i;
+    }
+    if (ok && nf == 0) ok = mr_fail(&err, MR_ERR_INVALID, "%s: no frames with ground truth", dir);
+    setting set[64];
+    int ns = 0;
+    static const double decs[] = {1, 1.5, 2, 3, 4};
+    for (int di = 0; di < 5; di++)
+        for (int th = 1; th <= 2; th++)
+            for (int rf = 0; rf <= 1; rf++) {
+                if (app_flag(opts, "quick") && (th == 2 || di % 2)) continue;
+                setting *s = &set[ns++];
+                memset(s, 0, sizeof *s);
+                s->decimate = decs[di];
+                s->threads = th;
+                s->refine = rf;
+                snprintf(s->name, sizeof s->name, "apriltag d%g t%d r%d", decs[di], th, rf);
+            }
+    for (int m = 0; m < 4; m++) {
+        setting *s = &set[ns++];
+        memset(s, 0, sizeof *s);
+        s->aruco = true;
+        s->refine = m;
+        s->threads = 0;
+        snprintf(s->name, sizeof s->name, "aruco %s", mr_aruco_refine_name((mr_aruco_refine)m));
+    }
+    result res[64];
+    char *csv = malloc(65536);
+    int len = 0;
+    if (!csv) ok = mr_fail(&err, MR_ERR_NOMEM, "out of memory");
+    if (ok) {
+        len = snprintf(csv, 65536,
+                       "detector,decimate,threads,refine,frames,ms_median,ms_p95,detect_ms_median,t_err_mm_median,"
+                       "t_err_pct_median,r_err_deg_median,reproj_rms_px_median,detection_rate,detection_rate_56px,"
+                       "pose_rate,flip_rate,jitter_raw_mm,jitter_raw_deg,jitter_filtered_mm,jitter_filtered_deg\n");
+        printf("bench tracking: %s, %d frames %dx%d, %s\n", dir, nf, imgs[0].width, imgs[0].height,
+               "ms = detection + pose per frame (median / p95)");
+        printf("%-22s %7s %7s %8s %7s %7s %6s %6s %6s %6s %6s %13s %13s\n", "setting", "ms med", "ms p95", "t err mm",
+               "t err %", "r err", "rms px", "det", "det56", "pose", "flip", "jitter raw", "jitter filt");
+    }
+    for (int i = 0; ok && i < ns; i++) {
+        ok = run_setting(&set[i], rec, imgs, fidx, nf, &res[i], &err);
+        if (!ok) break;
+        const result *r = &res[i];
+        printf("%-22s %7.2f %7.2f %8.1f %7.2f %7.3f %6.3f %5.1f%% %5.1f%% %5.1f%% %5.1f%% %5.2fmm/%.3f° %5.2fmm/%.3f°\n",
+               set[i].name, r->ms_med, r->ms_p95, r->t_err_mm, r->t_err_pct, r->r_err_deg, r->rms_px, 100 * r->det_rate,
+               100 * r->det_rate56, 100 * r->pose_rate, 100 * r->flip_rate, r->jit_raw_mm, r->jit_raw_deg, r->jit_filt_mm,
+               r->jit_filt_deg);
+        fflush(stdout);
+        len += snprintf(csv + len, 65536 - (size_t)len,
+                        "%s,%g,%d,%s,%d,%.4f,%.4f,%.4f,%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n",
+                        set[i].aruco ? "opencv-aruco" : "apriltag", set[i].aruco ? 1.0 : set[i].decimate, set[i].threads,
+                        set[i].aruco ? mr_aruco_refine_name((mr_aruco_refine)set[i].refine) : set[i].refine ? "1" : "0",
+                        r->frames, r->ms_med, r->ms_p95, r->det_ms_med, r->t_err_mm, r->t_err_pct, r->r_err_deg, r->rms_px,
+                        r->det_rate, r->det_rate56, r->pose_rate, r->flip_rate, r->jit_raw_mm, r->jit_raw_deg,
+                        r->jit_filt_mm, r->jit_filt_deg);
+    }
+    char path[4096];
+    if (ok) ok = mr_mkdirs(out, &err);
+    if (ok) {
+        mr_path_join(out, "bench_tracking.csv", path, sizeof path);
+        ok = mr_file_write_atomic(path, csv, (size_t)len, &err);
+    }
+    if (ok) {
+        char title[256];
+        snprintf(title, sizeof title, "mrcheck bench tracking: %d frames %dx%d — error against run time", nf, imgs[0].width,
+                 imgs[0].height);
+        mr_path_join(out, "bench_tracking.svg", path, sizeof path);
+        ok = write_svg(path, title, set, res, ns, &err);
+    }
+    if (ok) printf("wrote %s/bench_tracking.csv and bench_tracking.svg\n", out);
+    free(csv);
+    for (int i = 0; imgs && i < nf; i++) mr_image_free(&imgs[i]);
+    free(imgs);
+    free(fidx);
+    mr_recording_close(&rec);
+    return ok ? 0 : app_error(cmd, &err);
+}
