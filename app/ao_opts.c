@@ -23,6 +23,11 @@ bool app_ao_parse(const char *cmd, const app_opt *opts, mr_ao_params *ao, bool *
         else return app_errorf(cmd, "--ao-radius-mode %s: expected screen or view", v), false;
     }
     if ((v = app_get(opts, "ao-radius"))) {
+        /* In screen mode the radius is a fraction of the image, not a length:
+         * silently ignoring a length would hide a mistake. */
+        if (ao->radius_mode == MR_AO_RADIUS_SCREEN && app_get(opts, "ao-radius-mode"))
+            return app_errorf(cmd, "--ao-radius is a length for --ao-radius-mode view; screen mode takes --ao-screen-radius"),
+                   false;
         if (!app_double("ao-radius", v, 1e-30, 1e30, &d)) return false;
         ao->radius = d;
         /* A radius in scene units asks for the constant one unless the mode is named. */

@@ -62,7 +62,7 @@ void app_gfx_close(app_gfx *g);
     {"ao-radii", "K", "multi-radius: K radii R, R/2, ..; the darkest wins (default 1)", NULL},                            \
     {"ao-c", "C", "scheer attenuation c in [0,1e7] (default 1)", NULL},                                                    \
     {"ao-bias", "B", "bias (cosine / depth fraction of the radius, default 0.05)", NULL},                                  \
-    {"ao-strength", "S", "AO = 1 - S * occlusion (default 1)", NULL},                                                      \
+    {"ao-strength", "S", "AO = 1 - S * occlusion (default per method, e.g. scheer 3)", NULL},                                                      \
     {"ao-blur", "PX", "bilateral blur half-width in AO pixels, 0 = off (default 4)", NULL},                              \
     {"ao-half", NULL, "AO at half resolution with a joint bilateral upsample", NULL},                                    \
     {"ao-positions", NULL, "AO from a view-space positions texture", NULL},                                              \

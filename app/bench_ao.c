@@ -262,8 +262,8 @@ int bench_ao(int argc, char **argv) {
         {"hbao", MR_AO_HBAO, MR_AO_RADIUS_VIEW, {0}},       {"alchemy", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, {0}},
     };
     const int nc = (int)(sizeof cs / sizeof cs[0]);
-    const double rscale[] = {0.5, 1, 2}, strengths[] = {0.5, 1, 1.5, 2, 3, 4, 6}, biases[] = {0.02, 0.1};
-    const int nr = 3, ns = quick ? 2 : 7, nb = quick ? 1 : 2;
+    const double rscale[] = {0.5, 1, 2, 0.25}, strengths[] = {0.5, 1, 1.5, 2, 3, 4, 6, 8, 12}, biases[] = {0.02, 0.1};
+    const int nr = quick ? 3 : 4, ns = quick ? 2 : 9, nb = quick ? 1 : 2;
     const double qs[] = {1, 3};
     mr_image ao = {0};
     mr_path_join(out_dir, "bench_ao_tuning.csv", path, sizeof path);
@@ -313,6 +313,7 @@ int bench_ao(int argc, char **argv) {
     memset(agg_ms, 0, sizeof agg_ms); memset(agg_rf, 0, sizeof agg_rf); memset(agg_rs, 0, sizeof agg_rs);
     memset(agg_sf, 0, sizeof agg_sf); memset(agg_ss, 0, sizeof agg_ss); memset(agg_bf, 0, sizeof agg_bf);
     memset(agg_bs, 0, sizeof agg_bs); memset(agg_mf, 0, sizeof agg_mf);
+    static double pv_rf[MAX_VIEWS + 1][MAXC + 1], pv_rs[MAX_VIEWS + 1][MAXC + 1]; /* per view, reported samples, full, mask off */
     double none_rf = 0, none_rs = 0, none_sf = 0, none_ss = 0, none_bf = 0, none_bs = 0;
     mr_image *montage[MAX_VIEWS * 10];
     bool owned[MAX_VIEWS * 10] = {false}; /* montage tiles this function allocated */
@@ -331,6 +332,8 @@ int bench_ao(int argc, char **argv) {
         if (!ok) break;
         fprintf(csv, "\"%s\",none,,,,,,,0,full,off,%d,%d,0,0,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,-1\n", vd[v].name, w, h, mf.rmse,
                 mf.ssim, mf.bias, msr.rmse, msr.ssim, msr.bias);
+        pv_rf[v][0] = mf.rmse;
+        pv_rs[v][0] = msr.rmse;
         none_rf += mf.rmse / nv; none_rs += msr.rmse / nv; none_sf += mf.ssim / nv; none_ss += msr.ssim / nv;
         none_bf += mf.bias / nv; none_bs += msr.bias / nv;
         montage[nmont++] = &vd[v].gt_fixed;
@@ -360,6 +363,10 @@ int bench_ao(int argc, char **argv) {
                         agg_bf[c][si][res][mk] += mf.bias / nv;
                         agg_bs[c][si][res][mk] += msr.bias / nv;
                         agg_mf[c][si][res][mk] += masked / nv;
+                        if (si == (quick ? 0 : 1) && res == 0 && mk == 0) {
+                            pv_rf[v][c + 1] = mf.rmse;
+                            pv_rs[v][c + 1] = msr.rmse;
+                        }
                         if (si == (quick ? 0 : 1) && res == 0 && mk == 0 && nmont < MAX_VIEWS * 10) {
                             mr_image *keep = malloc(sizeof *keep);
                             if (keep) {
@@ -480,6 +487,17 @@ int bench_ao(int argc, char **argv) {
                                             agg_sf[c][s16][res][mk], agg_bf[c][s16][res][mk], agg_rs[c][s16][res][mk],
                                             agg_ss[c][s16][res][mk], agg_bs[c][s16][res][mk], masked);
                 }
+        len += (size_t)snprintf(md + len, sizeof md - len, "\nRMSE per view (fixed R / depth-scaled R), %d samples, full resolution, mask off:\n\n| view | none |",
+                                samples[s16]);
+        for (int c = 0; c < nc; c++) len += (size_t)snprintf(md + len, sizeof md - len, " %s |", cs[c].label);
+        len += (size_t)snprintf(md + len, sizeof md - len, "\n|---|---|");
+        for (int c = 0; c < nc; c++) len += (size_t)snprintf(md + len, sizeof md - len, "---|");
+        for (int v = 1; v <= nv; v++) {
+            len += (size_t)snprintf(md + len, sizeof md - len, "\n| %s |", vd[v].name);
+            for (int c = 0; c <= nc; c++)
+                len += (size_t)snprintf(md + len, sizeof md - len, " %.4f / %.4f |", pv_rf[v][c], pv_rs[v][c]);
+        }
+        len += (size_t)snprintf(md + len, sizeof md - len, "\n");
         len += (size_t)snprintf(md + len, sizeof md - len, "\nAO passes against triangle count (scheer, 16 samples, %dx%d):\n\n"
                                                            "| triangles | AO GPU ms | G-buffer GPU ms |\n|---|---|---|\n", w, h);
         for (int i = 0; i < ntri; i++)

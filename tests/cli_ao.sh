@@ -51,7 +51,7 @@ fi
 # Bad values: one line on stderr, non-zero exit, no output.
 for args in "--ao ssao" "--ao scheer --ao-samples 0" "--ao scheer --ao-samples 65" "--ao scheer --ao-radius-mode far" \
             "--ao scheer --ao-mask maybe" "--ao scheer --ao-kernel sobol" "--ao scheer --ao-c -1" "--ao scheer --ao-radius 0" \
-            "--ao scheer --ao-rmin 0.9 --ao-rmax 0.5"; do
+            "--ao scheer --ao-rmin 0.9 --ao-rmax 0.5" "--ao scheer --ao-radius-mode screen --ao-radius 1"; do
   rm -f "$tmp/bad.png"
   # shellcheck disable=SC2086
   if r --out "$tmp/bad.png" $args 2>"$tmp/bad.err"; then

@@ -348,9 +348,83 @@ static void test_groundtruth_pixels(void) {
             double corner = floor_band(&v, &res, &ao, 0, 0.12, 1, o, &nc), open = floor_band(&v, &res, &ao, 1.5, 2.5, 1, o, &no);
             CHECK(corner < 0.7 && open > 0.97);
         }
+        /* Screen mode: R = F z height / fy per pixel, the same closed form. */
+        mr_image aos = {0};
+        gp.radius_mode = MR_AO_RADIUS_SCREEN;
+        gp.screen_radius = 0.1;
+        CHECK_MSG(gt && mr_eval_ao_groundtruth(gt, &v, &res.depth, &res.normal, &gp, &aos, &err), "%s", err.msg);
+        if (aos.data) {
+            mr_camera c = mr_camera_resized(&v.camera, 96, 72);
+            double se = 0;
+            int n = 0;
+            const float *a = aos.data, *d = res.depth.data;
+            for (int y = 0; y < 72; y++)
+                for (int x = 0; x < 96; x++) {
+                    size_t i = (size_t)y * 96 + x;
+                    if (!(d[i] > 0)) continue;
+                    mr_dvec3 p = pixel_world(&v, &res.depth, x, y);
+                    double dist = 2.9 - p.z, R = gp.screen_radius * d[i] * c.height / c.fy;
+                    if (fabs(p.y) > 0.01 || dist < 0 || dist > 1.0 || p.x < -0.5 || p.x > 5) continue;
+                    double e = a[i] - mr_eval_ao_wall_analytic(dist, R);
+                    se += e * e;
+                    n++;
+                }
+            CHECK_MSG(n > 30 && sqrt(se / n) < 0.03, "screen-mode ground truth vs closed form: RMSE %.4f over %d pixels",
+                      n ? sqrt(se / n) : 0, n);
+        }
+        /* scheer is closer to the reference of its radius mode than no AO. */
+        for (int mode = 0; mode < 2 && ao.data && aos.data; mode++) {
+            mr_ao_params sp = MR_AO_DEFAULTS;
+            sp.method = MR_AO_SCHEER;
+            sp.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
+            sp.radius = 0.6;
+            sp.screen_radius = 0.1;
+            mr_frame_result rs;
+            if (!render_ao(s, &v, &sp, &rs)) continue;
+            mr_image ones = {0};
+            mr_image_alloc(&ones, 96, 72, 1, MR_PIX_F32, NULL);
+            for (int i = 0; i < 96 * 72; i++) ((float *)ones.data)[i] = 1.0f;
+            mr_image_metrics ms, m1;
+            const mr_image *ref = mode ? &ao : &aos;
+            CHECK(mr_image_compare(&rs.ao, ref, &res.depth, &ms, NULL) && mr_image_compare(&ones, ref, &res.depth, &m1, NULL));
+            CHECK_MSG(ms.rmse < 0.8 * m1.rmse && ms.ssim > m1.ssim, "scheer %s: RMSE %.4f SSIM %.3f vs no AO %.4f %.3f",
+                      mode ? "view" : "screen", ms.rmse, ms.ssim, m1.rmse, m1.ssim);
+            mr_image_free(&ones);
+            mr_frame_result_free(&rs);
+        }
+        mr_image_free(&aos);
         mr_image_free(&ao);
         mr_eval_gt_destroy(&gt);
         mr_frame_result_free(&res);
+    }
+    mr_scene_destroy(&s);
+}
+
+static double rmse(const mr_image *a, const mr_image *b);
+
+/* Half resolution with the joint bilateral upsample stays close to full
+ * resolution, and does not smear AO across the cube's silhouette. */
+static void test_half_res(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    mr_view v = corner_view(1, o, 128, 96);
+    mr_ao_params ao = MR_AO_DEFAULTS;
+    ao.method = MR_AO_SCHEER;
+    mr_frame_result full, half;
+    if (render_ao(s, &v, &ao, &full)) {
+        ao.half_res = true;
+        if (render_ao(s, &v, &ao, &half)) {
+            double e = rmse(&half.ao, &full.ao);
+            if (getenv("MR_TEST_VERBOSE")) printf("half vs full resolution: RMSE %.4f\n", e);
+            CHECK_MSG(e < 0.05, "half vs full resolution: RMSE %.4f", e);
+            /* Sky stays 1 next to geometry (no bleeding from the upsample). */
+            const float *d = full.depth.data, *a = half.ao.data;
+            int bad = 0;
+            for (int i = 0; i < 128 * 96; i++) bad += d[i] == 0 && a[i] != 1.0f;
+            CHECK(bad == 0);
+            mr_frame_result_free(&half);
+        }
+        mr_frame_result_free(&full);
     }
     mr_scene_destroy(&s);
 }
@@ -380,6 +454,8 @@ static void test_scale_invariance(void) {
                     res.ao.data = NULL;
                 } else {
                     double e = rmse(&res.ao, &ref);
+                    if (getenv("MR_TEST_VERBOSE"))
+                        printf("scheer%s scale %g offset %g: RMSE %.5f\n", half ? " half-res" : "", scales[i], offs[i].x, e);
                     CHECK_MSG(e < 0.01, "scheer%s at scale %g offset %g: RMSE %.5f vs scale 1", half ? " half-res" : "",
                               scales[i], offs[i].x, e);
                 }
@@ -544,6 +620,7 @@ int main(void) {
         test_corner_all_methods();
         test_groundtruth_pixels();
         test_scale_invariance();
+        test_half_res();
         test_finite();
         test_pass_list();
         test_mask();

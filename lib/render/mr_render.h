@@ -105,7 +105,10 @@ typedef struct mr_ao_params {
                                      [0,1e7]; default 1 */
     float bias;                   /* per-method bias (cosine / depth, as a fraction of
                                      the radius); default 0.05 */
-    float strength;               /* AO = 1 - strength * occlusion; <= 0 means 1 */
+    float strength;               /* AO = 1 - strength * occlusion; <= 0: the method's
+                                     default (scheer 3, crytek 1, filion 1, hbao 1.5,
+                                     alchemy 2: tuned once by `bench ao` on the demo
+                                     hall's tuning view at the default radius) */
     int blur_radius;              /* bilateral blur half-width in AO pixels; 0 = off;
                                      default 4 */
     bool half_res;                /* AO at half resolution + joint bilateral upsample */
@@ -119,7 +122,7 @@ typedef struct mr_ao_params {
                                      computing one (e.g. ray-traced ground truth); NULL */
 } mr_ao_params;
 #define MR_AO_DEFAULTS {MR_AO_NONE, MR_AO_RADIUS_SCREEN, 0.0, 0.05, 16, MR_AO_KERNEL_UNIFORM, 0.8f, 1.0f, 1, \
-                        1.0f, 0.05f, 1.0f, 4, false, false, MR_AO_MASK_OFF, false, false, NULL}
+                        1.0f, 0.05f, 0.0f, 4, false, false, MR_AO_MASK_OFF, false, false, NULL}
 
 /* Names used on the command line ("none", "scheer", ...); NULL if out of range. */
 const char *mr_ao_method_name(mr_ao_method m);
