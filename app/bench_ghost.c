@@ -7,6 +7,7 @@
  * pass/fail, never timed in tests. */
 #include "app.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -63,6 +64,7 @@ static bool write_svg(const char *path, const char *title, const ghost_row *rows
     }
     for (int i = 0; i < n; i++) {
         const ghost_row *r = &rows[i];
+        if (isnan(r->st.legibility)) continue; /* no important pixel: nothing to plot */
         double x = L + PW * r->ghost_ms / xmax, y = T + PH - PH * r->st.legibility;
         bool conflict = strcmp(r->scene, "conflict") == 0;
         const char *c = colours[r->mode_index];

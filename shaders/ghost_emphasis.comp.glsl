@@ -25,8 +25,53 @@ layout(binding = 1, rgba32f) uniform writeonly image2D u_oa;
 layout(binding = 2, rgba32f) uniform writeonly image2D u_ga;
 layout(std430, binding = 1) buffer Votes { int votes[]; };
 
+// Votes are pre-summed per workgroup: each invocation posts (key, vote) in
+// shared memory and the first invocation adds runs of equal keys, so a large
+// object costs one global atomic per workgroup instead of one per pixel.
+shared uint s_key[64];
+shared int s_vote[64];
+
+void vote(uint key, int v) {
+    uint i = gl_LocalInvocationIndex;
+    s_key[i] = key;
+    s_vote[i] = v;
+    barrier();
+    if (i == 0u) {
+        uint k = s_key[0];
+        int acc = 0;
+        for (uint j = 0u; j < 64u; j++) {
+            if (s_key[j] != k) {
+                if (acc != 0) atomicAdd(votes[k], acc);
+                k = s_key[j];
+                acc = 0;
+            }
+            acc += s_vote[j];
+        }
+        if (acc != 0) atomicAdd(votes[k], acc);
+    }
+}
+
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy), n = textureSize(u_mask, 0);
+    if (u_stage == 0) {
+        // Every invocation reaches the barrier in vote(), inside or not.
+        uint key = 0u;
+        int v = 0;
+        if (p.x < n.x && p.y < n.y) {
+            vec4 m = texelFetch(u_mask, p, 0);
+            float gkc = texelFetch(u_gkc, p, 0).r;
+            if (m.y > 0.5 && gkc > 1e-4) {
+                key = texelFetch(u_key, p, 0).x;
+                if (key == 0u) key = u_key_base + texelFetch(u_label, p, 0).x;
+                float lo = rgb_to_lab(texelFetch(u_o, p, 0).rgb).x;
+                float ld = rgb_to_lab(texelFetch(u_dgk, p, 0).rgb).x;
+                float d = sign(50.0 + sign(50.0 - ld) * 50.0 - lo);
+                v = int(round(clamp(gkc, 0.0, 4.0) * d * 1024.0));
+            }
+        }
+        vote(key, v);
+        return;
+    }
     if (p.x >= n.x || p.y >= n.y) return;
     vec4 m = texelFetch(u_mask, p, 0);
     float gkc = texelFetch(u_gkc, p, 0).r;
@@ -38,10 +83,6 @@ void main() {
     float ld = rgb_to_lab(texelFetch(u_dgk, p, 0).rgb).x;
     float lmax = 50.0 + sign(50.0 - ld) * 50.0;
     float dir = sign(lmax - lab.x);
-    if (u_stage == 0) {
-        if (act) atomicAdd(votes[key], int(round(clamp(gkc, 0.0, 4.0) * dir * 1024.0)));
-        return;
-    }
     vec4 g0 = texelFetch(u_g0, p, 0);
     vec3 ga = g0.rgb, oa = o;
     if (act) {

@@ -32,9 +32,25 @@ layout(std430, binding = 0) buffer Stats { uint im_sum; uint im_count; };
 
 const float PI = 3.14159265;
 
+// Sums for mean(IM) are reduced per workgroup in shared memory first, so
+// the global counters see one atomic per workgroup, not one per pixel.
+shared uint s_sum, s_count;
+void classify(ivec2 p, ivec2 n);
+
 void main() {
+    if (gl_LocalInvocationIndex == 0u) { s_sum = 0u; s_count = 0u; }
+    barrier();
     ivec2 p = ivec2(gl_GlobalInvocationID.xy), n = imageSize(u_mask);
-    if (p.x >= n.x || p.y >= n.y) return;
+    bool inside = p.x < n.x && p.y < n.y;
+    if (inside) classify(p, n);
+    barrier();
+    if (gl_LocalInvocationIndex == 0u && s_count > 0u) {
+        atomicAdd(im_sum, s_sum);
+        atomicAdd(im_count, s_count);
+    }
+}
+
+void classify(ivec2 p, ivec2 n) {
     float d = texelFetch(u_depth, p, 0).r, hd = texelFetch(u_hdepth, p, 0).r;
     bool dcov = hd > 0.0;
     bool model = d > 0.0 && d > hd;  // reversed Z: larger is nearer
@@ -73,7 +89,7 @@ void main() {
     imageStore(u_mask, p, vec4(im, region ? 1.0 : 0.0, sil && region ? 1.0 : 0.0, dcov ? 1.0 : 0.0));
     imageStore(u_key, p, uvec4(model ? texelFetch(u_ids, p, 0).x : 0u));
     if (region) {
-        atomicAdd(im_sum, uint(im * 256.0 + 0.5));
-        atomicAdd(im_count, 1u);
+        atomicAdd(s_sum, uint(im * 256.0 + 0.5));
+        atomicAdd(s_count, 1u);
     }
 }

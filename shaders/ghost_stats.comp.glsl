@@ -13,19 +13,36 @@ layout(binding = 2) uniform sampler2D u_o;
 layout(binding = 3) uniform sampler2D u_oa;
 layout(binding = 4) uniform sampler2D u_c;     // C in .r
 layout(std430, binding = 2) buffer Sums { uint region; uint important; uint legible; uint im_sum; uint dl_sum; uint c_sum; };
-void main() {
-    ivec2 p = ivec2(gl_GlobalInvocationID.xy), n = textureSize(u_mask, 0);
-    if (p.x >= n.x || p.y >= n.y) return;
+// Per-workgroup sums in shared memory, then one global atomic each.
+shared uint s_sums[6];
+
+void count(ivec2 p, ivec2 n) {
     vec4 m = texelFetch(u_mask, p, 0);
     if (m.y < 0.5) return;
-    atomicAdd(region, 1u);
-    atomicAdd(im_sum, uint(m.x * 256.0 + 0.5));
-    atomicAdd(c_sum, uint(clamp(texelFetch(u_c, p, 0).r, 0.0, 4.0) * 256.0 + 0.5));
+    atomicAdd(s_sums[0], 1u);
+    atomicAdd(s_sums[3], uint(m.x * 256.0 + 0.5));
+    atomicAdd(s_sums[5], uint(clamp(texelFetch(u_c, p, 0).r, 0.0, 4.0) * 256.0 + 0.5));
     float dl = abs(rgb_to_lab(texelFetch(u_oa, p, 0).rgb).x - rgb_to_lab(texelFetch(u_o, p, 0).rgb).x);
-    atomicAdd(dl_sum, uint(min(dl, 100.0) * 16.0 + 0.5)); // 1/16 L*: no overflow at 4K
+    atomicAdd(s_sums[4], uint(min(dl, 100.0) * 16.0 + 0.5)); // 1/16 L*: no overflow at 4K
     if (m.x > 0.3) {
-        atomicAdd(important, 1u);
+        atomicAdd(s_sums[1], 1u);
         float want = max(u_tc_min, u_gamma * m.x) + (m.z > 0.5 ? u_tc_sil : 0.0);
-        if (texelFetch(u_sal, p, 0).r >= want) atomicAdd(legible, 1u);
+        if (texelFetch(u_sal, p, 0).r >= want) atomicAdd(s_sums[2], 1u);
+    }
+}
+
+void main() {
+    if (gl_LocalInvocationIndex < 6u) s_sums[gl_LocalInvocationIndex] = 0u;
+    barrier();
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy), n = textureSize(u_mask, 0);
+    if (p.x < n.x && p.y < n.y) count(p, n);
+    barrier();
+    if (gl_LocalInvocationIndex == 0u) {
+        atomicAdd(region, s_sums[0]);
+        atomicAdd(important, s_sums[1]);
+        atomicAdd(legible, s_sums[2]);
+        atomicAdd(im_sum, s_sums[3]);
+        atomicAdd(dl_sum, s_sums[4]);
+        atomicAdd(c_sum, s_sums[5]);
     }
 }

@@ -88,6 +88,44 @@ static void test_curvature(void) {
     CHECK(isfinite(k[2]) && isfinite(k[3]));
 }
 
+/* The demo's conflict case: the hidden pipes take the partition's colour;
+ * the default hall keeps its coloured pipes and the same geometry. */
+static const mr_material *node_material(const mr_scene *s, const char *name) {
+    for (int32_t i = 0; i < s->node_count; i++)
+        if (strcmp(s->nodes[i].name, name) == 0 && s->nodes[i].mesh_first >= 0) {
+            int32_t m = s->meshes[s->nodes[i].mesh_first].material;
+            return m >= 0 ? &s->materials[m] : NULL;
+        }
+    return NULL;
+}
+
+static void test_demo_conflict(void) {
+    mr_demo_params dp = MR_DEMO_DEFAULTS;
+    mr_demo_hall plain, conflict;
+    mr_error err = {0};
+    CHECK_MSG(mr_demo_build(&dp, &plain, &err), "%s", err.msg);
+    dp.pipes_like_partition = true;
+    CHECK_MSG(mr_demo_build(&dp, &conflict, &err), "%s", err.msg);
+    if (plain.planned && conflict.planned) {
+        const mr_material *wall = node_material(conflict.planned, "Wall_Partition");
+        const mr_material *wall0 = node_material(plain.planned, "Wall_Partition");
+        CHECK(conflict.planned->node_count == plain.planned->node_count);
+        CHECK(cJSON_GetArraySize(conflict.discrepancies) == cJSON_GetArraySize(plain.discrepancies));
+        for (int k = 0; k < 4; k++) {
+            char name[16];
+            snprintf(name, sizeof name, "Pipe_%d", k);
+            const mr_material *pc = node_material(conflict.planned, name), *pp = node_material(plain.planned, name);
+            CHECK(pc && pp && wall && wall0);
+            if (pc && pp && wall && wall0) {
+                CHECK(memcmp(pc->base_color, wall->base_color, sizeof pc->base_color) == 0);
+                CHECK(memcmp(pp->base_color, wall0->base_color, sizeof pp->base_color) != 0);
+            }
+        }
+    }
+    mr_demo_free(&plain);
+    mr_demo_free(&conflict);
+}
+
 /* ------------------------------------------------------------- helpers */
 
 static mr_image img(int w, int h, int ch, float v) {
@@ -432,15 +470,29 @@ static void add_node(mr_scene *s, const char *name, mr_dmat4 world, int32_t mesh
 
 /* A wall at z = 5 in front of the camera, a hidden bar behind it at z = 6,
  * and (optionally) a hidden box far off to the side, out of view. */
-static mr_scene *wall_scene(bool bar_in_view) {
+static mr_scene *wall_scene_scaled(bool bar_in_view, double k, bool round_occluder) {
     mr_scene *s = mr_scene_create();
     mr_material a = {"wall", {0.5f, 0.5f, 0.45f, 1}, -1}, b = {"pipe", {0.7f, 0.05f, 0.05f, 1}, -1};
     int32_t ma = mr_scene_add_material(s, &a), mb = mr_scene_add_material(s, &b);
-    add_node(s, "Wall", mr_m4_translate(0, 0, 5), add_box(s, 6, 4, 0.1, ma), MR_LAYER_VISIBLE);
-    add_node(s, "Pipe", mr_m4_translate(bar_in_view ? 0 : 500, 0, 6), add_box(s, 3, 0.4, 0.4, mb), MR_LAYER_HIDDEN);
+    if (round_occluder) {
+        /* A smooth sphere: all its importance comes from mesh curvature. */
+        mr_mesh m;
+        sphere(&m, 1.6 * k, 48, 24);
+        m.material = ma;
+        mr_error err = {0};
+        int32_t id = mr_scene_add_mesh(s, &m, &err);
+        CHECK_MSG(id >= 0, "%s", err.msg);
+        add_node(s, "Ball", mr_m4_translate(0, 0, 5 * k), id, MR_LAYER_VISIBLE);
+    } else {
+        add_node(s, "Wall", mr_m4_translate(0, 0, 5 * k), add_box(s, 6 * k, 4 * k, 0.1 * k, ma), MR_LAYER_VISIBLE);
+    }
+    add_node(s, "Pipe", mr_m4_translate(bar_in_view ? 0 : 500 * k, 0, 6 * k), add_box(s, 3 * k, 0.4 * k, 0.4 * k, mb),
+             MR_LAYER_HIDDEN);
     mr_scene_update_bounds(s);
     return s;
 }
+
+static mr_scene *wall_scene(bool bar_in_view) { return wall_scene_scaled(bar_in_view, 1.0, false); }
 
 static bool render(const mr_scene *s, const mr_frame_params *p, mr_frame_result *res, char *passes, size_t n) {
     mr_view v = {{96, 72, 80, 80, 47.5, 35.5, {0}}, mr_m4_identity()};
@@ -519,8 +571,55 @@ done:
     mr_scene_destroy(&out_of_view);
 }
 
+/* Curvature importance: a denser occluder (higher bias) hides the bar
+ * more; curvature is taken in radians per pixel, so the same adaptive
+ * ghosted picture comes out at 1e-3 and 1e6 scene units. */
+static void test_frame_importance(void) {
+    char passes[512];
+    mr_frame_params p = MR_FRAME_DEFAULTS;
+    p.ghost.mode = MR_GHOST_G0;
+    p.ghost.importance = MR_GHOST_IMP_CURVATURE;
+    mr_scene *s = wall_scene(true);
+    mr_frame_result sparse, dense;
+    p.ghost.curv_bias = 0.0f;
+    if (render(s, &p, &sparse, passes, sizeof passes)) {
+        p.ghost.curv_bias = 0.8f;
+        if (render(s, &p, &dense, passes, sizeof passes)) {
+            const unsigned char *a = sparse.color.data, *b = dense.color.data;
+            int c = (36 * 96 + 48) * 3;
+            /* red minus green: the bar's colour showing through */
+            CHECK_MSG(a[c] - a[c + 1] > b[c] - b[c + 1] + 40, "sparse %d %d, dense %d %d", a[c], a[c + 1], b[c], b[c + 1]);
+            mr_frame_result_free(&dense);
+        }
+        mr_frame_result_free(&sparse);
+    }
+    mr_scene_destroy(&s);
+    p.ghost.curv_bias = 0.1f;
+    p.ghost.mode = MR_GHOST_ADAPTIVE;
+    mr_frame_result ref, res;
+    mr_scene *s1 = wall_scene_scaled(true, 1.0, true);
+    if (render(s1, &p, &ref, passes, sizeof passes)) {
+        static const double scales[] = {1e-3, 1e6};
+        for (int i = 0; i < 2; i++) {
+            mr_scene *sk = wall_scene_scaled(true, scales[i], true);
+            if (render(sk, &p, &res, passes, sizeof passes)) {
+                int bad = 0;
+                const unsigned char *a = ref.color.data, *b = res.color.data;
+                for (int j = 0; j < 96 * 72 * 3; j++) bad += abs(a[j] - b[j]) > 3;
+                CHECK_MSG(bad <= 96 * 72 * 3 / 200, "scale %g: %d channels differ", scales[i], bad);
+                mr_frame_result_free(&res);
+            }
+            mr_scene_destroy(&sk);
+        }
+        mr_frame_result_free(&ref);
+    }
+    mr_renderer_set_scene(g_r, NULL, NULL);
+    mr_scene_destroy(&s1);
+}
+
 int main(void) {
     test_curvature();
+    test_demo_conflict();
     mr_error err = {0};
     g_gpu = mr_gpu_create_headless(NULL, &err);
     if (!g_gpu) {
@@ -535,6 +634,7 @@ int main(void) {
         test_compose();
         test_unified_sign();
         test_frame();
+        test_frame_importance();
     }
     mr_renderer_destroy(&g_r);
     mr_gpu_destroy(&g_gpu);

@@ -193,7 +193,7 @@ typedef struct mr_ghost_stats {
                                   in the final image is >= C_desired; always measured
                                   with the two-Gaussian saliency; NaN if no pixel is important */
     double mean_abs_dL;        /* mean |L*(O_A) - L*(O)| over the region (0 unless adaptive) */
-    double mean_contrast_missing; /* mean C over the region (after G0) */
+    double mean_contrast_missing; /* mean C over the region (adaptive mode only, else 0) */
 } mr_ghost_stats;
 
 typedef struct mr_frame_params {

@@ -54,7 +54,6 @@ typedef struct mr_ghost_state {
     int32_t curv_count;
     /* per frame */
     GLuint o_tex;        /* the occluder image of this frame (linear when sampled) */
-    int label_final;     /* which of label[] holds the result */
 } mr_ghost_state;
 
 static void free_targets(mr_ghost_state *g) {
@@ -302,7 +301,6 @@ static void stage_emphasis(mr_ghost_state *g, GLuint o, GLuint d, const mr_ghost
         dispatch(g->w, g->h);
         cur = 1 - cur;
     }
-    g->label_final = cur;
     size_t nvotes = (size_t)key_base + (size_t)g->w * g->h + 2;
     ensure_votes(g, nvotes);
     static const GLint zero = 0;
