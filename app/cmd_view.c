@@ -970,6 +970,7 @@ static void write_state(view_app *a, const mr_image *screen) {
     cJSON_AddNumberToObject(j, "frame_index", a->have_frame ? (double)a->frame.index : -1);
     cJSON_AddBoolToObject(j, "pose_valid", a->have_frame && a->frame.pose_valid);
     cJSON_AddNumberToObject(j, "tags_seen", a->have_frame ? a->frame.tags_seen : -1);
+    cJSON_AddBoolToObject(j, "tracking_lost_dimmed", a->dimmed);
     cJSON_AddNumberToObject(j, "marks", a->mark_count);
     cJSON_AddNumberToObject(j, "snapshots", a->snap_count);
     cJSON_AddNumberToObject(j, "fb_width", a->fb_w);

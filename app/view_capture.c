@@ -446,7 +446,11 @@ static void *tracker(void *arg) {
             const mr_detection *d = mr_detector_detect(det, &work, &n, &e);
             mr_pose pose;
             memset(&pose, 0, sizeof pose);
-            if (d && mr_pose_solve(c->p.camera, c->p.markers, d, n, &prev, NULL, &pose, &e)) {
+            /* Intrinsics follow the frame size actually delivered (a
+             * camera may not honour the requested size). */
+            mr_camera cam = *c->p.camera;
+            if (work.width != cam.width || work.height != cam.height) cam = mr_camera_resized(&cam, work.width, work.height);
+            if (d && mr_pose_solve(&cam, c->p.markers, d, n, &prev, NULL, &pose, &e)) {
                 f.tags_seen = pose.tags_seen;
                 f.tags_used = pose.tags_used;
                 f.rms_px = pose.valid ? pose.rms_px : -1;

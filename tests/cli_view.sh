@@ -106,6 +106,19 @@ if view persist "0.5 state $tmp/s_persist.json
   [ "$(jget "$tmp/s_persist.json" alpha)" = "$a" ] && ok || bad "alpha not restored: $(jget "$tmp/s_persist.json" alpha) vs $a"
 else bad "second run failed: $(tail -3 "$tmp/persist.err")"; fi
 
+# 1a. Tracking lost: the demo's frame 3 shows no tag; the model stays at
+#     frame 2's pose, dimmed, and the status says so.
+if view lost "0.2 key .
+0.6 key .
+1.2 key .
+1.9 state $tmp/s_lost.json
+2.0 shot $tmp/lost.png
+2.1 quit"; then
+  [ "$(jget "$tmp/s_lost.json" frame_index)" = 3 ] && [ "$(jget "$tmp/s_lost.json" pose_valid)" = false ] \
+    && [ "$(jget "$tmp/s_lost.json" tracking_lost_dimmed)" = true ] && ok \
+    || bad "tracking lost: frame $(jget "$tmp/s_lost.json" frame_index) valid $(jget "$tmp/s_lost.json" pose_valid) dimmed $(jget "$tmp/s_lost.json" tracking_lost_dimmed)"
+else bad "tracking-lost run failed: $(tail -3 "$tmp/lost.err")"; fi
+
 # 1b. The shipped demo recording (recordings/demo, lib/session's format):
 #     recorded poses, play advances, the seek bar and step move the frame.
 rec=$(cd "$(dirname "$0")/.." && pwd)/recordings/demo
@@ -127,7 +140,8 @@ fi
 #    annotations.jsonl at once, whole, and survive kill -9 right after.
 rm -f "$tmp/session/annotations.jsonl"
 printf '%s\n' "0.2 key . " "0.6 key ." "1.4 tap @mark" "1.8 tap 150 150" "2.4 tap @note2" "60 quit" >"$tmp/mark.script"
-timeout 120 "$mr" view --scene "$d/scene_planned.json" --replay "$d" --out "$tmp/session" --config "$tmp/cfg.json" \
+# Started directly (no `timeout` wrapper), so $! is the viewer itself.
+"$mr" view --scene "$d/scene_planned.json" --replay "$d" --out "$tmp/session" --config "$tmp/cfg.json" \
   --size 480x360 --paused --script "$tmp/mark.script" >"$tmp/mark.out" 2>"$tmp/mark.err" &
 pid=$!
 for _ in $(seq 1 300); do
@@ -136,6 +150,7 @@ for _ in $(seq 1 300); do
 done
 kill -9 $pid 2>/dev/null
 wait $pid 2>/dev/null
+[ -e "/proc/$pid" ] && bad "the viewer survived kill -9"
 ann=$tmp/session/annotations.jsonl
 if [ -s "$ann" ]; then
   [ "$(wc -l <"$ann")" -eq 1 ] && [ "$(tail -c 1 "$ann" | od -An -c | tr -d ' ')" = '\n' ] && ok || bad "annotation is not one whole line"
@@ -187,6 +202,16 @@ if timeout 60 "$mr" view --scene "$d/scene_planned.json" --input /dev/video-mrch
   [ "$(jget "$tmp/s_nocam.json" source_state)" = no_camera ] && ok || bad "no camera: state $(jget "$tmp/s_nocam.json" source_state)"
   jget "$tmp/s_nocam.json" source_message | grep -q "no camera" && ok || bad "no camera message: $(jget "$tmp/s_nocam.json" source_message)"
 else bad "no-camera run failed: $(tail -3 "$tmp/nocam.err")"; fi
+
+# 5b. The camera appears later: the viewer keeps retrying and picks it up.
+printf '%s\n' "0.3 state $tmp/s_late0.json" "4.5 state $tmp/s_late1.json" "4.6 quit" >"$tmp/late.script"
+( sleep 5; cp "$d/frames/frame_002.png" "$tmp/late.png" ) &
+if timeout 60 "$mr" view --scene "$d/scene_planned.json" --input "$tmp/late.png" --camera "$d/camera.json" \
+     --view "$d/views/view_002.json" --config "$tmp/cfg2.json" --size 480x360 --script "$tmp/late.script" >/dev/null 2>"$tmp/late.err"; then
+  [ "$(jget "$tmp/s_late0.json" source_state)" = no_camera ] && [ "$(jget "$tmp/s_late1.json" have_frame)" = true ] \
+    && ok || bad "late camera: $(jget "$tmp/s_late0.json" source_state) -> have_frame $(jget "$tmp/s_late1.json" have_frame)"
+else bad "late-camera run failed: $(tail -3 "$tmp/late.err")"; fi
+wait
 
 # 6. A scene that does not load: message, the window stays usable.
 printf '%s\n' "0.3 tap @video" "0.8 state $tmp/s_noscene.json" "0.9 quit" >"$tmp/noscene.script"
