@@ -884,19 +884,14 @@ static void build_ui(view_app *a) {
         mr_ui_draw_rect(mr_ui_list(ui), b, MR_UI_RGBA(20, 20, 20, 200));
         mr_ui_label(ui, b, a->toast, MR_UI_RGBA(255, 255, 255, 255), true);
     }
-    /* The mark being made: a cross on the picture. */
-    if (a->note_open && a->have_res) {
-        float x = a->image_rect.x + (float)((a->mark_px + 0.5) * a->rw / a->camera.width + 0) * a->image_rect.w / a->rw;
-        float y = a->image_rect.y + (float)((a->mark_py + 0.5) * a->rh / a->camera.height) * a->image_rect.h / a->rh;
-        float s = mr_ui_mm(ui, 3), t = fmaxf(2, mr_ui_mm(ui, 0.4f));
-        mr_ui_draw_rect(mr_ui_list(ui), mr_ui_rect_make(x - s, y - t / 2, 2 * s, t), MR_UI_RGBA(255, 60, 60, 255));
-        mr_ui_draw_rect(mr_ui_list(ui), mr_ui_rect_make(x - t / 2, y - s, t, 2 * s), MR_UI_RGBA(255, 60, 60, 255));
-    }
-
     /* Note chooser. */
     if (a->note_open) {
         float w = fminf(full.w - 2 * g, 2 * colw + 3 * g), h = (T + g) * ((NOTE_COUNT + 1) / 2 + 2) + g;
-        mr_ui_rect p = mr_ui_rect_make(full.x + (full.w - w) / 2, full.y + (full.h - h) / 2, w, h);
+        /* On the side away from the mark, so the cross stays visible. */
+        float mx = a->image_rect.x + (float)((a->mark_px + 0.5) / a->camera.width) * a->image_rect.w;
+        float px = mx < full.x + full.w * 0.5f ? full.x + full.w - w - g : full.x + g;
+        if (full.w < 2 * w) px = full.x + (full.w - w) / 2;
+        mr_ui_rect p = mr_ui_rect_make(px, full.y + (full.h - h) / 2, w, h);
         mr_ui_panel(ui, p);
         mr_ui_panel(ui, p); /* darker */
         mr_ui_rect in = mr_ui_rect_inset(p, g);
@@ -913,6 +908,15 @@ static void build_ui(view_app *a) {
         mr_ui_rect bc = mr_ui_rect_make(in.x, in.y + ((NOTE_COUNT + 1) / 2) * (T + g), in.w, T);
         add_named(a, "cancel", bc);
         if (mr_ui_button(ui, 70, bc, "Cancel", MR_UI_NORMAL)) finish_mark(a, -1);
+    }
+
+    /* The mark being made: a cross on the picture, over everything. */
+    if (a->note_open && a->have_res) {
+        float x = a->image_rect.x + (float)((a->mark_px + 0.5) / a->camera.width) * a->image_rect.w;
+        float y = a->image_rect.y + (float)((a->mark_py + 0.5) / a->camera.height) * a->image_rect.h;
+        float s = mr_ui_mm(ui, 3), t = fmaxf(2, mr_ui_mm(ui, 0.4f));
+        mr_ui_draw_rect(mr_ui_list(ui), mr_ui_rect_make(x - s, y - t / 2, 2 * s, t), MR_UI_RGBA(255, 60, 60, 255));
+        mr_ui_draw_rect(mr_ui_list(ui), mr_ui_rect_make(x - t / 2, y - s, t, 2 * s), MR_UI_RGBA(255, 60, 60, 255));
     }
 
     /* Help. */

@@ -162,6 +162,16 @@ static void test_widgets(const mr_ui_font *font) {
     /* After release, moving over the slider does nothing. */
     FRAME(sl.x + k / 2, 220, false);
     CHECK_NEAR(val, 1, 1e-6);
+    /* A label too long for its rect is shrunk, then cut: it never spills. */
+    {
+        mr_ui_input in = at(0, 0, false);
+        mr_ui_begin(ui, &in);
+        mr_ui_rect lr = mr_ui_rect_make(10, 10, 60, 20);
+        mr_ui_label(ui, lr, "a very long message that cannot possibly fit in sixty pixels", 0xffffffffu, true);
+        const mr_ui_draw_list *l = mr_ui_end(ui);
+        CHECK(l->vertex_count > 0);
+        for (int i = 0; i < l->vertex_count; i++) CHECK(l->vertices[i].x >= lr.x && l->vertices[i].x <= lr.x + lr.w);
+    }
     /* The draw list is non-empty and every index is in range. */
     const mr_ui_draw_list *dl = mr_ui_end(ui);
     CHECK(dl->vertex_count > 0 && dl->index_count % 3 == 0);

@@ -128,10 +128,34 @@ static bool hover(mr_ui *ui, mr_ui_rect r) {
 #define C_ACCENT MR_UI_RGBA(214, 120, 28, 240)
 #define C_BORDER MR_UI_RGBA(255, 255, 255, 60)
 
+/* Text that does not fit first shrinks (down to 80 %, still legible at
+ * arm's length), then is cut with "..." so it never spills over its
+ * neighbours. */
 void mr_ui_label(mr_ui *ui, mr_ui_rect r, const char *text, uint32_t rgba, bool center) {
-    float th = mr_ui_text_px(ui);
+    float th = mr_ui_text_px(ui), pad = mr_ui_mm(ui, 1.0f);
+    float avail = r.w - 2 * pad;
     float w = mr_ui_text_width(ui->p.font, text, th);
-    float x = center ? r.x + (r.w - w) * 0.5f : r.x + mr_ui_mm(ui, 1.0f);
+    char buf[512];
+    if (w > avail && avail > 0) {
+        float s = avail / w;
+        if (s >= 0.8f) {
+            th *= s;
+        } else {
+            th *= 0.8f;
+            size_t n = strlen(text);
+            if (n > sizeof buf - 4) n = sizeof buf - 4;
+            while (n > 0) {
+                memcpy(buf, text, n);
+                memcpy(buf + n, "...", 4);
+                if (mr_ui_text_width(ui->p.font, buf, th) <= avail) break;
+                n--;
+            }
+            if (n == 0) snprintf(buf, sizeof buf, "...");
+            text = buf;
+        }
+        w = mr_ui_text_width(ui->p.font, text, th);
+    }
+    float x = center ? r.x + (r.w - w) * 0.5f : r.x + pad;
     float y = r.y + (r.h - th) * 0.5f;
     mr_ui_draw_text(&ui->dl, ui->p.font, x, y, th, text, rgba);
 }
