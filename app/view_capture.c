@@ -345,6 +345,10 @@ static void *live_reader(void *arg) {
     sp.height = c->p.camera->height;
     sp.retries = -1; /* we retry ourselves, forever, and say so in the UI */
     bool ended = false;
+    /* Files (video, image folders) play at their own pace, by timestamp, as
+     * a camera would deliver them; a camera paces itself. */
+    bool paced = false;
+    double t0_wall = 0, t0_src = 0;
     while (!stopping(c)) {
         if (ended) {
             sleep_s(0.1);
@@ -353,6 +357,8 @@ static void *live_reader(void *arg) {
         if (!src) {
             mr_error e = {0};
             src = mr_source_open(c->input, &sp, &e);
+            paced = src && strcmp(mr_source_kind(src), "v4l2") != 0;
+            t0_wall = -1;
             if (!src) {
                 char m[512];
                 snprintf(m, sizeof m, "no camera: %.440s (retrying)", e.msg);
@@ -366,6 +372,17 @@ static void *live_reader(void *arg) {
         mr_error e = {0};
         mr_read_status st = mr_source_read(src, &fr, &e);
         if (st == MR_READ_FRAME) {
+            if (paced) {
+                if (t0_wall < 0) {
+                    t0_wall = mr_time_now();
+                    t0_src = fr.timestamp;
+                }
+                double due = t0_wall + (fr.timestamp - t0_src);
+                while (!stopping(c) && mr_time_now() < due - 1e-3) {
+                    double left = due - mr_time_now();
+                    sleep_s(left > 0.05 ? 0.05 : left);
+                }
+            }
             mr_image img = {0};
             if (mr_image_alloc(&img, fr.image.width, fr.image.height, fr.image.channels, MR_PIX_U8, &e)) {
                 memcpy(img.data, fr.image.data, mr_image_bytes(&img));
