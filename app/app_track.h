@@ -18,7 +18,10 @@
     {"refine-edges", "0|1", "edge refinement (default 1)", NULL},                                         \
     {"sharpening", "S", "decode sharpening (default 0.25)", NULL},                                        \
     {"no-filter", NULL, "no One Euro filtering of the pose", NULL},                                       \
-    {"freeze", NULL, "freeze the filtered pose at the first valid one (still-image check)", NULL}
+    {"freeze", NULL, "freeze the filtered pose at the first valid one (still-image check)", NULL},     \
+    {"size", "WxH", "V4L2: requested frame size (default 1280x720)", NULL},                               \
+    {"fps", "F", "V4L2: requested frame rate; image folders: timestamp rate (default 30)", NULL},          \
+    {"pixel-format", "YUYV|MJPG", "V4L2: pixel format (default: YUYV if offered, else MJPG)", NULL}
 
 typedef struct app_tracker {
     mr_detector *det;
@@ -34,6 +37,10 @@ typedef struct app_tracker {
 /* The input: a recording folder (its camera and markers become defaults),
  * /dev/videoN, a video file, an image or a folder of images. */
 mr_source *app_open_input(const char *uri, bool gray, mr_recording **rec_info, mr_error *err);
+/* The same with --size/--fps/--pixel-format from opts (false: a bad value,
+ * already reported; *src NULL + err: the input could not be opened). */
+bool app_open_input_opts(const char *cmd, const app_opt *opts, bool gray, mr_recording **rec_info, mr_source **src,
+                         mr_error *err);
 
 /* Sets up detector, camera, markers and filter from the options; rec (may
  * be NULL) supplies defaults. Prints one line and returns false on error. */

@@ -18,7 +18,7 @@ typedef struct setting {
 typedef struct result {
     double ms_med, ms_p95, det_ms_med;
     double t_err_mm, t_err_pct, r_err_deg, rms_px;
-    double det_rate, det_rate56, pose_rate, flip_rate;
+    double det_rate, det_rate56, det_rate_still, pose_rate, flip_rate;
     double jit_raw_mm, jit_raw_deg, jit_filt_mm, jit_filt_deg;
     int frames;
 } result;
@@ -77,7 +77,7 @@ static void jitter_segment(const mr_dmat4 *p, int n, jitter_acc *acc) {
 }
 
 static bool run_setting(const setting *s, const mr_recording *rec, const mr_image *imgs, const int *fidx, int nf,
-                        result *res, mr_error *err) {
+                        const mr_filter_params *fparams, result *res, mr_error *err) {
     memset(res, 0, sizeof *res);
     mr_detector *det = NULL;
     mr_aruco *ar = NULL;
@@ -93,14 +93,14 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
         det = mr_detector_create(&dp, err);
         if (!det) return false;
     }
-    mr_pose_filter *filt = mr_pose_filter_create(NULL, err);
+    mr_pose_filter *filt = mr_pose_filter_create(fparams, err);
     double *ms = calloc((size_t)nf, sizeof *ms), *dms = calloc((size_t)nf, sizeof *dms);
     double *te = calloc((size_t)nf, sizeof *te), *tp = calloc((size_t)nf, sizeof *tp), *re = calloc((size_t)nf, sizeof *re);
     double *rm = calloc((size_t)nf, sizeof *rm);
     mr_dmat4 *seg_raw = calloc((size_t)nf, sizeof *seg_raw), *seg_f = calloc((size_t)nf, sizeof *seg_f);
     bool ok = filt && ms && dms && te && tp && re && rm && seg_raw && seg_f;
     if (!ok) mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    int nposes = 0, nflip = 0, vis = 0, vis_hit = 0, vis56 = 0, vis56_hit = 0, seg_n = 0;
+    int nposes = 0, nflip = 0, vis = 0, vis_hit = 0, vis56 = 0, vis56_hit = 0, vis_st = 0, vis_st_hit = 0, seg_n = 0;
     jitter_acc jr = {0}, jf = {0};
     mr_pose prev = {0};
     /* one untimed warm-up frame: thread pools, first allocations */
@@ -138,6 +138,10 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
             if (edge >= 56) {
                 vis56++;
                 vis56_hit += hit;
+            }
+            if (f->still) {
+                vis_st++;
+                vis_st_hit += hit;
             }
         }
         mr_dmat4 filtered = pose.world_from_camera;
@@ -190,6 +194,7 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
         res->rms_px = quantile(rm, nposes, 0.5);
         res->det_rate = vis ? (double)vis_hit / vis : NAN;
         res->det_rate56 = vis56 ? (double)vis56_hit / vis56 : NAN;
+        res->det_rate_still = vis_st ? (double)vis_st_hit / vis_st : NAN;
         res->pose_rate = nf ? (double)nposes / nf : 0;
         res->flip_rate = nposes ? (double)nflip / nposes : NAN;
         res->jit_raw_mm = jr.n ? 1e3 * sqrt(jr.sum_t2 / jr.n) : NAN;
@@ -272,6 +277,8 @@ int bench_tracking(int argc, char **argv) {
         {"out", "DIR", "write bench_tracking.csv and .svg there (default bench-out)", NULL},
         {"frames", "N", "use at most N frames (default all)", NULL},
         {"quick", NULL, "a few settings only", NULL},
+        {"min-cutoff", "HZ", "One Euro filter cutoff at rest (default 0.5)", NULL},
+        {"beta", "B", "One Euro filter speed coefficient (default 2)", NULL},
         {NULL, NULL, NULL, NULL},
     };
     bool help;
@@ -287,6 +294,10 @@ int bench_tracking(int argc, char **argv) {
     const char *out = app_get(opts, "out") ? app_get(opts, "out") : "bench-out";
     long max_frames = 1L << 30;
     if (app_get(opts, "frames") && !app_int("frames", app_get(opts, "frames"), 1, 1L << 30, &max_frames)) return 2;
+    mr_filter_params fparams = MR_FILTER_DEFAULTS;
+    if (app_get(opts, "min-cutoff") && !app_double("min-cutoff", app_get(opts, "min-cutoff"), 1e-3, 100, &fparams.min_cutoff)) return 2;
+    if (app_get(opts, "beta") && !app_double("beta", app_get(opts, "beta"), 1e-6, 1000, &fparams.beta)) return 2;
+    fparams.rot_min_cutoff = fparams.min_cutoff;
     mr_error err = {0};
     mr_recording *rec = mr_recording_open(dir, &err);
     if (!rec) return app_error(cmd, &err);
@@ -338,28 +349,28 @@ int bench_tracking(int argc, char **argv) {
     if (ok) {
         len = snprintf(csv, 65536,
                        "detector,decimate,threads,refine,frames,ms_median,ms_p95,detect_ms_median,t_err_mm_median,"
-                       "t_err_pct_median,r_err_deg_median,reproj_rms_px_median,detection_rate,detection_rate_56px,"
+                       "t_err_pct_median,r_err_deg_median,reproj_rms_px_median,detection_rate,detection_rate_56px,detection_rate_still,"
                        "pose_rate,flip_rate,jitter_raw_mm,jitter_raw_deg,jitter_filtered_mm,jitter_filtered_deg\n");
         printf("bench tracking: %s, %d frames %dx%d, %s\n", dir, nf, imgs[0].width, imgs[0].height,
                "ms = detection + pose per frame (median / p95)");
-        printf("%-22s %7s %7s %8s %7s %7s %6s %6s %6s %6s %6s %13s %13s\n", "setting", "ms med", "ms p95", "t err mm",
-               "t err %", "r err", "rms px", "det", "det56", "pose", "flip", "jitter raw", "jitter filt");
+        printf("%-22s %7s %7s %8s %7s %7s %6s %6s %6s %6s %6s %6s %13s %13s\n", "setting", "ms med", "ms p95", "t err mm",
+               "t err %", "r err", "rms px", "det", "det56", "still", "pose", "flip", "jitter raw", "jitter filt");
     }
     for (int i = 0; ok && i < ns; i++) {
-        ok = run_setting(&set[i], rec, imgs, fidx, nf, &res[i], &err);
+        ok = run_setting(&set[i], rec, imgs, fidx, nf, &fparams, &res[i], &err);
         if (!ok) break;
         const result *r = &res[i];
-        printf("%-22s %7.2f %7.2f %8.1f %7.2f %7.3f %6.3f %5.1f%% %5.1f%% %5.1f%% %5.1f%% %5.2fmm/%.3f° %5.2fmm/%.3f°\n",
+        printf("%-22s %7.2f %7.2f %8.1f %7.2f %7.3f %6.3f %5.1f%% %5.1f%% %5.1f%% %5.1f%% %5.1f%% %5.2fmm/%.3f° %5.2fmm/%.3f°\n",
                set[i].name, r->ms_med, r->ms_p95, r->t_err_mm, r->t_err_pct, r->r_err_deg, r->rms_px, 100 * r->det_rate,
-               100 * r->det_rate56, 100 * r->pose_rate, 100 * r->flip_rate, r->jit_raw_mm, r->jit_raw_deg, r->jit_filt_mm,
+               100 * r->det_rate56, 100 * r->det_rate_still, 100 * r->pose_rate, 100 * r->flip_rate, r->jit_raw_mm, r->jit_raw_deg, r->jit_filt_mm,
                r->jit_filt_deg);
         fflush(stdout);
         len += snprintf(csv + len, 65536 - (size_t)len,
-                        "%s,%g,%d,%s,%d,%.4f,%.4f,%.4f,%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n",
+                        "%s,%g,%d,%s,%d,%.4f,%.4f,%.4f,%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n",
                         set[i].aruco ? "opencv-aruco" : "apriltag", set[i].aruco ? 1.0 : set[i].decimate, set[i].threads,
                         set[i].aruco ? mr_aruco_refine_name((mr_aruco_refine)set[i].refine) : set[i].refine ? "1" : "0",
                         r->frames, r->ms_med, r->ms_p95, r->det_ms_med, r->t_err_mm, r->t_err_pct, r->r_err_deg, r->rms_px,
-                        r->det_rate, r->det_rate56, r->pose_rate, r->flip_rate, r->jit_raw_mm, r->jit_raw_deg,
+                        r->det_rate, r->det_rate56, r->det_rate_still, r->pose_rate, r->flip_rate, r->jit_raw_mm, r->jit_raw_deg,
                         r->jit_filt_mm, r->jit_filt_deg);
     }
     char path[4096];

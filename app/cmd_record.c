@@ -47,7 +47,8 @@ int cmd_record(int argc, char **argv) {
 
     mr_error err = {0};
     mr_recording *rec_in = NULL;
-    mr_source *src = app_open_input(input, app_flag(opts, "gray"), &rec_in, &err);
+    mr_source *src = NULL;
+    if (!app_open_input_opts(cmd, opts, app_flag(opts, "gray"), &rec_in, &src, &err)) return 2;
     if (!src) return app_error(cmd, &err);
     app_tracker t;
     bool ok = app_tracker_init(&t, cmd, opts, rec_in);

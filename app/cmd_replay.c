@@ -5,6 +5,7 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 int cmd_replay(int argc, char **argv) {
     static const char *cmd = "replay";
@@ -53,6 +54,7 @@ int cmd_replay(int argc, char **argv) {
         const mr_rec_frame *f = &rec->frames[i];
         if (f->index < from || (to >= 0 && f->index > to) || (f->index - from) % every != 0) continue;
         selected++;
+        if (isatty(2)) fprintf(stderr, "\rreplay: frame %lld", (long long)f->index);
         mr_image img;
         mr_error fe = {0};
         if (!mr_recording_load_image(rec, i, false, &img, &fe)) {
@@ -87,6 +89,7 @@ int cmd_replay(int argc, char **argv) {
         if (has_pose) cJSON_AddItemToObject(o, "world_from_camera", mr_json_from_dmat4(&pose));
         cJSON_AddItemToArray(log, o);
     }
+    if (isatty(2) && selected) fprintf(stderr, "\r\033[K");
     if (ok && selected == 0) ok = mr_fail(&err, MR_ERR_INVALID, "no recorded frame in the selected range");
     if (ok) {
         /* replay.jsonl: one line per written image, written atomically. */

@@ -56,7 +56,8 @@ int cmd_track(int argc, char **argv) {
 
     mr_error err = {0};
     mr_recording *rec = NULL;
-    mr_source *src = app_open_input(input, true, &rec, &err);
+    mr_source *src = NULL;
+    if (!app_open_input_opts(cmd, opts, true, &rec, &src, &err)) return 2;
     if (!src) return app_error(cmd, &err);
     app_tracker t;
     bool ok = app_tracker_init(&t, cmd, opts, rec);
@@ -106,6 +107,8 @@ int cmd_track(int argc, char **argv) {
             cJSON *o = cJSON_CreateObject();
             cJSON_AddNumberToObject(o, "frame", (double)f.index);
             cJSON_AddItemToObject(o, "detections", app_detections_json(r.dets, r.count));
+            /* with camera and markers the line also carries the pose */
+            if (want_pose) cJSON_AddItemToObject(o, "pose", app_pose_line(f.index, f.timestamp, &r));
             char *s = cJSON_PrintUnformatted(o);
             cJSON_Delete(o);
             if (s) puts(s);

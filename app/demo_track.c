@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* ------------------------------------------------------------ the path */
 
@@ -138,9 +139,16 @@ bool app_synth_recording(const char *dir, const app_synth_params *params, mr_err
     mr_demo_hall hall;
     if (!app_demo_hall(&hall, err)) return false;
     mr_marker_map map;
-    mr_camera cam = mr_camera_resized(&(mr_camera){0}, 1, 1); /* placeholder, set below */
-    mr_camera demo = app_demo_camera();
-    cam = mr_camera_resized(&demo, p.width, p.height);
+    /* The demo lens at another resolution: square pixels, the focal length
+     * scaled with the width, so 1280x720 is a 16:9 crop of a 1280x960. */
+    mr_camera cam = app_demo_camera();
+    double sc = (double)p.width / cam.width;
+    cam.fx *= sc;
+    cam.fy *= sc;
+    cam.cx = 0.5 * (p.width - 1) + (cam.cx - 0.5 * (app_demo_camera().width - 1)) * sc;
+    cam.cy = 0.5 * (p.height - 1) + (cam.cy - 0.5 * (app_demo_camera().height - 1)) * sc;
+    cam.width = p.width;
+    cam.height = p.height;
     bool ok = hall_markers(&hall, &map, err);
     app_gfx gfx = {0};
     ok = ok && app_gfx_open(&gfx, err) && mr_renderer_set_scene(gfx.renderer, hall.built, err);
@@ -220,7 +228,9 @@ bool app_synth_recording(const char *dir, const app_synth_params *params, mr_err
         mr_image_free(&frame);
         mr_image_free(&gray);
         if (ok && i % 10 == 0) mr_log(MR_LOG_INFO, "synth: frame %d/%d, %d tags", i, p.frames, n);
+        if (ok && isatty(2) && mr_log_get_level() < MR_LOG_INFO) fprintf(stderr, "\rsynth: frame %d/%d", i + 1, p.frames);
     }
+    if (isatty(2) && mr_log_get_level() < MR_LOG_INFO) fprintf(stderr, "\r\033[K");
     for (int k = 0; k < 16; k++) mr_image_free(&ideal[k]);
     if (ok) mr_log(MR_LOG_INFO, "synth: %d frames, %d with a pose", p.frames, with_pose);
     mr_recorder_close(&rec);

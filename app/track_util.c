@@ -24,7 +24,7 @@ void app_catch_signals(void) {
 
 bool app_interrupted(void) { return g_interrupted != 0; }
 
-mr_source *app_open_input(const char *uri, bool gray, mr_recording **rec_info, mr_error *err) {
+static mr_source *open_input(const char *uri, const mr_source_params *sp, mr_recording **rec_info, mr_error *err) {
     if (rec_info) *rec_info = NULL;
     if (uri && mr_is_recording(uri)) {
         mr_recording *rec = mr_recording_open(uri, err);
@@ -37,11 +37,28 @@ mr_source *app_open_input(const char *uri, bool gray, mr_recording **rec_info, m
                 return NULL;
             }
         }
-        return mr_recording_source(rec, gray, err);
+        return mr_recording_source(rec, sp->gray, err);
     }
+    return mr_source_open(uri, sp, err);
+}
+
+mr_source *app_open_input(const char *uri, bool gray, mr_recording **rec_info, mr_error *err) {
     mr_source_params sp = MR_SOURCE_DEFAULTS;
     sp.gray = gray;
-    return mr_source_open(uri, &sp, err);
+    return open_input(uri, &sp, rec_info, err);
+}
+
+bool app_open_input_opts(const char *cmd, const app_opt *opts, bool gray, mr_recording **rec_info, mr_source **src,
+                         mr_error *err) {
+    (void)cmd;
+    *src = NULL;
+    mr_source_params sp = MR_SOURCE_DEFAULTS;
+    sp.gray = gray;
+    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &sp.width, &sp.height)) return false;
+    if (app_get(opts, "fps") && !app_double("fps", app_get(opts, "fps"), 0.1, 1000, &sp.fps)) return false;
+    sp.pixel_format = app_get(opts, "pixel-format");
+    *src = open_input(app_get(opts, "input"), &sp, rec_info, err);
+    return true;
 }
 
 bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, const mr_recording *rec) {

@@ -8,7 +8,7 @@ pkgs=(
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   libglfw3-dev xvfb xauth xdotool fonts-dejavu-core
   libembree-dev
-  libopencv-dev
+  libopencv-dev libopencv-contrib-dev
 )
 missing=()
 for p in "${pkgs[@]}"; do

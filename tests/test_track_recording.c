@@ -56,6 +56,56 @@ static void track_all(mr_recording *rec, run *out) {
     mr_detector_destroy(&det);
 }
 
+/* Golden detections (apriltag habit: a .txt per image): frames 0 and 95 of
+ * the shipped recording with the default detector, one line per tag:
+ * "id hamming x0 y0 x1 y1 x2 y2 x3 y3". MR_UPDATE_GOLDEN=1 rewrites. */
+static void check_golden(const mr_recording *rec, int frame, const char *data_dir) {
+    char path[2048];
+    snprintf(path, sizeof path, "%s/golden/detections_%03d.txt", data_dir, frame);
+    mr_error err = {0};
+    mr_image img;
+    CHECK(mr_recording_load_image(rec, frame, true, &img, &err));
+    mr_detector *d = mr_detector_create(NULL, &err);
+    int n = 0;
+    const mr_detection *det = mr_detector_detect(d, &img, &n, &err);
+    char text[4096];
+    int len = 0;
+    for (int i = 0; det && i < n; i++) {
+        len += snprintf(text + len, sizeof text - (size_t)len, "%d %d", det[i].id, det[i].hamming);
+        for (int k = 0; k < 4; k++)
+            len += snprintf(text + len, sizeof text - (size_t)len, " %.4f %.4f", det[i].corners[k][0], det[i].corners[k][1]);
+        len += snprintf(text + len, sizeof text - (size_t)len, "\n");
+    }
+    if (getenv("MR_UPDATE_GOLDEN")) {
+        CHECK(mr_file_write_atomic(path, text, (size_t)len, &err));
+    } else {
+        size_t size = 0;
+        char *want = mr_file_read(path, &size, 0, &err);
+        CHECK_MSG(want != NULL, "%s", err.msg);
+        /* compare numerically: 0.01 px leaves room for libm differences */
+        const char *a = text, *b = want ? want : "";
+        int lines = 0;
+        while (want && *a && *b) {
+            int id1, h1, id2, h2, c1, c2;
+            double p[8], q[8];
+            c1 = sscanf(a, "%d %d %lf %lf %lf %lf %lf %lf %lf %lf", &id1, &h1, &p[0], &p[1], &p[2], &p[3], &p[4], &p[5], &p[6], &p[7]);
+            c2 = sscanf(b, "%d %d %lf %lf %lf %lf %lf %lf %lf %lf", &id2, &h2, &q[0], &q[1], &q[2], &q[3], &q[4], &q[5], &q[6], &q[7]);
+            CHECK(c1 == 10 && c2 == 10 && id1 == id2 && h1 == h2);
+            for (int k = 0; k < 8; k++) CHECK_NEAR(p[k], q[k], 0.01);
+            a = strchr(a, '\n');
+            b = strchr(b, '\n');
+            if (!a || !b) break;
+            a++;
+            b++;
+            lines++;
+        }
+        CHECK_MSG(lines == n && (!b || !*b), "frame %d: %d detections, golden has more or fewer", frame, n);
+        free(want);
+    }
+    mr_detector_destroy(&d);
+    mr_image_free(&img);
+}
+
 int main(void) {
     const char *src = getenv("MR_SOURCE_DIR");
     char dir[2048];
@@ -68,6 +118,9 @@ int main(void) {
     int gt = 0;
     for (int i = 0; i < rec->frame_count; i++) gt += rec->frames[i].has_gt;
     CHECK(gt == rec->frame_count);
+    const char *data = getenv("MR_TEST_DATA");
+    check_golden(rec, 0, data ? data : "tests/data");
+    check_golden(rec, 95, data ? data : "tests/data");
     static run a, b;
     track_all(rec, &a);
     double tp = median(a.tp, a.poses), re = median(a.re, a.poses), mp = median(a.multi_tp, a.multi);

@@ -65,7 +65,7 @@ bool mr_marker_map_from_json(const cJSON *obj, mr_marker_map *map, mr_error *err
         m->id = (int)id;
         if (!mr_m4_is_rigid(&m->world_from_tag, 1e-4)) {
             mr_marker_map_free(map);
-            return mr_fail(err, MR_ERR_INVALID, "marker map: tag id %d: world_from_tag is not a rigid transform", m->id);
+            return mr_fail(err, MR_ERR_INVALID, "marker map: tag id %d: world_from_tag is not a rigid transform", (int)id);
         }
         for (int k = 0; k < i; k++)
             if (map->tags[k].id == m->id) {

@@ -151,7 +151,9 @@ static bool dev_open(v4l2_src *s, mr_error *err) {
     req.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
     req.memory = V4L2_MEMORY_MMAP;
     if (xioctl(s->fd, VIDIOC_REQBUFS, &req) < 0 || req.count < 2) {
+        int e = errno;
         dev_close(s);
+        if (e == EBUSY) return mr_fail(err, MR_ERR_NODEVICE, "%s: device is busy (streaming to another program)", s->dev);
         return mr_fail(err, MR_ERR_UNSUPPORTED, "%s: memory-mapped streaming is not available", s->dev);
     }
     s->nbuf = req.count > NBUF ? NBUF : (int)req.count;
