@@ -25,7 +25,8 @@ void main() {
     if (!ao_view_pos(u_depth, u_pos, false, u_near, u_intr, ap * u_step, P)) { o_ao = 1.0; return; }
     vec3 n = ao_normal(u_normal, ap * u_step, P);
     float sigma = 0.5 * float(u_radius) + 0.5;
-    float tol = 0.02 * P.z * float(u_step);
+    float inv2s2 = 1.0 / (2.0 * sigma * sigma);
+    float inv_tol = 1.0 / (0.02 * P.z * float(u_step));
     float sum = 0.0, wsum = 0.0;
     for (int i = -u_radius; i <= u_radius; i++) {
         ivec2 q = ap + u_dir * i;
@@ -33,8 +34,11 @@ void main() {
         vec3 Q;
         if (!ao_view_pos(u_depth, u_pos, false, u_near, u_intr, q * u_step, Q)) continue;
         vec3 nq = ao_normal(u_normal, q * u_step, Q);
-        float dp = dot(Q - P, n) / tol;
-        float w = exp(-float(i * i) / (2.0 * sigma * sigma)) * exp(-dp * dp) * pow(max(dot(n, nq), 0.0), 8.0);
+        float dp = dot(Q - P, n) * inv_tol;
+        // One exp for the spatial and plane terms; (n.nq)^8 by squaring.
+        float c = max(dot(n, nq), 0.0);
+        c *= c; c *= c; c *= c;
+        float w = exp(-float(i * i) * inv2s2 - dp * dp) * c;
         float a = texelFetch(u_ao, q, 0).r;
         if (!(w > 0.0) || isnan(a)) continue;
         sum += w * a;

@@ -573,6 +573,22 @@ static void test_pass_list(void) {
     CHECK_MSG(strcmp(buf, "gbuffer ao_positions ao_mask ao ao_blur ao_upsample shade") == 0, "passes: %s", buf);
     CHECK_MSG(r1.ao_masked_fraction > 0.02 && r1.ao_masked_fraction < 0.9, "masked fraction %g", r1.ao_masked_fraction);
     mr_frame_result_free(&r1);
+    /* An external AO image (ground truth) is shaded with, no AO pass runs;
+     * one of the wrong size is refused. */
+    mr_image ext = {0};
+    mr_image_alloc(&ext, 96, 72, 1, MR_PIX_F32, NULL);
+    for (int i = 0; i < 96 * 72; i++) ((float *)ext.data)[i] = 0.25f;
+    p.ao.external = &ext;
+    CHECK(mr_render_frame(g_r, &v, &p, &r1, &err));
+    passes_of(&r1, buf, sizeof buf);
+    CHECK_MSG(strcmp(buf, "gbuffer shade") == 0, "external AO: %s", buf);
+    CHECK(r1.ao.data && ((float *)r1.ao.data)[100] == 0.25f);
+    mr_frame_result_free(&r1);
+    ext.width = 95;
+    CHECK(!mr_render_frame(g_r, &v, &p, &r1, &err));
+    p.ao.external = NULL;
+    ext.width = 96;
+    mr_image_free(&ext);
     mr_scene_destroy(&s);
     mr_renderer_set_scene(g_r, NULL, NULL);
 }

@@ -99,7 +99,9 @@ bool mr_image_compare(const mr_image *a, const mr_image *ref, const mr_image *ma
 
 /* ------------------------------------------------------------- plots */
 
-static const char *const k_colors[] = {"#3b6fb6", "#e08a2c", "#3a9a4a", "#c0392b", "#8e44ad", "#7f8c8d", "#16a085", "#d35400"};
+/* 16 distinguishable colours, so a plot with up to 16 series never repeats one. */
+static const char *const k_colors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
+                                       "#bcbd22", "#17becf", "#393b79", "#ad494a", "#637939", "#843c39", "#7b4173", "#000000"};
 
 bool mr_plot_svg(const char *path, const char *title, const char *xlabel, const char *ylabel,
                  const mr_plot_series *series, int nseries, bool log_x, mr_error *err) {
@@ -140,7 +142,7 @@ bool mr_plot_svg(const char *path, const char *title, const char *xlabel, const 
     OUT("<text x=\"16\" y=\"%.1f\" transform=\"rotate(-90 16 %.1f)\" text-anchor=\"middle\">%s</text>\n", T + ph / 2,
         T + ph / 2, ylabel);
     for (int s = 0; s < nseries; s++) {
-        const char *col = k_colors[s % 8];
+        const char *col = k_colors[s % 16];
         OUT("<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1.5\" points=\"", col);
         for (int i = 0; i < series[s].count; i++) {
             double xv = series[s].x[i], yv = series[s].y[i];

@@ -578,6 +578,8 @@ bool mr_pass_ao_read_back(frame *f, mr_error *err) {
     int pl = plan(f);
     o->ao_masked_fraction = -1;
     o->ao_reused = pl == AO_PLAN_REUSE;
+    if (f->p->ao.external && pl != AO_PLAN_EXTERNAL)
+        return mr_fail(err, MR_ERR_INVALID, "the external AO image must be F32x1 at the output size %dx%d", r->w, r->h);
     if (r->ao && r->ao->broken && f->p->ao.method != MR_AO_NONE) {
         *err = r->ao->error;
         mr_error_prefix(err, "ambient occlusion: ");
