@@ -144,6 +144,7 @@ typedef struct view_app {
     script_cmd *script;
     int script_count, script_next;
     double script_t0;
+    int64_t script_frame;          /* frames_drawn when the last command ran */
     bool script_started;
     char shot_path[1024], state_path[1024];
     /* stats */
@@ -587,15 +588,22 @@ static void script_tick(view_app *a) {
         a->script_started = true;
         a->script_t0 = mr_time_now();
     }
+    /* Times are earliest times: a command also waits until the input of
+     * the one before has been taken and its effect drawn, so a slow machine
+     * shifts the script but never reorders it. */
+    if (a->have_held || mr_window_pending(a->win) > 0 || (a->need_render && a->have_frame) ||
+        a->frames_drawn < a->script_frame + 2)
+        return;
     double t = mr_time_now() - a->script_t0;
-    while (a->script_next < a->script_count && a->script[a->script_next].t <= t) {
+    if (a->script_next < a->script_count && a->script[a->script_next].t <= t) {
+        a->script_frame = a->frames_drawn;
         const script_cmd *c = &a->script[a->script_next++];
         double x = c->a, y = c->b;
         mr_ui_rect r = mr_ui_rect_make((float)x, (float)y, 0, 0);
         if (c->target[0]) {
             if (!find_named(a, c->target, &r)) {
                 mr_log(MR_LOG_WARN, "view: script: no widget named @%s on screen", c->target);
-                continue;
+                return;
             }
             x = r.x + r.w * 0.5;
             y = r.y + r.h * 0.5;

@@ -222,6 +222,8 @@ bool mr_window_next_event(mr_window *w, mr_event *ev) {
 
 void mr_window_framebuffer_size(const mr_window *w, int *fw, int *fh) { glfwGetFramebufferSize(w->win, fw, fh); }
 
+int mr_window_pending(const mr_window *w) { return w->count; }
+
 double mr_window_px_per_mm(const mr_window *w) {
     int ww = 0, wh = 0, fw = 0, fh = 0;
     glfwGetWindowSize(w->win, &ww, &wh);
@@ -284,6 +286,7 @@ void mr_window_wait(mr_window *w, double t) { (void)w; (void)t; }
 void mr_window_wake(mr_window *w) { (void)w; }
 bool mr_window_next_event(mr_window *w, mr_event *ev) { (void)w; (void)ev; return false; }
 bool mr_window_push_event(mr_window *w, const mr_event *ev) { (void)w; (void)ev; return false; }
+int mr_window_pending(const mr_window *w) { (void)w; return 0; }
 void mr_window_framebuffer_size(const mr_window *w, int *fw, int *fh) { (void)w; *fw = *fh = 0; }
 double mr_window_px_per_mm(const mr_window *w) { (void)w; return 96.0 / 25.4; }
 void mr_window_set_fullscreen(mr_window *w, bool on) { (void)w; (void)on; }

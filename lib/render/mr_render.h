@@ -308,6 +308,8 @@ void mr_window_wait(mr_window *win, double timeout_s);
 void mr_window_wake(mr_window *win);
 bool mr_window_next_event(mr_window *win, mr_event *ev);
 bool mr_window_push_event(mr_window *win, const mr_event *ev);
+/* Events queued and not yet taken. */
+int mr_window_pending(const mr_window *win);
 void mr_window_framebuffer_size(const mr_window *win, int *w, int *h);
 /* Framebuffer pixels per millimetre on the window's monitor: the monitor's
  * physical size where it is plausible, else the content scale x 96 dpi. */
