@@ -216,55 +216,67 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
     return ok;
 }
 
-/* Error against run time: median ms per frame (x, log scale) against median
- * translation error (y), one point per setting. */
+/* Error against run time: median ms per frame (x) against median
+ * translation error (y), both log scale, one numbered point per setting;
+ * the legend on the right names the numbers. */
+static double log_pos(double v, double lo, double hi, double len) {
+    return len * log10(fmax(v, lo) / lo) / log10(hi / lo);
+}
+
 static bool write_svg(const char *path, const char *title, const setting *s, const result *r, int n, mr_error *err) {
-    double xmin = 1e9, xmax = 0, ymax = 0;
+    double xmin = 1e9, xmax = 0, ymin = 1e9, ymax = 0;
     for (int i = 0; i < n; i++) {
-        if (!isfinite(r[i].ms_med) || !isfinite(r[i].t_err_mm)) continue;
+        if (!isfinite(r[i].ms_med) || !isfinite(r[i].t_err_mm) || r[i].ms_med <= 0 || r[i].t_err_mm <= 0) continue;
         xmin = fmin(xmin, r[i].ms_med);
         xmax = fmax(xmax, r[i].ms_med);
+        ymin = fmin(ymin, r[i].t_err_mm);
         ymax = fmax(ymax, r[i].t_err_mm);
     }
-    if (xmax <= 0) xmin = 0.1, xmax = 1;
-    xmin = pow(10, floor(log10(fmax(xmin, 1e-3))));
+    if (xmax <= 0) xmin = 0.1, xmax = 1, ymin = 1, ymax = 10;
+    xmin = pow(10, floor(log10(xmin)));
     xmax = pow(10, ceil(log10(fmax(xmax, xmin * 10))));
-    ymax = ymax > 0 ? ymax * 1.15 : 1;
-    const int W = 900, H = 560, L = 80, R = 260, T = 50, B = 60;
-    size_t cap = 16384 + (size_t)n * 512;
+    ymin = pow(10, floor(log10(ymin)));
+    ymax = pow(10, ceil(log10(fmax(ymax, ymin * 10))));
+    const int W = 960, H = 600, L = 80, R = 300, T = 50, B = 60, PW = W - R - L, PH = H - B - T;
+    size_t cap = 16384 + (size_t)n * 640;
     char *o = malloc(cap);
     if (!o) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
     int len = snprintf(o, cap,
                        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" font-family=\"sans-serif\" font-size=\"12\">\n"
                        "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n<text x=\"%d\" y=\"24\" font-size=\"15\">%s</text>\n"
-                       "<line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"black\"/><line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"black\"/>\n"
                        "<text x=\"%d\" y=\"%d\">median ms per frame (detection + pose, log scale)</text>\n"
-                       "<text x=\"16\" y=\"%d\" transform=\"rotate(-90 16 %d)\">median translation error (mm)</text>\n",
-                       W, H, L, title, L, H - B, W - R, H - B, L, T, L, H - B, L + 150, H - 20, (H) / 2 + 60, (H) / 2 + 60);
+                       "<text x=\"16\" y=\"%d\" transform=\"rotate(-90 16 %d)\">median translation error, mm (log scale)</text>\n",
+                       W, H, L, title, L + 150, H - 20, H / 2 + 90, H / 2 + 90);
     for (double x = xmin; x <= xmax * 1.001; x *= 10) {
-        double px = L + (W - R - L) * log10(x / xmin) / log10(xmax / xmin);
-        len += snprintf(o + len, cap - (size_t)len, "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#ccc\"/><text x=\"%.1f\" y=\"%d\">%g</text>\n",
+        double px = L + log_pos(x, xmin, xmax, PW);
+        len += snprintf(o + len, cap - (size_t)len,
+                        "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#ccc\"/><text x=\"%.1f\" y=\"%d\">%g</text>\n",
                         px, T, px, H - B, px - 8, H - B + 16, x);
     }
-    for (int k = 0; k <= 4; k++) {
-        double y = ymax * k / 4, py = H - B - (H - B - T) * k / 4.0;
-        len += snprintf(o + len, cap - (size_t)len, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#ccc\"/><text x=\"%d\" y=\"%.1f\">%.1f</text>\n",
-                        L, py, W - R, py, L - 40, py + 4, y);
+    for (double y = ymin; y <= ymax * 1.001; y *= 10) {
+        double py = H - B - log_pos(y, ymin, ymax, PH);
+        len += snprintf(o + len, cap - (size_t)len,
+                        "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#ccc\"/><text x=\"%d\" y=\"%.1f\">%g</text>\n",
+                        L, py, W - R, py, L - 45, py + 4, y);
     }
+    len += snprintf(o + len, cap - (size_t)len,
+                    "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"black\"/>\n", L, T, PW, PH);
     for (int i = 0; i < n; i++) {
-        if (!isfinite(r[i].ms_med) || !isfinite(r[i].t_err_mm)) continue;
-        double px = L + (W - R - L) * log10(fmax(r[i].ms_med, xmin) / xmin) / log10(xmax / xmin);
-        double py = H - B - (H - B - T) * r[i].t_err_mm / ymax;
         const char *col = s[i].aruco ? "#e08a2c" : s[i].threads > 1 ? "#2c8a3b" : "#3b6fb6";
-        len += snprintf(o + len, cap - (size_t)len, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"><title>%s: %.2f ms, %.1f mm</title></circle>\n",
-                        px, py, col, s[i].name, r[i].ms_med, r[i].t_err_mm);
-        len += snprintf(o + len, cap - (size_t)len, "<text x=\"%d\" y=\"%d\" fill=\"%s\" font-size=\"10\">%s: %.2f ms, %.1f mm, det %.0f%%</text>\n",
-                        W - R + 10, T + 12 * i, col, s[i].name, r[i].ms_med, r[i].t_err_mm, 100 * r[i].det_rate);
+        len += snprintf(o + len, cap - (size_t)len,
+                        "<text x=\"%d\" y=\"%d\" fill=\"%s\" font-size=\"11\">%2d %s: %.2f ms, %.1f mm, %.2f%%, flip %.0f%%</text>\n",
+                        W - R + 10, T + 13 * i + 10, col, i + 1, s[i].name, r[i].ms_med, r[i].t_err_mm, r[i].t_err_pct,
+                        100 * r[i].flip_rate);
+        if (!isfinite(r[i].ms_med) || !isfinite(r[i].t_err_mm) || r[i].ms_med <= 0 || r[i].t_err_mm <= 0) continue;
+        double px = L + log_pos(r[i].ms_med, xmin, xmax, PW), py = H - B - log_pos(r[i].t_err_mm, ymin, ymax, PH);
+        len += snprintf(o + len, cap - (size_t)len,
+                        "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/><text x=\"%.1f\" y=\"%.1f\" fill=\"%s\" font-size=\"10\">%d</text>\n",
+                        px, py, col, px + 5, py - 4, col, i + 1);
     }
     len += snprintf(o + len, cap - (size_t)len,
                     "<text x=\"%d\" y=\"%d\" fill=\"#3b6fb6\">apriltag, 1 thread</text><text x=\"%d\" y=\"%d\" fill=\"#2c8a3b\">apriltag, 2 threads</text>"
-                    "<text x=\"%d\" y=\"%d\" fill=\"#e08a2c\">OpenCV aruco APRILTAG_36h11</text>\n</svg>\n",
-                    L + 10, T + 14, L + 160, T + 14, L + 310, T + 14);
+                    "<text x=\"%d\" y=\"%d\" fill=\"#e08a2c\">OpenCV aruco DICT_APRILTAG_36h11</text>\n</svg>\n",
+                    L + 10, T + 16, L + 160, T + 16, L + 310, T + 16);
     bool ok = mr_file_write_atomic(path, o, (size_t)len, err);
     free(o);
     return ok;

@@ -17,6 +17,7 @@ int cmd_replay(int argc, char **argv) {
         {"from", "F", "first frame number (default 0)", NULL},
         {"to", "T", "last frame number (default: the last)", NULL},
         {"raw", NULL, "use the raw pose instead of the filtered one", NULL},
+        {"video", "FILE.avi", "also write the overlays as a Motion-JPEG AVI at the recording's rate", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -25,7 +26,7 @@ int cmd_replay(int argc, char **argv) {
     int npos = 0;
     bool help;
     if (!app_parse(argc, argv, 2, opts, pos, 1, &npos,
-                   "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] [--raw]",
+                   "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] [--raw] [--video F.avi]",
                    &help))
         return 2;
     if (help) return 0;
@@ -50,6 +51,25 @@ int cmd_replay(int argc, char **argv) {
     bool ok = scene && mr_mkdirs(out, &err) && app_gfx_open(&gfx, &err) && mr_renderer_set_scene(gfx.renderer, scene, &err);
     cJSON *log = cJSON_CreateArray();
     int rendered = 0, plain = 0, selected = 0;
+    mr_video_writer *vw = NULL;
+    /* the video's rate: the recording's median frame interval */
+    double fps = 10;
+    if (rec->frame_count > 1) {
+        double *dt = malloc((size_t)rec->frame_count * sizeof *dt);
+        int n = 0;
+        for (int i = 1; dt && i < rec->frame_count; i++)
+            if (rec->frames[i].t > rec->frames[i - 1].t) dt[n++] = rec->frames[i].t - rec->frames[i - 1].t;
+        if (n > 0) {
+            for (int i = 1; i < n; i++)
+                for (int j = i; j > 0 && dt[j] < dt[j - 1]; j--) {
+                    double x = dt[j];
+                    dt[j] = dt[j - 1];
+                    dt[j - 1] = x;
+                }
+            fps = 1.0 / dt[n / 2] / (double)every;
+        }
+        free(dt);
+    }
     for (int i = 0; ok && i < rec->frame_count; i++) {
         const mr_rec_frame *f = &rec->frames[i];
         if (f->index < from || (to >= 0 && f->index > to) || (f->index - from) % every != 0) continue;
@@ -73,11 +93,15 @@ int cmd_replay(int argc, char **argv) {
             fp.alpha = (float)alpha;
             mr_frame_result res;
             ok = mr_render_frame(gfx.renderer, &view, &fp, &res, &err) && mr_image_save_png(path, &res.color, &err);
+            if (ok && app_get(opts, "video") && !vw) vw = mr_video_writer_open(app_get(opts, "video"), res.color.width, res.color.height, fps, &err);
+            if (ok && app_get(opts, "video")) ok = vw && mr_video_writer_add(vw, &res.color, &err);
             if (ok) mr_frame_result_free(&res);
             rendered++;
         } else {
             /* No pose: the camera frame alone keeps the sequence complete. */
             ok = mr_image_save_png(path, &img, &err);
+            if (ok && app_get(opts, "video") && !vw) vw = mr_video_writer_open(app_get(opts, "video"), img.width, img.height, fps, &err);
+            if (ok && app_get(opts, "video")) ok = vw && mr_video_writer_add(vw, &img, &err);
             plain++;
         }
         mr_image_free(&img);
@@ -118,6 +142,8 @@ int cmd_replay(int argc, char **argv) {
         free(buf);
     }
     cJSON_Delete(log);
+    if (ok && vw) ok = mr_video_writer_close(&vw, &err);
+    mr_video_writer_abort(&vw); /* after a failure: no half-written video */
     app_gfx_close(&gfx);
     mr_scene_destroy(&scene);
     mr_recording_close(&rec);

@@ -24,6 +24,10 @@ grep -q '^{"frame":0,"detections":\[{"id":2,"hamming":0,"corners":\[\[' "$tmp/de
 grep -q '"world_from_camera":\[' "$tmp/poses.jsonl" && grep -q '"filtered":\[' "$tmp/poses.jsonl" && ok || bad "pose lines lack matrices"
 # Same input, same output.
 "$mr" track --input "$rec" --out "$tmp/poses2.jsonl" 2>/dev/null && cmp -s "$tmp/poses.jsonl" "$tmp/poses2.jsonl" && ok || bad "track is not deterministic"
+# --freeze: one filtered pose for the whole run (a still-image check).
+"$mr" track --input "$rec" --freeze --out "$tmp/frozen.jsonl" 2>/dev/null && ok || bad "track --freeze failed"
+[ "$(grep -o '"filtered":\[[^]]*\]' "$tmp/frozen.jsonl" | sort -u | wc -l)" -eq 1 ] && ok || bad "--freeze: the filtered pose changed"
+[ "$(grep -c '"filtered"' "$tmp/frozen.jsonl")" -gt "$(grep -c '"valid":true' "$tmp/frozen.jsonl")" ] && ok || bad "--freeze: no held pose on frames without tags"
 # Explicit camera and markers from the recording's meta, on an image folder.
 "$mr" track --input "$rec/frames" --camera "$src/configs/cameras/demo_640x480.json" --markers "$src/configs/markers/demo_hall.json" \
   --decimate 1 --threads 2 --refine-edges 0 --family tag36h11 --max-frames 5 >"$tmp/folder.jsonl" 2>"$tmp/folder.err" \
@@ -126,6 +130,8 @@ if "$mr" demo --out "$tmp/demo" >"$tmp/demo.log" 2>&1; then
   done
   [ $n -eq 3 ] && ok || bad "replay wrote $n images, expected 3 (frames 20, 60, 100)"
   cmp -s "$tmp/rp1/replay.jsonl" "$tmp/rp2/replay.jsonl" && ok || bad "replay.jsonl differs"
+  "$mr" replay "$rec" --scene "$scene" --out "$tmp/rp5" --from 40 --to 50 --video "$tmp/rp5.avi" >/dev/null 2>"$tmp/rp5.err" \
+    && [ "$("$mr" track --input "$tmp/rp5.avi" --print-detections 2>/dev/null | wc -l)" -eq 11 ] && ok || bad "replay --video: $(cat "$tmp/rp5.err")"
   expect_fail replay_not_recording "" -- "$mr" replay "$tmp" --scene "$scene" --out "$tmp/rp3"
   expect_fail replay_bad_range "" -- "$mr" replay "$rec" --scene "$scene" --out "$tmp/rp4" --from 50 --to 10
   "$mr" synth --out "$tmp/syn" --frames 3 --motion-blur 1 >/dev/null 2>"$tmp/syn.err" && [ "$(wc -l <"$tmp/syn/groundtruth.jsonl")" -eq 3 ] \

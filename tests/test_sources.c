@@ -53,6 +53,9 @@ int main(void) {
     const char *t = getenv("MR_TEST_TMP"), *src = getenv("MR_SOURCE_DIR");
     snprintf(g_tmp, sizeof g_tmp, "%s/test_sources", t ? t : "/tmp/mrcheck-test");
     mr_error err = {0};
+    char cmd[1200];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_tmp); /* a clean start: no video from an earlier run */
+    if (system(cmd) != 0) return 1;
     CHECK(mr_mkdirs(g_tmp, &err));
     char dir[2048], video[2048], cut[2048], path[4200];
     snprintf(dir, sizeof dir, "%s/recordings/demo", src ? src : ".");
