@@ -97,6 +97,7 @@ int app_bench_ghost(int argc, char **argv);
 int cmd_demo(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
+int cmd_view(int argc, char **argv);
 int bench_ao(int argc, char **argv);
 
 /* Big scenes (scene_load.c): load with progress on a terminal and report

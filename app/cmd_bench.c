@@ -185,8 +185,8 @@ int cmd_bench(int argc, char **argv) {
     if (argc >= 3 && strcmp(argv[2], "frame") == 0) return bench_frame(argc, argv);
     if (argc >= 3 && strcmp(argv[2], "scene") == 0) return bench_scene(argc, argv);
     if (argc >= 3 && strcmp(argv[2], "ao") == 0) return bench_ao(argc, argv);
-    if (argc >= 3 && strcmp(argv[2], "tracking") == 0) return bench_tracking(argc, argv);
     if (argc >= 3 && strcmp(argv[2], "ghost") == 0) return app_bench_ghost(argc, argv);
+    if (argc >= 3 && strcmp(argv[2], "tracking") == 0) return bench_tracking(argc, argv);
     if (argc >= 3 && (strcmp(argv[2], "--help") == 0 || strcmp(argv[2], "-h") == 0)) {
         printf("usage: mrcheck bench {frame,ao,ghost,tracking,scene} [options]   (mrcheck bench NAME --help)\n");
         return 0;

@@ -11,6 +11,7 @@ static const struct {
 } k_commands[] = {
     {"demo", cmd_demo, "build the demo hall (as planned / as built), render camera frames and overlays"},
     {"render", cmd_render, "render one headless frame of a scene from a view"},
+    {"view", cmd_view, "the interactive check: overlay window with a touch UI, live or replayed"},
     {"bench", cmd_bench, "measure run time: bench frame, ao, ghost, tracking, scene"},
     {"synth", cmd_synth, "synthetic recording of the demo hall with ground truth (or a calibration set)"},
     {"track", cmd_track, "AprilTag detection and camera pose per frame (V4L2, video, images, recording)"},

@@ -6,8 +6,9 @@ pkgs=(
   cmake make gcc g++ pkg-config
   libcjson-dev libstb-dev libtinygltf-dev libapriltag-dev libmeshoptimizer-dev
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
-  libopencv-dev libopencv-contrib-dev
+  libglfw3-dev xvfb xauth xdotool fonts-dejavu-core
   libembree-dev
+  libopencv-dev libopencv-contrib-dev
 )
 missing=()
 for p in "${pkgs[@]}"; do

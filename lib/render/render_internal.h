@@ -30,6 +30,14 @@ struct mr_renderer {
     GLuint video_tex;
     int video_w, video_h;
     GLuint queries[MR_MAX_PASSES];
+    /* The last finished frame, for showing it in a window and for picking. */
+    struct {
+        bool valid;
+        GLuint tex;            /* texture holding the finished image */
+        mr_camera cam;         /* at the output size */
+        mr_dmat4 world_from_camera;
+        double near_plane;
+    } last;
     struct mr_ao_state *ao; /* pass_ao.c: AO targets, programs, kernel, reuse cache */
     struct mr_ghost_state *ghost; /* pass_ghost.c: targets, programs, caches; NULL until first used */
 };

@@ -199,6 +199,7 @@ static bool read_back(frame *f, mr_error *err) {
 bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params *params, mr_frame_result *out,
                      mr_error *err) {
     memset(out, 0, sizeof *out);
+    r->last.valid = false; /* targets may be reallocated below */
     mr_frame_params defaults = MR_FRAME_DEFAULTS;
     const mr_frame_params *p = params ? params : &defaults;
     if (!mr_camera_validate(&view->camera, err)) return false;
@@ -245,6 +246,11 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
             out->gpu_ms[k] = (double)ns * 1e-6;
         }
     bool ok = read_back(&f, err);
+    r->last.valid = ok;
+    r->last.tex = f.final_tex;
+    r->last.cam = f.cam;
+    r->last.world_from_camera = view->world_from_camera;
+    r->last.near_plane = f.near_plane;
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     GLenum e = glGetError();
     if (ok && e != GL_NO_ERROR) ok = mr_fail(err, MR_ERR_GL, "GL error 0x%x during the frame", e);

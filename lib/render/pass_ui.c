@@ -1,0 +1,176 @@
+/* The 2D layer of the window: the renderer's finished frame scaled into a
+ * rectangle of the window, then the touch UI's draw list on top, both with
+ * one small program. Vertices stream through one buffer that grows as
+ * needed; the atlas is uploaded only when its version changes. */
+#include "render_internal.h"
+
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct mr_draw2d {
+    mr_gpu *gpu;
+    GLuint prog, vao, vbo, ibo, atlas;
+    GLuint sampler;            /* linear filtering for the scaled frame */
+    size_t vbo_bytes, ibo_bytes;
+    uint32_t atlas_version;
+    int atlas_w, atlas_h;
+    int fb_w, fb_h;
+};
+
+mr_draw2d *mr_draw2d_create(mr_gpu *gpu, mr_error *err) {
+    if (!gpu) {
+        mr_fail(err, MR_ERR_INVALID, "2D layer needs a GPU context");
+        return NULL;
+    }
+    mr_draw2d *d = calloc(1, sizeof *d);
+    if (!d) {
+        mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    d->gpu = gpu;
+    static const char *const files[] = {"ui.vert.glsl", "ui.frag.glsl", NULL};
+    if (!(d->prog = mr_gl_program(files, err))) {
+        free(d);
+        return NULL;
+    }
+    glCreateVertexArrays(1, &d->vao);
+    glEnableVertexArrayAttrib(d->vao, 0);
+    glEnableVertexArrayAttrib(d->vao, 1);
+    glEnableVertexArrayAttrib(d->vao, 2);
+    glVertexArrayAttribFormat(d->vao, 0, 2, GL_FLOAT, GL_FALSE, (GLuint)offsetof(mr_draw2d_vertex, x));
+    glVertexArrayAttribFormat(d->vao, 1, 2, GL_FLOAT, GL_FALSE, (GLuint)offsetof(mr_draw2d_vertex, u));
+    glVertexArrayAttribFormat(d->vao, 2, 4, GL_UNSIGNED_BYTE, GL_TRUE, (GLuint)offsetof(mr_draw2d_vertex, rgba));
+    for (GLuint a = 0; a < 3; a++) glVertexArrayAttribBinding(d->vao, a, 0);
+    /* A sampler object, so the renderer's textures keep their own (nearest)
+     * filtering for its passes. */
+    glCreateSamplers(1, &d->sampler);
+    glSamplerParameteri(d->sampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glSamplerParameteri(d->sampler, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glSamplerParameteri(d->sampler, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glSamplerParameteri(d->sampler, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return d;
+}
+
+void mr_draw2d_destroy(mr_draw2d **dp) {
+    if (!dp || !*dp) return;
+    mr_draw2d *d = *dp;
+    glDeleteProgram(d->prog);
+    glDeleteVertexArrays(1, &d->vao);
+    glDeleteBuffers(1, &d->vbo);
+    glDeleteBuffers(1, &d->ibo);
+    glDeleteTextures(1, &d->atlas);
+    glDeleteSamplers(1, &d->sampler);
+    free(d);
+    *dp = NULL;
+}
+
+void mr_draw2d_begin(mr_draw2d *d, int fb_w, int fb_h, const float clear_srgb[3]) {
+    d->fb_w = fb_w > 0 ? fb_w : 1;
+    d->fb_h = fb_h > 0 ? fb_h : 1;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, d->fb_w, d->fb_h);
+    /* We write encoded sRGB values ourselves. */
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glClearColor(clear_srgb[0], clear_srgb[1], clear_srgb[2], 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+}
+
+/* Streams vertices and indices into buffers that only ever grow (buffer
+ * storage is immutable, so a bigger one replaces the old). */
+static bool upload(GLuint *buf, size_t *have, const void *data, size_t bytes) {
+    if (bytes > *have) {
+        glDeleteBuffers(1, buf);
+        size_t cap = *have ? *have : 64 * 1024;
+        while (cap < bytes) cap *= 2;
+        glCreateBuffers(1, buf);
+        glNamedBufferStorage(*buf, (GLsizeiptr)cap, NULL, GL_DYNAMIC_STORAGE_BIT);
+        *have = cap;
+    }
+    if (bytes) glNamedBufferSubData(*buf, 0, (GLsizeiptr)bytes, data);
+    return true;
+}
+
+static void draw(mr_draw2d *d, int mode, GLuint tex, int index_count) {
+    glUseProgram(d->prog);
+    glUniform2f(0, (float)d->fb_w, (float)d->fb_h);
+    glUniform1i(1, mode);
+    glBindTextureUnit(0, tex);
+    glVertexArrayVertexBuffer(d->vao, 0, d->vbo, 0, sizeof(mr_draw2d_vertex));
+    glVertexArrayElementBuffer(d->vao, d->ibo);
+    glBindVertexArray(d->vao);
+    glDrawElements(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, NULL);
+    glBindVertexArray(0);
+}
+
+bool mr_draw2d_frame(mr_draw2d *d, mr_renderer *r, float x, float y, float w, float h, mr_error *err) {
+    if (!r || !r->last.valid) return mr_fail(err, MR_ERR_INVALID, "no rendered frame to show");
+    /* Render targets hold the top image row first, so v runs with y. */
+    const mr_draw2d_vertex v[4] = {
+        {x, y, 0, 0, 0xffffffffu}, {x + w, y, 1, 0, 0xffffffffu},
+        {x + w, y + h, 1, 1, 0xffffffffu}, {x, y + h, 0, 1, 0xffffffffu},
+    };
+    static const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
+    upload(&d->vbo, &d->vbo_bytes, v, sizeof v);
+    upload(&d->ibo, &d->ibo_bytes, ix, sizeof ix);
+    glDisable(GL_BLEND);
+    glBindSampler(0, d->sampler);
+    draw(d, 1, r->last.tex, 6);
+    glBindSampler(0, 0);
+    GLenum e = glGetError();
+    if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x drawing the frame", e);
+    return true;
+}
+
+bool mr_draw2d_list_draw(mr_draw2d *d, const mr_draw2d_list *l, mr_error *err) {
+    if (!l || l->index_count <= 0) return true;
+    if (!l->atlas || l->atlas_w <= 0 || l->atlas_h <= 0) return mr_fail(err, MR_ERR_INVALID, "2D list without an atlas");
+    if (!d->atlas || d->atlas_version != l->atlas_version || d->atlas_w != l->atlas_w || d->atlas_h != l->atlas_h) {
+        glDeleteTextures(1, &d->atlas);
+        d->atlas = mr_gl_make_tex(GL_R8, l->atlas_w, l->atlas_h, GL_LINEAR);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glTextureSubImage2D(d->atlas, 0, 0, 0, l->atlas_w, l->atlas_h, GL_RED, GL_UNSIGNED_BYTE, l->atlas);
+        d->atlas_version = l->atlas_version;
+        d->atlas_w = l->atlas_w;
+        d->atlas_h = l->atlas_h;
+    }
+    upload(&d->vbo, &d->vbo_bytes, l->vertices, (size_t)l->vertex_count * sizeof *l->vertices);
+    upload(&d->ibo, &d->ibo_bytes, l->indices, (size_t)l->index_count * sizeof *l->indices);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    draw(d, 0, d->atlas, l->index_count);
+    glDisable(GL_BLEND);
+    GLenum e = glGetError();
+    if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x drawing the UI", e);
+    return true;
+}
+
+bool mr_draw2d_read(mr_draw2d *d, mr_image *out, mr_error *err) {
+    if (!mr_image_alloc(out, d->fb_w, d->fb_h, 3, MR_PIX_U8, err)) return false;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glReadBuffer(GL_BACK);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, d->fb_w, d->fb_h, GL_RGB, GL_UNSIGNED_BYTE, out->data);
+    /* GL's rows run bottom-up; images here are top row first. */
+    size_t row = (size_t)d->fb_w * 3;
+    uint8_t *p = out->data, *tmp = malloc(row);
+    if (!tmp) {
+        mr_image_free(out);
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    }
+    for (int y = 0; y < d->fb_h / 2; y++) {
+        uint8_t *a = p + (size_t)y * row, *b = p + (size_t)(d->fb_h - 1 - y) * row;
+        memcpy(tmp, a, row);
+        memcpy(a, b, row);
+        memcpy(b, tmp, row);
+    }
+    free(tmp);
+    GLenum e = glGetError();
+    if (e != GL_NO_ERROR) {
+        mr_image_free(out);
+        return mr_fail(err, MR_ERR_GL, "GL error 0x%x reading the window", e);
+    }
+    return true;
+}

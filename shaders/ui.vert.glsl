@@ -1,0 +1,17 @@
+// 2D layer: vertices in framebuffer pixels (origin top-left), turned into
+// clip space here so the CPU side never needs to know the window size.
+layout(location = 0) in vec2 a_pos;
+layout(location = 1) in vec2 a_uv;
+layout(location = 2) in vec4 a_color;   // sRGB bytes, normalised
+
+layout(location = 0) uniform vec2 u_fb_size;
+
+out vec2 v_uv;
+out vec4 v_color;
+
+void main() {
+    v_uv = a_uv;
+    v_color = a_color;
+    vec2 ndc = a_pos / u_fb_size * 2.0 - 1.0;
+    gl_Position = vec4(ndc.x, -ndc.y, 0.0, 1.0);
+}

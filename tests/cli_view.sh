@@ -1,0 +1,231 @@
+#!/usr/bin/env bash
+# `mrcheck view` end to end, in a real window under Xvfb. Input comes from
+# --script files (timed events that enter the window's own event queue, the
+# path real input takes) and, where xdotool exists, from real X events.
+# Checks: the window shows a non-blank overlay from the demo recording;
+# dragging the slider moves the picture towards the video or the model; a tap
+# on a toggle changes the pass list; a mark writes a valid line to
+# annotations.jsonl that survives kill -9 right after; snapshots; freeze;
+# settings persist; resizing does not crash; no camera and a broken scene
+# are shown in the UI with the window still running.
+# Usage: cli_view.sh MRCHECK TMPDIR. Exit 77 = skipped (no Xvfb / no GL).
+set -u
+mr=$1
+tmp=$2
+if [ -z "${DISPLAY:-}" ]; then
+  if ! command -v xvfb-run >/dev/null 2>&1; then
+    echo "cli_view: SKIPPED: no display and Xvfb is not installed (apt-get install xvfb xauth)"
+    exit 77
+  fi
+  exec xvfb-run -a -s "-screen 0 1024x768x24" bash "$0" "$@"
+fi
+rm -rf "$tmp" && mkdir -p "$tmp"
+pass=0 fail=0
+ok() { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
+# jget FILE KEY: a top-level scalar from the pretty-printed state JSON.
+jget() { sed -n "s/^[[:space:]]*\"$2\":[[:space:]]*\(.*\)$/\1/p" "$1" | head -1 | sed 's/,$//; s/^"//; s/"$//'; }
+# widget FILE NAME: "x y" of the centre of a named widget.
+widget() {
+  tr -d '\n\t ' <"$1" | sed -n "s/.*\"$2\":\[\([-0-9.e]*\),\([-0-9.e]*\),\([-0-9.e]*\),\([-0-9.e]*\)\].*/\1 \2 \3 \4/p" |
+    awk '{printf "%d %d\n", $1 + $3 / 2, $2 + $4 / 2}'
+}
+lt() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a + 0 < b + 0) }'; }
+
+if ! "$mr" demo --out "$tmp/demo" >"$tmp/demo.log" 2>&1; then
+  if grep -q "EGL" "$tmp/demo.log"; then echo "cli_view: SKIPPED: no EGL device"; exit 77; fi
+  cat "$tmp/demo.log"; echo "0 passed, 1 failed"; exit 1
+fi
+d=$tmp/demo
+# The demo's frame 2 sees a tag: replay starts paused there.
+view() { # view NAME SCRIPT [extra args...]: runs the viewer over the demo recording
+  local name=$1 script=$2
+  shift 2
+  printf '%s\n' "$script" >"$tmp/$name.script"
+  timeout 120 "$mr" view --scene "$d/scene_planned.json" --replay "$d" --out "$tmp/session" --config "$tmp/cfg.json" \
+    --size 480x360 --paused --script "$tmp/$name.script" "$@" >"$tmp/$name.out" 2>"$tmp/$name.err"
+}
+
+# 1. Overlay, slider direction, toggle and pass list, freeze, snapshot.
+if view main "0.2 key .
+0.6 key .
+1.4 state $tmp/s_start.json
+1.5 drag @alpha 0.5 0.0
+2.0 state $tmp/s_model.json
+2.1 drag @alpha 0.0 1.0
+2.6 state $tmp/s_video.json
+2.7 drag @alpha 0.99 0.75
+3.1 tap @video
+3.5 state $tmp/s_novideo.json
+3.6 tap @video
+3.65 tap @ao
+3.95 state $tmp/s_ao.json
+4.0 key f
+4.2 key space
+5.0 state $tmp/s_frozen.json
+5.1 key s
+5.6 quit" --stats; then
+  ok
+  if [ -s "$tmp/s_start.json" ]; then
+    [ "$(jget "$tmp/s_start.json" pose_valid)" = true ] && ok || bad "no pose on the demo's frame 2"
+    [ "$(jget "$tmp/s_start.json" passes)" = "gbuffer shade overlay" ] && ok || bad "passes at start: $(jget "$tmp/s_start.json" passes)"
+    lt 20 "$(jget "$tmp/s_start.json" screen_std)" && ok || bad "the window looks blank (std $(jget "$tmp/s_start.json" screen_std))"
+    lt 1 "$(jget "$tmp/s_start.json" diff_to_model)" && lt 1 "$(jget "$tmp/s_start.json" diff_to_video)" \
+      && ok || bad "alpha 0.5 should differ from both model and video"
+    lt 8.5 "$(jget "$tmp/s_start.json" target_px)" && ok || bad "touch targets under 9 mm"
+  else bad "no start state"; fi
+  # Slider to the left: the picture is the model; to the right: the video.
+  a=$(jget "$tmp/s_model.json" alpha); lt "$a" 0.02 && ok || bad "slider left gave alpha $a"
+  lt "$(jget "$tmp/s_model.json" diff_to_model)" "$(jget "$tmp/s_start.json" diff_to_model)" \
+    && ok || bad "dragging left did not move the picture towards the model"
+  lt "$(jget "$tmp/s_model.json" diff_to_model)" 0.5 && ok || bad "at alpha 0 the picture is not the model"
+  a=$(jget "$tmp/s_video.json" alpha); lt 0.98 "$a" && ok || bad "slider right gave alpha $a"
+  lt "$(jget "$tmp/s_video.json" diff_to_video)" "$(jget "$tmp/s_start.json" diff_to_video)" \
+    && ok || bad "dragging right did not move the picture towards the video"
+  # Video toggle: no video, no overlay pass.
+  [ "$(jget "$tmp/s_novideo.json" passes)" = "gbuffer shade" ] && ok || bad "video toggle: passes $(jget "$tmp/s_novideo.json" passes)"
+  # AO toggle: an AO pass joins the list.
+  jget "$tmp/s_ao.json" passes | grep -q " ao" && [ "$(jget "$tmp/s_ao.json" ao)" != none ] \
+    && ok || bad "AO toggle: passes $(jget "$tmp/s_ao.json" passes)"
+  # Frozen: play does not advance the frame.
+  [ "$(jget "$tmp/s_frozen.json" frozen)" = true ] && [ "$(jget "$tmp/s_frozen.json" frame_index)" = 2 ] \
+    && ok || bad "freeze: frozen=$(jget "$tmp/s_frozen.json" frozen) frame=$(jget "$tmp/s_frozen.json" frame_index)"
+  for f in snap_0001_screen.png snap_0001_frame.png snap_0001.json; do
+    [ -s "$tmp/session/snapshots/$f" ] && ok || bad "snapshot did not write $f"
+  done
+  grep -q "tracking (capture thread)" "$tmp/main.out" && grep -q "ui: widgets" "$tmp/main.out" \
+    && ok || bad "--stats printed no frame-time split"
+else
+  bad "view run failed: $(tail -3 "$tmp/main.err")"
+fi
+# Settings persist: the slider where it was left, the video back on.
+a=$(jget "$tmp/cfg.json" alpha)
+awk -v a="$a" 'BEGIN { exit !(a > 0.6 && a < 0.9) }' && ok || bad "settings file has alpha '$a'"
+if view persist "0.5 state $tmp/s_persist.json
+0.6 quit"; then
+  [ "$(jget "$tmp/s_persist.json" alpha)" = "$a" ] && ok || bad "alpha not restored: $(jget "$tmp/s_persist.json" alpha) vs $a"
+else bad "second run failed: $(tail -3 "$tmp/persist.err")"; fi
+
+# 1a. Tracking lost: the demo's frame 3 shows no tag; the model stays at
+#     frame 2's pose, dimmed, and the status says so.
+if view lost "0.2 key .
+0.6 key .
+1.2 key .
+1.9 state $tmp/s_lost.json
+2.0 shot $tmp/lost.png
+2.1 quit"; then
+  [ "$(jget "$tmp/s_lost.json" frame_index)" = 3 ] && [ "$(jget "$tmp/s_lost.json" pose_valid)" = false ] \
+    && [ "$(jget "$tmp/s_lost.json" tracking_lost_dimmed)" = true ] && ok \
+    || bad "tracking lost: frame $(jget "$tmp/s_lost.json" frame_index) valid $(jget "$tmp/s_lost.json" pose_valid) dimmed $(jget "$tmp/s_lost.json" tracking_lost_dimmed)"
+else bad "tracking-lost run failed: $(tail -3 "$tmp/lost.err")"; fi
+
+# 1b. The shipped demo recording (recordings/demo, lib/session's format):
+#     recorded poses, play advances, the seek bar and step move the frame.
+rec=$(cd "$(dirname "$0")/.." && pwd)/recordings/demo
+if [ -f "$rec/meta.json" ]; then
+  printf '%s\n' "0.3 state $tmp/r0.json" "0.4 key space" "1.5 key space" "1.7 state $tmp/r1.json" \
+    "1.8 drag @seek 0.2 0.9" "2.6 state $tmp/r2.json" "2.7 key ," "3.3 state $tmp/r3.json" "3.4 quit" >"$tmp/rec.script"
+  if timeout 120 "$mr" view --scene "$d/scene_planned.json" --replay "$rec" --out "$tmp/recsession" --config "$tmp/cfgr.json" \
+       --size 480x360 --paused --script "$tmp/rec.script" >/dev/null 2>"$tmp/rec.err"; then
+    [ "$(jget "$tmp/r0.json" pose_valid)" = true ] && [ "$(jget "$tmp/r0.json" frame_index)" = 0 ] && ok || bad "recording: no pose at frame 0"
+    lt 20 "$(jget "$tmp/r0.json" screen_std)" && ok || bad "recording: blank window"
+    jget "$tmp/r0.json" passes | grep -q overlay && ok || bad "recording: no overlay pass"
+    f1=$(jget "$tmp/r1.json" frame_index); lt 3 "$f1" && ok || bad "recording: play did not advance ($f1)"
+    f2=$(jget "$tmp/r2.json" frame_index); lt 90 "$f2" && ok || bad "recording: seek bar to 90% gave frame $f2"
+    f3=$(jget "$tmp/r3.json" frame_index); [ "$f3" = $((f2 - 1)) ] && ok || bad "recording: step back from $f2 gave $f3"
+  else bad "recording replay failed: $(tail -3 "$tmp/rec.err")"; fi
+fi
+
+# 2. A mark: tap in the picture, choose a note; the line must be in
+#    annotations.jsonl at once, whole, and survive kill -9 right after.
+rm -f "$tmp/session/annotations.jsonl"
+printf '%s\n' "0.2 key . " "0.6 key ." "1.4 tap @mark" "1.8 tap 150 150" "2.4 tap @note2" "60 quit" >"$tmp/mark.script"
+# Started directly (no `timeout` wrapper), so $! is the viewer itself.
+"$mr" view --scene "$d/scene_planned.json" --replay "$d" --out "$tmp/session" --config "$tmp/cfg.json" \
+  --size 480x360 --paused --script "$tmp/mark.script" >"$tmp/mark.out" 2>"$tmp/mark.err" &
+pid=$!
+for _ in $(seq 1 300); do
+  [ -s "$tmp/session/annotations.jsonl" ] && break
+  sleep 0.1
+done
+kill -9 $pid 2>/dev/null
+wait $pid 2>/dev/null
+[ -e "/proc/$pid" ] && bad "the viewer survived kill -9"
+ann=$tmp/session/annotations.jsonl
+if [ -s "$ann" ]; then
+  [ "$(wc -l <"$ann")" -eq 1 ] && [ "$(tail -c 1 "$ann" | od -An -c | tr -d ' ')" = '\n' ] && ok || bad "annotation is not one whole line"
+  line=$(head -1 "$ann")
+  for k in '"note":"extra"' '"hit":true' '"world":\[' '"node":"' '"pose":{' '"world_from_camera":\[' '"snapshot":{' '"frame_index":2'; do
+    echo "$line" | grep -q "$k" && ok || bad "annotation lacks $k: $line"
+  done
+  if command -v python3 >/dev/null 2>&1; then
+    python3 -c 'import json,sys; json.loads(open(sys.argv[1]).readline())' "$ann" && ok || bad "annotation is not valid JSON"
+  fi
+  snap=$(echo "$line" | sed -n 's/.*"screen":"\([^"]*\)".*/\1/p')
+  [ -n "$snap" ] && [ -s "$tmp/session/$snap" ] && ok || bad "mark snapshot missing ($snap)"
+else
+  bad "no annotation written: $(tail -3 "$tmp/mark.err")"
+fi
+
+# 3. Real X input (xdotool): a click on the Video toggle turns the overlay off.
+if command -v xdotool >/dev/null 2>&1; then
+  printf '%s\n' "0.5 state $tmp/x1.json" "4.0 state $tmp/x2.json" "4.5 quit" >"$tmp/x.script"
+  timeout 120 "$mr" view --scene "$d/scene_planned.json" --replay "$d" --out "$tmp/session" --config "$tmp/cfgx.json" \
+    --size 480x360 --paused --script "$tmp/x.script" >"$tmp/x.out" 2>"$tmp/x.err" &
+  pid=$!
+  for _ in $(seq 1 100); do [ -s "$tmp/x1.json" ] && break; sleep 0.1; done
+  wid=$(xdotool search --sync --limit 1 --name "mrcheck view" 2>/dev/null | head -1)
+  read -r vx vy < <(widget "$tmp/x1.json" video)
+  if [ -n "$wid" ] && [ -n "${vx:-}" ]; then
+    xdotool mousemove --window "$wid" "$vx" "$vy" sleep 0.2 mousedown 1 sleep 0.2 mouseup 1
+  fi
+  wait $pid
+  [ "$(jget "$tmp/x1.json" passes)" = "gbuffer shade overlay" ] && [ "$(jget "$tmp/x2.json" passes)" = "gbuffer shade" ] \
+    && ok || bad "xdotool click on Video: passes '$(jget "$tmp/x1.json" passes)' -> '$(jget "$tmp/x2.json" passes)'"
+fi
+
+# 4. Resizing does not crash, and the layout follows.
+if view resize "0.3 resize 300 220
+0.8 resize 700 500
+1.3 resize 160 120
+1.8 resize 480 360
+2.3 state $tmp/s_resize.json
+2.4 quit"; then
+  ok
+  [ "$(jget "$tmp/s_resize.json" fb_width)" = 480 ] && ok || bad "after resizing the framebuffer is $(jget "$tmp/s_resize.json" fb_width) wide"
+else bad "resize run failed: $(tail -3 "$tmp/resize.err")"; fi
+
+# 5. No camera: the message is on screen, the window keeps running.
+printf '%s\n' "0.5 state $tmp/s_nocam.json" "0.6 shot $tmp/nocam.png" "0.7 quit" >"$tmp/nocam.script"
+if timeout 60 "$mr" view --scene "$d/scene_planned.json" --input /dev/video-mrcheck-none --camera "$d/camera.json" \
+     --markers "$d/markers.json" --config "$tmp/cfg2.json" --size 480x360 --script "$tmp/nocam.script" >/dev/null 2>"$tmp/nocam.err"; then
+  [ "$(jget "$tmp/s_nocam.json" source_state)" = no_camera ] && ok || bad "no camera: state $(jget "$tmp/s_nocam.json" source_state)"
+  jget "$tmp/s_nocam.json" source_message | grep -q "no camera" && ok || bad "no camera message: $(jget "$tmp/s_nocam.json" source_message)"
+else bad "no-camera run failed: $(tail -3 "$tmp/nocam.err")"; fi
+
+# 5b. The camera appears later: the viewer keeps retrying and picks it up.
+printf '%s\n' "0.3 state $tmp/s_late0.json" "4.5 state $tmp/s_late1.json" "4.6 quit" >"$tmp/late.script"
+( sleep 5; cp "$d/frames/frame_002.png" "$tmp/late.png" ) &
+if timeout 60 "$mr" view --scene "$d/scene_planned.json" --input "$tmp/late.png" --camera "$d/camera.json" \
+     --view "$d/views/view_002.json" --config "$tmp/cfg2.json" --size 480x360 --script "$tmp/late.script" >/dev/null 2>"$tmp/late.err"; then
+  [ "$(jget "$tmp/s_late0.json" source_state)" = no_camera ] && [ "$(jget "$tmp/s_late1.json" have_frame)" = true ] \
+    && ok || bad "late camera: $(jget "$tmp/s_late0.json" source_state) -> have_frame $(jget "$tmp/s_late1.json" have_frame)"
+else bad "late-camera run failed: $(tail -3 "$tmp/late.err")"; fi
+wait
+
+# 6. A scene that does not load: message, the window stays usable.
+printf '%s\n' "0.3 tap @video" "0.8 state $tmp/s_noscene.json" "0.9 quit" >"$tmp/noscene.script"
+if timeout 60 "$mr" view --scene "$tmp/missing.glb" --replay "$d" --out "$tmp/session" --config "$tmp/cfg3.json" \
+     --size 480x360 --paused --script "$tmp/noscene.script" >/dev/null 2>"$tmp/noscene.err"; then
+  jget "$tmp/s_noscene.json" scene_message | grep -q "scene failed to load" && ok || bad "no scene message"
+  [ "$(jget "$tmp/s_noscene.json" show_video)" = false ] && ok || bad "controls dead without a scene"
+else bad "missing-scene run failed: $(tail -3 "$tmp/noscene.err")"; fi
+
+# 7. Bad arguments: one line on stderr, exit 2, before any window.
+"$mr" view --scene "$d/scene_planned.json" 2>"$tmp/bad.err"; rc=$?
+[ $rc -eq 2 ] && [ "$(wc -l <"$tmp/bad.err")" -eq 1 ] && ok || bad "missing input: rc $rc, $(cat "$tmp/bad.err")"
+"$mr" view --scene "$d/scene_planned.json" --input /dev/video0 2>"$tmp/bad2.err"; rc=$?
+[ $rc -ne 0 ] && [ "$(wc -l <"$tmp/bad2.err")" -eq 1 ] && ok || bad "--input without --camera: rc $rc"
+
+echo "cli_view: $pass passed, $fail failed"
+[ $fail -eq 0 ]

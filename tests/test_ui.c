@@ -1,0 +1,213 @@
+/* lib/ui without a display: layout, hit-testing, slider math, widget
+ * behaviour over scripted pointer input, and the draw list. */
+#include "mr_test.h"
+#include "mr_ui.h"
+
+#include <string.h>
+
+static mr_ui_input at(float x, float y, bool down) {
+    mr_ui_input in = {x, y, down, true};
+    return in;
+}
+
+static void test_rects(void) {
+    mr_ui_rect r = mr_ui_rect_make(10, 20, 100, 50);
+    CHECK(mr_ui_rect_contains(r, 10, 20));
+    CHECK(mr_ui_rect_contains(r, 109.9f, 69.9f));
+    CHECK(!mr_ui_rect_contains(r, 110, 30)); /* half-open: neighbours never share a pixel */
+    CHECK(!mr_ui_rect_contains(r, 9.9f, 30));
+    mr_ui_rect a = r;
+    mr_ui_rect left = mr_ui_cut_left(&a, 30);
+    CHECK_NEAR(left.w, 30, 0);
+    CHECK_NEAR(a.x, 40, 0);
+    CHECK_NEAR(a.w, 70, 0);
+    mr_ui_rect right = mr_ui_cut_right(&a, 500); /* clamps to what is there */
+    CHECK_NEAR(right.w, 70, 0);
+    CHECK_NEAR(a.w, 0, 0);
+    mr_ui_rect b = r;
+    mr_ui_rect top = mr_ui_cut_top(&b, 10), bottom = mr_ui_cut_bottom(&b, 15);
+    CHECK_NEAR(top.y, 20, 0);
+    CHECK_NEAR(bottom.y, 55, 0);
+    CHECK_NEAR(b.y, 30, 0);
+    CHECK_NEAR(b.h, 25, 0);
+    mr_ui_rect in = mr_ui_rect_inset(r, 100);
+    CHECK(in.w >= 0 && in.h >= 0);
+    mr_ui_rect fit = mr_ui_fit(mr_ui_rect_make(0, 0, 800, 400), 640, 480);
+    CHECK_NEAR(fit.h, 400, 1e-4);
+    CHECK_NEAR(fit.w, 400 * 640.0 / 480, 1e-3);
+    CHECK_NEAR(fit.x, (800 - fit.w) / 2, 1e-3);
+    mr_ui_rect bad = mr_ui_fit(mr_ui_rect_make(0, 0, 800, 400), 0, 480);
+    CHECK_NEAR(bad.w, 800, 0);
+}
+
+static void test_draw_list(const mr_ui_font *font) {
+    mr_ui_draw_list dl;
+    memset(&dl, 0, sizeof dl);
+    CHECK(mr_ui_draw_rect(&dl, mr_ui_rect_make(0, 0, 10, 10), 0xffffffffu));
+    CHECK(dl.vertex_count == 4 && dl.index_count == 6);
+    CHECK(mr_ui_draw_rect(&dl, mr_ui_rect_make(0, 0, 0, 10), 0xffffffffu)); /* empty: nothing */
+    CHECK(dl.vertex_count == 4);
+    CHECK(mr_ui_draw_frame(&dl, mr_ui_rect_make(0, 0, 10, 10), 1, 0xff0000ffu));
+    CHECK(dl.vertex_count == 4 + 16);
+    for (int i = 0; i < dl.index_count; i++) CHECK(dl.indices[i] < (uint32_t)dl.vertex_count);
+    int before = dl.vertex_count;
+    CHECK(mr_ui_draw_text(&dl, font, 5, 5, 20, "Hi there", 0xffffffffu));
+    CHECK(dl.vertex_count == before + 7 * 4); /* the space has no quad */
+    /* Growing far past the first allocation keeps indices valid. */
+    for (int i = 0; i < 5000; i++) mr_ui_draw_rect(&dl, mr_ui_rect_make((float)i, 0, 1, 1), 0xffffffffu);
+    CHECK(dl.vertex_count == before + 28 + 20000);
+    CHECK(dl.indices[dl.index_count - 1] == (uint32_t)dl.vertex_count - 1);
+    mr_ui_draw_list_clear(&dl);
+    CHECK(dl.vertex_count == 0 && dl.index_count == 0);
+    mr_ui_draw_list_free(&dl);
+    CHECK(dl.vertices == NULL);
+}
+
+static void test_font(const mr_ui_font *font) {
+    CHECK_NEAR(mr_ui_font_height(font), 24, 0);
+    float w1 = mr_ui_text_width(font, "mmmm", 24), w2 = mr_ui_text_width(font, "mmmm", 48);
+    CHECK(w1 > 20 && w1 < 200);
+    CHECK_NEAR(w2, 2 * w1, 1e-3);
+    CHECK(mr_ui_text_width(font, "", 24) == 0);
+    CHECK(mr_ui_text_width(font, "\x01\xff", 24) > 0); /* unknown characters draw as '?' */
+    mr_error err = {0};
+    mr_ui_font_params fp = MR_UI_FONT_DEFAULTS;
+    fp.path = "/nonexistent/font.ttf";
+    CHECK(mr_ui_font_create(&fp, &err) == NULL && err.code == MR_ERR_IO);
+}
+
+static void test_widgets(const mr_ui_font *font) {
+    mr_ui_params p = MR_UI_DEFAULTS;
+    p.font = font;
+    p.px_per_mm = 4.0;
+    mr_error err = {0};
+    mr_ui *ui = mr_ui_create(&p, &err);
+    CHECK(ui != NULL);
+    if (!ui) return;
+    CHECK_NEAR(mr_ui_target_px(ui), 36, 0); /* 9 mm at 4 px/mm */
+    CHECK_NEAR(mr_ui_mm(ui, 2.5f), 10, 1e-5);
+    mr_ui_rect btn = mr_ui_rect_make(100, 100, 80, 40);
+    mr_ui_rect sl = mr_ui_rect_make(0, 200, 400, 40);
+    float val = 0.5f;
+    bool on = false;
+    int clicks = 0;
+    /* A frame that describes the same UI every time, as the app does. */
+#define FRAME(x, y, down)                                                   \
+    do {                                                                    \
+        mr_ui_input in_ = at(x, y, down);                                   \
+        mr_ui_begin(ui, &in_);                                              \
+        mr_ui_panel(ui, mr_ui_rect_make(0, 300, 50, 50));                   \
+        if (mr_ui_button(ui, 1, btn, "Snap", MR_UI_NORMAL)) clicks++;       \
+        mr_ui_toggle(ui, 2, mr_ui_rect_make(200, 100, 80, 40), "AO", &on);   \
+        mr_ui_slider(ui, 3, sl, "alpha", &val, 0.0f, 1.0f);                 \
+        mr_ui_end(ui);                                                      \
+    } while (0)
+    float tx, ty;
+    /* Tap on the button: click on release. */
+    FRAME(120, 120, false);
+    CHECK(mr_ui_captured(ui));
+    FRAME(120, 120, true);
+    CHECK(clicks == 0);
+    FRAME(120, 120, false);
+    CHECK(clicks == 1);
+    CHECK(!mr_ui_scene_tap(ui, &tx, &ty));
+    /* Press on the button, slide off, release: cancelled, not a click. */
+    FRAME(120, 120, true);
+    FRAME(300, 20, true);
+    FRAME(300, 20, false);
+    CHECK(clicks == 1);
+    CHECK(!mr_ui_scene_tap(ui, &tx, &ty)); /* began on the UI: not a scene tap either */
+    /* Toggle. */
+    FRAME(210, 110, true);
+    FRAME(210, 110, false);
+    CHECK(on);
+    FRAME(210, 110, true);
+    FRAME(210, 110, false);
+    CHECK(!on);
+    /* Tap on empty space is a scene tap at the release point. */
+    FRAME(300, 20, false);
+    CHECK(!mr_ui_captured(ui));
+    FRAME(300, 20, true);
+    FRAME(301, 21, false);
+    CHECK(mr_ui_scene_tap(ui, &tx, &ty) && tx == 301 && ty == 21);
+    /* A drag over the scene is not a tap. */
+    FRAME(300, 20, true);
+    FRAME(360, 20, false);
+    CHECK(!mr_ui_scene_tap(ui, NULL, NULL));
+    /* A tap on a panel is swallowed. */
+    FRAME(10, 310, true);
+    FRAME(10, 310, false);
+    CHECK(!mr_ui_scene_tap(ui, NULL, NULL));
+    /* Slider math: ends map to lo/hi with half a knob of margin, clamps
+     * outside, and knob position inverts value. */
+    float k = mr_ui_mm(ui, 4.0f);
+    CHECK_NEAR(mr_ui_slider_value(ui, sl, sl.x + k / 2, 0, 1), 0, 1e-6);
+    CHECK_NEAR(mr_ui_slider_value(ui, sl, sl.x + sl.w - k / 2, 0, 1), 1, 1e-6);
+    CHECK_NEAR(mr_ui_slider_value(ui, sl, -100, 0, 1), 0, 0);
+    CHECK_NEAR(mr_ui_slider_value(ui, sl, 1e9f, 0, 1), 1, 0);
+    CHECK_NEAR(mr_ui_slider_value(ui, sl, sl.x + sl.w / 2, 0, 1), 0.5, 1e-6);
+    for (float v = 0; v <= 1.0f; v += 0.125f)
+        CHECK_NEAR(mr_ui_slider_value(ui, sl, mr_ui_slider_knob_x(ui, sl, v, 0, 1), 0, 1), v, 1e-5);
+    CHECK_NEAR(mr_ui_slider_value(ui, mr_ui_rect_make(0, 0, 0, 10), 5, 2, 3), 2, 0); /* degenerate */
+    /* Dragging the slider: press at the left end, move right: value follows
+     * and keeps following outside the track while held. */
+    FRAME(sl.x + k / 2, 220, true);
+    CHECK_NEAR(val, 0, 1e-6);
+    FRAME(sl.x + sl.w / 2, 220, true);
+    CHECK_NEAR(val, 0.5, 1e-6);
+    FRAME(sl.x + sl.w * 3, 500, true);
+    CHECK_NEAR(val, 1, 1e-6);
+    FRAME(sl.x + sl.w * 3, 500, false);
+    CHECK_NEAR(val, 1, 1e-6);
+    /* After release, moving over the slider does nothing. */
+    FRAME(sl.x + k / 2, 220, false);
+    CHECK_NEAR(val, 1, 1e-6);
+    /* A label too long for its rect is shrunk, then cut: it never spills. */
+    {
+        mr_ui_input in = at(0, 0, false);
+        mr_ui_begin(ui, &in);
+        mr_ui_rect lr = mr_ui_rect_make(10, 10, 60, 20);
+        mr_ui_label(ui, lr, "a very long message that cannot possibly fit in sixty pixels", 0xffffffffu, true);
+        const mr_ui_draw_list *l = mr_ui_end(ui);
+        CHECK(l->vertex_count > 0);
+        for (int i = 0; i < l->vertex_count; i++) CHECK(l->vertices[i].x >= lr.x && l->vertices[i].x <= lr.x + lr.w);
+    }
+    /* The draw list is non-empty and every index is in range. */
+    const mr_ui_draw_list *dl = mr_ui_end(ui);
+    CHECK(dl->vertex_count > 0 && dl->index_count % 3 == 0);
+    for (int i = 0; i < dl->index_count; i++) CHECK(dl->indices[i] < (uint32_t)dl->vertex_count);
+    CHECK(dl->atlas && dl->atlas_w > 0 && dl->atlas_h > 0);
+    /* The white texel is opaque. */
+    int wx = (int)(dl->white_u * dl->atlas_w), wy = (int)(dl->white_v * dl->atlas_h);
+    CHECK(dl->atlas[(size_t)wy * dl->atlas_w + wx] == 255);
+    CHECK(mr_ui_last_cpu_s(ui) >= 0);
+#undef FRAME
+    mr_ui_destroy(&ui);
+    CHECK(ui == NULL);
+    mr_ui_destroy(&ui);
+    mr_ui_params none = MR_UI_DEFAULTS;
+    CHECK(mr_ui_create(&none, &err) == NULL);
+}
+
+int main(void) {
+    test_rects();
+    char path[1024];
+    mr_error err = {0};
+    if (!mr_ui_font_find(path, sizeof path, &err)) {
+        printf("test_ui: skipped the font tests: %s\n", err.msg);
+        return mr_test_finish("test_ui");
+    }
+    mr_ui_font_params fp = MR_UI_FONT_DEFAULTS;
+    fp.path = path;
+    fp.pixel_height = 24;
+    mr_ui_font *font = mr_ui_font_create(&fp, &err);
+    CHECK_MSG(font != NULL, "%s", err.msg);
+    if (font) {
+        test_font(font);
+        test_draw_list(font);
+        test_widgets(font);
+    }
+    mr_ui_font_destroy(&font);
+    CHECK(font == NULL);
+    return mr_test_finish("test_ui");
+}
