@@ -82,6 +82,17 @@ mr_camera app_demo_camera(void);
 int app_demo_view_count(void);
 mr_view app_demo_view(int i);
 
+/* The ghosting option rows, to splice into a command's option table. */
+#define APP_GHOST_OPTS                                                                                           \
+    {"ghost", "MODE", "ghosted views of the hidden layer: off|alpha|g0|adaptive (default off)", NULL},            \
+    {"ghost-importance", "SRC", "importance map: curvature|saliency|auto (default auto)", NULL},                  \
+    {"ghost-saliency", "IMPL", "saliency pyramid: mipmap|gauss (default mipmap)", NULL},                         \
+    {"ghost-t", "T", "user transparency t in [0,1]: alpha = t * IM (default 1)", NULL},                          \
+    {"ghost-curv-scale", "S", "curvature (rad/px) to importance scale (default 2)", NULL},                        \
+    {"ghost-curv-bias", "B", "importance bias: higher = denser occluder (default 0.35)", NULL},                  \
+    {"ghost-tc-min", "C", "minimal desired contrast tc_minimal (default 0.1)", NULL},                            \
+    {"ghost-gamma", "G", "multiplier of IM in C_desired (default 0.5)", NULL},                                   \
+    {"ghost-tc-sil", "C", "extra desired contrast on hidden silhouettes (default 0.15)", NULL}
 /* Fills gp from the --ghost, --ghost-importance, --ghost-saliency and
  * --ghost-* number options present in opts; one line + false if bad. */
 bool app_ghost_options(const app_opt *opts, mr_ghost_params *gp);

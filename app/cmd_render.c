@@ -49,19 +49,19 @@ bool app_ghost_options(const app_opt *opts, mr_ghost_params *gp) {
         int k = -1;
         for (int i = 0; i < 4; i++)
             if (strcmp(m, names[i]) == 0) k = i;
-        if (k < 0) return app_errorf("render", "--ghost must be off, alpha, g0 or adaptive, got '%s'", m), false;
+        if (k < 0) return fprintf(stderr, "mrcheck: " "--ghost must be off, alpha, g0 or adaptive, got '%s'" "\n", m), false;
         gp->mode = (mr_ghost_mode)k;
     }
     if (im) {
         if (strcmp(im, "auto") == 0) gp->importance = MR_GHOST_IMP_AUTO;
         else if (strcmp(im, "curvature") == 0) gp->importance = MR_GHOST_IMP_CURVATURE;
         else if (strcmp(im, "saliency") == 0) gp->importance = MR_GHOST_IMP_SALIENCY;
-        else return app_errorf("render", "--ghost-importance must be curvature, saliency or auto, got '%s'", im), false;
+        else return fprintf(stderr, "mrcheck: " "--ghost-importance must be curvature, saliency or auto, got '%s'" "\n", im), false;
     }
     if (sal) {
         if (strcmp(sal, "mipmap") == 0) gp->saliency = MR_SALIENCY_MIPMAP;
         else if (strcmp(sal, "gauss") == 0) gp->saliency = MR_SALIENCY_GAUSS;
-        else return app_errorf("render", "--ghost-saliency must be mipmap or gauss, got '%s'", sal), false;
+        else return fprintf(stderr, "mrcheck: " "--ghost-saliency must be mipmap or gauss, got '%s'" "\n", sal), false;
     }
     static const struct { const char *name; double lo, hi; size_t off; } nums[] = {
         {"ghost-t", 0, 1, offsetof(mr_ghost_params, t)},
@@ -119,15 +119,7 @@ int cmd_render(int argc, char **argv) {
         {"hidden", "GLOB", "extra node-name glob for the hidden layer", NULL},
         {"hide-hidden", NULL, "leave the hidden layer out", NULL},
         APP_AO_OPTS,
-        {"ghost", "MODE", "ghosted views of the hidden layer: off|alpha|g0|adaptive (default off)", NULL},
-        {"ghost-importance", "SRC", "importance map: curvature|saliency|auto (default auto)", NULL},
-        {"ghost-saliency", "IMPL", "saliency pyramid: mipmap|gauss (default mipmap)", NULL},
-        {"ghost-t", "T", "user transparency t in [0,1]: alpha = t * IM (default 1)", NULL},
-        {"ghost-curv-scale", "S", "curvature (rad/px) to importance scale (default 2)", NULL},
-        {"ghost-curv-bias", "B", "importance bias: higher = denser occluder (default 0.35)", NULL},
-        {"ghost-tc-min", "C", "minimal desired contrast tc_minimal (default 0.1)", NULL},
-        {"ghost-gamma", "G", "multiplier of IM in C_desired (default 0.5)", NULL},
-        {"ghost-tc-sil", "C", "extra desired contrast on hidden silhouettes (default 0.15)", NULL},
+        APP_GHOST_OPTS,
         APP_DRAW_OPTS,
         {"lod-cache", "on|off", "read/write LOD levels in <scene>.mrlod (default on)", NULL},
         {"verbose", NULL, "print the passes that ran and more", NULL},

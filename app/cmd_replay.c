@@ -18,6 +18,8 @@ int cmd_replay(int argc, char **argv) {
         {"to", "T", "last frame number (default: the last)", NULL},
         {"raw", NULL, "use the raw pose instead of the filtered one", NULL},
         {"video", "FILE.avi", "also write the overlays as a Motion-JPEG AVI at the recording's rate", NULL},
+        APP_AO_OPTS,
+        APP_GHOST_OPTS,
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -26,7 +28,8 @@ int cmd_replay(int argc, char **argv) {
     int npos = 0;
     bool help;
     if (!app_parse(argc, argv, 2, opts, pos, 1, &npos,
-                   "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] [--raw] [--video F.avi]",
+                   "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] [--raw] "
+                   "[--video F.avi] [--ao METHOD ...] [--ghost MODE ...]",
                    &help))
         return 2;
     if (help) return 0;
@@ -42,6 +45,12 @@ int cmd_replay(int argc, char **argv) {
     if (to >= 0 && to < from) return app_errorf(cmd, "--to %ld is before --from %ld", to, from), 2;
     const char *out = app_get(opts, "out");
     bool raw = app_flag(opts, "raw");
+    /* Depth cues as on render: the same option tables and parsers. */
+    mr_frame_params base = MR_FRAME_DEFAULTS;
+    bool groundtruth = false;
+    mr_gt_params gtp = MR_GT_DEFAULTS;
+    if (!app_ao_parse(cmd, opts, &base.ao, &groundtruth, &gtp) || !app_ghost_options(opts, &base.ghost)) return 2;
+    if (groundtruth) return app_errorf(cmd, "--ao groundtruth is for single frames (mrcheck render), not replays"), 2;
 
     mr_error err = {0};
     mr_recording *rec = mr_recording_open(pos[0], &err);
@@ -88,7 +97,7 @@ int cmd_replay(int argc, char **argv) {
         mr_path_join(out, name, path, sizeof path);
         if (has_pose) {
             mr_view view = {mr_camera_resized(&rec->camera, img.width, img.height), pose};
-            mr_frame_params fp = MR_FRAME_DEFAULTS;
+            mr_frame_params fp = base;
             fp.video = &img;
             fp.alpha = (float)alpha;
             mr_frame_result res;

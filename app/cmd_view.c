@@ -106,6 +106,7 @@ typedef struct view_app {
     /* scene */
     mr_scene *scene;
     char scene_msg[600];
+    mr_scene_loader *loader; /* the scene loads on a thread; the window stays live meanwhile */
     /* frames */
     vw_capture *cap;
     vw_frame frame;
@@ -1193,6 +1194,30 @@ static void print_stats(view_app *a) {
     printf("  whole loop                 %8.2f ms per drawn frame\n", a->sum_loop_ms / nf);
 }
 
+/* Called once per loop iteration: shows the loader's progress and, when the
+ * scene is ready, uploads it (on this thread, which owns the GL context). */
+static void poll_scene_load(view_app *a) {
+    if (!a->loader) return;
+    const char *stage = NULL;
+    double frac = 0;
+    if (!mr_scene_loader_poll(a->loader, &stage, &frac)) {
+        snprintf(a->scene_msg, sizeof a->scene_msg, "loading scene: %s %.0f%%", stage ? stage : "", 100.0 * frac);
+        return;
+    }
+    mr_error err = {0};
+    a->scene = mr_scene_loader_finish(&a->loader, &err);
+    a->scene_msg[0] = 0;
+    if (!a->scene) {
+        snprintf(a->scene_msg, sizeof a->scene_msg, "scene failed to load: %.500s", err.msg);
+        mr_log(MR_LOG_ERROR, "view: %s", a->scene_msg);
+    } else if (!mr_renderer_set_scene(a->rend, a->scene, &err)) {
+        snprintf(a->scene_msg, sizeof a->scene_msg, "scene failed to upload: %.500s", err.msg);
+        mr_log(MR_LOG_ERROR, "view: %s", a->scene_msg);
+        mr_scene_destroy(&a->scene);
+    }
+    a->need_render = true;
+}
+
 int cmd_view(int argc, char **argv) {
     app_opt opts[] = {
         {"scene", "FILE", "glTF/GLB or scene config JSON (required)", NULL},
@@ -1210,6 +1235,8 @@ int cmd_view(int argc, char **argv) {
         {"retrack", NULL, "replay: track the frames again instead of using the recorded poses", NULL},
         {"script", "FILE", "timed input events (tests, demos): see cmd_view.c", NULL},
         {"stats", NULL, "print the frame-time split on exit", NULL},
+        {"ao", "METHOD", "start with this AO method (none, scheer, crytek, filion, hbao, alchemy); the A key cycles", NULL},
+        {"ghost", "MODE", "start with this ghosting mode (off, alpha, g0, adaptive); the G key cycles", NULL},
         {"verbose", NULL, "more log output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -1275,15 +1302,36 @@ int cmd_view(int argc, char **argv) {
     if (app_get(opts, "config")) snprintf(a->config_path, sizeof a->config_path, "%s", app_get(opts, "config"));
     else default_config_path(a->config_path, sizeof a->config_path);
     settings_load(a);
+    /* Flags win over the saved settings for this run (and are then saved). */
+    if (app_get(opts, "ao")) {
+        mr_ao_method m;
+        if (!mr_ao_method_parse(app_get(opts, "ao"), &m) || m >= MR_AO_METHOD_COUNT) {
+            rc = app_errorf(k_cmd, "--ao must be none, scheer, crytek, filion, hbao or alchemy, got '%s'", app_get(opts, "ao"));
+            goto done;
+        }
+        a->s.ao = m;
+    }
+    if (app_get(opts, "ghost")) {
+        int k = -1;
+        for (int i = 0; i < GHOST_COUNT; i++)
+            if (strcmp(app_get(opts, "ghost"), k_ghost_names[i]) == 0) k = i;
+        if (k < 0) {
+            rc = app_errorf(k_cmd, "--ghost must be off, alpha, g0 or adaptive, got '%s'", app_get(opts, "ghost"));
+            goto done;
+        }
+        a->s.ghost = (mr_ghost_mode)k;
+    }
 
     /* A scene that fails to load is shown as a message; the window still
      * opens, so the video and the controls stay usable. */
     mr_scene_params sp = MR_SCENE_DEFAULTS;
-    a->scene = mr_scene_load(scene_path, &sp, &err);
-    if (!a->scene) {
+    a->loader = mr_scene_load_async(scene_path, &sp, &err);
+    if (!a->loader) {
         snprintf(a->scene_msg, sizeof a->scene_msg, "scene failed to load: %.500s", err.msg);
         mr_log(MR_LOG_ERROR, "view: %s", a->scene_msg);
         memset(&err, 0, sizeof err);
+    } else {
+        snprintf(a->scene_msg, sizeof a->scene_msg, "loading scene ...");
     }
 
     mr_window_params wp = MR_WINDOW_DEFAULTS;
@@ -1297,11 +1345,6 @@ int cmd_view(int argc, char **argv) {
     a->rend = mr_renderer_create(mr_window_gpu(a->win), &err);
     a->d2 = a->rend ? mr_draw2d_create(mr_window_gpu(a->win), &err) : NULL;
     if (!a->d2) { rc = app_error(k_cmd, &err); goto done; }
-    if (a->scene && !mr_renderer_set_scene(a->rend, a->scene, &err)) {
-        snprintf(a->scene_msg, sizeof a->scene_msg, "scene failed to upload: %.500s", err.msg);
-        mr_scene_destroy(&a->scene);
-        memset(&err, 0, sizeof err);
-    }
     double ppmm = mr_window_px_per_mm(a->win) * a->ui_scale;
     mr_ui_params up = MR_UI_DEFAULTS;
     up.px_per_mm = ppmm;
@@ -1332,6 +1375,7 @@ int cmd_view(int argc, char **argv) {
 
     double last_save = mr_time_now();
     while (!a->quit) {
+        poll_scene_load(a);
         frame_tick(a);
         /* Settings are saved a moment after they change, not per slider
          * step, and again on exit. */
@@ -1352,6 +1396,10 @@ int cmd_view(int argc, char **argv) {
     if (a->stats) print_stats(a);
 
 done:
+    if (a->loader) {
+        mr_error ignored = {0};
+        a->scene = mr_scene_loader_finish(&a->loader, &ignored); /* waits for the thread */
+    }
     vw_capture_stop(&a->cap);
     vw_frame_free(&a->frame);
     vw_frame_free(&a->mark_frame);
