@@ -9,6 +9,7 @@ layout(binding = 0) uniform sampler2D u_base_tex; // sRGB texture: sampled linea
 layout(location = 0) out vec4 o_albedo;  // sRGB8 target: linear in, encoded on write
 layout(location = 1) out vec4 o_normal;  // xyz view normal, w = 1 where geometry
 layout(location = 2) out uvec2 o_ids;
+layout(location = 3) out vec4 o_pos;    // view-space position, w = 1 (AO positions path)
 
 void main() {
     vec4 c = v_color;
@@ -21,4 +22,5 @@ void main() {
     o_albedo = vec4(c.rgb, 1.0);
     o_normal = vec4(n, 1.0);
     o_ids = v_ids.xy;
+    o_pos = vec4(v_pos, 1.0);
 }

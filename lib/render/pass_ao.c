@@ -29,11 +29,10 @@ typedef struct ao_key {
 struct mr_ao_state {
     bool broken;          /* a shader failed: AO stays off, the error is reported */
     mr_error error;
-    GLuint prog_main, prog_blur, prog_up, prog_pos, prog_outline;
+    GLuint prog_main, prog_blur, prog_up, prog_outline;
     int w, h, aw, ah, step; /* G-buffer size, AO size, G-buffer pixels per AO pixel */
     GLuint tex_ao[2], fbo_ao[2]; /* AO resolution, ping-pong */
     GLuint tex_full, fbo_full;   /* upsampled result */
-    GLuint tex_pos, fbo_pos;     /* view-space positions */
     GLuint tex_mask, fbo_mask;   /* outline counts, depth-tested against the G-buffer */
     GLuint result;               /* texture with the finished AO (full resolution) */
     int cur;                     /* which tex_ao holds the latest AO */
@@ -196,12 +195,10 @@ static void free_targets(mr_ao_state *s) {
     glDeleteTextures(2, s->tex_ao);
     glDeleteFramebuffers(1, &s->fbo_full);
     glDeleteTextures(1, &s->tex_full);
-    glDeleteFramebuffers(1, &s->fbo_pos);
-    glDeleteTextures(1, &s->tex_pos);
     glDeleteFramebuffers(1, &s->fbo_mask);
     glDeleteTextures(1, &s->tex_mask);
     s->fbo_ao[0] = s->fbo_ao[1] = s->tex_ao[0] = s->tex_ao[1] = 0;
-    s->fbo_full = s->tex_full = s->fbo_pos = s->tex_pos = s->fbo_mask = s->tex_mask = 0;
+    s->fbo_full = s->tex_full = s->fbo_mask = s->tex_mask = 0;
     s->w = s->h = s->aw = s->ah = 0;
     s->valid = false;
 }
@@ -219,7 +216,6 @@ void mr_pass_ao_free(mr_renderer *r) {
     glDeleteProgram(s->prog_main);
     glDeleteProgram(s->prog_blur);
     glDeleteProgram(s->prog_up);
-    glDeleteProgram(s->prog_pos);
     glDeleteProgram(s->prog_outline);
     free(s);
     r->ao = NULL;
@@ -244,10 +240,9 @@ static bool ensure_programs(mr_ao_state *s) {
     static const char *const m[] = {"fullscreen.vert.glsl", "ao_main.frag.glsl", NULL};
     static const char *const b[] = {"fullscreen.vert.glsl", "ao_blur.frag.glsl", NULL};
     static const char *const u[] = {"fullscreen.vert.glsl", "ao_upsample.frag.glsl", NULL};
-    static const char *const p[] = {"fullscreen.vert.glsl", "ao_positions.frag.glsl", NULL};
     static const char *const o[] = {"ao_outline.vert.glsl", "ao_outline.frag.glsl", NULL};
     if ((s->prog_main = mr_gl_program(m, &s->error)) && (s->prog_blur = mr_gl_program(b, &s->error)) &&
-        (s->prog_up = mr_gl_program(u, &s->error)) && (s->prog_pos = mr_gl_program(p, &s->error)) &&
+        (s->prog_up = mr_gl_program(u, &s->error)) &&
         (s->prog_outline = mr_gl_program(o, &s->error)))
         return true;
     s->broken = true;
@@ -264,8 +259,6 @@ static void ensure_targets(mr_ao_state *s, int w, int h, int step) {
     }
     s->tex_full = mr_gl_make_tex(GL_R32F, w, h, GL_NEAREST);
     s->fbo_full = fbo_for(s->tex_full);
-    s->tex_pos = mr_gl_make_tex(GL_RGBA32F, w, h, GL_NEAREST);
-    s->fbo_pos = fbo_for(s->tex_pos);
     s->tex_mask = mr_gl_make_tex(GL_R16F, w, h, GL_NEAREST);
     s->fbo_mask = fbo_for(s->tex_mask);
     s->w = w; s->h = h; s->aw = aw; s->ah = ah;
@@ -392,7 +385,7 @@ static void common_uniforms(frame *f) {
     glUniform1f(3, (float)f->near_plane);
     glBindTextureUnit(0, f->r->gbuf.depth);
     glBindTextureUnit(1, f->r->gbuf.color[1]);
-    glBindTextureUnit(2, s->tex_pos);
+    glBindTextureUnit(2, f->r->gbuf.color[3]); /* positions, written by the G-buffer pass when used */
     glBindTextureUnit(3, s->tex_mask);
 }
 
@@ -406,17 +399,6 @@ static void fullscreen(frame *f, GLuint fbo, int w, int h) {
     glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
-void mr_pass_ao_positions(frame *f) {
-    mr_ao_state *s = f->r->ao;
-    glUseProgram(s->prog_pos);
-    /* Only the uniforms this shader declares: setting another location is
-     * an error. */
-    glUniform4f(0, (float)f->cam.fx, (float)f->cam.fy, (float)f->cam.cx, (float)f->cam.cy);
-    glUniform1f(3, (float)f->near_plane);
-    glBindTextureUnit(0, f->r->gbuf.depth);
-    glBindTextureUnit(2, 0); /* the target itself must not be bound for reading */
-    fullscreen(f, s->fbo_pos, s->w, s->h);
-}
 
 static bool ensure_outlines(mr_renderer *r, mr_ao_state *s) {
     const mr_scene *sc = r->scene;

@@ -24,6 +24,15 @@ void mr_pass_gbuffer(frame *f) {
     glClearNamedFramebufferfv(r->gbuf.fbo, GL_COLOR, 1, zero4);
     glClearNamedFramebufferuiv(r->gbuf.fbo, GL_COLOR, 2, zero_u);
     glClearNamedFramebufferfv(r->gbuf.fbo, GL_DEPTH, 0, &depth0);
+    /* View-space positions are rasterised (not un-projected from depth) so
+     * that AO also works where the projection cannot be inverted; the
+     * attachment costs bandwidth, so it is written only when this frame's AO
+     * reads positions. */
+    static const GLenum bufs[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                                   GL_COLOR_ATTACHMENT3};
+    bool want_pos = mr_pass_need_ao_positions(f);
+    glNamedFramebufferDrawBuffers(r->gbuf.fbo, want_pos ? 4 : 3, bufs);
+    if (want_pos) glClearNamedFramebufferfv(r->gbuf.fbo, GL_COLOR, 3, zero4);
     uint32_t mask = 1u << MR_LAYER_VISIBLE;
     /* With ghosting, the hidden layer goes to its own target D (pass_ghost.c). */
     if (!f->p->hide_hidden_layer && !mr_ghost_active(f)) mask |= 1u << MR_LAYER_HIDDEN;

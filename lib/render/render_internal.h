@@ -8,9 +8,9 @@
 
 #include "gpu_internal.h"
 
-/* A framebuffer with up to 3 colour textures and an optional depth texture. */
+/* A framebuffer with up to 4 colour textures and an optional depth texture. */
 typedef struct target {
-    GLuint fbo, color[3], depth;
+    GLuint fbo, color[4], depth;
 } target;
 
 struct mr_renderer {
@@ -132,7 +132,6 @@ bool mr_pass_need_ao_mask(frame *f);
 bool mr_pass_need_ao(frame *f);
 bool mr_pass_need_ao_blur(frame *f);
 bool mr_pass_need_ao_upsample(frame *f);
-void mr_pass_ao_positions(frame *f);
 void mr_pass_ao_mask(frame *f);
 void mr_pass_ao(frame *f);
 void mr_pass_ao_blur(frame *f);

@@ -31,7 +31,7 @@ void mr_gl_target_free(target *t) {
 
 bool mr_gl_target_make(target *t, int w, int h, const GLenum *fmts, int n, bool depth, mr_error *err) {
     glCreateFramebuffers(1, &t->fbo);
-    GLenum bufs[3];
+    GLenum bufs[4];
     for (int i = 0; i < n; i++) {
         t->color[i] = mr_gl_make_tex(fmts[i], w, h, GL_NEAREST);
         glNamedFramebufferTexture(t->fbo, GL_COLOR_ATTACHMENT0 + i, t->color[i], 0);
@@ -54,9 +54,11 @@ static bool ensure_targets(mr_renderer *r, int w, int h, mr_error *err) {
     mr_gl_target_free(&r->shaded);
     mr_gl_target_free(&r->composed);
     r->w = r->h = 0;
-    static const GLenum gfmt[3] = {GL_SRGB8_ALPHA8, GL_RGBA16F, GL_RG32UI};
+    /* albedo, view normal, ids, view-space position (written only when a
+     * frame's AO reads positions: see mr_pass_gbuffer) */
+    static const GLenum gfmt[4] = {GL_SRGB8_ALPHA8, GL_RGBA16F, GL_RG32UI, GL_RGBA32F};
     static const GLenum cfmt[1] = {GL_SRGB8_ALPHA8};
-    if (!mr_gl_target_make(&r->gbuf, w, h, gfmt, 3, true, err) || !mr_gl_target_make(&r->shaded, w, h, cfmt, 1, false, err) ||
+    if (!mr_gl_target_make(&r->gbuf, w, h, gfmt, 4, true, err) || !mr_gl_target_make(&r->shaded, w, h, cfmt, 1, false, err) ||
         !mr_gl_target_make(&r->composed, w, h, cfmt, 1, false, err))
         return false;
     r->w = w;
@@ -157,7 +159,6 @@ void mr_gl_projection(const mr_camera *c, double near_plane, float out[16]) {
 
 static const pass_desc k_passes[] = {
     {"gbuffer", mr_pass_need_always, mr_pass_gbuffer},
-    {"ao_positions", mr_pass_need_ao_positions, mr_pass_ao_positions},
     {"ao_mask", mr_pass_need_ao_mask, mr_pass_ao_mask},
     {"ao", mr_pass_need_ao, mr_pass_ao},
     {"ao_blur", mr_pass_need_ao_blur, mr_pass_ao_blur},
