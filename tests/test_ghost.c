@@ -659,6 +659,50 @@ static void test_frame_importance(void) {
     mr_scene_destroy(&s1);
 }
 
+/* The hidden layer D is shaded with AO of its own when AO is on: a hidden
+ * concave corner seen through a fully transparent occluder (t = 0, so G0 is
+ * D there) gets darker with AO, while the flat wall in front does not. */
+static void test_frame_hidden_ao(void) {
+    mr_scene *s = mr_scene_create();
+    mr_material a = {"wall", {0.5f, 0.5f, 0.45f, 1}, -1}, b = {"pipe", {0.8f, 0.8f, 0.8f, 1}, -1};
+    int32_t ma = mr_scene_add_material(s, &a), mb = mr_scene_add_material(s, &b);
+    add_node(s, "Wall", mr_m4_translate(0, 0, 5), add_box(s, 6, 4, 0.1, ma), MR_LAYER_VISIBLE);
+    add_node(s, "Back", mr_m4_translate(0, 0, 7.05), add_box(s, 4, 3, 0.1, mb), MR_LAYER_HIDDEN);
+    add_node(s, "Fin", mr_m4_translate(-1.0, 0, 6.5), add_box(s, 0.1, 3, 1.0, mb), MR_LAYER_HIDDEN);
+    mr_scene_update_bounds(s);
+    char passes[512];
+    mr_frame_params p = MR_FRAME_DEFAULTS;
+    p.ghost.mode = MR_GHOST_G0;
+    p.ghost.importance = MR_GHOST_IMP_CURVATURE;
+    p.ghost.t = 0.0f;
+    mr_frame_result plain, ao;
+    if (render(s, &p, &plain, passes, sizeof passes)) {
+        p.ao.method = MR_AO_SCHEER;
+        p.ao.want_ao = true;
+        if (render(s, &p, &ao, passes, sizeof passes)) {
+            /* Right of the fin, where it meets the back plate. */
+            double sum_plain = 0, sum_ao = 0;
+            const unsigned char *x = plain.color.data, *y = ao.color.data;
+            for (int row = 26; row < 46; row++)
+                for (int col = 36; col < 42; col++) {
+                    int i = (row * 96 + col) * 3;
+                    sum_plain += x[i] + x[i + 1] + x[i + 2];
+                    sum_ao += y[i] + y[i + 1] + y[i + 2];
+                }
+            CHECK_MSG(sum_ao < 0.97 * sum_plain, "hidden corner with AO %.0f vs without %.0f", sum_ao, sum_plain);
+            /* The main AO buffer sees only the flat wall: no occlusion. */
+            const float *v = ao.ao.data;
+            double mean = 0;
+            for (int i = 0; i < 96 * 72; i++) mean += v[i];
+            CHECK_MSG(mean / (96 * 72) > 0.98, "main AO over the flat wall %.3f", mean / (96 * 72));
+            mr_frame_result_free(&ao);
+        }
+        mr_frame_result_free(&plain);
+    }
+    mr_renderer_set_scene(g_r, NULL, NULL);
+    mr_scene_destroy(&s);
+}
+
 int main(void) {
     test_curvature();
     test_demo_conflict();
@@ -678,6 +722,7 @@ int main(void) {
         test_frame();
         test_frame_importance();
         test_frame_video();
+        test_frame_hidden_ao();
     }
     mr_renderer_destroy(&g_r);
     mr_gpu_destroy(&g_gpu);

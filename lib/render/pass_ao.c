@@ -208,8 +208,15 @@ static void free_outlines(mr_ao_state *s) {
     s->outline_built = false;
 }
 
+static void free_state(mr_ao_state *s);
+
 void mr_pass_ao_free(mr_renderer *r) {
-    mr_ao_state *s = r->ao;
+    free_state(r->ao);
+    free_state(r->ao_hidden);
+    r->ao = r->ao_hidden = NULL;
+}
+
+static void free_state(mr_ao_state *s) {
     if (!s) return;
     free_targets(s);
     free_outlines(s);
@@ -218,14 +225,16 @@ void mr_pass_ao_free(mr_renderer *r) {
     glDeleteProgram(s->prog_up);
     glDeleteProgram(s->prog_outline);
     free(s);
-    r->ao = NULL;
 }
 
 void mr_pass_ao_scene_changed(mr_renderer *r) {
-    if (!r->ao) return;
-    r->ao->scene_gen++;
-    r->ao->valid = false;
-    free_outlines(r->ao);
+    mr_ao_state *states[2] = {r->ao, r->ao_hidden};
+    for (int i = 0; i < 2; i++) {
+        if (!states[i]) continue;
+        states[i]->scene_gen++;
+        states[i]->valid = false;
+        free_outlines(states[i]);
+    }
 }
 
 static GLuint fbo_for(GLuint tex) {
@@ -556,4 +565,32 @@ bool mr_pass_ao_read_back(frame *f, mr_error *err) {
         free(dep);
     }
     return true;
+}
+
+GLuint mr_pass_ao_for_hidden(frame *f, const target *src) {
+    mr_renderer *r = f->r;
+    int main_plan = plan(f);
+    if (main_plan != AO_PLAN_RUN && main_plan != AO_PLAN_REUSE) return 0; /* no AO, or an external image */
+    /* The passes read r->ao and r->gbuf: point them at D's state and target
+     * for the duration, then put the main ones back. */
+    target main_gbuf = r->gbuf;
+    mr_ao_state *main_state = r->ao;
+    r->gbuf = *src;
+    r->ao = r->ao_hidden;
+    f->ao_plan = AO_PLAN_UNDECIDED;
+    GLuint tex = 0;
+    int pl = plan(f);
+    if (pl == AO_PLAN_RUN) {
+        r->ao->p.mask = MR_AO_MASK_OFF; /* outlines of D are not drawn */
+        r->ao->p.positions = false;     /* D has no positions attachment */
+        mr_pass_ao(f);
+        if (mr_pass_need_ao_blur(f)) mr_pass_ao_blur(f);
+        if (mr_pass_need_ao_upsample(f)) mr_pass_ao_upsample(f);
+    }
+    tex = mr_pass_ao_texture(f);
+    r->ao_hidden = r->ao;
+    r->ao = main_state;
+    r->gbuf = main_gbuf;
+    f->ao_plan = main_plan;
+    return tex;
 }

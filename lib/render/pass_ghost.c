@@ -443,6 +443,8 @@ void mr_pass_ghost_hidden(frame *f) {
     mr_geometry_draw(f, 1u << MR_LAYER_HIDDEN);
     glDisable(GL_DEPTH_TEST);
     GLuint keep = f->final_tex;
+    /* D is shaded like the model, with its own AO when AO is on. */
+    f->hidden_ao = mr_pass_ao_for_hidden(f, &g->hid);
     mr_shade_draw(f, &g->hid, &g->hid_shaded);
     f->final_tex = keep;
 }

@@ -80,9 +80,8 @@ void mr_shade_draw(frame *f, const target *src, const target *dst) {
         bg[i] = c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
     }
     glUniform3fv(18, 1, bg);
-    /* AO belongs to the main G-buffer; the ghosting's hidden-layer target
-     * is shaded without it. */
-    GLuint ao = src == &r->gbuf ? mr_pass_ao_texture(f) : 0; /* 0 when the frame has no AO */
+    /* The main G-buffer's AO, or the hidden layer's own (pass_ghost.c). */
+    GLuint ao = src == &r->gbuf ? mr_pass_ao_texture(f) : f->hidden_ao; /* 0 when there is no AO */
     glUniform1i(19, ao != 0);
     glBindTextureUnit(0, src->color[0]);
     glBindTextureUnit(1, src->color[1]);

@@ -39,6 +39,7 @@ struct mr_renderer {
         double near_plane;
     } last;
     struct mr_ao_state *ao; /* pass_ao.c: AO targets, programs, kernel, reuse cache */
+    struct mr_ao_state *ao_hidden; /* the same for the ghosting's hidden layer D */
     struct mr_ghost_state *ghost; /* pass_ghost.c: targets, programs, caches; NULL until first used */
 };
 
@@ -52,6 +53,7 @@ typedef struct frame {
     mr_frame_result *out;
     GLuint final_tex;       /* the texture holding the finished image */
     int ao_plan;            /* pass_ao.c: decided once per frame (off / reuse / run) */
+    GLuint hidden_ao;       /* AO of the hidden layer D (pass_ghost.c), 0 if none */
     int ghost;              /* pass_ghost.c: 0 not decided yet, 1 ghosting runs, -1 it does not */
 } frame;
 
@@ -138,6 +140,10 @@ void mr_pass_ao_blur(frame *f);
 void mr_pass_ao_upsample(frame *f);
 /* The finished AO texture of this frame (computed or reused), or 0. */
 GLuint mr_pass_ao_texture(frame *f);
+/* AO of another G-buffer-like target (the ghosting's hidden layer D) with
+ * the frame's AO settings, in a state of its own (reuse works per target);
+ * no corner mask, no positions path. Returns the AO texture or 0. */
+GLuint mr_pass_ao_for_hidden(frame *f, const target *src);
 /* Fills out->ao (if asked) and the mask statistics; reports a failed AO shader. */
 bool mr_pass_ao_read_back(frame *f, mr_error *err);
 void mr_pass_ao_scene_changed(mr_renderer *r);
