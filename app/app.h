@@ -75,6 +75,13 @@ bool app_ao_parse(const char *cmd, const app_opt *opts, mr_ao_params *ao, bool *
 /* Writes what --aux asks for: depth.pfm, normal.pfm, ao.pfm into dir. */
 bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err);
 
+/* A camera frame from n ideal pinhole renders (averaged: motion blur),
+ * rendered with a margin of `margin` px per side at `scale` times the
+ * resolution: lens distortion of cam, [1 2 1] optical blur, exposure gain,
+ * Gaussian sensor noise (sigma in 8-bit levels). In demo_track.c. */
+bool app_synth_frame(const mr_camera *cam, const mr_image *ideal, int n, int margin, int scale, double gain,
+                     double noise, mr_rng *rng, mr_image *out, mr_error *err);
+
 /* The demo hall built in memory (tag images included), its camera and its
  * standing viewpoints. In cmd_demo.c. */
 bool app_demo_hall(mr_demo_hall *hall, mr_error *err);

@@ -85,64 +85,6 @@ static bool write_scene_config(const char *path, const char *glb, const mr_demo_
     return ok;
 }
 
-/* Turns an ideal pinhole rendering into a camera frame: the lens distortion
- * of `cam`, a slight optical blur and sensor noise. `ideal` was rendered by
- * a camera with the same focal length and a margin of `margin` pixels on
- * every side, at `scale` times the resolution (supersampling). */
-static bool synth_camera_frame(const mr_camera *cam, const mr_image *ideal, int margin, int scale, uint64_t seed,
-                               mr_image *out, mr_error *err) {
-    mr_image raw;
-    if (!mr_image_alloc(&raw, cam->width, cam->height, 3, MR_PIX_U8, err)) return false;
-    float *acc = calloc((size_t)cam->width * cam->height * 3, sizeof *acc);
-    if (!acc) {
-        mr_image_free(&raw);
-        return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    }
-    for (int v = 0; v < cam->height; v++)
-        for (int u = 0; u < cam->width; u++) {
-            double x, y;
-            float px[4] = {0, 0, 0, 0};
-            if (mr_camera_undistort(cam, (u - cam->cx) / cam->fx, (v - cam->cy) / cam->fy, &x, &y)) {
-                double iu = (cam->fx * x + cam->cx + margin + 0.5) * scale - 0.5;
-                double iv = (cam->fy * y + cam->cy + margin + 0.5) * scale - 0.5;
-                mr_image_sample_bilinear(ideal, iu, iv, px);
-            }
-            memcpy(&acc[((size_t)v * cam->width + u) * 3], px, 3 * sizeof(float));
-        }
-    /* [1 2 1]/4 blur in both directions (sigma ~0.7 px), then noise. */
-    float *tmp = malloc((size_t)cam->width * cam->height * 3 * sizeof *tmp);
-    if (!tmp) {
-        free(acc);
-        mr_image_free(&raw);
-        return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    }
-    for (int pass = 0; pass < 2; pass++) {
-        const float *src = pass ? tmp : acc;
-        float *dst = pass ? acc : tmp;
-        for (int v = 0; v < cam->height; v++)
-            for (int u = 0; u < cam->width; u++)
-                for (int c = 0; c < 3; c++) {
-                    int du = pass ? 0 : 1, dv = pass ? 1 : 0;
-                    int u0 = u - du < 0 ? u : u - du, u1 = u + du >= cam->width ? u : u + du;
-                    int v0 = v - dv < 0 ? v : v - dv, v1 = v + dv >= cam->height ? v : v + dv;
-                    dst[((size_t)v * cam->width + u) * 3 + c] =
-                        0.25f * src[((size_t)v0 * cam->width + u0) * 3 + c] +
-                        0.5f * src[((size_t)v * cam->width + u) * 3 + c] +
-                        0.25f * src[((size_t)v1 * cam->width + u1) * 3 + c];
-                }
-    }
-    free(tmp);
-    mr_rng rng;
-    mr_rng_seed(&rng, seed);
-    unsigned char *o = raw.data;
-    for (size_t i = 0; i < (size_t)cam->width * cam->height * 3; i++) {
-        double val = acc[i] + 2.5 * mr_rng_normal(&rng);
-        o[i] = (unsigned char)(val < 0 ? 0 : val > 255 ? 255 : lrint(val));
-    }
-    free(acc);
-    *out = raw;
-    return true;
-}
 
 static bool run_demo(const char *dir, mr_error *err) {
     char path[4096], sub[4096];
@@ -208,6 +150,8 @@ static bool run_demo(const char *dir, mr_error *err) {
     memset(wide.dist, 0, sizeof wide.dist);
     for (int i = 0; ok && i < DEMO_VIEWS; i++) {
         mr_frame_result res = {0};
+        mr_rng rng;
+        mr_rng_seed(&rng, 1000u + (uint64_t)i); /* a different noise pattern per frame, the same every run */
         mr_frame_params fp = MR_FRAME_DEFAULTS;
         mr_view v = views[i];
         v.camera = wide;
@@ -215,7 +159,7 @@ static bool run_demo(const char *dir, mr_error *err) {
         fp.height = wide.height * scale;
         mr_image frame = {0};
         ok = mr_renderer_set_scene(gfx.renderer, built, err) && mr_render_frame(gfx.renderer, &v, &fp, &res, err) &&
-             synth_camera_frame(&cam, &res.color, margin, scale, 1000u + (uint64_t)i, &frame, err);
+             app_synth_frame(&cam, &res.color, 1, margin, scale, 1.0, 2.5, &rng, &frame, err);
         mr_frame_result_free(&res);
         snprintf(sub, sizeof sub, "frames/frame_%03d.png", i);
         mr_path_join(dir, sub, path, sizeof path);

@@ -1,8 +1,7 @@
 /* Synthetic recordings of the demo hall with ground truth, and a synthetic
- * calibration set (tag-grid board). The camera-frame synthesis extends the
- * one in cmd_demo.c (synth_camera_frame: lens distortion, [1 2 1] blur,
- * noise) with motion blur (sub-frame renders averaged) and exposure; it is a
- * separate copy so this file merges without touching the demo's code. */
+ * calibration set (tag-grid board). The camera-frame synthesis here
+ * (app_synth_frame: lens distortion, [1 2 1] blur, noise, motion blur,
+ * exposure) also makes the demo's camera frames. */
 #include "app_track.h"
 
 #include <math.h>
@@ -69,8 +68,8 @@ static mr_dmat4 path_pose(double s, bool *still) {
  * blur), rendered with a margin of `margin` px per side at `scale` times the
  * resolution: lens distortion of cam, [1 2 1] optical blur, exposure gain,
  * Gaussian sensor noise. */
-static bool synth_frame(const mr_camera *cam, const mr_image *ideal, int n, int margin, int scale, double gain,
-                        double noise, mr_rng *rng, mr_image *out, mr_error *err) {
+bool app_synth_frame(const mr_camera *cam, const mr_image *ideal, int n, int margin, int scale, double gain,
+                     double noise, mr_rng *rng, mr_image *out, mr_error *err) {
     size_t np = (size_t)cam->width * cam->height;
     float *acc = calloc(np * 3, sizeof *acc), *tmp = malloc(np * 3 * sizeof *tmp);
     if (!acc || !tmp || !mr_image_alloc(out, cam->width, cam->height, 3, MR_PIX_U8, err)) {
@@ -206,7 +205,7 @@ bool app_synth_recording(const char *dir, const app_synth_params *params, mr_err
         }
         double gain = 1.0 + p.exposure * sin(2 * M_PI * i / 40.0);
         mr_image frame = {0}, gray = {0};
-        ok = ok && synth_frame(&cam, ideal, p.motion_blur, margin, scale, gain, p.noise, &rng, &frame, err) &&
+        ok = ok && app_synth_frame(&cam, ideal, p.motion_blur, margin, scale, gain, p.noise, &rng, &frame, err) &&
              mr_image_to_gray(&frame, &gray, err);
         /* Track it as `record` would, so frames.jsonl holds real results. */
         mr_frame_record fr = {0};
