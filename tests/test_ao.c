@@ -9,42 +9,13 @@
 #include "mr_eval.h"
 #include "mr_render.h"
 #include "mr_test.h"
+#include "mr_test_scene.h"
 
 #include <stdlib.h>
 #include <string.h>
 
 /* --------------------------------------------------------- scene helpers */
 
-/* An axis-aligned box sx x sy x sz centred on its node origin, 24 vertices
- * (split at the edges, as CAD exports come). */
-static int32_t add_box(mr_scene *s, double sx, double sy, double sz) {
-    mr_mesh m;
-    memset(&m, 0, sizeof m);
-    snprintf(m.name, sizeof m.name, "box");
-    m.vertex_count = 24;
-    m.index_count = 36;
-    m.positions = malloc(72 * sizeof(float));
-    m.indices = malloc(36 * sizeof(uint32_t));
-    static const int faces[6][4][3] = {
-        {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}},     {{-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, -1}},
-        {{-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}},     {{-1, -1, 1}, {-1, -1, -1}, {1, -1, -1}, {1, -1, 1}},
-        {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},     {{1, -1, -1}, {-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}},
-    };
-    for (int f = 0; f < 6; f++) {
-        for (int v = 0; v < 4; v++) {
-            m.positions[(f * 4 + v) * 3 + 0] = (float)(faces[f][v][0] * sx / 2);
-            m.positions[(f * 4 + v) * 3 + 1] = (float)(faces[f][v][1] * sy / 2);
-            m.positions[(f * 4 + v) * 3 + 2] = (float)(faces[f][v][2] * sz / 2);
-        }
-        const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
-        for (int k = 0; k < 6; k++) m.indices[f * 6 + k] = (uint32_t)(f * 4) + q[k];
-    }
-    m.material = -1;
-    mr_error err = {0};
-    int32_t id = mr_scene_add_mesh(s, &m, &err);
-    CHECK_MSG(id >= 0, "%s", err.msg);
-    return id;
-}
 
 static void add_node(mr_scene *s, mr_dmat4 world, int32_t mesh) {
     mr_node n;
@@ -65,10 +36,10 @@ static void place(mr_scene *s, int32_t mesh, double k, mr_dvec3 off, double x, d
  * it (a concave corner), and a cube; all lengths times k, moved by off. */
 static mr_scene *corner_scene(double k, mr_dvec3 off, bool with_wall) {
     mr_scene *s = mr_scene_create();
-    place(s, add_box(s, 20 * k, 0.2 * k, 20 * k), k, off, 0, -0.1, 0);
+    place(s, mr_test_add_box(s, 20 * k, 0.2 * k, 20 * k, -1), k, off, 0, -0.1, 0);
     if (with_wall) {
-        place(s, add_box(s, 20 * k, 6 * k, 0.2 * k), k, off, 0, 3, 3.0);
-        place(s, add_box(s, 1 * k, 1 * k, 1 * k), k, off, -1.5, 0.5, 1.0);
+        place(s, mr_test_add_box(s, 20 * k, 6 * k, 0.2 * k, -1), k, off, 0, 3, 3.0);
+        place(s, mr_test_add_box(s, 1 * k, 1 * k, 1 * k, -1), k, off, -1.5, 0.5, 1.0);
     }
     mr_scene_update_bounds(s);
     return s;
@@ -139,7 +110,7 @@ static void test_kernels(void) {
 
 static void test_outline_dirs(void) {
     mr_scene *s = mr_scene_create();
-    int32_t b = add_box(s, 2, 1, 4);
+    int32_t b = mr_test_add_box(s, 2, 1, 4, -1);
     const mr_mesh *m = &s->meshes[b];
     float dirs[72];
     mr_error err = {0};
@@ -163,8 +134,8 @@ static void test_groundtruth_wall(void) {
     for (int far = 0; far < 2; far++) {
         double off = far ? 1e7 : 0;
         mr_scene *s = mr_scene_create();
-        add_node(s, mr_m4_translate(off, -0.5, off), add_box(s, 400, 1, 400));
-        add_node(s, mr_m4_translate(off + 0.5, 0, off), add_box(s, 1, 400, 400));
+        add_node(s, mr_m4_translate(off, -0.5, off), mr_test_add_box(s, 400, 1, 400, -1));
+        add_node(s, mr_m4_translate(off + 0.5, 0, off), mr_test_add_box(s, 1, 400, 400, -1));
         mr_scene_update_bounds(s);
         mr_error err = {0};
         mr_eval_gt *gt = mr_eval_gt_create(s, false, &err);

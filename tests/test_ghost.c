@@ -7,6 +7,7 @@
  * test_ghost_opencv.cc. Skips the GPU part (77) without an EGL device. */
 #include "mr_render.h"
 #include "mr_test.h"
+#include "mr_test_scene.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -428,45 +429,7 @@ static void test_unified_sign(void) {
 
 /* ---------------------------------------------------------------- frame */
 
-static int32_t add_box(mr_scene *s, double sx, double sy, double sz, int32_t material) {
-    mr_mesh m;
-    memset(&m, 0, sizeof m);
-    m.vertex_count = 24;
-    m.index_count = 36;
-    m.positions = malloc(72 * sizeof(float));
-    m.indices = malloc(36 * sizeof(uint32_t));
-    static const int faces[6][4][3] = {
-        {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}},     {{-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, -1}},
-        {{-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}},     {{-1, -1, 1}, {-1, -1, -1}, {1, -1, -1}, {1, -1, 1}},
-        {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},     {{1, -1, -1}, {-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}},
-    };
-    for (int f = 0; f < 6; f++) {
-        for (int v = 0; v < 4; v++) {
-            m.positions[(f * 4 + v) * 3 + 0] = (float)(faces[f][v][0] * sx / 2);
-            m.positions[(f * 4 + v) * 3 + 1] = (float)(faces[f][v][1] * sy / 2);
-            m.positions[(f * 4 + v) * 3 + 2] = (float)(faces[f][v][2] * sz / 2);
-        }
-        const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
-        for (int k = 0; k < 6; k++) m.indices[f * 6 + k] = (uint32_t)(f * 4) + q[k];
-    }
-    m.material = material;
-    mr_error err = {0};
-    int32_t id = mr_scene_add_mesh(s, &m, &err);
-    CHECK_MSG(id >= 0, "%s", err.msg);
-    return id;
-}
 
-static void add_node(mr_scene *s, const char *name, mr_dmat4 world, int32_t mesh, uint8_t layer) {
-    mr_node n;
-    memset(&n, 0, sizeof n);
-    snprintf(n.name, sizeof n.name, "%s", name);
-    n.parent = -1;
-    n.world = world;
-    n.mesh_first = mesh;
-    n.mesh_count = 1;
-    n.layer = layer;
-    mr_scene_add_node(s, &n);
-}
 
 /* A wall at z = 5 in front of the camera, a hidden bar behind it at z = 6,
  * and (optionally) a hidden box far off to the side, out of view. */
@@ -482,11 +445,11 @@ static mr_scene *wall_scene_scaled(bool bar_in_view, double k, bool round_occlud
         mr_error err = {0};
         int32_t id = mr_scene_add_mesh(s, &m, &err);
         CHECK_MSG(id >= 0, "%s", err.msg);
-        add_node(s, "Ball", mr_m4_translate(0, 0, 5 * k), id, MR_LAYER_VISIBLE);
+        mr_test_add_node(s, "Ball", mr_m4_translate(0, 0, 5 * k), id, MR_LAYER_VISIBLE);
     } else {
-        add_node(s, "Wall", mr_m4_translate(0, 0, 5 * k), add_box(s, 6 * k, 4 * k, 0.1 * k, ma), MR_LAYER_VISIBLE);
+        mr_test_add_node(s, "Wall", mr_m4_translate(0, 0, 5 * k), mr_test_add_box(s, 6 * k, 4 * k, 0.1 * k, ma), MR_LAYER_VISIBLE);
     }
-    add_node(s, "Pipe", mr_m4_translate(bar_in_view ? 0 : 500 * k, 0, 6 * k), add_box(s, 3 * k, 0.4 * k, 0.4 * k, mb),
+    mr_test_add_node(s, "Pipe", mr_m4_translate(bar_in_view ? 0 : 500 * k, 0, 6 * k), mr_test_add_box(s, 3 * k, 0.4 * k, 0.4 * k, mb),
              MR_LAYER_HIDDEN);
     mr_scene_update_bounds(s);
     return s;
@@ -579,7 +542,7 @@ static void test_frame_video(void) {
     mr_scene *s = mr_scene_create();
     mr_material b = {"pipe", {0.7f, 0.05f, 0.05f, 1}, -1};
     int32_t mb = mr_scene_add_material(s, &b);
-    add_node(s, "Pipe", mr_m4_translate(0, 0, 6), add_box(s, 3, 0.6, 0.4, mb), MR_LAYER_HIDDEN);
+    mr_test_add_node(s, "Pipe", mr_m4_translate(0, 0, 6), mr_test_add_box(s, 3, 0.6, 0.4, mb), MR_LAYER_HIDDEN);
     mr_scene_update_bounds(s);
     mr_image video;
     mr_image_alloc(&video, 96, 72, 3, MR_PIX_U8, NULL);
@@ -666,9 +629,9 @@ static void test_frame_hidden_ao(void) {
     mr_scene *s = mr_scene_create();
     mr_material a = {"wall", {0.5f, 0.5f, 0.45f, 1}, -1}, b = {"pipe", {0.8f, 0.8f, 0.8f, 1}, -1};
     int32_t ma = mr_scene_add_material(s, &a), mb = mr_scene_add_material(s, &b);
-    add_node(s, "Wall", mr_m4_translate(0, 0, 5), add_box(s, 6, 4, 0.1, ma), MR_LAYER_VISIBLE);
-    add_node(s, "Back", mr_m4_translate(0, 0, 7.05), add_box(s, 4, 3, 0.1, mb), MR_LAYER_HIDDEN);
-    add_node(s, "Fin", mr_m4_translate(-1.0, 0, 6.5), add_box(s, 0.1, 3, 1.0, mb), MR_LAYER_HIDDEN);
+    mr_test_add_node(s, "Wall", mr_m4_translate(0, 0, 5), mr_test_add_box(s, 6, 4, 0.1, ma), MR_LAYER_VISIBLE);
+    mr_test_add_node(s, "Back", mr_m4_translate(0, 0, 7.05), mr_test_add_box(s, 4, 3, 0.1, mb), MR_LAYER_HIDDEN);
+    mr_test_add_node(s, "Fin", mr_m4_translate(-1.0, 0, 6.5), mr_test_add_box(s, 0.1, 3, 1.0, mb), MR_LAYER_HIDDEN);
     mr_scene_update_bounds(s);
     char passes[512];
     mr_frame_params p = MR_FRAME_DEFAULTS;

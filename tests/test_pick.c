@@ -2,53 +2,24 @@
  * under it, read back from the G-buffer. Checked against planes at known
  * depths, at a far offset and at a tiny scale, plus misses and bad input. */
 #include "mr_test.h"
+#include "mr_test_scene.h"
+
 #include "mr_render.h"
 
 #include <string.h>
 
-/* A quad of size sx x sy in its node's z = 0 plane. */
-static int32_t add_quad(mr_scene *s, double sx, double sy) {
-    mr_mesh m;
-    memset(&m, 0, sizeof m);
-    snprintf(m.name, sizeof m.name, "quad");
-    m.vertex_count = 4;
-    m.index_count = 6;
-    m.positions = malloc(12 * sizeof(float));
-    m.indices = malloc(6 * sizeof(uint32_t));
-    const float p[12] = {(float)(-sx / 2), (float)(-sy / 2), 0, (float)(sx / 2), (float)(-sy / 2), 0,
-                         (float)(sx / 2),  (float)(sy / 2),  0, (float)(-sx / 2), (float)(sy / 2), 0};
-    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(m.positions, p, sizeof p);
-    memcpy(m.indices, idx, sizeof idx);
-    m.material = -1;
-    mr_error err = {0};
-    int32_t id = mr_scene_add_mesh(s, &m, &err);
-    CHECK_MSG(id >= 0, "%s", err.msg);
-    return id;
-}
 
-static void add_node(mr_scene *s, const char *name, mr_dmat4 world, int32_t mesh, uint8_t layer) {
-    mr_node n;
-    memset(&n, 0, sizeof n);
-    snprintf(n.name, sizeof n.name, "%s", name);
-    n.parent = -1;
-    n.world = world;
-    n.mesh_first = mesh;
-    n.mesh_count = 1;
-    n.layer = layer;
-    mr_scene_add_node(s, &n);
-}
 
 /* Two planes facing a camera at `offset` looking down +z: a wall (visible)
  * filling the left half at depth 4*scale, a panel (hidden layer) on the
  * right at depth 2*scale. */
 static void check_case(mr_renderer *r, double scale, mr_dvec3 offset) {
     mr_scene *s = mr_scene_create();
-    int32_t q = add_quad(s, 4 * scale, 6 * scale);
+    int32_t q = mr_test_add_quad(s, 4 * scale, 6 * scale, -1, false);
     mr_dmat4 w1 = mr_m4_translate(offset.x - 2 * scale, offset.y, offset.z + 4 * scale);
     mr_dmat4 w2 = mr_m4_translate(offset.x + 2 * scale, offset.y, offset.z + 2 * scale);
-    add_node(s, "wall", w1, q, MR_LAYER_VISIBLE);
-    add_node(s, "panel", w2, q, MR_LAYER_HIDDEN);
+    mr_test_add_node(s, "wall", w1, q, MR_LAYER_VISIBLE);
+    mr_test_add_node(s, "panel", w2, q, MR_LAYER_HIDDEN);
     mr_scene_update_bounds(s);
     mr_error err = {0};
     CHECK_MSG(mr_renderer_set_scene(r, s, &err), "%s", err.msg);

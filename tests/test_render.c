@@ -4,6 +4,7 @@
  * Skips (77) where no EGL device exists. */
 #include "mr_render.h"
 #include "mr_test.h"
+#include "mr_test_scene.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -11,61 +12,7 @@
 static mr_gpu *g_gpu;
 static mr_renderer *g_r;
 
-/* A quad in the z = 0 plane of its node, size sx x sy, facing -z. */
-static int32_t add_quad(mr_scene *s, double sx, double sy, int32_t material, bool uvs) {
-    mr_mesh m;
-    memset(&m, 0, sizeof m);
-    snprintf(m.name, sizeof m.name, "quad");
-    m.vertex_count = 4;
-    m.index_count = 6;
-    m.positions = malloc(12 * sizeof(float));
-    m.indices = malloc(6 * sizeof(uint32_t));
-    const float p[12] = {(float)(-sx / 2), (float)(-sy / 2), 0, (float)(sx / 2), (float)(-sy / 2), 0,
-                         (float)(sx / 2),  (float)(sy / 2),  0, (float)(-sx / 2), (float)(sy / 2), 0};
-    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(m.positions, p, sizeof p);
-    memcpy(m.indices, idx, sizeof idx);
-    if (uvs) {
-        m.uvs = malloc(8 * sizeof(float));
-        const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
-        memcpy(m.uvs, uv, sizeof uv);
-    }
-    m.material = material;
-    mr_error err = {0};
-    int32_t id = mr_scene_add_mesh(s, &m, &err);
-    CHECK_MSG(id >= 0, "%s", err.msg);
-    return id;
-}
 
-/* An axis-aligned box of size sx,sy,sz centred on its node origin. */
-static int32_t add_box(mr_scene *s, double sx, double sy, double sz, int32_t material) {
-    mr_mesh m;
-    memset(&m, 0, sizeof m);
-    snprintf(m.name, sizeof m.name, "box");
-    m.vertex_count = 24;
-    m.index_count = 36;
-    m.positions = malloc(72 * sizeof(float));
-    m.indices = malloc(36 * sizeof(uint32_t));
-    static const int faces[6][4][3] = {
-        {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}},     {{-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, -1}},
-        {{-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}},     {{-1, -1, 1}, {-1, -1, -1}, {1, -1, -1}, {1, -1, 1}},
-        {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},     {{1, -1, -1}, {-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}},
-    };
-    for (int f = 0; f < 6; f++) {
-        for (int v = 0; v < 4; v++) {
-            m.positions[(f * 4 + v) * 3 + 0] = (float)(faces[f][v][0] * sx / 2);
-            m.positions[(f * 4 + v) * 3 + 1] = (float)(faces[f][v][1] * sy / 2);
-            m.positions[(f * 4 + v) * 3 + 2] = (float)(faces[f][v][2] * sz / 2);
-        }
-        const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
-        for (int k = 0; k < 6; k++) m.indices[f * 6 + k] = (uint32_t)(f * 4) + q[k];
-    }
-    m.material = material;
-    mr_error err = {0};
-    int32_t id = mr_scene_add_mesh(s, &m, &err);
-    CHECK_MSG(id >= 0, "%s", err.msg);
-    return id;
-}
 
 static int32_t add_material(mr_scene *s, float r, float g, float b, int32_t tex) {
     mr_material mat;
@@ -75,17 +22,6 @@ static int32_t add_material(mr_scene *s, float r, float g, float b, int32_t tex)
     return mr_scene_add_material(s, &mat);
 }
 
-static void add_node(mr_scene *s, const char *name, mr_dmat4 world, int32_t mesh, uint8_t layer) {
-    mr_node n;
-    memset(&n, 0, sizeof n);
-    snprintf(n.name, sizeof n.name, "%s", name);
-    n.parent = -1;
-    n.world = world;
-    n.mesh_first = mesh;
-    n.mesh_count = 1;
-    n.layer = layer;
-    mr_scene_add_node(s, &n);
-}
 
 /* A small still life: floor, three boxes, a hidden pipe-like box behind a
  * wall, a checker-textured plate. `scale` multiplies all lengths, `offset`
@@ -107,16 +43,16 @@ static mr_scene *still_life(double scale, mr_dvec3 offset) {
             blue = add_material(s, 0.1f, 0.2f, 0.8f, -1), yel = add_material(s, 0.9f, 0.8f, 0.1f, -1),
             chk = add_material(s, 1, 1, 1, t);
     double k = scale;
-    int32_t floor_mesh = add_box(s, 20 * k, 0.2 * k, 20 * k, grey);
-    int32_t cube = add_box(s, 1 * k, 1 * k, 1 * k, red);
-    int32_t tall = add_box(s, 0.6 * k, 2.5 * k, 0.6 * k, blue);
-    int32_t wall = add_box(s, 4 * k, 2 * k, 0.1 * k, yel);
-    int32_t pipe = add_box(s, 3 * k, 0.2 * k, 0.2 * k, red);
-    int32_t plate = add_quad(s, 1 * k, 1 * k, chk, true);
+    int32_t floor_mesh = mr_test_add_box(s, 20 * k, 0.2 * k, 20 * k, grey);
+    int32_t cube = mr_test_add_box(s, 1 * k, 1 * k, 1 * k, red);
+    int32_t tall = mr_test_add_box(s, 0.6 * k, 2.5 * k, 0.6 * k, blue);
+    int32_t wall = mr_test_add_box(s, 4 * k, 2 * k, 0.1 * k, yel);
+    int32_t pipe = mr_test_add_box(s, 3 * k, 0.2 * k, 0.2 * k, red);
+    int32_t plate = mr_test_add_quad(s, 1 * k, 1 * k, chk, true);
     mr_dmat4 T;
 #define PLACE(name, mesh, px, py, pz, layer)                                                    \
     T = mr_m4_translate(offset.x + (px) * k, offset.y + (py) * k, offset.z + (pz) * k);         \
-    add_node(s, name, T, mesh, layer)
+    mr_test_add_node(s, name, T, mesh, layer)
     PLACE("Floor", floor_mesh, 0, -0.1, 0, MR_LAYER_VISIBLE);
     PLACE("Cube", cube, -1.5, 0.5, 1, MR_LAYER_VISIBLE);
     PLACE("Tall", tall, 1.2, 1.25, 0.5, MR_LAYER_VISIBLE);
@@ -126,7 +62,7 @@ static mr_scene *still_life(double scale, mr_dvec3 offset) {
     mr_dmat4 R = mr_m4_rotate_axis(mr_v3(0, 1, 0), 3.14159265358979 * 0.9);
     T = mr_m4_translate(offset.x + 0.2 * k, offset.y + 0.8 * k, offset.z - 0.5 * k);
     T = mr_m4_mul(&T, &R);
-    add_node(s, "Plate", T, plate, MR_LAYER_VISIBLE);
+    mr_test_add_node(s, "Plate", T, plate, MR_LAYER_VISIBLE);
 #undef PLACE
     mr_scene_update_bounds(s);
     return s;
@@ -174,8 +110,8 @@ static void test_analytic_shading(void) {
      * linear = albedo * (ambient + 1) exactly. */
     mr_scene *s = mr_scene_create();
     int32_t m = add_material(s, 0.25f, 0.5f, 0.125f, -1);
-    int32_t q = add_quad(s, 10, 10, m, false);
-    add_node(s, "Q", mr_m4_translate(0, 0, 5), q, MR_LAYER_VISIBLE);
+    int32_t q = mr_test_add_quad(s, 10, 10, m, false);
+    mr_test_add_node(s, "Q", mr_m4_translate(0, 0, 5), q, MR_LAYER_VISIBLE);
     s->light_count = 1;
     s->lights[0].direction[2] = -1; /* towards the camera at the origin */
     s->lights[0].color[0] = s->lights[0].color[1] = s->lights[0].color[2] = 0.6f;
@@ -246,7 +182,7 @@ static void test_zfight(void) {
         double tilt = (variant & 2) ? 1.0 : 0.0; /* radians about y */
         mr_scene *s = mr_scene_create();
         int32_t red = add_material(s, 1, 0, 0, -1), blue = add_material(s, 0, 0, 1, -1);
-        int32_t qn = add_quad(s, 40, 40, red, false), qf = add_quad(s, 40, 40, blue, false);
+        int32_t qn = mr_test_add_quad(s, 40, 40, red, false), qf = mr_test_add_quad(s, 40, 40, blue, false);
         mr_dmat4 R = mr_m4_rotate_axis(mr_v3(0, 1, 0), tilt);
         mr_dmat4 Tn = mr_m4_translate(0, 0, 1000.0), Tf = mr_m4_translate(0, 0, 1000.001);
         mr_dmat4 Wn = mr_m4_mul(&Tn, &R), Wf = mr_m4_mul(&Tf, &R);
@@ -257,11 +193,11 @@ static void test_zfight(void) {
         Wf = mr_m4_mul(&Wf, &R);
         (void)Tf;
         if (near_first) {
-            add_node(s, "near", Wn, qn, 0);
-            add_node(s, "far", Wf, qf, 0);
+            mr_test_add_node(s, "near", Wn, qn, 0);
+            mr_test_add_node(s, "far", Wf, qf, 0);
         } else {
-            add_node(s, "far", Wf, qf, 0);
-            add_node(s, "near", Wn, qn, 0);
+            mr_test_add_node(s, "far", Wf, qf, 0);
+            mr_test_add_node(s, "near", Wn, qn, 0);
         }
         mr_scene_update_bounds(s);
         /* 64x48 pixels spanning about 3 m at 1 km. */
