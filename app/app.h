@@ -27,6 +27,8 @@ bool app_flag(const app_opt *opts, const char *name);
 bool app_double(const char *opt, const char *s, double lo, double hi, double *out);
 bool app_int(const char *opt, const char *s, long lo, long hi, long *out);
 bool app_size(const char *opt, const char *s, int *w, int *h);
+/* Median of v[0..n) (sorts v in place); 0 for n <= 0. For benches. */
+double app_median(double *v, int n);
 /* Prints "mrcheck: <cmd>: <message>" on stderr and returns 1. */
 int app_error(const char *cmd, const mr_error *err);
 int app_errorf(const char *cmd, const char *fmt, ...)

@@ -33,17 +33,6 @@ typedef struct view_data {
     mr_image depth, normal, gt_fixed, gt_screen;
 } view_data;
 
-static int cmp_d(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median_of(double *v, int n) {
-    if (n <= 0) return 0;
-    qsort(v, (size_t)n, sizeof *v, cmp_d);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 /* Renders `frames` timed frames (plus one warm-up) and returns the median
  * GPU ms of the AO passes; the last frame's AO goes to *ao. */
 static bool run_ao(mr_renderer *r, const mr_view *v, const mr_ao_params *ao, int w, int h, int frames, double *ms,
@@ -72,7 +61,7 @@ static bool run_ao(mr_renderer *r, const mr_view *v, const mr_ao_params *ao, int
         }
         mr_frame_result_free(&res);
     }
-    *ms = median_of(t, n);
+    *ms = app_median(t, n);
     return true;
 }
 
@@ -421,8 +410,8 @@ int bench_ao(int argc, char **argv) {
             mr_frame_result_free(&res);
         }
         if (ok) {
-            tri_ms[ntri] = median_of(aoms, n);
-            tri_gb[ntri] = median_of(gbms, n);
+            tri_ms[ntri] = app_median(aoms, n);
+            tri_gb[ntri] = app_median(gbms, n);
             fprintf(tcsv, "%s,%llu,%.4f,%.4f,%d,%d,%d\n", gi < 3 ? "terrain" : "scene", (unsigned long long)tri_count[ntri],
                     tri_ms[ntri], tri_gb[ntri], w, h, n);
             ntri++;

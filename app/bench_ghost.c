@@ -23,17 +23,6 @@ typedef struct ghost_row {
 static const char *const k_pass_names[6] = {"ghost_hidden", "ghost_curvature", "ghost_importance",
                                             "ghost_g0",     "ghost_analysis",  "ghost_emphasis"};
 
-static int cmp_double(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n) {
-    if (n <= 0) return 0;
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 /* Legibility (y) against ghosting GPU ms (x), one marker per row: colour by
  * mode, filled for the conflict case, hollow for no conflict. */
 static bool write_svg(const char *path, const char *title, const ghost_row *rows, int n, mr_error *err) {
@@ -171,9 +160,9 @@ int app_bench_ghost(int argc, char **argv) {
                         mr_frame_result_free(&res);
                     }
                     if (!ok) break;
-                    for (int k = 0; k < 6; k++) r->pass_ms[k] = median(&samples[(size_t)k * frames], (int)frames);
-                    r->ghost_ms = median(&samples[(size_t)6 * frames], (int)frames);
-                    r->frame_ms = median(&samples[(size_t)7 * frames], (int)frames);
+                    for (int k = 0; k < 6; k++) r->pass_ms[k] = app_median(&samples[(size_t)k * frames], (int)frames);
+                    r->ghost_ms = app_median(&samples[(size_t)6 * frames], (int)frames);
+                    r->frame_ms = app_median(&samples[(size_t)7 * frames], (int)frames);
                     /* The measure, in one untimed frame (it adds GPU work). */
                     fp.timing = false;
                     fp.ghost.stats = true;

@@ -5,17 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int cmp_double(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n) {
-    if (n <= 0) return 0;
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 /* A horizontal bar chart of median GPU and CPU ms per pass. */
 static bool write_svg(const char *path, const char *title, int n, const char *const *names, const double *gpu,
                       const double *cpu, mr_error *err) {
@@ -147,14 +136,14 @@ static int bench_frame(int argc, char **argv) {
                mr_gpu_description(gfx.gpu), w, h, frames, (unsigned long long)tris, draws, load_ms);
         printf("  %-10s %10s %10s\n", "pass", "GPU ms", "CPU ms");
         for (int k = 0; k < npass; k++) {
-            mg[k] = median(&gpu[(size_t)k * frames], (int)frames);
-            mc[k] = median(&cpu[(size_t)k * frames], (int)frames);
+            mg[k] = app_median(&gpu[(size_t)k * frames], (int)frames);
+            mc[k] = app_median(&cpu[(size_t)k * frames], (int)frames);
             gsum += mg[k];
             printf("  %-10s %10.2f %10.2f\n", names[k], mg[k], mc[k]);
             len += snprintf(csv + len, sizeof csv - (size_t)len, "%s,%.4f,%.4f,%ld,%d,%d,%llu,%u\n", names[k], mg[k], mc[k],
                             frames, w, h, (unsigned long long)tris, draws);
         }
-        double mt = median(total, (int)frames);
+        double mt = app_median(total, (int)frames);
         printf("  %-10s %10.2f %10.2f   (frame incl. readback, wall clock)\n", "total", gsum, mt);
         len += snprintf(csv + len, sizeof csv - (size_t)len, "frame_wall,%.4f,%.4f,%ld,%d,%d,%llu,%u\n", gsum, mt, frames,
                         w, h, (unsigned long long)tris, draws);

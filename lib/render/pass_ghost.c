@@ -425,21 +425,7 @@ bool mr_pass_need_ghost_adaptive(frame *f) { return mr_ghost_active(f) && f->p->
 void mr_pass_ghost_hidden(frame *f) {
     mr_renderer *r = f->r;
     mr_ghost_state *g = r->ghost;
-    glBindFramebuffer(GL_FRAMEBUFFER, g->hid.fbo);
-    glViewport(0, 0, r->w, r->h);
-    glEnable(GL_FRAMEBUFFER_SRGB);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GREATER);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_CULL_FACE);
-    glDisable(GL_BLEND);
-    static const float zero4[4] = {0, 0, 0, 0};
-    static const GLuint zero_u[4] = {0, 0, 0, 0};
-    static const float depth0 = 0.0f;
-    glClearNamedFramebufferfv(g->hid.fbo, GL_COLOR, 0, zero4);
-    glClearNamedFramebufferfv(g->hid.fbo, GL_COLOR, 1, zero4);
-    glClearNamedFramebufferuiv(g->hid.fbo, GL_COLOR, 2, zero_u);
-    glClearNamedFramebufferfv(g->hid.fbo, GL_DEPTH, 0, &depth0);
+    mr_gbuffer_begin(f, &g->hid);
     mr_geometry_draw(f, 1u << MR_LAYER_HIDDEN);
     glDisable(GL_DEPTH_TEST);
     GLuint keep = f->final_tex;

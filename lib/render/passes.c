@@ -7,10 +7,9 @@
 bool mr_pass_need_always(frame *f) { (void)f; return true; }
 bool mr_pass_need_overlay(frame *f) { return f->p->video != NULL; }
 
-void mr_pass_gbuffer(frame *f) {
-    mr_renderer *r = f->r;
-    glBindFramebuffer(GL_FRAMEBUFFER, r->gbuf.fbo);
-    glViewport(0, 0, r->w, r->h);
+void mr_gbuffer_begin(frame *f, const target *t) {
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+    glViewport(0, 0, f->r->w, f->r->h);
     glEnable(GL_FRAMEBUFFER_SRGB);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
@@ -20,10 +19,16 @@ void mr_pass_gbuffer(frame *f) {
     static const float zero4[4] = {0, 0, 0, 0};
     static const GLuint zero_u[4] = {0, 0, 0, 0};
     static const float depth0 = 0.0f; /* reversed Z: clear to infinity */
-    glClearNamedFramebufferfv(r->gbuf.fbo, GL_COLOR, 0, zero4);
-    glClearNamedFramebufferfv(r->gbuf.fbo, GL_COLOR, 1, zero4);
-    glClearNamedFramebufferuiv(r->gbuf.fbo, GL_COLOR, 2, zero_u);
-    glClearNamedFramebufferfv(r->gbuf.fbo, GL_DEPTH, 0, &depth0);
+    glClearNamedFramebufferfv(t->fbo, GL_COLOR, 0, zero4);
+    glClearNamedFramebufferfv(t->fbo, GL_COLOR, 1, zero4);
+    glClearNamedFramebufferuiv(t->fbo, GL_COLOR, 2, zero_u);
+    glClearNamedFramebufferfv(t->fbo, GL_DEPTH, 0, &depth0);
+}
+
+void mr_pass_gbuffer(frame *f) {
+    mr_renderer *r = f->r;
+    static const float zero4[4] = {0, 0, 0, 0};
+    mr_gbuffer_begin(f, &r->gbuf);
     /* View-space positions are rasterised (not un-projected from depth) so
      * that AO also works where the projection cannot be inverted; the
      * attachment costs bandwidth, so it is written only when this frame's AO

@@ -99,6 +99,9 @@ void mr_geometry_aux_draw(frame *f, const mr_geo_aux *aux, uint32_t layer_mask);
 /* Passes (passes.c). */
 bool mr_pass_need_always(frame *f);
 bool mr_pass_need_overlay(frame *f);
+/* Binds a G-buffer-layout target, clears it (depth to infinity) and sets
+ * the depth state the geometry pass draws with. */
+void mr_gbuffer_begin(frame *f, const target *t);
 void mr_pass_gbuffer(frame *f);
 void mr_pass_shade(frame *f);
 void mr_pass_overlay(frame *f);
