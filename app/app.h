@@ -29,7 +29,12 @@ bool app_int(const char *opt, const char *s, long lo, long hi, long *out);
 bool app_size(const char *opt, const char *s, int *w, int *h);
 /* Median of v[0..n) (sorts v in place); 0 for n <= 0. For benches. */
 double app_median(double *v, int n);
-/* Prints "mrcheck: <cmd>: <message>" on stderr and returns 1. */
+/* Exit status of a command that found no GPU device, GL context or display
+ * (MR_ERR_NODEVICE): EX_UNAVAILABLE of sysexits.h. Tests skip on this status
+ * only, never on the text of a message. */
+#define APP_EXIT_NODEVICE 69
+/* Prints "mrcheck: <cmd>: <message>" on stderr and returns 1, or
+ * APP_EXIT_NODEVICE for MR_ERR_NODEVICE. */
 int app_error(const char *cmd, const mr_error *err);
 int app_errorf(const char *cmd, const char *fmt, ...)
 #if defined(__GNUC__)

@@ -116,7 +116,7 @@ bool app_size(const char *opt, const char *s, int *w, int *h) {
 
 int app_error(const char *cmd, const mr_error *err) {
     fprintf(stderr, "mrcheck: %s: %s\n", cmd, err->msg[0] ? err->msg : "failed");
-    return 1;
+    return err->code == MR_ERR_NODEVICE ? APP_EXIT_NODEVICE : 1;
 }
 
 int app_errorf(const char *cmd, const char *fmt, ...) {

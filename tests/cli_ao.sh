@@ -2,19 +2,15 @@
 # End-to-end checks of `mrcheck render --ao ...`: every method writes ao.pfm
 # through --aux, the pass list shows the AO passes (none when --ao none),
 # the ground truth works, and bad AO options fail with one line on stderr.
-# Usage: cli_ao.sh MRCHECK TMPDIR. Exit 77 = skipped (no EGL device).
+# Usage: cli_ao.sh MRCHECK TMPDIR. Exit 77 = skipped (no GL device: mrcheck exit 69).
 set -u
 mr=$1
 tmp=$2
 rm -rf "$tmp" && mkdir -p "$tmp"
-pass=0 fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
+# shellcheck source=common_cli.sh
+. "$(dirname "$0")/common_cli.sh"
 
-if ! "$mr" demo --out "$tmp/demo" >"$tmp/demo.log" 2>&1; then
-  if grep -q "EGL" "$tmp/demo.log"; then echo "cli_ao: SKIPPED: no EGL device"; exit 77; fi
-  cat "$tmp/demo.log"; echo "0 passed, 1 failed"; exit 1
-fi
+demo_or_exit cli_ao "$mr" "$tmp/demo"
 d=$tmp/demo
 r() { "$mr" render --scene "$d/scene_planned.json" --view "$d/views/view_001.json" --size 96x72 "$@"; }
 
@@ -61,5 +57,4 @@ for args in "--ao ssao" "--ao scheer --ao-samples 0" "--ao scheer --ao-samples 6
     [ ! -e "$tmp/bad.png" ] && ok || bad "$args: wrote an output"
   fi
 done
-echo "cli_ao: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+cli_finish cli_ao

@@ -3,19 +3,15 @@
 # triptychs, `render --ghost MODE` (pass list, the picture changes only
 # where hidden structure is), no ghosting pass without hidden structure in
 # view, and bad ghost options (one line on stderr, non-zero, no output).
-# Usage: cli_ghost.sh MRCHECK TMPDIR. Exit 77 = skipped (no EGL device).
+# Usage: cli_ghost.sh MRCHECK TMPDIR. Exit 77 = skipped (no GL device: mrcheck exit 69).
 set -u
 mr=$1
 tmp=$2
 rm -rf "$tmp" && mkdir -p "$tmp"
-pass=0 fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
+# shellcheck source=common_cli.sh
+. "$(dirname "$0")/common_cli.sh"
 
-if ! "$mr" demo --out "$tmp/demo" >"$tmp/demo.log" 2>&1; then
-  if grep -q "EGL" "$tmp/demo.log"; then echo "cli_ghost: SKIPPED: no EGL device"; exit 77; fi
-  cat "$tmp/demo.log"; echo "0 passed, 1 failed"; exit 1
-fi
+demo_or_exit cli_ghost "$mr" "$tmp/demo"
 d=$tmp/demo
 for c in conflict noconflict; do
   for m in alpha g0 adaptive triptych; do
@@ -53,22 +49,10 @@ echo "{$cam \"world_from_camera\": [-1,0,0,0, 0,-1,0,1.6, 0,0,1,100, 0,0,0,1]}" 
 "$mr" render --scene "$s" --view "$v" --size 160x120 --out "$tmp/hh.png" --ghost adaptive --hide-hidden --verbose 2>"$tmp/hh.err" \
   && grep -q "passes: gbuffer shade;" "$tmp/hh.err" && ok || bad "--hide-hidden still ghosts: $(cat "$tmp/hh.err")"
 
-expect_fail() {
-  local name=$1 out=$2; shift 3
-  "$@" >"$tmp/$name.out" 2>"$tmp/$name.err"
-  local rc=$?
-  local lines; lines=$(wc -l <"$tmp/$name.err")
-  if [ $rc -eq 0 ]; then bad "$name: exit 0"; return; fi
-  if [ $rc -ge 128 ]; then bad "$name: crashed (rc $rc)"; return; fi
-  if [ "$lines" -ne 1 ]; then bad "$name: $lines lines on stderr: $(cat "$tmp/$name.err")"; return; fi
-  if [ -n "$out" ] && [ -e "$out" ]; then bad "$name: output left behind"; return; fi
-  ok
-}
 expect_fail bad_mode "$tmp/b1.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b1.png" --ghost sometimes
 expect_fail bad_importance "$tmp/b2.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b2.png" --ghost g0 --ghost-importance colour
 expect_fail bad_saliency "$tmp/b3.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b3.png" --ghost g0 --ghost-saliency dog
 expect_fail bad_t "$tmp/b4.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b4.png" --ghost g0 --ghost-t 1.5
 expect_fail bad_bench "" -- "$mr" bench ghost --frames 0
 
-echo "cli_ghost: $pass passed, $fail failed"
-[ $fail -eq 0 ]
+cli_finish cli_ghost

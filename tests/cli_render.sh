@@ -2,20 +2,16 @@
 # End-to-end checks of `mrcheck demo` and `mrcheck render`, and of bad input:
 # every failure must print exactly one line on stderr, exit non-zero, and
 # leave no output file (not even a temporary one) behind.
-# Usage: cli_render.sh MRCHECK TMPDIR. Exit 77 = skipped (no EGL device).
+# Usage: cli_render.sh MRCHECK TMPDIR. Exit 77 = skipped (no GL device: mrcheck exit 69).
 set -u
 mr=$1
 tmp=$2
 rm -rf "$tmp" && mkdir -p "$tmp"
-pass=0 fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
+# shellcheck source=common_cli.sh
+. "$(dirname "$0")/common_cli.sh"
 
 # The demo writes the files the other cases use.
-if ! "$mr" demo --out "$tmp/demo" >"$tmp/demo.log" 2>&1; then
-  if grep -q "EGL" "$tmp/demo.log"; then echo "cli_render: SKIPPED: no EGL device"; exit 77; fi
-  cat "$tmp/demo.log"; echo "0 passed, 1 failed"; exit 1
-fi
+demo_or_exit cli_render "$mr" "$tmp/demo"
 d=$tmp/demo
 for f in hall_planned.glb hall_built.glb markers.json discrepancies.json camera.json scene_planned.json \
          frames/frame_000.png overlay/overlay_000.png views/view_000.json; do
@@ -40,18 +36,6 @@ cp "$d/hall_planned.glb" "$tmp/misnamed.gltf"
   && cmp -s "$tmp/misnamed.png" "$tmp/plain.png" && ok || bad "misnamed .glb did not render the same image"
 
 # --- bad input -----------------------------------------------------------
-# expect_fail NAME OUTFILE -- command...
-expect_fail() {
-  local name=$1 out=$2; shift 3
-  "$@" >"$tmp/$name.out" 2>"$tmp/$name.err"
-  local rc=$?
-  local lines; lines=$(wc -l <"$tmp/$name.err")
-  if [ $rc -eq 0 ]; then bad "$name: exit 0"; return; fi
-  if [ $rc -ge 128 ]; then bad "$name: crashed (rc $rc)"; return; fi
-  if [ "$lines" -ne 1 ]; then bad "$name: $lines lines on stderr: $(cat "$tmp/$name.err")"; return; fi
-  if [ -n "$out" ] && { [ -e "$out" ] || ls "$out".tmp.* >/dev/null 2>&1; }; then bad "$name: output left behind"; return; fi
-  ok
-}
 v=$d/views/view_000.json
 s=$d/scene_planned.json
 expect_fail missing_scene "$tmp/o1.png" -- "$mr" render --scene "$tmp/nope.glb" --view "$v" --out "$tmp/o1.png"
@@ -104,5 +88,4 @@ echo '{"gltf": "missing.glb"}' >"$tmp/cfg_missing.json"
 expect_fail config_missing_gltf "$tmp/o15.png" -- "$mr" render --scene "$tmp/cfg_missing.json" --view "$v" --out "$tmp/o15.png"
 ls "$tmp"/*.tmp.* >/dev/null 2>&1 && bad "temporary files left behind" || ok
 
-echo "cli_render: $pass passed, $fail failed"
-[ $fail -eq 0 ]
+cli_finish cli_render

@@ -4,14 +4,13 @@
 # batching, instancing and occlusion culling do not change the image; the
 # LOD cache is written next to the scene, reused, and ignored when damaged;
 # bad values give one line on stderr and a non-zero exit.
-# Usage: cli_scene.sh MRCHECK TMPDIR. Exit 77 = skipped (no EGL device).
+# Usage: cli_scene.sh MRCHECK TMPDIR. Exit 77 = skipped (no GL device: mrcheck exit 69).
 set -u
 mr=$1
 tmp=$2
 rm -rf "$tmp" && mkdir -p "$tmp"
-pass=0 fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
+# shellcheck source=common_cli.sh
+. "$(dirname "$0")/common_cli.sh"
 
 if "$mr" factory --halls 1 --out "$tmp/plant/s.glb" --views "$tmp/views" >"$tmp/synth.log" 2>&1; then
   for f in plant/s.glb views/view_floor.json views/view_aisle.json views/view_overview.json; do
@@ -23,10 +22,10 @@ else
 fi
 v=$tmp/views/view_floor.json
 r() { "$mr" render --scene "$tmp/plant/s.glb" --view "$v" --size 240x180 --lod off "$@"; }
-if ! r --out "$tmp/all.png" --verbose 2>"$tmp/all.err"; then
-  if grep -q "EGL" "$tmp/all.err"; then echo "cli_scene: SKIPPED: no EGL device"; exit 77; fi
-  bad "render failed: $(cat "$tmp/all.err")"
-fi
+r --out "$tmp/all.png" --verbose 2>"$tmp/all.err"
+rc=$?
+if [ $rc -eq "$MR_EXIT_NODEVICE" ]; then echo "cli_scene: SKIPPED: no GL device: $(cat "$tmp/all.err")"; exit 77; fi
+[ $rc -eq 0 ] && ok || bad "render failed (exit $rc): $(cat "$tmp/all.err")"
 grep -q "geometry: .* nodes visible" "$tmp/all.err" && ok || bad "verbose draw counts missing: $(cat "$tmp/all.err")"
 grep -q "peak RSS" "$tmp/all.err" && ok || bad "verbose load report missing"
 r --out "$tmp/none.png" --cull off --batch off --instancing off 2>"$tmp/none.err" \
@@ -54,15 +53,6 @@ printf 'x' >>"$tmp/tri.gltf.mrlod"
 rl "$tmp/lod3.png" 2>"$tmp/lod3.err" && grep -q "ignored" "$tmp/lod3.err" && cmp -s "$tmp/lod1.png" "$tmp/lod3.png" \
   && ok || bad "damaged LOD cache: $(cat "$tmp/lod3.err")"
 
-expect_fail() {
-  local name=$1; shift 2
-  "$@" >"$tmp/$name.out" 2>"$tmp/$name.err"
-  local rc=$? lines; lines=$(wc -l <"$tmp/$name.err")
-  if [ $rc -eq 0 ]; then bad "$name: exit 0"; return; fi
-  if [ $rc -ge 128 ]; then bad "$name: crashed (rc $rc)"; return; fi
-  if [ "$lines" -ne 1 ]; then bad "$name: $lines lines on stderr: $(cat "$tmp/$name.err")"; return; fi
-  ok
-}
 expect_fail bad_cull -- r --out "$tmp/x.png" --cull maybe
 expect_fail bad_tolerance -- r --out "$tmp/x.png" --lod-tolerance -1
 expect_fail bad_lod -- r --out "$tmp/x.png" --lod sometimes
@@ -72,5 +62,4 @@ expect_fail synth_both -- "$mr" factory --out "$tmp/y.glb" --triangles 1M --hall
 expect_fail bench_bad_sizes -- "$mr" bench scene --sizes 5Q --out "$tmp/b"
 [ ! -e "$tmp/x.png" ] && [ ! -e "$tmp/y.glb" ] && ok || bad "output left behind"
 
-echo "cli_scene: $pass passed, $fail failed"
-[ $fail -eq 0 ]
+cli_finish cli_scene

@@ -20,9 +20,8 @@ if [ -z "${DISPLAY:-}" ]; then
   exec xvfb-run -a -s "-screen 0 1024x768x24" bash "$0" "$@"
 fi
 rm -rf "$tmp" && mkdir -p "$tmp"
-pass=0 fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
+# shellcheck source=common_cli.sh
+. "$(dirname "$0")/common_cli.sh"
 # jget FILE KEY: a top-level scalar from the pretty-printed state JSON.
 jget() { sed -n "s/^[[:space:]]*\"$2\":[[:space:]]*\(.*\)$/\1/p" "$1" | head -1 | sed 's/,$//; s/^"//; s/"$//'; }
 # widget FILE NAME: "x y" of the centre of a named widget.
@@ -32,10 +31,7 @@ widget() {
 }
 lt() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a + 0 < b + 0) }'; }
 
-if ! "$mr" demo --out "$tmp/demo" >"$tmp/demo.log" 2>&1; then
-  if grep -q "EGL" "$tmp/demo.log"; then echo "cli_view: SKIPPED: no EGL device"; exit 77; fi
-  cat "$tmp/demo.log"; echo "0 passed, 1 failed"; exit 1
-fi
+demo_or_exit cli_view "$mr" "$tmp/demo"
 d=$tmp/demo
 # The demo's frame 2 sees a tag: replay starts paused there.
 view() { # view NAME SCRIPT [extra args...]: runs the viewer over the demo recording
@@ -227,5 +223,4 @@ else bad "missing-scene run failed: $(tail -3 "$tmp/noscene.err")"; fi
 "$mr" view --scene "$d/scene_planned.json" --input /dev/video0 2>"$tmp/bad2.err"; rc=$?
 [ $rc -ne 0 ] && [ "$(wc -l <"$tmp/bad2.err")" -eq 1 ] && ok || bad "--input without --camera: rc $rc"
 
-echo "cli_view: $pass passed, $fail failed"
-[ $fail -eq 0 ]
+cli_finish cli_view

@@ -6,6 +6,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "mr_core.h"
+
 static int mr_test_failures = 0;
 static int mr_test_checks = 0;
 
@@ -24,4 +26,17 @@ static inline int mr_test_finish(const char *name) {
     return mr_test_failures ? 1 : 0;
 }
 #define MR_TEST_SKIP 77
+
+/* For main() of a GPU test whose context could not be made: a skip (77)
+ * only when the error says there is no device (MR_ERR_NODEVICE; ctest
+ * reports it and scripts/test.sh fails on it where deps.sh installed EGL),
+ * any other error is a failure. */
+static inline int mr_test_no_gpu(const char *name, const mr_error *err) {
+    if (err->code == MR_ERR_NODEVICE) {
+        printf("%s: SKIPPED: no GL device (%s)\n", name, err->msg);
+        return MR_TEST_SKIP;
+    }
+    fprintf(stderr, "%s: FAILED: cannot create a GL context (%s)\n", name, err->msg);
+    return 1;
+}
 #endif

@@ -402,10 +402,7 @@ int main(void) {
     mr_error err = {0};
     mr_mkdirs(tmp_dir(), &err);
     g_gpu = mr_gpu_create_headless(NULL, &err);
-    if (!g_gpu) {
-        printf("test_massive: SKIPPED: no EGL device (%s)\n", err.msg);
-        return MR_TEST_SKIP;
-    }
+    if (!g_gpu) return mr_test_no_gpu("test_massive", &err);
     g_r = mr_renderer_create(g_gpu, &err);
     CHECK_MSG(g_r != NULL, "%s", err.msg);
     if (g_r) {

@@ -61,10 +61,7 @@ static void check_case(mr_renderer *r, double scale, mr_dvec3 offset) {
 int main(void) {
     mr_error err = {0};
     mr_gpu *gpu = mr_gpu_create_headless(NULL, &err);
-    if (!gpu) {
-        printf("test_pick: SKIPPED: no EGL device (%s)\n", err.msg);
-        return MR_TEST_SKIP;
-    }
+    if (!gpu) return mr_test_no_gpu("test_pick", &err);
     mr_renderer *r = mr_renderer_create(gpu, &err);
     CHECK_MSG(r != NULL, "%s", err.msg);
     if (r) {

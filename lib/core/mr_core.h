@@ -36,7 +36,8 @@ typedef enum mr_err_code {
     MR_ERR_INVALID,     /* well-formed but meaningless values */
     MR_ERR_NOMEM,       /* allocation failed or input too large */
     MR_ERR_UNSUPPORTED, /* valid but not handled by this build */
-    MR_ERR_NODEVICE,    /* no EGL/GL device or context */
+    MR_ERR_NODEVICE,    /* no EGL/GL device, GL context or display (only these: the
+                           command-line exit status and test skips rely on it) */
     MR_ERR_GL,          /* a GL call or shader failed */
 } mr_err_code;
 

@@ -74,8 +74,8 @@ static bool dev_open(v4l2_src *s, mr_error *err) {
     s->fd = open(s->dev, O_RDWR | O_NONBLOCK);
     if (s->fd < 0) {
         int e = errno;
-        if (e == ENOENT || e == ENODEV || e == ENXIO) return mr_fail(err, MR_ERR_NODEVICE, "%s: no such device", s->dev);
-        if (e == EBUSY) return mr_fail(err, MR_ERR_NODEVICE, "%s: device is busy (used by another program)", s->dev);
+        if (e == ENOENT || e == ENODEV || e == ENXIO) return mr_fail(err, MR_ERR_IO, "%s: no such device", s->dev);
+        if (e == EBUSY) return mr_fail(err, MR_ERR_IO, "%s: device is busy (used by another program)", s->dev);
         if (e == EACCES) return mr_fail(err, MR_ERR_IO, "%s: permission denied (video group?)", s->dev);
         return mr_fail(err, MR_ERR_IO, "%s: cannot open (%s)", s->dev, strerror(e));
     }
@@ -121,7 +121,7 @@ static bool dev_open(v4l2_src *s, mr_error *err) {
     if (xioctl(s->fd, VIDIOC_S_FMT, &fmt) < 0) {
         int e = errno;
         dev_close(s);
-        return mr_fail(err, e == EBUSY ? MR_ERR_NODEVICE : MR_ERR_UNSUPPORTED, "%s: cannot set the format (%s)", s->dev,
+        return mr_fail(err, e == EBUSY ? MR_ERR_IO : MR_ERR_UNSUPPORTED, "%s: cannot set the format (%s)", s->dev,
                        strerror(e));
     }
     if (fmt.fmt.pix.pixelformat != want) {
@@ -153,7 +153,7 @@ static bool dev_open(v4l2_src *s, mr_error *err) {
     if (xioctl(s->fd, VIDIOC_REQBUFS, &req) < 0 || req.count < 2) {
         int e = errno;
         dev_close(s);
-        if (e == EBUSY) return mr_fail(err, MR_ERR_NODEVICE, "%s: device is busy (streaming to another program)", s->dev);
+        if (e == EBUSY) return mr_fail(err, MR_ERR_IO, "%s: device is busy (streaming to another program)", s->dev);
         return mr_fail(err, MR_ERR_UNSUPPORTED, "%s: memory-mapped streaming is not available", s->dev);
     }
     s->nbuf = req.count > NBUF ? NBUF : (int)req.count;
@@ -179,7 +179,7 @@ static bool dev_open(v4l2_src *s, mr_error *err) {
     if (xioctl(s->fd, VIDIOC_STREAMON, &t) < 0) {
         int e = errno;
         dev_close(s);
-        return mr_fail(err, MR_ERR_NODEVICE, "%s: cannot start streaming (%s)", s->dev, strerror(e));
+        return mr_fail(err, MR_ERR_IO, "%s: cannot start streaming (%s)", s->dev, strerror(e));
     }
     s->streaming = true;
     return true;
@@ -274,7 +274,7 @@ static mr_read_status v4l2_read(void *impl, mr_frame *frame, mr_error *err) {
         }
         dev_close(s);
         if (attempt >= retries) {
-            mr_fail(err, MR_ERR_NODEVICE, "%s: device vanished and did not come back after %d attempts", s->dev, retries);
+            mr_fail(err, MR_ERR_IO, "%s: device vanished and did not come back after %d attempts", s->dev, retries);
             return MR_READ_ERROR;
         }
         attempt++;
