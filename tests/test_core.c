@@ -265,7 +265,7 @@ static void check_kept(const char *dir, const char *name, const char *old, const
 }
 
 static void test_atomic_writes(void) {
-    char dir[1200], path[1300], stray[256];
+    char dir[1200], path[1600], stray[256];
     snprintf(dir, sizeof dir, "%s/atomic", g_tmp);
     mr_error err = {0};
     CHECK(mr_mkdirs(dir, &err));
