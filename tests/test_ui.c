@@ -271,9 +271,11 @@ static void test_touch_targets(const mr_ui_font *font) {
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
         double ppmm = cases[c].dpi / 25.4;
-        for (int how = 0; how < 2; how++) {
+        for (int how = 0; how < 3; how++) {
             /* Created at the density (the view at start), or created at
-             * 96 dpi and told the new one (the window moved monitors). */
+             * 96 dpi and told the new one (the window moved monitors), or
+             * (at 96 dpi) left to the default density. */
+            if (how == 2 && cases[c].dpi != 96) continue;
             mr_ui_params up = MR_UI_DEFAULTS;
             up.font = font;
             up.px_per_mm = how == 0 ? ppmm : 0.0;
@@ -293,9 +295,9 @@ static void test_touch_targets(const mr_ui_font *font) {
                     double wmm = wd[i].r.w / ppmm, hmm = wd[i].r.h / ppmm;
                     smallest = fminf(smallest, (float)fmin(wmm, hmm));
                     CHECK_MSG(wmm >= 9.0 - 1e-3 && hmm >= 9.0 - 1e-3,
-                              "%s%s (%s): widget %s is %.2f x %.2f mm (%.1f x %.1f px at %.2f px/mm), want >= 9 mm "
+                              "%s%s (%s): widget %s is %.3f x %.3f mm (%.1f x %.1f px at %.2f px/mm), want >= 9 mm "
                               "on both sides (mm -> px conversion off?)", cases[c].what, seek ? ", replay" : "",
-                              how ? "density set later" : "density at create", wd[i].name, wmm, hmm, wd[i].r.w,
+                              how == 0 ? "density at create" : how == 1 ? "density set later" : "default density", wd[i].name, wmm, hmm, wd[i].r.w,
                               wd[i].r.h, ppmm);
                     CHECK_MSG(wd[i].r.x >= 0 && wd[i].r.y >= 0 && wd[i].r.x + wd[i].r.w <= cases[c].w + 1e-3f &&
                                   wd[i].r.y + wd[i].r.h <= cases[c].h + 1e-3f,
