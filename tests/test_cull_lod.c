@@ -1,7 +1,8 @@
 /* CPU tests of the big-scene machinery: BVH frustum culling never drops a
  * node that shows in the image (random views, checked against projected
  * geometry), the LOD error bound is a true bound (brute-force sampling) and
- * not a loose guess (a known offset), the LOD cache is used only when it
+ * not a loose guess (a known offset), and two-sided (a level that loses a
+ * protrusion), the LOD cache is used only when it
  * matches, synthetic factories are deterministic and keep their instancing
  * through .glb, a 100k-node scene loads, and truncated .glb files fail
  * cleanly. */
@@ -355,6 +356,112 @@ static void test_lod_bound(void) {
     mr_scene_destroy(&s);
 }
 
+/* A flat square plate in y = 0 (n x n vertices over [-0.5, 0.5]^2), with
+ * room for `extra` more vertices after the grid. */
+static mr_mesh plate(int n, uint32_t extra) {
+    mr_mesh m;
+    memset(&m, 0, sizeof m);
+    snprintf(m.name, sizeof m.name, "plate");
+    m.vertex_count = (uint32_t)(n * n) + extra;
+    m.index_count = (uint32_t)((n - 1) * (n - 1) * 6);
+    m.positions = calloc((size_t)m.vertex_count, 12);
+    m.indices = malloc((size_t)m.index_count * 4);
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            float *p = m.positions + 3 * (size_t)(j * n + i);
+            p[0] = (float)(-0.5 + (double)i / (n - 1));
+            p[2] = (float)(-0.5 + (double)j / (n - 1));
+        }
+    uint32_t ni = 0;
+    for (int j = 0; j + 1 < n; j++)
+        for (int i = 0; i + 1 < n; i++) {
+            uint32_t a = (uint32_t)(j * n + i), b = a + 1, c = a + (uint32_t)n, d = c + 1;
+            uint32_t q[6] = {a, c, b, b, c, d};
+            for (int k = 0; k < 6; k++) m.indices[ni++] = q[k];
+        }
+    m.material = -1;
+    return m;
+}
+
+/* The asymmetric case: a level that loses a protrusion. The full surface is
+ * a plate plus a thin spike (a pyramid of height h on a 2w-wide base); the
+ * level is the plate alone. d(full -> level) = h (the tip), d(level ->
+ * full) = 0 (the plate is in both), so a bound that looks one way only
+ * reports 0 for one argument order; a loose one reports much more than h. */
+static void test_lod_lost_protrusion(void) {
+    const double h = 0.1, w = 0.01;
+    mr_mesh m = plate(9, 5);
+    uint32_t g = m.vertex_count - 5; /* base corners g..g+3, tip g+4 */
+    for (int k = 0; k < 4; k++) {
+        float *p = m.positions + 3 * (size_t)(g + (uint32_t)k);
+        p[0] = (float)((k == 0 || k == 3) ? -w : w);
+        p[1] = 0.0f;
+        p[2] = (float)(k < 2 ? -w : w);
+    }
+    m.positions[3 * (size_t)(g + 4) + 1] = (float)h;
+    uint32_t nplate = m.index_count, nfull = nplate + 12;
+    uint32_t *full = malloc((size_t)nfull * 4);
+    memcpy(full, m.indices, (size_t)nplate * 4);
+    for (uint32_t k = 0; k < 4; k++) {
+        full[nplate + 3 * k] = g + k;
+        full[nplate + 3 * k + 1] = g + (k + 1) % 4;
+        full[nplate + 3 * k + 2] = g + 4;
+    }
+    const double eps = 1e-4;
+    double d_fl = sampled_distance(m.positions, full, nfull, m.indices, nplate, 8);
+    double d_lf = sampled_distance(m.positions, m.indices, nplate, full, nfull, 8);
+    CHECK_MSG(fabs(d_fl - h) < 1e-6 && d_lf < 1e-6, "test set-up: sampled full->level %g (want %g), level->full %g (want 0)",
+              d_fl, h, d_lf);
+    double e_fl = mr_lod_hausdorff_bound(m.positions, m.vertex_count, full, nfull, m.indices, nplate, 1e-4, 1.0);
+    double e_lf = mr_lod_hausdorff_bound(m.positions, m.vertex_count, m.indices, nplate, full, nfull, 1e-4, 1.0);
+    CHECK_MSG(e_fl >= h - eps && e_fl <= h * 1.05 + eps,
+              "lost spike, bound(full, level) = %g, want %g (the spike tip is %g from the level: the full->level "
+              "direction of the two-sided Hausdorff bound is missing or loose)", e_fl, h, h);
+    CHECK_MSG(e_lf >= h - eps && e_lf <= h * 1.05 + eps,
+              "lost spike, bound(level, full) = %g, want %g (the bound must be symmetric: the direction from the "
+              "second surface to the first is missing or loose)", e_lf, h);
+    CHECK_MSG(e_fl >= fmax(d_fl, d_lf) - 1e-9 && e_lf >= fmax(d_fl, d_lf) - 1e-9,
+              "lost spike: bounds %g / %g below brute-force sampling %g", e_fl, e_lf, fmax(d_fl, d_lf));
+    /* Identical surfaces: 0 both ways (a bound that adds slack fails here). */
+    double e0 = mr_lod_hausdorff_bound(m.positions, m.vertex_count, full, nfull, full, nfull, 1e-4, 1.0);
+    CHECK_MSG(e0 <= 1e-4 + 1e-9, "identical surfaces: bound %g, want 0 (within the resolution 1e-4)", e0);
+    free(full);
+    free(m.positions);
+    free(m.indices);
+
+    /* The same through the level builder: a fine plate with one grid
+     * vertex raised into a tent of height h. A level that collapses the tip
+     * lies flat in y = 0, so its certified error must reach h. */
+    mr_mesh t = plate(17, 0);
+    uint32_t tip = 8 * 17 + 8;
+    t.positions[3 * (size_t)tip + 1] = (float)h;
+    mr_scene *s = mr_scene_create();
+    mr_error err = {0};
+    CHECK_MSG(mr_scene_add_mesh(s, &t, &err) == 0, "%s", err.msg);
+    mr_lod_params lp = MR_LOD_DEFAULTS;
+    lp.max_error = 2 * h;
+    mr_lod *lod = mr_lod_build(s, &lp, &err);
+    CHECK_MSG(lod != NULL, "%s", err.msg);
+    if (lod) {
+        const mr_mesh *mm = &s->meshes[0];
+        const mr_mesh_lods *ml = &lod->meshes[0];
+        int dropped = 0;
+        for (int k = 0; k < ml->level_count; k++) {
+            const mr_lod_level *l = &ml->levels[k];
+            bool has_tip = false;
+            for (uint32_t i = 0; i < l->index_count; i++) has_tip = has_tip || l->indices[i] == tip;
+            if (has_tip) continue;
+            dropped++;
+            CHECK_MSG(l->error >= h - eps && l->error <= h * 1.05 + eps,
+                      "tent level %d drops the tip: certified error %g, want %g (the lost protrusion)", k, l->error, h);
+        }
+        CHECK_MSG(dropped > 0, "test set-up: no level of the tent dropped its tip (%d levels)", ml->level_count);
+        check_levels(mm, ml, &lp, "tent");
+    }
+    mr_lod_destroy(&lod);
+    mr_scene_destroy(&s);
+}
+
 static bool same_lod(const mr_lod *a, const mr_lod *b) {
     if (!a || !b || a->mesh_count != b->mesh_count) return false;
     for (int32_t i = 0; i < a->mesh_count; i++) {
@@ -553,6 +660,7 @@ int main(void) {
     RUN(test_no_false_cull);
     RUN(test_far_cull);
     RUN(test_lod_bound);
+    RUN(test_lod_lost_protrusion);
     RUN(test_lod_cache);
     RUN(test_synth_roundtrip);
     RUN(test_100k_and_truncation);

@@ -6,6 +6,7 @@
 #include "mr_test.h"
 #include "mr_test_scene.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -216,6 +217,72 @@ static void test_zfight(void) {
     }
 }
 
+/* Strong tangential distortion (p1, p2 of a tilted lens) with barrel k1:
+ * the overlay's GPU undistortion must follow the CPU camera model per
+ * pixel. The video encodes its own pixel position (red = 3 u, green = 4 v),
+ * so each output pixel says which source position the shader sampled; that
+ * must be where mr_camera_distort sends the pixel's ideal ray, and
+ * mr_camera_undistort must bring it back to the pixel, within 0.5 px. */
+static void test_overlay_tangential(const mr_scene *s, const mr_view *v) {
+    const int W = v->camera.width, H = v->camera.height;
+    mr_image video;
+    CHECK(mr_image_alloc(&video, W, H, 3, MR_PIX_U8, NULL));
+    unsigned char *vp = video.data;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            vp[(y * W + x) * 3 + 0] = (unsigned char)(x * 3);
+            vp[(y * W + x) * 3 + 1] = (unsigned char)(y * 4);
+            vp[(y * W + x) * 3 + 2] = 128;
+        }
+    mr_view vd = *v;
+    const double k1 = -0.15, p1 = 0.05, p2 = -0.04;
+    vd.camera.dist[0] = k1;
+    vd.camera.dist[2] = p1;
+    vd.camera.dist[3] = p2;
+    mr_frame_params p = MR_FRAME_DEFAULTS;
+    p.video = &video;
+    p.alpha = 1;
+    mr_frame_result res;
+    if (render(s, &vd, &p, &res)) {
+        const mr_camera *c = &vd.camera;
+        const unsigned char *o = res.color.data;
+        int inside = 0, bad = 0, bad_back = 0, wx = 0, wy = 0;
+        double worst = 0, worst_back = 0, sum = 0;
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                double xd, yd;
+                mr_camera_distort(c, (x - c->cx) / c->fx, (y - c->cy) / c->fy, &xd, &yd);
+                double u = xd * c->fx + c->cx, w = yd * c->fy + c->cy;
+                /* Away from the border, where clamping and black take over. */
+                if (u < 1 || w < 1 || u > W - 2 || w > H - 2) continue;
+                inside++;
+                double gu = o[(y * W + x) * 3 + 0] / 3.0, gw = o[(y * W + x) * 3 + 1] / 4.0;
+                double e = hypot(gu - u, gw - w);
+                sum += e;
+                if (e > worst) { worst = e; wx = x; wy = y; }
+                if (e > 0.5) bad++;
+                /* The sampled position, undistorted, is this pixel. */
+                double ux, uy;
+                bool conv = mr_camera_undistort(c, (gu - c->cx) / c->fx, (gw - c->cy) / c->fy, &ux, &uy);
+                double eb = conv ? hypot(ux * c->fx + c->cx - x, uy * c->fy + c->cy - y) : INFINITY;
+                if (eb > worst_back) worst_back = eb;
+                if (eb > 0.6) bad_back++;
+            }
+        CHECK_MSG(inside > W * H * 6 / 10, "tangential overlay: only %d of %d pixels sample inside the frame", inside,
+                  W * H);
+        CHECK_MSG(bad == 0 && worst < 0.5,
+                  "tangential overlay (k1 %g, p1 %g, p2 %g): %d of %d pixels sample the video more than 0.5 px from "
+                  "where the camera model puts them (worst %.2f px at %d,%d; mean %.3f px): the shader's distortion "
+                  "terms differ from mr_camera_distort", k1, p1, p2, bad, inside, worst, wx, wy, sum / inside);
+        CHECK_MSG(bad_back == 0, "tangential overlay: %d pixels do not undistort back onto themselves (worst %.2f px)",
+                  bad_back, worst_back);
+        printf("  tangential overlay: worst %.3f px, mean %.3f px over %d pixels; back %.3f px\n", worst, sum / inside,
+               inside, worst_back);
+        mr_frame_result_free(&res);
+    }
+    mr_image_free(&video);
+}
+
 static void test_overlay(void) {
     mr_scene *s = still_life(1, mr_v3(0, 0, 0));
     mr_view v = still_life_view(1, mr_v3(0, 0, 0), 80, 60);
@@ -310,6 +377,7 @@ static void test_overlay(void) {
         mr_frame_result_free(&virt);
     }
     mr_image_free(&video);
+    test_overlay_tangential(s, &v);
     mr_scene_destroy(&s);
 }
 

@@ -1,8 +1,10 @@
 /* lib/ui without a display: layout, hit-testing, slider math, widget
- * behaviour over scripted pointer input, and the draw list. */
+ * behaviour over scripted pointer input, the draw list, and the view's
+ * touch targets in millimetres at several screen densities. */
 #include "mr_test.h"
 #include "mr_ui.h"
 
+#include <math.h>
 #include <string.h>
 
 static mr_ui_input at(float x, float y, bool down) {
@@ -189,6 +191,133 @@ static void test_widgets(const mr_ui_font *font) {
     CHECK(mr_ui_create(&none, &err) == NULL);
 }
 
+/* ------------------------------------------------- touch targets */
+
+typedef struct named_widget {
+    const char *name;
+    mr_ui_rect r;
+} named_widget;
+
+/* The view's widgets, laid out as build_ui in app/cmd_view.c lays them out
+ * (status line, bottom bar with the transparency slider and the replay row,
+ * right column of toggles wrapping into more columns), with the same lib/ui
+ * calls and the same sizes in millimetres; build_ui itself lives in app/
+ * and needs a running view, so it is not callable from here. Each rect is
+ * drawn as the real widget. Returns the count. */
+static int view_layout(mr_ui *ui, float fb_w, float fb_h, bool seekable, named_widget *out) {
+    int n = 0;
+    float T = mr_ui_target_px(ui), g = mr_ui_mm(ui, 1.2f), th = mr_ui_text_px(ui);
+    const mr_ui_font *font = mr_ui_get_font(ui);
+    mr_ui_rect full = mr_ui_rect_make(0, 0, fb_w, fb_h);
+    mr_ui_cut_top(&full, th * 1.7f);
+    mr_ui_rect bottom = mr_ui_cut_bottom(&full, (T + g) * (seekable ? 2 : 1) + g);
+    mr_ui_rect inner = mr_ui_rect_inset(bottom, g);
+    float alpha = 0.5f, pos = 3;
+    out[n] = (named_widget){"alpha", mr_ui_cut_top(&inner, T)};
+    mr_ui_slider(ui, 1, out[n++].r, "model  <  >  video  50%", &alpha, 0, 1);
+    if (seekable) {
+        mr_ui_cut_top(&inner, g);
+        mr_ui_rect rrow = mr_ui_cut_top(&inner, T);
+        float bw = fmaxf(T * 1.6f, mr_ui_text_width(font, "Pause", th) + 2 * g);
+        out[n++] = (named_widget){"play", mr_ui_cut_left(&rrow, bw)};
+        mr_ui_cut_left(&rrow, g);
+        out[n++] = (named_widget){"back", mr_ui_cut_left(&rrow, T)};
+        mr_ui_cut_left(&rrow, g);
+        out[n++] = (named_widget){"forward", mr_ui_cut_left(&rrow, T)};
+        mr_ui_cut_left(&rrow, g);
+        out[n++] = (named_widget){"rate", mr_ui_cut_right(&rrow, T * 1.4f)};
+        mr_ui_cut_right(&rrow, g);
+        for (int i = n - 4; i < n; i++) mr_ui_button(ui, (uint32_t)(20 + i), out[i].r, out[i].name, MR_UI_NORMAL);
+        out[n] = (named_widget){"seek", rrow};
+        mr_ui_slider(ui, 24, out[n++].r, "frame 4", &pos, 0, 99);
+    }
+    static const char *items[] = {"freeze", "snapshot", "mark", "video", "hidden", "ao", "ghost", "help"};
+    static const char *labels[] = {"Freeze", "Snapshot", "Mark", "Video", "Hidden", "AO alchemy", "Ghost adaptive", "?"};
+    int ni = (int)(sizeof items / sizeof items[0]);
+    float colw = fmaxf(T * 2.4f, mr_ui_text_width(font, "AO alchemy", th) + 3 * g);
+    int per_col = (int)((full.h - g) / (T + g));
+    if (per_col < 1) per_col = 1;
+    int cols = (ni + per_col - 1) / per_col;
+    mr_ui_rect column = mr_ui_cut_right(&full, cols * (colw + g) + g);
+    for (int i = 0; i < ni; i++) {
+        int c = i / per_col, r = i % per_col;
+        out[n] = (named_widget){items[i], mr_ui_rect_make(column.x + column.w - (c + 1) * (colw + g),
+                                                          column.y + g + r * (T + g), colw, T)};
+        mr_ui_button(ui, (uint32_t)(40 + i), out[n++].r, labels[i], MR_UI_NORMAL);
+    }
+    return n;
+}
+
+static bool overlap(mr_ui_rect a, mr_ui_rect b) {
+    return a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
+}
+
+/* Every interactive widget of the view is at least 9 mm on both sides on
+ * the screen it is shown on, measured from its rectangle in pixels and the
+ * screen's own density (not the ui's idea of it), lies inside the window,
+ * and overlaps no other widget. The densities a view meets: a 96 dpi
+ * monitor, a 160 dpi tablet, a 2x content scale, and a tiny window. */
+static void test_touch_targets(const mr_ui_font *font) {
+    static const struct {
+        const char *what;
+        double dpi;   /* the screen's true density, dots per inch */
+        float w, h;   /* framebuffer pixels */
+    } cases[] = {
+        {"96 dpi monitor 1280x720", 96, 1280, 720},
+        {"160 dpi tablet 1280x800", 160, 1280, 800},
+        {"2x content scale 2560x1440", 192, 2560, 1440},
+        {"tiny 320x240 window at 96 dpi", 96, 320, 240},
+        {"267 dpi phone 1080x1920", 267, 1080, 1920},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        double ppmm = cases[c].dpi / 25.4;
+        for (int how = 0; how < 3; how++) {
+            /* Created at the density (the view at start), or created at
+             * 96 dpi and told the new one (the window moved monitors), or
+             * (at 96 dpi) left to the default density. */
+            if (how == 2 && cases[c].dpi != 96) continue;
+            mr_ui_params up = MR_UI_DEFAULTS;
+            up.font = font;
+            up.px_per_mm = how == 0 ? ppmm : 0.0;
+            mr_error err = {0};
+            mr_ui *ui = mr_ui_create(&up, &err);
+            CHECK_MSG(ui != NULL, "%s", err.msg);
+            if (!ui) continue;
+            if (how == 1) mr_ui_set_density(ui, ppmm);
+            for (int seek = 0; seek < 2; seek++) {
+                named_widget wd[32];
+                mr_ui_input in = at(-1, -1, false);
+                mr_ui_begin(ui, &in);
+                int n = view_layout(ui, cases[c].w, cases[c].h, seek != 0, wd);
+                mr_ui_end(ui);
+                float smallest = INFINITY;
+                for (int i = 0; i < n; i++) {
+                    double wmm = wd[i].r.w / ppmm, hmm = wd[i].r.h / ppmm;
+                    smallest = fminf(smallest, (float)fmin(wmm, hmm));
+                    CHECK_MSG(wmm >= 9.0 - 1e-3 && hmm >= 9.0 - 1e-3,
+                              "%s%s (%s): widget %s is %.3f x %.3f mm (%.1f x %.1f px at %.2f px/mm), want >= 9 mm "
+                              "on both sides (mm -> px conversion off?)", cases[c].what, seek ? ", replay" : "",
+                              how == 0 ? "density at create" : how == 1 ? "density set later" : "default density", wd[i].name, wmm, hmm, wd[i].r.w,
+                              wd[i].r.h, ppmm);
+                    CHECK_MSG(wd[i].r.x >= 0 && wd[i].r.y >= 0 && wd[i].r.x + wd[i].r.w <= cases[c].w + 1e-3f &&
+                                  wd[i].r.y + wd[i].r.h <= cases[c].h + 1e-3f,
+                              "%s: widget %s at (%.1f, %.1f) %.1f x %.1f px leaves the %gx%g window", cases[c].what,
+                              wd[i].name, wd[i].r.x, wd[i].r.y, wd[i].r.w, wd[i].r.h, cases[c].w, cases[c].h);
+                    for (int j = 0; j < i; j++)
+                        CHECK_MSG(!overlap(wd[i].r, wd[j].r), "%s%s: widgets %s and %s overlap", cases[c].what,
+                                  seek ? ", replay" : "", wd[i].name, wd[j].name);
+                }
+                /* Not inflated either: the smallest target is the 9 mm one
+                 * (a density read as dots per cm, say, would pass above). */
+                CHECK_MSG(smallest <= 9.6f, "%s: the smallest touch target is %.2f mm, want 9 mm (sizes scaled wrongly)",
+                          cases[c].what, smallest);
+                CHECK_MSG(n == (seek ? 14 : 9), "%s: %d widgets laid out", cases[c].what, n);
+            }
+            mr_ui_destroy(&ui);
+        }
+    }
+}
+
 int main(void) {
     test_rects();
     char path[1024];
@@ -206,6 +335,7 @@ int main(void) {
         test_font(font);
         test_draw_list(font);
         test_widgets(font);
+        test_touch_targets(font);
     }
     mr_ui_font_destroy(&font);
     CHECK(font == NULL);

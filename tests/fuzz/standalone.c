@@ -1,16 +1,44 @@
 /* Runs a fuzz target without libFuzzer, for ctest: every seed file in the
  * corpus folder, then deterministic mutations of them (bit flips, byte
  * overwrites with interesting values, truncations, insertions, splices).
- * Usage: fuzz_X_smoke CORPUS_DIR [ITERATIONS]. A crash fails the test. */
+ * Usage: fuzz_X_smoke CORPUS_DIR [ITERATIONS]. A crash fails the test; it
+ * says which seed or mutation crashed and saves that input as
+ * fuzz-crash-NAME.bin in the working folder, to replay by hand. */
 #include <dirent.h>
+#include <fcntl.h>
+#include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "mr_core.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+/* What runs now, for the crash handler (which may only write(2)). */
+static char g_what[2300], g_crash_path[600];
+static const uint8_t *g_input;
+static size_t g_input_size;
+
+static void on_crash(int sig) {
+    ssize_t r = write(2, g_what, strlen(g_what));
+    int fd = open(g_crash_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+        r = write(fd, g_input, g_input_size);
+        close(fd);
+    }
+    (void)r;
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+static void run_one(const uint8_t *data, size_t size) {
+    g_input = data;
+    g_input_size = size;
+    LLVMFuzzerTestOneInput(data, size);
+}
 
 int main(int argc, char **argv) {
     if (argc < 2) {
@@ -20,6 +48,7 @@ int main(int argc, char **argv) {
     long iters = argc > 2 ? atol(argv[2]) : 2000;
     uint8_t *seeds[64];
     size_t sizes[64];
+    char names[64][256];
     int n = 0;
     DIR *d = opendir(argv[1]);
     if (!d) {
@@ -34,6 +63,7 @@ int main(int argc, char **argv) {
         size_t sz;
         void *buf = mr_file_read(path, &sz, 1 << 24, NULL);
         if (!buf) continue;
+        snprintf(names[n], sizeof names[n], "%s", e->d_name);
         seeds[n] = buf;
         sizes[n++] = sz;
     }
@@ -42,7 +72,15 @@ int main(int argc, char **argv) {
         fprintf(stderr, "no seeds in %s\n", argv[1]);
         return 2;
     }
-    for (int i = 0; i < n; i++) LLVMFuzzerTestOneInput(seeds[i], sizes[i]);
+    const char *self = strrchr(argv[0], '/') ? strrchr(argv[0], '/') + 1 : argv[0];
+    snprintf(g_crash_path, sizeof g_crash_path, "fuzz-crash-%s.bin", self);
+    static const int sigs[] = {SIGSEGV, SIGILL, SIGABRT, SIGBUS, SIGFPE, SIGTRAP};
+    for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) signal(sigs[i], on_crash);
+    for (int i = 0; i < n; i++) {
+        snprintf(g_what, sizeof g_what, "%s: CRASH on seed %s/%s (input saved as %s)\n", self, argv[1], names[i],
+                 g_crash_path);
+        run_one(seeds[i], sizes[i]);
+    }
     mr_rng rng;
     mr_rng_seed(&rng, 12345);
     static const uint8_t interesting[] = {0, 1, 0x7f, 0x80, 0xff, '"', '[', '{', '-', '9', 'e'};
@@ -70,7 +108,9 @@ int main(int argc, char **argv) {
             }
             if (sz + 1 >= sizes[s] + 64) break;
         }
-        LLVMFuzzerTestOneInput(buf, sz);
+        snprintf(g_what, sizeof g_what, "%s: CRASH on mutation %ld of seed %s/%s (input saved as %s)\n", self, it,
+                 argv[1], names[s], g_crash_path);
+        run_one(buf, sz);
         free(buf);
     }
     for (int i = 0; i < n; i++) free(seeds[i]);
