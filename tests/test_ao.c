@@ -846,12 +846,299 @@ static void test_golden(void) {
                 }
                 double frac = (double)bad / (double)n;
                 CHECK_MSG(frac <= 0.01 && sum / n < 0.002,
-                          "AO golden %s: %.2f%% of pixels off by > 0.006 (max %.3f, mean %.4f): the %s AO changed", gc->name,
-                          100 * frac, worst, sum / n, mr_ao_method_name(gc->method));
+                          "AO golden %s: %.2f%% of pixels off by > 0.006 (max %.3f, mean %.4f): the AO of this case changed",
+                          gc->name, 100 * frac, worst, sum / n);
             }
             mr_image_free(&gold);
         }
         mr_frame_result_free(&res);
+    }
+    mr_scene_destroy(&s);
+    mr_renderer_set_scene(g_r, NULL, NULL);
+}
+
+
+/* ------------------------------------------------- corner mask, analytic */
+
+/* The corner scene's boxes (corner_scene with k = 1 at the origin):
+ * centre and half extents. An axis-aligned box's outline volume is the box
+ * grown by a = r / sqrt 3 on every side (each corner moves by r along
+ * (+-1,+-1,+-1)/sqrt 3). */
+static const double k_boxes[3][6] = {
+    {0, -0.1, 0, 10, 0.1, 10},   /* floor */
+    {0, 3, 3.0, 10, 3, 0.1},     /* wall, face at z = 2.9 */
+    {-1.5, 0.5, 1.0, 0.5, 0.5, 0.5}, /* cube */
+};
+
+/* How many outline volumes contain p (the camera is outside all of them, so
+ * this is what +1 entering / -1 leaving sums to), and how far p is from the
+ * nearest volume boundary (pixels closer than a rasterisation step are
+ * ambiguous). */
+static int analytic_count(mr_dvec3 p, double a, double *margin) {
+    const double q[3] = {p.x, p.y, p.z};
+    int count = 0;
+    *margin = 1e9;
+    for (int b = 0; b < 3; b++) {
+        double dmax = -1e9;
+        for (int k = 0; k < 3; k++) {
+            double d = fabs(q[k] - k_boxes[b][k]) - (k_boxes[b][3 + k] + a);
+            if (d > dmax) dmax = d;
+        }
+        count += dmax < 0;
+        if (fabs(dmax) < *margin) *margin = fabs(dmax);
+    }
+    return count;
+}
+
+/* Whether every geometry pixel within `rad` of (x, y) (a square: the
+ * separable blur's footprint) is in (want_in) or out of the mask. */
+static bool window_is(const mr_image *cnt, const mr_image *depth, int x, int y, int rad, bool want_in) {
+    const float *c = cnt->data, *d = depth->data;
+    for (int j = -rad; j <= rad; j++)
+        for (int i = -rad; i <= rad; i++) {
+            int u = x + i, v = y + j;
+            if (u < 0 || v < 0 || u >= cnt->width || v >= cnt->height) continue;
+            size_t k = (size_t)v * cnt->width + u;
+            if (d[k] > 0 && (c[k] >= 1.5f) != want_in) return false;
+        }
+    return true;
+}
+
+/* Park & Baek: the mask changes AO only where the outline count is >= 2.
+ * The same frame with and without the mask: where the count is >= 2 the
+ * masked AO is the unmasked AO, elsewhere it is exactly 1 (with the blur:
+ * where the whole blur footprint is on one side). The counts themselves are
+ * checked against the analytic count of grown boxes (view radius). */
+static void test_mask_count(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    mr_view v = corner_view(1, o, 96, 72);
+    for (int mode = 0; mode < 2; mode++)
+        for (int blur = 0; blur <= 2; blur += 2) {
+            const char *what = mode ? "view" : "screen";
+            mr_ao_params ao = MR_AO_DEFAULTS;
+            ao.method = MR_AO_SCHEER;
+            ao.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
+            ao.radius = 1.0;
+            ao.screen_radius = 0.1;
+            ao.blur_radius = blur;
+            mr_frame_result off, on;
+            if (!render_ao(s, &v, &ao, &off)) continue;
+            ao.mask = MR_AO_MASK_ON;
+            ao.want_mask = true;
+            if (!render_ao(s, &v, &ao, &on)) {
+                mr_frame_result_free(&off);
+                continue;
+            }
+            CHECK_MSG(on.ao_mask.data && on.ao_mask.width == 96 && on.ao_mask.height == 72,
+                      "mask on: no outline count image returned");
+            CHECK_MSG(!off.ao_mask.data, "mask off: an outline count image was returned");
+            if (!on.ao_mask.data) {
+                mr_frame_result_free(&on);
+                mr_frame_result_free(&off);
+                continue;
+            }
+            const float *cnt = on.ao_mask.data, *am = on.ao.data, *au = off.ao.data, *d = off.depth.data;
+            int in = 0, out = 0, in_occ = 0, out_occ = 0, bad_in = 0, bad_out = 0;
+            double worst_in = 0, worst_out = 0;
+            for (int y = 0; y < 72; y++)
+                for (int x = 0; x < 96; x++) {
+                    size_t i = (size_t)y * 96 + x;
+                    if (!(d[i] > 0)) continue;
+                    bool is_in = cnt[i] >= 1.5f;
+                    if (!window_is(&on.ao_mask, &off.depth, x, y, blur, is_in)) continue;
+                    if (is_in) {
+                        in++;
+                        in_occ += au[i] < 0.99f;
+                        double e = fabs(am[i] - au[i]);
+                        if (e > 1e-6) bad_in++;
+                        if (e > worst_in) worst_in = e;
+                    } else {
+                        out++;
+                        out_occ += au[i] < 0.99f;
+                        double e = fabs(am[i] - 1.0);
+                        if (e > (blur ? 1e-6 : 0)) bad_out++;
+                        if (e > worst_out) worst_out = e;
+                    }
+                }
+            CHECK_MSG(bad_in == 0, "mask on, %s, blur %d: %d of %d pixels with outline count >= 2 differ from the unmasked AO "
+                      "(max %.4f): the mask threshold skips corners", what, blur, bad_in, in, worst_in);
+            CHECK_MSG(bad_out == 0, "mask on, %s, blur %d: %d of %d pixels with outline count < 2 have AO != 1 (max %.4f): "
+                      "the mask threshold lets non-corners through", what, blur, bad_out, out, worst_out);
+            /* Both sides must have occluded pixels, or the checks above prove nothing. */
+            CHECK_MSG(in_occ > (blur ? 5 : 20) && out_occ > 20, "mask %s blur %d: too few occluded pixels to compare (%d in, %d out)", what,
+                      blur, in_occ, out_occ);
+            if (mode == 1 && blur == 0) {
+                double a = ao.radius / sqrt(3.0);
+                int checked = 0, wrong = 0, floor_open = 0, floor_corner = 0;
+                char first[160] = "";
+                for (int y = 0; y < 72; y++)
+                    for (int x = 0; x < 96; x++) {
+                        size_t i = (size_t)y * 96 + x;
+                        if (!(d[i] > 0)) continue;
+                        double margin;
+                        mr_dvec3 p = pixel_world(&v, &off.depth, x, y);
+                        int want = analytic_count(p, a, &margin);
+                        if (margin < 0.03) continue;
+                        checked++;
+                        if (fabs(cnt[i] - want) > 1e-3) {
+                            if (!wrong++)
+                                snprintf(first, sizeof first, "pixel (%d,%d) at (%.2f,%.2f,%.2f): count %g, expected %d", x, y, p.x,
+                                         p.y, p.z, cnt[i], want);
+                        }
+                        if (fabs(p.y) < 0.01 && p.x > -0.5) {
+                            double dist = 2.9 - p.z;
+                            floor_open += dist > 0.7 && want == 1;
+                            floor_corner += dist < 0.5 && want == 2;
+                        }
+                    }
+                CHECK_MSG(checked > 3000 && floor_open > 300 && floor_corner > 20,
+                          "outline count check covers too little (%d pixels, %d open floor, %d corner)", checked, floor_open,
+                          floor_corner);
+                CHECK_MSG(wrong == 0, "outline count wrong at %d of %d pixels (open floor must count 1, the floor-wall corner 2): %s",
+                          wrong, checked, first);
+            }
+            mr_frame_result_free(&on);
+            mr_frame_result_free(&off);
+        }
+    mr_scene_destroy(&s);
+    mr_renderer_set_scene(g_r, NULL, NULL);
+}
+
+/* The stand-alone mask is AO of its own: 1 - mask_strength inside the mask
+ * and 1 outside before the blur (so in [0,1] whatever --ao names and
+ * whatever its strength), and the blur is linear, so AO(s) = 1 - s * B with
+ * B = 1 - AO(1) the blurred mask. The stand-alone mask is always blurred
+ * (blur 0 means the default 4 there): where the whole blur footprint is
+ * inside the mask the AO is exactly 1 - s, where it is outside exactly 1. */
+static void test_mask_standalone(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    mr_view v = corner_view(1, o, 96, 72);
+    const mr_ao_method methods[3] = {MR_AO_SCHEER, MR_AO_CRYTEK, MR_AO_HBAO};
+    const float strengths[3] = {0.0f, 1.0f, 7.0f}; /* the method's strength plays no part */
+    for (int blur = 0; blur <= 2; blur += 2) {
+        int rad = blur ? blur : 4;
+        mr_image first = {0}, unit = {0};
+        for (int mi = 0; mi < 3; mi++) {
+            mr_ao_params ao = MR_AO_DEFAULTS;
+            ao.method = methods[mi];
+            ao.strength = strengths[mi];
+            ao.radius_mode = MR_AO_RADIUS_VIEW;
+            ao.radius = 1.0;
+            ao.blur_radius = blur;
+            ao.mask = MR_AO_MASK_STANDALONE;
+            ao.mask_strength = 0.6f;
+            ao.want_mask = true;
+            mr_frame_result res;
+            if (!render_ao(s, &v, &ao, &res)) continue;
+            const float *a = res.ao.data, *cnt = res.ao_mask.data, *d = res.depth.data;
+            CHECK_MSG(cnt != NULL, "standalone mask: no outline counts returned");
+            int out_of_range = 0, wrong = 0, inside = 0;
+            for (int i = 0; i < 96 * 72 && cnt; i++) {
+                out_of_range += !(a[i] >= 0 && a[i] <= 1);
+                if (!(d[i] > 0)) continue;
+                bool in = cnt[i] >= 1.5f;
+                if (!window_is(&res.ao_mask, &res.depth, i % 96, i / 96, rad, in)) continue;
+                inside += in;
+                wrong += fabsf(a[i] - (in ? 0.4f : 1.0f)) > 1e-5f;
+            }
+            CHECK_MSG(out_of_range == 0, "standalone %s blur %d: %d AO values outside [0,1]", mr_ao_method_name(ao.method), blur,
+                      out_of_range);
+            CHECK_MSG(wrong == 0 && inside > 10,
+                      "standalone %s (strength %g), blur %d: %d pixels are not 1 - 0.6 deep in the mask (%d pixels) and 1 outside",
+                      mr_ao_method_name(ao.method), strengths[mi], rad, wrong, inside);
+            if (mi == 0) {
+                first = res.ao;
+                res.ao.data = NULL;
+            } else if (first.data) {
+                double e = 0;
+                for (int i = 0; i < 96 * 72; i++) e = fmax(e, fabs(a[i] - ((float *)first.data)[i]));
+                CHECK_MSG(e <= 1e-6, "standalone mask with --ao %s differs from --ao scheer by %.4f: it must not depend on the method",
+                          mr_ao_method_name(ao.method), e);
+            }
+            mr_frame_result_free(&res);
+        }
+        /* Strength 1 gives the blurred mask B itself; 1.7 is clamped to 1
+         * before the blur; 0 means the default 0.5. */
+        const float ms[3] = {1.0f, 1.7f, 0.0f};
+        for (int k = 0; k < 3 && first.data; k++) {
+            mr_ao_params ao = MR_AO_DEFAULTS;
+            ao.method = MR_AO_SCHEER;
+            ao.radius_mode = MR_AO_RADIUS_VIEW;
+            ao.radius = 1.0;
+            ao.blur_radius = blur;
+            ao.mask = MR_AO_MASK_STANDALONE;
+            ao.mask_strength = ms[k];
+            mr_frame_result res;
+            if (!render_ao(s, &v, &ao, &res)) continue;
+            const float *a = res.ao.data, *f6 = first.data;
+            if (k == 0) {
+                unit = res.ao;
+                res.ao.data = NULL;
+                double e = 0;
+                int dark = 0;
+                for (int i = 0; i < 96 * 72; i++) {
+                    e = fmax(e, fabs(f6[i] - (1.0 - 0.6 * (1.0 - ((float *)unit.data)[i]))));
+                    dark += ((float *)unit.data)[i] < 0.5f;
+                }
+                CHECK_MSG(e <= 1e-5 && dark > 50, "standalone blur %d: AO(0.6) != 1 - 0.6 * blurred mask (max error %.5f, %d dark pixels)",
+                          blur, e, dark);
+            } else {
+                double want_s = k == 1 ? 1.0 : 0.5, e = 0;
+                for (int i = 0; i < 96 * 72 && unit.data; i++)
+                    e = fmax(e, fabs(a[i] - (1.0 - want_s * (1.0 - ((float *)unit.data)[i]))));
+                CHECK_MSG(e <= 1e-5, "standalone blur %d, mask_strength %g: AO is not 1 - %g * blurred mask (max error %.5f)", blur,
+                          ms[k], want_s, e);
+            }
+            mr_frame_result_free(&res);
+        }
+        mr_image_free(&first);
+        mr_image_free(&unit);
+    }
+    mr_scene_destroy(&s);
+    mr_renderer_set_scene(g_r, NULL, NULL);
+}
+
+/* Up to 5 radii (Doronin et al.): the darkest radius wins, so a fifth
+ * radius can only darken (per pixel, no blur) and does somewhere; 6 and
+ * more are clamped to 5. */
+static void test_radii(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    mr_view v = corner_view(1, o, 96, 72);
+    for (int mode = 0; mode < 2; mode++) {
+        mr_image img[3] = {{0}, {0}, {0}};
+        const int ks[3] = {4, 5, 6};
+        for (int k = 0; k < 3; k++) {
+            mr_ao_params ao = MR_AO_DEFAULTS;
+            ao.method = MR_AO_SCHEER;
+            ao.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
+            ao.radius = 2.0;
+            ao.screen_radius = 0.4;
+            ao.blur_radius = 0;
+            ao.radii = ks[k];
+            mr_frame_result res;
+            if (!render_ao(s, &v, &ao, &res)) continue;
+            img[k] = res.ao;
+            res.ao.data = NULL;
+            mr_frame_result_free(&res);
+        }
+        if (img[0].data && img[1].data && img[2].data) {
+            const float *a4 = img[0].data, *a5 = img[1].data, *a6 = img[2].data;
+            int brighter = 0, darker = 0, bad = 0, differ6 = 0;
+            for (int i = 0; i < 96 * 72; i++) {
+                brighter += a5[i] > a4[i] + 1e-6f;
+                darker += a5[i] < a4[i] - 1e-3f;
+                bad += !(a5[i] >= 0 && a5[i] <= 1);
+                differ6 += a6[i] != a5[i];
+            }
+            const char *what = mode ? "view" : "screen";
+            CHECK_MSG(brighter == 0 && bad == 0, "%s: 5 radii brighter than 4 at %d pixels, %d values outside [0,1]", what, brighter, bad);
+            CHECK_MSG(darker > 10, "%s: a fifth radius darkens only %d pixels: is it used?", what, darker);
+            CHECK_MSG(differ6 == 0, "%s: 6 radii are not clamped to 5 (%d pixels differ)", what, differ6);
+        }
+        for (int k = 0; k < 3; k++) mr_image_free(&img[k]);
     }
     mr_scene_destroy(&s);
     mr_renderer_set_scene(g_r, NULL, NULL);
@@ -884,6 +1171,9 @@ int main(void) {
         test_mask();
         test_pinned_reference();
         test_golden();
+        test_mask_count();
+        test_mask_standalone();
+        test_radii();
     }
     mr_renderer_destroy(&g_r);
     mr_gpu_destroy(&g_gpu);
