@@ -695,7 +695,9 @@ static void pin_view_free(pin_view *pv) {
  * pinned: mean |e| and RMSE may grow by 10% + 0.002, the 95th percentile by
  * 10% + 0.005, and the signed mean may move by 10% + 0.003 either way (a
  * change that brightens or darkens the AO must update this table on
- * purpose). Columns: mae, rmse, bias, p95. */
+ * purpose). Columns: mae, rmse, bias, p95. Slot 0 (MR_AO_NONE) holds the
+ * paper-pure scheer instead: no cosine bias, the whole unit ball as kernel
+ * (`--ao scheer --ao-bias 0 --ao-rmin 0`). */
 static const double k_pinned[PIN_VIEWS][MR_AO_METHOD_COUNT][2][4] = {
 #include "ao_pinned.inc"
 };
@@ -724,10 +726,15 @@ static void test_pinned_reference(void) {
             gp.seed = 11;
             CHECK_MSG(mr_eval_ao_groundtruth(gt, &pv.view, &g.depth, &g.normal, &gp, &ref[mode], &err), "%s", err.msg);
         }
-        for (int m = MR_AO_SCHEER; m < MR_AO_METHOD_COUNT && ref[0].data && ref[1].data; m++)
+        for (int m = 0; m < MR_AO_METHOD_COUNT && ref[0].data && ref[1].data; m++)
             for (int mode = 0; mode < 2; mode++) {
                 mr_ao_params ao = MR_AO_DEFAULTS;
-                ao.method = (mr_ao_method)m;
+                ao.method = m == 0 ? MR_AO_SCHEER : (mr_ao_method)m;
+                if (m == 0) {
+                    ao.bias = 0;
+                    ao.r_min = 0;
+                }
+                const char *mname = m == 0 ? "scheer-paper" : mr_ao_method_name(ao.method);
                 ao.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
                 ao.radius = 0.5;
                 mr_frame_result res;
@@ -736,18 +743,18 @@ static void test_pinned_reference(void) {
                 const double *k = k_pinned[vi][m][mode];
                 const char *what = mode ? "view" : "screen";
                 if (verbose)
-                    printf("    /* %s %s %s */ {%.4f, %.4f, %.4f, %.4f},\n", k_pin_names[vi], mr_ao_method_name(ao.method), what,
+                    printf("    /* %s %s %s */ {%.4f, %.4f, %.4f, %.4f},\n", k_pin_names[vi], mname, what,
                            e.mae, e.rmse, e.bias, e.p95);
                 CHECK_MSG(e.n > 1000, "%s: only %d geometry pixels", k_pin_names[vi], e.n);
                 CHECK_MSG(e.mae <= 1.1 * k[0] + 0.002, "%s %s %s: mean |AO - reference| %.4f > pinned %.4f",
-                          k_pin_names[vi], mr_ao_method_name(ao.method), what, e.mae, k[0]);
+                          k_pin_names[vi], mname, what, e.mae, k[0]);
                 CHECK_MSG(e.rmse <= 1.1 * k[1] + 0.002, "%s %s %s: RMSE against the reference %.4f > pinned %.4f",
-                          k_pin_names[vi], mr_ao_method_name(ao.method), what, e.rmse, k[1]);
+                          k_pin_names[vi], mname, what, e.rmse, k[1]);
                 CHECK_MSG(fabs(e.bias - k[2]) <= 0.1 * fabs(k[2]) + 0.003,
                           "%s %s %s: mean signed error (AO - reference) %.4f, pinned %.4f: the AO got %s",
-                          k_pin_names[vi], mr_ao_method_name(ao.method), what, e.bias, k[2], e.bias > k[2] ? "brighter" : "darker");
+                          k_pin_names[vi], mname, what, e.bias, k[2], e.bias > k[2] ? "brighter" : "darker");
                 CHECK_MSG(e.p95 <= 1.1 * k[3] + 0.005, "%s %s %s: 95th percentile of |AO - reference| %.4f > pinned %.4f",
-                          k_pin_names[vi], mr_ao_method_name(ao.method), what, e.p95, k[3]);
+                          k_pin_names[vi], mname, what, e.p95, k[3]);
                 mr_frame_result_free(&res);
             }
         mr_image_free(&ref[0]);
@@ -763,7 +770,8 @@ static void test_pinned_reference(void) {
 
 /* Each method's AO image on the corner scene (96x72), unblurred so that
  * every change to a shader shows per pixel, plus scheer blurred, at half
- * resolution, with 5 radii and the standalone mask, stored as 8-bit grey
+ * resolution, with 5 radii, the standalone mask and the paper-pure scheer
+ * (bias 0, kernel r_min 0: `--ao-bias 0 --ao-rmin 0`), stored as 8-bit grey
  * PNGs in tests/data/golden/ao_*.png (MR_UPDATE_GOLDEN=1 rewrites them).
  * A pixel mismatches when it is off by more than 0.006 (the PNG's rounding
  * is 0.002); at most 1% may, and the mean |difference| stays below 0.002. */
@@ -775,6 +783,7 @@ typedef struct golden_case {
     bool half;
     int radii;
     mr_ao_mask mask;
+    bool paper; /* scheer as the paper has it: no cosine bias, the whole unit ball as kernel */
 } golden_case;
 
 static void test_golden(void) {
@@ -782,20 +791,21 @@ static void test_golden(void) {
     CHECK_MSG(data != NULL, "MR_TEST_DATA not set: run through ctest, or set it to tests/data");
     if (!data) return;
     static const golden_case cases[] = {
-        {"scheer_screen", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF},
-        {"scheer_view", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF},
-        {"crytek_screen", MR_AO_CRYTEK, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF},
-        {"crytek_view", MR_AO_CRYTEK, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF},
-        {"filion_screen", MR_AO_FILION, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF},
-        {"filion_view", MR_AO_FILION, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF},
-        {"hbao_screen", MR_AO_HBAO, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF},
-        {"hbao_view", MR_AO_HBAO, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF},
-        {"alchemy_screen", MR_AO_ALCHEMY, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF},
-        {"alchemy_view", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF},
-        {"scheer_blur", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, 4, false, 1, MR_AO_MASK_OFF},
-        {"scheer_half", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, 4, true, 1, MR_AO_MASK_OFF},
-        {"scheer_radii5", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, 0, false, 5, MR_AO_MASK_OFF},
-        {"mask_standalone", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, 4, false, 1, MR_AO_MASK_STANDALONE},
+        {"scheer_screen", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"scheer_view", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"crytek_screen", MR_AO_CRYTEK, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"crytek_view", MR_AO_CRYTEK, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"filion_screen", MR_AO_FILION, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"filion_view", MR_AO_FILION, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"hbao_screen", MR_AO_HBAO, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"hbao_view", MR_AO_HBAO, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"alchemy_screen", MR_AO_ALCHEMY, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"alchemy_view", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"scheer_blur", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, 4, false, 1, MR_AO_MASK_OFF, false},
+        {"scheer_half", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, 4, true, 1, MR_AO_MASK_OFF, false},
+        {"scheer_radii5", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, 0, false, 5, MR_AO_MASK_OFF, false},
+        {"mask_standalone", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, 4, false, 1, MR_AO_MASK_STANDALONE, false},
+        {"scheer_paper", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, true},
     };
     mr_dvec3 o = mr_v3(0, 0, 0);
     mr_scene *s = corner_scene(1, o, true);
@@ -811,6 +821,10 @@ static void test_golden(void) {
         ao.half_res = gc->half;
         ao.radii = gc->radii;
         ao.mask = gc->mask;
+        if (gc->paper) {
+            ao.bias = 0;
+            ao.r_min = 0;
+        }
         mr_frame_result res;
         if (!render_ao(s, &v, &ao, &res)) continue;
         char path[1024];
