@@ -5,7 +5,12 @@
  * closed form, scale invariance (1e-3 .. 1e4 and a 1e7 offset), finite
  * output on extreme inputs (c in [0,1e7], depth near 0, sky, zero normals),
  * the pass list (no AO pass when off, reuse while the camera is frozen,
- * half resolution, corner masking). GPU parts skip where EGL is missing. */
+ * half resolution, corner masking); every method (and the paper-pure
+ * scheer) pinned against the Embree reference on a plane, the corner and
+ * two demo-hall views, and against stored goldens (tests/data/golden/ao_*,
+ * MR_TEST_DATA must point at tests/data); the corner mask against the
+ * unmasked frame and the analytic outline count; the stand-alone mask's own
+ * strength; 5 radii. GPU parts skip only where there is no EGL device. */
 #include "mr_eval.h"
 #include "mr_render.h"
 #include "mr_test.h"

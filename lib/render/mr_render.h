@@ -56,7 +56,8 @@ bool mr_renderer_set_scene(mr_renderer *r, const mr_scene *scene, mr_error *err)
  * ambient term of the shading. */
 typedef enum mr_ao_method {
     MR_AO_NONE = 0,    /* plain shading (Scheer & Keutel's D1): no AO pass runs */
-    MR_AO_SCHEER,      /* occlusion vectors, depth-scaled radius (D2; D3 with radius_mode view) */
+    MR_AO_SCHEER,      /* occlusion vectors, depth-scaled radius (D2; D3 with radius_mode view);
+                          as printed with bias 0 and r_min 0 (the whole ball) */
     MR_AO_CRYTEK,      /* Mittring 2007: ratio of sphere samples behind the depth buffer */
     MR_AO_FILION,      /* Filion & McNaughton 2008: hemisphere samples, depth-difference falloff */
     MR_AO_HBAO,        /* Bavoil et al. 2008: horizon search along image-space directions */
