@@ -80,6 +80,14 @@ bool app_ao_parse(const char *cmd, const app_opt *opts, mr_ao_params *ao, bool *
         else if (strcmp(v, "standalone") == 0) ao->mask = MR_AO_MASK_STANDALONE;
         else return app_errorf(cmd, "--ao-mask %s: expected off, on or standalone", v), false;
     }
+    if ((v = app_get(opts, "ao-mask-strength"))) {
+        /* Only the standalone mask has a strength of its own: silently
+         * ignoring it elsewhere would hide a mistake. */
+        if (ao->mask != MR_AO_MASK_STANDALONE)
+            return app_errorf(cmd, "--ao-mask-strength applies to --ao-mask standalone only"), false;
+        if (!app_double("ao-mask-strength", v, 1e-3, 1, &d)) return false;
+        ao->mask_strength = (float)d;
+    }
     gt->radius_mode = ao->radius_mode;
     gt->radius = ao->radius;
     gt->screen_radius = ao->screen_radius;

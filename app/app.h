@@ -64,9 +64,9 @@ void app_gfx_close(app_gfx *g);
     {"ao-screen-radius", "F", "screen mode: projected radius as a fraction of the image height (default 0.05)", NULL},  \
     {"ao-samples", "N", "samples per pixel, 1..64 (default 16)", NULL},                                                  \
     {"ao-kernel", "K", "sample kernel: uniform, stratified, latin, poisson (default uniform)", NULL},                    \
-    {"ao-rmin", "F", "kernel inner radius as a fraction of the radius (default 0.8)", NULL},                              \
+    {"ao-rmin", "F", "kernel inner radius as a fraction of the radius (default 0.8; 0 = the whole ball)", NULL},          \
     {"ao-rmax", "F", "kernel outer radius as a fraction of the radius (default 1)", NULL},                                \
-    {"ao-radii", "K", "multi-radius: K radii R, R/2, ..; the darkest wins (default 1)", NULL},                            \
+    {"ao-radii", "K", "multi-radius: K radii R, R/2, .., K in 1..5; the darkest wins (default 1)", NULL},                  \
     {"ao-c", "C", "scheer attenuation c in [0,1e7] (default 1)", NULL},                                                    \
     {"ao-bias", "B", "bias (cosine / depth fraction of the radius, default 0.05)", NULL},                                  \
     {"ao-strength", "S", "AO = 1 - S * occlusion (default per method, e.g. scheer 3)", NULL},                                                      \
@@ -74,6 +74,7 @@ void app_gfx_close(app_gfx *g);
     {"ao-half", NULL, "AO at half resolution with a joint bilateral upsample", NULL},                                    \
     {"ao-positions", NULL, "AO from a view-space positions texture", NULL},                                              \
     {"ao-mask", "M", "corner masking: off, on, standalone (default off)", NULL},                                          \
+    {"ao-mask-strength", "S", "standalone mask: AO = 1 - S in the corners before the blur, S in (0,1] (default 0.5)", NULL}, \
     {"ao-rays", "N", "groundtruth: rays per pixel (default 256)", NULL}
 /* Reads the APP_AO_OPTS values into ao (and gt for --ao groundtruth);
  * prints one line and returns false on a bad value. */

@@ -20,6 +20,7 @@ layout(location = 11) uniform float u_strength;
 layout(location = 12) uniform int u_radii;       // multi-radius count
 layout(location = 13) uniform int u_use_pos;
 layout(location = 14) uniform int u_use_mask;
+layout(location = 15) uniform float u_mask_strength; // standalone mask: 1 - this inside, in [0,1]
 layout(location = 16) uniform vec4 u_kernel[64];  // xyz in the unit ball shell [r_min, r_max]
 layout(location = 80) uniform vec4 u_kernel2[64]; // xy in the unit disk annulus [r_min, r_max]
 
@@ -185,7 +186,10 @@ void main() {
     if (!fetch_pos(fp, P)) { o_ao = 1.0; return; }   // sky: unoccluded
     if (u_use_mask != 0 || u_method == M_MASK_STANDALONE) {
         bool in_mask = texelFetch(u_mask, fp, 0).r > 1.5;
-        if (u_method == M_MASK_STANDALONE) { o_ao = in_mask ? 1.0 - 0.5 * u_strength : 1.0; return; }
+        // Stand-alone (Park & Baek sec. 5): the highlighted corners are the
+        // occlusion, with a strength of their own (clamped to [0,1] on the
+        // CPU) so the value is a visibility before the blur averages it.
+        if (u_method == M_MASK_STANDALONE) { o_ao = in_mask ? 1.0 - u_mask_strength : 1.0; return; }
         if (!in_mask) { o_ao = 1.0; return; }        // OdSSAO: nothing to do here
     }
     vec3 n = ao_normal(u_normal, fp, P);

@@ -37,6 +37,12 @@ if r --out "$tmp/opts.png" --ao scheer --ao-half --ao-positions --ao-mask on --a
 else
   bad "AO options failed: $(cat "$tmp/opts.err")"
 fi
+# Five radii (Doronin et al.), the stand-alone mask with its own strength,
+# and the paper-pure scheer (no cosine bias, the whole-ball kernel).
+for args in "--ao-radii 5" "--ao-mask standalone --ao-mask-strength 0.3" "--ao-bias 0 --ao-rmin 0 --ao-kernel uniform"; do
+  # shellcheck disable=SC2086
+  r --out "$tmp/more.png" --ao scheer $args 2>"$tmp/more.err" && [ -s "$tmp/more.png" ] && ok || bad "$args failed: $(cat "$tmp/more.err")"
+done
 # Ground truth (few rays: this is about the plumbing).
 if r --out "$tmp/gt.png" --ao groundtruth --ao-radius 1 --ao-rays 8 --aux "$tmp/aux_gt" 2>"$tmp/gt.err"; then
   [ -s "$tmp/aux_gt/ao.pfm" ] && [ -s "$tmp/gt.png" ] && ok || bad "groundtruth wrote no ao.pfm"
@@ -47,7 +53,10 @@ fi
 # Bad values: one line on stderr, non-zero exit, no output.
 for args in "--ao ssao" "--ao scheer --ao-samples 0" "--ao scheer --ao-samples 65" "--ao scheer --ao-radius-mode far" \
             "--ao scheer --ao-mask maybe" "--ao scheer --ao-kernel sobol" "--ao scheer --ao-c -1" "--ao scheer --ao-radius 0" \
-            "--ao scheer --ao-rmin 0.9 --ao-rmax 0.5" "--ao scheer --ao-radius-mode screen --ao-radius 1"; do
+            "--ao scheer --ao-rmin 0.9 --ao-rmax 0.5" "--ao scheer --ao-radius-mode screen --ao-radius 1" \
+            "--ao scheer --ao-radii 0" "--ao scheer --ao-radii 6" "--ao scheer --ao-radii -1" \
+            "--ao scheer --ao-mask-strength 0.5" "--ao scheer --ao-mask standalone --ao-mask-strength 2" \
+            "--ao scheer --ao-mask standalone --ao-mask-strength 0"; do
   rm -f "$tmp/bad.png"
   # shellcheck disable=SC2086
   if r --out "$tmp/bad.png" $args 2>"$tmp/bad.err"; then

@@ -56,7 +56,8 @@ bool mr_renderer_set_scene(mr_renderer *r, const mr_scene *scene, mr_error *err)
  * ambient term of the shading. */
 typedef enum mr_ao_method {
     MR_AO_NONE = 0,    /* plain shading (Scheer & Keutel's D1): no AO pass runs */
-    MR_AO_SCHEER,      /* occlusion vectors, depth-scaled radius (D2; D3 with radius_mode view) */
+    MR_AO_SCHEER,      /* occlusion vectors, depth-scaled radius (D2; D3 with radius_mode view);
+                          as printed with bias 0 and r_min 0 (the whole ball) */
     MR_AO_CRYTEK,      /* Mittring 2007: ratio of sphere samples behind the depth buffer */
     MR_AO_FILION,      /* Filion & McNaughton 2008: hemisphere samples, depth-difference falloff */
     MR_AO_HBAO,        /* Bavoil et al. 2008: horizon search along image-space directions */
@@ -82,11 +83,12 @@ typedef enum mr_ao_kernel {
 typedef enum mr_ao_mask {
     MR_AO_MASK_OFF = 0,
     MR_AO_MASK_ON,         /* AO only where >= 2 outline volumes contain the surface */
-    MR_AO_MASK_STANDALONE, /* the blurred mask itself is the AO (no sampling) */
+    MR_AO_MASK_STANDALONE, /* the mask itself is the AO (no sampling): 1 - mask_strength
+                              inside, 1 outside, then blurred (Park & Baek sec. 5) */
 } mr_ao_mask;
 
 #define MR_AO_MAX_SAMPLES 64
-#define MR_AO_MAX_RADII 4
+#define MR_AO_MAX_RADII 5 /* Doronin et al. merge 5 radii */
 
 typedef struct mr_ao_params {
     mr_ao_method method;          /* default MR_AO_NONE */
@@ -115,14 +117,19 @@ typedef struct mr_ao_params {
     bool positions;               /* read view-space positions from a positions texture
                                      instead of un-projecting depth */
     mr_ao_mask mask;              /* corner masking; default off */
+    float mask_strength;          /* standalone mask: AO = 1 - mask_strength inside the
+                                     mask before the blur, clamped to [0,1] (the method's
+                                     strength plays no part); 0 = 0.5, the paper's grey
+                                     highlight (Park & Baek give no number) */
     bool want_ao;                 /* fill mr_frame_result.ao */
+    bool want_mask;               /* fill mr_frame_result.ao_mask (debug / tests) */
     bool no_reuse;                /* recompute even if camera and settings are unchanged
                                      (benchmarks) */
     const mr_image *external;     /* F32x1 AO at the output size to shade with instead of
                                      computing one (e.g. ray-traced ground truth); NULL */
 } mr_ao_params;
 #define MR_AO_DEFAULTS {MR_AO_NONE, MR_AO_RADIUS_SCREEN, 0.0, 0.05, 16, MR_AO_KERNEL_UNIFORM, 0.8f, 1.0f, 1, \
-                        1.0f, 0.05f, 0.0f, 4, false, false, MR_AO_MASK_OFF, false, false, NULL}
+                        1.0f, 0.05f, 0.0f, 4, false, false, MR_AO_MASK_OFF, 0.5f, false, false, false, NULL}
 
 /* Names used on the command line ("none", "scheer", ...); NULL if out of range. */
 const char *mr_ao_method_name(mr_ao_method m);
@@ -230,6 +237,9 @@ typedef struct mr_frame_result {
     double near_plane;         /* the near plane used (scene units) */
     mr_image ao;               /* F32x1 ambient visibility in [0,1] at the output size
                                   (1 = unoccluded, 1 where nothing), when ao.want_ao */
+    mr_image ao_mask;          /* F32x1 outline count per pixel at the output size (the
+                                  corner mask is count >= 2), when ao.want_mask and
+                                  masking ran; empty otherwise */
     double ao_masked_fraction; /* corner masking: fraction of geometry pixels in the
                                   mask (-1 when masking is off) */
     bool ao_reused;            /* AO of the previous frame was reused (frozen camera) */

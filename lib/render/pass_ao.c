@@ -23,7 +23,7 @@ typedef struct ao_key {
     int w, h;
     bool hide_hidden;
     uint64_t scene_gen;
-    mr_ao_params p; /* resolved, with want_ao / no_reuse cleared */
+    mr_ao_params p; /* resolved, with want_ao / want_mask / no_reuse cleared */
 } ao_key;
 
 struct mr_ao_state {
@@ -305,8 +305,13 @@ static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
     if (p.blur_radius > 32) p.blur_radius = 32;
     if ((int)p.kernel < 0 || p.kernel > MR_AO_KERNEL_POISSON) p.kernel = MR_AO_KERNEL_UNIFORM;
     if ((int)p.mask < 0 || p.mask > MR_AO_MASK_STANDALONE) p.mask = MR_AO_MASK_OFF;
+    /* Clamped here, before the shader and the blur: the standalone mask is a
+     * visibility in [0,1] whatever the method and its strength. */
+    if (!(p.mask_strength > 0) || !isfinite(p.mask_strength)) p.mask_strength = 0.5f;
+    if (p.mask_strength > 1) p.mask_strength = 1;
     if ((int)p.radius_mode < 0 || p.radius_mode > MR_AO_RADIUS_VIEW) p.radius_mode = MR_AO_RADIUS_SCREEN;
     p.want_ao = false;
+    p.want_mask = false;
     p.no_reuse = false;
     p.external = NULL;
     return p;
@@ -485,6 +490,7 @@ void mr_pass_ao(frame *f) {
     glUniform1i(12, p->radii);
     glUniform1i(13, p->positions ? 1 : 0);
     glUniform1i(14, p->mask == MR_AO_MASK_ON ? 1 : 0);
+    glUniform1f(15, p->mask_strength);
     glUniform4fv(16, MR_AO_MAX_SAMPLES, s->kernel3);
     glUniform4fv(80, MR_AO_MAX_SAMPLES, s->kernel2);
     fullscreen(f, s->fbo_ao[0], s->aw, s->ah);
@@ -561,8 +567,12 @@ bool mr_pass_ao_read_back(frame *f, mr_error *err) {
                 in += cnt[i] > 1.5f;
             }
         o->ao_masked_fraction = geo ? (double)in / (double)geo : 0.0;
-        free(cnt);
         free(dep);
+        /* The counts themselves, for tests and debugging. */
+        bool ok = !f->p->ao.want_mask || mr_image_alloc(&o->ao_mask, r->w, r->h, 1, MR_PIX_F32, err);
+        if (ok && o->ao_mask.data) memcpy(o->ao_mask.data, cnt, n * sizeof *cnt);
+        free(cnt);
+        if (!ok) return false;
     }
     return true;
 }

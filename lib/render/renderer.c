@@ -266,6 +266,7 @@ void mr_frame_result_free(mr_frame_result *res) {
     mr_image_free(&res->depth);
     mr_image_free(&res->normal);
     mr_image_free(&res->ao);
+    mr_image_free(&res->ao_mask);
 }
 
 
