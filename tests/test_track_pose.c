@@ -6,6 +6,7 @@
  * noise, so the numbers are deterministic. */
 #include "mr_track.h"
 #include "mr_test.h"
+#include "mr_test_track.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -28,24 +29,6 @@ static void project_tag(const mr_camera *cam, const mr_marker_map *map, const mr
         det->corners[k][0] += sigma_px * mr_rng_normal(rng);
         det->corners[k][1] += sigma_px * mr_rng_normal(rng);
     }
-}
-
-/* The weak-perspective mirror of the truth (what IPPE's second solution
- * approximates): the tag turned about its centre so that its normal is
- * reflected about the line of sight. */
-static mr_dmat4 mirror_pose(const mr_marker *m, const mr_dmat4 *wfc) {
-    mr_dmat4 cfw = mr_m4_invert_rigid(wfc), cft = mr_m4_mul(&cfw, &m->world_from_tag);
-    mr_dvec3 c = mr_v3(cft.m[3], cft.m[7], cft.m[11]), r = mr_v3_normalize(c);
-    mr_dvec3 n = mr_v3(cft.m[2], cft.m[6], cft.m[10]);
-    mr_dvec3 n2 = mr_v3_sub(mr_v3_scale(r, 2 * mr_v3_dot(n, r)), n);
-    mr_dvec3 ax = mr_v3_cross(n, n2);
-    double ang = atan2(mr_v3_len(ax), mr_v3_dot(n, n2));
-    mr_dmat4 Q = mr_m4_rotate_axis(ax, ang), cft2 = mr_m4_mul(&Q, &cft);
-    cft2.m[3] = c.x;
-    cft2.m[7] = c.y;
-    cft2.m[11] = c.z;
-    mr_dmat4 tfc2 = mr_m4_invert_rigid(&cft2);
-    return mr_m4_mul(&m->world_from_tag, &tfc2);
 }
 
 /* One run of the tracker loop over a lone 0.3 m tag at distance d (+-0.3 m)
@@ -73,7 +56,7 @@ static flip_run lone_tag_run(double dist, double sigma, uint64_t seed) {
         mr_dvec3 eye = mr_v3(d * sin(th) * cos(phi), d * sin(th) * sin(phi), -d * cos(th));
         /* aimed slightly off the tag centre, as a hand-held camera */
         mr_dmat4 truth = mr_m4_look_at_cv(eye, mr_v3(0.02 * sin(t), 0.015 * cos(1.3 * t), 0), mr_v3(0, -1, 0));
-        mr_dmat4 mirror = mirror_pose(&tag, &truth);
+        mr_dmat4 mirror = mr_test_mirror_pose(&tag, &truth);
         mr_detection det;
         project_tag(&cam, &map, &tag, &truth, sigma, &rng, &det);
         mr_pose p, q;
