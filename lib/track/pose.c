@@ -31,9 +31,12 @@ void mr_mat_to_rotvec(const double R[9], double rv[3]) {
     double tr = R[0] + R[4] + R[8];
     double c = 0.5 * (tr - 1);
     c = c > 1 ? 1 : c < -1 ? -1 : c;
-    double th = acos(c);
     double v[3] = {R[7] - R[5], R[2] - R[6], R[3] - R[1]};
     double s2 = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); /* = 2 sin(th) */
+    /* atan2, not acos(c): near c = 1 acos turns rounding in the trace into
+     * ~1e-8 rad, so a rotation of 1e-16 read as 1.5e-8 (and the pose
+     * filter, stepping by a fraction of it, drifted at rest). */
+    double th = atan2(0.5 * s2, c);
     if (th < 1e-9) {
         rv[0] = 0.5 * v[0];
         rv[1] = 0.5 * v[1];
