@@ -466,10 +466,7 @@ static void test_bad_views(void) {
 int main(void) {
     mr_error err = {0};
     g_gpu = mr_gpu_create_headless(NULL, &err);
-    if (!g_gpu) {
-        printf("test_render: SKIPPED: no EGL device (%s)\n", err.msg);
-        return MR_TEST_SKIP;
-    }
+    if (!g_gpu) return mr_test_no_gpu("test_render", &err);
     g_r = mr_renderer_create(g_gpu, &err);
     CHECK_MSG(g_r != NULL, "%s", err.msg);
     if (g_r) {

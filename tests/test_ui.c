@@ -323,8 +323,10 @@ int main(void) {
     char path[1024];
     mr_error err = {0};
     if (!mr_ui_font_find(path, sizeof path, &err)) {
-        printf("test_ui: skipped the font tests: %s\n", err.msg);
-        return mr_test_finish("test_ui");
+        /* A partial skip is a skip, not a pass (scripts/test.sh fails on it
+         * where deps.sh installed fonts-dejavu-core). */
+        printf("test_ui: SKIPPED the font, widget and touch-target tests: %s\n", err.msg);
+        return mr_test_failures ? mr_test_finish("test_ui") : MR_TEST_SKIP;
     }
     mr_ui_font_params fp = MR_UI_FONT_DEFAULTS;
     fp.path = path;
