@@ -34,6 +34,7 @@ lod_one_sided_ba|lib/scene/lod.c|    return fmax(ab, ba);\n}|    (void)ab;\n    
 atomic_write_in_place|lib/core/file.c|snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid())|snprintf(tmp, sizeof tmp, "%s", path)|^test_core$
 atomic_temp_left|lib/core/file.c|        int e = errno;\n        remove(tmp);\n        return mr_fail(err, MR_ERR_IO, "cannot write %s: %s", path, strerror(e));\n    }\n    if|        int e = errno;\n        return mr_fail(err, MR_ERR_IO, "cannot write %s: %s", path, strerror(e));\n    }\n    if|^test_core$
 touch_target_px|lib/ui/widgets.c|ceilf(mr_ui_mm(ui, ui->p.min_target_mm))|ceilf(ui->p.min_target_mm)|^test_ui$
+touch_target_px_in_view|lib/ui/widgets.c|ceilf(mr_ui_mm(ui, ui->p.min_target_mm))|ceilf(ui->p.min_target_mm)|^cli_view$
 overlay_p1_p2_swapped|shaders/overlay.frag.glsl|p1 = u_dist[2], p2 = u_dist[3]|p1 = u_dist[3], p2 = u_dist[2]|^test_render$
 overlay_p2_sign|shaders/overlay.frag.glsl|2.0 * p1 * xy.x * xy.y + p2 * (r2|2.0 * p1 * xy.x * xy.y - p2 * (r2|^test_render$
 gl_context_4.9|lib/render/gpu.c|EGL_CONTEXT_MINOR_VERSION, 5,|EGL_CONTEXT_MINOR_VERSION, 9,|^(test_render|cli_render)$
@@ -80,7 +81,7 @@ while IFS='|' read -r name file text repl tests; do
     echo "SURVIVED $name ($file): tests '$tests' still pass"
     survived=$((survived + 1))
   else
-    why=$(grep -m1 -E "CHECK failed|FAIL:|FAILED|SKIPPED" "$backup/test.log" | cut -c1-200)
+    why=$(grep -E "CHECK failed|FAIL:|FAILED|SKIPPED" "$backup/test.log" | cut -c1-200 | head -n 3 | paste -sd "|" -)
     echo "caught   $name: $why"
     caught=$((caught + 1))
   fi
