@@ -215,8 +215,8 @@ static void test_legibility_metric(void) {
     }
     CHECK_MSG(leg[0] < 1e-6, "pure occluder (alpha 1): legibility %.4f, want 0", leg[0]);
     CHECK_MSG(leg[1] > 0.999, "D shown in full (alpha 0): legibility %.4f, want 1", leg[1]);
-    CHECK_MSG(leg[2] > 0.4 && leg[2] < 0.6, "alpha 0.5 blend: legibility %.3f, want about 0.5", leg[2]);
-    CHECK_MSG(leg[3] > leg[2] + 0.15 && leg[3] < 0.85, "alpha 0.25 blend: legibility %.3f (alpha 0.5: %.3f)", leg[3],
+    CHECK_MSG(leg[2] > 0.40 && leg[2] < 0.52, "alpha 0.5 blend: legibility %.3f, want about 0.5", leg[2]);
+    CHECK_MSG(leg[3] > 0.62 && leg[3] < 0.78, "alpha 0.25 blend: legibility %.3f (alpha 0.5: %.3f)", leg[3],
               leg[2]);
     /* The occluder's own stripes never count as hidden structure: an F
      * that keeps O but doubles its stripe contrast adds nothing of D. */
@@ -231,7 +231,7 @@ static void test_legibility_metric(void) {
     CHECK_MSG(mr_eval_ghost_legibility(&in, NULL, &l, &err), "%s", err.msg);
     printf("  legibility on constructed images: alpha 1 %.3f, 0 %.3f, 0.5 %.3f, 0.25 %.3f; stripes only %.3f\n", leg[0],
            leg[1], leg[2], leg[3], l.legibility);
-    CHECK_MSG(l.legibility < 0.35, "occluder edges strengthened, D absent: legibility %.3f", l.legibility);
+    CHECK_MSG(l.legibility < 0.1, "occluder edges strengthened, D absent: legibility %.3f", l.legibility);
     mr_image_free(&f);
     /* Bad input is refused. */
     mr_ghost_legibility_images bad = {&o, &o, &d, &o};
@@ -764,6 +764,10 @@ static void test_frame_hidden_ao(void) {
  * region more salient when D shows. */
 static void test_frame_legibility(void) {
     mr_scene *s = wall_scene(true);
+    /* The bar off the vertical centre: rows read back upside down show. */
+    for (int32_t i = 0; i < s->node_count; i++)
+        if (strcmp(s->nodes[i].name, "Pipe") == 0) s->nodes[i].world = mr_m4_translate(0, 0.9, 6);
+    mr_scene_update_bounds(s);
     char passes[512];
     mr_frame_params p = MR_FRAME_DEFAULTS;
     mr_frame_result off;
@@ -790,6 +794,14 @@ static void test_frame_legibility(void) {
             }
             CHECK_MSG(diff == 0, "case %d: read-back occluder differs from the plain frame at %d pixels", c, diff);
             CHECK_MSG(nreg > 96 * 72 / 50 && nreg < 96 * 72 / 3, "case %d: region of %d pixels", c, nreg);
+            if (c == FULL) {
+                /* t = 0: the frame shows D itself in the region. */
+                const unsigned char *dd = d.data, *ff = res.color.data;
+                int off_d = 0;
+                for (int i = 0; i < 96 * 72; i++)
+                    for (int k = 0; k < 3 && rg[i] > 0.5f; k++) off_d += abs(dd[3 * i + k] - ff[3 * i + k]) > 1;
+                CHECK_MSG(off_d == 0, "read-back hidden layer differs from the t = 0 frame at %d values", off_d);
+            }
             mr_ghost_legibility_images in = {&res.color, &o, &d, &reg};
             mr_legibility l;
             CHECK_MSG(mr_eval_ghost_legibility(&in, NULL, &l, &err), "%s", err.msg);
@@ -808,9 +820,9 @@ static void test_frame_legibility(void) {
            "cv::saliency ratio %.2f / %.2f / %.2f\n", leg[0], leg[1], leg[2], frac[2], ratio[0], ratio[1], ratio[2]);
     CHECK_MSG(leg[OCCLUDER] < 0.05, "hidden structure invisible (alpha 1) scores legibility %.3f", leg[OCCLUDER]);
     CHECK_MSG(leg[FULL] > 0.95, "D shown in full (t 0) scores legibility %.3f", leg[FULL]);
-    CHECK_MSG(leg[ADAPTIVE] > leg[OCCLUDER] + 0.1 && leg[ADAPTIVE] < leg[FULL] - 0.1,
+    CHECK_MSG(leg[ADAPTIVE] > 0.2 && leg[ADAPTIVE] < 0.8,
               "adaptive legibility %.3f not between invisible %.3f and full %.3f", leg[ADAPTIVE], leg[OCCLUDER], leg[FULL]);
-    CHECK_MSG(frac[ADAPTIVE] > 0.01 && frac[ADAPTIVE] < 0.5, "important fraction %.3f: should be some edges, not all",
+    CHECK_MSG(frac[ADAPTIVE] > 0.05 && frac[ADAPTIVE] < 0.35, "important fraction %.3f: should be some edges, not all",
               frac[ADAPTIVE]);
     CHECK_MSG(ratio[FULL] > 1.3 * ratio[OCCLUDER], "cv::saliency ratio with D shown %.2f vs invisible %.2f", ratio[FULL],
               ratio[OCCLUDER]);

@@ -691,20 +691,6 @@ bool mr_ghost_compose(mr_renderer *r, const mr_ghost_images *in, const mr_ghost_
     return ok;
 }
 
-/* GL rows run bottom-up; mr_image rows top-down. */
-static void flip_rows(mr_image *im) {
-    size_t row = (size_t)im->width * im->channels * (im->type == MR_PIX_F32 ? 4 : 1);
-    unsigned char *d = im->data, tmp[4 * 4096];
-    for (int y = 0; y < im->height / 2; y++)
-        for (size_t off = 0; off < row; off += sizeof tmp) {
-            size_t k = row - off < sizeof tmp ? row - off : sizeof tmp;
-            unsigned char *a = d + (size_t)y * row + off, *b = d + (size_t)(im->height - 1 - y) * row + off;
-            memcpy(tmp, a, k);
-            memcpy(a, b, k);
-            memcpy(b, tmp, k);
-        }
-}
-
 bool mr_ghost_read_layers(mr_renderer *r, mr_image *occluder, mr_image *hidden, mr_image *region, mr_error *err) {
     memset(occluder, 0, sizeof *occluder);
     memset(hidden, 0, sizeof *hidden);
@@ -716,7 +702,9 @@ bool mr_ghost_read_layers(mr_renderer *r, mr_image *occluder, mr_image *hidden, 
     bool ok = mr_image_alloc(occluder, w, h, 3, MR_PIX_U8, err) && mr_image_alloc(hidden, w, h, 3, MR_PIX_U8, err) &&
               mr_image_alloc(region, w, h, 1, MR_PIX_F32, err) && mr_image_alloc(&mask, w, h, 4, MR_PIX_F32, err);
     if (ok) {
-        /* The sRGB textures' bytes as stored: sRGB-encoded, like the frame's colour. */
+        /* The sRGB textures' bytes as stored: sRGB-encoded, like the frame's
+         * colour; rows already top first (the projection flips y, OpenCV's
+         * camera frame). */
         glPixelStorei(GL_PACK_ALIGNMENT, 1);
         glGetTextureImage(g->o_tex, 0, GL_RGB, GL_UNSIGNED_BYTE, (GLsizei)mr_image_bytes(occluder), occluder->data);
         glGetTextureImage(g->hid_shaded.color[0], 0, GL_RGB, GL_UNSIGNED_BYTE, (GLsizei)mr_image_bytes(hidden), hidden->data);
@@ -725,9 +713,6 @@ bool mr_ghost_read_layers(mr_renderer *r, mr_image *occluder, mr_image *hidden, 
         const float *m = mask.data;
         float *rg = region->data;
         for (size_t i = 0; i < (size_t)w * h; i++) rg[i] = m[i * 4 + 1] > 0.5f ? 1.0f : 0.0f;
-        flip_rows(occluder);
-        flip_rows(hidden);
-        flip_rows(region);
         ok = finish(err);
     }
     mr_image_free(&mask);
