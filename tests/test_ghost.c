@@ -831,7 +831,7 @@ static void test_frame_legibility(void) {
     /* After an image-level composition the frame's layers are gone. */
     mr_image o, d, reg;
     mr_error err = {0};
-    mr_image io = img(8, 8, 3, 0.5f), imk = img(8, 8, 1, 1.0f);
+    mr_image io = img(96, 72, 3, 0.5f), imk = img(96, 72, 1, 1.0f); /* the frame's size: no reallocation */
     mr_ghost_images gi = {&io, &io, &imk, &imk, NULL, NULL};
     mr_ghost_output out;
     CHECK_MSG(mr_ghost_compose(g_r, &gi, NULL, &out, &err), "%s", err.msg);
