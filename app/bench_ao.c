@@ -509,6 +509,37 @@ int bench_ao(int argc, char **argv) {
         }
         mr_path_join(out_dir, "bench_ao_montage.png", path, sizeof path);
         if (ok) ok = mr_montage_png(path, (const mr_image *const *)montage, nmont, 2 + nc, w, h, &err);
+        /* Scheer & Keutel's three renderings, shaded as in the paper (Phong
+         * with specular): D1 no AO, D2 scheer, D3 standard SSAO (crytek,
+         * constant radius), plus scheer-paper; 16 samples, one row per view. */
+        const int shaded_c[3] = {0, 3, 2};
+        mr_image shots[MAX_VIEWS * 4];
+        const mr_image *tiles[MAX_VIEWS * 4];
+        int nshot = 0;
+        ok = ok && mr_renderer_set_scene(gfx.renderer, scene, &err); /* step 4 changed it */
+        for (int v = 1; ok && v <= nv; v++)
+            for (int k = 0; ok && k < 4; k++) {
+                mr_frame_params fp = MR_FRAME_DEFAULTS;
+                fp.width = w;
+                fp.height = h;
+                fp.specular = 0.35f;
+                if (k > 0) {
+                    fp.ao = cs[shaded_c[k - 1]].tuned;
+                    fp.ao.samples = 16;
+                    fp.ao.no_reuse = true;
+                }
+                mr_frame_result res;
+                ok = mr_render_frame(gfx.renderer, &vd[v].view, &fp, &res, &err);
+                if (!ok) break;
+                shots[nshot] = res.color;
+                res.color.data = NULL;
+                tiles[nshot] = &shots[nshot];
+                nshot++;
+                mr_frame_result_free(&res);
+            }
+        mr_path_join(out_dir, "bench_ao_shaded.png", path, sizeof path);
+        if (ok) ok = mr_montage_png(path, tiles, nshot, 4, w, h, &err);
+        for (int i = 0; i < nshot; i++) mr_image_free(&shots[i]);
     }
     if (ok) {
         static char md[65536];
@@ -568,7 +599,8 @@ int bench_ao(int argc, char **argv) {
         ok = mr_file_write_atomic(path, md, len, &err);
         if (ok) printf("\nwrote %s/bench_ao.csv, bench_ao_tuning.csv, bench_ao_triangles.csv, bench_ao.svg, bench_ao_screen.svg, "
                        "bench_ao_montage.png (rows: views; columns: reference fixed R, reference depth-scaled R, then "
-                       "%d methods at %d samples), bench_ao.md in %.0f s\n", out_dir, nc, samples[quick ? 0 : 1], mr_time_now() - t0);
+                       "%d methods at %d samples), bench_ao_shaded.png (Phong-shaded D1, D2, D3, scheer-paper), "
+                       "bench_ao.md in %.0f s\n", out_dir, nc, samples[quick ? 0 : 1], mr_time_now() - t0);
     }
     if (!ok) rc = app_error(cmd, &err);
     for (int i = 0; i < nmont; i++)

@@ -125,8 +125,9 @@ typedef struct mr_plot_series {
 bool mr_plot_svg(const char *path, const char *title, const char *xlabel, const char *ylabel,
                  const mr_plot_series *series, int nseries, bool log_x, mr_error *err);
 
-/* Tiles F32x1 images (values in [0,1], each resized by nearest neighbour to
- * tile_w x tile_h) into a grey PNG, cols tiles per row, row-major. */
+/* Tiles F32x1 images (values in [0,1]) and RGB8 images, each resized by
+ * nearest neighbour to tile_w x tile_h, into a PNG (grey, or RGB when any
+ * tile is RGB8), cols tiles per row, row-major. */
 bool mr_montage_png(const char *path, const mr_image *const *images, int count, int cols, int tile_w, int tile_h,
                     mr_error *err);
 

@@ -225,9 +225,11 @@ typedef struct mr_frame_params {
     bool timing;               /* GPU timer queries per pass (adds a sync) */
     mr_ao_params ao;           /* ambient occlusion; default none */
     mr_ghost_params ghost;     /* ghosted views of the hidden layer; default off */
+    float specular;            /* Phong specular weight (white highlights); default 0 = Lambert only */
+    float shininess;           /* Phong exponent, >= 1; 0 = 32 */
 } mr_frame_params;
 #define MR_FRAME_DEFAULTS {0, 0, NULL, 0.5f, false, {0.62f, 0.66f, 0.70f}, false, false, false, MR_AO_DEFAULTS, \
-                           MR_GHOST_DEFAULTS}
+                           MR_GHOST_DEFAULTS, 0.0f, 0.0f}
 
 #define MR_MAX_PASSES 32
 
