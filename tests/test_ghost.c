@@ -160,9 +160,10 @@ static float grey_of(double L) {
 
 /* 64x48 images: the region is x 16..47, y 12..35. D (neutral greys, L*):
  * 70 outside the region (its background) and at x 16..23, a faint step to
- * 80 at x 24..31 (dE 10: IM 0.4, above the old 0.3 threshold, below 0.5),
- * 30 at x 32..39 and 45 at x 40..47 (dE 15: IM 0.6, just above 0.5). The
- * important edges are then exactly: 80|30 and 30|45 inside (24 each), the
+ * 82 at x 24..31 (dE 12: IM 0.48, above the old 0.3 threshold, just below
+ * 0.5), 30 at x 32..39 and 43 at x 40..47 (dE 13: IM 0.52, just above
+ * 0.5; a few per cent off in the L* scale or the threshold moves one of
+ * them). The important edges are then exactly: 82|30 and 30|43 inside (24 each), the
  * dark part's top and bottom silhouettes (16 each) and its right one (24):
  * 104 of the 1592 neighbour pairs that touch the region. O: vertical
  * stripes L* 45 / 55, 4 pixels wide (its own edges fall on D's). */
@@ -177,7 +178,7 @@ static void legibility_images(mr_image *o, mr_image *d, mr_image *reg) {
             q[0] = q[1] = q[2] = grey_of((x / 4) % 2 ? 55 : 45);
             if (x < 16 || x >= 48 || y < 12 || y >= 36) continue;
             px(reg, x, y)[0] = 1;
-            double L = x < 24 ? 70 : x < 32 ? 80 : x < 40 ? 30 : 45;
+            double L = x < 24 ? 70 : x < 32 ? 82 : x < 40 ? 30 : 43;
             q = px(d, x, y);
             q[0] = q[1] = q[2] = grey_of(L);
         }
@@ -207,8 +208,8 @@ static void test_legibility_metric(void) {
         CHECK_MSG(mr_eval_ghost_legibility(&in, NULL, &l, &err), "%s", err.msg);
         CHECK_MSG(l.region == 32 * 24 && l.edges == 1592, "region %lld pixels, %lld edges (want 768, 1592)", l.region,
                   l.edges);
-        CHECK_MSG(l.important == 104, "important edges of D: %lld, want 104 (the dE 10 step below the threshold, "
-                  "the dE 15 step above it)", l.important);
+        CHECK_MSG(l.important == 104, "important edges of D: %lld, want 104 (the dE 12 step below the threshold, "
+                  "the dE 13 step above it)", l.important);
         CHECK_MSG(l.important_fraction < 0.07, "important fraction %.3f: not every edge is important", l.important_fraction);
         leg[k] = l.legibility;
         mr_image_free(&f);
@@ -218,6 +219,28 @@ static void test_legibility_metric(void) {
     CHECK_MSG(leg[2] > 0.40 && leg[2] < 0.52, "alpha 0.5 blend: legibility %.3f, want about 0.5", leg[2]);
     CHECK_MSG(leg[3] > 0.62 && leg[3] < 0.78, "alpha 0.25 blend: legibility %.3f (alpha 0.5: %.3f)", leg[3],
               leg[2]);
+    /* The same images as 8-bit sRGB (what frames are) measure the same. */
+    {
+        mr_image f8 = {0}, o8 = {0}, d8 = {0}, fl = blend_final(&o, &d, &reg, 0.5f);
+        mr_image *src[3] = {&fl, &o, &d}, *dst[3] = {&f8, &o8, &d8};
+        for (int k = 0; k < 3; k++) {
+            mr_image_alloc(dst[k], 64, 48, 3, MR_PIX_U8, NULL);
+            const float *sp = src[k]->data;
+            unsigned char *dp = dst[k]->data;
+            for (int i = 0; i < 64 * 48 * 3; i++) {
+                double v = sp[i] <= 0.0031308f ? 12.92 * sp[i] : 1.055 * pow(sp[i], 1 / 2.4) - 0.055;
+                dp[i] = (unsigned char)lrint(v * 255.0);
+            }
+        }
+        mr_ghost_legibility_images in8 = {&f8, &o8, &d8, &reg};
+        mr_legibility l8;
+        CHECK_MSG(mr_eval_ghost_legibility(&in8, NULL, &l8, &err), "%s", err.msg);
+        CHECK_MSG(l8.important == 104 && fabs(l8.legibility - leg[2]) < 0.02,
+                  "8-bit sRGB input: %lld important edges, legibility %.3f (linear float: 104, %.3f)", l8.important,
+                  l8.legibility, leg[2]);
+        for (int k = 0; k < 3; k++) mr_image_free(dst[k]);
+        mr_image_free(&fl);
+    }
     /* The occluder's own stripes never count as hidden structure: an F
      * that keeps O but doubles its stripe contrast adds nothing of D. */
     mr_image f = blend_final(&o, &d, &reg, 1.0f);

@@ -27,17 +27,9 @@ static double srgb_decode(double v) { return v <= 0.04045 ? v / 12.92 : pow((v +
 
 static double lab_f(double t) { return t > 0.008856 ? cbrt(t) : 7.787 * t + 16.0 / 116.0; }
 
-/* Pixel i of an RGB image (U8: sRGB-encoded; F32: linear) as L*a*b*
- * (D65, as OpenCV's cvtColor). */
-static void lab_at(const mr_image *im, size_t i, double lab[3]) {
+void mr_eval_rgb_to_lab(const double rgb[3], double lab[3]) {
     double c[3];
-    for (int k = 0; k < 3; k++) {
-        if (im->type == MR_PIX_U8) c[k] = srgb_decode(((const unsigned char *)im->data)[i * 3 + k] / 255.0);
-        else {
-            double v = ((const float *)im->data)[i * 3 + k];
-            c[k] = v > 0 ? (v < 1 ? v : 1) : 0;
-        }
-    }
+    for (int k = 0; k < 3; k++) c[k] = rgb[k] > 0 ? (rgb[k] < 1 ? rgb[k] : 1) : 0;
     double x = (0.412453 * c[0] + 0.357580 * c[1] + 0.180423 * c[2]) / 0.950456;
     double y = 0.212671 * c[0] + 0.715160 * c[1] + 0.072169 * c[2];
     double z = (0.019334 * c[0] + 0.119193 * c[1] + 0.950227 * c[2]) / 1.088754;
@@ -45,6 +37,15 @@ static void lab_at(const mr_image *im, size_t i, double lab[3]) {
     lab[0] = y > 0.008856 ? 116.0 * fy - 16.0 : 903.3 * y;
     lab[1] = 500.0 * (lab_f(x) - fy);
     lab[2] = 200.0 * (fy - lab_f(z));
+}
+
+/* Pixel i of an RGB image (U8: sRGB-encoded; F32: linear) as L*a*b*. */
+static void lab_at(const mr_image *im, size_t i, double lab[3]) {
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = im->type == MR_PIX_U8 ? srgb_decode(((const unsigned char *)im->data)[i * 3 + k] / 255.0)
+                                     : ((const float *)im->data)[i * 3 + k];
+    mr_eval_rgb_to_lab(c, lab);
 }
 
 static bool rgb_ok(const mr_image *im, int w, int h) {

@@ -105,6 +105,9 @@ typedef struct mr_legibility {
 
 bool mr_eval_ghost_legibility(const mr_ghost_legibility_images *in, const mr_legibility_params *params,
                               mr_legibility *out, mr_error *err);
+/* Linear RGB (clamped to [0,1]) -> CIE L*a*b* (D65, as OpenCV's cvtColor),
+ * the conversion the legibility measure uses. */
+void mr_eval_rgb_to_lab(const double rgb[3], double lab[3]);
 
 /* An independent second opinion: OpenCV contrib's spectral-residual saliency
  * (cv::saliency) of `final` (RGB8 sRGB or F32x3 linear); *ratio = mean
