@@ -221,7 +221,14 @@ int app_bench_ghost(int argc, char **argv) {
         if (!csv) ok = mr_fail(&err, MR_ERR_NOMEM, "out of memory");
         int len = 0;
         if (ok) {
-            len = snprintf(csv, cap, "scene,importance,saliency,saliency_levels,mode");
+            len = snprintf(csv, cap,
+                           "# legibility_edge_transfer: mean over D's important edges (4 dE(D)/100 > 0.5) of the part "
+                           "of D's contrast over the occluder that the final image shows (0 occluder only, 1 D in full); "
+                           "edge_contrast_dE / full_contrast_dE: mean dE the final image / D in full adds over the "
+                           "occluder there; cv_saliency_ratio: OpenCV spectral-residual saliency, region mean / mean "
+                           "elsewhere (_occluder: of the occluder alone); target_reached: pixels reaching C_desired, the "
+                           "adaptive stage's own target (a diagnostic, not legibility)\n"
+                           "scene,importance,saliency,saliency_levels,mode");
             for (int k = 0; k < 6; k++) len += snprintf(csv + len, cap - (size_t)len, ",%s_gpu_ms", k_pass_names[k]);
             len += snprintf(csv + len, cap - (size_t)len,
                             ",ghost_gpu_ms,frame_wall_ms,legibility_edge_transfer,edge_contrast_dE,full_contrast_dE,"

@@ -83,7 +83,7 @@ for b in "${benches[@]}"; do
         else run bench_ao docs/bench/ao $mr bench ao --quick --frames 3 --out docs/bench/ao --quiet; fi ;;
     ghost)
         if [ "$full" = 1 ]; then run bench_ghost docs/bench/ghost $mr bench ghost --out docs/bench/ghost --quiet
-        else run bench_ghost docs/bench/ghost $mr bench ghost --size 320x240 --frames 3 --out docs/bench/ghost --quiet; fi ;;
+        else run bench_ghost docs/bench/ghost $mr bench ghost --frames 3 --out docs/bench/ghost --quiet; fi ;;
     tracking)
         run bench_tracking docs/bench/tracking/640x480 \
             $mr bench tracking --recording recordings/demo --out docs/bench/tracking/640x480
@@ -97,7 +97,7 @@ for b in "${benches[@]}"; do
         # The bench writes its generated scenes next to the CSV: keep only
         # the tables.
         if [ "$full" = 1 ]; then run bench_scene docs/bench/scene $mr bench scene --out docs/bench/scene --quiet
-        else run bench_scene docs/bench/scene $mr bench scene --sizes 1M,5M --size 640x480 --frames 3 --out docs/bench/scene --quiet; fi
+        else run bench_scene docs/bench/scene $mr bench scene --sizes 1M,5M --frames 3 --out docs/bench/scene --quiet; fi
         find docs/bench/scene -type f ! -name '*.csv' ! -name '*.md' ! -name '*.svg' ! -name '*.log' -delete
         find docs/bench/scene -mindepth 1 -type d -empty -delete ;;
     *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene)" >&2; exit 2 ;;
