@@ -367,7 +367,8 @@ int bench_ao(int argc, char **argv) {
     if (csv)
         fprintf(csv, "# role: Scheer & Keutel's D1 (no AO), D2 (scheer, depth-scaled radius), D3 (standard SSAO = crytek, "
                      "constant radius) or -; radius_policy: tuned, or the reference's own radius; tuned: no = the paper's "
-                     "parameters; *_fixed: against ray-traced AO with fixed R, *_screen: with the depth-scaled R\n"
+                     "parameters; strength <= 0: the method's default; *_fixed: against ray-traced AO with fixed R, *_screen: with "
+                     "the depth-scaled R\n"
                      "view,contender,role,radius_policy,tuned,radius_mode,radius,screen_radius,strength,bias,c,kernel,r_min,"
                      "r_max,samples,resolution,mask,width,height,"
                      "gpu_ms_median,frames,rmse_fixed,ssim_fixed,bias_fixed,rmse_screen,ssim_screen,bias_screen,masked_fraction\n");
@@ -565,14 +566,15 @@ int bench_ao(int argc, char **argv) {
                     if (cs[c].mode == MR_AO_RADIUS_SCREEN) snprintf(rad, sizeof rad, "%.3g of height", cs[c].tuned.screen_radius);
                     else snprintf(rad, sizeof rad, "%.3g units", cs[c].tuned.radius);
                     if (cs[c].radius != TUNE_RADIUS) snprintf(rad + strlen(rad), sizeof rad - strlen(rad), " (ref.)");
-                    char kern[64];
+                    char kern[64], strength[32] = "default";
+                    if (cs[c].tuned.strength > 0) snprintf(strength, sizeof strength, "%g", cs[c].tuned.strength);
                     snprintf(kern, sizeof kern, "%s [%g,%g]", mr_ao_kernel_name(cs[c].tuned.kernel), cs[c].tuned.r_min,
                              cs[c].tuned.r_max);
                     char masked[32] = "-";
                     if (mk) snprintf(masked, sizeof masked, "%.3f", agg_mf[c][s16][res][mk]);
                     len += (size_t)snprintf(md + len, sizeof md - len,
-                                            "| %s | %s | %s | %g | %g | %g | %s | %s | %s | %.2f | %.4f | %.3f | %+.4f | %.4f | %.3f | %+.4f | %s |\n",
-                                            cs[c].label, cs[c].role, rad, cs[c].tuned.strength, cs[c].tuned.bias,
+                                            "| %s | %s | %s | %s | %g | %g | %s | %s | %s | %.2f | %.4f | %.3f | %+.4f | %.4f | %.3f | %+.4f | %s |\n",
+                                            cs[c].label, cs[c].role, rad, strength, cs[c].tuned.bias,
                                             cs[c].tuned.c, kern, res ? "half" : "full",
                                             mk ? "on" : "off", agg_ms[c][s16][res][mk], agg_rf[c][s16][res][mk],
                                             agg_sf[c][s16][res][mk], agg_bf[c][s16][res][mk], agg_rs[c][s16][res][mk],
