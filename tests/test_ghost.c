@@ -199,9 +199,11 @@ static void test_legibility_metric(void) {
     mr_image o, d, reg;
     legibility_images(&o, &d, &reg);
     mr_error err = {0};
-    const float alphas[4] = {1.0f, 0.0f, 0.5f, 0.25f};
-    double leg[4] = {0};
-    for (int k = 0; k < 4; k++) {
+    /* alpha -0.3: D's contrast over O exaggerated by 30 %: no edge shows
+     * more than D in full. alpha 1.5: D's edges reversed: they show nothing of D. */
+    const float alphas[6] = {1.0f, 0.0f, 0.5f, 0.25f, -0.3f, 1.5f};
+    double leg[6] = {0};
+    for (int k = 0; k < 6; k++) {
         mr_image f = blend_final(&o, &d, &reg, alphas[k]);
         mr_ghost_legibility_images in = {&f, &o, &d, &reg};
         mr_legibility l;
@@ -217,6 +219,9 @@ static void test_legibility_metric(void) {
     CHECK_MSG(leg[0] < 1e-6, "pure occluder (alpha 1): legibility %.4f, want 0", leg[0]);
     CHECK_MSG(leg[1] > 0.999, "D shown in full (alpha 0): legibility %.4f, want 1", leg[1]);
     CHECK_MSG(leg[2] > 0.40 && leg[2] < 0.52, "alpha 0.5 blend: legibility %.3f, want about 0.5", leg[2]);
+    CHECK_MSG(leg[4] > 0.99 && leg[4] <= 1.0, "D exaggerated (alpha -0.3): legibility %.4f, want 1 (at most D in full)",
+              leg[4]);
+    CHECK_MSG(leg[5] >= 0 && leg[5] < 0.02, "D's edges reversed (alpha 1.5): legibility %.4f, want 0", leg[5]);
     CHECK_MSG(leg[3] > 0.62 && leg[3] < 0.78, "alpha 0.25 blend: legibility %.3f (alpha 0.5: %.3f)", leg[3],
               leg[2]);
     /* The same images as 8-bit sRGB (what frames are) measure the same. */
