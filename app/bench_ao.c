@@ -6,10 +6,21 @@
  * frames) and RMSE, SSIM and signed bias against two ray-traced references
  * (Embree): a fixed radius R in scene units, and a radius that grows with
  * depth exactly like scheer's (the reference a depth-scaled method aims at).
- * Free parameters (radius, strength, bias) are tuned once per method for
- * the lowest RMSE on a tuning view that is not reported, then frozen. A
- * second table times the AO pass alone on scenes of very different
- * triangle counts. Measurements only: nothing here passes or fails. */
+ * Free parameters (radius, strength, bias, and scheer's attenuation c) are
+ * tuned once per method for the lowest RMSE on a tuning view that is not
+ * reported, then frozen. Each method runs twice: with its radius tuned, and
+ * with its radius at the reference's own (R, or the depth-scaled fraction
+ * of the height), only strength / bias / c tuned, so a method cannot win by
+ * choosing a radius the reference does not use. Scheer & Keutel's three
+ * renderings: D1 = no AO (AO = 1; the AO maps compared here do not depend
+ * on the shading model), D2 = scheer with its depth-scaled radius (tuned,
+ * and paper-pure: no cosine bias, whole-ball uniform kernel, c = 1, default
+ * strength, the reference's radius, nothing tuned), D3 = "standard SSAO
+ * with a decreasing size of the sample radius in depth" = crytek
+ * (Mittring) with a constant view-space radius; scheer with a constant
+ * radius is an extra row (scheer-view), not D3. A second table times the
+ * AO pass alone on scenes of very different triangle counts. Measurements
+ * only: nothing here passes or fails. */
 #include "app.h"
 
 #include <math.h>
@@ -18,14 +29,20 @@
 
 #define MAX_VIEWS 16
 
-/* The methods raced: scheer twice, as the paper's D2 (depth-scaled radius,
- * tuned against the depth-scaled reference) and D3 (constant radius). */
+/* The methods raced. role: Scheer & Keutel's rendering it stands for, or
+ * "-". radius: TUNE_RADIUS (tuned with the rest), REF_RADIUS (the
+ * reference's own; the rest tuned) or PAPER (the reference's radius and
+ * the paper's parameters; nothing tuned). */
+enum { TUNE_RADIUS, REF_RADIUS, PAPER };
 typedef struct contender {
-    const char *label;
+    const char *label, *role;
     mr_ao_method method;
     mr_ao_radius_mode mode;
+    int radius;
     mr_ao_params tuned;
 } contender;
+
+static const char *const k_radius_policy[3] = {"tuned", "reference", "reference"};
 
 typedef struct view_data {
     char name[256];
@@ -122,8 +139,13 @@ static mr_scene *terrain_scene(int n, mr_error *err) {
 }
 
 static void fmt_params(char *buf, size_t n, const mr_ao_params *p) {
-    snprintf(buf, n, "%s,%g,%g,%g,%g,%g", p->radius_mode == MR_AO_RADIUS_SCREEN ? "screen" : "view", p->radius,
-             p->screen_radius, p->strength, p->bias, p->c);
+    snprintf(buf, n, "%s,%g,%g,%g,%g,%g,%s,%g,%g", p->radius_mode == MR_AO_RADIUS_SCREEN ? "screen" : "view", p->radius,
+             p->screen_radius, p->strength, p->bias, p->c, mr_ao_kernel_name(p->kernel), p->r_min, p->r_max);
+}
+
+/* contender,role,radius_policy,tuned */
+static void fmt_contender(char *buf, size_t n, const contender *c) {
+    snprintf(buf, n, "%s,%s,%s,%s", c->label, c->role, k_radius_policy[c->radius], c->radius == PAPER ? "no" : "yes");
 }
 
 int bench_ao(int argc, char **argv) {
@@ -243,27 +265,47 @@ int bench_ao(int argc, char **argv) {
                    mr_gpu_description(gfx.gpu), w, h, (unsigned long long)mr_scene_triangle_count(scene), rays, radius,
                    screen_radius, nv + 1, t_gt);
 
-    /* 2. Tuning on vd[0]: radius, strength, bias for the lowest RMSE against
-     * the reference of the method's own radius mode. */
+    /* 2. Tuning on vd[0]: radius (unless fixed at the reference's), strength,
+     * bias and (scheer) c for the lowest RMSE against the reference of the
+     * method's own radius mode. */
     contender cs[] = {
-        {"scheer", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, {0}}, {"scheer-view", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, {0}},
-        {"crytek", MR_AO_CRYTEK, MR_AO_RADIUS_VIEW, {0}},   {"filion", MR_AO_FILION, MR_AO_RADIUS_VIEW, {0}},
-        {"hbao", MR_AO_HBAO, MR_AO_RADIUS_VIEW, {0}},       {"alchemy", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, {0}},
+        {"scheer", "D2", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
+        {"scheer@R", "D2", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
+        {"scheer-paper", "D2", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, PAPER, {0}},
+        {"crytek", "D3", MR_AO_CRYTEK, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+        {"crytek@R", "D3", MR_AO_CRYTEK, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+        {"scheer-view", "-", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+        {"scheer-view@R", "-", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+        {"filion", "-", MR_AO_FILION, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+        {"filion@R", "-", MR_AO_FILION, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+        {"hbao", "-", MR_AO_HBAO, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+        {"hbao@R", "-", MR_AO_HBAO, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+        {"alchemy", "-", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+        {"alchemy@R", "-", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
     };
     const int nc = (int)(sizeof cs / sizeof cs[0]);
-    const double rscale[] = {0.5, 1, 2, 0.25}, strengths[] = {0.5, 1, 1.5, 2, 3, 4, 6, 8, 12}, biases[] = {0.02, 0.1};
+    const double rscale[] = {1, 0.5, 2, 0.25}, strengths[] = {0.5, 1, 1.5, 2, 3, 4, 6, 8, 12}, biases[] = {0.02, 0.1},
+                 cvals[] = {1, 0.25, 4};
     const int nr = quick ? 3 : 4, ns = quick ? 2 : 9, nb = quick ? 1 : 2;
     const double qs[] = {1, 3};
     mr_image ao = {0};
     mr_path_join(out_dir, "bench_ao_tuning.csv", path, sizeof path);
     FILE *tune = ok ? fopen(path, "w") : NULL;
     if (ok && !tune) ok = mr_fail(&err, MR_ERR_IO, "cannot write %s", path);
-    if (tune) fprintf(tune, "method,radius_mode,radius,screen_radius,strength,bias,c,rmse_own_reference\n");
+    if (tune)
+        fprintf(tune, "# rmse_own_reference: RMSE on the tuning view against the reference of the method's radius mode\n"
+                      "contender,role,radius_policy,tuned,radius_mode,radius,screen_radius,strength,bias,c,kernel,r_min,r_max,"
+                      "rmse_own_reference\n");
     for (int c = 0; ok && c < nc; c++) {
         double best = INFINITY;
-        for (int a = 0; ok && a < nr; a++)
-            for (int b = 0; ok && b < ns; b++)
-                for (int k = 0; ok && k < nb; k++) {
+        bool paper = cs[c].radius == PAPER;
+        /* The radius grid's first entry is the reference's own radius. */
+        int na = cs[c].radius == TUNE_RADIUS ? nr : 1, nbb = paper ? 1 : ns, nk = paper ? 1 : nb,
+            ncv = cs[c].method == MR_AO_SCHEER && !paper ? 3 : 1;
+        for (int a = 0; ok && a < na; a++)
+            for (int b = 0; ok && b < nbb; b++)
+                for (int k = 0; ok && k < nk; k++)
+                for (int cv = 0; ok && cv < ncv; cv++) {
                     mr_ao_params p = MR_AO_DEFAULTS;
                     p.method = cs[c].method;
                     p.radius_mode = cs[c].mode;
@@ -271,23 +313,36 @@ int bench_ao(int argc, char **argv) {
                     p.screen_radius = screen_radius * rscale[a];
                     p.strength = (float)(quick ? qs[b] : strengths[b]);
                     p.bias = (float)biases[k];
+                    p.c = (float)cvals[cv];
+                    if (paper) {
+                        /* Scheer & Keutel as printed: cosine weight without a
+                         * bias, offsets uniform in the ball (the hemisphere
+                         * after the flip), c = 1, the method's default strength. */
+                        p.strength = 0;
+                        p.bias = 0;
+                        p.c = 1;
+                        p.kernel = MR_AO_KERNEL_UNIFORM;
+                        p.r_min = 0;
+                        p.r_max = 1;
+                    }
                     double ms;
                     mr_image_metrics m;
                     ok = run_ao(gfx.renderer, &vd[0].view, &p, w, h, 0, &ms, &ao, NULL, &err) &&
                          mr_image_compare(&ao, cs[c].mode == MR_AO_RADIUS_SCREEN ? &vd[0].gt_screen : &vd[0].gt_fixed,
                                           &vd[0].depth, &m, &err);
                     if (!ok) break;
-                    char pb[256];
+                    char pb[256], pc[128];
                     fmt_params(pb, sizeof pb, &p);
-                    fprintf(tune, "%s,%s,%.5f\n", cs[c].label, pb, m.rmse);
+                    fmt_contender(pc, sizeof pc, &cs[c]);
+                    fprintf(tune, "%s,%s,%.5f\n", pc, pb, m.rmse);
                     if (m.rmse < best) {
                         best = m.rmse;
                         cs[c].tuned = p;
                     }
                 }
         if (ok && app_flag(opts, "verbose"))
-            printf("  tuned %-12s radius %g screen %g strength %g bias %g: RMSE %.4f\n", cs[c].label, cs[c].tuned.radius,
-                   cs[c].tuned.screen_radius, cs[c].tuned.strength, cs[c].tuned.bias, best);
+            printf("  tuned %-14s radius %g screen %g strength %g bias %g c %g: RMSE %.4f\n", cs[c].label,
+                   cs[c].tuned.radius, cs[c].tuned.screen_radius, cs[c].tuned.strength, cs[c].tuned.bias, cs[c].tuned.c, best);
     }
     if (tune) fclose(tune);
 
@@ -295,7 +350,7 @@ int bench_ao(int argc, char **argv) {
     const int samples_full[] = {8, 16, 32, 64}, samples_quick[] = {8, 32};
     const int *samples = quick ? samples_quick : samples_full;
     const int nsamp = quick ? 2 : 4, nres = quick ? 1 : 2;
-    enum { MAXC = 8, MAXS = 4 };
+    enum { MAXC = 16, MAXS = 4 };
     /* Means over views for the plot and the summary: [contender][samples][res][mask]. */
     static double agg_ms[MAXC][MAXS][2][2], agg_rf[MAXC][MAXS][2][2], agg_rs[MAXC][MAXS][2][2], agg_sf[MAXC][MAXS][2][2],
         agg_ss[MAXC][MAXS][2][2], agg_bf[MAXC][MAXS][2][2], agg_bs[MAXC][MAXS][2][2], agg_mf[MAXC][MAXS][2][2];
@@ -310,7 +365,12 @@ int bench_ao(int argc, char **argv) {
     mr_path_join(out_dir, "bench_ao.csv", path, sizeof path);
     if (ok && !(csv = fopen(path, "w"))) ok = mr_fail(&err, MR_ERR_IO, "cannot write %s", path);
     if (csv)
-        fprintf(csv, "view,method,radius_mode,radius,screen_radius,strength,bias,c,samples,resolution,mask,width,height,"
+        fprintf(csv, "# role: Scheer & Keutel's D1 (no AO), D2 (scheer, depth-scaled radius), D3 (standard SSAO = crytek, "
+                     "constant radius) or -; radius_policy: tuned, or the reference's own radius; tuned: no = the paper's "
+                     "parameters; strength <= 0: the method's default; *_fixed: against ray-traced AO with fixed R, *_screen: with "
+                     "the depth-scaled R\n"
+                     "view,contender,role,radius_policy,tuned,radius_mode,radius,screen_radius,strength,bias,c,kernel,r_min,"
+                     "r_max,samples,resolution,mask,width,height,"
                      "gpu_ms_median,frames,rmse_fixed,ssim_fixed,bias_fixed,rmse_screen,ssim_screen,bias_screen,masked_fraction\n");
     for (int v = 1; ok && v <= nv; v++) {
         /* Plain shading (D1): AO = 1 everywhere. */
@@ -319,7 +379,7 @@ int bench_ao(int argc, char **argv) {
         mr_image_metrics mf, msr;
         ok = run_ao(gfx.renderer, &vd[v].view, &p0, w, h, 0, &ms, &ao, NULL, &err) && metrics(&ao, &vd[v], &mf, &msr, &err);
         if (!ok) break;
-        fprintf(csv, "\"%s\",none,,,,,,,0,full,off,%d,%d,0,0,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,-1\n", vd[v].name, w, h, mf.rmse,
+        fprintf(csv, "\"%s\",none,D1,-,no,,,,,,,,,,0,full,off,%d,%d,0,0,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,-1\n", vd[v].name, w, h, mf.rmse,
                 mf.ssim, mf.bias, msr.rmse, msr.ssim, msr.bias);
         pv_rf[v][0] = mf.rmse;
         pv_rs[v][0] = msr.rmse;
@@ -339,10 +399,11 @@ int bench_ao(int argc, char **argv) {
                         ok = run_ao(gfx.renderer, &vd[v].view, &p, w, h, (int)frames, &ms, &ao, &masked, &err) &&
                              metrics(&ao, &vd[v], &mf, &msr, &err);
                         if (!ok) break;
-                        char pb[256];
+                        char pb[256], pc[128];
                         fmt_params(pb, sizeof pb, &p);
+                        fmt_contender(pc, sizeof pc, &cs[c]);
                         fprintf(csv, "\"%s\",%s,%s,%d,%s,%s,%d,%d,%.4f,%ld,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.4f\n", vd[v].name,
-                                cs[c].label, pb, p.samples, res ? "half" : "full", mk ? "on" : "off", w, h, ms, frames, mf.rmse,
+                                pc, pb, p.samples, res ? "half" : "full", mk ? "on" : "off", w, h, ms, frames, mf.rmse,
                                 mf.ssim, mf.bias, msr.rmse, msr.ssim, msr.bias, masked);
                         agg_ms[c][si][res][mk] += ms / nv;
                         agg_rf[c][si][res][mk] += mf.rmse / nv;
@@ -449,16 +510,53 @@ int bench_ao(int argc, char **argv) {
         }
         mr_path_join(out_dir, "bench_ao_montage.png", path, sizeof path);
         if (ok) ok = mr_montage_png(path, (const mr_image *const *)montage, nmont, 2 + nc, w, h, &err);
+        /* Scheer & Keutel's three renderings, shaded as in the paper (Phong
+         * with specular): D1 no AO, D2 scheer, D3 standard SSAO (crytek,
+         * constant radius), plus scheer-paper; 16 samples, one row per view. */
+        const int shaded_c[3] = {0, 3, 2};
+        mr_image shots[MAX_VIEWS * 4];
+        const mr_image *tiles[MAX_VIEWS * 4];
+        int nshot = 0;
+        ok = ok && mr_renderer_set_scene(gfx.renderer, scene, &err); /* step 4 changed it */
+        for (int v = 1; ok && v <= nv; v++)
+            for (int k = 0; ok && k < 4; k++) {
+                mr_frame_params fp = MR_FRAME_DEFAULTS;
+                fp.width = w;
+                fp.height = h;
+                fp.specular = 0.35f;
+                if (k > 0) {
+                    fp.ao = cs[shaded_c[k - 1]].tuned;
+                    fp.ao.samples = 16;
+                    fp.ao.no_reuse = true;
+                }
+                mr_frame_result res;
+                ok = mr_render_frame(gfx.renderer, &vd[v].view, &fp, &res, &err);
+                if (!ok) break;
+                shots[nshot] = res.color;
+                res.color.data = NULL;
+                tiles[nshot] = &shots[nshot];
+                nshot++;
+                mr_frame_result_free(&res);
+            }
+        mr_path_join(out_dir, "bench_ao_shaded.png", path, sizeof path);
+        if (ok) ok = mr_montage_png(path, tiles, nshot, 4, w, h, &err);
+        for (int i = 0; i < nshot; i++) mr_image_free(&shots[i]);
     }
     if (ok) {
-        char md[16384];
+        static char md[65536];
         size_t len = 0;
         len += (size_t)snprintf(md + len, sizeof md - len,
                                 "AO at %dx%d, %d samples (%s), mean over %d views; tuned on '%s'\n\n"
-                                "| method | tuned radius | strength | bias | res | mask | GPU ms | RMSE fixed R | SSIM fixed | bias fixed | RMSE depth-scaled R | SSIM d-s | bias d-s | masked |\n"
-                                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-                                w, h, samples[quick ? 0 : 1], "GPU ms: median of timer queries", nv, vd[0].name);
-        len += (size_t)snprintf(md + len, sizeof md - len, "| none (D1) | - | - | - | full | off | 0 | %.4f | %.3f | %+.4f | %.4f | %.3f | %+.4f | - |\n",
+                                "D1 = no AO, D2 = scheer (depth-scaled radius), D3 = standard SSAO (crytek, constant "
+                                "radius), as Scheer & Keutel name them. `@R`: the radius is the reference's own (R = %g "
+                                "units, or %g of the height), only strength / bias / c tuned; `scheer-paper`: the "
+                                "paper's parameters (bias 0, whole-ball uniform kernel, c 1, default strength), nothing "
+                                "tuned.\n\n"
+                                "| method | role | radius | strength | bias | c | kernel | res | mask | GPU ms | RMSE fixed R | SSIM fixed | bias fixed | RMSE depth-scaled R | SSIM d-s | bias d-s | masked |\n"
+                                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+                                w, h, samples[quick ? 0 : 1], "GPU ms: median of timer queries", nv, vd[0].name, radius,
+                                screen_radius);
+        len += (size_t)snprintf(md + len, sizeof md - len, "| none | D1 | - | - | - | - | - | full | off | 0 | %.4f | %.3f | %+.4f | %.4f | %.3f | %+.4f | - |\n",
                                 none_rf, none_sf, none_bf, none_rs, none_ss, none_bs);
         int s16 = quick ? 0 : 1;
         for (int c = 0; c < nc; c++)
@@ -467,11 +565,17 @@ int bench_ao(int argc, char **argv) {
                     char rad[64];
                     if (cs[c].mode == MR_AO_RADIUS_SCREEN) snprintf(rad, sizeof rad, "%.3g of height", cs[c].tuned.screen_radius);
                     else snprintf(rad, sizeof rad, "%.3g units", cs[c].tuned.radius);
+                    if (cs[c].radius != TUNE_RADIUS) snprintf(rad + strlen(rad), sizeof rad - strlen(rad), " (ref.)");
+                    char kern[64], strength[32] = "default";
+                    if (cs[c].tuned.strength > 0) snprintf(strength, sizeof strength, "%g", cs[c].tuned.strength);
+                    snprintf(kern, sizeof kern, "%s [%g,%g]", mr_ao_kernel_name(cs[c].tuned.kernel), cs[c].tuned.r_min,
+                             cs[c].tuned.r_max);
                     char masked[32] = "-";
                     if (mk) snprintf(masked, sizeof masked, "%.3f", agg_mf[c][s16][res][mk]);
                     len += (size_t)snprintf(md + len, sizeof md - len,
-                                            "| %s | %s | %g | %g | %s | %s | %.2f | %.4f | %.3f | %+.4f | %.4f | %.3f | %+.4f | %s |\n",
-                                            cs[c].label, rad, cs[c].tuned.strength, cs[c].tuned.bias, res ? "half" : "full",
+                                            "| %s | %s | %s | %s | %g | %g | %s | %s | %s | %.2f | %.4f | %.3f | %+.4f | %.4f | %.3f | %+.4f | %s |\n",
+                                            cs[c].label, cs[c].role, rad, strength, cs[c].tuned.bias,
+                                            cs[c].tuned.c, kern, res ? "half" : "full",
                                             mk ? "on" : "off", agg_ms[c][s16][res][mk], agg_rf[c][s16][res][mk],
                                             agg_sf[c][s16][res][mk], agg_bf[c][s16][res][mk], agg_rs[c][s16][res][mk],
                                             agg_ss[c][s16][res][mk], agg_bs[c][s16][res][mk], masked);
@@ -497,7 +601,8 @@ int bench_ao(int argc, char **argv) {
         ok = mr_file_write_atomic(path, md, len, &err);
         if (ok) printf("\nwrote %s/bench_ao.csv, bench_ao_tuning.csv, bench_ao_triangles.csv, bench_ao.svg, bench_ao_screen.svg, "
                        "bench_ao_montage.png (rows: views; columns: reference fixed R, reference depth-scaled R, then "
-                       "%d methods at %d samples), bench_ao.md in %.0f s\n", out_dir, nc, samples[quick ? 0 : 1], mr_time_now() - t0);
+                       "%d methods at %d samples), bench_ao_shaded.png (Phong-shaded D1, D2, D3, scheer-paper), "
+                       "bench_ao.md in %.0f s\n", out_dir, nc, samples[quick ? 0 : 1], mr_time_now() - t0);
     }
     if (!ok) rc = app_error(cmd, &err);
     for (int i = 0; i < nmont; i++)

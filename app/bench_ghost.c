@@ -1,9 +1,24 @@
 /* mrcheck bench ghost: ghosted views on the demo partition (pipes hidden
  * behind it), for the conflict case (pipes coloured like the partition) and
- * the no-conflict case: per importance source, saliency implementation and
- * mode, the GPU ms of the ghosting passes against the legibility measure
- * (fraction of important pixels whose final saliency still reaches
- * C_desired) and the occluder's mean lightness change. CSV + SVG; never
+ * the no-conflict case: per importance source, saliency implementation,
+ * eq. 9's levels and mode, the GPU ms of the ghosting passes against
+ * measures that do not use the ghosting's own target:
+ *  - legibility (mr_eval_ghost_legibility): the important edges of the
+ *    hidden layer D alone (neighbour pairs touching the region with
+ *    4 * dE*ab(D) / 100 > 0.5, above the curvature bias 0.35); per edge the
+ *    contrast F adds over the occluder O, h_F = dF - dO, projected on what
+ *    showing D in full would add, h_R; mean of clamp(h_F.h_R / |h_R|^2, 0, 1).
+ *    0: only the occluder; 1: D in full; ~1 - alpha for alpha blending.
+ *    With edge_contrast_dE (mean |h_F|) and full_contrast_dE (mean |h_R|).
+ *  - cv_saliency_ratio: OpenCV contrib's spectral-residual saliency of the
+ *    final image, mean over the region / mean elsewhere, beside the same for
+ *    the occluder alone (cv_saliency_ratio_occluder: hidden structure
+ *    invisible).
+ *  - target_reached: the old measure, the fraction of pixels with IM > 0.3
+ *    whose final saliency reaches C_desired: what the adaptive stage itself
+ *    optimises, so only a diagnostic of the optimiser.
+ * and the occluder's mean lightness change. Kalkofen et al. judge
+ * legibility by a user study; these are proxies. CSV + SVG; never
  * pass/fail, never timed in tests. */
 #include "app.h"
 
@@ -13,11 +28,13 @@
 #include <unistd.h>
 
 typedef struct ghost_row {
-    const char *scene, *importance, *saliency, *mode;
+    const char *scene, *importance, *saliency, *levels, *mode;
     int mode_index;
     double pass_ms[6]; /* ghost_hidden, ghost_curvature, ghost_importance, ghost_g0, ghost_analysis, ghost_emphasis */
     double ghost_ms, frame_ms;
     mr_ghost_stats st;
+    mr_legibility leg;
+    double sal_ratio, sal_ratio_occluder;
 } ghost_row;
 
 static const char *const k_pass_names[6] = {"ghost_hidden", "ghost_curvature", "ghost_importance",
@@ -40,7 +57,7 @@ static bool write_svg(const char *path, const char *title, const ghost_row *rows
                        "<text x=\"10\" y=\"22\" font-size=\"14\">%s</text>\n"
                        "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"black\"/>\n"
                        "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">GPU ms of the ghosting passes (median)</text>\n"
-                       "<text x=\"18\" y=\"%d\" transform=\"rotate(-90 18 %d)\" text-anchor=\"middle\">legibility</text>\n",
+                       "<text x=\"18\" y=\"%d\" transform=\"rotate(-90 18 %d)\" text-anchor=\"middle\">legibility (edge transfer of D)</text>\n",
                        W, H, title, L, T, PW, PH, L + PW / 2, T + PH + 36, T + PH / 2, T + PH / 2);
     for (int k = 0; k <= 4; k++) {
         double v = k / 4.0;
@@ -53,8 +70,8 @@ static bool write_svg(const char *path, const char *title, const ghost_row *rows
     }
     for (int i = 0; i < n; i++) {
         const ghost_row *r = &rows[i];
-        if (isnan(r->st.legibility)) continue; /* no important pixel: nothing to plot */
-        double x = L + PW * r->ghost_ms / xmax, y = T + PH - PH * r->st.legibility;
+        if (isnan(r->leg.legibility) || strcmp(r->levels, "offset") != 0) continue; /* nothing to plot; one level set */
+        double x = L + PW * r->ghost_ms / xmax, y = T + PH - PH * r->leg.legibility;
         bool conflict = strcmp(r->scene, "conflict") == 0;
         const char *c = colours[r->mode_index];
         if (strcmp(r->saliency, "gauss") == 0)
@@ -112,7 +129,8 @@ int app_bench_ghost(int argc, char **argv) {
     static const char *const imps[2] = {"curvature", "saliency"};
     static const char *const sals[2] = {"mipmap", "gauss"};
     static const char *const modes[3] = {"alpha", "g0", "adaptive"};
-    enum { NROWS = 2 * 2 * 2 * 3 };
+    static const char *const levels[2] = {"offset", "printed"};
+    enum { NROWS = 2 * 2 * 2 * 2 * 3 };
     ghost_row rows[NROWS];
     int nrows = 0;
     app_gfx gfx = {0};
@@ -122,14 +140,17 @@ int app_bench_ghost(int argc, char **argv) {
     for (int sc = 0; ok && sc < 2; sc++) {
         mr_demo_hall hall;
         ok = app_demo_ghost_hall(sc == 0, &hall, &err) && mr_renderer_set_scene(gfx.renderer, hall.planned, &err);
+        double occ_ratio = NAN;
         for (int im = 0; ok && im < 2; im++)
             for (int sa = 0; ok && sa < 2; sa++)
+                for (int lv = 0; ok && lv < 2; lv++)
                 for (int mo = 0; ok && mo < 3; mo++) {
                     ghost_row *r = &rows[nrows];
                     memset(r, 0, sizeof *r);
                     r->scene = scenes[sc];
                     r->importance = imps[im];
                     r->saliency = sals[sa];
+                    r->levels = levels[lv];
                     r->mode = modes[mo];
                     r->mode_index = mo;
                     mr_frame_params fp = MR_FRAME_DEFAULTS;
@@ -139,6 +160,7 @@ int app_bench_ghost(int argc, char **argv) {
                     fp.ghost.mode = (mr_ghost_mode)(MR_GHOST_ALPHA + mo);
                     fp.ghost.importance = im ? MR_GHOST_IMP_SALIENCY : MR_GHOST_IMP_CURVATURE;
                     fp.ghost.saliency = sa ? MR_SALIENCY_GAUSS : MR_SALIENCY_MIPMAP;
+                    fp.ghost.saliency_levels = lv ? MR_SAL_LEVELS_PRINTED : MR_SAL_LEVELS_OFFSET;
                     for (long f = -2; ok && f < frames; f++) {
                         mr_frame_result res;
                         double t0 = mr_time_now();
@@ -170,6 +192,18 @@ int app_bench_ghost(int argc, char **argv) {
                     ok = mr_render_frame(gfx.renderer, &view, &fp, &res, &err);
                     if (ok) {
                         r->st = res.ghost;
+                        mr_image o, d, reg;
+                        ok = mr_ghost_read_layers(gfx.renderer, &o, &d, &reg, &err);
+                        if (ok) {
+                            mr_ghost_legibility_images li = {&res.color, &o, &d, &reg};
+                            ok = mr_eval_ghost_legibility(&li, NULL, &r->leg, &err) &&
+                                 mr_eval_saliency_ratio(&res.color, &reg, &r->sal_ratio, &err) &&
+                                 (!isnan(occ_ratio) || mr_eval_saliency_ratio(&o, &reg, &occ_ratio, &err));
+                            r->sal_ratio_occluder = occ_ratio;
+                        }
+                        mr_image_free(&o);
+                        mr_image_free(&d);
+                        mr_image_free(&reg);
                         mr_frame_result_free(&res);
                     }
                     nrows++;
@@ -187,26 +221,40 @@ int app_bench_ghost(int argc, char **argv) {
         if (!csv) ok = mr_fail(&err, MR_ERR_NOMEM, "out of memory");
         int len = 0;
         if (ok) {
-            len = snprintf(csv, cap, "scene,importance,saliency,mode");
+            len = snprintf(csv, cap,
+                           "# legibility_edge_transfer: mean over D's important edges (4 dE(D)/100 > 0.5) of the part "
+                           "of D's contrast over the occluder that the final image shows (0 occluder only, 1 D in full); "
+                           "edge_contrast_dE / full_contrast_dE: mean dE the final image / D in full adds over the "
+                           "occluder there; cv_saliency_ratio: OpenCV spectral-residual saliency, region mean / mean "
+                           "elsewhere (_occluder: of the occluder alone); target_reached: pixels reaching C_desired, the "
+                           "adaptive stage's own target (a diagnostic, not legibility)\n"
+                           "scene,importance,saliency,saliency_levels,mode");
             for (int k = 0; k < 6; k++) len += snprintf(csv + len, cap - (size_t)len, ",%s_gpu_ms", k_pass_names[k]);
             len += snprintf(csv + len, cap - (size_t)len,
-                            ",ghost_gpu_ms,frame_wall_ms,legibility,mean_abs_dL,region_fraction,mean_importance,"
-                            "mean_contrast_missing,width,height,frames\n");
+                            ",ghost_gpu_ms,frame_wall_ms,legibility_edge_transfer,edge_contrast_dE,full_contrast_dE,"
+                            "important_edge_fraction,cv_saliency_ratio,cv_saliency_ratio_occluder,target_reached,"
+                            "mean_abs_dL,region_fraction,mean_importance,mean_contrast_missing,width,height,frames\n");
             printf("bench ghost: %s, %dx%d, demo view %ld, median of %ld frames\n", mr_gpu_description(gfx.gpu), w, h,
                    view_index, frames);
-            printf("  %-10s %-9s %-6s %-8s %8s %8s %8s %8s %8s %8s %9s %10s %7s\n", "scene", "IM", "sal", "mode", "hidden",
-                   "curv", "import", "g0", "analys", "emph", "ghost ms", "legibility", "|dL*|");
+            printf("  %-10s %-9s %-6s %-7s %-8s %8s %8s %8s %8s %8s %8s %9s %10s %7s %7s %7s\n", "scene", "IM", "sal",
+                   "levels", "mode", "hidden", "curv", "import", "g0", "analys", "emph", "ghost ms", "legibility",
+                   "cv-sal", "target", "|dL*|");
         }
         for (int i = 0; ok && i < nrows; i++) {
             const ghost_row *r = &rows[i];
-            len += snprintf(csv + len, cap - (size_t)len, "%s,%s,%s,%s", r->scene, r->importance, r->saliency, r->mode);
+            len += snprintf(csv + len, cap - (size_t)len, "%s,%s,%s,%s,%s", r->scene, r->importance, r->saliency,
+                            r->levels, r->mode);
             for (int k = 0; k < 6; k++) len += snprintf(csv + len, cap - (size_t)len, ",%.4f", r->pass_ms[k]);
-            len += snprintf(csv + len, cap - (size_t)len, ",%.4f,%.4f,%.4f,%.3f,%.4f,%.4f,%.4f,%d,%d,%ld\n", r->ghost_ms,
-                            r->frame_ms, r->st.legibility, r->st.mean_abs_dL, r->st.region_fraction, r->st.mean_importance,
-                            r->st.mean_contrast_missing, w, h, frames);
-            printf("  %-10s %-9s %-6s %-8s %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %9.2f %10.3f %7.2f\n", r->scene,
-                   r->importance, r->saliency, r->mode, r->pass_ms[0], r->pass_ms[1], r->pass_ms[2], r->pass_ms[3],
-                   r->pass_ms[4], r->pass_ms[5], r->ghost_ms, r->st.legibility, r->st.mean_abs_dL);
+            len += snprintf(csv + len, cap - (size_t)len,
+                            ",%.4f,%.4f,%.4f,%.3f,%.3f,%.4f,%.3f,%.3f,%.4f,%.3f,%.4f,%.4f,%.4f,%d,%d,%ld\n", r->ghost_ms,
+                            r->frame_ms, r->leg.legibility, r->leg.edge_contrast, r->leg.full_contrast,
+                            r->leg.important_fraction, r->sal_ratio, r->sal_ratio_occluder, r->st.target_reached,
+                            r->st.mean_abs_dL, r->st.region_fraction, r->st.mean_importance, r->st.mean_contrast_missing, w,
+                            h, frames);
+            printf("  %-10s %-9s %-6s %-7s %-8s %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %9.2f %10.3f %7.2f %7.3f %7.2f\n",
+                   r->scene, r->importance, r->saliency, r->levels, r->mode, r->pass_ms[0], r->pass_ms[1], r->pass_ms[2],
+                   r->pass_ms[3], r->pass_ms[4], r->pass_ms[5], r->ghost_ms, r->leg.legibility, r->sal_ratio,
+                   r->st.target_reached, r->st.mean_abs_dL);
         }
         char path[4096], title[256];
         if (ok) {
@@ -214,7 +262,7 @@ int app_bench_ghost(int argc, char **argv) {
             ok = mr_file_write_atomic(path, csv, (size_t)len, &err);
         }
         free(csv);
-        snprintf(title, sizeof title, "mrcheck bench ghost: legibility against run time, %dx%d, demo view %ld", w, h,
+        snprintf(title, sizeof title, "mrcheck bench ghost: legibility against run time, %dx%d, demo view %ld (eq. 9 levels: offset)", w, h,
                  view_index);
         mr_path_join(out_dir, "bench_ghost.svg", path, sizeof path);
         ok = ok && write_svg(path, title, rows, nrows, &err);

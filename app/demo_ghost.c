@@ -62,7 +62,7 @@ bool app_demo_ghost(const char *dir, mr_error *err) {
             snprintf(sub, sizeof sub, "ghost/%s_%s.png", cases[c], mode_names[m]);
             mr_path_join(dir, sub, path, sizeof path);
             ok = mr_image_save_png(path, &res.color, err);
-            printf("  ghost %-10s %-8s legibility %.3f region %.3f meanIM %.3f C %.3f mean |dL*| %.2f\n", cases[c], mode_names[m], res.ghost.legibility, res.ghost.region_fraction, res.ghost.mean_importance, res.ghost.mean_contrast_missing,
+            printf("  ghost %-10s %-8s target reached %.3f region %.3f meanIM %.3f C %.3f mean |dL*| %.2f\n", cases[c], mode_names[m], res.ghost.target_reached, res.ghost.region_fraction, res.ghost.mean_importance, res.ghost.mean_contrast_missing,
                    res.ghost.mean_abs_dL);
             shots[m] = res.color; /* keeps the pixels; res.depth/normal are empty */
         }

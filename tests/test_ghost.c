@@ -3,8 +3,13 @@
  * patterns for both pyramids, G_A = G0 where C = 0, contrast raised on a
  * constructed conflict, one lightness sign per object (ids and connected
  * regions), and the frame's pass list (no ghosting pass without hidden
- * structure in view). The comparison against OpenCV's cvtColor is in
- * test_ghost_opencv.cc. Skips the GPU part (77) without an EGL device. */
+ * structure in view). The legibility measure (mr_eval_ghost_legibility)
+ * on constructed images with a known set of important edges, and on
+ * frames where the hidden structure is invisible or shown in full; eq. 9's
+ * printed levels against the default on an analytic square. The comparison
+ * against OpenCV's cvtColor is in test_ghost_opencv.cc. Skips the GPU part
+ * (77) without an EGL device. */
+#include "mr_eval.h"
 #include "mr_render.h"
 #include "mr_test.h"
 #include "mr_test_scene.h"
@@ -151,6 +156,119 @@ static float grey_of(double L) {
     return (float)(fy > 6.0 / 29 ? fy * fy * fy : 3 * (6.0 / 29) * (6.0 / 29) * (fy - 4.0 / 29));
 }
 
+/* ---------------------------------------------------------- legibility */
+
+/* 64x48 images: the region is x 16..47, y 12..35. D (neutral greys, L*):
+ * 70 outside the region (its background) and at x 16..23, a faint step to
+ * 82 at x 24..31 (dE 12: IM 0.48, above the old 0.3 threshold, just below
+ * 0.5), 30 at x 32..39 and 43 at x 40..47 (dE 13: IM 0.52, just above
+ * 0.5; a few per cent off in the L* scale or the threshold moves one of
+ * them). The important edges are then exactly: 82|30 and 30|43 inside (24 each), the
+ * dark part's top and bottom silhouettes (16 each) and its right one (24):
+ * 104 of the 1592 neighbour pairs that touch the region. O: vertical
+ * stripes L* 45 / 55, 4 pixels wide (its own edges fall on D's). */
+static void legibility_images(mr_image *o, mr_image *d, mr_image *reg) {
+    const int w = 64, h = 48;
+    *o = img(w, h, 3, 0);
+    *d = img(w, h, 3, grey_of(70));
+    *reg = img(w, h, 1, 0);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            float *q = px(o, x, y);
+            q[0] = q[1] = q[2] = grey_of((x / 4) % 2 ? 55 : 45);
+            if (x < 16 || x >= 48 || y < 12 || y >= 36) continue;
+            px(reg, x, y)[0] = 1;
+            double L = x < 24 ? 70 : x < 32 ? 82 : x < 40 ? 30 : 43;
+            q = px(d, x, y);
+            q[0] = q[1] = q[2] = grey_of(L);
+        }
+}
+
+/* F = (1 - a) * R + a * O in linear RGB, R = D in the region, O outside. */
+static mr_image blend_final(const mr_image *o, const mr_image *d, const mr_image *reg, float a) {
+    mr_image f = img(o->width, o->height, 3, 0);
+    const float *po = o->data, *pd = d->data, *pr = reg->data;
+    float *pf = f.data;
+    for (int i = 0; i < o->width * o->height; i++)
+        for (int k = 0; k < 3; k++)
+            pf[i * 3 + k] = pr[i] > 0.5f ? (1 - a) * pd[i * 3 + k] + a * po[i * 3 + k] : po[i * 3 + k];
+    return f;
+}
+
+static void test_legibility_metric(void) {
+    mr_image o, d, reg;
+    legibility_images(&o, &d, &reg);
+    mr_error err = {0};
+    /* alpha -0.3: D's contrast over O exaggerated by 30 %: no edge shows
+     * more than D in full. alpha 1.5: D's edges reversed: they show nothing of D. */
+    const float alphas[6] = {1.0f, 0.0f, 0.5f, 0.25f, -0.3f, 1.5f};
+    double leg[6] = {0};
+    for (int k = 0; k < 6; k++) {
+        mr_image f = blend_final(&o, &d, &reg, alphas[k]);
+        mr_ghost_legibility_images in = {&f, &o, &d, &reg};
+        mr_legibility l;
+        CHECK_MSG(mr_eval_ghost_legibility(&in, NULL, &l, &err), "%s", err.msg);
+        CHECK_MSG(l.region == 32 * 24 && l.edges == 1592, "region %lld pixels, %lld edges (want 768, 1592)", l.region,
+                  l.edges);
+        CHECK_MSG(l.important == 104, "important edges of D: %lld, want 104 (the dE 12 step below the threshold, "
+                  "the dE 13 step above it)", l.important);
+        CHECK_MSG(l.important_fraction < 0.07, "important fraction %.3f: not every edge is important", l.important_fraction);
+        leg[k] = l.legibility;
+        mr_image_free(&f);
+    }
+    CHECK_MSG(leg[0] < 1e-6, "pure occluder (alpha 1): legibility %.4f, want 0", leg[0]);
+    CHECK_MSG(leg[1] > 0.999, "D shown in full (alpha 0): legibility %.4f, want 1", leg[1]);
+    CHECK_MSG(leg[2] > 0.40 && leg[2] < 0.52, "alpha 0.5 blend: legibility %.3f, want about 0.5", leg[2]);
+    CHECK_MSG(leg[4] > 0.99 && leg[4] <= 1.0, "D exaggerated (alpha -0.3): legibility %.4f, want 1 (at most D in full)",
+              leg[4]);
+    CHECK_MSG(leg[5] >= 0 && leg[5] < 0.02, "D's edges reversed (alpha 1.5): legibility %.4f, want 0", leg[5]);
+    CHECK_MSG(leg[3] > 0.62 && leg[3] < 0.78, "alpha 0.25 blend: legibility %.3f (alpha 0.5: %.3f)", leg[3],
+              leg[2]);
+    /* The same images as 8-bit sRGB (what frames are) measure the same. */
+    {
+        mr_image f8 = {0}, o8 = {0}, d8 = {0}, fl = blend_final(&o, &d, &reg, 0.5f);
+        mr_image *src[3] = {&fl, &o, &d}, *dst[3] = {&f8, &o8, &d8};
+        for (int k = 0; k < 3; k++) {
+            mr_image_alloc(dst[k], 64, 48, 3, MR_PIX_U8, NULL);
+            const float *sp = src[k]->data;
+            unsigned char *dp = dst[k]->data;
+            for (int i = 0; i < 64 * 48 * 3; i++) {
+                double v = sp[i] <= 0.0031308f ? 12.92 * sp[i] : 1.055 * pow(sp[i], 1 / 2.4) - 0.055;
+                dp[i] = (unsigned char)lrint(v * 255.0);
+            }
+        }
+        mr_ghost_legibility_images in8 = {&f8, &o8, &d8, &reg};
+        mr_legibility l8;
+        CHECK_MSG(mr_eval_ghost_legibility(&in8, NULL, &l8, &err), "%s", err.msg);
+        CHECK_MSG(l8.important == 104 && fabs(l8.legibility - leg[2]) < 0.02,
+                  "8-bit sRGB input: %lld important edges, legibility %.3f (linear float: 104, %.3f)", l8.important,
+                  l8.legibility, leg[2]);
+        for (int k = 0; k < 3; k++) mr_image_free(dst[k]);
+        mr_image_free(&fl);
+    }
+    /* The occluder's own stripes never count as hidden structure: an F
+     * that keeps O but doubles its stripe contrast adds nothing of D. */
+    mr_image f = blend_final(&o, &d, &reg, 1.0f);
+    for (int y = 0; y < 48; y++)
+        for (int x = 0; x < 64; x++) {
+            float *q = px(&f, x, y);
+            q[0] = q[1] = q[2] = grey_of((x / 4) % 2 ? 60 : 40);
+        }
+    mr_ghost_legibility_images in = {&f, &o, &d, &reg};
+    mr_legibility l;
+    CHECK_MSG(mr_eval_ghost_legibility(&in, NULL, &l, &err), "%s", err.msg);
+    printf("  legibility on constructed images: alpha 1 %.3f, 0 %.3f, 0.5 %.3f, 0.25 %.3f; stripes only %.3f\n", leg[0],
+           leg[1], leg[2], leg[3], l.legibility);
+    CHECK_MSG(l.legibility < 0.1, "occluder edges strengthened, D absent: legibility %.3f", l.legibility);
+    mr_image_free(&f);
+    /* Bad input is refused. */
+    mr_ghost_legibility_images bad = {&o, &o, &d, &o};
+    CHECK_MSG(!mr_eval_ghost_legibility(&bad, NULL, &l, &err), "a 3-channel region was accepted");
+    mr_image_free(&o);
+    mr_image_free(&d);
+    mr_image_free(&reg);
+}
+
 /* ----------------------------------------------------------------- lab */
 
 static void test_lab(void) {
@@ -208,7 +326,7 @@ static void test_saliency(void) {
     for (int impl = 0; impl < 2; impl++) {
         mr_error err = {0};
         mr_image flat = img(w, h, 3, 0.3f), dot = img(w, h, 3, 0.02f), s;
-        if (mr_ghost_saliency(g_r, &flat, (mr_saliency_impl)impl, 4.0f, &s, &err)) {
+        if (mr_ghost_saliency(g_r, &flat, (mr_saliency_impl)impl, MR_SAL_LEVELS_OFFSET, 4.0f, &s, &err)) {
             float mx = 0;
             for (int i = 0; i < w * h; i++) mx = fmaxf(mx, fabsf(((float *)s.data)[i]));
             CHECK_MSG(mx < 1e-4f, "impl %d: flat image saliency %g", impl, mx);
@@ -222,7 +340,7 @@ static void test_saliency(void) {
                 float *q = px(&dot, x, y);
                 q[0] = q[1] = q[2] = 1.0f;
             }
-        if (mr_ghost_saliency(g_r, &dot, (mr_saliency_impl)impl, 4.0f, &s, &err)) {
+        if (mr_ghost_saliency(g_r, &dot, (mr_saliency_impl)impl, MR_SAL_LEVELS_OFFSET, 4.0f, &s, &err)) {
             const float *v = s.data;
             int best = 0;
             for (int i = 1; i < w * h; i++)
@@ -288,7 +406,7 @@ static bool compose(scene_imgs *s, const mr_ghost_params *gp, mr_ghost_output *o
 static double mean_sal(const mr_image *rgb, const scene_imgs *s) {
     mr_image sal;
     mr_error err = {0};
-    if (!mr_ghost_saliency(g_r, rgb, MR_SALIENCY_MIPMAP, 4.0f, &sal, &err)) {
+    if (!mr_ghost_saliency(g_r, rgb, MR_SALIENCY_MIPMAP, MR_SAL_LEVELS_OFFSET, 4.0f, &sal, &err)) {
         CHECK_MSG(false, "%s", err.msg);
         return 0;
     }
@@ -666,9 +784,135 @@ static void test_frame_hidden_ao(void) {
     mr_scene_destroy(&s);
 }
 
+/* Legibility on frames of the wall scene (a red bar behind a grey wall):
+ * the layers read back match the frame without ghosting outside the
+ * region; hidden structure made invisible (IM = 1 everywhere, so alpha 1)
+ * scores about 0, D shown in full (t = 0) about 1, the adaptive view in
+ * between; and OpenCV's saliency, knowing nothing of ours, finds the
+ * region more salient when D shows. */
+static void test_frame_legibility(void) {
+    mr_scene *s = wall_scene(true);
+    /* The bar off the vertical centre: rows read back upside down show. */
+    for (int32_t i = 0; i < s->node_count; i++)
+        if (strcmp(s->nodes[i].name, "Pipe") == 0) s->nodes[i].world = mr_m4_translate(0, 0.9, 6);
+    mr_scene_update_bounds(s);
+    char passes[512];
+    mr_frame_params p = MR_FRAME_DEFAULTS;
+    mr_frame_result off;
+    if (!render(s, &p, &off, passes, sizeof passes)) goto done;
+    p.ghost.importance = MR_GHOST_IMP_CURVATURE;
+    enum { OCCLUDER, FULL, ADAPTIVE };
+    double leg[3] = {NAN, NAN, NAN}, frac[3] = {NAN, NAN, NAN}, ratio[3] = {NAN, NAN, NAN};
+    for (int c = 0; c < 3; c++) {
+        p.ghost.mode = c == ADAPTIVE ? MR_GHOST_ADAPTIVE : MR_GHOST_G0;
+        p.ghost.curv_bias = c == OCCLUDER ? 1.0f : 0.35f;
+        p.ghost.t = c == FULL ? 0.0f : 1.0f;
+        mr_frame_result res;
+        if (!render(s, &p, &res, passes, sizeof passes)) continue;
+        mr_image o, d, reg;
+        mr_error err = {0};
+        if (mr_ghost_read_layers(g_r, &o, &d, &reg, &err)) {
+            /* Outside the region the occluder is the unghosted frame. */
+            const unsigned char *a = off.color.data, *b = o.data;
+            const float *rg = reg.data;
+            int diff = 0, nreg = 0;
+            for (int i = 0; i < 96 * 72; i++) {
+                if (rg[i] > 0.5f) { nreg++; continue; }
+                if (memcmp(a + 3 * i, b + 3 * i, 3) != 0) diff++;
+            }
+            CHECK_MSG(diff == 0, "case %d: read-back occluder differs from the plain frame at %d pixels", c, diff);
+            CHECK_MSG(nreg > 96 * 72 / 50 && nreg < 96 * 72 / 3, "case %d: region of %d pixels", c, nreg);
+            if (c == FULL) {
+                /* t = 0: the frame shows D itself in the region. */
+                const unsigned char *dd = d.data, *ff = res.color.data;
+                int off_d = 0;
+                for (int i = 0; i < 96 * 72; i++)
+                    for (int k = 0; k < 3 && rg[i] > 0.5f; k++) off_d += abs(dd[3 * i + k] - ff[3 * i + k]) > 1;
+                CHECK_MSG(off_d == 0, "read-back hidden layer differs from the t = 0 frame at %d values", off_d);
+            }
+            mr_ghost_legibility_images in = {&res.color, &o, &d, &reg};
+            mr_legibility l;
+            CHECK_MSG(mr_eval_ghost_legibility(&in, NULL, &l, &err), "%s", err.msg);
+            leg[c] = l.legibility;
+            frac[c] = l.important_fraction;
+            CHECK_MSG(mr_eval_saliency_ratio(&res.color, &reg, &ratio[c], &err), "%s", err.msg);
+            mr_image_free(&o);
+            mr_image_free(&d);
+            mr_image_free(&reg);
+        } else {
+            CHECK_MSG(false, "case %d: %s", c, err.msg);
+        }
+        mr_frame_result_free(&res);
+    }
+    printf("  frame legibility: occluder %.3f, D in full %.3f, adaptive %.3f; important fraction %.3f; "
+           "cv::saliency ratio %.2f / %.2f / %.2f\n", leg[0], leg[1], leg[2], frac[2], ratio[0], ratio[1], ratio[2]);
+    CHECK_MSG(leg[OCCLUDER] < 0.05, "hidden structure invisible (alpha 1) scores legibility %.3f", leg[OCCLUDER]);
+    CHECK_MSG(leg[FULL] > 0.95, "D shown in full (t 0) scores legibility %.3f", leg[FULL]);
+    CHECK_MSG(leg[ADAPTIVE] > 0.2 && leg[ADAPTIVE] < 0.8,
+              "adaptive legibility %.3f not between invisible %.3f and full %.3f", leg[ADAPTIVE], leg[OCCLUDER], leg[FULL]);
+    CHECK_MSG(frac[ADAPTIVE] > 0.05 && frac[ADAPTIVE] < 0.35, "important fraction %.3f: should be some edges, not all",
+              frac[ADAPTIVE]);
+    CHECK_MSG(ratio[FULL] > 1.3 * ratio[OCCLUDER], "cv::saliency ratio with D shown %.2f vs invisible %.2f", ratio[FULL],
+              ratio[OCCLUDER]);
+    CHECK_MSG(ratio[ADAPTIVE] > ratio[OCCLUDER], "cv::saliency ratio adaptive %.2f vs invisible %.2f", ratio[ADAPTIVE],
+              ratio[OCCLUDER]);
+    /* After an image-level composition the frame's layers are gone. */
+    mr_image o, d, reg;
+    mr_error err = {0};
+    mr_image io = img(96, 72, 3, 0.5f), imk = img(96, 72, 1, 1.0f); /* the frame's size: no reallocation */
+    mr_ghost_images gi = {&io, &io, &imk, &imk, NULL, NULL};
+    mr_ghost_output out;
+    CHECK_MSG(mr_ghost_compose(g_r, &gi, NULL, &out, &err), "%s", err.msg);
+    mr_ghost_output_free(&out);
+    CHECK_MSG(!mr_ghost_read_layers(g_r, &o, &d, &reg, &err), "layers read back after mr_ghost_compose replaced them");
+    mr_image_free(&io);
+    mr_image_free(&imk);
+    mr_frame_result_free(&off);
+done:
+    mr_renderer_set_scene(g_r, NULL, NULL);
+    mr_scene_destroy(&s);
+}
+
+/* Eq. 9's levels on a 256x256 dark image (L* 20) with a bright square
+ * (L* 80) over x, y in 64..191. At the centre levels 0..6 all see the
+ * square, so the default (surrounds up to level 6) gives 0 there. As
+ * printed, the surrounds of n = 2 are levels 6, 7, 8, and levels 7 and 8
+ * both average to 20 + 0.25 * 60 = 35 at the centre: c_L = 2 * 45 / 9 = 10,
+ * S = 4 * 10 / 100 = 0.4 (mip-map pyramid). The two-Gaussian version only
+ * approximates: 0 by default, clearly positive as printed. */
+static void test_saliency_levels(void) {
+    const int n = 256;
+    mr_image im = img(n, n, 3, grey_of(20));
+    for (int y = 64; y < 192; y++)
+        for (int x = 64; x < 192; x++) {
+            float *q = px(&im, x, y);
+            q[0] = q[1] = q[2] = grey_of(80);
+        }
+    for (int impl = 0; impl < 2; impl++)
+        for (int lv = 0; lv < 2; lv++) {
+            mr_image s;
+            mr_error err = {0};
+            if (!mr_ghost_saliency(g_r, &im, (mr_saliency_impl)impl, (mr_saliency_levels)lv, 4.0f, &s, &err)) {
+                CHECK_MSG(false, "%s", err.msg);
+                continue;
+            }
+            const float *v = s.data;
+            double c = 0.25 * (v[127 * n + 127] + v[127 * n + 128] + v[128 * n + 127] + v[128 * n + 128]);
+            if (lv == MR_SAL_LEVELS_OFFSET)
+                CHECK_MSG(c < 0.01, "impl %d, default levels: centre saliency %.4f, want 0", impl, c);
+            else if (impl == MR_SALIENCY_MIPMAP)
+                CHECK_MSG(fabs(c - 0.4) < 0.01, "mip-map, printed levels: centre saliency %.4f, want 0.4", c);
+            else
+                CHECK_MSG(c > 0.1, "two Gaussians, printed levels: centre saliency %.4f, want > 0.1", c);
+            mr_image_free(&s);
+        }
+    mr_image_free(&im);
+}
+
 int main(void) {
     test_curvature();
     test_demo_conflict();
+    test_legibility_metric();
     mr_error err = {0};
     g_gpu = mr_gpu_create_headless(NULL, &err);
     if (!g_gpu) {
@@ -686,6 +930,8 @@ int main(void) {
         test_frame_importance();
         test_frame_video();
         test_frame_hidden_ao();
+        test_frame_legibility();
+        test_saliency_levels();
     }
     mr_renderer_destroy(&g_r);
     mr_gpu_destroy(&g_gpu);

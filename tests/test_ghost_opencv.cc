@@ -1,7 +1,9 @@
-// The GPU's CIE L*a*b* conversion (mr_ghost_lab) against OpenCV's cvtColor,
-// the reference: within 0.5 Delta E (CIE76) over a grid of the RGB cube and
-// random colours. OpenCV stays in this test; lib/ does not use it.
+// The GPU's CIE L*a*b* conversion (mr_ghost_lab) and the CPU one of the
+// legibility measure (mr_eval_rgb_to_lab) against OpenCV's cvtColor, the
+// reference: within 0.5 Delta E (CIE76) over a grid of the RGB cube and
+// random colours. (OpenCV's saliency module is used in lib/eval/saliency.cc.)
 // Exit 77 without an EGL device.
+#include "mr_eval.h"
 #include "mr_render.h"
 
 #include <opencv2/imgproc.hpp>
@@ -71,6 +73,19 @@ int main() {
                     gf[1], gf[2], rf[0], rf[1], rf[2]);
         if (!(worst <= 0.5)) {
             std::fprintf(stderr, "test_ghost_opencv: Delta E %.4f > 0.5 against cvtColor\n", worst);
+            failures++;
+        }
+        double worst_cpu = 0;
+        for (int i = 0; i < w * h; i++) {
+            double rgb[3] = {lin[size_t(i) * 3], lin[size_t(i) * 3 + 1], lin[size_t(i) * 3 + 2]}, l[3], d2 = 0;
+            mr_eval_rgb_to_lab(rgb, l);
+            for (int c = 0; c < 3; c++) d2 += (l[c] - ref.ptr<float>()[i * 3 + c]) * (l[c] - ref.ptr<float>()[i * 3 + c]);
+            worst_cpu = std::fmax(worst_cpu, std::sqrt(d2));
+        }
+        std::printf("test_ghost_opencv: legibility's CPU L*a*b*: worst Delta E %.4f against cvtColor\n", worst_cpu);
+        if (!(worst_cpu <= 0.5)) {
+            std::fprintf(stderr, "test_ghost_opencv: CPU L*a*b* (mr_eval_rgb_to_lab) Delta E %.4f > 0.5 against cvtColor\n",
+                         worst_cpu);
             failures++;
         }
         mr_image_free(&lab);

@@ -7,6 +7,7 @@
 #include <string.h>
 
 static bool is_f32x1(const mr_image *a) { return a && a->data && a->type == MR_PIX_F32 && a->channels == 1; }
+static bool is_u8x3(const mr_image *a) { return a && a->data && a->type == MR_PIX_U8 && a->channels == 3; }
 
 /* Separable Gaussian (sigma 1.5, 11 taps) with clamp-to-edge borders. */
 static void gauss11(const double *in, double *tmp, double *out, int w, int h) {
@@ -171,22 +172,29 @@ bool mr_plot_svg(const char *path, const char *title, const char *xlabel, const 
 bool mr_montage_png(const char *path, const mr_image *const *images, int count, int cols, int tile_w, int tile_h,
                     mr_error *err) {
     if (count <= 0 || cols <= 0 || tile_w <= 0 || tile_h <= 0) return mr_fail(err, MR_ERR_INVALID, "empty montage");
-    int rows = (count + cols - 1) / cols, gap = 2;
+    int rows = (count + cols - 1) / cols, gap = 2, ch = 1;
+    for (int k = 0; k < count; k++)
+        if (is_u8x3(images[k])) ch = 3;
     mr_image m = {0};
-    if (!mr_image_alloc(&m, cols * (tile_w + gap), rows * (tile_h + gap), 1, MR_PIX_U8, err)) return false;
+    if (!mr_image_alloc(&m, cols * (tile_w + gap), rows * (tile_h + gap), ch, MR_PIX_U8, err)) return false;
     memset(m.data, 255, mr_image_bytes(&m));
     unsigned char *d = m.data;
     for (int k = 0; k < count; k++) {
         const mr_image *im = images[k];
-        if (!is_f32x1(im)) continue;
-        const float *s = im->data;
+        bool rgb = is_u8x3(im);
+        if (!rgb && !is_f32x1(im)) continue;
         int ox = (k % cols) * (tile_w + gap), oy = (k / cols) * (tile_h + gap);
         for (int y = 0; y < tile_h; y++)
             for (int x = 0; x < tile_w; x++) {
-                int sx = x * im->width / tile_w, sy = y * im->height / tile_h;
-                float v = s[(size_t)sy * im->width + sx];
+                size_t si = (size_t)(y * im->height / tile_h) * im->width + (size_t)(x * im->width / tile_w);
+                unsigned char *o = d + ((size_t)(oy + y) * m.width + ox + x) * ch;
+                if (rgb) {
+                    memcpy(o, (const unsigned char *)im->data + si * 3, 3);
+                    continue;
+                }
+                float v = ((const float *)im->data)[si];
                 v = isfinite(v) ? (v < 0 ? 0 : v > 1 ? 1 : v) : 0;
-                d[(size_t)(oy + y) * m.width + ox + x] = (unsigned char)lrintf(v * 255.0f);
+                memset(o, (unsigned char)lrintf(v * 255.0f), (size_t)ch);
             }
     }
     bool ok = mr_image_save_png(path, &m, err);

@@ -74,6 +74,47 @@ typedef struct mr_image_metrics {
 bool mr_image_compare(const mr_image *a, const mr_image *ref, const mr_image *mask, mr_image_metrics *out,
                       mr_error *err);
 
+/* ------------------------------------------------ ghosting legibility
+ * Measured from the hidden layer D alone, never from the ghosting's own
+ * target C_desired (see lib/eval/legibility.c for the full definition). */
+
+typedef struct mr_ghost_legibility_images {
+    const mr_image *final;    /* the ghosted image F: RGB8 sRGB or F32x3 linear */
+    const mr_image *occluder; /* O: what lies in front (the frame without ghosting) */
+    const mr_image *hidden;   /* D: the hidden layer rendered alone */
+    const mr_image *region;   /* F32x1: 1 where hidden structure lies behind an occluder */
+} mr_ghost_legibility_images;
+
+typedef struct mr_legibility_params {
+    double edge_threshold; /* an edge of D is important when gain * dE*ab / 100 exceeds this;
+                              default 0.5 (above the curvature bias 0.35; dE 12.5 at gain 4) */
+    double gain;           /* the saliency gain, so the threshold reads in IM units; default 4 */
+} mr_legibility_params;
+#define MR_LEGIBILITY_DEFAULTS {0.5, 4.0}
+
+typedef struct mr_legibility {
+    long long region;          /* region pixels */
+    long long edges;           /* neighbour pairs touching the region */
+    long long important;       /* of those, important edges of D */
+    double important_fraction; /* important / edges (NaN without edges) */
+    double legibility;         /* mean of clamp(h_F . h_R / |h_R|^2, 0, 1) over important edges:
+                                  0 = only the occluder, 1 = D in full; NaN if none */
+    double edge_contrast;      /* mean |h_F|: dE*ab the hidden edges add over the occluder */
+    double full_contrast;      /* mean |h_R|: the same with D shown in full */
+} mr_legibility;
+
+bool mr_eval_ghost_legibility(const mr_ghost_legibility_images *in, const mr_legibility_params *params,
+                              mr_legibility *out, mr_error *err);
+/* Linear RGB (clamped to [0,1]) -> CIE L*a*b* (D65, as OpenCV's cvtColor),
+ * the conversion the legibility measure uses. */
+void mr_eval_rgb_to_lab(const double rgb[3], double lab[3]);
+
+/* An independent second opinion: OpenCV contrib's spectral-residual saliency
+ * (cv::saliency) of `final` (RGB8 sRGB or F32x3 linear); *ratio = mean
+ * saliency inside the region / mean outside it (NaN if a side is empty or
+ * nothing outside is salient). > 1: the hidden structure draws the eye. */
+bool mr_eval_saliency_ratio(const mr_image *final, const mr_image *region, double *ratio, mr_error *err);
+
 /* ------------------------------------------------------------ reports */
 
 typedef struct mr_plot_series {
@@ -87,8 +128,9 @@ typedef struct mr_plot_series {
 bool mr_plot_svg(const char *path, const char *title, const char *xlabel, const char *ylabel,
                  const mr_plot_series *series, int nseries, bool log_x, mr_error *err);
 
-/* Tiles F32x1 images (values in [0,1], each resized by nearest neighbour to
- * tile_w x tile_h) into a grey PNG, cols tiles per row, row-major. */
+/* Tiles F32x1 images (values in [0,1]) and RGB8 images, each resized by
+ * nearest neighbour to tile_w x tile_h, into a PNG (grey, or RGB when any
+ * tile is RGB8), cols tiles per row, row-major. */
 bool mr_montage_png(const char *path, const mr_image *const *images, int count, int cols, int tile_w, int tile_h,
                     mr_error *err);
 

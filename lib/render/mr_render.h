@@ -171,6 +171,20 @@ typedef enum mr_saliency_impl {
     MR_SALIENCY_GAUSS,       /* two separable Gaussians approximating eq. 9 */
 } mr_saliency_impl;
 
+/* Which pyramid levels eq. 9's centre-surround differences read. As printed,
+ * k_n - k_{n+m} with n = 0..2 and m = n+2..n+4 reaches surround levels
+ * 2n+2..2n+4 (2..8, nine levels). The default reads m as the surround level
+ * offset, surrounds n+2..n+4 (2..6), as Itti et al. and Veas et al. do; it
+ * is also the only reading that fits the paper's own remark that the wide
+ * Gaussian of the two-Gaussian version is "approximately 40 samples" (sigma
+ * 16 here; the printed levels need sigma 58, about 350 samples), and the
+ * printed level 8 is 256 pixels wide: the image mean at test and tablet
+ * sizes. */
+typedef enum mr_saliency_levels {
+    MR_SAL_LEVELS_OFFSET = 0, /* surrounds n+2..n+4 (levels 0..6); default */
+    MR_SAL_LEVELS_PRINTED,    /* surrounds n+m, m = n+2..n+4 (levels 0..8), eq. 9 as printed */
+} mr_saliency_levels;
+
 typedef struct mr_ghost_params {
     mr_ghost_mode mode;          /* default MR_GHOST_OFF */
     mr_ghost_importance importance; /* default auto */
@@ -188,17 +202,19 @@ typedef struct mr_ghost_params {
     float sigma_c;               /* Gaussian GK on C, pixels; default 3 */
     float sigma_d;               /* Gaussian GK on D, pixels; default 3 */
     bool stats;                  /* fill mr_frame_result.ghost (extra GPU work and a read-back) */
+    mr_saliency_levels saliency_levels; /* eq. 9's levels; default MR_SAL_LEVELS_OFFSET */
 } mr_ghost_params;
-#define MR_GHOST_DEFAULTS {MR_GHOST_OFF, MR_GHOST_IMP_AUTO, MR_SALIENCY_MIPMAP, 1.0f, 2.0f, 0.35f, 4.0f, 0.1f, 0.5f, 0.15f, 200.0f, 3.0f, 3.0f, false}
+#define MR_GHOST_DEFAULTS {MR_GHOST_OFF, MR_GHOST_IMP_AUTO, MR_SALIENCY_MIPMAP, 1.0f, 2.0f, 0.35f, 4.0f, 0.1f, 0.5f, 0.15f, 200.0f, 3.0f, 3.0f, false, MR_SAL_LEVELS_OFFSET}
 
 /* Legibility of a ghosted frame (when mr_ghost_params.stats). */
 typedef struct mr_ghost_stats {
     bool valid;
     double region_fraction;    /* fraction of the image where hidden structure lies behind an occluder */
     double mean_importance;    /* mean IM over that region */
-    double legibility;         /* fraction of important pixels (IM > 0.3 in the region) whose saliency
-                                  in the final image is >= C_desired; always measured
-                                  with the two-Gaussian saliency; NaN if no pixel is important */
+    double target_reached;     /* fraction of region pixels with IM > 0.3 whose saliency in the final
+                                  image is >= C_desired: the adaptive stage's own target, so a
+                                  diagnostic of the optimiser, NOT a legibility measure (that is
+                                  mr_eval_ghost_legibility); two-Gaussian saliency; NaN if none */
     double mean_abs_dL;        /* mean |L*(O_A) - L*(O)| over the region (0 unless adaptive) */
     double mean_contrast_missing; /* mean C over the region (adaptive mode only, else 0) */
 } mr_ghost_stats;
@@ -216,9 +232,11 @@ typedef struct mr_frame_params {
     bool timing;               /* GPU timer queries per pass (adds a sync) */
     mr_ao_params ao;           /* ambient occlusion; default none */
     mr_ghost_params ghost;     /* ghosted views of the hidden layer; default off */
+    float specular;            /* Phong specular weight (white highlights); default 0 = Lambert only */
+    float shininess;           /* Phong exponent, >= 1; 0 = 32 */
 } mr_frame_params;
 #define MR_FRAME_DEFAULTS {0, 0, NULL, 0.5f, false, {0.62f, 0.66f, 0.70f}, false, false, false, MR_AO_DEFAULTS, \
-                           MR_GHOST_DEFAULTS}
+                           MR_GHOST_DEFAULTS, 0.0f, 0.0f}
 
 #define MR_MAX_PASSES 32
 
@@ -368,9 +386,17 @@ bool mr_draw2d_read(mr_draw2d *d, mr_image *out, mr_error *err);
 
 /* Linear RGB -> CIE L*a*b* (D65, as OpenCV's cvtColor) or back (inverse). */
 bool mr_ghost_lab(mr_renderer *r, const mr_image *in, bool inverse, mr_image *out, mr_error *err);
-/* Saliency S of a linear RGB image (F32x1, scaled by saliency_gain). */
-bool mr_ghost_saliency(mr_renderer *r, const mr_image *rgb, mr_saliency_impl impl, float saliency_gain,
-                       mr_image *out, mr_error *err);
+/* Saliency S of a linear RGB image (F32x1, scaled by saliency_gain), with
+ * eq. 9's levels read as `levels` says. */
+bool mr_ghost_saliency(mr_renderer *r, const mr_image *rgb, mr_saliency_impl impl, mr_saliency_levels levels,
+                       float saliency_gain, mr_image *out, mr_error *err);
+
+/* The layers of the last frame that ghosted, as the ghosting saw them, for
+ * measuring it (mr_eval_ghost_legibility): the occluder O and the hidden
+ * layer D shaded alone (RGB8 sRGB, top row first, like mr_frame_result.color)
+ * and the region (F32x1, 1 where D lies behind an occluder). Valid until the
+ * next frame; false + err if no frame ghosted since the last resize. */
+bool mr_ghost_read_layers(mr_renderer *r, mr_image *occluder, mr_image *hidden, mr_image *region, mr_error *err);
 
 typedef struct mr_ghost_images {
     const mr_image *occluder;   /* O, F32x3 linear RGB */

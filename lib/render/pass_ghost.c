@@ -21,16 +21,20 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Eq. 9 with centres 0..2 and surrounds c+2..c+4 reads levels 0..6. */
-#define SAL_LEVELS 7
+/* Eq. 9 with centres 0..2 reads levels 0..6 with surrounds n+2..n+4 (the
+ * default) and levels 0..8 as printed (surrounds n+m, m = n+2..n+4); see
+ * mr_saliency_levels for why the default is not the printed one. */
+#define SAL_LEVELS 9
 /* Sigmas of the two-Gaussian approximation, in level-0 pixels: a Gaussian
  * pyramid with a unit-sigma f_p gives level n the variance (4^n - 1) / 3;
  * the positive terms (levels 0,1,2) average a variance of 2, the negative
- * ones (2,3,3,4,4,4,5,5,6) about 261. The wide one is cut at 20 pixels each
- * side, the paper's "approximately 40 samples". */
+ * ones (2,3,3,4,4,4,5,5,6) about 261, as printed (2,3,4,4,5,6,6,7,8) about
+ * 3397. The default's wide one is cut at 20 pixels each side, the paper's
+ * "approximately 40 samples"; the printed one at 3 sigma. */
 #define SAL_SIGMA_POS 1.41421356f
 #define SAL_SIGMA_NEG 16.2f
 #define SAL_RADIUS_NEG 20
+#define SAL_SIGMA_NEG_PRINTED 58.28f
 /* Pointer-jumping steps of the connected-region labelling of the video
  * occluder; each step at least halves the label path of a region. */
 #define LABEL_STEPS 24
@@ -54,6 +58,7 @@ typedef struct mr_ghost_state {
     bool curv_built;
     /* per frame */
     GLuint o_tex;        /* the occluder image of this frame (linear when sampled) */
+    bool layers_valid;   /* o_tex, hid_shaded and mask hold a frame's layers (mr_ghost_read_layers) */
 } mr_ghost_state;
 
 static void free_targets(mr_ghost_state *g) {
@@ -68,6 +73,7 @@ static void free_targets(mr_ghost_state *g) {
     g->label[0] = g->label[1] = g->g0 = g->c = g->gkc = g->dgk = g->oa = g->ga = g->in_o = g->in_d = 0;
     g->out_view = g->out_store = 0;
     g->w = g->h = 0;
+    g->layers_valid = false;
 }
 
 void mr_ghost_scene_changed(mr_renderer *r) {
@@ -223,12 +229,15 @@ static void blur(mr_ghost_state *g, GLuint src, GLuint dst, float sigma, int rad
 static int radius_of(float sigma) { return (int)ceilf(3.0f * sigma); }
 
 /* Saliency of a linear RGB texture into an R32F texture. */
-static void saliency(mr_ghost_state *g, GLuint src, GLuint dst, mr_saliency_impl impl, float gain) {
+static void saliency(mr_ghost_state *g, GLuint src, GLuint dst, mr_saliency_impl impl, mr_saliency_levels levels,
+                     float gain) {
+    bool printed = levels == MR_SAL_LEVELS_PRINTED;
     lab_convert(g, src, g->lab, false);
     glUseProgram(g->prog_sal);
     if (impl == MR_SALIENCY_GAUSS) {
         blur(g, g->lab, g->gpos, SAL_SIGMA_POS, radius_of(SAL_SIGMA_POS));
-        blur(g, g->lab, g->gneg, SAL_SIGMA_NEG, SAL_RADIUS_NEG);
+        if (printed) blur(g, g->lab, g->gneg, SAL_SIGMA_NEG_PRINTED, radius_of(SAL_SIGMA_NEG_PRINTED));
+        else blur(g, g->lab, g->gneg, SAL_SIGMA_NEG, SAL_RADIUS_NEG);
         glUseProgram(g->prog_sal);
         glUniform1i(0, 1);
         glBindTextureUnit(0, g->gpos);
@@ -243,6 +252,7 @@ static void saliency(mr_ghost_state *g, GLuint src, GLuint dst, mr_saliency_impl
     }
     glUniform1f(1, gain);
     glUniform1i(2, g->lab_levels - 1);
+    glUniform1i(3, printed ? 1 : 0);
     glBindImageTexture(0, dst, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     dispatch(g->w, g->h);
 }
@@ -263,7 +273,7 @@ static void stage_g0(mr_ghost_state *g, GLuint o, GLuint d, const mr_ghost_param
 }
 
 static void stage_analysis(mr_ghost_state *g, const mr_ghost_params *gp) {
-    saliency(g, g->g0, g->sal_g0, gp->saliency, gp->saliency_gain);
+    saliency(g, g->g0, g->sal_g0, gp->saliency, gp->saliency_levels, gp->saliency_gain);
     glUseProgram(g->prog_ana);
     glUniform1f(0, gp->tc_minimal);
     glUniform1f(1, gp->gamma);
@@ -324,11 +334,13 @@ static void stage_emphasis(mr_ghost_state *g, GLuint o, GLuint d, const mr_ghost
     dispatch(g->w, g->h);
 }
 
-/* Legibility and lightness change of the finished ghosted view. */
+/* How far the adaptive stage reached its own target, and the lightness
+ * change of the finished ghosted view (legibility proper is measured by
+ * mr_eval_ghost_legibility from D alone). */
 static void stage_stats(mr_ghost_state *g, GLuint o, bool adaptive, const mr_ghost_params *gp, mr_ghost_stats *st) {
     /* One yardstick for every configuration: the measure always uses the
      * two-Gaussian saliency, whichever pyramid the analysis used. */
-    saliency(g, adaptive ? g->ga : g->g0, g->sal_final, MR_SALIENCY_GAUSS, gp->saliency_gain);
+    saliency(g, adaptive ? g->ga : g->g0, g->sal_final, MR_SALIENCY_GAUSS, gp->saliency_levels, gp->saliency_gain);
     static const GLuint zero = 0;
     glClearNamedBufferData(g->ssbo_sums, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glUseProgram(g->prog_stats);
@@ -348,7 +360,7 @@ static void stage_stats(mr_ghost_state *g, GLuint o, bool adaptive, const mr_gho
     st->valid = true;
     st->region_fraction = s[0] / npx;
     st->mean_importance = s[3] / 256.0 / reg;
-    st->legibility = s[1] > 0 ? (double)s[2] / s[1] : NAN; /* no important pixel: undefined */
+    st->target_reached = s[1] > 0 ? (double)s[2] / s[1] : NAN; /* no important pixel: undefined */
     st->mean_abs_dL = s[4] / 16.0 / reg;
     st->mean_contrast_missing = adaptive ? s[5] / 256.0 / reg : 0.0;
 }
@@ -392,7 +404,7 @@ static bool finite_in(float v, float lo, float hi) { return v >= lo && v <= hi; 
 bool mr_ghost_prepare(mr_renderer *r, const mr_ghost_params *gp, int w, int h, mr_error *err) {
     if (gp->mode == MR_GHOST_OFF) return true;
     if ((unsigned)gp->mode > MR_GHOST_ADAPTIVE || (unsigned)gp->importance > MR_GHOST_IMP_SALIENCY ||
-        (unsigned)gp->saliency > MR_SALIENCY_GAUSS)
+        (unsigned)gp->saliency > MR_SALIENCY_GAUSS || (unsigned)gp->saliency_levels > MR_SAL_LEVELS_PRINTED)
         return mr_fail(err, MR_ERR_INVALID, "ghost: unknown mode, importance source or saliency implementation");
     if (!finite_in(gp->t, 0, 1)) return mr_fail(err, MR_ERR_INVALID, "ghost: t must be in [0,1]");
     if (!finite_in(gp->curv_scale, 0, 1e6f) || !finite_in(gp->curv_bias, -1e6f, 1e6f) ||
@@ -486,7 +498,7 @@ void mr_pass_ghost_importance(frame *f) {
     const mr_ghost_params *gp = &f->p->ghost;
     g->o_tex = f->final_tex;
     bool sal = needs_saliency_of_o(f);
-    if (sal) saliency(g, g->o_tex, g->sal_o, gp->saliency, gp->saliency_gain);
+    if (sal) saliency(g, g->o_tex, g->sal_o, gp->saliency, gp->saliency_levels, gp->saliency_gain);
     static const GLuint zero = 0;
     glClearNamedBufferData(g->ssbo_stats, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glUseProgram(g->prog_imp);
@@ -513,6 +525,7 @@ void mr_pass_ghost_importance(frame *f) {
 void mr_pass_ghost_g0(frame *f) {
     mr_ghost_state *g = f->r->ghost;
     stage_g0(g, g->o_tex, g->hid_shaded.color[0], &f->p->ghost);
+    g->layers_valid = true;
     f->final_tex = g->out_view;
     if (f->p->ghost.stats && f->p->ghost.mode != MR_GHOST_ADAPTIVE) {
         /* C is not computed outside adaptive mode: report zero missing. */
@@ -583,15 +596,16 @@ bool mr_ghost_lab(mr_renderer *r, const mr_image *in, bool inverse, mr_image *ou
     return true;
 }
 
-bool mr_ghost_saliency(mr_renderer *r, const mr_image *rgb, mr_saliency_impl impl, float gain, mr_image *out,
-                       mr_error *err) {
+bool mr_ghost_saliency(mr_renderer *r, const mr_image *rgb, mr_saliency_impl impl, mr_saliency_levels levels,
+                       float gain, mr_image *out, mr_error *err) {
     memset(out, 0, sizeof *out);
     mr_ghost_state *g;
     if (!rgb) return mr_fail(err, MR_ERR_INVALID, "ghost: no image");
     if (!begin_images(r, rgb->width, rgb->height, &g, err)) return false;
     if (!check_img(rgb, g->w, g->h, 3, "the input", err)) return false;
     upload_rgba(g->in_o, rgb);
-    saliency(g, g->in_o, g->sal_o, impl, gain);
+    if ((unsigned)levels > MR_SAL_LEVELS_PRINTED) return mr_fail(err, MR_ERR_INVALID, "ghost: unknown saliency levels");
+    saliency(g, g->in_o, g->sal_o, impl, levels, gain);
     if (!read_tex(g->sal_o, g->w, g->h, 1, out, err)) return false;
     if (!finish(err)) {
         mr_image_free(out);
@@ -655,6 +669,7 @@ bool mr_ghost_compose(mr_renderer *r, const mr_ghost_images *in, const mr_ghost_
     free(mask);
     free(keys);
     glNamedBufferSubData(g->ssbo_stats, 0, sizeof stats, stats);
+    g->layers_valid = false; /* the mask is the caller's now */
     upload_rgba(g->in_o, in->occluder);
     upload_rgba(g->in_d, in->occludee);
     stage_g0(g, g->in_o, g->in_d, &gp);
@@ -673,5 +688,38 @@ bool mr_ghost_compose(mr_renderer *r, const mr_ghost_images *in, const mr_ghost_
     mr_image_free(&rgba);
     ok = ok && finish(err);
     if (!ok) mr_ghost_output_free(out);
+    return ok;
+}
+
+bool mr_ghost_read_layers(mr_renderer *r, mr_image *occluder, mr_image *hidden, mr_image *region, mr_error *err) {
+    memset(occluder, 0, sizeof *occluder);
+    memset(hidden, 0, sizeof *hidden);
+    memset(region, 0, sizeof *region);
+    mr_ghost_state *g = r ? r->ghost : NULL;
+    if (!g || !g->layers_valid || !g->o_tex) return mr_fail(err, MR_ERR_INVALID, "ghost: no ghosted frame to read");
+    int w = g->w, h = g->h;
+    mr_image mask = {0};
+    bool ok = mr_image_alloc(occluder, w, h, 3, MR_PIX_U8, err) && mr_image_alloc(hidden, w, h, 3, MR_PIX_U8, err) &&
+              mr_image_alloc(region, w, h, 1, MR_PIX_F32, err) && mr_image_alloc(&mask, w, h, 4, MR_PIX_F32, err);
+    if (ok) {
+        /* The sRGB textures' bytes as stored: sRGB-encoded, like the frame's
+         * colour; rows already top first (the projection flips y, OpenCV's
+         * camera frame). */
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glGetTextureImage(g->o_tex, 0, GL_RGB, GL_UNSIGNED_BYTE, (GLsizei)mr_image_bytes(occluder), occluder->data);
+        glGetTextureImage(g->hid_shaded.color[0], 0, GL_RGB, GL_UNSIGNED_BYTE, (GLsizei)mr_image_bytes(hidden), hidden->data);
+        glGetTextureImage(g->mask, 0, GL_RGBA, GL_FLOAT, (GLsizei)mr_image_bytes(&mask), mask.data);
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        const float *m = mask.data;
+        float *rg = region->data;
+        for (size_t i = 0; i < (size_t)w * h; i++) rg[i] = m[i * 4 + 1] > 0.5f ? 1.0f : 0.0f;
+        ok = finish(err);
+    }
+    mr_image_free(&mask);
+    if (!ok) {
+        mr_image_free(occluder);
+        mr_image_free(hidden);
+        mr_image_free(region);
+    }
     return ok;
 }

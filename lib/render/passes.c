@@ -85,6 +85,8 @@ void mr_shade_draw(frame *f, const target *src, const target *dst) {
         bg[i] = c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
     }
     glUniform3fv(18, 1, bg);
+    glUniform1f(20, f->p->specular > 0 ? f->p->specular : 0.0f);
+    glUniform1f(21, f->p->shininess >= 1 ? f->p->shininess : 32.0f);
     /* The main G-buffer's AO, or the hidden layer's own (pass_ghost.c). */
     GLuint ao = src == &r->gbuf ? mr_pass_ao_texture(f) : f->hidden_ao; /* 0 when there is no AO */
     glUniform1i(19, ao != 0);

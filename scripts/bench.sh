@@ -1,0 +1,106 @@
+#!/usr/bin/env bash
+# Rebuilds mrcheck and regenerates every bench table committed under
+# docs/bench/ (ao, ghost, tracking, scene), each stamped with the commit it
+# was made at and the exact command.
+#
+#   scripts/bench.sh [ao|ghost|tracking|scene ...]   (default: all four)
+#
+# Commit first, then run: the stamp names HEAD and says "dirty" when the
+# working tree differs from it (tables of uncommitted code). Sizes are
+# chosen so that all four finish in about 10 minutes on the shared 2-core
+# build VM with Mesa llvmpipe (measured times in docs/bench/README.md);
+# set MR_BENCH_FULL=1 for the benches' own, larger defaults. Benches are
+# measurements: this script fails only when a bench cannot run.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+benches=("$@")
+[ ${#benches[@]} -gt 0 ] || benches=(ao ghost tracking scene)
+full=${MR_BENCH_FULL:-0}
+
+cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build build -j"$(nproc)" --target mrcheck >/dev/null
+mr=./build/mrcheck
+
+commit=$(git rev-parse --short HEAD)
+dirty=clean
+if [ -n "$(git status --porcelain -- . ':!docs/bench')" ]; then dirty=dirty; fi
+when=$(date -u +%Y-%m-%dT%H:%MZ)
+
+# stamp FILE COMMAND: one "# " line at the top of a CSV, a paragraph at the
+# top of a Markdown file.
+stamp() {
+    local f=$1 cmd=$2 tmp
+    tmp=$(mktemp)
+    case $f in
+    *.csv) printf '# made at commit %s (%s), %s, by: %s\n' "$commit" "$dirty" "$when" "$cmd" >"$tmp" ;;
+    *.md) printf '_Made at commit `%s` (%s), %s, by `scripts/bench.sh`:_ `%s`\n\n' "$commit" "$dirty" "$when" "$cmd" >"$tmp" ;;
+    esac
+    cat "$f" >>"$tmp"
+    mv "$tmp" "$f"
+}
+
+# csv_md CSV TITLE > MD: the CSV as a Markdown table ("#" lines become
+# notes above it).
+csv_md() {
+    awk -F, -v title="$2" '
+        BEGIN { print "## " title "\n" }
+        /^#/ { sub(/^# ?/, ""); print "> " $0 "\n"; next }
+        !hdr { hdr = 1; line = "|"; sep = "|"; for (i = 1; i <= NF; i++) { line = line " " $i " |"; sep = sep "---|" }
+               print line; print sep; next }
+        { line = "|"; for (i = 1; i <= NF; i++) { gsub(/"/, "", $i); line = line " " $i " |" } print line }
+        END { print "" }' "$1"
+}
+
+# run NAME DIR CMD...: runs one bench into DIR (emptied first), keeps its
+# stdout as NAME.log, stamps every CSV and Markdown file it wrote.
+run() {
+    local name=$1 dir=$2
+    shift 2
+    local cmd="$*"
+    rm -rf "$dir"
+    mkdir -p "$dir"
+    echo "bench.sh: $cmd" >&2
+    local t0=$SECONDS
+    "$@" >"$dir/$name.log"
+    echo "bench.sh: $name done in $((SECONDS - t0)) s" >&2
+    for f in "$dir"/*.csv; do
+        [ -e "$f" ] || continue
+        csv_md "$f" "$(basename "$f")" >"${f%.csv}.table.md"
+        stamp "${f%.csv}.table.md" "$cmd"
+        stamp "$f" "$cmd"
+    done
+    for f in "$dir"/*.md; do
+        case $f in *.table.md) ;; *) stamp "$f" "$cmd" ;; esac
+    done
+    sed -i "1i bench.sh: commit $commit ($dirty), $when: $cmd" "$dir/$name.log"
+}
+
+for b in "${benches[@]}"; do
+    case $b in
+    ao)
+        if [ "$full" = 1 ]; then run bench_ao docs/bench/ao $mr bench ao --out docs/bench/ao --quiet
+        else run bench_ao docs/bench/ao $mr bench ao --quick --frames 3 --out docs/bench/ao --quiet; fi ;;
+    ghost)
+        if [ "$full" = 1 ]; then run bench_ghost docs/bench/ghost $mr bench ghost --out docs/bench/ghost --quiet
+        else run bench_ghost docs/bench/ghost $mr bench ghost --frames 3 --out docs/bench/ghost --quiet; fi ;;
+    tracking)
+        run bench_tracking docs/bench/tracking/640x480 \
+            $mr bench tracking --recording recordings/demo --out docs/bench/tracking/640x480
+        # The 1280x720 recording is synthesised (deterministic), not shipped.
+        tmp=$(mktemp -d)
+        $mr synth --out "$tmp/rec720" --size 1280x720 --jpeg 90 >/dev/null
+        run bench_tracking docs/bench/tracking/1280x720 \
+            $mr bench tracking --recording "$tmp/rec720" --out docs/bench/tracking/1280x720
+        rm -rf "$tmp" ;;
+    scene)
+        # The bench writes its generated scenes next to the CSV: keep only
+        # the tables.
+        if [ "$full" = 1 ]; then run bench_scene docs/bench/scene $mr bench scene --out docs/bench/scene --quiet
+        else run bench_scene docs/bench/scene $mr bench scene --sizes 1M,5M --frames 3 --out docs/bench/scene --quiet; fi
+        find docs/bench/scene -type f ! -name '*.csv' ! -name '*.md' ! -name '*.svg' ! -name '*.log' -delete
+        find docs/bench/scene -mindepth 1 -type d -empty -delete ;;
+    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene)" >&2; exit 2 ;;
+    esac
+done
+echo "bench.sh: wrote docs/bench/ at commit $commit ($dirty)" >&2
