@@ -54,5 +54,11 @@ expect_fail bad_importance "$tmp/b2.png" -- "$mr" render --scene "$s" --view "$v
 expect_fail bad_saliency "$tmp/b3.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b3.png" --ghost g0 --ghost-saliency dog
 expect_fail bad_t "$tmp/b4.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b4.png" --ghost g0 --ghost-t 1.5
 expect_fail bad_bench "" -- "$mr" bench ghost --frames 0
+# The bench runs end to end and reports the legibility that does not use
+# the adaptive stage's own target, with the definitions in the CSV.
+"$mr" bench ghost --size 64x48 --frames 1 --out "$tmp/bench" >"$tmp/bench.out" 2>"$tmp/bench.err" \
+  && grep -q "^# legibility_edge_transfer: " "$tmp/bench/bench_ghost.csv" \
+  && grep -q "^scene,.*,legibility_edge_transfer,.*,cv_saliency_ratio," "$tmp/bench/bench_ghost.csv" \
+  && [ -s "$tmp/bench/bench_ghost.svg" ] && ok || bad "bench ghost: $(cat "$tmp/bench.err")"
 
 cli_finish cli_ghost

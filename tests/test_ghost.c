@@ -915,10 +915,7 @@ int main(void) {
     test_legibility_metric();
     mr_error err = {0};
     g_gpu = mr_gpu_create_headless(NULL, &err);
-    if (!g_gpu) {
-        printf("test_ghost: SKIPPED (GPU part): no EGL device (%s)\n", err.msg);
-        return mr_test_failures ? mr_test_finish("test_ghost") : MR_TEST_SKIP;
-    }
+    if (!g_gpu) return mr_test_no_gpu("test_ghost", &err);
     g_r = mr_renderer_create(g_gpu, &err);
     CHECK_MSG(g_r != NULL, "%s", err.msg);
     if (g_r) {

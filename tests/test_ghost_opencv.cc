@@ -5,6 +5,7 @@
 // Exit 77 without an EGL device.
 #include "mr_eval.h"
 #include "mr_render.h"
+#include "mr_test.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -17,10 +18,7 @@ static float srgb_encode(float c) { return c <= 0.0031308f ? 12.92f * c : 1.055f
 int main() {
     mr_error err = {};
     mr_gpu *gpu = mr_gpu_create_headless(nullptr, &err);
-    if (!gpu) {
-        std::printf("test_ghost_opencv: SKIPPED: no EGL device (%s)\n", err.msg);
-        return 77;
-    }
+    if (!gpu) return mr_test_no_gpu("test_ghost_opencv", &err);
     mr_renderer *r = mr_renderer_create(gpu, &err);
     int failures = 0;
     if (!r) {

@@ -38,14 +38,7 @@ static double centre(mr_renderer *r, mr_scene *s, const double d[3], float specu
 int main(void) {
     mr_error err = {0};
     mr_gpu *gpu = mr_gpu_create_headless(NULL, &err);
-    if (!gpu) {
-        if (err.code == MR_ERR_NODEVICE) {
-            printf("test_shade: SKIPPED: no EGL device (%s)\n", err.msg);
-            return MR_TEST_SKIP;
-        }
-        CHECK_MSG(false, "no GL context: %s", err.msg);
-        return mr_test_finish("test_shade");
-    }
+    if (!gpu) return mr_test_no_gpu("test_shade", &err);
     mr_renderer *r = mr_renderer_create(gpu, &err);
     CHECK_MSG(r != NULL, "%s", err.msg);
     if (r) {
