@@ -1,0 +1,253 @@
+/* mr_view.h — the interactive check (`mrcheck view`) as a controller that
+ * runs without a window: state, settings, key map, layout, replay control,
+ * the tracking-lost policy and the scripted input of tests.
+ *
+ * Input events in (pointer in framebuffer pixels, keys), plain data about
+ * the newest camera frame and the source in, actions and a draw list (lib/ui)
+ * out. The caller (app/cmd_view.c) owns the window, the renderer and the
+ * capture threads and carries the actions out; nothing here touches GL,
+ * GLFW, files other than the settings file, or app/.
+ *
+ * Depends on: lib/core, lib/ui, and plain types of lib/render's header
+ * (mr_event, MR_KEY_*, mr_ao_method, mr_ghost_mode). One way only.
+ */
+#ifndef MR_VIEW_CTL_H
+#define MR_VIEW_CTL_H
+
+#include "mr_core.h"
+#include "mr_render.h"
+#include "mr_ui.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------- settings */
+
+/* Replay rates the rate button and [ ] step through. */
+#define MR_VIEW_RATE_COUNT 5
+extern const double mr_view_rates[MR_VIEW_RATE_COUNT];   /* 0.25 .. 4 */
+/* Notes offered when marking (a tap is quicker than typing on a tablet). */
+#define MR_VIEW_NOTE_COUNT 6
+extern const char *const mr_view_notes[MR_VIEW_NOTE_COUNT];
+
+/* What persists between runs (~/.config/mrcheck/view.json). */
+typedef struct mr_view_settings {
+    float alpha;          /* video transparency: 0 model only, 1 video only; default 0.5 */
+    bool show_video;      /* default true */
+    bool hide_hidden;     /* hide the hidden layer; default false */
+    int rate_i;           /* index into mr_view_rates; default 2 (1x) */
+    mr_ao_method ao;      /* default MR_AO_NONE */
+    mr_ghost_mode ghost;  /* default MR_GHOST_OFF */
+} mr_view_settings;
+#define MR_VIEW_SETTINGS_DEFAULTS {0.5f, true, false, 2, MR_AO_NONE, MR_GHOST_OFF}
+
+/* "off", "alpha", "g0", "adaptive". */
+const char *mr_view_ghost_name(mr_ghost_mode m);
+bool mr_view_ghost_parse(const char *name, mr_ghost_mode *out);
+/* $XDG_CONFIG_HOME/mrcheck/view.json, else ~/.config/mrcheck/view.json,
+ * else ./.mrcheck-view.json. */
+void mr_view_default_config_path(char *out, size_t n);
+/* Tolerant: starts from the defaults; a missing file is no warning; a file
+ * that does not parse, or a key with a wrong type or out of range, keeps the
+ * default for what it cannot use and says so in `warn` (empty when all was
+ * well). Never fails. */
+void mr_view_settings_load(const char *path, mr_view_settings *s, char *warn, size_t warn_n);
+/* Creates the folder and writes atomically (temporary file + rename), so a
+ * crash never leaves a half-written file. */
+bool mr_view_settings_save(const char *path, const mr_view_settings *s, mr_error *err);
+
+/* ---------------------------------------------------------------- layout */
+
+typedef enum mr_view_widget_id {
+    MR_VW_ALPHA = 0, MR_VW_PLAY, MR_VW_BACK, MR_VW_FORWARD, MR_VW_RATE, MR_VW_SEEK,
+    MR_VW_FREEZE, MR_VW_SNAPSHOT, MR_VW_MARK, MR_VW_VIDEO, MR_VW_HIDDEN, MR_VW_AO, MR_VW_GHOST, MR_VW_HELP,
+    MR_VW_NOTE1, MR_VW_NOTE6 = MR_VW_NOTE1 + MR_VIEW_NOTE_COUNT - 1, MR_VW_CANCEL,
+    MR_VW_COUNT
+} mr_view_widget_id;
+
+/* The name scripts use (`tap @video`): "alpha", "play", ..., "note1", "cancel". */
+const char *mr_view_widget_name(mr_view_widget_id id);
+
+typedef struct mr_view_layout_params {
+    float fb_w, fb_h;     /* framebuffer pixels */
+    bool seekable;        /* replay: the play / step / rate / seek row */
+    bool note_open;       /* the note chooser after a tap in mark mode */
+    float mark_x;         /* the mark's window x, to put the chooser on the other side */
+} mr_view_layout_params;
+
+typedef struct mr_view_layout {
+    mr_ui_rect status, bottom, column, notes; /* panels (zero size when absent) */
+    mr_ui_rect picture;   /* what is left for messages over the picture */
+    bool shown[MR_VW_COUNT];
+    mr_ui_rect rect[MR_VW_COUNT];
+    int dropped;          /* widgets left out because the window is too small */
+} mr_view_layout;
+
+/* RectCut in millimetres through the ui's density: a status line on top, the
+ * transparency slider (and the replay row) at the bottom, a column of toggles
+ * at the right that wraps into more columns when the window is short. Every
+ * shown widget is at least the ui's touch target (9 mm) on both sides, inside
+ * the window, and overlaps no other. A window too small for all of them
+ * leaves out the lowest priorities first (help, then ghost, AO, hidden, ...;
+ * in the replay row rate, then seek); the keys still reach them all. */
+void mr_view_layout_compute(const mr_ui *ui, const mr_view_layout_params *p, mr_view_layout *out);
+
+/* --------------------------------------------------- tracking-lost policy */
+
+typedef struct mr_view_render_choice {
+    float alpha;          /* the alpha to render with */
+    bool use_pose;        /* false: no pose yet, draw from a neutral pose (video only) */
+    bool dimmed;          /* tracking lost: model faded at the last good pose */
+} mr_view_render_choice;
+
+/* Tracking lost keeps the last good pose but lets the video through, so a
+ * stale model never passes for the truth: alpha goes to
+ * 1 - (1 - alpha) * 0.35 (only with video shown; frozen pictures stay as
+ * they are). No pose yet: video only. */
+mr_view_render_choice mr_view_render_policy(const mr_view_settings *s, bool have_pose, bool pose_valid,
+                                            bool frozen);
+
+/* ------------------------------------------------------------ controller */
+
+typedef enum mr_view_action_type {
+    MR_VA_NONE = 0,
+    MR_VA_RENDER,         /* a setting the picture depends on changed: render again */
+    MR_VA_FREEZE,         /* on: freeze frame and pose */
+    MR_VA_SNAPSHOT,       /* screen + raw frame + pose, from this frame's screen */
+    MR_VA_MARK_AT,        /* x, y: window pixel to mark; answer with mr_viewer_note_open */
+    MR_VA_MARK_FINISH,    /* i: note index, or -1 cancelled */
+    MR_VA_PLAY,           /* on: replay plays */
+    MR_VA_STEP,           /* i: frames (+1 / -1) */
+    MR_VA_SEEK,           /* i: frame index (large: the last) */
+    MR_VA_RATE,           /* x: replay rate */
+    MR_VA_FULLSCREEN,     /* toggle */
+    MR_VA_RESIZE,         /* x, y: window size (scripts) */
+    MR_VA_SHOT,           /* path: save this frame's screen as PNG (scripts) */
+    MR_VA_STATE,          /* path: write a state snapshot JSON (scripts) */
+    MR_VA_QUIT,
+} mr_view_action_type;
+
+typedef struct mr_view_action {
+    mr_view_action_type type;
+    bool on;
+    int64_t i;
+    double x, y;
+    const char *path;     /* valid until the next call into the controller */
+} mr_view_action;
+
+#define MR_VIEW_MAX_ACTIONS 64
+typedef struct mr_view_actions {
+    mr_view_action a[MR_VIEW_MAX_ACTIONS];
+    int count;            /* set to 0 before each call that fills it */
+    mr_view_action overflow; /* scratch: what a full list drops */
+} mr_view_actions;
+
+typedef struct mr_viewer mr_viewer;
+
+typedef struct mr_viewer_params {
+    double px_per_mm;          /* screen density (already times any UI scale); 0 = 96 dpi */
+    const char *font_path;     /* NULL = a system sans font */
+    const char *config_path;   /* settings file; NULL = none (nothing saved) */
+    double now;                /* clock at start, seconds (mr_time_now) */
+    double save_delay_s;       /* settings are saved this long after a change; 0 = 1 s */
+    double script_wait_s;      /* a script starts with the first picture, or after this; 0 = 3 s */
+} mr_viewer_params;
+#define MR_VIEWER_DEFAULTS {0.0, NULL, NULL, 0.0, 0.0, 0.0}
+
+/* Plain data about what the window shows, given each frame. */
+typedef struct mr_viewer_frame {
+    double now;                /* clock, seconds */
+    float fb_w, fb_h;          /* framebuffer pixels */
+    double px_per_mm;          /* 0 = unchanged */
+    /* the newest camera frame */
+    bool have_frame, have_pose, pose_valid;
+    int64_t index, count;      /* count -1 if unknown (live) */
+    int tags_seen;
+    double rms_px;
+    /* the source */
+    bool seekable, playing;    /* replay */
+    const char *source_desc;   /* "replay", "live /dev/video0" */
+    const char *source_msg;    /* a failure to show ("no camera ..."), or NULL */
+    const char *scene_msg;     /* loading / failure of the scene, or NULL */
+    /* the rendered picture */
+    bool have_image;           /* a picture is on screen */
+    mr_ui_rect image_rect;     /* where, in framebuffer pixels */
+    bool dimmed;               /* the policy dimmed it */
+    const char *passes;        /* the frame's pass list */
+    double fps;
+} mr_viewer_frame;
+
+/* NULL + err when the font cannot be found (MR_ERR_IO) or memory runs out.
+ * Reads the settings file (warnings go to the log). */
+mr_viewer *mr_viewer_create(const mr_viewer_params *p, mr_error *err);
+void mr_viewer_destroy(mr_viewer **v);
+
+/* Queues one input event (window events and scripted ones alike). */
+void mr_viewer_push_event(mr_viewer *v, const mr_event *e);
+/* Events queued and not yet taken. */
+int mr_viewer_pending(const mr_viewer *v);
+
+/* First half of a frame: runs the script commands that are due, then takes
+ * queued input (at most one press or release per frame, so a quick tap is
+ * never lost; moves and keys at once). Key actions go to *out. `busy`: a
+ * render is pending, so a script waits for its effect to be drawn. */
+void mr_viewer_input(mr_viewer *v, double now, bool busy, mr_view_actions *out);
+/* Second half: lays out and draws the UI for this frame; taps on widgets go
+ * to *out. Returns the draw list (valid until the next call). Also saves
+ * the settings a moment after they changed. */
+const mr_ui_draw_list *mr_viewer_ui(mr_viewer *v, const mr_viewer_frame *f, mr_view_actions *out);
+
+/* Answers to actions. */
+void mr_viewer_note_open(mr_viewer *v, float mark_x, float mark_y); /* MARK_AT worked: window px */
+void mr_viewer_toast(mr_viewer *v, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* State. */
+const mr_view_settings *mr_viewer_settings(const mr_viewer *v);
+/* Replaces the settings for this run without marking them changed (flags). */
+void mr_viewer_set_settings(mr_viewer *v, const mr_view_settings *s);
+bool mr_viewer_frozen(const mr_viewer *v);
+bool mr_viewer_note_is_open(const mr_viewer *v);
+bool mr_viewer_wants_input(const mr_viewer *v); /* script running, press held or queued */
+const mr_ui *mr_viewer_ui_ctx(const mr_viewer *v);
+const mr_view_layout *mr_viewer_layout(const mr_viewer *v);
+/* Saves now if changed; false + err if it could not. */
+bool mr_viewer_save_settings(mr_viewer *v, mr_error *err);
+/* The controller's part of a `state` snapshot (settings, modes, widgets). */
+cJSON *mr_viewer_state_json(const mr_viewer *v);
+
+/* ---------------------------------------------------------------- script */
+
+/* A script of timed input: one command per line, `T COMMAND ARGS`, T in
+ * seconds from the first picture on screen. Widgets are named (`@alpha`),
+ * so scripts survive layout changes:
+ *   tap X Y | tap @name        down X Y | up X Y | move X Y
+ *   drag @slider F0 F1         (fractions of the slider's width)
+ *   key K                      (a character, or esc enter left right up down home end f1 f11 space tab)
+ *   resize W H | shot OUT.png | state OUT.json | quit
+ * Input enters the controller's queue, the path real input takes. */
+typedef struct mr_view_script mr_view_script;
+/* NULL + err (MR_ERR_IO, or MR_ERR_PARSE naming the line) on a bad file. */
+mr_view_script *mr_view_script_load(const char *path, mr_error *err);
+void mr_view_script_destroy(mr_view_script **s);
+/* Hands the script to the controller, which owns it from then on (*s is
+ * set to NULL); it replaces any earlier one. */
+void mr_viewer_set_script(mr_viewer *v, mr_view_script **s);
+/* Parses a key name as scripts write it. */
+bool mr_view_key_parse(const char *s, int *key);
+
+/* Every key and what it does (what `?` shows). */
+typedef struct mr_view_key_help {
+    const char *keys, *what;
+} mr_view_key_help;
+extern const mr_view_key_help mr_view_keymap[];
+extern const int mr_view_keymap_count;
+
+#ifdef __cplusplus
+}
+#endif
+#endif
