@@ -1,8 +1,10 @@
 /* lib/ui without a display: layout, hit-testing, slider math, widget
  * behaviour over scripted pointer input, the draw list, and the view's
- * touch targets in millimetres at several screen densities. */
+ * touch targets in millimetres at several screen densities (the view's
+ * own layout from lib/view; tests/test_view.c tries more windows). */
 #include "mr_test.h"
 #include "mr_ui.h"
+#include "mr_view.h"
 
 #include <math.h>
 #include <string.h>
@@ -198,52 +200,19 @@ typedef struct named_widget {
     mr_ui_rect r;
 } named_widget;
 
-/* The view's widgets, laid out as build_ui in app/cmd_view.c lays them out
- * (status line, bottom bar with the transparency slider and the replay row,
- * right column of toggles wrapping into more columns), with the same lib/ui
- * calls and the same sizes in millimetres; build_ui itself lives in app/
- * and needs a running view, so it is not callable from here. Each rect is
- * drawn as the real widget. Returns the count. */
+/* The view's widgets as the view lays them out: the real layout of
+ * lib/view (mr_view_layout_compute, what the window draws), with each
+ * shown rect drawn as its widget. Returns the count. */
 static int view_layout(mr_ui *ui, float fb_w, float fb_h, bool seekable, named_widget *out) {
+    mr_view_layout_params lp = {fb_w, fb_h, seekable, false, 0};
+    mr_view_layout L;
+    mr_view_layout_compute(ui, &lp, &L);
     int n = 0;
-    float T = mr_ui_target_px(ui), g = mr_ui_mm(ui, 1.2f), th = mr_ui_text_px(ui);
-    const mr_ui_font *font = mr_ui_get_font(ui);
-    mr_ui_rect full = mr_ui_rect_make(0, 0, fb_w, fb_h);
-    mr_ui_cut_top(&full, th * 1.7f);
-    mr_ui_rect bottom = mr_ui_cut_bottom(&full, (T + g) * (seekable ? 2 : 1) + g);
-    mr_ui_rect inner = mr_ui_rect_inset(bottom, g);
-    float alpha = 0.5f, pos = 3;
-    out[n] = (named_widget){"alpha", mr_ui_cut_top(&inner, T)};
-    mr_ui_slider(ui, 1, out[n++].r, "model  <  >  video  50%", &alpha, 0, 1);
-    if (seekable) {
-        mr_ui_cut_top(&inner, g);
-        mr_ui_rect rrow = mr_ui_cut_top(&inner, T);
-        float bw = fmaxf(T * 1.6f, mr_ui_text_width(font, "Pause", th) + 2 * g);
-        out[n++] = (named_widget){"play", mr_ui_cut_left(&rrow, bw)};
-        mr_ui_cut_left(&rrow, g);
-        out[n++] = (named_widget){"back", mr_ui_cut_left(&rrow, T)};
-        mr_ui_cut_left(&rrow, g);
-        out[n++] = (named_widget){"forward", mr_ui_cut_left(&rrow, T)};
-        mr_ui_cut_left(&rrow, g);
-        out[n++] = (named_widget){"rate", mr_ui_cut_right(&rrow, T * 1.4f)};
-        mr_ui_cut_right(&rrow, g);
-        for (int i = n - 4; i < n; i++) mr_ui_button(ui, (uint32_t)(20 + i), out[i].r, out[i].name, MR_UI_NORMAL);
-        out[n] = (named_widget){"seek", rrow};
-        mr_ui_slider(ui, 24, out[n++].r, "frame 4", &pos, 0, 99);
-    }
-    static const char *items[] = {"freeze", "snapshot", "mark", "video", "hidden", "ao", "ghost", "help"};
-    static const char *labels[] = {"Freeze", "Snapshot", "Mark", "Video", "Hidden", "AO alchemy", "Ghost adaptive", "?"};
-    int ni = (int)(sizeof items / sizeof items[0]);
-    float colw = fmaxf(T * 2.4f, mr_ui_text_width(font, "AO alchemy", th) + 3 * g);
-    int per_col = (int)((full.h - g) / (T + g));
-    if (per_col < 1) per_col = 1;
-    int cols = (ni + per_col - 1) / per_col;
-    mr_ui_rect column = mr_ui_cut_right(&full, cols * (colw + g) + g);
-    for (int i = 0; i < ni; i++) {
-        int c = i / per_col, r = i % per_col;
-        out[n] = (named_widget){items[i], mr_ui_rect_make(column.x + column.w - (c + 1) * (colw + g),
-                                                          column.y + g + r * (T + g), colw, T)};
-        mr_ui_button(ui, (uint32_t)(40 + i), out[n++].r, labels[i], MR_UI_NORMAL);
+    for (int i = 0; i < MR_VW_COUNT; i++) {
+        if (!L.shown[i]) continue;
+        out[n] = (named_widget){mr_view_widget_name((mr_view_widget_id)i), L.rect[i]};
+        mr_ui_button(ui, (uint32_t)(100 + i), out[n].r, out[n].name, MR_UI_NORMAL);
+        n++;
     }
     return n;
 }

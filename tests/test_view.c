@@ -1,0 +1,728 @@
+/* lib/view without a window: the controller driven by synthetic events and
+ * a fake clock. Slider, toggles (act on release, slide off cancels), the
+ * key map, AO and ghost cycling, settings (round trip, damaged files,
+ * atomic writes), replay controls, the tracking-lost policy, the real
+ * layout at several densities and in windows too small for it, scripts. */
+#include "mr_test.h"
+#include "mr_view.h"
+
+#include <errno.h>
+#include <string.h>
+#include <unistd.h>
+
+/* test_view links with -Wl,--wrap=rename (tests/CMakeLists.txt): the test
+ * sees that the settings file arrives by rename and can make it fail. */
+int __real_rename(const char *from, const char *to);
+int __wrap_rename(const char *from, const char *to);
+static struct {
+    int fail;            /* errno to fail with, 0: pass through */
+    int renames;
+    char to[1200];
+} g_rn;
+int __wrap_rename(const char *from, const char *to) {
+    g_rn.renames++;
+    snprintf(g_rn.to, sizeof g_rn.to, "%s", to);
+    if (g_rn.fail) {
+        errno = g_rn.fail;
+        return -1;
+    }
+    return __real_rename(from, to);
+}
+
+static char g_tmp[1024];
+
+static void tmp_path(char *out, size_t n, const char *name) { snprintf(out, n, "%s/%s", g_tmp, name); }
+
+static void write_text(const char *path, const char *text) {
+    FILE *f = fopen(path, "wb");
+    if (!f) return;
+    fputs(text, f);
+    fclose(f);
+}
+
+static char *read_text(const char *path) {
+    mr_error err = {0};
+    size_t n = 0;
+    return mr_file_read(path, &n, 1 << 20, &err);
+}
+
+/* ------------------------------------------------------------ the rig */
+
+typedef struct rig {
+    mr_viewer *v;
+    mr_viewer_frame f;
+    mr_view_actions acts;  /* everything the last step asked for */
+    double t;
+} rig;
+
+static bool rig_open(rig *r, const char *config, double ppmm, mr_error *err) {
+    memset(r, 0, sizeof *r);
+    mr_viewer_params p = MR_VIEWER_DEFAULTS;
+    p.px_per_mm = ppmm;
+    p.config_path = config;
+    p.now = 0;
+    r->v = mr_viewer_create(&p, err);
+    r->f.fb_w = 960;
+    r->f.fb_h = 720;
+    r->f.px_per_mm = ppmm;
+    r->f.have_frame = r->f.have_pose = r->f.pose_valid = true;
+    r->f.index = 2;
+    r->f.count = 100;
+    r->f.tags_seen = 3;
+    r->f.source_desc = "replay";
+    r->f.have_image = true;
+    r->f.image_rect = mr_ui_rect_make(100, 60, 640, 480);
+    r->f.passes = "gbuffer shade overlay";
+    return r->v != NULL;
+}
+
+/* One frame: input, then UI; the actions of both halves in r->acts. */
+static void step(rig *r) {
+    r->t += 1.0 / 60;
+    mr_view_actions a = {0}, b = {0};
+    mr_viewer_input(r->v, r->t, false, &a);
+    r->f.now = r->t;
+    mr_viewer_ui(r->v, &r->f, &b);
+    r->acts = a;
+    for (int i = 0; i < b.count && r->acts.count < MR_VIEW_MAX_ACTIONS; i++) r->acts.a[r->acts.count++] = b.a[i];
+}
+
+static void ev(rig *r, mr_event_type t, double x, double y) {
+    mr_event e = {t, x, y, 0};
+    mr_viewer_push_event(r->v, &e);
+}
+
+static void key(rig *r, int k) {
+    mr_event e = {MR_EVENT_KEY, 0, 0, k};
+    mr_viewer_push_event(r->v, &e);
+    step(r);
+}
+
+/* How many actions of a type the last step asked for; *first gets the first. */
+static int count(const rig *r, mr_view_action_type t, mr_view_action *first) {
+    int n = 0;
+    for (int i = 0; i < r->acts.count; i++)
+        if (r->acts.a[i].type == t) {
+            if (!n && first) *first = r->acts.a[i];
+            n++;
+        }
+    return n;
+}
+
+static mr_ui_rect wrect(const rig *r, mr_view_widget_id id) { return mr_viewer_layout(r->v)->rect[id]; }
+static float cx(mr_ui_rect b) { return b.x + b.w / 2; }
+static float cy(mr_ui_rect b) { return b.y + b.h / 2; }
+
+/* A press and a release at (x, y), one frame each (as the window sees a
+ * tap); the actions of all three frames are counted together in *acts. */
+static void tap_at(rig *r, float x, float y, mr_view_actions *acts) {
+    memset(acts, 0, sizeof *acts);
+    ev(r, MR_EVENT_POINTER_MOVE, x, y);
+    ev(r, MR_EVENT_POINTER_DOWN, x, y);
+    ev(r, MR_EVENT_POINTER_UP, x, y);
+    for (int k = 0; k < 3; k++) {
+        step(r);
+        for (int i = 0; i < r->acts.count && acts->count < MR_VIEW_MAX_ACTIONS; i++) acts->a[acts->count++] = r->acts.a[i];
+    }
+    r->acts = *acts;
+}
+
+static void tap(rig *r, mr_view_widget_id id) {
+    mr_view_actions all;
+    CHECK_MSG(mr_viewer_layout(r->v)->shown[id], "widget %s is not on screen", mr_view_widget_name(id));
+    tap_at(r, cx(wrect(r, id)), cy(wrect(r, id)), &all);
+}
+
+/* ------------------------------------------------------------- slider */
+
+static void test_slider(rig *r) {
+    step(r);
+    mr_ui_rect s = wrect(r, MR_VW_ALPHA);
+    const mr_ui *ui = mr_viewer_ui_ctx(r->v);
+    /* Press at the knob of 0.3, hold: alpha follows the pointer. */
+    float x3 = mr_ui_slider_knob_x(ui, s, 0.3f, 0, 1);
+    ev(r, MR_EVENT_POINTER_MOVE, x3, cy(s));
+    ev(r, MR_EVENT_POINTER_DOWN, x3, cy(s));
+    step(r);
+    CHECK_MSG(fabs(mr_viewer_settings(r->v)->alpha - 0.3) < 1e-4, "slider pressed at 0.3 gave alpha %.4f",
+              mr_viewer_settings(r->v)->alpha);
+    CHECK_MSG(count(r, MR_VA_RENDER, NULL) == 1, "moving the slider asked for %d renders, want 1",
+              count(r, MR_VA_RENDER, NULL));
+    /* Dragged far left, past the end: 0, which is the model only. */
+    ev(r, MR_EVENT_POINTER_MOVE, -500, cy(s) + 300);
+    step(r);
+    float a = mr_viewer_settings(r->v)->alpha;
+    CHECK_MSG(a == 0.0f, "slider dragged past the left end gave alpha %g, want 0 (model only)", a);
+    mr_view_render_choice c = mr_view_render_policy(mr_viewer_settings(r->v), true, true, false);
+    CHECK_MSG(c.alpha == 0.0f && !c.dimmed, "alpha 0 with a good pose renders with alpha %g, want 0 (model only)",
+              c.alpha);
+    /* Far right: 1 (video only), never beyond. */
+    ev(r, MR_EVENT_POINTER_MOVE, 1e5, cy(s));
+    step(r);
+    a = mr_viewer_settings(r->v)->alpha;
+    CHECK_MSG(a == 1.0f, "slider dragged past the right end gave alpha %g, want 1 (video only)", a);
+    /* Back to 0.75 and let go: it stays. */
+    float x75 = mr_ui_slider_knob_x(ui, s, 0.75f, 0, 1);
+    ev(r, MR_EVENT_POINTER_MOVE, x75, cy(s));
+    step(r);
+    ev(r, MR_EVENT_POINTER_UP, x75, cy(s));
+    step(r);
+    ev(r, MR_EVENT_POINTER_MOVE, s.x + 2, cy(s));
+    step(r);
+    a = mr_viewer_settings(r->v)->alpha;
+    CHECK_MSG(fabs(a - 0.75) < 1e-4, "after release at 0.75 and a hover, alpha is %g", a);
+    for (int i = 0; i < 14; i++) {
+        key(r, MR_KEY_UP);
+        a = mr_viewer_settings(r->v)->alpha;
+        CHECK_MSG(a >= 0 && a <= 1, "Up made alpha %g, outside [0, 1]", a);
+    }
+    CHECK_MSG(a == 1.0f, "Up 14 times from 0.75 gave alpha %g, want 1", a);
+}
+
+/* ------------------------------------------------- toggles on release */
+
+static void test_toggles(rig *r) {
+    step(r);
+    mr_ui_rect b = wrect(r, MR_VW_VIDEO);
+    bool before = mr_viewer_settings(r->v)->show_video;
+    ev(r, MR_EVENT_POINTER_MOVE, cx(b), cy(b));
+    ev(r, MR_EVENT_POINTER_DOWN, cx(b), cy(b));
+    step(r);
+    CHECK_MSG(mr_viewer_settings(r->v)->show_video == before && count(r, MR_VA_RENDER, NULL) == 0,
+              "the Video toggle acted on press (it must act on release)");
+    ev(r, MR_EVENT_POINTER_UP, cx(b), cy(b));
+    step(r);
+    CHECK_MSG(mr_viewer_settings(r->v)->show_video == !before && count(r, MR_VA_RENDER, NULL) == 1,
+              "the Video toggle did not act on release over it");
+    /* Freeze: press, nothing; release, FREEZE on. */
+    mr_ui_rect fz = wrect(r, MR_VW_FREEZE);
+    ev(r, MR_EVENT_POINTER_MOVE, cx(fz), cy(fz));
+    ev(r, MR_EVENT_POINTER_DOWN, cx(fz), cy(fz));
+    step(r);
+    CHECK_MSG(count(r, MR_VA_FREEZE, NULL) == 0 && !mr_viewer_frozen(r->v), "Freeze acted on press");
+    ev(r, MR_EVENT_POINTER_UP, cx(fz), cy(fz));
+    step(r);
+    mr_view_action x;
+    CHECK_MSG(count(r, MR_VA_FREEZE, &x) == 1 && x.on && mr_viewer_frozen(r->v), "Freeze did not act on release");
+    /* Slide off: press on Video, move onto the picture, release there:
+     * nothing, and not a tap on the scene either (no mark in mark mode). */
+    key(r, 'm');
+    before = mr_viewer_settings(r->v)->show_video;
+    ev(r, MR_EVENT_POINTER_MOVE, cx(b), cy(b));
+    ev(r, MR_EVENT_POINTER_DOWN, cx(b), cy(b));
+    step(r);
+    ev(r, MR_EVENT_POINTER_MOVE, 300, 300);
+    step(r);
+    ev(r, MR_EVENT_POINTER_UP, 300, 300);
+    step(r);
+    CHECK_MSG(mr_viewer_settings(r->v)->show_video == before && count(r, MR_VA_RENDER, NULL) == 0,
+              "a finger that slid off the Video toggle still toggled it");
+    CHECK_MSG(count(r, MR_VA_MARK_AT, NULL) == 0, "a slide off a toggle was taken as a tap on the scene");
+    /* A real tap on the picture in mark mode asks for a mark there. */
+    mr_view_actions all;
+    tap_at(r, 300, 300, &all);
+    CHECK_MSG(count(r, MR_VA_MARK_AT, &x) == 1 && x.x == 300 && x.y == 300, "a tap on the picture in mark mode "
+              "gave %d MARK_AT actions", count(r, MR_VA_MARK_AT, NULL));
+    /* The chooser opens; note 2 by tap finishes the mark with note index 1. */
+    mr_viewer_note_open(r->v, 0.3f, 0.5f);
+    step(r);
+    CHECK_MSG(mr_viewer_layout(r->v)->shown[MR_VW_NOTE1 + 1], "no note chooser after the mark");
+    tap(r, MR_VW_NOTE1 + 1);
+    CHECK_MSG(count(r, MR_VA_MARK_FINISH, &x) == 1 && x.i == 1, "tap on note 2 gave %d MARK_FINISH (i %lld)",
+              count(r, MR_VA_MARK_FINISH, NULL), (long long)x.i);
+    CHECK_MSG(!mr_viewer_note_is_open(r->v), "the chooser stayed open after a note");
+    key(r, 'f'); /* unfreeze for the next tests */
+}
+
+/* ------------------------------------------------------------ key map */
+
+static void test_keys(rig *r) {
+    r->f.seekable = true;
+    r->f.playing = false;
+    step(r);
+    if (mr_viewer_frozen(r->v)) key(r, 'f');
+    mr_view_action x;
+    mr_view_settings s0 = *mr_viewer_settings(r->v);
+    s0.alpha = 0.5f;
+    s0.rate_i = 2;
+    mr_viewer_set_settings(r->v, &s0);
+    key(r, '+');
+    CHECK_MSG(fabs(mr_viewer_settings(r->v)->alpha - 0.6) < 1e-6, "+ gave alpha %g from 0.5, want 0.6",
+              mr_viewer_settings(r->v)->alpha);
+    key(r, '=');
+    key(r, MR_KEY_UP);
+    CHECK_MSG(fabs(mr_viewer_settings(r->v)->alpha - 0.8) < 1e-6, "= and Up gave %g, want 0.8", mr_viewer_settings(r->v)->alpha);
+    key(r, '-');
+    key(r, MR_KEY_DOWN);
+    CHECK_MSG(fabs(mr_viewer_settings(r->v)->alpha - 0.6) < 1e-6, "- and Down gave %g, want 0.6", mr_viewer_settings(r->v)->alpha);
+    key(r, 'f');
+    CHECK_MSG(count(r, MR_VA_FREEZE, &x) == 1 && x.on, "f did not freeze");
+    key(r, '.');
+    CHECK_MSG(count(r, MR_VA_FREEZE, &x) == 1 && !x.on && r->acts.a[0].type == MR_VA_FREEZE,
+              "stepping while frozen did not unfreeze first");
+    CHECK_MSG(count(r, MR_VA_STEP, &x) == 1 && x.i == 1, ". did not step +1");
+    key(r, MR_KEY_RIGHT);
+    CHECK_MSG(count(r, MR_VA_STEP, &x) == 1 && x.i == 1, "Right did not step +1");
+    key(r, ',');
+    CHECK_MSG(count(r, MR_VA_STEP, &x) == 1 && x.i == -1, ", did not step -1");
+    key(r, MR_KEY_LEFT);
+    CHECK_MSG(count(r, MR_VA_STEP, &x) == 1 && x.i == -1, "Left did not step -1");
+    key(r, 's');
+    CHECK_MSG(count(r, MR_VA_SNAPSHOT, NULL) == 1, "s asked for no snapshot");
+    bool v0 = mr_viewer_settings(r->v)->show_video;
+    key(r, 'v');
+    CHECK_MSG(mr_viewer_settings(r->v)->show_video == !v0 && count(r, MR_VA_RENDER, NULL) == 1, "v did not toggle the video");
+    bool h0 = mr_viewer_settings(r->v)->hide_hidden;
+    key(r, 'h');
+    CHECK_MSG(mr_viewer_settings(r->v)->hide_hidden == !h0 && count(r, MR_VA_RENDER, NULL) == 1, "h did not toggle the hidden layer");
+    key(r, ' ');
+    CHECK_MSG(count(r, MR_VA_PLAY, &x) == 1 && x.on, "space while paused did not ask to play");
+    r->f.playing = true;
+    step(r);
+    key(r, ' ');
+    CHECK_MSG(count(r, MR_VA_PLAY, &x) == 1 && !x.on, "space while playing did not ask to pause");
+    key(r, MR_KEY_HOME);
+    CHECK_MSG(count(r, MR_VA_SEEK, &x) == 1 && x.i == 0, "Home did not seek to 0");
+    key(r, MR_KEY_END);
+    CHECK_MSG(count(r, MR_VA_SEEK, &x) == 1 && x.i >= 1000000, "End did not seek to the end");
+    key(r, '[');
+    CHECK_MSG(count(r, MR_VA_RATE, &x) == 1 && x.x == 0.5, "[ from 1x gave rate %g, want 0.5", x.x);
+    key(r, ']');
+    key(r, ']');
+    CHECK_MSG(count(r, MR_VA_RATE, &x) == 1 && x.x == 2.0, "] ] from 0.5x gave rate %g, want 2", x.x);
+    for (int i = 0; i < 5; i++) key(r, ']');
+    CHECK_MSG(x.x == 2.0 && mr_viewer_settings(r->v)->rate_i == MR_VIEW_RATE_COUNT - 1, "] does not stop at 4x");
+    key(r, MR_KEY_F11);
+    CHECK_MSG(count(r, MR_VA_FULLSCREEN, NULL) == 1, "F11 did not toggle fullscreen");
+    key(r, '?');
+    cJSON *j = mr_viewer_state_json(r->v);
+    CHECK_MSG(cJSON_IsTrue(cJSON_GetObjectItem(j, "help")), "? did not open the help");
+    cJSON_Delete(j);
+    key(r, MR_KEY_ESCAPE);
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 0, "Esc with the help open quit instead of closing the help");
+    key(r, MR_KEY_F1);
+    key(r, MR_KEY_F1);
+    j = mr_viewer_state_json(r->v);
+    CHECK_MSG(!cJSON_IsTrue(cJSON_GetObjectItem(j, "help")), "F1 twice left the help open");
+    cJSON_Delete(j);
+    /* Mark mode: Enter marks the picture's centre; Esc leaves the mode. */
+    key(r, 'm');
+    key(r, MR_KEY_ENTER);
+    CHECK_MSG(count(r, MR_VA_MARK_AT, &x) == 1 && x.x == cx(r->f.image_rect) && x.y == cy(r->f.image_rect),
+              "Enter in mark mode did not mark the picture's centre");
+    key(r, MR_KEY_ESCAPE);
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 0, "Esc in mark mode quit");
+    key(r, MR_KEY_ENTER);
+    CHECK_MSG(count(r, MR_VA_MARK_AT, NULL) == 0, "Esc did not leave mark mode");
+    /* The chooser: 1..6 choose, Esc cancels, other keys do nothing. */
+    key(r, 'm');
+    mr_viewer_note_open(r->v, 0.5f, 0.5f);
+    key(r, 'q');
+    CHECK_MSG(count(r, MR_VA_MARK_FINISH, &x) == 1 && x.i == -1 && count(r, MR_VA_QUIT, NULL) == 0,
+              "q with the chooser open did not cancel the mark (or quit)");
+    key(r, 'm');
+    mr_viewer_note_open(r->v, 0.5f, 0.5f);
+    key(r, 'v');
+    CHECK_MSG(r->acts.count == 0, "v with the chooser open did something");
+    key(r, '6');
+    CHECK_MSG(count(r, MR_VA_MARK_FINISH, &x) == 1 && x.i == 5, "6 did not choose note 6");
+    key(r, 'q');
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 1, "q did not quit");
+    key(r, MR_KEY_ESCAPE);
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 1, "Esc did not quit");
+    /* Live input: no replay keys. */
+    r->f.seekable = false;
+    step(r);
+    key(r, ' ');
+    key(r, '.');
+    CHECK_MSG(r->acts.count == 0, "replay keys act on live input");
+    /* A window close is a quit. */
+    ev(r, MR_EVENT_CLOSE, 0, 0);
+    step(r);
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 1, "closing the window did not quit");
+}
+
+/* ---------------------------------------------------- AO / ghost order */
+
+static void test_cycling(rig *r) {
+    mr_view_settings s = *mr_viewer_settings(r->v);
+    s.ao = MR_AO_NONE;
+    s.ghost = MR_GHOST_OFF;
+    mr_viewer_set_settings(r->v, &s);
+    step(r);
+    for (int i = 1; i <= MR_AO_METHOD_COUNT; i++) {
+        if (i % 2) key(r, 'a');
+        else tap(r, MR_VW_AO);
+        int want = i % MR_AO_METHOD_COUNT;
+        CHECK_MSG((int)mr_viewer_settings(r->v)->ao == want, "AO press %d (%s) gave %s, want %s", i,
+                  i % 2 ? "key a" : "button", mr_ao_method_name(mr_viewer_settings(r->v)->ao),
+                  mr_ao_method_name((mr_ao_method)want));
+        CHECK_MSG(count(r, MR_VA_RENDER, NULL) == 1, "AO change asked for no render");
+    }
+    static const mr_ghost_mode order[] = {MR_GHOST_ALPHA, MR_GHOST_G0, MR_GHOST_ADAPTIVE, MR_GHOST_OFF, MR_GHOST_ALPHA};
+    for (int i = 0; i < 5; i++) {
+        if (i % 2) tap(r, MR_VW_GHOST);
+        else key(r, 'g');
+        CHECK_MSG(mr_viewer_settings(r->v)->ghost == order[i], "ghost press %d gave %s, want %s", i + 1,
+                  mr_view_ghost_name(mr_viewer_settings(r->v)->ghost), mr_view_ghost_name(order[i]));
+    }
+}
+
+/* ---------------------------------------------------------- settings */
+
+static bool same(const mr_view_settings *a, const mr_view_settings *b) {
+    return a->alpha == b->alpha && a->show_video == b->show_video && a->hide_hidden == b->hide_hidden &&
+           a->rate_i == b->rate_i && a->ao == b->ao && a->ghost == b->ghost;
+}
+
+static void test_settings(void) {
+    char path[1200], warn[1024];
+    tmp_path(path, sizeof path, "cfg/sub/view.json");
+    unlink(path);
+    mr_view_settings d = MR_VIEW_SETTINGS_DEFAULTS, s;
+    mr_view_settings_load(path, &s, warn, sizeof warn);
+    CHECK_MSG(same(&s, &d) && !warn[0], "a missing settings file: not the defaults, or a warning '%s'", warn);
+    CHECK(d.alpha == 0.5f && d.show_video && !d.hide_hidden && d.rate_i == 2 && d.ao == MR_AO_NONE &&
+          d.ghost == MR_GHOST_OFF);
+    /* Round trip of every field, in a folder that does not exist yet. */
+    mr_view_settings w = {0.25f, false, true, 4, MR_AO_HBAO, MR_GHOST_G0};
+    mr_error err = {0};
+    g_rn.renames = 0;
+    CHECK_MSG(mr_view_settings_save(path, &w, &err), "save: %s", err.msg);
+    mr_view_settings_load(path, &s, warn, sizeof warn);
+    CHECK_MSG(same(&s, &w) && !warn[0], "settings round trip: read back alpha %g video %d hidden %d rate %d ao %s "
+              "ghost %s, warning '%s'", s.alpha, s.show_video, s.hide_hidden, s.rate_i, mr_ao_method_name(s.ao),
+              mr_view_ghost_name(s.ghost), warn);
+    /* Atomic: the file arrives by rename; a failed rename leaves the old
+     * file whole and the save reports it. */
+    CHECK_MSG(g_rn.renames >= 1 && strcmp(g_rn.to, path) == 0,
+              "the settings file was not written by rename over it (written in place: not atomic)");
+    char *old = read_text(path);
+    mr_view_settings w2 = w;
+    w2.alpha = 0.9f;
+    g_rn.fail = EIO;
+    memset(&err, 0, sizeof err);
+    bool ok = mr_view_settings_save(path, &w2, &err);
+    g_rn.fail = 0;
+    char *now = read_text(path);
+    CHECK_MSG(!ok && err.msg[0], "a save whose rename failed reported success");
+    CHECK_MSG(old && now && strcmp(old, now) == 0, "a failed save changed the settings file in place (not atomic)");
+    free(old);
+    free(now);
+    /* Damaged files: a warning, defaults for what cannot be used, the rest
+     * kept, never a crash. */
+    static const struct {
+        const char *text, *what;
+        bool keeps_alpha;     /* alpha 0.25 in the text survives */
+    } bad[] = {
+        {"{\"alpha\": 0.25, \"ao\": \"hbao\"", "truncated JSON", false},
+        {"garbage \x01\xff", "not JSON", false},
+        {"", "an empty file", false},
+        {"[1, 2, 3]", "an array", false},
+        {"{\"alpha\": 1.5}", "alpha out of range", false},
+        {"{\"alpha\": \"half\"}", "alpha a string", false},
+        {"{\"alpha\": 0.25, \"show_video\": 1}", "show_video a number", true},
+        {"{\"alpha\": 0.25, \"ao\": \"magic\"}", "an unknown AO method", true},
+        {"{\"alpha\": 0.25, \"ghost\": 3}", "ghost a number", true},
+        {"{\"alpha\": 0.25, \"rate\": 3}", "a rate not on the list", true},
+        {"{\"alpha\": 0.25, \"hide_hidden_layer\": null}", "hide_hidden_layer null", true},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        write_text(path, bad[i].text);
+        mr_view_settings_load(path, &s, warn, sizeof warn);
+        CHECK_MSG(warn[0], "settings with %s gave no warning", bad[i].what);
+        CHECK_MSG(s.alpha == (bad[i].keeps_alpha ? 0.25f : d.alpha), "settings with %s: alpha %g", bad[i].what, s.alpha);
+        CHECK_MSG(s.show_video == d.show_video && s.hide_hidden == d.hide_hidden && s.rate_i == d.rate_i &&
+                      s.ao == d.ao && s.ghost == d.ghost,
+                  "settings with %s: a damaged field did not fall back to its default", bad[i].what);
+    }
+    /* The controller reads the file at start and saves a moment after a
+     * change, not at once (a slider drag would write per step). */
+    w.alpha = 0.25f;
+    CHECK(mr_view_settings_save(path, &w, &err));
+    rig r;
+    if (!rig_open(&r, path, 96 / 25.4, &err)) return;
+    CHECK_MSG(same(mr_viewer_settings(r.v), &w), "the controller did not start from the settings file");
+    step(&r);
+    key(&r, 'v');
+    mr_view_settings_load(path, &s, warn, sizeof warn);
+    CHECK_MSG(s.show_video == w.show_video, "settings saved at once on a change (want a moment later)");
+    for (int i = 0; i < 70; i++) step(&r); /* > 1 s of frames */
+    mr_view_settings_load(path, &s, warn, sizeof warn);
+    CHECK_MSG(s.show_video == !w.show_video, "settings not saved a second after a change");
+    mr_viewer_destroy(&r.v);
+    CHECK(r.v == NULL);
+    mr_viewer_destroy(&r.v);
+}
+
+/* ----------------------------------------------------------- replay */
+
+static void test_replay(rig *r) {
+    r->f.seekable = true;
+    r->f.playing = false;
+    r->f.index = 10;
+    r->f.count = 101;
+    mr_view_settings s = *mr_viewer_settings(r->v);
+    s.rate_i = MR_VIEW_RATE_COUNT - 1;
+    mr_viewer_set_settings(r->v, &s);
+    step(r);
+    if (mr_viewer_frozen(r->v)) key(r, 'f');
+    mr_view_action x;
+    tap(r, MR_VW_PLAY);
+    CHECK_MSG(count(r, MR_VA_PLAY, &x) == 1 && x.on, "Play while paused did not ask to play");
+    r->f.playing = true;
+    tap(r, MR_VW_PLAY);
+    CHECK_MSG(count(r, MR_VA_PLAY, &x) == 1 && !x.on, "Pause while playing did not ask to pause");
+    tap(r, MR_VW_BACK);
+    CHECK_MSG(count(r, MR_VA_STEP, &x) == 1 && x.i == -1, "< did not step back");
+    tap(r, MR_VW_FORWARD);
+    CHECK_MSG(count(r, MR_VA_STEP, &x) == 1 && x.i == 1, "> did not step forward");
+    tap(r, MR_VW_RATE);
+    CHECK_MSG(count(r, MR_VA_RATE, &x) == 1 && x.x == 0.25, "the rate button after 4x gave %g, want 0.25", x.x);
+    tap(r, MR_VW_RATE);
+    CHECK_MSG(count(r, MR_VA_RATE, &x) == 1 && x.x == 0.5, "the rate button after 0.25x gave %g, want 0.5", x.x);
+    /* Seek bar pressed at 90%: frame 90 of 0..100. */
+    key(r, 'f');
+    mr_ui_rect sk = wrect(r, MR_VW_SEEK);
+    float x9 = mr_ui_slider_knob_x(mr_viewer_ui_ctx(r->v), sk, 90.0f, 0, 100);
+    ev(r, MR_EVENT_POINTER_MOVE, x9, cy(sk));
+    ev(r, MR_EVENT_POINTER_DOWN, x9, cy(sk));
+    step(r);
+    CHECK_MSG(count(r, MR_VA_SEEK, &x) == 1 && x.i == 90, "seek bar at 90%% gave %d seeks to %lld, want frame 90",
+              count(r, MR_VA_SEEK, NULL), (long long)x.i);
+    CHECK_MSG(count(r, MR_VA_FREEZE, &x) == 1 && !x.on, "seeking while frozen did not unfreeze");
+    r->f.index = 90;
+    step(r);
+    CHECK_MSG(count(r, MR_VA_SEEK, NULL) == 0, "holding the seek bar on the shown frame seeks again");
+    ev(r, MR_EVENT_POINTER_UP, x9, cy(sk));
+    step(r);
+    /* Live input: no replay row. */
+    r->f.seekable = false;
+    step(r);
+    for (int id = MR_VW_PLAY; id <= MR_VW_SEEK; id++)
+        CHECK_MSG(!mr_viewer_layout(r->v)->shown[id], "live input shows the replay widget %s",
+                  mr_view_widget_name((mr_view_widget_id)id));
+}
+
+/* -------------------------------------------------- tracking lost */
+
+static void test_tracking_lost(void) {
+    for (int k = 0; k < 3; k++) {
+        mr_view_settings s = MR_VIEW_SETTINGS_DEFAULTS;
+        s.alpha = k == 0 ? 0.0f : k == 1 ? 0.5f : 0.8f;
+        mr_view_render_choice good = mr_view_render_policy(&s, true, true, false);
+        CHECK_MSG(good.alpha == s.alpha && good.use_pose && !good.dimmed, "a good pose changed alpha %g to %g",
+                  s.alpha, good.alpha);
+        /* Lost: towards the video, at the last good pose, model still there. */
+        mr_view_render_choice lost = mr_view_render_policy(&s, true, false, false);
+        double want = 1.0 - (1.0 - s.alpha) * 0.35;
+        CHECK_MSG(lost.dimmed && lost.use_pose && fabs(lost.alpha - want) < 1e-6,
+                  "tracking lost at alpha %g: alpha %g (want %g, faded towards the video), dimmed %d, pose %d",
+                  s.alpha, lost.alpha, want, lost.dimmed, lost.use_pose);
+        CHECK_MSG(lost.alpha > s.alpha && lost.alpha < 1.0f, "tracking lost at alpha %g gave %g: want between the "
+                  "setting and video only", s.alpha, lost.alpha);
+        /* Frozen: the still is what the user chose to look at. */
+        mr_view_render_choice fr = mr_view_render_policy(&s, true, false, true);
+        CHECK_MSG(fr.alpha == s.alpha && !fr.dimmed, "a frozen picture was dimmed");
+        /* No video: nothing to fade to. */
+        s.show_video = false;
+        mr_view_render_choice nv = mr_view_render_policy(&s, true, false, false);
+        CHECK_MSG(nv.alpha == s.alpha && nv.dimmed, "tracking lost without video changed alpha to %g", nv.alpha);
+        /* Never a pose: video only, from a neutral pose. */
+        s.show_video = true;
+        mr_view_render_choice np = mr_view_render_policy(&s, false, false, false);
+        CHECK_MSG(np.alpha == 1.0f && !np.use_pose, "no pose yet: alpha %g, pose %d (want video only)", np.alpha,
+                  np.use_pose);
+    }
+}
+
+/* ------------------------------------------------------------ layout */
+
+static bool overlap(mr_ui_rect a, mr_ui_rect b) {
+    return a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
+}
+
+/* Every shown widget: >= 9 mm on both sides at the screen's own density,
+ * inside the window, clear of the others. Returns how many are shown. */
+static int check_layout(const mr_view_layout *L, double ppmm, float w, float h, const char *what) {
+    int n = 0;
+    float smallest = INFINITY;
+    for (int i = 0; i < MR_VW_COUNT; i++) {
+        if (!L->shown[i]) continue;
+        n++;
+        mr_ui_rect r = L->rect[i];
+        double wmm = r.w / ppmm, hmm = r.h / ppmm;
+        smallest = fminf(smallest, (float)fmin(wmm, hmm));
+        CHECK_MSG(wmm >= 9.0 - 1e-3 && hmm >= 9.0 - 1e-3, "%s: widget %s is %.2f x %.2f mm, want >= 9 mm", what,
+                  mr_view_widget_name((mr_view_widget_id)i), wmm, hmm);
+        CHECK_MSG(r.x >= 0 && r.y >= 0 && r.x + r.w <= w + 1e-3f && r.y + r.h <= h + 1e-3f,
+                  "%s: widget %s at (%.1f, %.1f) %.1f x %.1f leaves the %gx%g window", what,
+                  mr_view_widget_name((mr_view_widget_id)i), r.x, r.y, r.w, r.h, w, h);
+        for (int j = 0; j < i; j++)
+            CHECK_MSG(!L->shown[j] || !overlap(r, L->rect[j]), "%s: widgets %s and %s overlap", what,
+                      mr_view_widget_name((mr_view_widget_id)i), mr_view_widget_name((mr_view_widget_id)j));
+    }
+    if (n) CHECK_MSG(smallest <= 9.6f, "%s: the smallest target is %.2f mm, want 9 (sizes scaled wrongly)", what, smallest);
+    return n;
+}
+
+static void test_layout(const char *font_path) {
+    static const struct {
+        const char *what;
+        double dpi;
+        float w, h;
+        bool all;       /* everything fits */
+    } cases[] = {
+        {"96 dpi 1280x720", 96, 1280, 720, true},
+        {"160 dpi tablet 1280x800", 160, 1280, 800, true},
+        {"2x scale 2560x1440", 192, 2560, 1440, true},
+        {"96 dpi 480x360 (the CLI test's window)", 96, 480, 360, true},
+        {"267 dpi phone 1080x1920", 267, 1080, 1920, true},
+        {"96 dpi 480x150, short", 96, 480, 150, false},
+        {"96 dpi 160x120, tiny", 96, 160, 120, false},
+        {"160 dpi 200x150, tiny", 160, 200, 150, false},
+        {"96 dpi 40x30, smaller than a target", 96, 40, 30, false},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        double ppmm = cases[c].dpi / 25.4;
+        mr_ui_font_params fp = MR_UI_FONT_DEFAULTS;
+        fp.path = font_path;
+        fp.pixel_height = 20;
+        mr_error err = {0};
+        mr_ui_font *font = mr_ui_font_create(&fp, &err);
+        mr_ui_params up = MR_UI_DEFAULTS;
+        up.font = font;
+        up.px_per_mm = ppmm;
+        mr_ui *ui = font ? mr_ui_create(&up, &err) : NULL;
+        CHECK_MSG(ui != NULL, "%s", err.msg);
+        for (int mode = 0; ui && mode < 4; mode++) {
+            bool seek = mode & 1, notes = mode & 2;
+            char what[200];
+            snprintf(what, sizeof what, "%s%s%s", cases[c].what, seek ? ", replay" : "", notes ? ", note chooser" : "");
+            mr_view_layout_params lp = {cases[c].w, cases[c].h, seek, notes, cases[c].w * 0.25f};
+            mr_view_layout L;
+            mr_view_layout_compute(ui, &lp, &L);
+            int n = check_layout(&L, ppmm, cases[c].w, cases[c].h, what);
+            int want = 9 + (seek ? 5 : 0) + (notes ? 7 : 0);
+            if (cases[c].all) {
+                CHECK_MSG(n == want && L.dropped == 0, "%s: %d widgets shown (%d dropped), want all %d", what, n,
+                          L.dropped, want);
+            } else {
+                CHECK_MSG(n + L.dropped == want && (L.dropped > 0 || !seek), "%s: %d shown + %d dropped, want %d "
+                          "in all and some dropped", what, n, L.dropped, want);
+                /* Lower priorities go first: the column is a prefix of
+                 * freeze, snapshot, mark, video, hidden, ao, ghost, help. */
+                for (int i = MR_VW_SNAPSHOT; i <= MR_VW_HELP; i++)
+                    CHECK_MSG(!L.shown[i] || L.shown[i - 1], "%s: %s shown but %s (higher priority) left out", what,
+                              mr_view_widget_name((mr_view_widget_id)i), mr_view_widget_name((mr_view_widget_id)(i - 1)));
+                CHECK_MSG(!L.shown[MR_VW_RATE] || L.shown[MR_VW_SEEK], "%s: the rate button kept, the seek bar left out",
+                          what);
+            }
+            if (notes && cases[c].all && L.picture.w >= 2 * L.notes.w) {
+                /* The chooser sits over the picture, away from the mark. */
+                CHECK_MSG(L.notes.x > lp.mark_x, "%s: the chooser covers the mark", what);
+                lp.mark_x = cases[c].w * 0.6f;
+                mr_view_layout_compute(ui, &lp, &L);
+                CHECK_MSG(L.notes.x + L.notes.w < lp.mark_x, "%s: the chooser covers a mark on the right", what);
+            } else if (notes && cases[c].all) {
+                CHECK_MSG(fabsf(L.notes.x + L.notes.w / 2 - (L.picture.x + L.picture.w / 2)) < 1,
+                          "%s: a chooser with no room beside the mark is not centred", what);
+            }
+        }
+        /* The transparency slider, the main control, survives in tiny windows. */
+        mr_view_layout_params lp = {160 * (float)ppmm / 3.78f, 120 * (float)ppmm / 3.78f, true, false, 0};
+        mr_view_layout L;
+        if (ui) {
+            mr_view_layout_compute(ui, &lp, &L);
+            CHECK_MSG(L.shown[MR_VW_ALPHA] && L.shown[MR_VW_PLAY] && !L.shown[MR_VW_HELP],
+                      "%s: a 42x32 mm window shows alpha %d, play %d, help %d (want the slider and play, no help)",
+                      cases[c].what, L.shown[MR_VW_ALPHA], L.shown[MR_VW_PLAY], L.shown[MR_VW_HELP]);
+        }
+        mr_ui_destroy(&ui);
+        mr_ui_font_destroy(&font);
+    }
+}
+
+/* ------------------------------------------------------------ scripts */
+
+static void test_script(const char *font_path) {
+    char sp[1200], st[1200];
+    tmp_path(sp, sizeof sp, "s.script");
+    tmp_path(st, sizeof st, "s_state.json");
+    char text[2600];
+    snprintf(text, sizeof text,
+             "# comment\n0.1 tap @video\n\n0.2 key f\n0.3 state %s\n0.35 drag @alpha 0.5 0.0\n0.4 resize 300 200\n"
+             "0.5 quit\n", st);
+    write_text(sp, text);
+    mr_error err = {0};
+    mr_view_script *s = mr_view_script_load(sp, &err);
+    CHECK_MSG(s != NULL, "script: %s", err.msg);
+    rig r;
+    if (!s || !rig_open(&r, NULL, 96 / 25.4, &err)) {
+        mr_view_script_destroy(&s);
+        return;
+    }
+    (void)font_path;
+    mr_viewer_set_script(r.v, &s);
+    CHECK(s == NULL);
+    bool video = mr_viewer_settings(r.v)->show_video, froze = false, state = false, quit = false, resize = false;
+    double t_state = -1, t_quit = -1;
+    for (int i = 0; i < 200 && !quit; i++) {
+        step(&r);
+        if (count(&r, MR_VA_FREEZE, NULL)) froze = true;
+        mr_view_action x;
+        if (count(&r, MR_VA_STATE, &x)) {
+            state = x.path && strcmp(x.path, st) == 0;
+            t_state = r.t;
+        }
+        if (count(&r, MR_VA_RESIZE, &x)) resize = x.x == 300 && x.y == 200;
+        if (count(&r, MR_VA_QUIT, NULL)) {
+            quit = true;
+            t_quit = r.t;
+        }
+    }
+    CHECK_MSG(mr_viewer_settings(r.v)->show_video == !video, "script tap @video did not toggle the video");
+    CHECK_MSG(froze && state && resize && quit, "script: freeze %d state %d resize %d quit %d", froze, state, resize,
+              quit);
+    CHECK_MSG(mr_viewer_settings(r.v)->alpha == 0.0f, "script drag @alpha to 0 gave %g", mr_viewer_settings(r.v)->alpha);
+    CHECK_MSG(t_state >= 0.3 && t_quit >= 0.5 && t_quit > t_state, "script commands ran early or out of order "
+              "(state at %.3f s, quit at %.3f s)", t_state, t_quit);
+    mr_viewer_destroy(&r.v);
+    /* A bad line names the file and line. */
+    write_text(sp, "0.1 tap @video\n0.2 fly 1 2\n");
+    memset(&err, 0, sizeof err);
+    s = mr_view_script_load(sp, &err);
+    CHECK_MSG(s == NULL && err.code == MR_ERR_PARSE && strstr(err.msg, ":2:"), "bad script line: %s", err.msg);
+    mr_view_script_destroy(&s);
+    int k = 0;
+    CHECK(mr_view_key_parse("esc", &k) && k == MR_KEY_ESCAPE);
+    CHECK(mr_view_key_parse("space", &k) && k == ' ');
+    CHECK(!mr_view_key_parse("nokey", &k));
+}
+
+int main(void) {
+    const char *t = getenv("MR_TEST_TMP");
+    snprintf(g_tmp, sizeof g_tmp, "%s/test_view", t && t[0] ? t : "/tmp");
+    mr_error err = {0};
+    CHECK_MSG(mr_mkdirs(g_tmp, &err), "%s", err.msg);
+    test_tracking_lost();
+    test_settings();
+    char font[1024];
+    if (!mr_ui_font_find(font, sizeof font, &err)) {
+        printf("test_view: SKIPPED the controller tests (no font): %s\n", err.msg);
+        return mr_test_failures ? mr_test_finish("test_view") : MR_TEST_SKIP;
+    }
+    rig r;
+    CHECK_MSG(rig_open(&r, NULL, 96 / 25.4, &err), "%s", err.msg);
+    if (r.v) {
+        test_slider(&r);
+        test_toggles(&r);
+        test_keys(&r);
+        test_cycling(&r);
+        test_replay(&r);
+        mr_viewer_destroy(&r.v);
+    }
+    test_layout(font);
+    test_script(font);
+    return mr_test_finish("test_view");
+}
