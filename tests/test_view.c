@@ -648,6 +648,43 @@ static void test_layout(const char *font_path) {
     }
 }
 
+/* Every window size from tiny to large, in small steps: the rules hold
+ * everywhere (not only at the sizes above), and widgets come back in
+ * priority order as the window grows. */
+static void test_layout_sweep(const char *font_path) {
+    double ppmm = 96 / 25.4;
+    mr_ui_font_params fp = MR_UI_FONT_DEFAULTS;
+    fp.path = font_path;
+    fp.pixel_height = 12;
+    mr_error err = {0};
+    mr_ui_font *font = mr_ui_font_create(&fp, &err);
+    mr_ui_params up = MR_UI_DEFAULTS;
+    up.font = font;
+    up.px_per_mm = ppmm;
+    mr_ui *ui = font ? mr_ui_create(&up, &err) : NULL;
+    CHECK_MSG(ui != NULL, "%s", err.msg);
+    for (float w = 20; ui && w <= 900; w += 7)
+        for (float h = 20; h <= 700; h += 23) {
+            char what[64];
+            snprintf(what, sizeof what, "replay window %gx%g at 96 dpi", w, h);
+            mr_view_layout_params lp = {w, h, true, false, 0};
+            mr_view_layout L;
+            mr_view_layout_compute(ui, &lp, &L);
+            int n = check_layout(&L, ppmm, w, h, what);
+            CHECK_MSG(n + L.dropped == 14, "%s: %d shown + %d dropped, want 14", what, n, L.dropped);
+            for (int i = MR_VW_SNAPSHOT; i <= MR_VW_HELP; i++)
+                CHECK_MSG(!L.shown[i] || L.shown[i - 1], "%s: %s shown but %s left out", what,
+                          mr_view_widget_name((mr_view_widget_id)i), mr_view_widget_name((mr_view_widget_id)(i - 1)));
+            CHECK_MSG(!L.shown[MR_VW_RATE] || L.shown[MR_VW_SEEK], "%s: the rate button kept, the seek bar left out",
+                      what);
+            CHECK_MSG(!L.shown[MR_VW_PLAY] || L.shown[MR_VW_ALPHA], "%s: replay buttons without the slider", what);
+            if (mr_test_failures > 20) goto out;
+        }
+out:
+    mr_ui_destroy(&ui);
+    mr_ui_font_destroy(&font);
+}
+
 /* ------------------------------------------------------------ scripts */
 
 static void test_script(const char *font_path) {
@@ -728,6 +765,7 @@ int main(void) {
         mr_viewer_destroy(&r.v);
     }
     test_layout(font);
+    test_layout_sweep(font);
     test_script(font);
     return mr_test_finish("test_view");
 }
