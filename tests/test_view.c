@@ -571,6 +571,22 @@ static int check_layout(const mr_view_layout *L, double ppmm, float w, float h, 
     return n;
 }
 
+/* A ui at a density, for the layout alone (the font's bake size does not
+ * matter to it). */
+static mr_ui *make_ui(const char *font_path, float font_px, double ppmm, mr_ui_font **font) {
+    mr_ui_font_params fp = MR_UI_FONT_DEFAULTS;
+    fp.path = font_path;
+    fp.pixel_height = font_px;
+    mr_error err = {0};
+    *font = mr_ui_font_create(&fp, &err);
+    mr_ui_params up = MR_UI_DEFAULTS;
+    up.font = *font;
+    up.px_per_mm = ppmm;
+    mr_ui *ui = *font ? mr_ui_create(&up, &err) : NULL;
+    CHECK_MSG(ui != NULL, "%s", err.msg);
+    return ui;
+}
+
 static void test_layout(const char *font_path) {
     static const struct {
         const char *what;
@@ -590,16 +606,8 @@ static void test_layout(const char *font_path) {
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
         double ppmm = cases[c].dpi / 25.4;
-        mr_ui_font_params fp = MR_UI_FONT_DEFAULTS;
-        fp.path = font_path;
-        fp.pixel_height = 20;
-        mr_error err = {0};
-        mr_ui_font *font = mr_ui_font_create(&fp, &err);
-        mr_ui_params up = MR_UI_DEFAULTS;
-        up.font = font;
-        up.px_per_mm = ppmm;
-        mr_ui *ui = font ? mr_ui_create(&up, &err) : NULL;
-        CHECK_MSG(ui != NULL, "%s", err.msg);
+        mr_ui_font *font = NULL;
+        mr_ui *ui = make_ui(font_path, 20, ppmm, &font);
         for (int mode = 0; ui && mode < 4; mode++) {
             bool seek = mode & 1, notes = mode & 2;
             char what[200];
@@ -653,16 +661,8 @@ static void test_layout(const char *font_path) {
  * priority order as the window grows. */
 static void test_layout_sweep(const char *font_path) {
     double ppmm = 96 / 25.4;
-    mr_ui_font_params fp = MR_UI_FONT_DEFAULTS;
-    fp.path = font_path;
-    fp.pixel_height = 12;
-    mr_error err = {0};
-    mr_ui_font *font = mr_ui_font_create(&fp, &err);
-    mr_ui_params up = MR_UI_DEFAULTS;
-    up.font = font;
-    up.px_per_mm = ppmm;
-    mr_ui *ui = font ? mr_ui_create(&up, &err) : NULL;
-    CHECK_MSG(ui != NULL, "%s", err.msg);
+    mr_ui_font *font = NULL;
+    mr_ui *ui = make_ui(font_path, 12, ppmm, &font);
     for (float w = 20; ui && w <= 900; w += 7)
         for (float h = 20; h <= 700; h += 23) {
             char what[64];
@@ -687,7 +687,7 @@ out:
 
 /* ------------------------------------------------------------ scripts */
 
-static void test_script(const char *font_path) {
+static void test_script(void) {
     char sp[1200], st[1200];
     tmp_path(sp, sizeof sp, "s.script");
     tmp_path(st, sizeof st, "s_state.json");
@@ -704,7 +704,6 @@ static void test_script(const char *font_path) {
         mr_view_script_destroy(&s);
         return;
     }
-    (void)font_path;
     mr_viewer_set_script(r.v, &s);
     CHECK(s == NULL);
     bool video = mr_viewer_settings(r.v)->show_video, froze = false, state = false, quit = false, resize = false;
@@ -766,6 +765,6 @@ int main(void) {
     }
     test_layout(font);
     test_layout_sweep(font);
-    test_script(font);
+    test_script();
     return mr_test_finish("test_view");
 }
