@@ -37,6 +37,12 @@ touch_target_px|lib/ui/widgets.c|ceilf(mr_ui_mm(ui, ui->p.min_target_mm))|ceilf(
 touch_target_px_in_view|lib/ui/widgets.c|ceilf(mr_ui_mm(ui, ui->p.min_target_mm))|ceilf(ui->p.min_target_mm)|^cli_view$
 overlay_p1_p2_swapped|shaders/overlay.frag.glsl|p1 = u_dist[2], p2 = u_dist[3]|p1 = u_dist[3], p2 = u_dist[2]|^test_render$
 overlay_p2_sign|shaders/overlay.frag.glsl|2.0 * p1 * xy.x * xy.y + p2 * (r2|2.0 * p1 * xy.x * xy.y - p2 * (r2|^test_render$
+view_act_on_press|lib/ui/widgets.c|bool clicked = enabled && ui->released && ui->active == id && over;|bool clicked = enabled && ui->pressed && over;|^test_view$
+view_slide_off_acts|lib/ui/widgets.c|bool clicked = enabled && ui->released && ui->active == id && over;|bool clicked = enabled && ui->released && ui->active == id;|^test_view$
+view_ao_cycle_backwards|lib/view/controller.c|v->s.ao = (mr_ao_method)((v->s.ao + 1) % MR_AO_METHOD_COUNT);|v->s.ao = (mr_ao_method)((v->s.ao + MR_AO_METHOD_COUNT - 1) % MR_AO_METHOD_COUNT);|^test_view$
+view_settings_in_place|lib/view/settings.c|    bool ok = (!dir[0] |    FILE *fo = fopen(path, "wb");\n    char *txt = cJSON_Print(j);\n    if (fo && txt) fputs(txt, fo);\n    if (fo) fclose(fo);\n    free(txt);\n    bool ok = true;\n    if (0) ok = (!dir[0] |^test_view$
+view_lost_fades_to_model|lib/view/controller.c|1.0f - (1.0f - s->alpha) * 0.35f|s->alpha * 0.35f|^test_view$
+view_layout_drops_first|lib/view/controller.c|        if (i >= shown) {|        if (i < n - shown) {|^test_view$
 gl_context_4.9|lib/render/gpu.c|EGL_CONTEXT_MINOR_VERSION, 5,|EGL_CONTEXT_MINOR_VERSION, 9,|^(test_render|cli_render)$
 LIST
 )
