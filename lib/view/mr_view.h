@@ -8,8 +8,10 @@
  * capture threads and carries the actions out; nothing here touches GL,
  * GLFW, files other than the settings file, or app/.
  *
- * Depends on: lib/core, lib/ui, and plain types of lib/render's header
- * (mr_event, MR_KEY_*, mr_ao_method, mr_ghost_mode). One way only.
+ * Depends on: lib/core, lib/ui, and from lib/render only plain types and
+ * names (mr_event, MR_KEY_*, mr_ao_method, mr_ghost_mode,
+ * mr_ao_method_name/parse): no GL or GLFW call. One way only: nothing
+ * below lib/view includes this header.
  */
 #ifndef MR_VIEW_CTL_H
 #define MR_VIEW_CTL_H
