@@ -469,6 +469,12 @@ static void test_annotations_reader(void) {
     }
     CHECK(mr_annotations_parse(good, strlen(good), &an, &err) && an.count == 1 && an.bad_lines == 0);
     mr_annotations_free(&an);
+    /* A whole object without its newline is still a torn write (the crash
+     * came before the '\n'): skipped, not read. */
+    CHECK(mr_annotations_parse(good, strlen(good) - 1, &an, &err));
+    CHECK_MSG(an.count == 0 && an.bad_lines == 0 && an.torn_tail,
+              "a last line without newline was read (%d marks) or not reported torn", an.count);
+    mr_annotations_free(&an);
     free(good);
 }
 
