@@ -439,6 +439,7 @@ static void test_annotations_reader(void) {
         "[1,2,3]\n",                                                     /* not an object */
         "{\"note\":\"no type\"}\n",                                      /* no type */
         "{\"type\":5}\n",                                                /* type not a string */
+        "{\"type\":\"\"}\n",                                               /* empty type */
         "{\"type\":\"discrepancy\",\"pixel\":[1]}\n",                    /* pixel not [x,y] */
         "{\"type\":\"discrepancy\",\"world\":[1,2]}\n",                  /* world not [x,y,z] */
         "{\"type\":\"discrepancy\",\"hit\":true,\"world\":null}\n",      /* a hit without a point */

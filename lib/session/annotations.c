@@ -75,7 +75,7 @@ static bool parse_annotation(const cJSON *o, mr_annotation *a) {
     memset(a, 0, sizeof *a);
     a->frame_index = -1;
     a->world_from_camera = mr_m4_identity();
-    if (!cJSON_IsObject(o) || !get_str(o, "type", a->type, sizeof a->type, true)) return false;
+    if (!cJSON_IsObject(o) || !get_str(o, "type", a->type, sizeof a->type, true) || !a->type[0]) return false;
     double fi = -1;
     if (!get_num(o, "time_unix", &a->time_unix) || !get_num(o, "timestamp", &a->timestamp) ||
         !get_num(o, "frame_index", &fi) || !get_num(o, "depth", &a->depth))

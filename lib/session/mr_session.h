@@ -142,6 +142,9 @@ typedef struct mr_replay mr_replay;
  * line format, supplies timestamps and poses by "frame" number). Fails if
  * there are no frames. */
 mr_replay *mr_replay_open(const char *dir, mr_error *err);
+/* The index of a recording already read (takes ownership of rec, also on
+ * failure; used by mr_replay_open and the fuzz target). */
+mr_replay *mr_replay_from_recording(mr_recording *rec, mr_error *err);
 void mr_replay_close(mr_replay **r); /* NULLs *r; accepts NULL */
 int64_t mr_replay_count(const mr_replay *r);
 /* Frame at position i; NULL if out of range. */
@@ -196,7 +199,7 @@ typedef struct mr_annotations {
 
 /* Tolerant reader: a torn last line is skipped, a garbage line anywhere is
  * counted and skipped; a line is garbage if it is not a JSON object with a
- * string "type", or if a present field has the wrong shape (non-finite
+ * non-empty string "type", or if a present field has the wrong shape (non-finite
  * numbers, pixel not [x,y], world not [x,y,z] or null, a non-rigid pose).
  * Fails only when out of memory. mr_annotations_load: a missing file is
  * zero annotations. */

@@ -55,41 +55,11 @@ static void read_folder_lines(mr_replay *r, const char *dir) {
     if (tmp.bad_lines) mr_log(MR_LOG_WARN, "%s: skipped %d unreadable line(s)", path, tmp.bad_lines);
 }
 
-mr_replay *mr_replay_open(const char *dir, mr_error *err) {
-    mr_replay *r = calloc(1, sizeof *r);
-    if (!r) {
-        mr_fail(err, MR_ERR_NOMEM, "out of memory");
-        return NULL;
-    }
-    if (mr_is_recording(dir)) {
-        r->rec = mr_recording_open(dir, err);
-        if (!r->rec) goto fail;
-        r->count = r->rec->frame_count;
-        if (r->count <= 0) {
-            mr_fail(err, MR_ERR_IO, "recording %s has no frames", dir);
-            goto fail;
-        }
-    } else {
-        char sub[4096];
-        mr_error ignored = {0};
-        mr_path_join(dir, "frames", sub, sizeof sub);
-        const char *from = sub;
-        if (!mr_image_folder_list(sub, &r->names, &r->name_count, &ignored) || r->name_count == 0) {
-            mr_image_folder_free(&r->names, r->name_count);
-            from = dir;
-            if (!mr_image_folder_list(dir, &r->names, &r->name_count, &ignored) || r->name_count == 0) {
-                mr_fail(err, MR_ERR_IO, "%s holds no frames (expected a recording or images in %s/frames/)", dir, dir);
-                goto fail;
-            }
-        }
-        snprintf(r->dir, sizeof r->dir, "%s", from);
-        r->count = r->name_count;
-    }
+/* Positions 0 .. count-1 with their defaults, then what the recording
+ * says (a plain folder's frames.jsonl is read by the caller). */
+static bool fill_frames(mr_replay *r, mr_error *err) {
     r->frames = calloc((size_t)r->count, sizeof *r->frames);
-    if (!r->frames) {
-        mr_fail(err, MR_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
+    if (!r->frames) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
     for (int64_t i = 0; i < r->count; i++) {
         mr_replay_frame *f = &r->frames[i];
         f->index = i;
@@ -99,11 +69,58 @@ mr_replay *mr_replay_open(const char *dir, mr_error *err) {
         f->pose = mr_m4_identity();
         if (r->rec) from_rec_frame(&r->rec->frames[i], f);
     }
-    if (!r->rec) read_folder_lines(r, dir);
+    return true;
+}
+
+mr_replay *mr_replay_from_recording(mr_recording *rec, mr_error *err) {
+    mr_replay *r = calloc(1, sizeof *r);
+    if (!r) {
+        mr_recording_close(&rec);
+        mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    r->rec = rec;
+    r->count = rec->frame_count;
+    if (r->count <= 0) {
+        mr_fail(err, MR_ERR_IO, "recording %s has no frames", rec->dir);
+        mr_replay_close(&r);
+        return NULL;
+    }
+    if (!fill_frames(r, err)) mr_replay_close(&r);
     return r;
-fail:
-    mr_replay_close(&r);
-    return NULL;
+}
+
+mr_replay *mr_replay_open(const char *dir, mr_error *err) {
+    if (mr_is_recording(dir)) {
+        mr_recording *rec = mr_recording_open(dir, err);
+        return rec ? mr_replay_from_recording(rec, err) : NULL;
+    }
+    mr_replay *r = calloc(1, sizeof *r);
+    if (!r) {
+        mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    char sub[4096];
+    mr_error ignored = {0};
+    mr_path_join(dir, "frames", sub, sizeof sub);
+    const char *from = sub;
+    if (!mr_image_folder_list(sub, &r->names, &r->name_count, &ignored) || r->name_count == 0) {
+        mr_image_folder_free(&r->names, r->name_count);
+        from = dir;
+        if (!mr_image_folder_list(dir, &r->names, &r->name_count, &ignored) || r->name_count == 0) {
+            mr_fail(err, MR_ERR_IO, "%s holds no frames (expected a recording or images in %s/frames/)", dir, dir);
+            mr_replay_close(&r);
+            return NULL;
+        }
+    }
+    snprintf(r->dir, sizeof r->dir, "%s", from);
+    r->count = r->name_count;
+    if (!fill_frames(r, err)) {
+        mr_replay_close(&r);
+        return NULL;
+    }
+    read_folder_lines(r, dir);
+    return r;
 }
 
 void mr_replay_close(mr_replay **r) {
