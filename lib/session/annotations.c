@@ -115,17 +115,13 @@ static bool ann_line(void *vctx, const char *line, size_t n) {
         return false;
     }
     mr_annotations *a = c->a;
-    if (a->count == c->cap) {
-        int cap = c->cap ? 2 * c->cap : 16;
-        mr_annotation *ni = realloc(a->items, (size_t)cap * sizeof *ni);
-        if (!ni) {
-            cJSON_Delete(o);
-            c->oom = true;
-            return false;
-        }
-        a->items = ni;
-        c->cap = cap;
+    mr_annotation *ni = mr_sess_grow(a->items, a->count, &c->cap, 16, sizeof *ni);
+    if (!ni) {
+        cJSON_Delete(o);
+        c->oom = true;
+        return false;
     }
+    a->items = ni;
     an.json = o;
     a->items[a->count++] = an;
     return true;

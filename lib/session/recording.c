@@ -301,6 +301,14 @@ char *mr_sess_json_line(const cJSON *obj, size_t *n) {
     return line;
 }
 
+void *mr_sess_grow(void *items, int count, int *cap, int first, size_t elem) {
+    if (items && count < *cap) return items;
+    int ncap = *cap ? 2 * *cap : first;
+    void *n = realloc(items, (size_t)ncap * elem);
+    if (n) *cap = ncap;
+    return n;
+}
+
 typedef struct frames_ctx { mr_recording *rec; int cap; bool oom; } frames_ctx;
 
 static bool frame_line(void *vctx, const char *line, size_t n) {
@@ -315,17 +323,13 @@ static bool frame_line(void *vctx, const char *line, size_t n) {
         return false;
     }
     mr_recording *r = c->rec;
-    if (r->frame_count == c->cap) {
-        int cap = c->cap ? 2 * c->cap : 256;
-        mr_rec_frame *nf = realloc(r->frames, (size_t)cap * sizeof *nf);
-        if (!nf) {
-            free(f.detections);
-            c->oom = true;
-            return false;
-        }
-        r->frames = nf;
-        c->cap = cap;
+    mr_rec_frame *nf = mr_sess_grow(r->frames, r->frame_count, &c->cap, 256, sizeof *nf);
+    if (!nf) {
+        free(f.detections);
+        c->oom = true;
+        return false;
     }
+    r->frames = nf;
     r->frames[r->frame_count++] = f;
     return true;
 }

@@ -18,4 +18,9 @@ void mr_sess_for_lines(const char *text, size_t size, mr_sess_line_fn fn, void *
  * ending in '\n' (*n its length); NULL when out of memory. */
 char *mr_sess_json_line(const cJSON *obj, size_t *n);
 
+/* Makes room for one more element in a growing array (items holding count
+ * elements, capacity *cap, doubling from first): returns the array to use
+ * from now on, or NULL when out of memory (items is then left as it was). */
+void *mr_sess_grow(void *items, int count, int *cap, int first, size_t elem);
+
 #endif
