@@ -242,6 +242,12 @@ void mr_tracker_destroy(mr_tracker **t); /* NULLs *t; accepts NULL */
  * clock). false + err only when the frame cannot be processed (too small,
  * bad image); a frame without tags or without a pose is success. */
 bool mr_tracker_frame(mr_tracker *t, const mr_image *image, double timestamp, mr_tracker_result *out, mr_error *err);
+/* The same from detections found elsewhere (another detector, e.g. the
+ * aruco peer in `bench tracking`, or detections read from a recording):
+ * everything after detection, for a frame of width x height pixels.
+ * out->detections is dets. */
+bool mr_tracker_detections(mr_tracker *t, const mr_detection *dets, int count, int width, int height, double timestamp,
+                           mr_tracker_result *out, mr_error *err);
 /* Forgets the previous pose and restarts the filter (a cut in the input);
  * a freeze is lifted. */
 void mr_tracker_reset(mr_tracker *t);

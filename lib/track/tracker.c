@@ -96,25 +96,37 @@ const mr_camera *mr_tracker_camera(const mr_tracker *t) { return t->has_camera ?
 const mr_marker_map *mr_tracker_markers(const mr_tracker *t) { return t->has_markers ? &t->markers : NULL; }
 
 bool mr_tracker_frame(mr_tracker *t, const mr_image *image, double timestamp, mr_tracker_result *out, mr_error *err) {
+    int n = 0;
+    const mr_detection *d = mr_detector_detect(t->det, image, &n, err);
+    if (!d) {
+        memset(out, 0, sizeof *out);
+        out->filtered = mr_m4_identity();
+        return false;
+    }
+    return mr_tracker_detections(t, d, n, image->width, image->height, timestamp, out, err);
+}
+
+bool mr_tracker_detections(mr_tracker *t, const mr_detection *dets, int count, int width, int height, double timestamp,
+                           mr_tracker_result *out, mr_error *err) {
     memset(out, 0, sizeof *out);
     out->filtered = mr_m4_identity();
-    out->detections = mr_detector_detect(t->det, image, &out->detection_count, err);
-    if (!out->detections) return false;
+    if (count < 0 || (count > 0 && !dets) || width <= 0 || height <= 0)
+        return mr_fail(err, MR_ERR_INVALID, "tracker: bad detections or frame size");
+    out->detections = dets;
+    out->detection_count = count;
     out->frozen = mr_tracker_frozen(t);
     if (!t->has_camera || !t->has_markers) return true;
     out->solved = true;
     mr_camera cam = t->camera;
-    if (image->width != cam.width || image->height != cam.height) {
+    if (width != cam.width || height != cam.height) {
         /* Same lens, other resolution (e.g. a camera delivering 640x480
          * for a 1280x960 calibration): scale the intrinsics. */
-        cam = mr_camera_resized(&t->camera, image->width, image->height);
+        cam = mr_camera_resized(&t->camera, width, height);
     }
     double age = timestamp - t->prev_t;
     const mr_pose *prev = t->prev.valid && age >= 0 && age < t->prev_max_age_s ? &t->prev : NULL;
     out->prev_used = prev != NULL;
-    if (!mr_pose_solve(&cam, &t->markers, out->detections, out->detection_count, prev, &t->pose_params, &out->pose,
-                       err))
-        return false;
+    if (!mr_pose_solve(&cam, &t->markers, dets, count, prev, &t->pose_params, &out->pose, err)) return false;
     if (out->pose.valid) {
         t->prev = out->pose;
         t->prev_t = timestamp;
