@@ -159,7 +159,7 @@ static void test_freeze_hold(void) {
 
 /* A frame at half the calibrated size: the intrinsics are rescaled, so the
  * pose stays near where the full frame puts it (frame 0's two tags are
- * about 14 px wide at half size: 0.29 units apart today, at ~12 units;
+ * about 14 px wide at half size: 0.29 units apart today;
  * unscaled intrinsics put it ~8 units away). */
 static void test_resized_frame(void) {
     mr_image half;
