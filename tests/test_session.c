@@ -49,6 +49,15 @@ static bool same_m4(const mr_dmat4 *a, const mr_dmat4 *b) {
     return true;
 }
 
+/* A recorder in dir and a 64x48 grey image for its frames. */
+static mr_recorder *open_recorder(const char *dir, const mr_recorder_params *rp, mr_image *img) {
+    mr_error err = {0};
+    mr_recorder *r = mr_recorder_create(dir, rp, &err);
+    CHECK_MSG(r != NULL, "recorder in %s: %s", dir, err.msg);
+    if (r) mr_image_alloc(img, 64, 48, 1, MR_PIX_U8, NULL);
+    return r;
+}
+
 static mr_dmat4 pose_of(int i) {
     return mr_m4_look_at_cv(mr_v3(1.0 + 0.1 * i, 1.6, 3.0 - 0.05 * i), mr_v3(0.1 * i, 1.5, 0), mr_v3(0, 1, 0));
 }
@@ -66,11 +75,9 @@ static void test_round_trip(void) {
     rp.frame_ext = ".png";
     rp.ground_truth = true;
     mr_error err = {0};
-    mr_recorder *r = mr_recorder_create(dir, &rp, &err);
-    CHECK_MSG(r != NULL, "%s", err.msg);
-    if (!r) return;
     mr_image img;
-    mr_image_alloc(&img, 64, 48, 1, MR_PIX_U8, NULL);
+    mr_recorder *r = open_recorder(dir, &rp, &img);
+    if (!r) return;
     for (int i = 0; i < 5; i++) {
         for (int k = 0; k < 64 * 48; k++) ((unsigned char *)img.data)[k] = (unsigned char)(k * 7 + i * 31);
         mr_detection d[2] = {{3, 0, 40, {{1.25, 2.5}, {10, 2.5}, {10, 11}, {1.25, 11}}},
@@ -227,11 +234,9 @@ static void test_replay(void) {
     rp.camera = &cam;
     rp.frame_ext = ".png";
     mr_error err = {0};
-    mr_recorder *r = mr_recorder_create(dir, &rp, &err);
-    CHECK_MSG(r != NULL, "%s", err.msg);
-    if (!r) return;
     mr_image img;
-    mr_image_alloc(&img, 64, 48, 1, MR_PIX_U8, NULL);
+    mr_recorder *r = open_recorder(dir, &rp, &img);
+    if (!r) return;
     for (int i = 0; i < 4; i++) {
         memset(img.data, 40 * i + 10, 64 * 48);
         mr_frame_record fr = {0};
