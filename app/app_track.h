@@ -23,15 +23,13 @@
     {"fps", "F", "V4L2: requested frame rate; image folders: timestamp rate (default 30)", NULL},          \
     {"pixel-format", "YUYV|MJPG", "V4L2: pixel format (default: YUYV if offered, else MJPG)", NULL}
 
+/* A command's tracker: the one mr_tracker (lib/track) set up from the
+ * options, plus what was loaded for it. */
 typedef struct app_tracker {
-    mr_detector *det;
-    bool has_camera, has_markers;
-    mr_camera camera;
-    mr_marker_map markers;
-    mr_pose_filter *filter;   /* NULL with --no-filter */
-    bool freeze;
-    mr_pose prev;             /* previous raw pose (for single-tag disambiguation) */
-    double prev_t;
+    mr_tracker *tracker;
+    bool has_camera, has_markers; /* both: poses are solved */
+    const mr_camera *camera;      /* the tracker's copies (NULL if none) */
+    const mr_marker_map *markers;
 } app_tracker;
 
 /* The input: a recording folder (its camera and markers become defaults),
@@ -42,25 +40,14 @@ mr_source *app_open_input(const char *uri, bool gray, mr_recording **rec_info, m
 bool app_open_input_opts(const char *cmd, const app_opt *opts, bool gray, mr_recording **rec_info, mr_source **src,
                          mr_error *err);
 
-/* Sets up detector, camera, markers and filter from the options; rec (may
- * be NULL) supplies defaults. Prints one line and returns false on error. */
+/* Sets up the tracker from the options; rec (may be NULL) supplies the
+ * camera and markers by default. Prints one line and returns false on error. */
 bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, const mr_recording *rec);
 void app_tracker_free(app_tracker *t);
 
-typedef struct app_track_result {
-    const mr_detection *dets;
-    int count;
-    mr_pose pose;             /* raw */
-    bool has_filtered;
-    mr_dmat4 filtered;
-} app_track_result;
-
-/* Detects and (with camera and markers) solves and filters one frame. */
-bool app_tracker_frame(app_tracker *t, const mr_frame *f, app_track_result *r, mr_error *err);
-
 /* JSON helpers for the line formats. */
 cJSON *app_detections_json(const mr_detection *d, int n);
-cJSON *app_pose_line(int64_t frame, double t, const app_track_result *r);
+cJSON *app_pose_line(int64_t frame, double t, const mr_tracker_result *r);
 
 /* Synthetic recordings of the demo hall (demo_track.c). */
 typedef struct app_synth_params {

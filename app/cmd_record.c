@@ -63,8 +63,8 @@ int cmd_record(int argc, char **argv) {
         return app_errorf(cmd, "--camera and --markers are required (unless the input is a recording)");
     }
     mr_recorder_params rp = MR_RECORDER_DEFAULTS;
-    rp.camera = &t.camera;
-    rp.markers = &t.markers;
+    rp.camera = t.camera;
+    rp.markers = t.markers;
     rp.source = input;
     rp.jpeg_quality = (int)q;
     rp.frame_ext = app_flag(opts, "png") ? ".png" : ".jpg";
@@ -88,13 +88,13 @@ int cmd_record(int argc, char **argv) {
         }
         if (frames == 0) t_first = f.timestamp;
         if (rate > 0) sleep_until(wall0 + frames / rate);
-        app_track_result r;
+        mr_tracker_result r;
         mr_error fe = {0};
         mr_frame_record fr = {0};
         fr.t = f.timestamp - t_first;
-        if (app_tracker_frame(&t, &f, &r, &fe)) {
-            fr.detections = r.dets;
-            fr.detection_count = r.count;
+        if (mr_tracker_frame(t.tracker, &f.image, f.timestamp, &r, &fe)) {
+            fr.detections = r.detections;
+            fr.detection_count = r.detection_count;
             fr.pose = r.pose;
             fr.has_filtered = r.has_filtered;
             fr.filtered = r.filtered;

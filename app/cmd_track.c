@@ -88,9 +88,9 @@ int cmd_track(int argc, char **argv) {
             break;
         }
         frames++;
-        app_track_result r;
+        mr_tracker_result r;
         mr_error fe = {0};
-        if (!app_tracker_frame(&t, &f, &r, &fe)) {
+        if (!mr_tracker_frame(t.tracker, &f.image, f.timestamp, &r, &fe)) {
             /* One bad frame (too small, broken) does not end the run. */
             if (failed == 0 && frames == 1) snprintf(held, sizeof held, "frame %lld: %s", (long long)f.index, fe.msg);
             else fprintf(stderr, "mrcheck: track: warning: frame %lld: %s\n", (long long)f.index, fe.msg);
@@ -101,12 +101,12 @@ int cmd_track(int argc, char **argv) {
             fprintf(stderr, "mrcheck: track: warning: %s\n", held);
             held[0] = 0;
         }
-        with_tags += r.count > 0;
+        with_tags += r.detection_count > 0;
         with_pose += r.pose.valid;
         if (print_det) {
             cJSON *o = cJSON_CreateObject();
             cJSON_AddNumberToObject(o, "frame", (double)f.index);
-            cJSON_AddItemToObject(o, "detections", app_detections_json(r.dets, r.count));
+            cJSON_AddItemToObject(o, "detections", app_detections_json(r.detections, r.detection_count));
             /* with camera and markers the line also carries the pose */
             if (want_pose) cJSON_AddItemToObject(o, "pose", app_pose_line(f.index, f.timestamp, &r));
             char *s = cJSON_PrintUnformatted(o);

@@ -64,98 +64,65 @@ bool app_open_input_opts(const char *cmd, const app_opt *opts, bool gray, mr_rec
 bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, const mr_recording *rec) {
     memset(t, 0, sizeof *t);
     mr_error err = {0};
-    const char *cam = app_get(opts, "camera"), *mk = app_get(opts, "markers");
-    if (cam) {
-        if (!mr_camera_load(cam, &t->camera, &err)) return app_error(cmd, &err), false;
-        t->has_camera = true;
+    mr_camera cam;
+    mr_marker_map loaded = {0};
+    mr_tracker_params tp = MR_TRACKER_DEFAULTS;
+    const char *cam_path = app_get(opts, "camera"), *mk = app_get(opts, "markers");
+    if (cam_path) {
+        if (!mr_camera_load(cam_path, &cam, &err)) return app_error(cmd, &err), false;
+        tp.camera = &cam;
     } else if (rec) {
-        t->camera = rec->camera;
-        t->has_camera = true;
+        tp.camera = &rec->camera;
     }
     if (mk) {
-        if (!mr_marker_map_load(mk, &t->markers, &err)) return app_error(cmd, &err), false;
-        t->has_markers = true;
+        if (!mr_marker_map_load(mk, &loaded, &err)) return app_error(cmd, &err), false;
+        tp.markers = &loaded;
     } else if (rec && rec->has_markers) {
-        t->markers = rec->markers;
-        t->markers.tags = malloc((size_t)rec->markers.count * sizeof *t->markers.tags);
-        if (!t->markers.tags) return app_errorf(cmd, "out of memory"), false;
-        memcpy(t->markers.tags, rec->markers.tags, (size_t)rec->markers.count * sizeof *t->markers.tags);
-        t->has_markers = true;
+        tp.markers = &rec->markers;
     }
-    mr_detector_params dp = MR_DETECTOR_DEFAULTS;
-    dp.family = app_get(opts, "family") ? app_get(opts, "family") : t->has_markers ? t->markers.family : NULL;
+    const char *family = app_get(opts, "family");
+    tp.detector.family = family;
     double v;
     long l;
+    bool ok = false;
     if (app_get(opts, "decimate")) {
-        if (!app_double("decimate", app_get(opts, "decimate"), 1, 16, &v)) goto fail;
-        dp.decimate = v;
+        if (!app_double("decimate", app_get(opts, "decimate"), 1, 16, &v)) goto done;
+        tp.detector.decimate = v;
     }
     if (app_get(opts, "threads")) {
-        if (!app_int("threads", app_get(opts, "threads"), 1, 64, &l)) goto fail;
-        dp.threads = (int)l;
+        if (!app_int("threads", app_get(opts, "threads"), 1, 64, &l)) goto done;
+        tp.detector.threads = (int)l;
     }
     if (app_get(opts, "refine-edges")) {
-        if (!app_int("refine-edges", app_get(opts, "refine-edges"), 0, 1, &l)) goto fail;
-        dp.refine_edges = l ? 1 : -1;
+        if (!app_int("refine-edges", app_get(opts, "refine-edges"), 0, 1, &l)) goto done;
+        tp.detector.refine_edges = l ? 1 : -1;
     }
     if (app_get(opts, "sharpening")) {
-        if (!app_double("sharpening", app_get(opts, "sharpening"), 0, 10, &v)) goto fail;
-        dp.sharpening = v > 0 ? v : -1;
+        if (!app_double("sharpening", app_get(opts, "sharpening"), 0, 10, &v)) goto done;
+        tp.detector.sharpening = v > 0 ? v : -1;
     }
-    t->det = mr_detector_create(&dp, &err);
-    if (!t->det) {
+    tp.no_filter = app_flag(opts, "no-filter");
+    tp.freeze_first = app_flag(opts, "freeze");
+    t->tracker = mr_tracker_create(&tp, &err);
+    if (!t->tracker) {
         app_error(cmd, &err);
-        goto fail;
+        goto done;
     }
-    if (t->has_markers && app_get(opts, "family") && strcmp(app_get(opts, "family"), t->markers.family) != 0)
-        mr_log(MR_LOG_WARN, "--family %s differs from the marker map's %s", app_get(opts, "family"), t->markers.family);
-    if (!app_flag(opts, "no-filter")) {
-        t->filter = mr_pose_filter_create(NULL, &err);
-        if (!t->filter) {
-            app_error(cmd, &err);
-            goto fail;
-        }
-    }
-    t->freeze = app_flag(opts, "freeze");
-    return true;
-fail:
-    app_tracker_free(t);
-    return false;
+    t->camera = mr_tracker_camera(t->tracker);
+    t->markers = mr_tracker_markers(t->tracker);
+    t->has_camera = t->camera != NULL;
+    t->has_markers = t->markers != NULL;
+    if (t->markers && family && strcmp(family, t->markers->family) != 0)
+        mr_log(MR_LOG_WARN, "--family %s differs from the marker map's %s", family, t->markers->family);
+    ok = true;
+done:
+    mr_marker_map_free(&loaded); /* the tracker keeps its own copy */
+    return ok;
 }
 
 void app_tracker_free(app_tracker *t) {
-    mr_detector_destroy(&t->det);
-    mr_pose_filter_destroy(&t->filter);
-    mr_marker_map_free(&t->markers);
-}
-
-bool app_tracker_frame(app_tracker *t, const mr_frame *f, app_track_result *r, mr_error *err) {
-    memset(r, 0, sizeof *r);
-    r->dets = mr_detector_detect(t->det, &f->image, &r->count, err);
-    if (!r->dets) return false;
-    if (!t->has_camera || !t->has_markers) return true;
-    mr_camera cam = t->camera;
-    if (f->image.width != cam.width || f->image.height != cam.height) {
-        /* Same lens, other resolution (e.g. a camera delivering 640x480
-         * for a 1280x960 calibration): scale the intrinsics. */
-        cam = mr_camera_resized(&t->camera, f->image.width, f->image.height);
-    }
-    /* The previous pose only helps if it is recent. */
-    const mr_pose *prev = t->prev.valid && f->timestamp - t->prev_t < 0.5 && f->timestamp >= t->prev_t ? &t->prev : NULL;
-    if (!mr_pose_solve(&cam, &t->markers, r->dets, r->count, prev, NULL, &r->pose, err)) return false;
-    if (r->pose.valid) {
-        t->prev = r->pose;
-        t->prev_t = f->timestamp;
-        if (t->filter) {
-            mr_pose_filter_update(t->filter, f->timestamp, &r->pose.world_from_camera, &r->filtered);
-            if (t->freeze && !mr_pose_filter_frozen(t->filter)) mr_pose_filter_freeze(t->filter, true);
-            r->has_filtered = true;
-        }
-    } else if (t->filter && mr_pose_filter_frozen(t->filter)) {
-        /* Frozen: the held pose stands even when the tags are lost. */
-        r->has_filtered = mr_pose_filter_last(t->filter, &r->filtered);
-    }
-    return true;
+    mr_tracker_destroy(&t->tracker);
+    memset(t, 0, sizeof *t);
 }
 
 cJSON *app_detections_json(const mr_detection *d, int n) {
@@ -175,7 +142,7 @@ cJSON *app_detections_json(const mr_detection *d, int n) {
     return a;
 }
 
-cJSON *app_pose_line(int64_t frame, double t, const app_track_result *r) {
+cJSON *app_pose_line(int64_t frame, double t, const mr_tracker_result *r) {
     cJSON *o = cJSON_CreateObject();
     cJSON_AddNumberToObject(o, "frame", (double)frame);
     cJSON_AddNumberToObject(o, "t", t);

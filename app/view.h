@@ -37,6 +37,8 @@ typedef struct vw_capture_params {
     const mr_dmat4 *fixed_pose; /* a still with a known view: no tracking */
     bool retrack;             /* replay: detect and solve again instead of
                                  using the recorded poses */
+    bool start_paused;        /* replay: start paused on the first frame
+                                 (nothing is read past it until asked) */
     double retry_s;           /* between attempts to reopen a lost camera */
     void (*wake)(void *ctx);  /* called after a new frame is published */
     void *wake_ctx;
@@ -64,9 +66,8 @@ void vw_capture_freeze(vw_capture *c, bool frozen);
  * newer one arrived first (newest wins), tracking time sum in ms. */
 void vw_capture_counts(vw_capture *c, int64_t *read, int64_t *tracked, int64_t *dropped, double *track_ms_sum);
 
-/* Appends one JSON line to path durably: O_APPEND, one write, fsync of the
- * file (and of the folder when the file is new), so a kill -9 right after
- * loses nothing. */
+/* Appends one JSON line to path durably: mr_annotation_append (lib/session),
+ * kept under this name for the view's callers. */
 bool vw_append_line(const char *path, const cJSON *obj, mr_error *err);
 
 #endif

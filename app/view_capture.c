@@ -9,31 +9,10 @@
 
 #include "mr_session.h"
 
-#include <dirent.h>
-#include <errno.h>
-#include <fcntl.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
-#include <sys/stat.h>
 #include <time.h>
-#include <unistd.h>
-
-/* A recording (or a folder of frames) opened for random access, so replay
- * can seek and step backwards. */
-typedef struct replay_index {
-    char dir[2048];           /* folder holding the frame images */
-    char **names;
-    int64_t count;
-    double *t;                /* timestamps, seconds */
-    bool *has_pose;
-    mr_dmat4 *pose;           /* recorded world_from_camera per frame */
-    int *tags;                /* recorded tags seen, -1 unknown */
-    double *rms;
-    mr_recording *rec;        /* a recording (lib/session), or NULL: a plain
-                                 folder of frames */
-} replay_index;
 
 struct vw_capture {
     vw_capture_params p;
@@ -53,7 +32,8 @@ struct vw_capture {
     /* out slot */
     vw_frame out;
     /* replay controls */
-    replay_index rp;
+    mr_replay *rp;            /* replay: random access (lib/session) */
+    int64_t rp_count;
     bool seekable, playing, frozen;
     double rate;
     int64_t cur, seek_req;
@@ -108,146 +88,9 @@ static void put_raw(vw_capture *c, mr_image *img, double t, int64_t index) {
 
 /* ------------------------------------------------------------- replay */
 
-static bool is_image_name(const char *n) {
-    const char *e = strrchr(n, '.');
-    if (!e || n[0] == '.') return false;
-    static const char *const exts[] = {".png", ".jpg", ".jpeg", ".pgm", ".ppm", ".bmp"};
-    for (size_t i = 0; i < sizeof exts / sizeof exts[0]; i++)
-        if (strcasecmp(e, exts[i]) == 0) return true;
-    return false;
-}
-
-static int cmp_name(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
-
-static bool list_images(replay_index *r, const char *dir) {
-    DIR *d = opendir(dir);
-    if (!d) return false;
-    struct dirent *e;
-    int64_t cap = 0;
-    while ((e = readdir(d))) {
-        if (!is_image_name(e->d_name)) continue;
-        if (r->count == cap) {
-            cap = cap ? cap * 2 : 256;
-            char **n = realloc(r->names, (size_t)cap * sizeof *n);
-            if (!n) break;
-            r->names = n;
-        }
-        r->names[r->count++] = strdup(e->d_name);
-    }
-    closedir(d);
-    if (r->count == 0) return false;
-    qsort(r->names, (size_t)r->count, sizeof *r->names, cmp_name);
-    snprintf(r->dir, sizeof r->dir, "%s", dir);
-    return true;
-}
-
-/* frames.jsonl (DESIGN.md §2): one object per frame with its index,
- * timestamp and pose. Field names vary between writers, so a few are
- * accepted; a torn or unreadable line is skipped. */
-static void read_frames_jsonl(replay_index *r, const char *path) {
-    size_t size = 0;
-    char *text = mr_file_read(path, &size, 0, NULL);
-    if (!text) return;
-    int64_t line_no = 0;
-    for (char *line = text; line && *line; line_no++) {
-        char *nl = strchr(line, '\n');
-        if (nl) *nl = 0;
-        cJSON *j = cJSON_Parse(line);
-        if (j) {
-            double idx = (double)line_no, t = -1;
-            mr_json_number(j, "index", &idx, false, NULL);
-            if (!mr_json_number(j, "timestamp", &t, false, NULL)) mr_json_number(j, "t", &t, false, NULL);
-            int64_t i = (int64_t)idx;
-            if (i >= 0 && i < r->count) {
-                if (t >= 0) r->t[i] = t;
-                const cJSON *pose = cJSON_GetObjectItemCaseSensitive(j, "pose");
-                const cJSON *holder = j;
-                if (cJSON_IsObject(pose)) holder = pose;
-                mr_dmat4 m;
-                const cJSON *valid = cJSON_GetObjectItemCaseSensitive(holder, "valid");
-                bool ok = !cJSON_IsFalse(valid);
-                if (ok && (mr_json_dmat4(holder, "world_from_camera", &m, NULL) ||
-                           (cJSON_IsArray(pose) && mr_json_dmat4(j, "pose", &m, NULL))) &&
-                    mr_m4_is_rigid(&m, 1e-4)) {
-                    r->has_pose[i] = true;
-                    r->pose[i] = m;
-                }
-                double v;
-                if (mr_json_number(holder, "tags_seen", &v, false, NULL)) r->tags[i] = (int)v;
-                if (mr_json_number(holder, "rms_px", &v, false, NULL)) r->rms[i] = v;
-            }
-            cJSON_Delete(j);
-        }
-        line = nl ? nl + 1 : NULL;
-    }
-    free(text);
-}
-
-static void replay_free(replay_index *r) {
-    mr_recording_close(&r->rec);
-    for (int64_t i = 0; r->names && i < r->count; i++) free(r->names[i]);
-    free(r->names);
-    free(r->t);
-    free(r->has_pose);
-    free(r->pose);
-    free(r->tags);
-    free(r->rms);
-    memset(r, 0, sizeof *r);
-}
-
-static bool replay_open(replay_index *r, const char *dir, mr_error *err) {
-    char sub[4096];
-    if (mr_is_recording(dir)) {
-        r->rec = mr_recording_open(dir, err);
-        if (!r->rec) return false;
-        r->count = r->rec->frame_count;
-        if (r->count <= 0) {
-            replay_free(r);
-            return mr_fail(err, MR_ERR_IO, "recording %s has no frames", dir);
-        }
-    } else {
-        mr_path_join(dir, "frames", sub, sizeof sub);
-        if (!list_images(r, sub) && !list_images(r, dir))
-            return mr_fail(err, MR_ERR_IO, "%s holds no frames (expected a recording or images in %s/frames/)", dir,
-                           dir);
-    }
-    r->t = calloc((size_t)r->count, sizeof *r->t);
-    r->has_pose = calloc((size_t)r->count, sizeof *r->has_pose);
-    r->pose = calloc((size_t)r->count, sizeof *r->pose);
-    r->tags = calloc((size_t)r->count, sizeof *r->tags);
-    r->rms = calloc((size_t)r->count, sizeof *r->rms);
-    if (!r->t || !r->has_pose || !r->pose || !r->tags || !r->rms) {
-        replay_free(r);
-        return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    }
-    for (int64_t i = 0; i < r->count; i++) {
-        r->t[i] = (double)i / 30.0; /* without timestamps: 30 fps */
-        r->tags[i] = -1;
-        r->rms[i] = -1;
-    }
-    if (r->rec) {
-        /* The recording's own poses: the filtered one where recorded, as
-         * the live view showed it, else the raw pose. */
-        for (int64_t i = 0; i < r->count; i++) {
-            const mr_rec_frame *f = &r->rec->frames[i];
-            r->t[i] = f->t;
-            r->tags[i] = f->pose.tags_seen;
-            r->rms[i] = f->pose.valid ? f->pose.rms_px : -1;
-            if (f->pose.valid) {
-                r->has_pose[i] = true;
-                r->pose[i] = f->has_filtered ? f->filtered : f->pose.world_from_camera;
-            }
-        }
-        return true;
-    }
-    mr_path_join(dir, "frames.jsonl", sub, sizeof sub);
-    read_frames_jsonl(r, sub);
-    return true;
-}
-
 static void *replay_reader(void *arg) {
     vw_capture *c = arg;
-    replay_index *r = &c->rp;
+    const mr_replay *r = c->rp;
     double anchor_wall = 0, anchor_t = 0;
     bool anchored = false;
     pthread_mutex_lock(&c->mu);
@@ -278,8 +121,8 @@ static void *replay_reader(void *arg) {
             wait_s(c, 0.2);
             continue;
         }
-        if (next >= r->count) {
-            next = r->count - 1;
+        if (next >= c->rp_count) {
+            next = c->rp_count - 1;
             if (paced) {
                 c->playing = false;
                 c->state = VW_ENDED;
@@ -294,10 +137,10 @@ static void *replay_reader(void *arg) {
              * reset on play, seek and rate change so nothing jumps. */
             if (!anchored) {
                 anchor_wall = mr_time_now();
-                anchor_t = r->t[c->cur >= 0 ? c->cur : 0];
+                anchor_t = mr_replay_frame_at(r, c->cur >= 0 ? c->cur : 0)->t;
                 anchored = true;
             }
-            double due = anchor_wall + (r->t[next] - anchor_t) / (c->rate > 0 ? c->rate : 1);
+            double due = anchor_wall + (mr_replay_frame_at(r, next)->t - anchor_t) / (c->rate > 0 ? c->rate : 1);
             double now = mr_time_now();
             if (due > now + 0.001) {
                 wait_s(c, due - now > 0.2 ? 0.2 : due - now);
@@ -305,22 +148,15 @@ static void *replay_reader(void *arg) {
             }
         }
         c->cur = next;
-        if (c->state == VW_ENDED && next < r->count - 1) {
+        if (c->state == VW_ENDED && next < c->rp_count - 1) {
             c->state = VW_RUNNING;
             c->msg[0] = 0;
         }
         pthread_mutex_unlock(&c->mu);
         mr_image img = {0};
         mr_error e = {0};
-        bool loaded;
-        if (r->rec) {
-            loaded = mr_recording_load_image(r->rec, (int)next, false, &img, &e);
-        } else {
-            char path[8192];
-            mr_path_join(r->dir, r->names[next], path, sizeof path);
-            loaded = mr_image_load(path, 3, &img, &e);
-        }
-        if (loaded) put_raw(c, &img, r->t[next], next);
+        bool loaded = mr_replay_load_image(r, next, false, &img, &e);
+        if (loaded) put_raw(c, &img, mr_replay_frame_at(r, next)->t, next);
         else mr_log(MR_LOG_WARN, "replay: skipping frame %lld: %s", (long long)next, e.msg);
         pthread_mutex_lock(&c->mu);
     }
@@ -405,20 +241,38 @@ static void *live_reader(void *arg) {
 
 /* ------------------------------------------------------------ tracker */
 
+/* One frame through the one tracker (lib/track), as `mrcheck track` runs
+ * it: the view shows the filtered pose of a frame with a valid pose and
+ * otherwise keeps the last one it showed. */
+static void track_frame(mr_tracker *trk, const mr_image *img, double t, vw_frame *f, mr_dmat4 *last_pose) {
+    mr_tracker_result r;
+    mr_error e = {0};
+    if (!mr_tracker_frame(trk, img, t, &r, &e)) {
+        mr_log(MR_LOG_DEBUG, "view: tracking failed: %s", e.msg);
+        return;
+    }
+    f->tags_seen = r.pose.tags_seen;
+    f->tags_used = r.pose.tags_used;
+    f->rms_px = r.pose.valid ? r.pose.rms_px : -1;
+    if (r.pose.valid) {
+        f->pose_valid = true;
+        *last_pose = r.has_filtered ? r.filtered : r.pose.world_from_camera;
+    }
+}
+
 static void *tracker(void *arg) {
     vw_capture *c = arg;
-    mr_error err = {0};
-    mr_detector *det = NULL;
-    mr_pose_filter *filt = NULL;
+    mr_tracker *trk = NULL;
     if (c->p.markers) {
-        mr_detector_params dp = MR_DETECTOR_DEFAULTS;
-        dp.family = c->p.markers->family;
-        det = mr_detector_create(&dp, &err);
-        if (!det) mr_log(MR_LOG_ERROR, "view: %s", err.msg);
-        filt = mr_pose_filter_create(NULL, &err);
+        /* Intrinsics follow the frame size actually delivered (a camera may
+         * not honour the requested size): the tracker rescales them. */
+        mr_tracker_params tp = MR_TRACKER_DEFAULTS;
+        tp.camera = c->p.camera;
+        tp.markers = c->p.markers;
+        mr_error err = {0};
+        trk = mr_tracker_create(&tp, &err);
+        if (!trk) mr_log(MR_LOG_ERROR, "view: %s", err.msg);
     }
-    mr_pose prev;
-    memset(&prev, 0, sizeof prev);
     bool have_pose = false, was_frozen = false;
     mr_dmat4 last_pose = mr_m4_identity();
     mr_image work = {0};
@@ -443,44 +297,23 @@ static void *tracker(void *arg) {
         memset(&f, 0, sizeof f);
         f.timestamp = t;
         f.index = index;
-        f.count = c->seekable ? c->rp.count : -1;
+        f.count = c->seekable ? c->rp_count : -1;
         f.tags_seen = -1;
         f.rms_px = -1;
-        if (filt && frozen != was_frozen) mr_pose_filter_freeze(filt, frozen);
+        if (trk && frozen != was_frozen) mr_tracker_freeze(trk, frozen);
         was_frozen = frozen;
+        const mr_replay_frame *rf = c->seekable ? mr_replay_frame_at(c->rp, index) : NULL;
         if (c->p.fixed_pose) {
             f.pose_valid = true;
             last_pose = *c->p.fixed_pose;
-        } else if (c->seekable && !c->p.retrack && index >= 0 && index < c->rp.count && c->rp.has_pose[index]) {
+        } else if (rf && !c->p.retrack && rf->has_pose) {
             /* A recording's own poses: the replay shows what was seen. */
             f.pose_valid = true;
-            last_pose = c->rp.pose[index];
-            f.tags_seen = c->rp.tags[index];
-            f.rms_px = c->rp.rms[index];
-        } else if (det && c->p.markers) {
-            int n = 0;
-            mr_error e = {0};
-            const mr_detection *d = mr_detector_detect(det, &work, &n, &e);
-            mr_pose pose;
-            memset(&pose, 0, sizeof pose);
-            /* Intrinsics follow the frame size actually delivered (a
-             * camera may not honour the requested size). */
-            mr_camera cam = *c->p.camera;
-            if (work.width != cam.width || work.height != cam.height) cam = mr_camera_resized(&cam, work.width, work.height);
-            if (d && mr_pose_solve(&cam, c->p.markers, d, n, &prev, NULL, &pose, &e)) {
-                f.tags_seen = pose.tags_seen;
-                f.tags_used = pose.tags_used;
-                f.rms_px = pose.valid ? pose.rms_px : -1;
-                if (pose.valid) {
-                    prev = pose;
-                    mr_dmat4 out;
-                    mr_pose_filter_update(filt, t, &pose.world_from_camera, &out);
-                    f.pose_valid = true;
-                    last_pose = out;
-                }
-            } else if (!d) {
-                mr_log(MR_LOG_DEBUG, "view: detection failed: %s", e.msg);
-            }
+            last_pose = rf->pose;
+            f.tags_seen = rf->tags_seen;
+            f.rms_px = rf->rms_px;
+        } else if (trk) {
+            track_frame(trk, &work, t, &f, &last_pose);
         }
         if (f.pose_valid) have_pose = true;
         f.have_pose = have_pose;
@@ -501,8 +334,7 @@ static void *tracker(void *arg) {
     }
     pthread_mutex_unlock(&c->mu);
     mr_image_free(&work);
-    mr_detector_destroy(&det);
-    mr_pose_filter_destroy(&filt);
+    mr_tracker_destroy(&trk);
     return NULL;
 }
 
@@ -519,14 +351,16 @@ vw_capture *vw_capture_start(const vw_capture_params *p, mr_error *err) {
     c->rate = 1.0;
     c->cur = -1;
     c->seek_req = -1;
-    c->playing = true;
+    c->playing = !p->start_paused;
     pthread_mutex_init(&c->mu, NULL);
     pthread_cond_init(&c->cv, NULL);
     if (p->replay_dir) {
-        if (!replay_open(&c->rp, p->replay_dir, err)) {
+        c->rp = mr_replay_open(p->replay_dir, err);
+        if (!c->rp) {
             vw_capture_stop(&c);
             return NULL;
         }
+        c->rp_count = mr_replay_count(c->rp);
         c->seekable = true;
     } else {
         snprintf(c->input, sizeof c->input, "%s", p->input ? p->input : "");
@@ -552,7 +386,7 @@ void vw_capture_stop(vw_capture **cp) {
     if (c->tracker_started) pthread_join(c->tracker, NULL);
     mr_image_free(&c->raw);
     vw_frame_free(&c->out);
-    replay_free(&c->rp);
+    mr_replay_close(&c->rp);
     pthread_mutex_destroy(&c->mu);
     pthread_cond_destroy(&c->cv);
     free(c);
@@ -597,7 +431,7 @@ bool vw_capture_seekable(vw_capture *c) { return c->seekable; }
 void vw_capture_play(vw_capture *c, bool playing) {
     CONTROL({
         /* Play at the end starts over. */
-        if (playing && !c->playing && c->seekable && c->cur >= c->rp.count - 1) c->seek_req = 0;
+        if (playing && !c->playing && c->seekable && c->cur >= c->rp_count - 1) c->seek_req = 0;
         c->playing = playing;
         c->rate_changed = true;
     });
@@ -610,7 +444,7 @@ bool vw_capture_playing(vw_capture *c) {
 }
 void vw_capture_step(vw_capture *c, int delta) { CONTROL(c->step_req += delta); }
 void vw_capture_seek(vw_capture *c, int64_t index) {
-    CONTROL(c->seek_req = index < 0 ? 0 : c->seekable && index >= c->rp.count ? c->rp.count - 1 : index);
+    CONTROL(c->seek_req = index < 0 ? 0 : c->seekable && index >= c->rp_count ? c->rp_count - 1 : index);
 }
 void vw_capture_rate(vw_capture *c, double rate) { CONTROL({ c->rate = rate; c->rate_changed = true; }); }
 void vw_capture_freeze(vw_capture *c, bool frozen) { CONTROL({ c->frozen = frozen; c->rate_changed = true; }); }
@@ -626,46 +460,4 @@ void vw_capture_counts(vw_capture *c, int64_t *read, int64_t *tracked, int64_t *
 
 /* ------------------------------------------------------ durable append */
 
-bool vw_append_line(const char *path, const cJSON *obj, mr_error *err) {
-    char *text = cJSON_PrintUnformatted(obj);
-    if (!text) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    size_t n = strlen(text);
-    char *line = malloc(n + 2);
-    if (!line) {
-        free(text);
-        return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    }
-    memcpy(line, text, n);
-    line[n] = '\n';
-    free(text);
-    bool existed = mr_file_exists(path);
-    int fd = open(path, O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        free(line);
-        return mr_fail(err, MR_ERR_IO, "cannot open %s: %s", path, strerror(errno));
-    }
-    /* One write: with O_APPEND the line lands whole at the end. */
-    size_t done = 0;
-    while (done < n + 1) {
-        ssize_t w = write(fd, line + done, n + 1 - done);
-        if (w < 0 && errno == EINTR) continue;
-        if (w <= 0) break;
-        done += (size_t)w;
-    }
-    free(line);
-    bool ok = done == n + 1 && fsync(fd) == 0;
-    int e = errno;
-    close(fd);
-    if (!ok) return mr_fail(err, MR_ERR_IO, "cannot append to %s: %s", path, strerror(e));
-    if (!existed) {
-        /* A new file is only durable once its folder entry is. */
-        char dir[4096];
-        mr_path_dir(path, dir, sizeof dir);
-        int dfd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-        if (dfd >= 0) {
-            fsync(dfd);
-            close(dfd);
-        }
-    }
-    return true;
-}
+bool vw_append_line(const char *path, const cJSON *obj, mr_error *err) { return mr_annotation_append(path, obj, err); }

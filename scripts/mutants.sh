@@ -29,6 +29,11 @@ beta_dropped|lib/track/filter.c|f->p.min_cutoff + f->p.beta * sqrt(speed)|f->p.m
 rot_jump_reset_removed|lib/track/filter.c|mr_pose_angle_deg(raw, &f->raw_last) > f->p.jump_deg|0|^test_track
 rot_jump_40deg|lib/track/filter.c|p.jump_deg = or_default(p.jump_deg, 20.0);|p.jump_deg = or_default(p.jump_deg, 40.0);|^test_track
 gap_reset_removed|lib/track/filter.c|dt > f->p.max_gap_s)) reset = true;|dt > 1e9)) reset = true;|^test_track
+prev_pose_age_inclusive|lib/track/tracker.c|age >= 0 && age < t->prev_max_age_s|age >= 0 && age <= t->prev_max_age_s|^test_track
+prev_pose_always|lib/track/tracker.c|t->prev.valid && age >= 0 && age < t->prev_max_age_s|t->prev.valid && age == age|^test_track
+prev_pose_backwards|lib/track/tracker.c|age >= 0 && age < t->prev_max_age_s|age < t->prev_max_age_s|^test_track
+annotation_folder_not_synced|lib/session/annotations.c|    bool existed = mr_file_exists(path);|    bool existed = true;|^test_session$
+replay_seek_time_strict|lib/session/replay.c|if (r->frames[mid].t <= t) lo = mid + 1;|if (r->frames[mid].t < t) lo = mid + 1;|^test_session$
 lod_one_sided_ab|lib/scene/lod.c|    return fmax(ab, ba);\n}|    (void)ba;\n    return ab;\n}|^test_cull_lod$
 lod_one_sided_ba|lib/scene/lod.c|    return fmax(ab, ba);\n}|    (void)ab;\n    return ba;\n}|^test_cull_lod$
 atomic_write_in_place|lib/core/file.c|snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid())|snprintf(tmp, sizeof tmp, "%s", path)|^test_core$

@@ -1,12 +1,33 @@
 /* lib/session: recording round trip, torn and garbage lines, no overwrite,
- * the recording as a frame source, and a small mutation fuzz of the reader.
- * The kill -9 case runs in tests/cli_track.sh. */
+ * the recording as a frame source, a small mutation fuzz of the reader,
+ * the replay index (random access, seek by frame and by time), the durable
+ * annotation append (fsync calls seen through the linker: --wrap=fsync)
+ * and the tolerant annotations reader. The kill -9 case runs in
+ * tests/cli_track.sh and tests/cli_view.sh. */
 #include "mr_session.h"
 #include "mr_test.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+/* fsync as the linker sees it: counts file and folder syncs, or fails. */
+int __real_fsync(int fd);
+int __wrap_fsync(int fd);
+static int g_sync_files, g_sync_dirs;
+static bool g_sync_fail;
+int __wrap_fsync(int fd) {
+    struct stat st;
+    if (fstat(fd, &st) == 0 && S_ISDIR(st.st_mode)) g_sync_dirs++;
+    else g_sync_files++;
+    if (g_sync_fail) {
+        errno = EIO;
+        return -1;
+    }
+    return __real_fsync(fd);
+}
 
 static char g_tmp[1024];
 
@@ -28,6 +49,15 @@ static bool same_m4(const mr_dmat4 *a, const mr_dmat4 *b) {
     return true;
 }
 
+/* A recorder in dir and a 64x48 grey image for its frames. */
+static mr_recorder *open_recorder(const char *dir, const mr_recorder_params *rp, mr_image *img) {
+    mr_error err = {0};
+    mr_recorder *r = mr_recorder_create(dir, rp, &err);
+    CHECK_MSG(r != NULL, "recorder in %s: %s", dir, err.msg);
+    if (r) mr_image_alloc(img, 64, 48, 1, MR_PIX_U8, NULL);
+    return r;
+}
+
 static mr_dmat4 pose_of(int i) {
     return mr_m4_look_at_cv(mr_v3(1.0 + 0.1 * i, 1.6, 3.0 - 0.05 * i), mr_v3(0.1 * i, 1.5, 0), mr_v3(0, 1, 0));
 }
@@ -45,11 +75,9 @@ static void test_round_trip(void) {
     rp.frame_ext = ".png";
     rp.ground_truth = true;
     mr_error err = {0};
-    mr_recorder *r = mr_recorder_create(dir, &rp, &err);
-    CHECK_MSG(r != NULL, "%s", err.msg);
-    if (!r) return;
     mr_image img;
-    mr_image_alloc(&img, 64, 48, 1, MR_PIX_U8, NULL);
+    mr_recorder *r = open_recorder(dir, &rp, &img);
+    if (!r) return;
     for (int i = 0; i < 5; i++) {
         for (int k = 0; k < 64 * 48; k++) ((unsigned char *)img.data)[k] = (unsigned char)(k * 7 + i * 31);
         mr_detection d[2] = {{3, 0, 40, {{1.25, 2.5}, {10, 2.5}, {10, 11}, {1.25, 11}}},
@@ -188,6 +216,274 @@ static void test_mutations(void) {
     CHECK(frames > 0 && frames < 3000);
 }
 
+static void write_text(const char *path, const char *text) {
+    FILE *f = fopen(path, "wb");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+/* The replay index: positions in file order, frame numbers with a gap,
+ * seeks by frame number and by time at and around every boundary. */
+static void test_replay(void) {
+    char dir[1100], path[1200];
+    tmp_path("rec_replay", dir, sizeof dir);
+    mr_camera cam = {64, 48, 50, 50, 31.5, 23.5, {0, 0, 0, 0, 0}};
+    mr_recorder_params rp = MR_RECORDER_DEFAULTS;
+    rp.camera = &cam;
+    rp.frame_ext = ".png";
+    mr_error err = {0};
+    mr_image img;
+    mr_recorder *r = open_recorder(dir, &rp, &img);
+    if (!r) return;
+    for (int i = 0; i < 4; i++) {
+        memset(img.data, 40 * i + 10, 64 * 48);
+        mr_frame_record fr = {0};
+        fr.t = 0.5 * i;
+        fr.pose.valid = i != 1;
+        fr.pose.world_from_camera = pose_of(i);
+        fr.pose.tags_seen = i + 1;
+        fr.pose.rms_px = 0.5 + i;
+        fr.has_filtered = i == 2;
+        fr.filtered = pose_of(10 + i);
+        CHECK(mr_recorder_append(r, &fr, &img, &err));
+    }
+    mr_recorder_close(&r);
+    /* A frame number gap (frames 4-6 lost) at t = 3. */
+    snprintf(path, sizeof path, "%s/frames.jsonl", dir);
+    append_text(path, "{\"frame\":7,\"t\":3,\"image\":\"frames/000001.png\"}\n");
+    mr_replay *rp_ = mr_replay_open(dir, &err);
+    CHECK_MSG(rp_ != NULL, "replay of a recording: %s", err.msg);
+    if (!rp_) return;
+    CHECK_MSG(mr_replay_count(rp_) == 5 && mr_replay_recording(rp_) != NULL, "replay count %lld",
+              (long long)mr_replay_count(rp_));
+    const mr_replay_frame *f0 = mr_replay_frame_at(rp_, 0), *f1 = mr_replay_frame_at(rp_, 1),
+                          *f2 = mr_replay_frame_at(rp_, 2), *f4 = mr_replay_frame_at(rp_, 4);
+    CHECK_MSG(f0 && f1 && f2 && f4 && mr_replay_frame_at(rp_, 5) == NULL && mr_replay_frame_at(rp_, -1) == NULL,
+              "frame_at range");
+    if (f0 && f1 && f2 && f4) {
+        mr_dmat4 raw0 = pose_of(0), filt2 = pose_of(12);
+        CHECK_MSG(f0->has_pose && same_m4(&f0->pose, &raw0) && f0->tags_seen == 1 && f0->rms_px == 0.5,
+                  "replay frame 0: the raw pose (nothing filtered recorded)");
+        CHECK_MSG(f2->has_pose && same_m4(&f2->pose, &filt2) && f2->t == 1.0, "replay frame 2: the filtered pose wins");
+        CHECK_MSG(!f1->has_pose && f1->rms_px == -1, "replay frame 1: no pose, rms unknown");
+        CHECK_MSG(f4->index == 7 && f4->t == 3.0 && !f4->has_pose, "replay position 4 is frame 7 at 3 s");
+    }
+    /* By frame number: the first position at or after it. */
+    static const int64_t by_frame[][2] = {{-5, 0}, {0, 0}, {1, 1}, {3, 3}, {4, 4}, {6, 4}, {7, 4}, {100, 4}};
+    for (size_t k = 0; k < sizeof by_frame / sizeof by_frame[0]; k++)
+        CHECK_MSG(mr_replay_seek_frame(rp_, by_frame[k][0]) == by_frame[k][1], "seek to frame %lld gave %lld, want %lld",
+                  (long long)by_frame[k][0], (long long)mr_replay_seek_frame(rp_, by_frame[k][0]),
+                  (long long)by_frame[k][1]);
+    /* By time: the frame showing then (last with t <= time). */
+    static const double by_time[][2] = {{-1, 0}, {0, 0}, {0.49, 0}, {0.5, 1}, {0.51, 1}, {1.5, 3},
+                                        {2.99, 3}, {3.0, 4}, {1e9, 4}};
+    for (size_t k = 0; k < sizeof by_time / sizeof by_time[0]; k++)
+        CHECK_MSG(mr_replay_seek_time(rp_, by_time[k][0]) == (int64_t)by_time[k][1], "seek to %g s gave %lld, want %g",
+                  by_time[k][0], (long long)mr_replay_seek_time(rp_, by_time[k][0]), by_time[k][1]);
+    /* Random access to the images, backwards too. */
+    for (int i = 3; i >= 0; i--) {
+        mr_image back;
+        CHECK_MSG(mr_replay_load_image(rp_, i, true, &back, &err), "load %d: %s", i, err.msg);
+        CHECK_MSG(back.data && ((unsigned char *)back.data)[100] == 40 * i + 10, "replay image %d is another frame", i);
+        mr_image_free(&back);
+    }
+    mr_image back;
+    CHECK(!mr_replay_load_image(rp_, 5, true, &back, &err));
+    mr_replay_close(&rp_);
+    CHECK(rp_ == NULL);
+    mr_replay_close(NULL);
+
+    /* A plain folder of frames, with a frames.jsonl in the recording format. */
+    tmp_path("plain/frames", dir, sizeof dir);
+    CHECK(mr_mkdirs(dir, &err));
+    for (int i = 0; i < 3; i++) {
+        memset(img.data, 50 * i + 20, 64 * 48);
+        snprintf(path, sizeof path, "%s/%c.png", dir, 'c' - i); /* c, b, a: sorted by name */
+        CHECK(mr_image_save_png(path, &img, &err));
+    }
+    tmp_path("plain", dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/frames.jsonl", dir);
+    write_text(path, "{\"frame\":1,\"t\":0.7,\"pose\":{\"valid\":true,\"world_from_camera\":"
+                     "[1,0,0,1,0,1,0,2,0,0,1,3,0,0,0,1],\"tags_seen\":2,\"rms_px\":0.3}}\nnot json\n");
+    rp_ = mr_replay_open(dir, &err);
+    CHECK_MSG(rp_ != NULL, "replay of a plain folder: %s", err.msg);
+    if (rp_) {
+        const mr_replay_frame *a = mr_replay_frame_at(rp_, 0), *b = mr_replay_frame_at(rp_, 1),
+                              *c = mr_replay_frame_at(rp_, 2);
+        CHECK_MSG(mr_replay_count(rp_) == 3 && mr_replay_recording(rp_) == NULL, "plain folder: 3 frames");
+        CHECK_MSG(a && b && c && a->t == 0 && b->t == 0.7 && c->t == 2.0 / 30 && !a->has_pose && b->has_pose &&
+                      !c->has_pose && b->pose.m[7] == 2 && b->tags_seen == 2 && b->rms_px == 0.3,
+                  "plain folder: frame 1 from frames.jsonl, the others at 30 fps without a pose");
+        CHECK(mr_replay_load_image(rp_, 0, true, &back, &err) && ((unsigned char *)back.data)[0] == 120);
+        mr_image_free(&back);
+        mr_replay_close(&rp_);
+    }
+    tmp_path("empty", dir, sizeof dir);
+    CHECK(mr_mkdirs(dir, &err));
+    err.msg[0] = 0;
+    CHECK_MSG(mr_replay_open(dir, &err) == NULL && strstr(err.msg, "no frames"), "an empty folder must be refused");
+    mr_image_free(&img);
+}
+
+/* One mark as the view writes it (app/cmd_view.c's finish_mark). */
+static cJSON *mark_json(int k, bool hit) {
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "type", "discrepancy");
+    cJSON_AddNumberToObject(o, "time_unix", 1.7e9 + k);
+    cJSON_AddNumberToObject(o, "frame_index", 10 + k);
+    cJSON_AddNumberToObject(o, "timestamp", 0.25 * k);
+    cJSON_AddStringToObject(o, "note", k ? "moved" : "missing");
+    double px[2] = {12.5 + k, 7.25};
+    cJSON_AddItemToObject(o, "pixel", mr_json_from_doubles(px, 2));
+    cJSON_AddBoolToObject(o, "hit", hit);
+    if (hit) {
+        double w[3] = {1.5, 2.5, -3.5 + k};
+        cJSON_AddItemToObject(o, "world", mr_json_from_doubles(w, 3));
+        cJSON_AddNumberToObject(o, "depth", 4.5);
+        cJSON_AddStringToObject(o, "node", "pipe_03");
+        cJSON_AddStringToObject(o, "layer", "hidden");
+    } else {
+        cJSON_AddNullToObject(o, "world");
+        cJSON_AddNullToObject(o, "node");
+    }
+    cJSON *p = cJSON_AddObjectToObject(o, "pose");
+    cJSON_AddBoolToObject(p, "valid", true);
+    mr_dmat4 m = pose_of(k);
+    cJSON_AddItemToObject(p, "world_from_camera", mr_json_from_dmat4(&m));
+    cJSON *snap = cJSON_AddObjectToObject(o, "snapshot");
+    cJSON_AddStringToObject(snap, "screen", "snapshots/x_screen.png");
+    return o;
+}
+
+static char *print_line(const cJSON *o) {
+    char *s = cJSON_PrintUnformatted(o);
+    size_t n = strlen(s);
+    char *l = malloc(n + 2);
+    memcpy(l, s, n);
+    memcpy(l + n, "\n", 2);
+    free(s);
+    return l;
+}
+
+static void test_annotation_append(void) {
+    char dir[1100], path[1200];
+    tmp_path("session_ann", dir, sizeof dir);
+    mr_error err = {0};
+    CHECK(mr_mkdirs(dir, &err));
+    snprintf(path, sizeof path, "%s/annotations.jsonl", dir);
+    cJSON *a = mark_json(0, true), *b = mark_json(1, false);
+    char *la = print_line(a), *lb = print_line(b);
+    /* A new file: the line, then the file synced and its folder too. */
+    g_sync_files = g_sync_dirs = 0;
+    CHECK_MSG(mr_annotation_append(path, a, &err), "append: %s", err.msg);
+    CHECK_MSG(g_sync_files == 1 && g_sync_dirs == 1, "a new annotations file: %d file and %d folder fsyncs (want 1, 1)",
+              g_sync_files, g_sync_dirs);
+    size_t size = 0;
+    char *text = mr_file_read(path, &size, 0, &err);
+    CHECK_MSG(text && strcmp(text, la) == 0, "the file holds other than the one line: %.100s", text ? text : "");
+    free(text);
+    /* An existing file: appended after what is there, only the file synced. */
+    g_sync_files = g_sync_dirs = 0;
+    CHECK(mr_annotation_append(path, b, &err));
+    CHECK_MSG(g_sync_files == 1 && g_sync_dirs == 0, "appending: %d file and %d folder fsyncs (want 1, 0)", g_sync_files,
+              g_sync_dirs);
+    text = mr_file_read(path, &size, 0, &err);
+    size_t na = strlen(la);
+    CHECK_MSG(text && size == na + strlen(lb) && memcmp(text, la, na) == 0 && strcmp(text + na, lb) == 0,
+              "the second line must follow the first whole (O_APPEND)");
+    free(text);
+    /* A failing sync is an error, with the file named. */
+    g_sync_fail = true;
+    err.msg[0] = 0;
+    CHECK_MSG(!mr_annotation_append(path, a, &err) && strstr(err.msg, "annotations.jsonl"),
+              "a failed fsync must fail the append: %s", err.msg);
+    g_sync_fail = false;
+    /* A folder that does not exist: an error, not a crash. */
+    snprintf(path, sizeof path, "%s/missing/annotations.jsonl", dir);
+    CHECK(!mr_annotation_append(path, a, &err) && err.msg[0]);
+
+    /* Read back: two marks, then the third (its sync failed, but the line
+     * was written). */
+    snprintf(path, sizeof path, "%s/annotations.jsonl", dir);
+    mr_annotations an;
+    CHECK(mr_annotations_load(path, &an, &err));
+    CHECK_MSG(an.count == 3 && an.bad_lines == 0 && !an.torn_tail, "read %d marks, %d bad", an.count, an.bad_lines);
+    if (an.count >= 2) {
+        const mr_annotation *x = &an.items[0], *y = &an.items[1];
+        mr_dmat4 p0 = pose_of(0);
+        CHECK_MSG(strcmp(x->type, "discrepancy") == 0 && x->time_unix == 1.7e9 && x->frame_index == 10 &&
+                      x->timestamp == 0 && strcmp(x->note, "missing") == 0 && x->has_pixel && x->pixel[0] == 12.5 &&
+                      x->pixel[1] == 7.25 && x->hit && x->world[2] == -3.5 && x->depth == 4.5 &&
+                      strcmp(x->node, "pipe_03") == 0 && strcmp(x->layer, "hidden") == 0 && x->has_pose &&
+                      x->pose_valid && same_m4(&x->world_from_camera, &p0),
+                  "mark 1 read back with other fields");
+        CHECK_MSG(!y->hit && y->node[0] == 0 && y->frame_index == 11 && strcmp(y->note, "moved") == 0 &&
+                      cJSON_IsString(cJSON_GetObjectItem(cJSON_GetObjectItem(y->json, "snapshot"), "screen")),
+                  "mark 2 read back with other fields");
+    }
+    mr_annotations_free(&an);
+    CHECK(an.count == 0 && an.items == NULL);
+    /* A missing file is no marks. */
+    snprintf(path, sizeof path, "%s/none.jsonl", dir);
+    CHECK(mr_annotations_load(path, &an, &err) && an.count == 0);
+    cJSON_Delete(a);
+    cJSON_Delete(b);
+    free(la);
+    free(lb);
+}
+
+/* The tolerant reader: every kind of bad line counted, a torn tail skipped. */
+static void test_annotations_reader(void) {
+    cJSON *a = mark_json(2, true);
+    char *good = print_line(a);
+    cJSON_Delete(a);
+    static const char *const bad[] = {
+        "garbage {{{\n",
+        "[1,2,3]\n",                                                     /* not an object */
+        "{\"note\":\"no type\"}\n",                                      /* no type */
+        "{\"type\":5}\n",                                                /* type not a string */
+        "{\"type\":\"\"}\n",                                               /* empty type */
+        "{\"type\":\"discrepancy\",\"pixel\":[1]}\n",                    /* pixel not [x,y] */
+        "{\"type\":\"discrepancy\",\"world\":[1,2]}\n",                  /* world not [x,y,z] */
+        "{\"type\":\"discrepancy\",\"hit\":true,\"world\":null}\n",      /* a hit without a point */
+        "{\"type\":\"discrepancy\",\"frame_index\":1.5}\n",              /* not a frame number */
+        "{\"type\":\"discrepancy\",\"pose\":{\"world_from_camera\":[2,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1]}}\n",
+        "{\"type\":\"discrepancy\",\"timestamp\":\"soon\"}\n",           /* not a number */
+    };
+    int nbad = (int)(sizeof bad / sizeof bad[0]);
+    char text[8192] = "";
+    strcat(text, good);
+    for (int i = 0; i < nbad; i++) strcat(text, bad[i]);
+    strcat(text, "\n  \n");
+    strcat(text, good);
+    strcat(text, "{\"type\":\"discrepancy\",\"note\":\"torn");
+    mr_annotations an;
+    mr_error err = {0};
+    CHECK(mr_annotations_parse(text, strlen(text), &an, &err));
+    CHECK_MSG(an.count == 2 && an.bad_lines == nbad && an.torn_tail,
+              "annotations: %d read (want 2), %d bad (want %d), torn %d (want 1)", an.count, an.bad_lines, nbad,
+              an.torn_tail);
+    for (int i = 0; i < an.count; i++) CHECK(an.items[i].frame_index == 12 && an.items[i].world[2] == -1.5);
+    mr_annotations_free(&an);
+    /* Each bad line alone is refused (and the good one alone read). */
+    for (int i = 0; i < nbad; i++) {
+        CHECK(mr_annotations_parse(bad[i], strlen(bad[i]), &an, &err));
+        CHECK_MSG(an.count == 0 && an.bad_lines == 1, "bad annotation line %d was accepted: %s", i, bad[i]);
+        mr_annotations_free(&an);
+    }
+    CHECK(mr_annotations_parse(good, strlen(good), &an, &err) && an.count == 1 && an.bad_lines == 0);
+    mr_annotations_free(&an);
+    /* A whole object without its newline is still a torn write (the crash
+     * came before the '\n'): skipped, not read. */
+    CHECK(mr_annotations_parse(good, strlen(good) - 1, &an, &err));
+    CHECK_MSG(an.count == 0 && an.bad_lines == 0 && an.torn_tail,
+              "a last line without newline was read (%d marks) or not reported torn", an.count);
+    mr_annotations_free(&an);
+    free(good);
+}
+
 int main(void) {
     const char *t = getenv("MR_TEST_TMP");
     snprintf(g_tmp, sizeof g_tmp, "%s/test_session", t ? t : "/tmp/mrcheck-test");
@@ -201,5 +497,8 @@ int main(void) {
     }
     test_round_trip();
     test_mutations();
+    test_replay();
+    test_annotation_append();
+    test_annotations_reader();
     return mr_test_finish("test_session");
 }

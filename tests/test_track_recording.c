@@ -2,7 +2,8 @@
  * hall rendered along a walking path with pauses, lens distortion, noise,
  * motion blur, exposure changes, JPEG; 120 frames at 10 Hz, 640x480, tags
  * 25-57 px) against its ground truth, run as `mrcheck track` runs it
- * (detect, solve with the previous pose, One Euro filter): tracked
+ * (the one tracker, mr_tracker: detect, solve with the previous pose by
+ * its policy, One Euro filter): tracked
  * fraction, error percentiles and maximum, flips and jitter, each pinned
  * just above today's value (see check_today), and golden detections. */
 #include "mr_session.h"
@@ -26,11 +27,6 @@ static double percentile(double *v, int n, double q) {
 }
 
 #define MAXF 512
-#define MAXD 16
-
-/* Detections of every frame, found once: the pose runs below (and the
- * mutation checks in the report) change only the solver and the filter. */
-typedef struct frame_dets { int n; mr_detection d[MAXD]; } frame_dets;
 
 typedef struct run {
     int frames, poses, multi;
@@ -39,49 +35,35 @@ typedef struct run {
     mr_dmat4 pose[MAXF], filt[MAXF];
 } run;
 
-static void detect_all(const mr_recording *rec, frame_dets *fd) {
-    mr_error err = {0};
-    mr_detector *det = mr_detector_create(NULL, &err);
-    for (int i = 0; i < rec->frame_count && i < MAXF; i++) {
-        fd[i].n = 0;
-        mr_image img;
-        CHECK_MSG(mr_recording_load_image(rec, i, true, &img, &err), "frame %d: %s", i, err.msg);
-        int n = 0;
-        const mr_detection *d = mr_detector_detect(det, &img, &n, &err);
-        CHECK_MSG(d != NULL, "frame %d: %s", i, err.msg);
-        for (int k = 0; d && k < n && k < MAXD; k++) fd[i].d[fd[i].n++] = d[k];
-        mr_image_free(&img);
-    }
-    mr_detector_destroy(&det);
-}
-
-/* The tracker as `mrcheck track` runs it (app/track_util.c): the previous
- * pose helps only if it is under 0.5 s old; valid poses feed the One Euro
- * filter with default parameters. */
-static void track_all(const mr_recording *rec, const frame_dets *fd, run *out) {
+/* The recording through the one tracker (mr_tracker, default parameters)
+ * as `mrcheck track` runs it: grey frames, recorded timestamps. */
+static void track_all(const mr_recording *rec, run *out) {
     memset(out, 0, sizeof *out);
     mr_error err = {0};
-    mr_pose_filter *filt = mr_pose_filter_create(NULL, &err);
-    mr_pose prev = {0};
-    double prev_t = 0;
+    mr_tracker_params tp = MR_TRACKER_DEFAULTS;
+    tp.camera = &rec->camera;
+    tp.markers = &rec->markers;
+    mr_tracker *t = mr_tracker_create(&tp, &err);
+    CHECK_MSG(t != NULL, "tracker: %s", err.msg);
+    if (!t) return;
     out->frames = rec->frame_count < MAXF ? rec->frame_count : MAXF;
     for (int i = 0; i < out->frames; i++) {
-        double t = rec->frames[i].t;
-        const mr_pose *pp = prev.valid && t - prev_t < 0.5 && t >= prev_t ? &prev : NULL;
-        mr_pose p;
-        CHECK(mr_pose_solve(&rec->camera, &rec->markers, fd[i].d, fd[i].n, pp, NULL, &p, &err));
-        out->valid[i] = p.valid;
-        out->pose[i] = p.world_from_camera;
-        out->tags_used[i] = p.tags_used;
-        out->tag0[i] = p.ids_used[0];
-        if (!p.valid) continue;
-        prev = p;
-        prev_t = t;
-        mr_pose_filter_update(filt, t, &p.world_from_camera, &out->filt[i]);
+        mr_image img;
+        CHECK_MSG(mr_recording_load_image(rec, i, true, &img, &err), "frame %d: %s", i, err.msg);
+        mr_tracker_result r;
+        CHECK_MSG(mr_tracker_frame(t, &img, rec->frames[i].t, &r, &err), "frame %d: %s", i, err.msg);
+        mr_image_free(&img);
+        const mr_pose *p = &r.pose;
+        out->valid[i] = p->valid;
+        out->pose[i] = p->world_from_camera;
+        out->tags_used[i] = p->tags_used;
+        out->tag0[i] = p->ids_used[0];
+        if (!p->valid) continue;
+        out->filt[i] = r.filtered;
         out->poses++;
-        out->multi += p.tags_used >= 2;
+        out->multi += p->tags_used >= 2;
     }
-    mr_pose_filter_destroy(&filt);
+    mr_tracker_destroy(&t);
 }
 
 /* Error of a pose against ground truth as a rotation vector (radians, in
@@ -330,10 +312,8 @@ int main(void) {
     const char *data = getenv("MR_TEST_DATA");
     check_golden(rec, 0, data ? data : "tests/data");
     check_golden(rec, 95, data ? data : "tests/data");
-    static frame_dets fd[MAXF], fd2[MAXF];
     static run a, b;
-    detect_all(rec, fd);
-    track_all(rec, fd, &a);
+    track_all(rec, &a);
     err_stats raw, filt;
     error_stats(rec, &a, false, &raw);
     error_stats(rec, &a, true, &filt);
@@ -341,8 +321,7 @@ int main(void) {
     print_stats("filtered", &filt, a.frames);
     check_today(&raw, &filt, a.frames, a.multi);
     /* The same frames give the same detections and poses, bit for bit. */
-    detect_all(rec, fd2);
-    track_all(rec, fd2, &b);
+    track_all(rec, &b);
     bool same = true;
     for (int i = 0; i < a.frames; i++)
         same = same && a.valid[i] == b.valid[i] && (!a.valid[i] || memcmp(&a.pose[i], &b.pose[i], sizeof a.pose[i]) == 0);

@@ -12,6 +12,12 @@
  *                      "filtered": [16]}
  *   groundtruth.jsonl  synthetic recordings: {"frame","t",
  *                      "world_from_camera", "still"}
+ *   annotations.jsonl  discrepancy marks of `mrcheck view` (in its session
+ *                      folder): {"type","time_unix","frame_index",
+ *                      "timestamp","note","pixel":[x,y],"hit",
+ *                      "world":[3]|null,"depth","node","layer",
+ *                      "pose":{"valid","world_from_camera",...},
+ *                      "snapshot":{"screen","frame","pose"}}
  *
  * Crash safety: the .jsonl files are append-only; each line is written
  * whole, flushed and fsync'd before the next frame, so after a kill -9 at
@@ -114,6 +120,92 @@ bool mr_recording_parse_meta(mr_recording *rec, const cJSON *meta, mr_error *err
 mr_source *mr_recording_source(mr_recording *rec, bool gray, mr_error *err);
 /* True if dir looks like a recording (has meta.json and frames.jsonl). */
 bool mr_is_recording(const char *dir);
+
+/* ---------------------------------------------------------- replay index */
+
+/* A recording (or a plain folder of frames) opened for random access, so a
+ * replay can seek, step backwards and pace itself by timestamps. Positions
+ * are 0 .. count-1 in file order (recordings) or name order (folders). */
+typedef struct mr_replay_frame {
+    int64_t index;                  /* the recorded frame number (folders: the position) */
+    double t;                       /* seconds; folders without frames.jsonl: position / 30 */
+    bool has_pose;                  /* a recorded pose to show */
+    mr_dmat4 pose;                  /* the filtered pose where recorded (as the
+                                       live view showed it), else the raw one */
+    int tags_seen;                  /* recorded tags seen, -1 unknown */
+    double rms_px;                  /* recorded RMS of a valid pose, -1 unknown */
+} mr_replay_frame;
+
+typedef struct mr_replay mr_replay;
+/* A recording folder (meta.json + frames.jsonl), or a folder of images
+ * (DIR/frames/ or DIR itself; a frames.jsonl beside them, in the recording
+ * line format, supplies timestamps and poses by "frame" number). Fails if
+ * there are no frames. */
+mr_replay *mr_replay_open(const char *dir, mr_error *err);
+/* The index of a recording already read (takes ownership of rec, also on
+ * failure; used by mr_replay_open and the fuzz target). */
+mr_replay *mr_replay_from_recording(mr_recording *rec, mr_error *err);
+void mr_replay_close(mr_replay **r); /* NULLs *r; accepts NULL */
+int64_t mr_replay_count(const mr_replay *r);
+/* Frame at position i; NULL if out of range. */
+const mr_replay_frame *mr_replay_frame_at(const mr_replay *r, int64_t i);
+/* Seek by frame number: the position of the first frame whose number is
+ * >= index (the last position if none; 0 for index <= the first). */
+int64_t mr_replay_seek_frame(const mr_replay *r, int64_t index);
+/* Seek by time: the frame showing at t, i.e. the last position whose
+ * timestamp is <= t (0 before the first). Timestamps are taken in file
+ * order as non-decreasing, as every writer produces them. */
+int64_t mr_replay_seek_time(const mr_replay *r, double t);
+/* Loads the image at position i (8-bit, grey if gray else RGB). */
+bool mr_replay_load_image(const mr_replay *r, int64_t i, bool gray, mr_image *img, mr_error *err);
+/* The recording behind it (NULL for a plain folder). */
+const mr_recording *mr_replay_recording(const mr_replay *r);
+
+/* ------------------------------------------------------------ annotations */
+
+/* Appends obj as one line to path durably: O_APPEND and one write (the line
+ * lands whole at the end even with other writers), fsync of the file, and
+ * fsync of its folder when the file is new (a new name is only durable
+ * once its folder entry is), so a kill -9 right after loses nothing. */
+bool mr_annotation_append(const char *path, const cJSON *obj, mr_error *err);
+
+/* One mark as read back (the fields the exports need; `json` holds the
+ * whole line for the rest). */
+typedef struct mr_annotation {
+    char type[32];                  /* "discrepancy" */
+    double time_unix;               /* when it was marked, Unix seconds; 0 unknown */
+    int64_t frame_index;            /* -1 unknown */
+    double timestamp;               /* the frame's time, seconds */
+    char note[128];
+    bool has_pixel;
+    double pixel[2];                /* where it was marked, screen pixels */
+    bool hit;                       /* the mark lies on the model */
+    double world[3];                /* the picked point (hit only), scene units */
+    double depth;                   /* distance along the view ray (hit only) */
+    char node[256];                 /* picked node name, "" none */
+    char layer[16];                 /* "visible" / "hidden" / "" */
+    bool has_pose;                  /* pose.world_from_camera present */
+    bool pose_valid;
+    mr_dmat4 world_from_camera;
+    cJSON *json;                    /* the whole line (owned) */
+} mr_annotation;
+
+typedef struct mr_annotations {
+    mr_annotation *items;
+    int count;
+    int bad_lines;                  /* garbage lines skipped */
+    bool torn_tail;                 /* a torn last line (no newline) was ignored */
+} mr_annotations;
+
+/* Tolerant reader: a torn last line is skipped, a garbage line anywhere is
+ * counted and skipped; a line is garbage if it is not a JSON object with a
+ * non-empty string "type", or if a present field has the wrong shape (non-finite
+ * numbers, pixel not [x,y], world not [x,y,z] or null, a non-rigid pose).
+ * Fails only when out of memory. mr_annotations_load: a missing file is
+ * zero annotations. */
+bool mr_annotations_parse(const char *text, size_t size, mr_annotations *out, mr_error *err);
+bool mr_annotations_load(const char *path, mr_annotations *out, mr_error *err);
+void mr_annotations_free(mr_annotations *a); /* zeroes it */
 
 #ifdef __cplusplus
 }

@@ -1,5 +1,5 @@
 /* Recordings: crash-safe writer and tolerant reader (see mr_session.h). */
-#include "mr_session.h"
+#include "session_internal.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -22,16 +22,12 @@ struct mr_recorder {
 
 /* Writes one whole line with O_APPEND and syncs it: a crash leaves either
  * the complete line or a torn tail that the reader skips. */
-static bool append_line(int fd, const char *line, mr_error *err) {
-    size_t n = strlen(line), off = 0;
-    while (off < n) {
-        ssize_t w = write(fd, line + off, n - off);
-        if (w < 0 && errno == EINTR) continue;
-        if (w <= 0) return mr_fail(err, MR_ERR_IO, "cannot append to the recording (%s)", strerror(errno));
-        off += (size_t)w;
-    }
-    if (fsync(fd) != 0 && errno != EINVAL) return mr_fail(err, MR_ERR_IO, "cannot sync the recording (%s)", strerror(errno));
-    return true;
+static bool append_line(int fd, const char *line, size_t n, mr_error *err) {
+    bool sync_failed = false;
+    int e = mr_sess_write_line(fd, line, n, &sync_failed);
+    if (e == 0) return true;
+    if (sync_failed) return mr_fail(err, MR_ERR_IO, "cannot sync the recording (%s)", strerror(e));
+    return mr_fail(err, MR_ERR_IO, "cannot append to the recording (%s)", strerror(e));
 }
 
 static int open_append(const char *dir, const char *name, mr_error *err) {
@@ -137,22 +133,12 @@ bool mr_recorder_append(mr_recorder *r, mr_frame_record *rec, const mr_image *im
     for (int i = 0; i < rec->pose.tags_used && i < MR_POSE_MAX_IDS; i++)
         cJSON_AddItemToArray(ids, cJSON_CreateNumber(rec->pose.ids_used[i]));
     if (rec->has_filtered) cJSON_AddItemToObject(o, "filtered", mr_json_from_dmat4(&rec->filtered));
-    char *s = cJSON_PrintUnformatted(o);
+    size_t n = 0;
+    char *line = mr_sess_json_line(o, &n);
     cJSON_Delete(o);
-    if (!s) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    size_t n = strlen(s);
-    char *line = malloc(n + 2);
-    bool ok = line != NULL;
-    if (ok) {
-        memcpy(line, s, n);
-        line[n] = '\n';
-        line[n + 1] = 0;
-        ok = append_line(r->fd_frames, line, err);
-    } else {
-        mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    }
+    if (!line) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    bool ok = append_line(r->fd_frames, line, n, err);
     free(line);
-    free(s);
     if (ok) r->next++;
     return ok;
 }
@@ -164,19 +150,12 @@ bool mr_recorder_ground_truth(mr_recorder *r, int64_t index, double t, const mr_
     cJSON_AddNumberToObject(o, "t", t);
     cJSON_AddItemToObject(o, "world_from_camera", mr_json_from_dmat4(wfc));
     cJSON_AddBoolToObject(o, "still", still);
-    char *s = cJSON_PrintUnformatted(o);
+    size_t n = 0;
+    char *line = mr_sess_json_line(o, &n);
     cJSON_Delete(o);
-    if (!s) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    size_t n = strlen(s);
-    char *line = malloc(n + 2);
-    bool ok = line != NULL;
-    if (ok) {
-        memcpy(line, s, n);
-        memcpy(line + n, "\n", 2);
-        ok = append_line(r->fd_gt, line, err);
-    }
+    if (!line) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    bool ok = append_line(r->fd_gt, line, n, err);
     free(line);
-    free(s);
     return ok;
 }
 
@@ -270,10 +249,7 @@ static bool parse_frame_line(const cJSON *o, mr_rec_frame *f) {
     return true;
 }
 
-/* Calls fn for each complete line; a last line without '\n' is torn (a
- * crash mid-write) and reported through *torn. */
-typedef bool (*line_fn)(void *ctx, const char *line, size_t n);
-static void for_lines(const char *text, size_t size, line_fn fn, void *ctx, bool *torn, int *bad) {
+void mr_sess_for_lines(const char *text, size_t size, mr_sess_line_fn fn, void *ctx, bool *torn, int *bad) {
     size_t pos = 0;
     while (pos < size) {
         const char *nl = memchr(text + pos, '\n', size - pos);
@@ -292,6 +268,47 @@ static void for_lines(const char *text, size_t size, line_fn fn, void *ctx, bool
     }
 }
 
+int mr_sess_write_line(int fd, const char *line, size_t n, bool *sync_failed) {
+    *sync_failed = false;
+    size_t off = 0;
+    while (off < n) {
+        ssize_t w = write(fd, line + off, n - off);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) return w < 0 ? errno : EIO;
+        off += (size_t)w;
+    }
+    /* EINVAL: the file does not support syncing (a pipe, some special file
+     * systems); nothing more can be done there. */
+    if (fsync(fd) != 0 && errno != EINVAL) {
+        *sync_failed = true;
+        return errno;
+    }
+    return 0;
+}
+
+char *mr_sess_json_line(const cJSON *obj, size_t *n) {
+    char *s = cJSON_PrintUnformatted(obj);
+    if (!s) return NULL;
+    size_t len = strlen(s);
+    char *line = malloc(len + 2);
+    if (line) {
+        memcpy(line, s, len);
+        line[len] = '\n';
+        line[len + 1] = 0;
+        *n = len + 1;
+    }
+    free(s);
+    return line;
+}
+
+void *mr_sess_grow(void *items, int count, int *cap, int first, size_t elem) {
+    if (items && count < *cap) return items;
+    int ncap = *cap ? 2 * *cap : first;
+    void *n = realloc(items, (size_t)ncap * elem);
+    if (n) *cap = ncap;
+    return n;
+}
+
 typedef struct frames_ctx { mr_recording *rec; int cap; bool oom; } frames_ctx;
 
 static bool frame_line(void *vctx, const char *line, size_t n) {
@@ -306,17 +323,13 @@ static bool frame_line(void *vctx, const char *line, size_t n) {
         return false;
     }
     mr_recording *r = c->rec;
-    if (r->frame_count == c->cap) {
-        int cap = c->cap ? 2 * c->cap : 256;
-        mr_rec_frame *nf = realloc(r->frames, (size_t)cap * sizeof *nf);
-        if (!nf) {
-            free(f.detections);
-            c->oom = true;
-            return false;
-        }
-        r->frames = nf;
-        c->cap = cap;
+    mr_rec_frame *nf = mr_sess_grow(r->frames, r->frame_count, &c->cap, 256, sizeof *nf);
+    if (!nf) {
+        free(f.detections);
+        c->oom = true;
+        return false;
     }
+    r->frames = nf;
     r->frames[r->frame_count++] = f;
     return true;
 }
@@ -325,7 +338,7 @@ bool mr_recording_parse_frames(mr_recording *rec, const char *text, size_t size,
     frames_ctx c = {rec, rec->frame_count, false};
     bool torn = false;
     int bad = 0;
-    for_lines(text, size, frame_line, &c, &torn, &bad);
+    mr_sess_for_lines(text, size, frame_line, &c, &torn, &bad);
     rec->bad_lines += bad;
     rec->torn_tail = rec->torn_tail || torn;
     if (c.oom) return mr_fail(err, MR_ERR_NOMEM, "out of memory reading the recording");
@@ -368,7 +381,7 @@ static bool gt_line(void *vctx, const char *line, size_t n) {
 void mr_recording_parse_ground_truth(mr_recording *rec, const char *text, size_t size) {
     bool torn = false;
     int bad = 0;
-    for_lines(text, size, gt_line, rec, &torn, &bad);
+    mr_sess_for_lines(text, size, gt_line, rec, &torn, &bad);
     rec->bad_lines += bad;
 }
 

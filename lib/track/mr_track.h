@@ -172,6 +172,93 @@ bool mr_pose_filter_update(mr_pose_filter *f, double t, const mr_dmat4 *raw, mr_
 /* The last output (identity before the first sample); false if none yet. */
 bool mr_pose_filter_last(const mr_pose_filter *f, mr_dmat4 *out);
 
+/* --------------------------------------------------------------- tracker */
+
+/* The one tracking pipeline every command uses (track, record, view
+ * --retrack, bench tracking, demo, synth): per frame
+ *
+ *   detect tags -> undistort + solve the pose (mr_pose_solve, with the
+ *   previous pose by the policy below) -> One Euro filter -> quality
+ *
+ * Previous-pose policy: the last valid raw pose steers the solve (it picks
+ * between a single tag's two IPPE solutions) only while it is fresh:
+ * 0 <= t - t_prev < prev_max_age_s, which defaults to the filter's gap reset
+ * (max_gap_s, 0.5 s). A pose older than that no longer describes where the
+ * camera is (the filter itself has forgotten it), so letting it choose
+ * between two mirror solutions would be a guess presented as memory; a
+ * timestamp going backwards (a seek) also drops it. Without it, the solver
+ * takes the candidate most tags agree with, then the lowest error.
+ *
+ * Usage (all a caller needs):
+ *
+ *   mr_tracker_params tp = MR_TRACKER_DEFAULTS;
+ *   tp.camera = &cam;           // NULL: detection only
+ *   tp.markers = &map;          // NULL: detection only
+ *   mr_tracker *t = mr_tracker_create(&tp, &err);
+ *   while (read a frame) {
+ *       mr_tracker_result r;
+ *       if (!mr_tracker_frame(t, &frame.image, frame.timestamp, &r, &err)) ...; // bad frame
+ *       if (r.pose.valid) use r.pose (raw) or, if r.has_filtered, r.filtered;
+ *   }
+ *   mr_tracker_destroy(&t);
+ */
+typedef struct mr_tracker_params {
+    const mr_camera *camera;        /* intrinsics (copied); frames of another
+                                       size get them rescaled. NULL: detect only */
+    const mr_marker_map *markers;   /* marker map (copied). NULL: detect only */
+    mr_detector_params detector;    /* family NULL: the marker map's, else tag36h11 */
+    mr_pose_params pose;            /* zero = mr_pose_solve's defaults */
+    mr_filter_params filter;        /* zero = the One Euro defaults */
+    bool no_filter;                 /* raw poses only: has_filtered stays false */
+    bool freeze_first;              /* freeze the filter at the first valid pose
+                                       (a check on a still image) */
+    double prev_max_age_s;          /* previous-pose policy above, seconds;
+                                       0 = the filter's max_gap_s (0.5 s) */
+} mr_tracker_params;
+/* Zero everywhere means default (nested params included). */
+#define MR_TRACKER_DEFAULTS {.camera = NULL, .markers = NULL, .no_filter = false, .freeze_first = false, .prev_max_age_s = 0.0}
+
+typedef struct mr_tracker_result {
+    const mr_detection *detections; /* detection_count, sorted by id; owned by
+                                       the tracker, valid until the next frame */
+    int detection_count;
+    bool solved;                    /* camera and markers known: a pose was sought */
+    mr_pose pose;                   /* raw pose and its quality (valid, tags_seen,
+                                       tags_used, ids_used, rms_px, ambiguous) */
+    bool prev_used;                 /* the previous pose steered the solve */
+    bool has_filtered;              /* filtered holds the filter's output: after a
+                                       valid pose, or the held pose while frozen */
+    mr_dmat4 filtered;              /* filtered world_from_camera */
+    bool filter_reset;              /* the filter restarted on this frame (first
+                                       pose, jump, gap) */
+    bool frozen;                    /* the filter holds its pose */
+} mr_tracker_result;
+
+typedef struct mr_tracker mr_tracker;
+/* NULL + err on bad parameters (an invalid camera, an unknown family). */
+mr_tracker *mr_tracker_create(const mr_tracker_params *params, mr_error *err);
+void mr_tracker_destroy(mr_tracker **t); /* NULLs *t; accepts NULL */
+/* One frame (8-bit, 1, 3 or 4 channels) at `timestamp` (seconds, source
+ * clock). false + err only when the frame cannot be processed (too small,
+ * bad image); a frame without tags or without a pose is success. */
+bool mr_tracker_frame(mr_tracker *t, const mr_image *image, double timestamp, mr_tracker_result *out, mr_error *err);
+/* The same from detections found elsewhere (another detector, e.g. the
+ * aruco peer in `bench tracking`, or detections read from a recording):
+ * everything after detection, for a frame of width x height pixels.
+ * out->detections is dets. */
+bool mr_tracker_detections(mr_tracker *t, const mr_detection *dets, int count, int width, int height, double timestamp,
+                           mr_tracker_result *out, mr_error *err);
+/* Forgets the previous pose and restarts the filter (a cut in the input);
+ * a freeze is lifted. */
+void mr_tracker_reset(mr_tracker *t);
+/* While frozen the filtered pose stays where it is whatever the frames show
+ * (the view's freeze); unfreezing restarts the filter. */
+void mr_tracker_freeze(mr_tracker *t, bool frozen);
+bool mr_tracker_frozen(const mr_tracker *t);
+/* The copies the tracker works with (NULL if it has none). */
+const mr_camera *mr_tracker_camera(const mr_tracker *t);
+const mr_marker_map *mr_tracker_markers(const mr_tracker *t);
+
 /* ---------------------------------------------------------- frame sources */
 
 typedef struct mr_frame {
@@ -214,6 +301,13 @@ const char *mr_source_kind(const mr_source *src); /* "v4l2", "images", "video", 
  * err says why; for live devices the source already retried. Frames that
  * cannot be decoded are skipped with a warning on the log. */
 mr_read_status mr_source_read(mr_source *src, mr_frame *frame, mr_error *err);
+
+/* The image files of a folder (png, jpg, jpeg, pgm, ppm, pnm, bmp, tga;
+ * no hidden files), sorted by name: *count malloc'd names in a malloc'd
+ * array, freed by mr_image_folder_free. No images is success (*count 0);
+ * false + err if the folder cannot be read. */
+bool mr_image_folder_list(const char *dir, char ***names, int *count, mr_error *err);
+void mr_image_folder_free(char ***names, int count); /* NULLs *names */
 
 /* V4L2 directly (mr_source_open uses it for /dev/... paths). */
 mr_source *mr_source_open_v4l2(const char *device, const mr_source_params *params, mr_error *err);

@@ -61,6 +61,41 @@ static bool is_image_name(const char *n) {
 
 static int cmp_str(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
 
+bool mr_image_folder_list(const char *dir, char ***names, int *count, mr_error *err) {
+    *names = NULL;
+    *count = 0;
+    DIR *d = opendir(dir);
+    if (!d) return mr_fail(err, MR_ERR_IO, "%s: cannot open the folder", dir);
+    int cap = 0;
+    bool ok = true;
+    struct dirent *e;
+    while (ok && (e = readdir(d))) {
+        if (!is_image_name(e->d_name)) continue;
+        if (*count == cap) {
+            cap = cap ? 2 * cap : 64;
+            char **nn = realloc(*names, (size_t)cap * sizeof *nn);
+            if (!nn) ok = false;
+            else *names = nn;
+        }
+        if (ok && !((*names)[*count] = strdup(e->d_name))) ok = false;
+        if (ok) (*count)++;
+    }
+    closedir(d);
+    if (!ok) {
+        mr_image_folder_free(names, *count);
+        *count = 0;
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory listing %s", dir);
+    }
+    if (*count) qsort(*names, (size_t)*count, sizeof **names, cmp_str);
+    return true;
+}
+
+void mr_image_folder_free(char ***names, int count) {
+    if (!names || !*names) return;
+    for (int i = 0; i < count; i++) free((*names)[i]);
+    free(*names);
+    *names = NULL;
+}
 static void seq_close(void *impl) {
     image_seq *s = impl;
     for (int i = 0; i < s->count; i++) free(s->names[i]);
@@ -119,32 +154,15 @@ static mr_source *open_images(const char *uri, bool is_dir, const mr_source_para
         return mr_source_from_ops(&k_seq_ops, s, err);
     }
     snprintf(s->dir, sizeof s->dir, "%s", uri);
-    DIR *d = opendir(uri);
-    if (!d) {
+    if (!mr_image_folder_list(uri, &s->names, &s->count, err)) {
         seq_close(s);
-        mr_fail(err, MR_ERR_IO, "%s: cannot open the folder", uri);
         return NULL;
     }
-    int cap = 0;
-    struct dirent *e;
-    while ((e = readdir(d))) {
-        if (!is_image_name(e->d_name)) continue;
-        if (s->count == cap) {
-            cap = cap ? 2 * cap : 64;
-            char **nn = realloc(s->names, (size_t)cap * sizeof *nn);
-            if (!nn) break;
-            s->names = nn;
-        }
-        if (!(s->names[s->count] = strdup(e->d_name))) break;
-        s->count++;
-    }
-    closedir(d);
     if (s->count == 0) {
         seq_close(s);
         mr_fail(err, MR_ERR_INVALID, "%s: no image files (png, jpg, pgm, ppm, bmp) in the folder", uri);
         return NULL;
     }
-    qsort(s->names, (size_t)s->count, sizeof *s->names, cmp_str);
     return mr_source_from_ops(&k_seq_ops, s, err);
 }
 

@@ -1,0 +1,158 @@
+/* annotations.jsonl: durable append and a tolerant reader (mr_session.h). */
+#include "session_internal.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+bool mr_annotation_append(const char *path, const cJSON *obj, mr_error *err) {
+    size_t n = 0;
+    char *line = mr_sess_json_line(obj, &n);
+    if (!line) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    bool existed = mr_file_exists(path);
+    int fd = open(path, O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        int e = errno;
+        free(line);
+        return mr_fail(err, MR_ERR_IO, "cannot open %s: %s", path, strerror(e));
+    }
+    /* One write: with O_APPEND the line lands whole at the end. */
+    bool sync_failed;
+    int e = mr_sess_write_line(fd, line, n, &sync_failed);
+    free(line);
+    close(fd);
+    if (e) return mr_fail(err, MR_ERR_IO, "cannot append to %s: %s", path, strerror(e));
+    if (!existed) {
+        /* A new file is only durable once its folder entry is. */
+        char dir[4096];
+        mr_path_dir(path, dir, sizeof dir);
+        int dfd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (dfd >= 0) {
+            fsync(dfd);
+            close(dfd);
+        }
+    }
+    return true;
+}
+
+/* A string field into buf; absent is fine, a non-string or too long is not. */
+static bool get_str(const cJSON *o, const char *key, char *buf, size_t n, bool required) {
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+    if (!v || cJSON_IsNull(v)) return !required;
+    if (!cJSON_IsString(v) || strlen(v->valuestring) >= n) return false;
+    snprintf(buf, n, "%s", v->valuestring);
+    return true;
+}
+
+/* A finite number; absent is fine. */
+static bool get_num(const cJSON *o, const char *key, double *out) {
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+    if (!v) return true;
+    if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble)) return false;
+    *out = v->valuedouble;
+    return true;
+}
+
+/* An array of exactly n finite numbers; absent or null: *has false. */
+static bool get_vec(const cJSON *o, const char *key, double *out, int n, bool *has) {
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+    *has = false;
+    if (!v || cJSON_IsNull(v)) return true;
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != n) return false;
+    for (int i = 0; i < n; i++) {
+        const cJSON *x = cJSON_GetArrayItem(v, i);
+        if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble)) return false;
+        out[i] = x->valuedouble;
+    }
+    *has = true;
+    return true;
+}
+
+static bool parse_annotation(const cJSON *o, mr_annotation *a) {
+    memset(a, 0, sizeof *a);
+    a->frame_index = -1;
+    a->world_from_camera = mr_m4_identity();
+    if (!cJSON_IsObject(o) || !get_str(o, "type", a->type, sizeof a->type, true) || !a->type[0]) return false;
+    double fi = -1;
+    if (!get_num(o, "time_unix", &a->time_unix) || !get_num(o, "timestamp", &a->timestamp) ||
+        !get_num(o, "frame_index", &fi) || !get_num(o, "depth", &a->depth))
+        return false;
+    if (fi != -1 && !(fi >= 0 && fi < 1e15 && fi == floor(fi))) return false;
+    a->frame_index = (int64_t)fi;
+    bool has_world = false;
+    if (!get_str(o, "note", a->note, sizeof a->note, false) || !get_str(o, "node", a->node, sizeof a->node, false) ||
+        !get_str(o, "layer", a->layer, sizeof a->layer, false) || !get_vec(o, "pixel", a->pixel, 2, &a->has_pixel) ||
+        !get_vec(o, "world", a->world, 3, &has_world))
+        return false;
+    a->hit = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(o, "hit"));
+    if (a->hit && !has_world) return false; /* a hit names its point */
+    const cJSON *p = cJSON_GetObjectItemCaseSensitive(o, "pose");
+    if (p) {
+        if (!cJSON_IsObject(p)) return false;
+        if (cJSON_GetObjectItemCaseSensitive(p, "world_from_camera")) {
+            if (!mr_json_dmat4(p, "world_from_camera", &a->world_from_camera, NULL) ||
+                !mr_m4_is_rigid(&a->world_from_camera, 1e-6))
+                return false;
+            a->has_pose = true;
+        }
+        a->pose_valid = a->has_pose && cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(p, "valid"));
+    }
+    return true;
+}
+
+typedef struct ann_ctx { mr_annotations *a; int cap; bool oom; } ann_ctx;
+
+static bool ann_line(void *vctx, const char *line, size_t n) {
+    ann_ctx *c = vctx;
+    cJSON *o = cJSON_ParseWithLength(line, n);
+    if (!o) return false;
+    mr_annotation an;
+    if (!parse_annotation(o, &an)) {
+        cJSON_Delete(o);
+        return false;
+    }
+    mr_annotations *a = c->a;
+    mr_annotation *ni = mr_sess_grow(a->items, a->count, &c->cap, 16, sizeof *ni);
+    if (!ni) {
+        cJSON_Delete(o);
+        c->oom = true;
+        return false;
+    }
+    a->items = ni;
+    an.json = o;
+    a->items[a->count++] = an;
+    return true;
+}
+
+bool mr_annotations_parse(const char *text, size_t size, mr_annotations *out, mr_error *err) {
+    memset(out, 0, sizeof *out);
+    ann_ctx c = {out, 0, false};
+    mr_sess_for_lines(text, size, ann_line, &c, &out->torn_tail, &out->bad_lines);
+    if (c.oom) {
+        mr_annotations_free(out);
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory reading annotations");
+    }
+    return true;
+}
+
+bool mr_annotations_load(const char *path, mr_annotations *out, mr_error *err) {
+    memset(out, 0, sizeof *out);
+    if (!mr_file_exists(path)) return true;
+    size_t size = 0;
+    char *text = mr_file_read(path, &size, 0, err);
+    if (!text) return false;
+    bool ok = mr_annotations_parse(text, size, out, err);
+    free(text);
+    if (ok && out->bad_lines) mr_log(MR_LOG_WARN, "%s: skipped %d unreadable line(s)", path, out->bad_lines);
+    return ok;
+}
+
+void mr_annotations_free(mr_annotations *a) {
+    if (!a) return;
+    for (int i = 0; i < a->count; i++) cJSON_Delete(a->items[i].json);
+    free(a->items);
+    memset(a, 0, sizeof *a);
+}

@@ -1,0 +1,144 @@
+/* The one tracker: detect -> solve (previous pose by one policy) -> filter
+ * (see mr_track.h for the policy and why). */
+#include "mr_track.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct mr_tracker {
+    mr_detector *det;
+    bool has_camera, has_markers;
+    mr_camera camera;
+    mr_marker_map markers;      /* own copy */
+    mr_pose_params pose_params;
+    mr_pose_filter *filter;     /* NULL with no_filter */
+    bool freeze_first;
+    double prev_max_age_s;      /* resolved, > 0 */
+    mr_pose prev;               /* last valid raw pose */
+    double prev_t;
+};
+
+static bool copy_markers(const mr_marker_map *src, mr_marker_map *dst, mr_error *err) {
+    *dst = *src;
+    dst->tags = NULL;
+    if (src->count <= 0) return true;
+    dst->tags = malloc((size_t)src->count * sizeof *dst->tags);
+    if (!dst->tags) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    memcpy(dst->tags, src->tags, (size_t)src->count * sizeof *dst->tags);
+    return true;
+}
+
+mr_tracker *mr_tracker_create(const mr_tracker_params *params, mr_error *err) {
+    mr_tracker_params p = params ? *params : (mr_tracker_params)MR_TRACKER_DEFAULTS;
+    if (!(p.prev_max_age_s >= 0) || !isfinite(p.prev_max_age_s)) {
+        mr_fail(err, MR_ERR_INVALID, "tracker: prev_max_age_s must be finite and >= 0");
+        return NULL;
+    }
+    if (p.camera && !mr_camera_validate(p.camera, err)) return NULL;
+    mr_tracker *t = calloc(1, sizeof *t);
+    if (!t) {
+        mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    if (p.camera) {
+        t->camera = *p.camera;
+        t->has_camera = true;
+    }
+    if (p.markers) {
+        if (!copy_markers(p.markers, &t->markers, err)) goto fail;
+        t->has_markers = true;
+    }
+    mr_detector_params dp = p.detector;
+    if (!dp.family && t->has_markers) dp.family = t->markers.family;
+    t->det = mr_detector_create(&dp, err);
+    if (!t->det) goto fail;
+    if (!p.no_filter) {
+        t->filter = mr_pose_filter_create(&p.filter, err);
+        if (!t->filter) goto fail;
+    }
+    t->pose_params = p.pose;
+    t->freeze_first = p.freeze_first;
+    /* The filter's own default gap (filter.c) when neither is given. */
+    t->prev_max_age_s = p.prev_max_age_s > 0 ? p.prev_max_age_s : p.filter.max_gap_s > 0 ? p.filter.max_gap_s : 0.5;
+    return t;
+fail:
+    mr_tracker_destroy(&t);
+    return NULL;
+}
+
+void mr_tracker_destroy(mr_tracker **t) {
+    if (!t || !*t) return;
+    mr_detector_destroy(&(*t)->det);
+    mr_pose_filter_destroy(&(*t)->filter);
+    mr_marker_map_free(&(*t)->markers);
+    free(*t);
+    *t = NULL;
+}
+
+void mr_tracker_reset(mr_tracker *t) {
+    memset(&t->prev, 0, sizeof t->prev);
+    t->prev_t = 0;
+    if (t->filter) {
+        mr_pose_filter_freeze(t->filter, false);
+        mr_pose_filter_reset(t->filter);
+    }
+}
+
+void mr_tracker_freeze(mr_tracker *t, bool frozen) {
+    if (t->filter) mr_pose_filter_freeze(t->filter, frozen);
+}
+
+bool mr_tracker_frozen(const mr_tracker *t) { return t->filter && mr_pose_filter_frozen(t->filter); }
+
+const mr_camera *mr_tracker_camera(const mr_tracker *t) { return t->has_camera ? &t->camera : NULL; }
+
+const mr_marker_map *mr_tracker_markers(const mr_tracker *t) { return t->has_markers ? &t->markers : NULL; }
+
+bool mr_tracker_frame(mr_tracker *t, const mr_image *image, double timestamp, mr_tracker_result *out, mr_error *err) {
+    int n = 0;
+    const mr_detection *d = mr_detector_detect(t->det, image, &n, err);
+    if (!d) {
+        memset(out, 0, sizeof *out);
+        out->filtered = mr_m4_identity();
+        return false;
+    }
+    return mr_tracker_detections(t, d, n, image->width, image->height, timestamp, out, err);
+}
+
+bool mr_tracker_detections(mr_tracker *t, const mr_detection *dets, int count, int width, int height, double timestamp,
+                           mr_tracker_result *out, mr_error *err) {
+    memset(out, 0, sizeof *out);
+    out->filtered = mr_m4_identity();
+    if (count < 0 || (count > 0 && !dets) || width <= 0 || height <= 0)
+        return mr_fail(err, MR_ERR_INVALID, "tracker: bad detections or frame size");
+    out->detections = dets;
+    out->detection_count = count;
+    out->frozen = mr_tracker_frozen(t);
+    if (!t->has_camera || !t->has_markers) return true;
+    out->solved = true;
+    mr_camera cam = t->camera;
+    if (width != cam.width || height != cam.height) {
+        /* Same lens, other resolution (e.g. a camera delivering 640x480
+         * for a 1280x960 calibration): scale the intrinsics. */
+        cam = mr_camera_resized(&t->camera, width, height);
+    }
+    double age = timestamp - t->prev_t;
+    const mr_pose *prev = t->prev.valid && age >= 0 && age < t->prev_max_age_s ? &t->prev : NULL;
+    out->prev_used = prev != NULL;
+    if (!mr_pose_solve(&cam, &t->markers, dets, count, prev, &t->pose_params, &out->pose, err)) return false;
+    if (out->pose.valid) {
+        t->prev = out->pose;
+        t->prev_t = timestamp;
+        if (t->filter) {
+            out->filter_reset = mr_pose_filter_update(t->filter, timestamp, &out->pose.world_from_camera, &out->filtered);
+            if (t->freeze_first && !mr_pose_filter_frozen(t->filter)) mr_pose_filter_freeze(t->filter, true);
+            out->has_filtered = true;
+        }
+    } else if (t->filter && mr_pose_filter_frozen(t->filter)) {
+        /* Frozen: the held pose stands even when the tags are lost. */
+        out->has_filtered = mr_pose_filter_last(t->filter, &out->filtered);
+    }
+    out->frozen = mr_tracker_frozen(t);
+    return true;
+}
