@@ -458,8 +458,8 @@ static void submit_nodes(frame *f, const int32_t *nodes, int32_t nvis) {
     double t0 = mr_time_now();
 
     /* 2. LOD choice and bucketing of (node, mesh) pairs. */
-    double tol = dp->lod_tolerance == 0 ? 0.005 : dp->lod_tolerance;
-    double pix = dp->lod_pixels == 0 ? 1.0 : dp->lod_pixels;
+    double tol = dp->lod_tolerance == 0 ? MR_DRAW_DEFAULT_LOD_TOLERANCE : dp->lod_tolerance;
+    double pix = dp->lod_pixels == 0 ? MR_DRAW_DEFAULT_LOD_PIXELS : dp->lod_pixels;
     bool use_lod = g->lod && !dp->no_lod && tol > 0;
     double fmax_t = 0;
     if (use_lod) {

@@ -277,17 +277,17 @@ static void ensure_targets(mr_ao_state *s, int w, int h, int step) {
  * can make them divide by zero or loop without end. */
 static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
     mr_ao_params p = *in;
-    if (p.samples <= 0) p.samples = 16;
+    if (p.samples <= 0) p.samples = MR_AO_DEFAULT_SAMPLES;
     if (p.samples > MR_AO_MAX_SAMPLES) p.samples = MR_AO_MAX_SAMPLES;
-    if (p.radii <= 0) p.radii = 1;
+    if (p.radii <= 0) p.radii = MR_AO_DEFAULT_RADII;
     if (p.radii > MR_AO_MAX_RADII) p.radii = MR_AO_MAX_RADII;
-    if (!(p.screen_radius > 0) || !isfinite(p.screen_radius)) p.screen_radius = 0.05;
+    if (!(p.screen_radius > 0) || !isfinite(p.screen_radius)) p.screen_radius = MR_AO_DEFAULT_SCREEN_RADIUS;
     if (!(p.radius > 0) || !isfinite(p.radius)) {
         double diag = 0;
         if (scene)
             for (int i = 0; i < 3; i++) diag += (scene->bounds_max[i] - scene->bounds_min[i]) * (scene->bounds_max[i] - scene->bounds_min[i]);
         diag = sqrt(diag);
-        p.radius = diag > 0 && isfinite(diag) ? 0.02 * diag : 1.0;
+        p.radius = diag > 0 && isfinite(diag) ? MR_AO_DEFAULT_RADIUS_FRACTION * diag : 1.0;
     }
     /* Each estimator has its own scale (scheer's attenuated cosines average
      * well below the visibility they stand for), so each has its own
@@ -296,9 +296,9 @@ static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
     static const float k_strength[MR_AO_METHOD_COUNT] = {1.0f, 3.0f, 1.0f, 1.0f, 1.5f, 2.0f};
     if (!(p.strength > 0) || !isfinite(p.strength))
         p.strength = p.method > MR_AO_NONE && p.method < MR_AO_METHOD_COUNT ? k_strength[p.method] : 1.0f;
-    if (!(p.c >= 0) || !isfinite(p.c)) p.c = 1.0f;
-    if (!(p.bias >= 0) || !(p.bias < 0.9f)) p.bias = 0.05f;
-    if (!(p.r_max > 0 && p.r_max <= 1)) p.r_max = 1.0f;
+    if (!(p.c >= 0) || !isfinite(p.c)) p.c = MR_AO_DEFAULT_C;
+    if (!(p.bias >= 0) || !(p.bias < 0.9f)) p.bias = MR_AO_DEFAULT_BIAS;
+    if (!(p.r_max > 0 && p.r_max <= 1)) p.r_max = MR_AO_DEFAULT_R_MAX;
     if (!(p.r_min >= 0)) p.r_min = 0.0f;
     if (p.r_min > p.r_max) p.r_min = p.r_max;
     if (p.blur_radius < 0) p.blur_radius = 0;
@@ -307,7 +307,7 @@ static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
     if ((int)p.mask < 0 || p.mask > MR_AO_MASK_STANDALONE) p.mask = MR_AO_MASK_OFF;
     /* Clamped here, before the shader and the blur: the standalone mask is a
      * visibility in [0,1] whatever the method and its strength. */
-    if (!(p.mask_strength > 0) || !isfinite(p.mask_strength)) p.mask_strength = 0.5f;
+    if (!(p.mask_strength > 0) || !isfinite(p.mask_strength)) p.mask_strength = MR_AO_DEFAULT_MASK_STRENGTH;
     if (p.mask_strength > 1) p.mask_strength = 1;
     if ((int)p.radius_mode < 0 || p.radius_mode > MR_AO_RADIUS_VIEW) p.radius_mode = MR_AO_RADIUS_SCREEN;
     p.want_ao = false;
@@ -501,7 +501,7 @@ void mr_pass_ao(frame *f) {
 
 void mr_pass_ao_blur(frame *f) {
     mr_ao_state *s = f->r->ao;
-    int radius = s->p.blur_radius > 0 ? s->p.blur_radius : 4;
+    int radius = s->p.blur_radius > 0 ? s->p.blur_radius : MR_AO_DEFAULT_BLUR_RADIUS;
     glUseProgram(s->prog_blur);
     common_uniforms(f);
     glUniform1i(5, radius);

@@ -86,7 +86,7 @@ void mr_shade_draw(frame *f, const target *src, const target *dst) {
     }
     glUniform3fv(18, 1, bg);
     glUniform1f(20, f->p->specular > 0 ? f->p->specular : 0.0f);
-    glUniform1f(21, f->p->shininess >= 1 ? f->p->shininess : 32.0f);
+    glUniform1f(21, f->p->shininess >= 1 ? f->p->shininess : MR_FRAME_DEFAULT_SHININESS);
     /* The main G-buffer's AO, or the hidden layer's own (pass_ghost.c). */
     GLuint ao = src == &r->gbuf ? mr_pass_ao_texture(f) : f->hidden_ao; /* 0 when there is no AO */
     glUniform1i(19, ao != 0);

@@ -23,7 +23,7 @@ GLuint mr_gl_make_tex(GLenum fmt, int w, int h, GLenum filter) {
 
 void mr_gl_target_free(target *t) {
     glDeleteFramebuffers(1, &t->fbo);
-    glDeleteTextures(3, t->color);
+    glDeleteTextures((GLsizei)(sizeof t->color / sizeof t->color[0]), t->color);
     glDeleteTextures(1, &t->depth);
     memset(t, 0, sizeof *t);
 }
@@ -97,6 +97,10 @@ mr_renderer *mr_renderer_create(mr_gpu *gpu, mr_error *err) {
 void mr_renderer_destroy(mr_renderer **rp) {
     if (!rp || !*rp) return;
     mr_renderer *r = *rp;
+    /* A deleted program that is still current lives on until another one
+     * is made current: let go of it, so destroy really frees. */
+    glUseProgram(0);
+    glBindVertexArray(0);
     mr_pass_ao_free(r);
     mr_ghost_free(r);
     mr_geometry_free(r);
