@@ -4,7 +4,8 @@ in vec2 v_uv;
 flat in vec4 v_color;   // linear RGBA
 flat in uvec3 v_ids;    // node index + 1, layer, has texture
 
-layout(binding = 0) uniform sampler2D u_base_tex; // sRGB texture: sampled linear
+#include "mr_bindings.h"
+layout(binding = MR_TEX_GBUFFER_BASE_COLOR) uniform sampler2D u_base_tex; // sRGB texture: sampled linear
 
 layout(location = 0) out vec4 o_albedo;  // sRGB8 target: linear in, encoded on write
 layout(location = 1) out vec4 o_normal;  // xyz view normal, w = 1 where geometry

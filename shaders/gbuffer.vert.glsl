@@ -4,6 +4,7 @@
 // small however far the scene is from the origin. The instance record comes
 // in as per-instance attributes (the indirect command's baseInstance selects
 // it), so one multi-draw covers many meshes and nodes.
+#include "mr_bindings.h"
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
@@ -14,7 +15,7 @@ layout(location = 9) in vec4 a_normal2;
 layout(location = 10) in vec4 a_color;      // linear RGBA base colour
 layout(location = 11) in uvec4 a_ids;       // node index + 1, layer, has texture
 
-layout(location = 2) uniform mat4 u_proj;   // reversed-Z, infinite far
+layout(location = MR_LOC_PROJECTION) uniform mat4 u_proj;   // reversed-Z, infinite far
 
 out vec3 v_pos;     // view space, OpenCV axes
 out vec3 v_normal;  // view space

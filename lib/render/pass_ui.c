@@ -95,9 +95,9 @@ static bool upload(GLuint *buf, size_t *have, const void *data, size_t bytes) {
 
 static void draw(mr_draw2d *d, int mode, GLuint tex, int index_count) {
     glUseProgram(d->prog);
-    glUniform2f(0, (float)d->fb_w, (float)d->fb_h);
-    glUniform1i(1, mode);
-    glBindTextureUnit(0, tex);
+    glUniform2f(MR_LOC_UI_FB_SIZE, (float)d->fb_w, (float)d->fb_h);
+    glUniform1i(MR_LOC_UI_MODE, mode);
+    glBindTextureUnit(MR_TEX_UI_TEX, tex);
     glVertexArrayVertexBuffer(d->vao, 0, d->vbo, 0, sizeof(mr_draw2d_vertex));
     glVertexArrayElementBuffer(d->vao, d->ibo);
     glBindVertexArray(d->vao);
