@@ -2,8 +2,8 @@
 // along its integrated normal by the AO radius. In screen mode the radius
 // grows with the vertex's depth (r = k z), like scheer's sampling radius.
 #include "mr_bindings.h"
-layout(location = 0) in vec3 a_position;
-layout(location = 1) in vec3 a_dir;             // integrated normal (mesh space)
+layout(location = MR_ATTR_POSITION) in vec3 a_position;
+layout(location = MR_ATTR_OUTLINE_DIR) in vec3 a_dir;             // integrated normal (mesh space)
 
 layout(location = MR_LOC_MODELVIEW) uniform mat4 u_modelview;
 layout(location = MR_LOC_NORMAL_MATRIX) uniform mat3 u_normal_mat;

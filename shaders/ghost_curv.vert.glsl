@@ -2,8 +2,8 @@
 // G-buffer (uniform locations 0-2 set by mr_geometry_draw), plus the mesh's
 // per-vertex principal curvature (attribute 3, 1/mesh units).
 #include "mr_bindings.h"
-layout(location = 0) in vec3 a_position;
-layout(location = 3) in float a_kappa;
+layout(location = MR_ATTR_POSITION) in vec3 a_position;
+layout(location = MR_ATTR_CURVATURE) in float a_kappa;
 
 layout(location = MR_LOC_MODELVIEW) uniform mat4 u_modelview;
 layout(location = MR_LOC_NORMAL_MATRIX) uniform mat3 u_normal_mat;

@@ -11,6 +11,34 @@
 #ifndef MR_BINDINGS_H
 #define MR_BINDINGS_H
 
+/* Vertex attributes of the scene's geometry (geometry.c lays the buffers
+ * out; gbuffer.vert reads all, ao_outline.vert and ghost_curv.vert read the
+ * position and a stream of their own in a slot of the same numbering). */
+#define MR_ATTR_POSITION                   0
+#define MR_ATTR_NORMAL                     1
+#define MR_ATTR_UV                         2
+#define MR_ATTR_INSTANCE                   3  /* 9 slots: model-view (4), normal matrix (3), colour, ids */
+#define MR_ATTR_INST_MODELVIEW             MR_ATTR_INSTANCE
+#define MR_ATTR_INST_NORMAL0               (MR_ATTR_INSTANCE + 4)
+#define MR_ATTR_INST_NORMAL1               (MR_ATTR_INSTANCE + 5)
+#define MR_ATTR_INST_NORMAL2               (MR_ATTR_INSTANCE + 6)
+#define MR_ATTR_INST_COLOR                 (MR_ATTR_INSTANCE + 7)
+#define MR_ATTR_INST_IDS                   (MR_ATTR_INSTANCE + 8)
+#define MR_ATTR_INSTANCE_SLOTS             9
+#define MR_ATTR_OUTLINE_DIR                1  /* ao_outline: integrated normal */
+#define MR_ATTR_CURVATURE                  3  /* ghost_curv: per-vertex curvature */
+/* The UI's 2D vertices (pass_ui.c). */
+#define MR_ATTR_UI_POS                     0
+#define MR_ATTR_UI_UV                      1
+#define MR_ATTR_UI_COLOR                   2
+
+/* The G-buffer's colour outputs = its target's attachments (passes.c). */
+#define MR_OUT_GBUFFER_ALBEDO              0
+#define MR_OUT_GBUFFER_NORMAL              1
+#define MR_OUT_GBUFFER_IDS                 2
+#define MR_OUT_GBUFFER_POSITIONS           3
+#define MR_OUT_GBUFFER_COUNT               4
+
 /* The scene drawn through a view (gbuffer, ao_outline, ghost_curv). */
 #define MR_LOC_MODELVIEW                   0
 #define MR_LOC_NORMAL_MATRIX               1

@@ -270,26 +270,28 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
         glCreateBuffers(1, &g->vbo[p]);
         glNamedBufferStorage(g->vbo[p], (GLsizeiptr)(verts[p] ? verts[p] : 1) * stride[p], NULL, GL_DYNAMIC_STORAGE_BIT);
         glVertexArrayVertexBuffer(g->vao[p], 0, g->vbo[p], 0, stride[p]);
-        glEnableVertexArrayAttrib(g->vao[p], 0);
-        glVertexArrayAttribFormat(g->vao[p], 0, 3, GL_FLOAT, GL_FALSE, 0);
-        glVertexArrayAttribBinding(g->vao[p], 0, 0);
-        glEnableVertexArrayAttrib(g->vao[p], 1);
-        glVertexArrayAttribFormat(g->vao[p], 1, 3, GL_FLOAT, GL_FALSE, 12);
-        glVertexArrayAttribBinding(g->vao[p], 1, 0);
+        glEnableVertexArrayAttrib(g->vao[p], MR_ATTR_POSITION);
+        glVertexArrayAttribFormat(g->vao[p], MR_ATTR_POSITION, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(g->vao[p], MR_ATTR_POSITION, 0);
+        glEnableVertexArrayAttrib(g->vao[p], MR_ATTR_NORMAL);
+        glVertexArrayAttribFormat(g->vao[p], MR_ATTR_NORMAL, 3, GL_FLOAT, GL_FALSE, 12);
+        glVertexArrayAttribBinding(g->vao[p], MR_ATTR_NORMAL, 0);
         if (p == 1) {
-            glEnableVertexArrayAttrib(g->vao[p], 2);
-            glVertexArrayAttribFormat(g->vao[p], 2, 2, GL_FLOAT, GL_FALSE, 24);
-            glVertexArrayAttribBinding(g->vao[p], 2, 0);
+            glEnableVertexArrayAttrib(g->vao[p], MR_ATTR_UV);
+            glVertexArrayAttribFormat(g->vao[p], MR_ATTR_UV, 2, GL_FLOAT, GL_FALSE, 24);
+            glVertexArrayAttribBinding(g->vao[p], MR_ATTR_UV, 0);
         }
         /* Attributes 3..11: the instance record, one per instance (divisor
          * 1); the command's baseInstance offsets into it, so this works on
          * plain GL 4.5 (no gl_BaseInstance needed), and llvmpipe fetches
          * attributes much faster than it loads from an SSBO per vertex. */
-        for (GLuint a = 0; a < 9; a++) {
-            glEnableVertexArrayAttrib(g->vao[p], 3 + a);
-            if (a == 8) glVertexArrayAttribIFormat(g->vao[p], 3 + a, 4, GL_UNSIGNED_INT, (GLuint)offsetof(gpu_instance, ids));
-            else glVertexArrayAttribFormat(g->vao[p], 3 + a, 4, GL_FLOAT, GL_FALSE, a * 16);
-            glVertexArrayAttribBinding(g->vao[p], 3 + a, 1);
+        for (GLuint a = 0; a < MR_ATTR_INSTANCE_SLOTS; a++) {
+            GLuint slot = MR_ATTR_INSTANCE + a;
+            glEnableVertexArrayAttrib(g->vao[p], slot);
+            if (slot == MR_ATTR_INST_IDS)
+                glVertexArrayAttribIFormat(g->vao[p], slot, 4, GL_UNSIGNED_INT, (GLuint)offsetof(gpu_instance, ids));
+            else glVertexArrayAttribFormat(g->vao[p], slot, 4, GL_FLOAT, GL_FALSE, a * 16);
+            glVertexArrayAttribBinding(g->vao[p], slot, 1);
         }
         glVertexArrayBindingDivisor(g->vao[p], 1, 1);
     }
@@ -805,9 +807,9 @@ bool mr_geometry_aux_create(mr_renderer *r, float *const *per_mesh, int comps, G
         free(buf);
         glCreateVertexArrays(1, &aux->vao[p]);
         glVertexArrayVertexBuffer(aux->vao[p], 0, g->vbo[p], 0, stride[p]);
-        glEnableVertexArrayAttrib(aux->vao[p], 0);
-        glVertexArrayAttribFormat(aux->vao[p], 0, 3, GL_FLOAT, GL_FALSE, 0);
-        glVertexArrayAttribBinding(aux->vao[p], 0, 0);
+        glEnableVertexArrayAttrib(aux->vao[p], MR_ATTR_POSITION);
+        glVertexArrayAttribFormat(aux->vao[p], MR_ATTR_POSITION, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(aux->vao[p], MR_ATTR_POSITION, 0);
         glVertexArrayVertexBuffer(aux->vao[p], 1, aux->vbo[p], 0, comps * (GLsizei)sizeof(float));
         glEnableVertexArrayAttrib(aux->vao[p], attrib);
         glVertexArrayAttribFormat(aux->vao[p], attrib, comps, GL_FLOAT, GL_FALSE, 0);

@@ -524,7 +524,7 @@ static bool ensure_outlines(mr_renderer *r, mr_ao_state *s) {
             dirs[i] = NULL; /* no outline: the mesh never masks */
         }
     }
-    bool ok = mr_geometry_aux_create(r, dirs, 3, 1, &s->outline);
+    bool ok = mr_geometry_aux_create(r, dirs, 3, MR_ATTR_OUTLINE_DIR, &s->outline);
     for (int32_t i = 0; i < sc->mesh_count; i++) free(dirs[i]);
     free(dirs);
     return ok;

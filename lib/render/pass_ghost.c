@@ -443,11 +443,11 @@ void mr_pass_ghost_hidden(frame *f) {
     mr_geometry_draw(r, &v, f->out);
     glDisable(GL_DEPTH_TEST);
     frame_put(f, RES_HIDDEN_DEPTH, g->hid.depth);
-    frame_put(f, RES_HIDDEN_NORMAL, g->hid.color[1]);
-    frame_put(f, RES_HIDDEN_IDS, g->hid.color[2]);
+    frame_put(f, RES_HIDDEN_NORMAL, g->hid.color[MR_OUT_GBUFFER_NORMAL]);
+    frame_put(f, RES_HIDDEN_IDS, g->hid.color[MR_OUT_GBUFFER_IDS]);
     /* D is shaded like the model, with its own AO when AO is on. */
-    GLuint ao = mr_ao_hidden_run(f, g->hid.depth, g->hid.color[1]);
-    mr_shade_draw(f, g->hid.color[0], g->hid.color[1], ao, &g->hid_shaded);
+    GLuint ao = mr_ao_hidden_run(f, g->hid.depth, g->hid.color[MR_OUT_GBUFFER_NORMAL]);
+    mr_shade_draw(f, g->hid.color[MR_OUT_GBUFFER_ALBEDO], g->hid.color[MR_OUT_GBUFFER_NORMAL], ao, &g->hid_shaded);
     frame_put(f, RES_HIDDEN_SHADED, g->hid_shaded.color[0]);
 }
 
@@ -464,7 +464,7 @@ static void ensure_curvature(mr_renderer *r, mr_ghost_state *g) {
         k[i] = malloc((size_t)(m->vertex_count ? m->vertex_count : 1) * sizeof **k);
         if (k[i]) mr_mesh_curvature(m, k[i]);
     }
-    mr_geometry_aux_create(r, k, 1, 3, &g->curv_aux);
+    mr_geometry_aux_create(r, k, 1, MR_ATTR_CURVATURE, &g->curv_aux);
     for (int32_t i = 0; i < s->mesh_count; i++) free(k[i]);
     free(k);
 }

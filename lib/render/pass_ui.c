@@ -35,13 +35,14 @@ mr_draw2d *mr_draw2d_create(mr_gpu *gpu, mr_error *err) {
         return NULL;
     }
     glCreateVertexArrays(1, &d->vao);
-    glEnableVertexArrayAttrib(d->vao, 0);
-    glEnableVertexArrayAttrib(d->vao, 1);
-    glEnableVertexArrayAttrib(d->vao, 2);
-    glVertexArrayAttribFormat(d->vao, 0, 2, GL_FLOAT, GL_FALSE, (GLuint)offsetof(mr_draw2d_vertex, x));
-    glVertexArrayAttribFormat(d->vao, 1, 2, GL_FLOAT, GL_FALSE, (GLuint)offsetof(mr_draw2d_vertex, u));
-    glVertexArrayAttribFormat(d->vao, 2, 4, GL_UNSIGNED_BYTE, GL_TRUE, (GLuint)offsetof(mr_draw2d_vertex, rgba));
-    for (GLuint a = 0; a < 3; a++) glVertexArrayAttribBinding(d->vao, a, 0);
+    static const GLuint attrs[3] = {MR_ATTR_UI_POS, MR_ATTR_UI_UV, MR_ATTR_UI_COLOR};
+    for (int a = 0; a < 3; a++) {
+        glEnableVertexArrayAttrib(d->vao, attrs[a]);
+        glVertexArrayAttribBinding(d->vao, attrs[a], 0);
+    }
+    glVertexArrayAttribFormat(d->vao, MR_ATTR_UI_POS, 2, GL_FLOAT, GL_FALSE, (GLuint)offsetof(mr_draw2d_vertex, x));
+    glVertexArrayAttribFormat(d->vao, MR_ATTR_UI_UV, 2, GL_FLOAT, GL_FALSE, (GLuint)offsetof(mr_draw2d_vertex, u));
+    glVertexArrayAttribFormat(d->vao, MR_ATTR_UI_COLOR, 4, GL_UNSIGNED_BYTE, GL_TRUE, (GLuint)offsetof(mr_draw2d_vertex, rgba));
     /* A sampler object, so the renderer's textures keep their own (nearest)
      * filtering for its passes. */
     glCreateSamplers(1, &d->sampler);

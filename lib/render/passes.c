@@ -67,8 +67,10 @@ bool mr_pass_prepare_gbuffer(frame *f, mr_error *err) {
     if (!b || !ensure_program(&b->prog_gbuffer, "gbuffer.vert.glsl", "gbuffer.frag.glsl", err)) return false;
     /* albedo, view normal, ids, view-space position (written only when a
      * frame's AO reads positions: see mr_pass_gbuffer) */
-    static const GLenum gfmt[4] = {GL_SRGB8_ALPHA8, GL_RGBA16F, GL_RG32UI, GL_RGBA32F};
-    return b->gbuf.fbo || mr_gl_target_make(&b->gbuf, b->w, b->h, gfmt, 4, true, err);
+    static const GLenum gfmt[MR_OUT_GBUFFER_COUNT] = {
+        [MR_OUT_GBUFFER_ALBEDO] = GL_SRGB8_ALPHA8, [MR_OUT_GBUFFER_NORMAL] = GL_RGBA16F,
+        [MR_OUT_GBUFFER_IDS] = GL_RG32UI, [MR_OUT_GBUFFER_POSITIONS] = GL_RGBA32F};
+    return b->gbuf.fbo || mr_gl_target_make(&b->gbuf, b->w, b->h, gfmt, MR_OUT_GBUFFER_COUNT, true, err);
 }
 
 bool mr_pass_prepare_shade(frame *f, mr_error *err) {
@@ -109,9 +111,9 @@ void mr_gbuffer_begin(frame *f, const target *t) {
     static const float zero4[4] = {0, 0, 0, 0};
     static const GLuint zero_u[4] = {0, 0, 0, 0};
     static const float depth0 = 0.0f; /* reversed Z: clear to infinity */
-    glClearNamedFramebufferfv(t->fbo, GL_COLOR, 0, zero4);
-    glClearNamedFramebufferfv(t->fbo, GL_COLOR, 1, zero4);
-    glClearNamedFramebufferuiv(t->fbo, GL_COLOR, 2, zero_u);
+    glClearNamedFramebufferfv(t->fbo, GL_COLOR, MR_OUT_GBUFFER_ALBEDO, zero4);
+    glClearNamedFramebufferfv(t->fbo, GL_COLOR, MR_OUT_GBUFFER_NORMAL, zero4);
+    glClearNamedFramebufferuiv(t->fbo, GL_COLOR, MR_OUT_GBUFFER_IDS, zero_u);
     glClearNamedFramebufferfv(t->fbo, GL_DEPTH, 0, &depth0);
 }
 
@@ -123,11 +125,12 @@ void mr_pass_gbuffer(frame *f) {
      * that AO also works where the projection cannot be inverted; the
      * attachment costs bandwidth, so it is written only when this frame's AO
      * reads positions. */
-    static const GLenum bufs[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
-                                   GL_COLOR_ATTACHMENT3};
+    static const GLenum bufs[MR_OUT_GBUFFER_COUNT] = {
+        GL_COLOR_ATTACHMENT0 + MR_OUT_GBUFFER_ALBEDO, GL_COLOR_ATTACHMENT0 + MR_OUT_GBUFFER_NORMAL,
+        GL_COLOR_ATTACHMENT0 + MR_OUT_GBUFFER_IDS, GL_COLOR_ATTACHMENT0 + MR_OUT_GBUFFER_POSITIONS};
     bool want_pos = (f->reading & RES(RES_POSITIONS)) != 0;
-    glNamedFramebufferDrawBuffers(b->gbuf.fbo, want_pos ? 4 : 3, bufs);
-    if (want_pos) glClearNamedFramebufferfv(b->gbuf.fbo, GL_COLOR, 3, zero4);
+    glNamedFramebufferDrawBuffers(b->gbuf.fbo, want_pos ? MR_OUT_GBUFFER_COUNT : MR_OUT_GBUFFER_POSITIONS, bufs);
+    if (want_pos) glClearNamedFramebufferfv(b->gbuf.fbo, GL_COLOR, MR_OUT_GBUFFER_POSITIONS, zero4);
     uint32_t mask = 1u << MR_LAYER_VISIBLE;
     /* With ghosting, the hidden layer goes to its own target D (pass_ghost.c). */
     if (!f->p->hide_hidden_layer && !(f->writing & RES(RES_HIDDEN_DEPTH))) mask |= 1u << MR_LAYER_HIDDEN;
@@ -135,10 +138,10 @@ void mr_pass_gbuffer(frame *f) {
     mr_geometry_draw(f->r, &v, f->out);
     glDisable(GL_DEPTH_TEST);
     frame_put(f, RES_DEPTH, b->gbuf.depth);
-    frame_put(f, RES_ALBEDO, b->gbuf.color[0]);
-    frame_put(f, RES_NORMAL, b->gbuf.color[1]);
-    frame_put(f, RES_IDS, b->gbuf.color[2]);
-    if (want_pos) frame_put(f, RES_POSITIONS, b->gbuf.color[3]);
+    frame_put(f, RES_ALBEDO, b->gbuf.color[MR_OUT_GBUFFER_ALBEDO]);
+    frame_put(f, RES_NORMAL, b->gbuf.color[MR_OUT_GBUFFER_NORMAL]);
+    frame_put(f, RES_IDS, b->gbuf.color[MR_OUT_GBUFFER_IDS]);
+    if (want_pos) frame_put(f, RES_POSITIONS, b->gbuf.color[MR_OUT_GBUFFER_POSITIONS]);
 }
 
 void mr_pass_shade(frame *f) {

@@ -94,8 +94,10 @@ typedef struct pass_desc {
     void (*run)(frame *f);
     void (*scene_changed)(mr_renderer *r);  /* drops what was derived from the scene; NULL */
     void (*destroy)(mr_renderer *r);        /* frees the file's state (idempotent); NULL */
-    uint32_t reads, writes;                 /* RES() bits */
-    uint32_t (*reads_now)(const frame *f);  /* the part of `reads` this frame reads; NULL = all */
+    uint32_t reads;                         /* RES() bits it needs an earlier pass to have written */
+    uint32_t uses;                          /* RES() bits it reads when some earlier pass made them */
+    uint32_t writes;                        /* RES() bits */
+    uint32_t (*reads_now)(const frame *f);  /* the part of `reads` this frame needs; NULL = all */
 } pass_desc;
 
 /* A way to draw the scene: from the frame's camera or any other eye. */

@@ -86,7 +86,7 @@ static const pass_desc k_passes[] = {
      .run = mr_pass_ghost_hidden, .scene_changed = mr_ghost_scene_changed, .destroy = mr_ghost_free,
      .writes = HIDDEN},
     {.name = "shade", .prepare = mr_pass_prepare_shade, .run = mr_pass_shade,
-     .reads = RES(RES_ALBEDO) | RES(RES_NORMAL) | RES(RES_AO), .writes = RES(RES_SHADED) | RES(RES_IMAGE)},
+     .reads = RES(RES_ALBEDO) | RES(RES_NORMAL), .uses = RES(RES_AO), .writes = RES(RES_SHADED) | RES(RES_IMAGE)},
     {.name = "overlay", .needed = mr_pass_need_overlay, .prepare = mr_pass_prepare_overlay, .run = mr_pass_overlay,
      .reads = RES(RES_IMAGE), .writes = RES(RES_IMAGE)},
     /* Ghosting after the overlay: with video, the occluder O is what the
@@ -95,7 +95,8 @@ static const pass_desc k_passes[] = {
      .writes = RES(RES_CURVATURE)},
     {.name = "ghost_importance", .needed = mr_pass_need_ghost, .run = mr_pass_ghost_importance,
      .reads = RES(RES_IMAGE) | RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_IDS) | RES(RES_HIDDEN_DEPTH) |
-              RES(RES_HIDDEN_IDS) | RES(RES_CURVATURE),
+              RES(RES_HIDDEN_IDS),
+     .uses = RES(RES_CURVATURE),
      .writes = RES(RES_GHOST_MASK)},
     {.name = "ghost_g0", .needed = mr_pass_need_ghost, .run = mr_pass_ghost_g0,
      .reads = RES(RES_IMAGE) | RES(RES_HIDDEN_SHADED) | RES(RES_GHOST_MASK), .writes = RES(RES_IMAGE)},
@@ -261,7 +262,17 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
         const pass_desc *d = &k_passes[i];
         need[i] = !d->needed || d->needed(&f);
         if (!need[i]) continue;
-        f.reading |= d->reads_now ? d->reads_now(&f) & d->reads : d->reads;
+        uint32_t reads = d->reads_now ? d->reads_now(&f) & d->reads : d->reads;
+        /* A row that needs what no earlier row of this frame makes is a
+         * mistake in the registry (order or declarations), not in the input. */
+        uint32_t missing = reads & ~f.writing;
+        if (missing) {
+            int k = 0;
+            while (!(missing & RES(k))) k++;
+            return mr_fail(err, MR_ERR_GL, "pass %s reads \"%s\", which no earlier pass of this frame writes",
+                           d->name ? d->name : "(unlisted)", mr_resource_names[k]);
+        }
+        f.reading |= reads;
         f.writing |= d->writes;
     }
     for (size_t i = 0; i < PASS_COUNT; i++)
