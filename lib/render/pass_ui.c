@@ -117,9 +117,9 @@ bool mr_draw2d_frame(mr_draw2d *d, mr_renderer *r, float x, float y, float w, fl
     upload(&d->vbo, &d->vbo_bytes, v, sizeof v);
     upload(&d->ibo, &d->ibo_bytes, ix, sizeof ix);
     glDisable(GL_BLEND);
-    glBindSampler(0, d->sampler);
+    glBindSampler(MR_TEX_UI_TEX, d->sampler);
     draw(d, 1, r->last.tex, 6);
-    glBindSampler(0, 0);
+    glBindSampler(MR_TEX_UI_TEX, 0);
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x drawing the frame", e);
     return true;
