@@ -232,7 +232,7 @@ static void free_state(mr_ao_state *s) {
     free(s);
 }
 
-void mr_pass_ao_scene_changed(mr_renderer *r) {
+static void mr_pass_ao_scene_changed(mr_renderer *r) {
     mr_ao_state *states[2] = {r->ao, r->ao_hidden};
     for (int i = 0; i < 2; i++) {
         if (!states[i]) continue;
@@ -385,18 +385,18 @@ static bool runs(const frame *f) { return plan_of(f, f->r->ao) == AO_PLAN_RUN; }
 /* The standalone mask is a hard 0/1 stencil: it needs the blur to be AO. */
 static bool blur_wanted(const mr_ao_params *p) { return p->blur_radius > 0 || p->mask == MR_AO_MASK_STANDALONE; }
 
-bool mr_pass_need_ao(const frame *f) { return runs(f); }
-bool mr_pass_need_ao_mask(const frame *f) { return runs(f) && resolve(&f->p->ao, f->r->scene).mask != MR_AO_MASK_OFF; }
-bool mr_pass_need_ao_blur(const frame *f) {
+static bool mr_pass_need_ao(const frame *f) { return runs(f); }
+static bool mr_pass_need_ao_mask(const frame *f) { return runs(f) && resolve(&f->p->ao, f->r->scene).mask != MR_AO_MASK_OFF; }
+static bool mr_pass_need_ao_blur(const frame *f) {
     if (!runs(f)) return false;
     mr_ao_params p = resolve(&f->p->ao, f->r->scene);
     return blur_wanted(&p);
 }
-bool mr_pass_need_ao_upsample(const frame *f) { return runs(f) && f->p->ao.half_res; }
-bool mr_pass_need_ao_reuse(const frame *f) { return plan_of(f, f->r->ao) == AO_PLAN_REUSE; }
-bool mr_pass_need_ao_external(const frame *f) { return plan_of(f, f->r->ao) == AO_PLAN_EXTERNAL; }
+static bool mr_pass_need_ao_upsample(const frame *f) { return runs(f) && f->p->ao.half_res; }
+static bool mr_pass_need_ao_reuse(const frame *f) { return plan_of(f, f->r->ao) == AO_PLAN_REUSE; }
+static bool mr_pass_need_ao_external(const frame *f) { return plan_of(f, f->r->ao) == AO_PLAN_EXTERNAL; }
 
-uint32_t mr_pass_ao_reads(const frame *f) {
+static uint32_t mr_pass_ao_reads(const frame *f) {
     mr_ao_params p = resolve(&f->p->ao, f->r->scene);
     uint32_t r = RES(RES_DEPTH) | RES(RES_NORMAL);
     if (p.positions && p.mask != MR_AO_MASK_STANDALONE) r |= RES(RES_POSITIONS);
@@ -442,19 +442,19 @@ static bool prepare_state(frame *f, mr_ao_state *s, mr_error *err) {
 }
 
 /* Called for ao_mask and ao: the second call finds everything in place. */
-bool mr_pass_prepare_ao(frame *f, mr_error *err) {
+static bool mr_pass_prepare_ao(frame *f, mr_error *err) {
     mr_ao_state *s = state_of(&f->r->ao, err);
     return s && prepare_state(f, s, err);
 }
 
-bool mr_pass_prepare_ao_external(frame *f, mr_error *err) {
+static bool mr_pass_prepare_ao_external(frame *f, mr_error *err) {
     mr_ao_state *s = state_of(&f->r->ao, err);
     if (!s) return false;
     ensure_targets(s, f->r->w, f->r->h, s->step > 0 ? s->step : 1);
     return true;
 }
 
-void mr_pass_ao_external(frame *f) {
+static void mr_pass_ao_external(frame *f) {
     mr_renderer *r = f->r;
     mr_ao_state *s = r->ao;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
@@ -465,7 +465,7 @@ void mr_pass_ao_external(frame *f) {
     frame_put(f, RES_AO, s->result);
 }
 
-void mr_pass_ao_reuse(frame *f) {
+static void mr_pass_ao_reuse(frame *f) {
     mr_ao_state *s = f->r->ao;
     frame_put(f, RES_AO, s->result);
     if (s->p.mask != MR_AO_MASK_OFF) frame_put(f, RES_AO_MASK, s->tex_mask);
@@ -539,7 +539,7 @@ static bool ensure_outlines(mr_renderer *r, mr_ao_state *s) {
  * float target, +1 on entering faces and -1 on leaving ones, depth-tested
  * against the G-buffer without writing depth; a count >= 2 marks a pixel
  * where two volumes overlap at the visible surface: a corner. */
-void mr_pass_ao_mask(frame *f) {
+static void mr_pass_ao_mask(frame *f) {
     mr_renderer *r = f->r;
     mr_ao_state *s = r->ao;
     static const float zero[4] = {0, 0, 0, 0};
@@ -622,19 +622,19 @@ static void stage_upsample(frame *f, mr_ao_state *s, const ao_inputs *in) {
     s->result = s->tex_full;
 }
 
-void mr_pass_ao(frame *f) {
+static void mr_pass_ao(frame *f) {
     ao_inputs in = main_inputs(f);
     stage_main(f, f->r->ao, &in);
     frame_put(f, RES_AO, f->r->ao->result);
 }
 
-void mr_pass_ao_blur(frame *f) {
+static void mr_pass_ao_blur(frame *f) {
     ao_inputs in = main_inputs(f);
     stage_blur(f, f->r->ao, &in);
     frame_put(f, RES_AO, f->r->ao->result);
 }
 
-void mr_pass_ao_upsample(frame *f) {
+static void mr_pass_ao_upsample(frame *f) {
     ao_inputs in = main_inputs(f);
     stage_upsample(f, f->r->ao, &in);
     frame_put(f, RES_AO, f->r->ao->result);
@@ -719,3 +719,28 @@ GLuint mr_ao_hidden_run(frame *f, GLuint depth, GLuint normal) {
     }
     return f->ao_hidden_plan == AO_PLAN_RUN || f->ao_hidden_plan == AO_PLAN_REUSE ? s->result : 0;
 }
+
+/* The rows of the registry (k_passes in renderer.c). */
+#define AO_DESTROY .scene_changed = mr_pass_ao_scene_changed, .destroy = mr_pass_ao_free
+const pass_desc mr_pass_desc_ao_mask = {
+    .name = "ao_mask", .needed = mr_pass_need_ao_mask, .prepare = mr_pass_prepare_ao, .run = mr_pass_ao_mask,
+    AO_DESTROY, .reads = RES(RES_DEPTH), .writes = RES(RES_AO_MASK)};
+const pass_desc mr_pass_desc_ao = {
+    .name = "ao", .needed = mr_pass_need_ao, .prepare = mr_pass_prepare_ao, .run = mr_pass_ao, AO_DESTROY,
+    .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_POSITIONS) | RES(RES_AO_MASK), .writes = RES(RES_AO),
+    .reads_now = mr_pass_ao_reads};
+const pass_desc mr_pass_desc_ao_blur = {
+    .name = "ao_blur", .needed = mr_pass_need_ao_blur, .run = mr_pass_ao_blur, AO_DESTROY,
+    .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_AO), .writes = RES(RES_AO)};
+const pass_desc mr_pass_desc_ao_upsample = {
+    .name = "ao_upsample", .needed = mr_pass_need_ao_upsample, .run = mr_pass_ao_upsample, AO_DESTROY,
+    .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_AO), .writes = RES(RES_AO)};
+/* Not listed (no GPU work of their own): the AO of an earlier frame with the
+ * same camera, size, scene and settings, or an AO image given from outside
+ * (ground truth), stands in for the AO passes. */
+const pass_desc mr_pass_desc_ao_reuse = {
+    .needed = mr_pass_need_ao_reuse, .run = mr_pass_ao_reuse, AO_DESTROY,
+    .writes = RES(RES_AO) | RES(RES_AO_MASK)};
+const pass_desc mr_pass_desc_ao_external = {
+    .needed = mr_pass_need_ao_external, .prepare = mr_pass_prepare_ao_external, .run = mr_pass_ao_external,
+    AO_DESTROY, .writes = RES(RES_AO)};

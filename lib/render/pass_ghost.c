@@ -76,14 +76,14 @@ static void free_targets(mr_ghost_state *g) {
     g->layers_valid = false;
 }
 
-void mr_ghost_scene_changed(mr_renderer *r) {
+static void mr_ghost_scene_changed(mr_renderer *r) {
     mr_ghost_state *g = r ? r->ghost : NULL;
     if (!g) return;
     mr_geometry_aux_free(&g->curv_aux);
     g->curv_built = false;
 }
 
-void mr_ghost_free(mr_renderer *r) {
+static void mr_ghost_free(mr_renderer *r) {
     mr_ghost_state *g = r->ghost;
     if (!g) return;
     mr_ghost_scene_changed(r);
@@ -423,19 +423,19 @@ static bool ghosting(const frame *f) {
     return p->ghost.mode != MR_GHOST_OFF && !p->hide_hidden_layer && hidden_in_view(f);
 }
 
-bool mr_pass_need_ghost(const frame *f) { return ghosting(f); }
-bool mr_pass_need_ghost_curvature(const frame *f) {
+static bool mr_pass_need_ghost(const frame *f) { return ghosting(f); }
+static bool mr_pass_need_ghost_curvature(const frame *f) {
     return ghosting(f) && f->p->ghost.importance != MR_GHOST_IMP_SALIENCY;
 }
-bool mr_pass_need_ghost_adaptive(const frame *f) { return ghosting(f) && f->p->ghost.mode == MR_GHOST_ADAPTIVE; }
+static bool mr_pass_need_ghost_adaptive(const frame *f) { return ghosting(f) && f->p->ghost.mode == MR_GHOST_ADAPTIVE; }
 
 /* Programs (first use), targets (size changes) and D's AO state. */
-bool mr_pass_prepare_ghost(frame *f, mr_error *err) {
+static bool mr_pass_prepare_ghost(frame *f, mr_error *err) {
     mr_ghost_state *g = state(f->r, err);
     return g && ensure_size(g, f->r->w, f->r->h, err) && mr_ao_hidden_prepare(f, err);
 }
 
-void mr_pass_ghost_hidden(frame *f) {
+static void mr_pass_ghost_hidden(frame *f) {
     mr_renderer *r = f->r;
     mr_ghost_state *g = r->ghost;
     mr_gbuffer_begin(f, &g->hid);
@@ -469,7 +469,7 @@ static void ensure_curvature(mr_renderer *r, mr_ghost_state *g) {
     free(k);
 }
 
-void mr_pass_ghost_curvature(frame *f) {
+static void mr_pass_ghost_curvature(frame *f) {
     mr_renderer *r = f->r;
     mr_ghost_state *g = r->ghost;
     ensure_curvature(r, g);
@@ -494,7 +494,7 @@ static bool needs_saliency_of_o(const frame *f) {
     return im == MR_GHOST_IMP_SALIENCY || (im == MR_GHOST_IMP_AUTO && f->p->video != NULL);
 }
 
-void mr_pass_ghost_importance(frame *f) {
+static void mr_pass_ghost_importance(frame *f) {
     mr_renderer *r = f->r;
     mr_ghost_state *g = r->ghost;
     const mr_ghost_params *gp = &f->p->ghost;
@@ -524,7 +524,7 @@ void mr_pass_ghost_importance(frame *f) {
     dispatch(g->w, g->h);
 }
 
-void mr_pass_ghost_g0(frame *f) {
+static void mr_pass_ghost_g0(frame *f) {
     mr_ghost_state *g = f->r->ghost;
     stage_g0(g, g->o_tex, frame_get(f, RES_HIDDEN_SHADED), &f->p->ghost);
     g->layers_valid = true;
@@ -537,9 +537,9 @@ void mr_pass_ghost_g0(frame *f) {
     }
 }
 
-void mr_pass_ghost_analysis(frame *f) { stage_analysis(f->r->ghost, &f->p->ghost); }
+static void mr_pass_ghost_analysis(frame *f) { stage_analysis(f->r->ghost, &f->p->ghost); }
 
-void mr_pass_ghost_emphasis(frame *f) {
+static void mr_pass_ghost_emphasis(frame *f) {
     mr_ghost_state *g = f->r->ghost;
     uint32_t key_base = (uint32_t)(f->r->scene ? f->r->scene->node_count : 0) + 1;
     stage_emphasis(g, g->o_tex, frame_get(f, RES_HIDDEN_SHADED), &f->p->ghost, key_base, f->p->video != NULL);
@@ -725,3 +725,28 @@ bool mr_ghost_read_layers(mr_renderer *r, mr_image *occluder, mr_image *hidden, 
     }
     return ok;
 }
+
+/* The rows of the registry (k_passes in renderer.c). Programs and targets
+ * are made by ghost_hidden's prepare for all of them. */
+#define GHOST_DESTROY .scene_changed = mr_ghost_scene_changed, .destroy = mr_ghost_free
+const pass_desc mr_pass_desc_ghost_hidden = {
+    .name = "ghost_hidden", .needed = mr_pass_need_ghost, .prepare = mr_pass_prepare_ghost,
+    .run = mr_pass_ghost_hidden, GHOST_DESTROY,
+    .writes = RES(RES_HIDDEN_DEPTH) | RES(RES_HIDDEN_NORMAL) | RES(RES_HIDDEN_IDS) | RES(RES_HIDDEN_SHADED)};
+const pass_desc mr_pass_desc_ghost_curvature = {
+    .name = "ghost_curvature", .needed = mr_pass_need_ghost_curvature, .run = mr_pass_ghost_curvature, GHOST_DESTROY,
+    .writes = RES(RES_CURVATURE)};
+const pass_desc mr_pass_desc_ghost_importance = {
+    .name = "ghost_importance", .needed = mr_pass_need_ghost, .run = mr_pass_ghost_importance, GHOST_DESTROY,
+    .reads = RES(RES_IMAGE) | RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_IDS) | RES(RES_HIDDEN_DEPTH) |
+             RES(RES_HIDDEN_IDS),
+    .uses = RES(RES_CURVATURE), .writes = RES(RES_GHOST_MASK)};
+const pass_desc mr_pass_desc_ghost_g0 = {
+    .name = "ghost_g0", .needed = mr_pass_need_ghost, .run = mr_pass_ghost_g0, GHOST_DESTROY,
+    .reads = RES(RES_IMAGE) | RES(RES_HIDDEN_SHADED) | RES(RES_GHOST_MASK), .writes = RES(RES_IMAGE)};
+const pass_desc mr_pass_desc_ghost_analysis = {
+    .name = "ghost_analysis", .needed = mr_pass_need_ghost_adaptive, .run = mr_pass_ghost_analysis, GHOST_DESTROY,
+    .reads = RES(RES_GHOST_MASK)};
+const pass_desc mr_pass_desc_ghost_emphasis = {
+    .name = "ghost_emphasis", .needed = mr_pass_need_ghost_adaptive, .run = mr_pass_ghost_emphasis, GHOST_DESTROY,
+    .reads = RES(RES_HIDDEN_SHADED) | RES(RES_GHOST_MASK), .writes = RES(RES_IMAGE)};

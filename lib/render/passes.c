@@ -62,7 +62,7 @@ static bool ensure_program(GLuint *prog, const char *vert, const char *frag, mr_
     return *prog || (*prog = mr_gl_program(files, err)) != 0;
 }
 
-bool mr_pass_prepare_gbuffer(frame *f, mr_error *err) {
+static bool mr_pass_prepare_gbuffer(frame *f, mr_error *err) {
     struct mr_base_state *b = base(f, err);
     if (!b || !ensure_program(&b->prog_gbuffer, "gbuffer.vert.glsl", "gbuffer.frag.glsl", err)) return false;
     /* albedo, view normal, ids, view-space position (written only when a
@@ -73,14 +73,14 @@ bool mr_pass_prepare_gbuffer(frame *f, mr_error *err) {
     return b->gbuf.fbo || mr_gl_target_make(&b->gbuf, b->w, b->h, gfmt, MR_OUT_GBUFFER_COUNT, true, err);
 }
 
-bool mr_pass_prepare_shade(frame *f, mr_error *err) {
+static bool mr_pass_prepare_shade(frame *f, mr_error *err) {
     struct mr_base_state *b = base(f, err);
     if (!b || !ensure_program(&b->prog_shade, "fullscreen.vert.glsl", "shade.frag.glsl", err)) return false;
     static const GLenum cfmt[1] = {GL_SRGB8_ALPHA8};
     return b->shaded.fbo || mr_gl_target_make(&b->shaded, b->w, b->h, cfmt, 1, false, err);
 }
 
-bool mr_pass_prepare_overlay(frame *f, mr_error *err) {
+static bool mr_pass_prepare_overlay(frame *f, mr_error *err) {
     struct mr_base_state *b = base(f, err);
     if (!b || !ensure_program(&b->prog_overlay, "fullscreen.vert.glsl", "overlay.frag.glsl", err)) return false;
     static const GLenum cfmt[1] = {GL_SRGB8_ALPHA8};
@@ -95,7 +95,7 @@ bool mr_pass_prepare_overlay(frame *f, mr_error *err) {
     return true;
 }
 
-bool mr_pass_need_overlay(const frame *f) { return f->p->video != NULL; }
+static bool mr_pass_need_overlay(const frame *f) { return f->p->video != NULL; }
 
 GLuint mr_gbuffer_program(const frame *f) { return f->r->base ? f->r->base->prog_gbuffer : 0; }
 
@@ -117,7 +117,7 @@ void mr_gbuffer_begin(frame *f, const target *t) {
     glClearNamedFramebufferfv(t->fbo, GL_DEPTH, 0, &depth0);
 }
 
-void mr_pass_gbuffer(frame *f) {
+static void mr_pass_gbuffer(frame *f) {
     struct mr_base_state *b = f->r->base;
     static const float zero4[4] = {0, 0, 0, 0};
     mr_gbuffer_begin(f, &b->gbuf);
@@ -144,7 +144,7 @@ void mr_pass_gbuffer(frame *f) {
     if (want_pos) frame_put(f, RES_POSITIONS, b->gbuf.color[MR_OUT_GBUFFER_POSITIONS]);
 }
 
-void mr_pass_shade(frame *f) {
+static void mr_pass_shade(frame *f) {
     struct mr_base_state *b = f->r->base;
     mr_shade_draw(f, frame_get(f, RES_ALBEDO), frame_get(f, RES_NORMAL), frame_get(f, RES_AO), &b->shaded);
     frame_put(f, RES_SHADED, b->shaded.color[0]);
@@ -197,7 +197,7 @@ void mr_shade_draw(frame *f, GLuint albedo, GLuint normal, GLuint ao, const targ
 }
 
 
-void mr_pass_overlay(frame *f) {
+static void mr_pass_overlay(frame *f) {
     mr_renderer *r = f->r;
     struct mr_base_state *b = r->base;
     const mr_image *v = f->p->video;
@@ -228,3 +228,14 @@ void mr_pass_overlay(frame *f) {
     frame_put(f, RES_IMAGE, b->composed.color[0]);
 }
 
+
+/* The rows of the registry (k_passes in renderer.c). */
+const pass_desc mr_pass_desc_gbuffer = {
+    .name = "gbuffer", .prepare = mr_pass_prepare_gbuffer, .run = mr_pass_gbuffer, .destroy = mr_base_free,
+    .writes = RES(RES_DEPTH) | RES(RES_ALBEDO) | RES(RES_NORMAL) | RES(RES_IDS) | RES(RES_POSITIONS)};
+const pass_desc mr_pass_desc_shade = {
+    .name = "shade", .prepare = mr_pass_prepare_shade, .run = mr_pass_shade, .destroy = mr_base_free,
+    .reads = RES(RES_ALBEDO) | RES(RES_NORMAL), .uses = RES(RES_AO), .writes = RES(RES_SHADED) | RES(RES_IMAGE)};
+const pass_desc mr_pass_desc_overlay = {
+    .name = "overlay", .needed = mr_pass_need_overlay, .prepare = mr_pass_prepare_overlay, .run = mr_pass_overlay,
+    .destroy = mr_base_free, .reads = RES(RES_IMAGE), .writes = RES(RES_IMAGE)};

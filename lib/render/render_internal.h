@@ -145,17 +145,17 @@ void mr_geometry_aux_free(mr_geo_aux *aux);
  * (camera relative, composed in double) and MR_LOC_NORMAL_MATRIX. */
 void mr_geometry_aux_draw(mr_renderer *r, const mr_geo_view *view, const mr_geo_aux *aux);
 
-/* The pass files' rows and helpers. Each file defines its rows' functions;
- * renderer.c lists them. */
+/* The registry's rows: each pass file defines its descriptors, renderer.c
+ * lists them in order. */
+extern const pass_desc mr_pass_desc_gbuffer, mr_pass_desc_shade, mr_pass_desc_overlay;         /* passes.c */
+extern const pass_desc mr_pass_desc_ao_mask, mr_pass_desc_ao, mr_pass_desc_ao_blur, mr_pass_desc_ao_upsample,
+    mr_pass_desc_ao_reuse, mr_pass_desc_ao_external;                                            /* pass_ao.c */
+extern const pass_desc mr_pass_desc_ghost_hidden, mr_pass_desc_ghost_curvature, mr_pass_desc_ghost_importance,
+    mr_pass_desc_ghost_g0, mr_pass_desc_ghost_analysis, mr_pass_desc_ghost_emphasis;            /* pass_ghost.c */
 
-/* passes.c: gbuffer, shade, overlay. */
-bool mr_pass_need_overlay(const frame *f);
-bool mr_pass_prepare_gbuffer(frame *f, mr_error *err);
-bool mr_pass_prepare_shade(frame *f, mr_error *err);
-bool mr_pass_prepare_overlay(frame *f, mr_error *err);
-void mr_pass_gbuffer(frame *f);
-void mr_pass_shade(frame *f);
-void mr_pass_overlay(frame *f);
+/* Helpers the pass files share. */
+
+/* passes.c */
 void mr_base_free(mr_renderer *r);
 /* Binds a G-buffer-layout target, clears it (depth to infinity) and sets
  * the depth state the geometry pass draws with. */
@@ -169,36 +169,9 @@ void mr_shade_draw(frame *f, GLuint albedo, GLuint normal, GLuint ao, const targ
 /* pass_ghost.c: ghosted views. The G-buffer pass leaves the hidden layer
  * out when "hidden.*" is made this frame. */
 bool mr_ghost_check_params(const mr_ghost_params *gp, mr_error *err);
-bool mr_pass_need_ghost(const frame *f);
-bool mr_pass_need_ghost_curvature(const frame *f);
-bool mr_pass_need_ghost_adaptive(const frame *f);
-bool mr_pass_prepare_ghost(frame *f, mr_error *err);
-void mr_pass_ghost_hidden(frame *f);
-void mr_pass_ghost_curvature(frame *f);
-void mr_pass_ghost_importance(frame *f);
-void mr_pass_ghost_g0(frame *f);
-void mr_pass_ghost_analysis(frame *f);
-void mr_pass_ghost_emphasis(frame *f);
-void mr_ghost_scene_changed(mr_renderer *r);
-void mr_ghost_free(mr_renderer *r);
 
 /* pass_ao.c: ambient occlusion. */
 typedef struct mr_ao_state mr_ao_state;
-bool mr_pass_need_ao(const frame *f);
-bool mr_pass_need_ao_mask(const frame *f);
-bool mr_pass_need_ao_blur(const frame *f);
-bool mr_pass_need_ao_upsample(const frame *f);
-bool mr_pass_need_ao_reuse(const frame *f);
-bool mr_pass_need_ao_external(const frame *f);
-uint32_t mr_pass_ao_reads(const frame *f);
-bool mr_pass_prepare_ao(frame *f, mr_error *err);
-bool mr_pass_prepare_ao_external(frame *f, mr_error *err);
-void mr_pass_ao_mask(frame *f);
-void mr_pass_ao(frame *f);
-void mr_pass_ao_blur(frame *f);
-void mr_pass_ao_upsample(frame *f);
-void mr_pass_ao_reuse(frame *f);
-void mr_pass_ao_external(frame *f);
 /* AO of the hidden layer D (depth, normal) with the frame's AO settings, in
  * a state of its own (reuse works per target); no corner mask, no
  * positions path. prepare before run; run returns the AO texture or 0. */
@@ -206,7 +179,6 @@ bool mr_ao_hidden_prepare(frame *f, mr_error *err);
 GLuint mr_ao_hidden_run(frame *f, GLuint depth, GLuint normal);
 /* Fills out->ao (if asked) and the mask statistics. */
 bool mr_pass_ao_read_back(frame *f, mr_error *err);
-void mr_pass_ao_scene_changed(mr_renderer *r);
 void mr_pass_ao_free(mr_renderer *r);
 
 #endif

@@ -59,51 +59,26 @@ const char *const mr_resource_names[RES_COUNT] = {
     [RES_CURVATURE] = "curvature", [RES_GHOST_MASK] = "ghost.mask",
 };
 
-#define GBUF (RES(RES_DEPTH) | RES(RES_ALBEDO) | RES(RES_NORMAL) | RES(RES_IDS))
-#define HIDDEN (RES(RES_HIDDEN_DEPTH) | RES(RES_HIDDEN_NORMAL) | RES(RES_HIDDEN_IDS) | RES(RES_HIDDEN_SHADED))
-
-/* The registry: one row per pass, in the order they run. */
-static const pass_desc k_passes[] = {
-    {.name = "gbuffer", .prepare = mr_pass_prepare_gbuffer, .run = mr_pass_gbuffer, .destroy = mr_base_free,
-     .writes = GBUF | RES(RES_POSITIONS)},
-    {.name = "ao_mask", .needed = mr_pass_need_ao_mask, .prepare = mr_pass_prepare_ao, .run = mr_pass_ao_mask,
-     .scene_changed = mr_pass_ao_scene_changed, .destroy = mr_pass_ao_free, .reads = RES(RES_DEPTH),
-     .writes = RES(RES_AO_MASK)},
-    {.name = "ao", .needed = mr_pass_need_ao, .prepare = mr_pass_prepare_ao, .run = mr_pass_ao,
-     .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_POSITIONS) | RES(RES_AO_MASK), .writes = RES(RES_AO),
-     .reads_now = mr_pass_ao_reads},
-    {.name = "ao_blur", .needed = mr_pass_need_ao_blur, .run = mr_pass_ao_blur,
-     .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_AO), .writes = RES(RES_AO)},
-    {.name = "ao_upsample", .needed = mr_pass_need_ao_upsample, .run = mr_pass_ao_upsample,
-     .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_AO), .writes = RES(RES_AO)},
-    /* Not listed (no GPU work of their own): the AO of an earlier frame with
-     * the same camera, size, scene and settings, or an AO image given from
-     * outside (ground truth), stands in for the AO passes. */
-    {.needed = mr_pass_need_ao_reuse, .run = mr_pass_ao_reuse, .writes = RES(RES_AO) | RES(RES_AO_MASK)},
-    {.needed = mr_pass_need_ao_external, .prepare = mr_pass_prepare_ao_external, .run = mr_pass_ao_external,
-     .writes = RES(RES_AO)},
-    {.name = "ghost_hidden", .needed = mr_pass_need_ghost, .prepare = mr_pass_prepare_ghost,
-     .run = mr_pass_ghost_hidden, .scene_changed = mr_ghost_scene_changed, .destroy = mr_ghost_free,
-     .writes = HIDDEN},
-    {.name = "shade", .prepare = mr_pass_prepare_shade, .run = mr_pass_shade,
-     .reads = RES(RES_ALBEDO) | RES(RES_NORMAL), .uses = RES(RES_AO), .writes = RES(RES_SHADED) | RES(RES_IMAGE)},
-    {.name = "overlay", .needed = mr_pass_need_overlay, .prepare = mr_pass_prepare_overlay, .run = mr_pass_overlay,
-     .reads = RES(RES_IMAGE), .writes = RES(RES_IMAGE)},
+/* The registry: one row per pass, in the order they run; each row's
+ * descriptor lives in its pass's file. */
+static const pass_desc *const k_passes[] = {
+    &mr_pass_desc_gbuffer,
+    &mr_pass_desc_ao_mask,
+    &mr_pass_desc_ao,
+    &mr_pass_desc_ao_blur,
+    &mr_pass_desc_ao_upsample,
+    &mr_pass_desc_ao_reuse,
+    &mr_pass_desc_ao_external,
+    &mr_pass_desc_ghost_hidden,
+    &mr_pass_desc_shade,
+    &mr_pass_desc_overlay,
     /* Ghosting after the overlay: with video, the occluder O is what the
      * user sees in front of the hidden structure (the real wall). */
-    {.name = "ghost_curvature", .needed = mr_pass_need_ghost_curvature, .run = mr_pass_ghost_curvature,
-     .writes = RES(RES_CURVATURE)},
-    {.name = "ghost_importance", .needed = mr_pass_need_ghost, .run = mr_pass_ghost_importance,
-     .reads = RES(RES_IMAGE) | RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_IDS) | RES(RES_HIDDEN_DEPTH) |
-              RES(RES_HIDDEN_IDS),
-     .uses = RES(RES_CURVATURE),
-     .writes = RES(RES_GHOST_MASK)},
-    {.name = "ghost_g0", .needed = mr_pass_need_ghost, .run = mr_pass_ghost_g0,
-     .reads = RES(RES_IMAGE) | RES(RES_HIDDEN_SHADED) | RES(RES_GHOST_MASK), .writes = RES(RES_IMAGE)},
-    {.name = "ghost_analysis", .needed = mr_pass_need_ghost_adaptive, .run = mr_pass_ghost_analysis,
-     .reads = RES(RES_GHOST_MASK)},
-    {.name = "ghost_emphasis", .needed = mr_pass_need_ghost_adaptive, .run = mr_pass_ghost_emphasis,
-     .reads = RES(RES_HIDDEN_SHADED) | RES(RES_GHOST_MASK), .writes = RES(RES_IMAGE)},
+    &mr_pass_desc_ghost_curvature,
+    &mr_pass_desc_ghost_importance,
+    &mr_pass_desc_ghost_g0,
+    &mr_pass_desc_ghost_analysis,
+    &mr_pass_desc_ghost_emphasis,
 };
 #define PASS_COUNT (sizeof k_passes / sizeof k_passes[0])
 
@@ -148,7 +123,7 @@ void mr_renderer_destroy(mr_renderer **rp) {
     glUseProgram(0);
     glBindVertexArray(0);
     for (size_t i = 0; i < PASS_COUNT; i++)
-        if (k_passes[i].destroy) k_passes[i].destroy(r);
+        if (k_passes[i]->destroy) k_passes[i]->destroy(r);
     mr_geometry_free(r);
     glDeleteVertexArrays(1, &r->empty_vao);
     glDeleteQueries(MR_MAX_PASSES, r->queries);
@@ -159,7 +134,7 @@ void mr_renderer_destroy(mr_renderer **rp) {
 
 bool mr_renderer_set_scene(mr_renderer *r, const mr_scene *s, mr_error *err) {
     for (size_t i = 0; i < PASS_COUNT; i++)
-        if (k_passes[i].scene_changed) k_passes[i].scene_changed(r);
+        if (k_passes[i]->scene_changed) k_passes[i]->scene_changed(r);
     mr_geometry_free(r);
     if (!s) return true;
     return mr_geometry_upload(r, s, err);
@@ -259,7 +234,7 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
      * sees the state the frame started with. */
     bool need[PASS_COUNT];
     for (size_t i = 0; i < PASS_COUNT; i++) {
-        const pass_desc *d = &k_passes[i];
+        const pass_desc *d = k_passes[i];
         need[i] = !d->needed || d->needed(&f);
         if (!need[i]) continue;
         uint32_t reads = d->reads_now ? d->reads_now(&f) & d->reads : d->reads;
@@ -276,10 +251,10 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
         f.writing |= d->writes;
     }
     for (size_t i = 0; i < PASS_COUNT; i++)
-        if (need[i] && k_passes[i].prepare && !k_passes[i].prepare(&f, err)) return false;
+        if (need[i] && k_passes[i]->prepare && !k_passes[i]->prepare(&f, err)) return false;
     for (size_t i = 0; i < PASS_COUNT; i++) {
         if (!need[i]) continue;
-        const pass_desc *d = &k_passes[i];
+        const pass_desc *d = k_passes[i];
         if (!d->name) {
             d->run(&f);
             continue;
