@@ -1,6 +1,7 @@
-# Turns shaders/*.glsl into one C file: a table of {name, source} pairs.
+# Turns shaders/*.glsl and shaders/*.h (mr_bindings.h, shared with the C
+# side) into one C file: a table of {name, source} pairs.
 # Sources are emitted as hex byte arrays so no character needs escaping.
-file(GLOB files ${SHADER_DIR}/*.glsl)
+file(GLOB files ${SHADER_DIR}/*.glsl ${SHADER_DIR}/*.h)
 list(SORT files)
 set(body "/* generated from the GLSL files in shaders/ by cmake/embed_shaders.cmake */\n#include <stddef.h>\n")
 set(table "")

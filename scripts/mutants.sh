@@ -49,6 +49,10 @@ view_settings_in_place|lib/view/settings.c|    bool ok = (!dir[0] |    FILE *fo 
 view_lost_fades_to_model|lib/view/controller.c|1.0f - (1.0f - s->alpha) * 0.35f|s->alpha * 0.35f|^test_view$
 view_layout_drops_first|lib/view/controller.c|        if (i >= shown) {|        if (i < n - shown) {|^test_view$
 gl_context_4.9|lib/render/gpu.c|EGL_CONTEXT_MINOR_VERSION, 5,|EGL_CONTEXT_MINOR_VERSION, 9,|^(test_render|cli_render)$
+gl_target_leaks_positions|lib/render/renderer.c|glDeleteTextures((GLsizei)(sizeof t->color / sizeof t->color[0]), t->color);|glDeleteTextures(3, t->color);|^test_gl_objects$
+ao_reuse_never|lib/render/pass_ao.c|return memcmp(&key, &s->last, sizeof key) == 0 ? AO_PLAN_REUSE : AO_PLAN_RUN;|(void)key; return AO_PLAN_RUN;|^test_ao$
+registry_gbuffer_skipped|lib/render/passes.c|.name = "gbuffer", .prepare|.name = "gbuffer", .needed = mr_pass_need_overlay, .prepare|^test_render$
+ghost_hidden_in_gbuffer|lib/render/passes.c|!(f->writing & RES(RES_HIDDEN_DEPTH))|true|^test_ghost$
 LIST
 )
 

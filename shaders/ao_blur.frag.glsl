@@ -2,20 +2,21 @@
 // counts by a Gaussian in pixels times how close it lies to the centre's
 // tangent plane (relative to the centre's depth, so any scene scale and
 // grazing planes blur alike) times the agreement of the normals.
+#include "mr_bindings.h"
 #include "ao_common.glsl"
 
-layout(location = 0) uniform vec4 u_intr;    // G-buffer intrinsics
-layout(location = 1) uniform ivec2 u_full;   // G-buffer size
-layout(location = 2) uniform int u_step;     // G-buffer pixels per AO pixel
-layout(location = 3) uniform float u_near;
-layout(location = 4) uniform ivec2 u_dir;    // (1,0) or (0,1)
-layout(location = 5) uniform int u_radius;   // taps each side
-layout(location = 6) uniform ivec2 u_ao_size;
+layout(location = MR_LOC_AO_INTR) uniform vec4 u_intr;    // G-buffer intrinsics
+layout(location = MR_LOC_AO_FULL) uniform ivec2 u_full;   // G-buffer size
+layout(location = MR_LOC_AO_STEP) uniform int u_step;     // G-buffer pixels per AO pixel
+layout(location = MR_LOC_AO_NEAR) uniform float u_near;
+layout(location = MR_LOC_AO_BLUR_DIR) uniform ivec2 u_dir;    // (1,0) or (0,1)
+layout(location = MR_LOC_AO_BLUR_RADIUS) uniform int u_radius;   // taps each side
+layout(location = MR_LOC_AO_SIZE) uniform ivec2 u_ao_size;
 
-layout(binding = 0) uniform sampler2D u_depth;
-layout(binding = 1) uniform sampler2D u_normal;
-layout(binding = 2) uniform sampler2D u_pos;  // unused here
-layout(binding = 4) uniform sampler2D u_ao;
+layout(binding = MR_TEX_AO_DEPTH) uniform sampler2D u_depth;
+layout(binding = MR_TEX_AO_NORMAL) uniform sampler2D u_normal;
+layout(binding = MR_TEX_AO_POSITIONS) uniform sampler2D u_pos;  // unused here
+layout(binding = MR_TEX_AO_INPUT) uniform sampler2D u_ao;
 
 layout(location = 0) out float o_ao;
 

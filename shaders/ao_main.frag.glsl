@@ -3,40 +3,41 @@
 // [0,1], 1 = unoccluded. The AO target may be half the G-buffer's size: AO
 // pixel i reads the G-buffer at i * u_step, everything else works at full
 // resolution with the full-resolution intrinsics.
+#include "mr_bindings.h"
 #include "ao_common.glsl"
 
-layout(location = 0) uniform vec4 u_intr;        // fx fy cx cy of the G-buffer (pixels)
-layout(location = 1) uniform ivec2 u_full;       // G-buffer size
-layout(location = 2) uniform int u_step;         // 1 full resolution, 2 half
-layout(location = 3) uniform float u_near;       // near plane (scene units)
-layout(location = 4) uniform int u_method;       // mr_ao_method; 100 = standalone corner mask
-layout(location = 5) uniform int u_samples;      // 1..64
-layout(location = 6) uniform int u_radius_mode;  // 0 screen (r = k z), 1 view (r constant)
-layout(location = 7) uniform float u_radius;     // view mode radius (scene units)
-layout(location = 8) uniform float u_screen_k;   // screen mode: r = k * z
-layout(location = 9) uniform float u_c;          // scheer attenuation
-layout(location = 10) uniform float u_bias;      // fraction of the radius / cosine
-layout(location = 11) uniform float u_strength;
-layout(location = 12) uniform int u_radii;       // multi-radius count
-layout(location = 13) uniform int u_use_pos;
-layout(location = 14) uniform int u_use_mask;
-layout(location = 15) uniform float u_mask_strength; // standalone mask: 1 - this inside, in [0,1]
-layout(location = 16) uniform vec4 u_kernel[64];  // xyz in the unit ball shell [r_min, r_max]
-layout(location = 80) uniform vec4 u_kernel2[64]; // xy in the unit disk annulus [r_min, r_max]
+layout(location = MR_LOC_AO_INTR) uniform vec4 u_intr;        // fx fy cx cy of the G-buffer (pixels)
+layout(location = MR_LOC_AO_FULL) uniform ivec2 u_full;       // G-buffer size
+layout(location = MR_LOC_AO_STEP) uniform int u_step;         // 1 full resolution, 2 half
+layout(location = MR_LOC_AO_NEAR) uniform float u_near;       // near plane (scene units)
+layout(location = MR_LOC_AO_METHOD) uniform int u_method;       // mr_ao_method; 100 = standalone corner mask
+layout(location = MR_LOC_AO_SAMPLES) uniform int u_samples;      // 1..64
+layout(location = MR_LOC_AO_RADIUS_MODE) uniform int u_radius_mode;  // 0 screen (r = k z), 1 view (r constant)
+layout(location = MR_LOC_AO_RADIUS) uniform float u_radius;     // view mode radius (scene units)
+layout(location = MR_LOC_AO_SCREEN_K) uniform float u_screen_k;   // screen mode: r = k * z
+layout(location = MR_LOC_AO_C) uniform float u_c;          // scheer attenuation
+layout(location = MR_LOC_AO_BIAS) uniform float u_bias;      // fraction of the radius / cosine
+layout(location = MR_LOC_AO_STRENGTH) uniform float u_strength;
+layout(location = MR_LOC_AO_RADII) uniform int u_radii;       // multi-radius count
+layout(location = MR_LOC_AO_USE_POS) uniform int u_use_pos;
+layout(location = MR_LOC_AO_USE_MASK) uniform int u_use_mask;
+layout(location = MR_LOC_AO_MASK_STRENGTH) uniform float u_mask_strength; // standalone mask: 1 - this inside, in [0,1]
+layout(location = MR_LOC_AO_KERNEL) uniform vec4 u_kernel[MR_AO_KERNEL_SIZE];  // xyz in the unit ball shell [r_min, r_max]
+layout(location = MR_LOC_AO_KERNEL2) uniform vec4 u_kernel2[MR_AO_KERNEL_SIZE]; // xy in the unit disk annulus [r_min, r_max]
 
-layout(binding = 0) uniform sampler2D u_depth;
-layout(binding = 1) uniform sampler2D u_normal;
-layout(binding = 2) uniform sampler2D u_pos;
-layout(binding = 3) uniform sampler2D u_mask;
+layout(binding = MR_TEX_AO_DEPTH) uniform sampler2D u_depth;
+layout(binding = MR_TEX_AO_NORMAL) uniform sampler2D u_normal;
+layout(binding = MR_TEX_AO_POSITIONS) uniform sampler2D u_pos;
+layout(binding = MR_TEX_AO_MASK) uniform sampler2D u_mask;
 
 layout(location = 0) out float o_ao;
 
-#define M_SCHEER 1
-#define M_CRYTEK 2
-#define M_FILION 3
-#define M_HBAO 4
-#define M_ALCHEMY 5
-#define M_MASK_STANDALONE 100
+#define M_SCHEER MR_AO_METHOD_ID_SCHEER
+#define M_CRYTEK MR_AO_METHOD_ID_CRYTEK
+#define M_FILION MR_AO_METHOD_ID_FILION
+#define M_HBAO MR_AO_METHOD_ID_HBAO
+#define M_ALCHEMY MR_AO_METHOD_ID_ALCHEMY
+#define M_MASK_STANDALONE MR_AO_METHOD_MASK_STANDALONE
 
 bool fetch_pos(ivec2 q, out vec3 p) {
     return ao_view_pos(u_depth, u_pos, u_use_pos != 0, u_near, u_intr, q, p);

@@ -1,15 +1,16 @@
 // Outline volumes for corner masking (Park & Baek): every vertex pushed out
 // along its integrated normal by the AO radius. In screen mode the radius
 // grows with the vertex's depth (r = k z), like scheer's sampling radius.
-layout(location = 0) in vec3 a_position;
-layout(location = 1) in vec3 a_dir;             // integrated normal (mesh space)
+#include "mr_bindings.h"
+layout(location = MR_ATTR_POSITION) in vec3 a_position;
+layout(location = MR_ATTR_OUTLINE_DIR) in vec3 a_dir;             // integrated normal (mesh space)
 
-layout(location = 0) uniform mat4 u_modelview;
-layout(location = 1) uniform mat3 u_normal_mat;
-layout(location = 2) uniform mat4 u_proj;
-layout(location = 3) uniform int u_radius_mode; // 0 screen, 1 view
-layout(location = 4) uniform float u_radius;    // view mode (scene units)
-layout(location = 5) uniform float u_screen_k;  // screen mode
+layout(location = MR_LOC_MODELVIEW) uniform mat4 u_modelview;
+layout(location = MR_LOC_NORMAL_MATRIX) uniform mat3 u_normal_mat;
+layout(location = MR_LOC_PROJECTION) uniform mat4 u_proj;
+layout(location = MR_LOC_OUTLINE_RADIUS_MODE) uniform int u_radius_mode; // 0 screen, 1 view
+layout(location = MR_LOC_OUTLINE_RADIUS) uniform float u_radius;    // view mode (scene units)
+layout(location = MR_LOC_OUTLINE_SCREEN_K) uniform float u_screen_k;  // screen mode
 
 out vec3 v_pos;
 out vec3 v_dir;

@@ -2,18 +2,19 @@
 // low-resolution texels around a full-resolution pixel, weighted bilinearly
 // and by how well their G-buffer samples (taken at 2*j) agree with this
 // pixel's depth plane and normal; so AO never leaks across silhouettes.
+#include "mr_bindings.h"
 #include "ao_common.glsl"
 
-layout(location = 0) uniform vec4 u_intr;
-layout(location = 1) uniform ivec2 u_full;
-layout(location = 2) uniform int u_step;     // 2
-layout(location = 3) uniform float u_near;
-layout(location = 6) uniform ivec2 u_ao_size;
+layout(location = MR_LOC_AO_INTR) uniform vec4 u_intr;
+layout(location = MR_LOC_AO_FULL) uniform ivec2 u_full;
+layout(location = MR_LOC_AO_STEP) uniform int u_step;     // 2
+layout(location = MR_LOC_AO_NEAR) uniform float u_near;
+layout(location = MR_LOC_AO_SIZE) uniform ivec2 u_ao_size;
 
-layout(binding = 0) uniform sampler2D u_depth;
-layout(binding = 1) uniform sampler2D u_normal;
-layout(binding = 2) uniform sampler2D u_pos;
-layout(binding = 4) uniform sampler2D u_ao;
+layout(binding = MR_TEX_AO_DEPTH) uniform sampler2D u_depth;
+layout(binding = MR_TEX_AO_NORMAL) uniform sampler2D u_normal;
+layout(binding = MR_TEX_AO_POSITIONS) uniform sampler2D u_pos;
+layout(binding = MR_TEX_AO_INPUT) uniform sampler2D u_ao;
 
 layout(location = 0) out float o_ao;
 

@@ -4,12 +4,13 @@ in vec2 v_uv;
 flat in vec4 v_color;   // linear RGBA
 flat in uvec3 v_ids;    // node index + 1, layer, has texture
 
-layout(binding = 0) uniform sampler2D u_base_tex; // sRGB texture: sampled linear
+#include "mr_bindings.h"
+layout(binding = MR_TEX_GBUFFER_BASE_COLOR) uniform sampler2D u_base_tex; // sRGB texture: sampled linear
 
-layout(location = 0) out vec4 o_albedo;  // sRGB8 target: linear in, encoded on write
-layout(location = 1) out vec4 o_normal;  // xyz view normal, w = 1 where geometry
-layout(location = 2) out uvec2 o_ids;
-layout(location = 3) out vec4 o_pos;    // view-space position, w = 1 (AO positions path)
+layout(location = MR_OUT_GBUFFER_ALBEDO) out vec4 o_albedo;  // sRGB8 target: linear in, encoded on write
+layout(location = MR_OUT_GBUFFER_NORMAL) out vec4 o_normal;  // xyz view normal, w = 1 where geometry
+layout(location = MR_OUT_GBUFFER_IDS) out uvec2 o_ids;
+layout(location = MR_OUT_GBUFFER_POSITIONS) out vec4 o_pos;    // view-space position, w = 1 (AO positions path)
 
 void main() {
     vec4 c = v_color;

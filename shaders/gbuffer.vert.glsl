@@ -4,17 +4,18 @@
 // small however far the scene is from the origin. The instance record comes
 // in as per-instance attributes (the indirect command's baseInstance selects
 // it), so one multi-draw covers many meshes and nodes.
-layout(location = 0) in vec3 a_position;
-layout(location = 1) in vec3 a_normal;
-layout(location = 2) in vec2 a_uv;
-layout(location = 3) in mat4 a_modelview;   // camera (OpenCV axes) from mesh; 3..6
-layout(location = 7) in vec4 a_normal0;     // columns of the inverse transpose
-layout(location = 8) in vec4 a_normal1;     // of the model-view's 3x3
-layout(location = 9) in vec4 a_normal2;
-layout(location = 10) in vec4 a_color;      // linear RGBA base colour
-layout(location = 11) in uvec4 a_ids;       // node index + 1, layer, has texture
+#include "mr_bindings.h"
+layout(location = MR_ATTR_POSITION) in vec3 a_position;
+layout(location = MR_ATTR_NORMAL) in vec3 a_normal;
+layout(location = MR_ATTR_UV) in vec2 a_uv;
+layout(location = MR_ATTR_INST_MODELVIEW) in mat4 a_modelview;   // camera (OpenCV axes) from mesh; 3..6
+layout(location = MR_ATTR_INST_NORMAL0) in vec4 a_normal0;     // columns of the inverse transpose
+layout(location = MR_ATTR_INST_NORMAL1) in vec4 a_normal1;     // of the model-view's 3x3
+layout(location = MR_ATTR_INST_NORMAL2) in vec4 a_normal2;
+layout(location = MR_ATTR_INST_COLOR) in vec4 a_color;      // linear RGBA base colour
+layout(location = MR_ATTR_INST_IDS) in uvec4 a_ids;       // node index + 1, layer, has texture
 
-layout(location = 2) uniform mat4 u_proj;   // reversed-Z, infinite far
+layout(location = MR_LOC_PROJECTION) uniform mat4 u_proj;   // reversed-Z, infinite far
 
 out vec3 v_pos;     // view space, OpenCV axes
 out vec3 v_normal;  // view space

@@ -3,14 +3,15 @@
 //   C_desired = max(tc_minimal, gamma * IM) + tc_silhouette on the hidden
 //               structure's silhouette,
 //   C = max(0, C_desired - S(G0)).
+#include "mr_bindings.h"
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(location = 0) uniform float u_tc_min;
-layout(location = 1) uniform float u_gamma;
-layout(location = 2) uniform float u_tc_sil;
-layout(binding = 0) uniform sampler2D u_mask;
-layout(binding = 1) uniform sampler2D u_sal;   // S(G0)
-layout(binding = 2) uniform sampler2D u_g0;    // .a = alpha
-layout(binding = 0, rgba32f) uniform writeonly image2D u_c;
+layout(location = MR_LOC_ANA_TC_MIN) uniform float u_tc_min;
+layout(location = MR_LOC_ANA_GAMMA) uniform float u_gamma;
+layout(location = MR_LOC_ANA_TC_SIL) uniform float u_tc_sil;
+layout(binding = MR_TEX_ANA_MASK) uniform sampler2D u_mask;
+layout(binding = MR_TEX_ANA_SAL) uniform sampler2D u_sal;   // S(G0)
+layout(binding = MR_TEX_ANA_G0) uniform sampler2D u_g0;    // .a = alpha
+layout(binding = MR_IMG_ANA_C, rgba32f) uniform writeonly image2D u_c;
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy), n = imageSize(u_c);
     if (p.x >= n.x || p.y >= n.y) return;

@@ -1,12 +1,13 @@
 // One direction of a separable Gaussian (clamp-to-edge), all four channels.
 // The kernel is cut at u_radius and renormalised over what is kept, so a
 // flat image stays exactly flat.
+#include "mr_bindings.h"
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(location = 0) uniform ivec2 u_dir;
-layout(location = 1) uniform float u_sigma;   // pixels
-layout(location = 2) uniform int u_radius;
-layout(binding = 0) uniform sampler2D u_src;
-layout(binding = 0, rgba32f) uniform writeonly image2D u_dst;
+layout(location = MR_LOC_GBLUR_DIR) uniform ivec2 u_dir;
+layout(location = MR_LOC_GBLUR_SIGMA) uniform float u_sigma;   // pixels
+layout(location = MR_LOC_GBLUR_RADIUS) uniform int u_radius;
+layout(binding = MR_TEX_GBLUR_SRC) uniform sampler2D u_src;
+layout(binding = MR_IMG_GBLUR_DST, rgba32f) uniform writeonly image2D u_dst;
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy), n = imageSize(u_dst);
     if (p.x >= n.x || p.y >= n.y) return;

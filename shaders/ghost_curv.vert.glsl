@@ -1,12 +1,13 @@
 // Curvature pass of the occluder (visible layer): the same transform as the
 // G-buffer (uniform locations 0-2 set by mr_geometry_draw), plus the mesh's
 // per-vertex principal curvature (attribute 3, 1/mesh units).
-layout(location = 0) in vec3 a_position;
-layout(location = 3) in float a_kappa;
+#include "mr_bindings.h"
+layout(location = MR_ATTR_POSITION) in vec3 a_position;
+layout(location = MR_ATTR_CURVATURE) in float a_kappa;
 
-layout(location = 0) uniform mat4 u_modelview;
-layout(location = 1) uniform mat3 u_normal_mat;
-layout(location = 2) uniform mat4 u_proj;
+layout(location = MR_LOC_MODELVIEW) uniform mat4 u_modelview;
+layout(location = MR_LOC_NORMAL_MATRIX) uniform mat3 u_normal_mat;
+layout(location = MR_LOC_PROJECTION) uniform mat4 u_proj;
 
 out float v_kappa; // 1/view units
 

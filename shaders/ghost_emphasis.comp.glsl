@@ -7,23 +7,24 @@
 //  u_stage 1 (apply): each object takes the sign of its vote, so it is
 //    either lightened or darkened, never both:
 //      L*(O_A) = L*(O) + gain * GK(C) * sign,  G_A = LAB^-1(O_A)*alpha + D*(1-alpha).
+#include "mr_bindings.h"
 #include "ghost_lab.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(location = 0) uniform int u_stage;
-layout(location = 1) uniform uint u_key_base;  // first key of the video regions
-layout(location = 2) uniform float u_gain;
-layout(binding = 0) uniform sampler2D u_o;
-layout(binding = 1) uniform sampler2D u_d;
-layout(binding = 2) uniform sampler2D u_dgk;   // GK(D), linear
-layout(binding = 3) uniform sampler2D u_gkc;   // GK(C) in .r
-layout(binding = 4) uniform sampler2D u_mask;
-layout(binding = 5) uniform sampler2D u_g0;
-layout(binding = 6) uniform usampler2D u_key;
-layout(binding = 7) uniform usampler2D u_label;
-layout(binding = 0, rgba8) uniform writeonly image2D u_out;
-layout(binding = 1, rgba32f) uniform writeonly image2D u_oa;
-layout(binding = 2, rgba32f) uniform writeonly image2D u_ga;
-layout(std430, binding = 1) buffer Votes { int votes[]; };
+layout(location = MR_LOC_EMPH_STAGE) uniform int u_stage;
+layout(location = MR_LOC_EMPH_KEY_BASE) uniform uint u_key_base;  // first key of the video regions
+layout(location = MR_LOC_EMPH_GAIN) uniform float u_gain;
+layout(binding = MR_TEX_EMPH_O) uniform sampler2D u_o;
+layout(binding = MR_TEX_EMPH_D) uniform sampler2D u_d;
+layout(binding = MR_TEX_EMPH_DGK) uniform sampler2D u_dgk;   // GK(D), linear
+layout(binding = MR_TEX_EMPH_GKC) uniform sampler2D u_gkc;   // GK(C) in .r
+layout(binding = MR_TEX_EMPH_MASK) uniform sampler2D u_mask;
+layout(binding = MR_TEX_EMPH_G0) uniform sampler2D u_g0;
+layout(binding = MR_TEX_EMPH_KEY) uniform usampler2D u_key;
+layout(binding = MR_TEX_EMPH_LABEL) uniform usampler2D u_label;
+layout(binding = MR_IMG_EMPH_OUT, rgba8) uniform writeonly image2D u_out;
+layout(binding = MR_IMG_EMPH_OA, rgba32f) uniform writeonly image2D u_oa;
+layout(binding = MR_IMG_EMPH_GA, rgba32f) uniform writeonly image2D u_ga;
+layout(std430, binding = MR_SSBO_EMPH_VOTES) buffer Votes { int votes[]; };
 
 // Votes are pre-summed per workgroup: each invocation posts (key, vote) in
 // shared memory and the first invocation adds runs of equal keys, so a large

@@ -3,16 +3,17 @@
 //  D visible, unoccluded: alpha = 0 (D as it is)
 //  elsewhere:           alpha = 1 (O as it is)
 // Writes G0 (linear, alpha in .a) and the finished sRGB image.
+#include "mr_bindings.h"
 #include "ghost_lab.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(location = 0) uniform int u_mode;   // 1 alpha, 2 g0, 3 adaptive
-layout(location = 1) uniform float u_t;
-layout(binding = 0) uniform sampler2D u_o;     // occluder, linear
-layout(binding = 1) uniform sampler2D u_d;     // occludee, linear
-layout(binding = 2) uniform sampler2D u_mask;
-layout(binding = 0, rgba32f) uniform writeonly image2D u_g0;
-layout(binding = 1, rgba8) uniform writeonly image2D u_out; // storage of an sRGB view: encoded here
-layout(std430, binding = 0) buffer Stats { uint im_sum; uint im_count; };
+layout(location = MR_LOC_G0_MODE) uniform int u_mode;   // 1 alpha, 2 g0, 3 adaptive
+layout(location = MR_LOC_G0_T) uniform float u_t;
+layout(binding = MR_TEX_G0_O) uniform sampler2D u_o;     // occluder, linear
+layout(binding = MR_TEX_G0_D) uniform sampler2D u_d;     // occludee, linear
+layout(binding = MR_TEX_G0_MASK) uniform sampler2D u_mask;
+layout(binding = MR_IMG_G0_G0, rgba32f) uniform writeonly image2D u_g0;
+layout(binding = MR_IMG_G0_OUT, rgba8) uniform writeonly image2D u_out; // storage of an sRGB view: encoded here
+layout(std430, binding = MR_SSBO_G0_STATS) buffer Stats { uint im_sum; uint im_count; };
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy), n = imageSize(u_g0);
     if (p.x >= n.x || p.y >= n.y) return;

@@ -11,24 +11,25 @@
 //  IM (saliency): the saliency of O (computed before), clamped to [0,1].
 // Writes mask = (IM, region, silhouette, D coverage), the occluder object
 // key (node index + 1, or 0 for the video) and the sums for mean(IM).
+#include "mr_bindings.h"
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(location = 0) uniform int u_video;     // 1: the video is an occluder
-layout(location = 1) uniform int u_importance; // 0 auto, 1 curvature, 2 saliency
-layout(location = 2) uniform float u_scale;
-layout(location = 3) uniform float u_bias;
-layout(location = 4) uniform float u_near;
-layout(location = 5) uniform float u_fx;
-layout(location = 6) uniform int u_have_saliency;
-layout(binding = 0) uniform sampler2D u_depth;     // main (visible layer), reversed Z
-layout(binding = 1) uniform sampler2D u_normal;
-layout(binding = 2) uniform usampler2D u_ids;
-layout(binding = 3) uniform sampler2D u_hdepth;    // hidden layer D
-layout(binding = 4) uniform usampler2D u_hids;
-layout(binding = 5) uniform sampler2D u_curv;
-layout(binding = 6) uniform sampler2D u_sal;
-layout(binding = 0, rgba32f) uniform writeonly image2D u_mask;
-layout(binding = 1, r32ui) uniform writeonly uimage2D u_key;
-layout(std430, binding = 0) buffer Stats { uint im_sum; uint im_count; };
+layout(location = MR_LOC_IMP_VIDEO) uniform int u_video;     // 1: the video is an occluder
+layout(location = MR_LOC_IMP_IMPORTANCE) uniform int u_importance; // 0 auto, 1 curvature, 2 saliency
+layout(location = MR_LOC_IMP_SCALE) uniform float u_scale;
+layout(location = MR_LOC_IMP_BIAS) uniform float u_bias;
+layout(location = MR_LOC_IMP_NEAR) uniform float u_near;
+layout(location = MR_LOC_IMP_FX) uniform float u_fx;
+layout(location = MR_LOC_IMP_HAVE_SALIENCY) uniform int u_have_saliency;
+layout(binding = MR_TEX_IMP_DEPTH) uniform sampler2D u_depth;     // main (visible layer), reversed Z
+layout(binding = MR_TEX_IMP_NORMAL) uniform sampler2D u_normal;
+layout(binding = MR_TEX_IMP_IDS) uniform usampler2D u_ids;
+layout(binding = MR_TEX_IMP_HIDDEN_DEPTH) uniform sampler2D u_hdepth;    // hidden layer D
+layout(binding = MR_TEX_IMP_HIDDEN_IDS) uniform usampler2D u_hids;
+layout(binding = MR_TEX_IMP_CURVATURE) uniform sampler2D u_curv;
+layout(binding = MR_TEX_IMP_SAL) uniform sampler2D u_sal;
+layout(binding = MR_IMG_IMP_MASK, rgba32f) uniform writeonly image2D u_mask;
+layout(binding = MR_IMG_IMP_KEY, r32ui) uniform writeonly uimage2D u_key;
+layout(std430, binding = MR_SSBO_IMP_STATS) buffer Stats { uint im_sum; uint im_count; };
 
 const float PI = 3.14159265;
 

@@ -3,12 +3,13 @@
 // pixel's own index + 1; every further step takes the smallest label of the
 // 4-neighbourhood and then jumps to the label of the pixel that label names
 // (pointer jumping), so long regions converge in few steps.
+#include "mr_bindings.h"
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(location = 0) uniform int u_init;
-layout(binding = 0) uniform sampler2D u_mask;
-layout(binding = 1) uniform usampler2D u_key;
-layout(binding = 2) uniform usampler2D u_src;
-layout(binding = 0, r32ui) uniform writeonly uimage2D u_dst;
+layout(location = MR_LOC_LABEL_INIT) uniform int u_init;
+layout(binding = MR_TEX_LABEL_MASK) uniform sampler2D u_mask;
+layout(binding = MR_TEX_LABEL_KEY) uniform usampler2D u_key;
+layout(binding = MR_TEX_LABEL_SRC) uniform usampler2D u_src;
+layout(binding = MR_IMG_LABEL_DST, r32ui) uniform writeonly uimage2D u_dst;
 bool member(ivec2 q) { return texelFetch(u_mask, q, 0).y > 0.5 && texelFetch(u_key, q, 0).x == 0u; }
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy), n = imageSize(u_dst);

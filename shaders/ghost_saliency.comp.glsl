@@ -10,14 +10,15 @@
 //          (levels 0,1,2, three times each) as one Gaussian, all negative
 //          terms (levels 2..6, or 2..8 printed) as another, so
 //          c = 9 (G+ - G-) / p.
+#include "mr_bindings.h"
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(location = 0) uniform int u_impl;
-layout(location = 1) uniform float u_gain;
-layout(location = 2) uniform int u_max_level;
-layout(location = 3) uniform int u_printed;
-layout(binding = 0) uniform sampler2D u_pyr;      // impl 0: Lab with mips; impl 1: G+ (Lab)
-layout(binding = 1) uniform sampler2D u_surround; // impl 1: G- (Lab)
-layout(binding = 0, r32f) uniform writeonly image2D u_dst;
+layout(location = MR_LOC_SAL_IMPL) uniform int u_impl;
+layout(location = MR_LOC_SAL_GAIN) uniform float u_gain;
+layout(location = MR_LOC_SAL_MAX_LEVEL) uniform int u_max_level;
+layout(location = MR_LOC_SAL_PRINTED) uniform int u_printed;
+layout(binding = MR_TEX_SAL_PYR) uniform sampler2D u_pyr;      // impl 0: Lab with mips; impl 1: G+ (Lab)
+layout(binding = MR_TEX_SAL_SURROUND) uniform sampler2D u_surround; // impl 1: G- (Lab)
+layout(binding = MR_IMG_SAL_DST, r32f) uniform writeonly image2D u_dst;
 vec3 level(vec2 uv, int n) { return textureLod(u_pyr, uv, float(min(n, u_max_level))).rgb; }
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy), n = imageSize(u_dst);

@@ -2,17 +2,18 @@
 // (IM > 0.3, above the flat-wall bias) whose saliency in the final image reaches
 // C_desired = max(tc_minimal, gamma * IM) (+ tc_silhouette on silhouettes),
 // and the mean |L*(O_A) - L*(O)|. Sums in fixed point (1/256; 1/16 for L*).
+#include "mr_bindings.h"
 #include "ghost_lab.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(location = 0) uniform float u_tc_min;
-layout(location = 1) uniform float u_gamma;
-layout(location = 2) uniform float u_tc_sil;
-layout(binding = 0) uniform sampler2D u_mask;
-layout(binding = 1) uniform sampler2D u_sal;   // S(final)
-layout(binding = 2) uniform sampler2D u_o;
-layout(binding = 3) uniform sampler2D u_oa;
-layout(binding = 4) uniform sampler2D u_c;     // C in .r
-layout(std430, binding = 2) buffer Sums { uint region; uint important; uint legible; uint im_sum; uint dl_sum; uint c_sum; };
+layout(location = MR_LOC_STATS_TC_MIN) uniform float u_tc_min;
+layout(location = MR_LOC_STATS_GAMMA) uniform float u_gamma;
+layout(location = MR_LOC_STATS_TC_SIL) uniform float u_tc_sil;
+layout(binding = MR_TEX_STATS_MASK) uniform sampler2D u_mask;
+layout(binding = MR_TEX_STATS_SAL) uniform sampler2D u_sal;   // S(final)
+layout(binding = MR_TEX_STATS_O) uniform sampler2D u_o;
+layout(binding = MR_TEX_STATS_OA) uniform sampler2D u_oa;
+layout(binding = MR_TEX_STATS_C) uniform sampler2D u_c;     // C in .r
+layout(std430, binding = MR_SSBO_STATS_SUMS) buffer Sums { uint region; uint important; uint legible; uint im_sum; uint dl_sum; uint c_sum; };
 // Per-workgroup sums in shared memory, then one global atomic each.
 shared uint s_sums[6];
 

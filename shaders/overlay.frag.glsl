@@ -3,16 +3,17 @@
 // distortion model, then blended with the virtual image:
 //   out = mix(virtual, video, alpha)   (alpha 0 = virtual only, 1 = video only)
 // Blending happens in linear light; both inputs are sRGB textures.
+#include "mr_bindings.h"
 #include "common.glsl"
 
-layout(location = 0) uniform vec4 u_intr;        // fx fy cx cy of the output image
-layout(location = 1) uniform vec4 u_video_intr;  // fx fy cx cy of the video frame
-layout(location = 2) uniform vec2 u_video_size;  // pixels
-layout(location = 3) uniform float u_dist[5];    // k1 k2 p1 p2 k3
-layout(location = 8) uniform float u_alpha;
+layout(location = MR_LOC_OVERLAY_OUT_K) uniform vec4 u_intr;        // fx fy cx cy of the output image
+layout(location = MR_LOC_OVERLAY_VIDEO_K) uniform vec4 u_video_intr;  // fx fy cx cy of the video frame
+layout(location = MR_LOC_OVERLAY_VIDEO_SIZE) uniform vec2 u_video_size;  // pixels
+layout(location = MR_LOC_OVERLAY_DIST) uniform float u_dist[5];    // k1 k2 p1 p2 k3
+layout(location = MR_LOC_OVERLAY_ALPHA) uniform float u_alpha;
 
-layout(binding = 0) uniform sampler2D u_virtual;
-layout(binding = 1) uniform sampler2D u_video;
+layout(binding = MR_TEX_OVERLAY_VIRTUAL) uniform sampler2D u_virtual;
+layout(binding = MR_TEX_OVERLAY_VIDEO) uniform sampler2D u_video;
 
 layout(location = 0) out vec4 o_color; // sRGB8 target
 

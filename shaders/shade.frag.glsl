@@ -2,21 +2,22 @@
 // specular term (Scheer & Keutel's D1 is "standard Phong shading"): white
 // highlights r = reflect(-l, n), (r . v)^shininess, viewer at infinity along
 // the camera axis as in fixed-function OpenGL (camera frame: z forward).
+#include "mr_bindings.h"
 #include "common.glsl"
 
-#define MAX_LIGHTS 8
-layout(location = 0) uniform int u_light_count;
-layout(location = 1) uniform vec3 u_light_dir[MAX_LIGHTS];   // view space, towards the light
-layout(location = 9) uniform vec3 u_light_color[MAX_LIGHTS];
-layout(location = 17) uniform float u_ambient;
-layout(location = 18) uniform vec3 u_background;              // linear
-layout(location = 19) uniform int u_use_ao;                    // AO texture bound at 2
-layout(location = 20) uniform float u_specular;                // 0 = Lambert only
-layout(location = 21) uniform float u_shininess;
+#define MAX_LIGHTS MR_SHADE_MAX_LIGHTS
+layout(location = MR_LOC_SHADE_LIGHT_COUNT) uniform int u_light_count;
+layout(location = MR_LOC_SHADE_LIGHT_DIR) uniform vec3 u_light_dir[MAX_LIGHTS];   // view space, towards the light
+layout(location = MR_LOC_SHADE_LIGHT_COLOR) uniform vec3 u_light_color[MAX_LIGHTS];
+layout(location = MR_LOC_SHADE_AMBIENT) uniform float u_ambient;
+layout(location = MR_LOC_SHADE_BACKGROUND) uniform vec3 u_background;              // linear
+layout(location = MR_LOC_SHADE_HAVE_AO) uniform int u_use_ao;                    // AO texture bound at 2
+layout(location = MR_LOC_SHADE_SPECULAR) uniform float u_specular;                // 0 = Lambert only
+layout(location = MR_LOC_SHADE_SHININESS) uniform float u_shininess;
 
-layout(binding = 0) uniform sampler2D u_albedo;
-layout(binding = 1) uniform sampler2D u_normal;
-layout(binding = 2) uniform sampler2D u_ao;      // ambient visibility, 1 = unoccluded
+layout(binding = MR_TEX_SHADE_ALBEDO) uniform sampler2D u_albedo;
+layout(binding = MR_TEX_SHADE_NORMAL) uniform sampler2D u_normal;
+layout(binding = MR_TEX_SHADE_AO) uniform sampler2D u_ao;      // ambient visibility, 1 = unoccluded
 
 layout(location = 0) out vec4 o_color; // sRGB8 target
 

@@ -2,13 +2,14 @@
 // space as UI toolkits do); mode 1 draws the renderer's finished frame,
 // whose sRGB texture is decoded on sampling and re-encoded here because
 // the window framebuffer is not assumed to be sRGB-capable.
+#include "mr_bindings.h"
 #include "common.glsl"
 
 in vec2 v_uv;
 in vec4 v_color;
 
-layout(location = 1) uniform int u_mode;
-layout(binding = 0) uniform sampler2D u_tex;
+layout(location = MR_LOC_UI_MODE) uniform int u_mode;
+layout(binding = MR_TEX_UI_TEX) uniform sampler2D u_tex;
 
 layout(location = 0) out vec4 o_color;
 

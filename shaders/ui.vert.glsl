@@ -1,10 +1,11 @@
 // 2D layer: vertices in framebuffer pixels (origin top-left), turned into
 // clip space here so the CPU side never needs to know the window size.
-layout(location = 0) in vec2 a_pos;
-layout(location = 1) in vec2 a_uv;
-layout(location = 2) in vec4 a_color;   // sRGB bytes, normalised
+#include "mr_bindings.h"
+layout(location = MR_ATTR_UI_POS) in vec2 a_pos;
+layout(location = MR_ATTR_UI_UV) in vec2 a_uv;
+layout(location = MR_ATTR_UI_COLOR) in vec4 a_color;   // sRGB bytes, normalised
 
-layout(location = 0) uniform vec2 u_fb_size;
+layout(location = MR_LOC_UI_FB_SIZE) uniform vec2 u_fb_size;
 
 out vec2 v_uv;
 out vec4 v_color;

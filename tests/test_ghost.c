@@ -584,6 +584,43 @@ static bool render(const mr_scene *s, const mr_frame_params *p, mr_frame_result 
     return ok;
 }
 
+/* While a frame ghosts, the G-buffer leaves the hidden layer to the ghost
+ * passes (its own target D): where a hidden pipe sticks out past the wall,
+ * the frame's depth (the main G-buffer) has nothing, and has the pipe when
+ * ghosting is off. */
+static void test_hidden_layer_left_to_ghosting(void) {
+    mr_scene *s = mr_scene_create();
+    mr_material a = {"wall", {0.8f, 0.8f, 0.8f, 1}, -1}, b = {"pipe", {0.9f, 0.1f, 0.1f, 1}, -1};
+    int32_t ma = mr_scene_add_material(s, &a), mb = mr_scene_add_material(s, &b);
+    /* 96x72, fx 80: the wall spans columns 32..64, the pipe 8..88. */
+    mr_test_add_node(s, "Wall", mr_m4_translate(0, 0, 5), mr_test_add_box(s, 2, 2, 0.1, ma), MR_LAYER_VISIBLE);
+    mr_test_add_node(s, "Pipe", mr_m4_translate(0, 0, 6), mr_test_add_box(s, 6, 0.4, 0.4, mb), MR_LAYER_HIDDEN);
+    mr_scene_update_bounds(s);
+    mr_frame_params p = MR_FRAME_DEFAULTS;
+    p.want_depth = true;
+    char passes[512];
+    mr_frame_result off, on;
+    if (render(s, &p, &off, passes, sizeof passes)) {
+        p.ghost.mode = MR_GHOST_G0;
+        if (render(s, &p, &on, passes, sizeof passes)) {
+            const float *d_off = off.depth.data, *d_on = on.depth.data;
+            int out = 36 * 96 + 80, behind = 36 * 96 + 48;
+            CHECK_MSG(strstr(passes, "ghost_hidden") != NULL, "the frame does not ghost: %s", passes);
+            CHECK_MSG(fabsf(d_off[out] - 5.8f) < 0.05f, "ghosting off: depth of the protruding pipe %.3f, want 5.8",
+                      d_off[out]);
+            CHECK_MSG(d_on[out] == 0.0f,
+                      "ghosting on: the main G-buffer has the hidden layer (depth %.3f where only the pipe is)",
+                      d_on[out]);
+            CHECK_MSG(fabsf(d_on[behind] - 4.95f) < 0.05f, "ghosting on: depth of the wall %.3f, want 4.95",
+                      d_on[behind]);
+            mr_frame_result_free(&on);
+        }
+        mr_frame_result_free(&off);
+    }
+    mr_renderer_set_scene(g_r, NULL, NULL);
+    mr_scene_destroy(&s);
+}
+
 static void test_frame(void) {
     mr_scene *in_view = wall_scene(true), *out_of_view = wall_scene(false);
     char passes[512];
@@ -924,6 +961,7 @@ int main(void) {
         test_compose();
         test_unified_sign();
         test_frame();
+        test_hidden_layer_left_to_ghosting();
         test_frame_importance();
         test_frame_video();
         test_frame_hidden_ao();

@@ -270,26 +270,28 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
         glCreateBuffers(1, &g->vbo[p]);
         glNamedBufferStorage(g->vbo[p], (GLsizeiptr)(verts[p] ? verts[p] : 1) * stride[p], NULL, GL_DYNAMIC_STORAGE_BIT);
         glVertexArrayVertexBuffer(g->vao[p], 0, g->vbo[p], 0, stride[p]);
-        glEnableVertexArrayAttrib(g->vao[p], 0);
-        glVertexArrayAttribFormat(g->vao[p], 0, 3, GL_FLOAT, GL_FALSE, 0);
-        glVertexArrayAttribBinding(g->vao[p], 0, 0);
-        glEnableVertexArrayAttrib(g->vao[p], 1);
-        glVertexArrayAttribFormat(g->vao[p], 1, 3, GL_FLOAT, GL_FALSE, 12);
-        glVertexArrayAttribBinding(g->vao[p], 1, 0);
+        glEnableVertexArrayAttrib(g->vao[p], MR_ATTR_POSITION);
+        glVertexArrayAttribFormat(g->vao[p], MR_ATTR_POSITION, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(g->vao[p], MR_ATTR_POSITION, 0);
+        glEnableVertexArrayAttrib(g->vao[p], MR_ATTR_NORMAL);
+        glVertexArrayAttribFormat(g->vao[p], MR_ATTR_NORMAL, 3, GL_FLOAT, GL_FALSE, 12);
+        glVertexArrayAttribBinding(g->vao[p], MR_ATTR_NORMAL, 0);
         if (p == 1) {
-            glEnableVertexArrayAttrib(g->vao[p], 2);
-            glVertexArrayAttribFormat(g->vao[p], 2, 2, GL_FLOAT, GL_FALSE, 24);
-            glVertexArrayAttribBinding(g->vao[p], 2, 0);
+            glEnableVertexArrayAttrib(g->vao[p], MR_ATTR_UV);
+            glVertexArrayAttribFormat(g->vao[p], MR_ATTR_UV, 2, GL_FLOAT, GL_FALSE, 24);
+            glVertexArrayAttribBinding(g->vao[p], MR_ATTR_UV, 0);
         }
         /* Attributes 3..11: the instance record, one per instance (divisor
          * 1); the command's baseInstance offsets into it, so this works on
          * plain GL 4.5 (no gl_BaseInstance needed), and llvmpipe fetches
          * attributes much faster than it loads from an SSBO per vertex. */
-        for (GLuint a = 0; a < 9; a++) {
-            glEnableVertexArrayAttrib(g->vao[p], 3 + a);
-            if (a == 8) glVertexArrayAttribIFormat(g->vao[p], 3 + a, 4, GL_UNSIGNED_INT, (GLuint)offsetof(gpu_instance, ids));
-            else glVertexArrayAttribFormat(g->vao[p], 3 + a, 4, GL_FLOAT, GL_FALSE, a * 16);
-            glVertexArrayAttribBinding(g->vao[p], 3 + a, 1);
+        for (GLuint a = 0; a < MR_ATTR_INSTANCE_SLOTS; a++) {
+            GLuint slot = MR_ATTR_INSTANCE + a;
+            glEnableVertexArrayAttrib(g->vao[p], slot);
+            if (slot == MR_ATTR_INST_IDS)
+                glVertexArrayAttribIFormat(g->vao[p], slot, 4, GL_UNSIGNED_INT, (GLuint)offsetof(gpu_instance, ids));
+            else glVertexArrayAttribFormat(g->vao[p], slot, 4, GL_FLOAT, GL_FALSE, a * 16);
+            glVertexArrayAttribBinding(g->vao[p], slot, 1);
         }
         glVertexArrayBindingDivisor(g->vao[p], 1, 1);
     }
@@ -391,8 +393,8 @@ bool mr_renderer_set_lod(mr_renderer *r, const mr_lod *lod, mr_error *err) {
  * the box's nearest depth. A displacement e at depth z moves the image point
  * by at most f e sqrt(1 + t^2) / z, where t bounds |(x, y) / z| inside the
  * view. Returns INFINITY where the box reaches the near plane. */
-static double pixels_per_unit(const frame *f, const double *bb, double fmax_t) {
-    const double *M = f->cam_from_world.m;
+static double pixels_per_unit(const mr_geo_view *vw, const double *bb, double fmax_t) {
+    const double *M = vw->cam_from_world.m;
     double c = M[11], e = 0;
     for (int k = 0; k < 3; k++) {
         double mid = 0.5 * bb[k] + 0.5 * bb[3 + k], half = 0.5 * bb[3 + k] - 0.5 * bb[k];
@@ -400,7 +402,7 @@ static double pixels_per_unit(const frame *f, const double *bb, double fmax_t) {
         e += fabs(M[8 + k]) * half;
     }
     double zmin = c - e;
-    if (!(zmin > f->near_plane)) return INFINITY;
+    if (!(zmin > vw->near_plane)) return INFINITY;
     return fmax_t / zmin;
 }
 
@@ -416,9 +418,9 @@ static int choose_level(const geo_mesh *gm, double scale, double ppu, double tol
 }
 
 /* Camera-relative model-view of one instance, in double, then float. */
-static bool fill_instance(const frame *f, const mr_node *n, const mr_mesh *m, const geo_mesh *gm, int32_t node,
+static bool fill_instance(const mr_geo_view *vw, const mr_node *n, const mr_mesh *m, const geo_mesh *gm, int32_t node,
                           gpu_instance *out) {
-    mr_dmat4 cn = mr_m4_mul(&f->cam_from_world, &n->world);
+    mr_dmat4 cn = mr_m4_mul(&vw->cam_from_world, &n->world);
     mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
     mr_dmat4 mv = mr_m4_mul(&cn, &T);
     const double *a = mv.m;
@@ -450,23 +452,23 @@ static bool fill_instance(const frame *f, const mr_node *n, const mr_mesh *m, co
 
 /* Steps 2-4 for a list of visible nodes: LOD choice, bucketing, instance
  * records and commands, submission. Adds to the frame's statistics. */
-static void submit_nodes(frame *f, const int32_t *nodes, int32_t nvis) {
-    mr_renderer *r = f->r;
+static void submit_nodes(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *out, const int32_t *nodes,
+                         int32_t nvis) {
     const mr_scene *s = r->scene;
     struct mr_geo *g = r->geo;
     const mr_draw_params *dp = &r->draw;
     double t0 = mr_time_now();
 
     /* 2. LOD choice and bucketing of (node, mesh) pairs. */
-    double tol = dp->lod_tolerance == 0 ? 0.005 : dp->lod_tolerance;
-    double pix = dp->lod_pixels == 0 ? 1.0 : dp->lod_pixels;
+    double tol = dp->lod_tolerance == 0 ? MR_DRAW_DEFAULT_LOD_TOLERANCE : dp->lod_tolerance;
+    double pix = dp->lod_pixels == 0 ? MR_DRAW_DEFAULT_LOD_PIXELS : dp->lod_pixels;
     bool use_lod = g->lod && !dp->no_lod && tol > 0;
     double fmax_t = 0;
     if (use_lod) {
         /* Largest |x/z|, |y/z| over the image corners (with the margin). */
-        double ax = fmax(fabs((-1.5 - f->cam.cx) / f->cam.fx), fabs((f->cam.width + 0.5 - f->cam.cx) / f->cam.fx));
-        double ay = fmax(fabs((-1.5 - f->cam.cy) / f->cam.fy), fabs((f->cam.height + 0.5 - f->cam.cy) / f->cam.fy));
-        fmax_t = fmax(f->cam.fx, f->cam.fy) * sqrt(1 + ax * ax + ay * ay);
+        double ax = fmax(fabs((-1.5 - vw->cam.cx) / vw->cam.fx), fabs((vw->cam.width + 0.5 - vw->cam.cx) / vw->cam.fx));
+        double ay = fmax(fabs((-1.5 - vw->cam.cy) / vw->cam.fy), fabs((vw->cam.height + 0.5 - vw->cam.cy) / vw->cam.fy));
+        fmax_t = fmax(vw->cam.fx, vw->cam.fy) * sqrt(1 + ax * ax + ay * ay);
     }
     size_t nkeys = (size_t)g->mesh_count * LEVELS;
     memset(g->key_count, 0, (nkeys + 1) * sizeof *g->key_count);
@@ -478,7 +480,7 @@ static void submit_nodes(frame *f, const int32_t *nodes, int32_t nvis) {
         const mr_node *n = &s->nodes[ni];
         int32_t last = n->mesh_first + n->mesh_count;
         if (last > g->mesh_count) last = g->mesh_count;
-        double ppu = use_lod ? pixels_per_unit(f, mr_bvh_bounds(g->bvh, ni), fmax_t) : INFINITY;
+        double ppu = use_lod ? pixels_per_unit(vw, mr_bvh_bounds(g->bvh, ni), fmax_t) : INFINITY;
         for (int32_t mi = n->mesh_first; mi < last; mi++) {
             const geo_mesh *gm = &g->meshes[mi];
             if (gm->count[0] == 0) continue;
@@ -509,7 +511,7 @@ static void submit_nodes(frame *f, const int32_t *nodes, int32_t nvis) {
     for (size_t i = 0; i < nrec; i++) {
         const geo_rec *rc = &g->sorted[i];
         const geo_mesh *gm = &g->meshes[rc->mesh];
-        if (!fill_instance(f, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, rc->node, &g->inst[ninst])) continue;
+        if (!fill_instance(vw, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, rc->node, &g->inst[ninst])) continue;
         int level = (int)(rc->key % LEVELS);
         /* Same bucket as the last command (records skipped as degenerate
          * leave no gap: the command's instances stay contiguous). */
@@ -538,17 +540,17 @@ static void submit_nodes(frame *f, const int32_t *nodes, int32_t nvis) {
     /* 4. Submission. */
     glNamedBufferSubData(g->inst_buf, 0, (GLsizeiptr)ninst * (GLsizeiptr)sizeof(gpu_instance), g->inst);
     glNamedBufferData(g->cmd_buf, (GLsizeiptr)ncmd * (GLsizeiptr)sizeof(draw_cmd), g->cmds, GL_STREAM_DRAW);
-    glUseProgram(r->prog_gbuffer);
+    glUseProgram(vw->program);
     float proj[16];
-    mr_gl_projection(&f->cam, f->near_plane, proj);
-    glUniformMatrix4fv(2, 1, GL_FALSE, proj);
+    mr_gl_projection(&vw->cam, vw->near_plane, proj);
+    glUniformMatrix4fv(MR_LOC_PROJECTION, 1, GL_FALSE, proj);
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, g->cmd_buf);
     uint32_t calls = 0;
     for (int32_t grp = 0; grp < g->group_count; grp++) {
         int32_t first = g->group_first[grp], count = g->group_cmds[grp];
         if (first < 0 || count == 0) continue;
         glBindVertexArray(g->vao[grp > 0 ? 1 : 0]);
-        if (grp > 0) glBindTextureUnit(0, r->textures[grp - 1]);
+        if (grp > 0) glBindTextureUnit(MR_TEX_GBUFFER_BASE_COLOR, r->textures[grp - 1]);
         if (!dp->no_batch) {
             glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, (const void *)((size_t)first * sizeof(draw_cmd)),
                                         count, 0);
@@ -567,8 +569,10 @@ static void submit_nodes(frame *f, const int32_t *nodes, int32_t nvis) {
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     glBindVertexArray(0);
     r->stats.gl_draw_calls += calls;
-    f->out->triangles += tris;
-    f->out->draw_calls += calls;
+    if (out) {
+        out->triangles += tris;
+        out->draw_calls += calls;
+    }
 }
 
 /* ---------------------------------------------------- occlusion culling
@@ -586,8 +590,8 @@ static void submit_nodes(frame *f, const int32_t *nodes, int32_t nvis) {
 
 #define HZ_TILE 8
 
-static bool box_screen(const frame *f, const double *bb, double rect[4], double *near_depth) {
-    const double *M = f->cam_from_world.m;
+static bool box_screen(const mr_geo_view *vw, const double *bb, double rect[4], double *near_depth) {
+    const double *M = vw->cam_from_world.m;
     double zmin = INFINITY;
     rect[0] = rect[1] = INFINITY;
     rect[2] = rect[3] = -INFINITY;
@@ -596,15 +600,15 @@ static bool box_screen(const frame *f, const double *bb, double rect[4], double 
         double x = M[0] * p[0] + M[1] * p[1] + M[2] * p[2] + M[3];
         double y = M[4] * p[0] + M[5] * p[1] + M[6] * p[2] + M[7];
         double z = M[8] * p[0] + M[9] * p[1] + M[10] * p[2] + M[11];
-        if (!(z > f->near_plane)) return false; /* reaches the camera: cannot be tested */
-        double u = f->cam.fx * x / z + f->cam.cx, v = f->cam.fy * y / z + f->cam.cy;
+        if (!(z > vw->near_plane)) return false; /* reaches the camera: cannot be tested */
+        double u = vw->cam.fx * x / z + vw->cam.cx, v = vw->cam.fy * y / z + vw->cam.cy;
         rect[0] = fmin(rect[0], u);
         rect[1] = fmin(rect[1], v);
         rect[2] = fmax(rect[2], u);
         rect[3] = fmax(rect[3], v);
         zmin = fmin(zmin, z);
     }
-    *near_depth = f->near_plane / zmin; /* reversed Z: the box's nearest depth */
+    *near_depth = vw->near_plane / zmin; /* reversed Z: the box's nearest depth */
     return true;
 }
 
@@ -686,8 +690,8 @@ static bool occluded(const struct mr_geo *g, int levels, const double rect[4], d
     return true;
 }
 
-void mr_geometry_draw(frame *f, uint32_t layer_mask) {
-    mr_renderer *r = f->r;
+void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *out) {
+    uint32_t layer_mask = vw->layers;
     const mr_scene *s = r->scene;
     struct mr_geo *g = r->geo;
     if (!s || !g) return;
@@ -695,7 +699,7 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
     double t0 = mr_time_now();
 
     /* 1. Frustum culling. */
-    mr_frustum fr = mr_frustum_from_camera(&f->cam, &f->view->world_from_camera, f->near_plane, 1.0);
+    mr_frustum fr = mr_frustum_from_camera(&vw->cam, &vw->world_from_camera, vw->near_plane, 1.0);
     mr_bvh_stats bst;
     int32_t nvis = mr_bvh_cull(g->bvh, dp->no_cull ? NULL : &fr, layer_mask, g->visible, &bst);
     uint32_t ndrawable = 0;
@@ -711,7 +715,7 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
      * reversed Z (a pass drawing without depth, e.g. an x-ray view of the
      * hidden layer, gets plain frustum culling). */
     bool depth_ok = false;
-    if (dp->occlusion && !dp->no_cull && nvis >= 64 && w == f->cam.width && h == f->cam.height) {
+    if (dp->occlusion && !dp->no_cull && nvis >= 64 && w == vw->cam.width && h == vw->cam.height) {
         GLint fbo = 0, type = GL_NONE, func = 0;
         GLboolean mask = GL_FALSE;
         glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fbo);
@@ -723,7 +727,7 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
                    (func == GL_GREATER || func == GL_GEQUAL);
     }
     if (!depth_ok) {
-        submit_nodes(f, g->visible, nvis);
+        submit_nodes(r, vw, out, g->visible, nvis);
         return;
     }
 
@@ -736,13 +740,13 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
     for (int32_t i = 0; i < nvis; i++) {
         double rect[4], nd;
         const double *bb = mr_bvh_bounds(g->bvh, g->visible[i]);
-        bool big = !box_screen(f, bb, rect, &nd) ||
+        bool big = !box_screen(vw, bb, rect, &nd) ||
                    (fmin(rect[2], w) - fmax(rect[0], 0)) * (fmin(rect[3], h) - fmax(rect[1], 0)) >= min_area;
         if (big) g->visible[nocc++] = g->visible[i];
         else rest[nrest++] = g->visible[i];
     }
     r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
-    submit_nodes(f, g->visible, nocc);
+    submit_nodes(r, vw, out, g->visible, nocc);
 
     /* 3. Their depth as a pyramid; the rest tested against it. */
     t0 = mr_time_now();
@@ -750,7 +754,7 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
     if (npx > g->depth_cap) {
         float *d = realloc(g->depth, npx * sizeof *d);
         if (!d) {
-            submit_nodes(f, rest, nrest);
+            submit_nodes(r, vw, out, rest, nrest);
             return;
         }
         g->depth = d;
@@ -766,12 +770,12 @@ void mr_geometry_draw(frame *f, uint32_t layer_mask) {
     for (int32_t i = 0; i < nrest; i++) {
         double rect[4], nd;
         const double *bb = mr_bvh_bounds(g->bvh, rest[i]);
-        if (levels > 0 && box_screen(f, bb, rect, &nd) && occluded(g, levels, rect, nd, w, h)) continue;
+        if (levels > 0 && box_screen(vw, bb, rect, &nd) && occluded(g, levels, rect, nd, w, h)) continue;
         rest[nkeep++] = rest[i];
     }
     r->stats.nodes_occluded += (uint32_t)(nrest - nkeep);
     r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
-    submit_nodes(f, rest, nkeep);
+    submit_nodes(r, vw, out, rest, nkeep);
 }
 
 /* ------------------------------------------------------ auxiliary streams */
@@ -803,9 +807,9 @@ bool mr_geometry_aux_create(mr_renderer *r, float *const *per_mesh, int comps, G
         free(buf);
         glCreateVertexArrays(1, &aux->vao[p]);
         glVertexArrayVertexBuffer(aux->vao[p], 0, g->vbo[p], 0, stride[p]);
-        glEnableVertexArrayAttrib(aux->vao[p], 0);
-        glVertexArrayAttribFormat(aux->vao[p], 0, 3, GL_FLOAT, GL_FALSE, 0);
-        glVertexArrayAttribBinding(aux->vao[p], 0, 0);
+        glEnableVertexArrayAttrib(aux->vao[p], MR_ATTR_POSITION);
+        glVertexArrayAttribFormat(aux->vao[p], MR_ATTR_POSITION, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(aux->vao[p], MR_ATTR_POSITION, 0);
         glVertexArrayVertexBuffer(aux->vao[p], 1, aux->vbo[p], 0, comps * (GLsizei)sizeof(float));
         glEnableVertexArrayAttrib(aux->vao[p], attrib);
         glVertexArrayAttribFormat(aux->vao[p], attrib, comps, GL_FLOAT, GL_FALSE, 0);
@@ -823,15 +827,19 @@ void mr_geometry_aux_free(mr_geo_aux *aux) {
     memset(aux, 0, sizeof *aux);
 }
 
-void mr_geometry_aux_draw(frame *f, const mr_geo_aux *aux, uint32_t layer_mask) {
-    mr_renderer *r = f->r;
+void mr_geometry_aux_draw(mr_renderer *r, const mr_geo_view *vw, const mr_geo_aux *aux) {
+    uint32_t layer_mask = vw->layers;
     struct mr_geo *g = r->geo;
     const mr_scene *s = r->scene;
     if (!g || !s || !aux->valid) return;
+    glUseProgram(vw->program);
+    float proj[16];
+    mr_gl_projection(&vw->cam, vw->near_plane, proj);
+    glUniformMatrix4fv(MR_LOC_PROJECTION, 1, GL_FALSE, proj);
     for (int32_t ni = 0; ni < s->node_count; ni++) {
         const mr_node *n = &s->nodes[ni];
         if (n->mesh_first < 0 || n->mesh_count <= 0 || !(layer_mask & (1u << n->layer))) continue;
-        mr_dmat4 cam_from_node = mr_m4_mul(&f->cam_from_world, &n->world);
+        mr_dmat4 cam_from_node = mr_m4_mul(&vw->cam_from_world, &n->world);
         for (int32_t k = 0; k < n->mesh_count; k++) {
             int32_t mi = n->mesh_first + k;
             if (mi >= g->mesh_count || mi >= s->mesh_count) break;
@@ -845,8 +853,8 @@ void mr_geometry_aux_draw(frame *f, const mr_geo_aux *aux, uint32_t layer_mask) 
             mr_m4_to_gl(&mv, mvf);
             for (int rr = 0; rr < 3; rr++)
                 for (int cc = 0; cc < 3; cc++) nm[cc * 3 + rr] = (float)inv.m[cc * 4 + rr];
-            glUniformMatrix4fv(0, 1, GL_FALSE, mvf);
-            glUniformMatrix3fv(1, 1, GL_FALSE, nm);
+            glUniformMatrix4fv(MR_LOC_MODELVIEW, 1, GL_FALSE, mvf);
+            glUniformMatrix3fv(MR_LOC_NORMAL_MATRIX, 1, GL_FALSE, nm);
             glBindVertexArray(aux->vao[gm->pool]);
             glDrawElementsBaseVertex(GL_TRIANGLES, (GLsizei)gm->count[0], GL_UNSIGNED_INT,
                                      (const void *)((size_t)gm->first[0] * 4), gm->base_vertex);

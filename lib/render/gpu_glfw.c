@@ -129,8 +129,8 @@ static void on_glfw_error(int code, const char *msg) { mr_log(MR_LOG_DEBUG, "GLF
 mr_window *mr_window_create(const mr_window_params *params, mr_error *err) {
     mr_window_params p = MR_WINDOW_DEFAULTS;
     if (params) p = *params;
-    if (p.width <= 0) p.width = 960;
-    if (p.height <= 0) p.height = 720;
+    if (p.width <= 0) p.width = MR_WINDOW_DEFAULT_WIDTH;
+    if (p.height <= 0) p.height = MR_WINDOW_DEFAULT_HEIGHT;
     if (g_windows == 0) {
         glfwSetErrorCallback(on_glfw_error);
         if (!glfwInit()) {

@@ -25,7 +25,7 @@ typedef struct mr_gpu mr_gpu;
 typedef struct mr_gpu_params {
     bool debug;   /* enable GL debug output (messages go to the log), default off */
 } mr_gpu_params;
-#define MR_GPU_DEFAULTS {false}
+#define MR_GPU_DEFAULTS {.debug = false}
 
 /* Headless OpenGL 4.5 core context through EGL: the surfaceless Mesa
  * platform first, then an EGL device. NULL + MR_ERR_NODEVICE (one line) if
@@ -128,8 +128,25 @@ typedef struct mr_ao_params {
     const mr_image *external;     /* F32x1 AO at the output size to shade with instead of
                                      computing one (e.g. ray-traced ground truth); NULL */
 } mr_ao_params;
-#define MR_AO_DEFAULTS {MR_AO_NONE, MR_AO_RADIUS_SCREEN, 0.0, 0.05, 16, MR_AO_KERNEL_UNIFORM, 0.8f, 1.0f, 1, \
-                        1.0f, 0.05f, 0.0f, 4, false, false, MR_AO_MASK_OFF, 0.5f, false, false, false, NULL}
+/* Each default is written once, here: the initialiser below, the AO pass
+ * (which puts them in where a field is zero or out of range) and option
+ * tables all name these. Fields not named in MR_AO_DEFAULTS are zero. */
+#define MR_AO_DEFAULT_SCREEN_RADIUS 0.05
+#define MR_AO_DEFAULT_SAMPLES 16
+#define MR_AO_DEFAULT_R_MIN 0.8f
+#define MR_AO_DEFAULT_R_MAX 1.0f
+#define MR_AO_DEFAULT_RADII 1
+#define MR_AO_DEFAULT_C 1.0f
+#define MR_AO_DEFAULT_BIAS 0.05f
+#define MR_AO_DEFAULT_BLUR_RADIUS 4
+#define MR_AO_DEFAULT_MASK_STRENGTH 0.5f
+#define MR_AO_DEFAULT_RADIUS_FRACTION 0.02 /* of the scene's bounding-box diagonal */
+#define MR_AO_DEFAULTS {.method = MR_AO_NONE, .radius_mode = MR_AO_RADIUS_SCREEN, \
+                        .screen_radius = MR_AO_DEFAULT_SCREEN_RADIUS, .samples = MR_AO_DEFAULT_SAMPLES, \
+                        .kernel = MR_AO_KERNEL_UNIFORM, .r_min = MR_AO_DEFAULT_R_MIN, .r_max = MR_AO_DEFAULT_R_MAX, \
+                        .radii = MR_AO_DEFAULT_RADII, .c = MR_AO_DEFAULT_C, .bias = MR_AO_DEFAULT_BIAS, \
+                        .blur_radius = MR_AO_DEFAULT_BLUR_RADIUS, .mask = MR_AO_MASK_OFF, \
+                        .mask_strength = MR_AO_DEFAULT_MASK_STRENGTH}
 
 /* Names used on the command line ("none", "scheer", ...); NULL if out of range. */
 const char *mr_ao_method_name(mr_ao_method m);
@@ -204,7 +221,23 @@ typedef struct mr_ghost_params {
     bool stats;                  /* fill mr_frame_result.ghost (extra GPU work and a read-back) */
     mr_saliency_levels saliency_levels; /* eq. 9's levels; default MR_SAL_LEVELS_OFFSET */
 } mr_ghost_params;
-#define MR_GHOST_DEFAULTS {MR_GHOST_OFF, MR_GHOST_IMP_AUTO, MR_SALIENCY_MIPMAP, 1.0f, 2.0f, 0.35f, 4.0f, 0.1f, 0.5f, 0.15f, 200.0f, 3.0f, 3.0f, false, MR_SAL_LEVELS_OFFSET}
+#define MR_GHOST_DEFAULT_T 1.0f
+#define MR_GHOST_DEFAULT_CURV_SCALE 2.0f
+#define MR_GHOST_DEFAULT_CURV_BIAS 0.35f
+#define MR_GHOST_DEFAULT_SALIENCY_GAIN 4.0f
+#define MR_GHOST_DEFAULT_TC_MINIMAL 0.1f
+#define MR_GHOST_DEFAULT_GAMMA 0.5f
+#define MR_GHOST_DEFAULT_TC_SILHOUETTE 0.15f
+#define MR_GHOST_DEFAULT_EMPHASIS_GAIN 200.0f
+#define MR_GHOST_DEFAULT_SIGMA_C 3.0f
+#define MR_GHOST_DEFAULT_SIGMA_D 3.0f
+#define MR_GHOST_DEFAULTS {.mode = MR_GHOST_OFF, .importance = MR_GHOST_IMP_AUTO, .saliency = MR_SALIENCY_MIPMAP, \
+                           .t = MR_GHOST_DEFAULT_T, .curv_scale = MR_GHOST_DEFAULT_CURV_SCALE, \
+                           .curv_bias = MR_GHOST_DEFAULT_CURV_BIAS, .saliency_gain = MR_GHOST_DEFAULT_SALIENCY_GAIN, \
+                           .tc_minimal = MR_GHOST_DEFAULT_TC_MINIMAL, .gamma = MR_GHOST_DEFAULT_GAMMA, \
+                           .tc_silhouette = MR_GHOST_DEFAULT_TC_SILHOUETTE, \
+                           .emphasis_gain = MR_GHOST_DEFAULT_EMPHASIS_GAIN, .sigma_c = MR_GHOST_DEFAULT_SIGMA_C, \
+                           .sigma_d = MR_GHOST_DEFAULT_SIGMA_D, .saliency_levels = MR_SAL_LEVELS_OFFSET}
 
 /* Legibility of a ghosted frame (when mr_ghost_params.stats). */
 typedef struct mr_ghost_stats {
@@ -235,8 +268,12 @@ typedef struct mr_frame_params {
     float specular;            /* Phong specular weight (white highlights); default 0 = Lambert only */
     float shininess;           /* Phong exponent, >= 1; 0 = 32 */
 } mr_frame_params;
-#define MR_FRAME_DEFAULTS {0, 0, NULL, 0.5f, false, {0.62f, 0.66f, 0.70f}, false, false, false, MR_AO_DEFAULTS, \
-                           MR_GHOST_DEFAULTS, 0.0f, 0.0f}
+#define MR_FRAME_DEFAULT_ALPHA 0.5f
+#define MR_FRAME_DEFAULT_BACKGROUND {0.62f, 0.66f, 0.70f}
+#define MR_FRAME_DEFAULT_SHININESS 32.0f /* used where shininess < 1 */
+/* Designated initialisers in declaration order (C; g++ accepts them too). */
+#define MR_FRAME_DEFAULTS {.alpha = MR_FRAME_DEFAULT_ALPHA, .background = MR_FRAME_DEFAULT_BACKGROUND, \
+                           .ao = MR_AO_DEFAULTS, .ghost = MR_GHOST_DEFAULTS}
 
 #define MR_MAX_PASSES 32
 
@@ -302,7 +339,9 @@ typedef struct mr_window_params {
     bool debug;               /* GL debug output to the log */
     const char *title;        /* NULL = "mrcheck" */
 } mr_window_params;
-#define MR_WINDOW_DEFAULTS {0, 0, false, false, false, NULL}
+#define MR_WINDOW_DEFAULT_WIDTH 960
+#define MR_WINDOW_DEFAULT_HEIGHT 720
+#define MR_WINDOW_DEFAULTS {.width = 0, .height = 0, .title = NULL} /* 0 = the default size */
 
 typedef enum mr_event_type {
     MR_EVENT_NONE = 0,
@@ -443,7 +482,9 @@ typedef struct mr_draw_params {
                               of the rest on the CPU; exact (same image),
                               costs a depth read-back; default off */
 } mr_draw_params;
-#define MR_DRAW_DEFAULTS {false, false, false, false, 0.0, 0.0, false}
+#define MR_DRAW_DEFAULT_LOD_TOLERANCE 0.005
+#define MR_DRAW_DEFAULT_LOD_PIXELS 1.0
+#define MR_DRAW_DEFAULTS {.no_cull = false, .lod_tolerance = 0.0, .lod_pixels = 0.0} /* 0 = the defaults above */
 
 /* What the last frame's geometry submission did (summed over the passes
  * that drew geometry). */

@@ -13,7 +13,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { AO_PLAN_UNDECIDED = 0, AO_PLAN_OFF, AO_PLAN_REUSE, AO_PLAN_RUN, AO_PLAN_EXTERNAL };
+_Static_assert(MR_AO_SCHEER == MR_AO_METHOD_ID_SCHEER && MR_AO_CRYTEK == MR_AO_METHOD_ID_CRYTEK &&
+                   MR_AO_FILION == MR_AO_METHOD_ID_FILION && MR_AO_HBAO == MR_AO_METHOD_ID_HBAO &&
+                   MR_AO_ALCHEMY == MR_AO_METHOD_ID_ALCHEMY && MR_AO_MAX_SAMPLES == MR_AO_KERNEL_SIZE,
+               "shaders/mr_bindings.h and mr_render.h disagree on AO method ids or the kernel size");
+
+enum { AO_PLAN_OFF = 0, AO_PLAN_REUSE, AO_PLAN_RUN, AO_PLAN_EXTERNAL };
 
 /* Everything that makes an AO buffer what it is; equal keys mean the last
  * buffer can be shown again. */
@@ -227,7 +232,7 @@ static void free_state(mr_ao_state *s) {
     free(s);
 }
 
-void mr_pass_ao_scene_changed(mr_renderer *r) {
+static void mr_pass_ao_scene_changed(mr_renderer *r) {
     mr_ao_state *states[2] = {r->ao, r->ao_hidden};
     for (int i = 0; i < 2; i++) {
         if (!states[i]) continue;
@@ -277,17 +282,17 @@ static void ensure_targets(mr_ao_state *s, int w, int h, int step) {
  * can make them divide by zero or loop without end. */
 static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
     mr_ao_params p = *in;
-    if (p.samples <= 0) p.samples = 16;
+    if (p.samples <= 0) p.samples = MR_AO_DEFAULT_SAMPLES;
     if (p.samples > MR_AO_MAX_SAMPLES) p.samples = MR_AO_MAX_SAMPLES;
-    if (p.radii <= 0) p.radii = 1;
+    if (p.radii <= 0) p.radii = MR_AO_DEFAULT_RADII;
     if (p.radii > MR_AO_MAX_RADII) p.radii = MR_AO_MAX_RADII;
-    if (!(p.screen_radius > 0) || !isfinite(p.screen_radius)) p.screen_radius = 0.05;
+    if (!(p.screen_radius > 0) || !isfinite(p.screen_radius)) p.screen_radius = MR_AO_DEFAULT_SCREEN_RADIUS;
     if (!(p.radius > 0) || !isfinite(p.radius)) {
         double diag = 0;
         if (scene)
             for (int i = 0; i < 3; i++) diag += (scene->bounds_max[i] - scene->bounds_min[i]) * (scene->bounds_max[i] - scene->bounds_min[i]);
         diag = sqrt(diag);
-        p.radius = diag > 0 && isfinite(diag) ? 0.02 * diag : 1.0;
+        p.radius = diag > 0 && isfinite(diag) ? MR_AO_DEFAULT_RADIUS_FRACTION * diag : 1.0;
     }
     /* Each estimator has its own scale (scheer's attenuated cosines average
      * well below the visibility they stand for), so each has its own
@@ -296,9 +301,9 @@ static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
     static const float k_strength[MR_AO_METHOD_COUNT] = {1.0f, 3.0f, 1.0f, 1.0f, 1.5f, 2.0f};
     if (!(p.strength > 0) || !isfinite(p.strength))
         p.strength = p.method > MR_AO_NONE && p.method < MR_AO_METHOD_COUNT ? k_strength[p.method] : 1.0f;
-    if (!(p.c >= 0) || !isfinite(p.c)) p.c = 1.0f;
-    if (!(p.bias >= 0) || !(p.bias < 0.9f)) p.bias = 0.05f;
-    if (!(p.r_max > 0 && p.r_max <= 1)) p.r_max = 1.0f;
+    if (!(p.c >= 0) || !isfinite(p.c)) p.c = MR_AO_DEFAULT_C;
+    if (!(p.bias >= 0) || !(p.bias < 0.9f)) p.bias = MR_AO_DEFAULT_BIAS;
+    if (!(p.r_max > 0 && p.r_max <= 1)) p.r_max = MR_AO_DEFAULT_R_MAX;
     if (!(p.r_min >= 0)) p.r_min = 0.0f;
     if (p.r_min > p.r_max) p.r_min = p.r_max;
     if (p.blur_radius < 0) p.blur_radius = 0;
@@ -307,7 +312,7 @@ static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
     if ((int)p.mask < 0 || p.mask > MR_AO_MASK_STANDALONE) p.mask = MR_AO_MASK_OFF;
     /* Clamped here, before the shader and the blur: the standalone mask is a
      * visibility in [0,1] whatever the method and its strength. */
-    if (!(p.mask_strength > 0) || !isfinite(p.mask_strength)) p.mask_strength = 0.5f;
+    if (!(p.mask_strength > 0) || !isfinite(p.mask_strength)) p.mask_strength = MR_AO_DEFAULT_MASK_STRENGTH;
     if (p.mask_strength > 1) p.mask_strength = 1;
     if ((int)p.radius_mode < 0 || p.radius_mode > MR_AO_RADIUS_VIEW) p.radius_mode = MR_AO_RADIUS_SCREEN;
     p.want_ao = false;
@@ -317,29 +322,103 @@ static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
     return p;
 }
 
-static int plan(frame *f) {
-    if (f->ao_plan != AO_PLAN_UNDECIDED) return f->ao_plan;
-    mr_renderer *r = f->r;
+/* The frame's AO plan from the state before the frame: pure, so every
+ * needed() can ask it and get the same answer. */
+static bool external_ok(const frame *f) {
+    const mr_image *ext = f->p->ao.external;
+    return ext && ext->data && ext->type == MR_PIX_F32 && ext->channels == 1 && ext->width == f->r->w &&
+           ext->height == f->r->h;
+}
+
+/* Keys are compared with memcmp, so the parameters are copied field by
+ * field into zeroed storage: the padding of a struct copy is unspecified. */
+static void copy_fields(mr_ao_params *d, const mr_ao_params *p) {
+    memset(d, 0, sizeof *d);
+    d->method = p->method;
+    d->radius_mode = p->radius_mode;
+    d->radius = p->radius;
+    d->screen_radius = p->screen_radius;
+    d->samples = p->samples;
+    d->kernel = p->kernel;
+    d->r_min = p->r_min;
+    d->r_max = p->r_max;
+    d->radii = p->radii;
+    d->c = p->c;
+    d->bias = p->bias;
+    d->strength = p->strength;
+    d->blur_radius = p->blur_radius;
+    d->half_res = p->half_res;
+    d->positions = p->positions;
+    d->mask = p->mask;
+    d->mask_strength = p->mask_strength;
+    d->want_ao = p->want_ao;
+    d->want_mask = p->want_mask;
+    d->no_reuse = p->no_reuse;
+    d->external = p->external;
+}
+
+static ao_key key_of(const frame *f, const mr_ao_params *resolved, uint64_t scene_gen) {
+    ao_key key;
+    memset(&key, 0, sizeof key); /* padding too: keys are compared with memcmp */
+    key.pose = f->view->world_from_camera;
+    key.cam = f->cam;
+    key.w = f->r->w;
+    key.h = f->r->h;
+    key.hide_hidden = f->p->hide_hidden_layer;
+    key.scene_gen = scene_gen;
+    copy_fields(&key.p, resolved);
+    return key;
+}
+
+static int plan_of(const frame *f, const mr_ao_state *s) {
     const mr_ao_params *in = &f->p->ao;
-    f->ao_plan = AO_PLAN_OFF;
-    const mr_image *ext = in->external;
-    if (ext && ext->data && ext->type == MR_PIX_F32 && ext->channels == 1 && ext->width == r->w && ext->height == r->h) {
-        /* An AO image from outside (ground truth): upload, no AO pass runs. */
-        if (!r->ao && !(r->ao = calloc(1, sizeof *r->ao))) return f->ao_plan;
-        mr_ao_state *s = r->ao;
-        ensure_targets(s, r->w, r->h, s->step > 0 ? s->step : 1);
-        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-        glTextureSubImage2D(s->tex_full, 0, 0, 0, r->w, r->h, GL_RED, GL_FLOAT, ext->data);
-        s->result = s->tex_full;
-        s->valid = false; /* the next computed AO must not mistake this for its own */
-        s->p.mask = MR_AO_MASK_OFF;
-        return f->ao_plan = AO_PLAN_EXTERNAL;
+    if (external_ok(f)) return AO_PLAN_EXTERNAL; /* an AO image from outside: no AO pass runs */
+    if (in->method <= MR_AO_NONE || in->method >= MR_AO_METHOD_COUNT) return AO_PLAN_OFF;
+    if (s && s->broken) return AO_PLAN_OFF;
+    if (!s || !s->valid || in->no_reuse) return AO_PLAN_RUN;
+    mr_ao_params p = resolve(in, f->r->scene);
+    ao_key key = key_of(f, &p, s->scene_gen);
+    return memcmp(&key, &s->last, sizeof key) == 0 ? AO_PLAN_REUSE : AO_PLAN_RUN;
+}
+
+static bool runs(const frame *f) { return plan_of(f, f->r->ao) == AO_PLAN_RUN; }
+/* The standalone mask is a hard 0/1 stencil: it needs the blur to be AO. */
+static bool blur_wanted(const mr_ao_params *p) { return p->blur_radius > 0 || p->mask == MR_AO_MASK_STANDALONE; }
+
+static bool mr_pass_need_ao(const frame *f) { return runs(f); }
+static bool mr_pass_need_ao_mask(const frame *f) { return runs(f) && resolve(&f->p->ao, f->r->scene).mask != MR_AO_MASK_OFF; }
+static bool mr_pass_need_ao_blur(const frame *f) {
+    if (!runs(f)) return false;
+    mr_ao_params p = resolve(&f->p->ao, f->r->scene);
+    return blur_wanted(&p);
+}
+static bool mr_pass_need_ao_upsample(const frame *f) { return runs(f) && f->p->ao.half_res; }
+static bool mr_pass_need_ao_reuse(const frame *f) { return plan_of(f, f->r->ao) == AO_PLAN_REUSE; }
+static bool mr_pass_need_ao_external(const frame *f) { return plan_of(f, f->r->ao) == AO_PLAN_EXTERNAL; }
+
+static uint32_t mr_pass_ao_reads(const frame *f) {
+    mr_ao_params p = resolve(&f->p->ao, f->r->scene);
+    uint32_t r = RES(RES_DEPTH) | RES(RES_NORMAL);
+    if (p.positions && p.mask != MR_AO_MASK_STANDALONE) r |= RES(RES_POSITIONS);
+    if (p.mask != MR_AO_MASK_OFF) r |= RES(RES_AO_MASK);
+    return r;
+}
+
+static mr_ao_state *state_of(mr_ao_state **sp, mr_error *err) {
+    if (!*sp && !(*sp = calloc(1, sizeof **sp))) mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    return *sp;
+}
+
+/* Programs, targets and kernel for a computed AO; remembers the key, so the
+ * next frame with the same one reuses the result. */
+static bool prepare_state(frame *f, mr_ao_state *s, mr_error *err) {
+    if (!ensure_programs(s)) {
+        *err = s->error;
+        mr_error_prefix(err, "ambient occlusion: ");
+        return false;
     }
-    if (in->method <= MR_AO_NONE || in->method >= MR_AO_METHOD_COUNT) return f->ao_plan;
-    if (!r->ao && !(r->ao = calloc(1, sizeof *r->ao))) return f->ao_plan;
-    mr_ao_state *s = r->ao;
-    if (s->broken || !ensure_programs(s)) return f->ao_plan;
-    s->p = resolve(in, r->scene);
+    mr_renderer *r = f->r;
+    s->p = resolve(&f->p->ao, r->scene);
     s->step = s->p.half_res ? 2 : 1;
     ensure_targets(s, r->w, r->h, s->step);
     s->screen_k = (float)(s->p.screen_radius * f->cam.height / f->cam.fy);
@@ -357,50 +436,64 @@ static int plan(frame *f) {
         s->k_rmin = s->p.r_min;
         s->k_rmax = s->p.r_max;
     }
-    ao_key key;
-    memset(&key, 0, sizeof key);
-    key.pose = f->view->world_from_camera;
-    key.cam = f->cam;
-    key.w = r->w;
-    key.h = r->h;
-    key.hide_hidden = f->p->hide_hidden_layer;
-    key.scene_gen = s->scene_gen;
-    key.p = s->p;
-    if (s->valid && !in->no_reuse && memcmp(&key, &s->last, sizeof key) == 0) {
-        f->ao_plan = AO_PLAN_REUSE;
-    } else {
-        f->ao_plan = AO_PLAN_RUN;
-        s->last = key;
-        s->valid = false; /* until the passes below have run */
-    }
-    return f->ao_plan;
+    s->last = key_of(f, &s->p, s->scene_gen);
+    s->valid = false; /* until the passes have run */
+    return true;
 }
 
-GLuint mr_pass_ao_texture(frame *f) {
-    int pl = plan(f);
-    return pl == AO_PLAN_RUN || pl == AO_PLAN_REUSE || pl == AO_PLAN_EXTERNAL ? f->r->ao->result : 0;
+/* Called for ao_mask and ao: the second call finds everything in place. */
+static bool mr_pass_prepare_ao(frame *f, mr_error *err) {
+    mr_ao_state *s = state_of(&f->r->ao, err);
+    return s && prepare_state(f, s, err);
 }
 
-bool mr_pass_need_ao(frame *f) { return plan(f) == AO_PLAN_RUN; }
-bool mr_pass_need_ao_positions(frame *f) { return plan(f) == AO_PLAN_RUN && f->r->ao->p.positions && f->r->ao->p.mask != MR_AO_MASK_STANDALONE; }
-bool mr_pass_need_ao_mask(frame *f) { return plan(f) == AO_PLAN_RUN && f->r->ao->p.mask != MR_AO_MASK_OFF; }
-bool mr_pass_need_ao_blur(frame *f) {
-    /* The standalone mask is a hard 0/1 stencil: it needs the blur to be AO. */
-    return plan(f) == AO_PLAN_RUN && (f->r->ao->p.blur_radius > 0 || f->r->ao->p.mask == MR_AO_MASK_STANDALONE);
+static bool mr_pass_prepare_ao_external(frame *f, mr_error *err) {
+    mr_ao_state *s = state_of(&f->r->ao, err);
+    if (!s) return false;
+    ensure_targets(s, f->r->w, f->r->h, s->step > 0 ? s->step : 1);
+    return true;
 }
-bool mr_pass_need_ao_upsample(frame *f) { return plan(f) == AO_PLAN_RUN && f->r->ao->step > 1; }
 
-/* The uniforms the full-screen AO shaders share (locations 0..3). */
-static void common_uniforms(frame *f) {
+static void mr_pass_ao_external(frame *f) {
+    mr_renderer *r = f->r;
+    mr_ao_state *s = r->ao;
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTextureSubImage2D(s->tex_full, 0, 0, 0, r->w, r->h, GL_RED, GL_FLOAT, f->p->ao.external->data);
+    s->result = s->tex_full;
+    s->valid = false; /* the next computed AO must not mistake this for its own */
+    s->p.mask = MR_AO_MASK_OFF;
+    frame_put(f, RES_AO, s->result);
+}
+
+static void mr_pass_ao_reuse(frame *f) {
     mr_ao_state *s = f->r->ao;
-    glUniform4f(0, (float)f->cam.fx, (float)f->cam.fy, (float)f->cam.cx, (float)f->cam.cy);
-    glUniform2i(1, f->r->w, f->r->h);
-    glUniform1i(2, s->step);
-    glUniform1f(3, (float)f->near_plane);
-    glBindTextureUnit(0, f->r->gbuf.depth);
-    glBindTextureUnit(1, f->r->gbuf.color[1]);
-    glBindTextureUnit(2, f->r->gbuf.color[3]); /* positions, written by the G-buffer pass when used */
-    glBindTextureUnit(3, s->tex_mask);
+    frame_put(f, RES_AO, s->result);
+    if (s->p.mask != MR_AO_MASK_OFF) frame_put(f, RES_AO_MASK, s->tex_mask);
+    f->ao_reused = true;
+}
+
+/* What the full-screen AO shaders read: a G-buffer's depth and normal, the
+ * positions (0 unless that path is on) and the outline counts. */
+typedef struct ao_inputs {
+    GLuint depth, normal, positions, mask;
+} ao_inputs;
+
+static ao_inputs main_inputs(const frame *f) {
+    ao_inputs in = {frame_get(f, RES_DEPTH), frame_get(f, RES_NORMAL), frame_get(f, RES_POSITIONS),
+                    frame_get(f, RES_AO_MASK)};
+    return in;
+}
+
+/* The uniforms the full-screen AO shaders share. */
+static void common_uniforms(frame *f, const mr_ao_state *s, const ao_inputs *in) {
+    glUniform4f(MR_LOC_AO_INTR, (float)f->cam.fx, (float)f->cam.fy, (float)f->cam.cx, (float)f->cam.cy);
+    glUniform2i(MR_LOC_AO_FULL, f->r->w, f->r->h);
+    glUniform1i(MR_LOC_AO_STEP, s->step);
+    glUniform1f(MR_LOC_AO_NEAR, (float)f->near_plane);
+    glBindTextureUnit(MR_TEX_AO_DEPTH, in->depth);
+    glBindTextureUnit(MR_TEX_AO_NORMAL, in->normal);
+    glBindTextureUnit(MR_TEX_AO_POSITIONS, in->positions);
+    glBindTextureUnit(MR_TEX_AO_MASK, in->mask);
 }
 
 static void fullscreen(frame *f, GLuint fbo, int w, int h) {
@@ -412,7 +505,6 @@ static void fullscreen(frame *f, GLuint fbo, int w, int h) {
     glBindVertexArray(f->r->empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
 }
-
 
 static bool ensure_outlines(mr_renderer *r, mr_ao_state *s) {
     const mr_scene *sc = r->scene;
@@ -432,7 +524,7 @@ static bool ensure_outlines(mr_renderer *r, mr_ao_state *s) {
             dirs[i] = NULL; /* no outline: the mesh never masks */
         }
     }
-    bool ok = mr_geometry_aux_create(r, dirs, 3, 1, &s->outline);
+    bool ok = mr_geometry_aux_create(r, dirs, 3, MR_ATTR_OUTLINE_DIR, &s->outline);
     for (int32_t i = 0; i < sc->mesh_count; i++) free(dirs[i]);
     free(dirs);
     return ok;
@@ -442,12 +534,18 @@ static bool ensure_outlines(mr_renderer *r, mr_ao_state *s) {
  * float target, +1 on entering faces and -1 on leaving ones, depth-tested
  * against the G-buffer without writing depth; a count >= 2 marks a pixel
  * where two volumes overlap at the visible surface: a corner. */
-void mr_pass_ao_mask(frame *f) {
+
+/* Park & Baek: draw every outline volume with additive blending into a
+ * float target, +1 on entering faces and -1 on leaving ones, depth-tested
+ * against the G-buffer without writing depth; a count >= 2 marks a pixel
+ * where two volumes overlap at the visible surface: a corner. */
+static void mr_pass_ao_mask(frame *f) {
     mr_renderer *r = f->r;
     mr_ao_state *s = r->ao;
     static const float zero[4] = {0, 0, 0, 0};
-    glNamedFramebufferTexture(s->fbo_mask, GL_DEPTH_ATTACHMENT, r->gbuf.depth, 0);
+    glNamedFramebufferTexture(s->fbo_mask, GL_DEPTH_ATTACHMENT, frame_get(f, RES_DEPTH), 0);
     glClearNamedFramebufferfv(s->fbo_mask, GL_COLOR, 0, zero);
+    frame_put(f, RES_AO_MASK, s->tex_mask);
     if (!ensure_outlines(r, s)) return;
     glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_mask);
     glViewport(0, 0, s->w, s->h);
@@ -460,106 +558,121 @@ void mr_pass_ao_mask(frame *f) {
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ONE);
     glUseProgram(s->prog_outline);
-    float proj[16];
-    mr_gl_projection(&f->cam, f->near_plane, proj);
-    glUniformMatrix4fv(2, 1, GL_FALSE, proj);
-    glUniform1i(3, s->p.radius_mode == MR_AO_RADIUS_SCREEN ? 0 : 1);
-    glUniform1f(4, (float)s->p.radius);
-    glUniform1f(5, s->screen_k);
+    glUniform1i(MR_LOC_OUTLINE_RADIUS_MODE, s->p.radius_mode == MR_AO_RADIUS_SCREEN ? 0 : 1);
+    glUniform1f(MR_LOC_OUTLINE_RADIUS, (float)s->p.radius);
+    glUniform1f(MR_LOC_OUTLINE_SCREEN_K, s->screen_k);
     uint32_t mask = 1u << MR_LAYER_VISIBLE;
     if (!f->p->hide_hidden_layer) mask |= 1u << MR_LAYER_HIDDEN;
-    mr_geometry_aux_draw(f, &s->outline, mask);
+    mr_geo_view v = mr_frame_view(f, s->prog_outline, mask);
+    mr_geometry_aux_draw(r, &v, &s->outline);
     glDisable(GL_BLEND);
     glDisable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
 }
 
-void mr_pass_ao(frame *f) {
-    mr_ao_state *s = f->r->ao;
+static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
     const mr_ao_params *p = &s->p;
     glUseProgram(s->prog_main);
-    common_uniforms(f);
-    glUniform1i(4, p->mask == MR_AO_MASK_STANDALONE ? 100 : (int)p->method);
-    glUniform1i(5, p->samples);
-    glUniform1i(6, p->radius_mode == MR_AO_RADIUS_SCREEN ? 0 : 1);
-    glUniform1f(7, (float)p->radius);
-    glUniform1f(8, s->screen_k);
-    glUniform1f(9, p->c);
-    glUniform1f(10, p->bias);
-    glUniform1f(11, p->strength);
-    glUniform1i(12, p->radii);
-    glUniform1i(13, p->positions ? 1 : 0);
-    glUniform1i(14, p->mask == MR_AO_MASK_ON ? 1 : 0);
-    glUniform1f(15, p->mask_strength);
-    glUniform4fv(16, MR_AO_MAX_SAMPLES, s->kernel3);
-    glUniform4fv(80, MR_AO_MAX_SAMPLES, s->kernel2);
+    common_uniforms(f, s, in);
+    glUniform1i(MR_LOC_AO_METHOD, p->mask == MR_AO_MASK_STANDALONE ? MR_AO_METHOD_MASK_STANDALONE : (int)p->method);
+    glUniform1i(MR_LOC_AO_SAMPLES, p->samples);
+    glUniform1i(MR_LOC_AO_RADIUS_MODE, p->radius_mode == MR_AO_RADIUS_SCREEN ? 0 : 1);
+    glUniform1f(MR_LOC_AO_RADIUS, (float)p->radius);
+    glUniform1f(MR_LOC_AO_SCREEN_K, s->screen_k);
+    glUniform1f(MR_LOC_AO_C, p->c);
+    glUniform1f(MR_LOC_AO_BIAS, p->bias);
+    glUniform1f(MR_LOC_AO_STRENGTH, p->strength);
+    glUniform1i(MR_LOC_AO_RADII, p->radii);
+    /* The standalone mask samples no AO, so the G-buffer writes no
+     * positions for it: depth is un-projected instead. */
+    glUniform1i(MR_LOC_AO_USE_POS, p->positions && p->mask != MR_AO_MASK_STANDALONE ? 1 : 0);
+    glUniform1i(MR_LOC_AO_USE_MASK, p->mask == MR_AO_MASK_ON ? 1 : 0);
+    glUniform1f(MR_LOC_AO_MASK_STRENGTH, p->mask_strength);
+    glUniform4fv(MR_LOC_AO_KERNEL, MR_AO_MAX_SAMPLES, s->kernel3);
+    glUniform4fv(MR_LOC_AO_KERNEL2, MR_AO_MAX_SAMPLES, s->kernel2);
     fullscreen(f, s->fbo_ao[0], s->aw, s->ah);
     s->cur = 0;
     s->result = s->tex_ao[0];
     s->valid = true;
 }
 
-void mr_pass_ao_blur(frame *f) {
-    mr_ao_state *s = f->r->ao;
-    int radius = s->p.blur_radius > 0 ? s->p.blur_radius : 4;
+static void stage_blur(frame *f, mr_ao_state *s, const ao_inputs *in) {
+    int radius = s->p.blur_radius > 0 ? s->p.blur_radius : MR_AO_DEFAULT_BLUR_RADIUS;
     glUseProgram(s->prog_blur);
-    common_uniforms(f);
-    glUniform1i(5, radius);
-    glUniform2i(6, s->aw, s->ah);
+    common_uniforms(f, s, in);
+    glUniform1i(MR_LOC_AO_BLUR_RADIUS, radius);
+    glUniform2i(MR_LOC_AO_SIZE, s->aw, s->ah);
     for (int pass = 0; pass < 2; pass++) {
-        glUniform2i(4, pass == 0, pass == 1);
-        glBindTextureUnit(4, s->tex_ao[s->cur]);
+        glUniform2i(MR_LOC_AO_BLUR_DIR, pass == 0, pass == 1);
+        glBindTextureUnit(MR_TEX_AO_INPUT, s->tex_ao[s->cur]);
         fullscreen(f, s->fbo_ao[1 - s->cur], s->aw, s->ah);
         s->cur = 1 - s->cur;
     }
-    glBindTextureUnit(4, 0);
+    glBindTextureUnit(MR_TEX_AO_INPUT, 0);
     s->result = s->tex_ao[s->cur];
 }
 
-void mr_pass_ao_upsample(frame *f) {
-    mr_ao_state *s = f->r->ao;
+static void stage_upsample(frame *f, mr_ao_state *s, const ao_inputs *in) {
     glUseProgram(s->prog_up);
-    common_uniforms(f);
-    glUniform2i(6, s->aw, s->ah);
-    glBindTextureUnit(4, s->tex_ao[s->cur]);
+    common_uniforms(f, s, in);
+    glUniform2i(MR_LOC_AO_SIZE, s->aw, s->ah);
+    glBindTextureUnit(MR_TEX_AO_INPUT, s->tex_ao[s->cur]);
     fullscreen(f, s->fbo_full, s->w, s->h);
-    glBindTextureUnit(4, 0);
+    glBindTextureUnit(MR_TEX_AO_INPUT, 0);
     s->result = s->tex_full;
+}
+
+static void mr_pass_ao(frame *f) {
+    ao_inputs in = main_inputs(f);
+    stage_main(f, f->r->ao, &in);
+    frame_put(f, RES_AO, f->r->ao->result);
+}
+
+static void mr_pass_ao_blur(frame *f) {
+    ao_inputs in = main_inputs(f);
+    stage_blur(f, f->r->ao, &in);
+    frame_put(f, RES_AO, f->r->ao->result);
+}
+
+static void mr_pass_ao_upsample(frame *f) {
+    ao_inputs in = main_inputs(f);
+    stage_upsample(f, f->r->ao, &in);
+    frame_put(f, RES_AO, f->r->ao->result);
 }
 
 bool mr_pass_ao_read_back(frame *f, mr_error *err) {
     mr_renderer *r = f->r;
     mr_frame_result *o = f->out;
-    int pl = plan(f);
     o->ao_masked_fraction = -1;
-    o->ao_reused = pl == AO_PLAN_REUSE;
-    if (f->p->ao.external && pl != AO_PLAN_EXTERNAL)
+    o->ao_reused = f->ao_reused;
+    if (f->p->ao.external && !external_ok(f))
         return mr_fail(err, MR_ERR_INVALID, "the external AO image must be F32x1 at the output size %dx%d", r->w, r->h);
     if (r->ao && r->ao->broken && f->p->ao.method != MR_AO_NONE) {
         *err = r->ao->error;
         mr_error_prefix(err, "ambient occlusion: ");
         return false;
     }
+    GLuint ao = frame_get(f, RES_AO), mask = frame_get(f, RES_AO_MASK);
     if (f->p->ao.want_ao) {
         if (!mr_image_alloc(&o->ao, r->w, r->h, 1, MR_PIX_F32, err)) return false;
         float *a = o->ao.data;
         size_t n = (size_t)r->w * r->h;
-        if (pl == AO_PLAN_RUN || pl == AO_PLAN_REUSE || pl == AO_PLAN_EXTERNAL) {
+        if (ao) {
             glPixelStorei(GL_PACK_ALIGNMENT, 4);
-            glGetTextureImage(r->ao->result, 0, GL_RED, GL_FLOAT, (GLsizei)(n * sizeof *a), a);
+            glGetTextureImage(ao, 0, GL_RED, GL_FLOAT, (GLsizei)(n * sizeof *a), a);
         } else {
             for (size_t i = 0; i < n; i++) a[i] = 1.0f;
         }
     }
-    if ((pl == AO_PLAN_RUN || pl == AO_PLAN_REUSE) && r->ao->p.mask != MR_AO_MASK_OFF) {
+    if (mask) {
         size_t n = (size_t)r->w * r->h;
         float *cnt = malloc(n * sizeof *cnt), *dep = malloc(n * sizeof *dep);
         if (!cnt || !dep) {
             free(cnt); free(dep);
             return mr_fail(err, MR_ERR_NOMEM, "out of memory reading the AO mask");
         }
-        glGetTextureImage(r->ao->tex_mask, 0, GL_RED, GL_FLOAT, (GLsizei)(n * sizeof *cnt), cnt);
-        glGetTextureImage(r->gbuf.depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, (GLsizei)(n * sizeof *dep), dep);
+        glGetTextureImage(mask, 0, GL_RED, GL_FLOAT, (GLsizei)(n * sizeof *cnt), cnt);
+        glGetTextureImage(frame_get(f, RES_DEPTH), 0, GL_DEPTH_COMPONENT, GL_FLOAT, (GLsizei)(n * sizeof *dep), dep);
         size_t geo = 0, in = 0;
         for (size_t i = 0; i < n; i++)
             if (dep[i] > 0) {
@@ -577,30 +690,57 @@ bool mr_pass_ao_read_back(frame *f, mr_error *err) {
     return true;
 }
 
-GLuint mr_pass_ao_for_hidden(frame *f, const target *src) {
+/* The hidden layer D gets AO when the main image has computed (or reused)
+ * AO, in a state of its own; decided in ghost_hidden's prepare. */
+bool mr_ao_hidden_prepare(frame *f, mr_error *err) {
     mr_renderer *r = f->r;
-    int main_plan = plan(f);
-    if (main_plan != AO_PLAN_RUN && main_plan != AO_PLAN_REUSE) return 0; /* no AO, or an external image */
-    /* The passes read r->ao and r->gbuf: point them at D's state and target
-     * for the duration, then put the main ones back. */
-    target main_gbuf = r->gbuf;
-    mr_ao_state *main_state = r->ao;
-    r->gbuf = *src;
-    r->ao = r->ao_hidden;
-    f->ao_plan = AO_PLAN_UNDECIDED;
-    GLuint tex = 0;
-    int pl = plan(f);
+    int main_plan = plan_of(f, r->ao);
+    f->ao_hidden_plan = AO_PLAN_OFF;
+    if (main_plan != AO_PLAN_RUN && main_plan != AO_PLAN_REUSE) return true; /* no AO, or an external image */
+    mr_ao_state *s = state_of(&r->ao_hidden, err);
+    if (!s) return false;
+    int pl = plan_of(f, s);
     if (pl == AO_PLAN_RUN) {
-        r->ao->p.mask = MR_AO_MASK_OFF; /* outlines of D are not drawn */
-        r->ao->p.positions = false;     /* D has no positions attachment */
-        mr_pass_ao(f);
-        if (mr_pass_need_ao_blur(f)) mr_pass_ao_blur(f);
-        if (mr_pass_need_ao_upsample(f)) mr_pass_ao_upsample(f);
+        if (!prepare_state(f, s, err)) return false;
+        s->p.mask = MR_AO_MASK_OFF; /* outlines of D are not drawn */
+        s->p.positions = false;     /* D has no positions attachment */
     }
-    tex = mr_pass_ao_texture(f);
-    r->ao_hidden = r->ao;
-    r->ao = main_state;
-    r->gbuf = main_gbuf;
-    f->ao_plan = main_plan;
-    return tex;
+    f->ao_hidden_plan = pl;
+    return true;
 }
+
+GLuint mr_ao_hidden_run(frame *f, GLuint depth, GLuint normal) {
+    mr_ao_state *s = f->r->ao_hidden;
+    if (f->ao_hidden_plan == AO_PLAN_RUN) {
+        ao_inputs in = {depth, normal, 0, s->tex_mask};
+        stage_main(f, s, &in);
+        if (blur_wanted(&s->p)) stage_blur(f, s, &in);
+        if (s->step > 1) stage_upsample(f, s, &in);
+    }
+    return f->ao_hidden_plan == AO_PLAN_RUN || f->ao_hidden_plan == AO_PLAN_REUSE ? s->result : 0;
+}
+
+/* The rows of the registry (k_passes in renderer.c). */
+#define AO_DESTROY .scene_changed = mr_pass_ao_scene_changed, .destroy = mr_pass_ao_free
+const pass_desc mr_pass_desc_ao_mask = {
+    .name = "ao_mask", .needed = mr_pass_need_ao_mask, .prepare = mr_pass_prepare_ao, .run = mr_pass_ao_mask,
+    AO_DESTROY, .reads = RES(RES_DEPTH), .writes = RES(RES_AO_MASK)};
+const pass_desc mr_pass_desc_ao = {
+    .name = "ao", .needed = mr_pass_need_ao, .prepare = mr_pass_prepare_ao, .run = mr_pass_ao, AO_DESTROY,
+    .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_POSITIONS) | RES(RES_AO_MASK), .writes = RES(RES_AO),
+    .reads_now = mr_pass_ao_reads};
+const pass_desc mr_pass_desc_ao_blur = {
+    .name = "ao_blur", .needed = mr_pass_need_ao_blur, .run = mr_pass_ao_blur, AO_DESTROY,
+    .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_AO), .writes = RES(RES_AO)};
+const pass_desc mr_pass_desc_ao_upsample = {
+    .name = "ao_upsample", .needed = mr_pass_need_ao_upsample, .run = mr_pass_ao_upsample, AO_DESTROY,
+    .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_AO), .writes = RES(RES_AO)};
+/* Not listed (no GPU work of their own): the AO of an earlier frame with the
+ * same camera, size, scene and settings, or an AO image given from outside
+ * (ground truth), stands in for the AO passes. */
+const pass_desc mr_pass_desc_ao_reuse = {
+    .needed = mr_pass_need_ao_reuse, .run = mr_pass_ao_reuse, AO_DESTROY,
+    .writes = RES(RES_AO) | RES(RES_AO_MASK)};
+const pass_desc mr_pass_desc_ao_external = {
+    .needed = mr_pass_need_ao_external, .prepare = mr_pass_prepare_ao_external, .run = mr_pass_ao_external,
+    AO_DESTROY, .writes = RES(RES_AO)};

@@ -76,14 +76,14 @@ static void free_targets(mr_ghost_state *g) {
     g->layers_valid = false;
 }
 
-void mr_ghost_scene_changed(mr_renderer *r) {
+static void mr_ghost_scene_changed(mr_renderer *r) {
     mr_ghost_state *g = r ? r->ghost : NULL;
     if (!g) return;
     mr_geometry_aux_free(&g->curv_aux);
     g->curv_built = false;
 }
 
-void mr_ghost_free(mr_renderer *r) {
+static void mr_ghost_free(mr_renderer *r) {
     mr_ghost_state *g = r->ghost;
     if (!g) return;
     mr_ghost_scene_changed(r);
@@ -203,19 +203,19 @@ static void dispatch(int w, int h) {
 /* src (linear RGB, sampled) -> dst (rgba32f), forward or inverse. */
 static void lab_convert(mr_ghost_state *g, GLuint src, GLuint dst, bool inverse) {
     glUseProgram(g->prog_lab);
-    glUniform1i(0, inverse ? 1 : 0);
-    glBindTextureUnit(0, src);
-    glBindImageTexture(0, dst, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glUniform1i(MR_LOC_LAB_INVERSE, inverse ? 1 : 0);
+    glBindTextureUnit(MR_TEX_LAB_SRC, src);
+    glBindImageTexture(MR_IMG_LAB_DST, dst, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     dispatch(g->w, g->h);
 }
 
 static void blur_pass(mr_ghost_state *g, GLuint src, GLuint dst, int dx, int dy, float sigma, int radius) {
     glUseProgram(g->prog_blur);
-    glUniform2i(0, dx, dy);
-    glUniform1f(1, sigma);
-    glUniform1i(2, radius);
-    glBindTextureUnit(0, src);
-    glBindImageTexture(0, dst, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glUniform2i(MR_LOC_GBLUR_DIR, dx, dy);
+    glUniform1f(MR_LOC_GBLUR_SIGMA, sigma);
+    glUniform1i(MR_LOC_GBLUR_RADIUS, radius);
+    glBindTextureUnit(MR_TEX_GBLUR_SRC, src);
+    glBindImageTexture(MR_IMG_GBLUR_DST, dst, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     dispatch(g->w, g->h);
 }
 
@@ -239,21 +239,21 @@ static void saliency(mr_ghost_state *g, GLuint src, GLuint dst, mr_saliency_impl
         if (printed) blur(g, g->lab, g->gneg, SAL_SIGMA_NEG_PRINTED, radius_of(SAL_SIGMA_NEG_PRINTED));
         else blur(g, g->lab, g->gneg, SAL_SIGMA_NEG, SAL_RADIUS_NEG);
         glUseProgram(g->prog_sal);
-        glUniform1i(0, 1);
-        glBindTextureUnit(0, g->gpos);
-        glBindTextureUnit(1, g->gneg);
+        glUniform1i(MR_LOC_SAL_IMPL, 1);
+        glBindTextureUnit(MR_TEX_SAL_PYR, g->gpos);
+        glBindTextureUnit(MR_TEX_SAL_SURROUND, g->gneg);
     } else {
         /* The built-in (box) mip-map generation is the pyramid of eq. 10. */
         glGenerateTextureMipmap(g->lab);
         glUseProgram(g->prog_sal);
-        glUniform1i(0, 0);
-        glBindTextureUnit(0, g->lab);
-        glBindTextureUnit(1, g->lab);
+        glUniform1i(MR_LOC_SAL_IMPL, 0);
+        glBindTextureUnit(MR_TEX_SAL_PYR, g->lab);
+        glBindTextureUnit(MR_TEX_SAL_SURROUND, g->lab);
     }
-    glUniform1f(1, gain);
-    glUniform1i(2, g->lab_levels - 1);
-    glUniform1i(3, printed ? 1 : 0);
-    glBindImageTexture(0, dst, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glUniform1f(MR_LOC_SAL_GAIN, gain);
+    glUniform1i(MR_LOC_SAL_MAX_LEVEL, g->lab_levels - 1);
+    glUniform1i(MR_LOC_SAL_PRINTED, printed ? 1 : 0);
+    glBindImageTexture(MR_IMG_SAL_DST, dst, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     dispatch(g->w, g->h);
 }
 
@@ -261,27 +261,27 @@ static void saliency(mr_ghost_state *g, GLuint src, GLuint dst, mr_saliency_impl
  * the finished image. Reads mean(IM) from ssbo_stats (mode alpha). */
 static void stage_g0(mr_ghost_state *g, GLuint o, GLuint d, const mr_ghost_params *gp) {
     glUseProgram(g->prog_g0);
-    glUniform1i(0, (int)gp->mode);
-    glUniform1f(1, gp->t);
-    glBindTextureUnit(0, o);
-    glBindTextureUnit(1, d);
-    glBindTextureUnit(2, g->mask);
-    glBindImageTexture(0, g->g0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(1, g->out_store, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, g->ssbo_stats);
+    glUniform1i(MR_LOC_G0_MODE, (int)gp->mode);
+    glUniform1f(MR_LOC_G0_T, gp->t);
+    glBindTextureUnit(MR_TEX_G0_O, o);
+    glBindTextureUnit(MR_TEX_G0_D, d);
+    glBindTextureUnit(MR_TEX_G0_MASK, g->mask);
+    glBindImageTexture(MR_IMG_G0_G0, g->g0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(MR_IMG_G0_OUT, g->out_store, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MR_SSBO_G0_STATS, g->ssbo_stats);
     dispatch(g->w, g->h);
 }
 
 static void stage_analysis(mr_ghost_state *g, const mr_ghost_params *gp) {
     saliency(g, g->g0, g->sal_g0, gp->saliency, gp->saliency_levels, gp->saliency_gain);
     glUseProgram(g->prog_ana);
-    glUniform1f(0, gp->tc_minimal);
-    glUniform1f(1, gp->gamma);
-    glUniform1f(2, gp->tc_silhouette);
-    glBindTextureUnit(0, g->mask);
-    glBindTextureUnit(1, g->sal_g0);
-    glBindTextureUnit(2, g->g0);
-    glBindImageTexture(0, g->c, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glUniform1f(MR_LOC_ANA_TC_MIN, gp->tc_minimal);
+    glUniform1f(MR_LOC_ANA_GAMMA, gp->gamma);
+    glUniform1f(MR_LOC_ANA_TC_SIL, gp->tc_silhouette);
+    glBindTextureUnit(MR_TEX_ANA_MASK, g->mask);
+    glBindTextureUnit(MR_TEX_ANA_SAL, g->sal_g0);
+    glBindTextureUnit(MR_TEX_ANA_G0, g->g0);
+    glBindImageTexture(MR_IMG_ANA_C, g->c, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     dispatch(g->w, g->h);
 }
 
@@ -295,17 +295,17 @@ static void stage_emphasis(mr_ghost_state *g, GLuint o, GLuint d, const mr_ghost
      * has no object id (video without a model in front); otherwise the
      * single init step writes zeros. */
     glUseProgram(g->prog_label);
-    glBindTextureUnit(0, g->mask);
-    glBindTextureUnit(1, g->key);
+    glBindTextureUnit(MR_TEX_LABEL_MASK, g->mask);
+    glBindTextureUnit(MR_TEX_LABEL_KEY, g->key);
     int cur = 0;
-    glUniform1i(0, 1);
-    glBindTextureUnit(2, g->label[1]);
-    glBindImageTexture(0, g->label[0], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
+    glUniform1i(MR_LOC_LABEL_INIT, 1);
+    glBindTextureUnit(MR_TEX_LABEL_SRC, g->label[1]);
+    glBindImageTexture(MR_IMG_LABEL_DST, g->label[0], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
     dispatch(g->w, g->h);
-    glUniform1i(0, 0);
+    glUniform1i(MR_LOC_LABEL_INIT, 0);
     for (int i = 0; regions && i < LABEL_STEPS; i++) {
-        glBindTextureUnit(2, g->label[cur]);
-        glBindImageTexture(0, g->label[1 - cur], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
+        glBindTextureUnit(MR_TEX_LABEL_SRC, g->label[cur]);
+        glBindImageTexture(MR_IMG_LABEL_DST, g->label[1 - cur], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
         dispatch(g->w, g->h);
         cur = 1 - cur;
     }
@@ -314,23 +314,23 @@ static void stage_emphasis(mr_ghost_state *g, GLuint o, GLuint d, const mr_ghost
     static const GLint zero = 0;
     glClearNamedBufferSubData(g->ssbo_votes, GL_R32I, 0, (GLsizeiptr)(nvotes * sizeof(GLint)), GL_RED_INTEGER, GL_INT, &zero);
     glUseProgram(g->prog_emph);
-    glUniform1ui(1, key_base);
-    glUniform1f(2, gp->emphasis_gain);
-    glBindTextureUnit(0, o);
-    glBindTextureUnit(1, d);
-    glBindTextureUnit(2, g->dgk);
-    glBindTextureUnit(3, g->gkc);
-    glBindTextureUnit(4, g->mask);
-    glBindTextureUnit(5, g->g0);
-    glBindTextureUnit(6, g->key);
-    glBindTextureUnit(7, g->label[cur]);
-    glBindImageTexture(0, g->out_store, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-    glBindImageTexture(1, g->oa, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(2, g->ga, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, g->ssbo_votes);
-    glUniform1i(0, 0);
+    glUniform1ui(MR_LOC_EMPH_KEY_BASE, key_base);
+    glUniform1f(MR_LOC_EMPH_GAIN, gp->emphasis_gain);
+    glBindTextureUnit(MR_TEX_EMPH_O, o);
+    glBindTextureUnit(MR_TEX_EMPH_D, d);
+    glBindTextureUnit(MR_TEX_EMPH_DGK, g->dgk);
+    glBindTextureUnit(MR_TEX_EMPH_GKC, g->gkc);
+    glBindTextureUnit(MR_TEX_EMPH_MASK, g->mask);
+    glBindTextureUnit(MR_TEX_EMPH_G0, g->g0);
+    glBindTextureUnit(MR_TEX_EMPH_KEY, g->key);
+    glBindTextureUnit(MR_TEX_EMPH_LABEL, g->label[cur]);
+    glBindImageTexture(MR_IMG_EMPH_OUT, g->out_store, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    glBindImageTexture(MR_IMG_EMPH_OA, g->oa, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(MR_IMG_EMPH_GA, g->ga, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MR_SSBO_EMPH_VOTES, g->ssbo_votes);
+    glUniform1i(MR_LOC_EMPH_STAGE, 0);
     dispatch(g->w, g->h);
-    glUniform1i(0, 1);
+    glUniform1i(MR_LOC_EMPH_STAGE, 1);
     dispatch(g->w, g->h);
 }
 
@@ -344,15 +344,15 @@ static void stage_stats(mr_ghost_state *g, GLuint o, bool adaptive, const mr_gho
     static const GLuint zero = 0;
     glClearNamedBufferData(g->ssbo_sums, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glUseProgram(g->prog_stats);
-    glUniform1f(0, gp->tc_minimal);
-    glUniform1f(1, gp->gamma);
-    glUniform1f(2, gp->tc_silhouette);
-    glBindTextureUnit(0, g->mask);
-    glBindTextureUnit(1, g->sal_final);
-    glBindTextureUnit(2, o);
-    glBindTextureUnit(3, adaptive ? g->oa : o);
-    glBindTextureUnit(4, g->c);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, g->ssbo_sums);
+    glUniform1f(MR_LOC_STATS_TC_MIN, gp->tc_minimal);
+    glUniform1f(MR_LOC_STATS_GAMMA, gp->gamma);
+    glUniform1f(MR_LOC_STATS_TC_SIL, gp->tc_silhouette);
+    glBindTextureUnit(MR_TEX_STATS_MASK, g->mask);
+    glBindTextureUnit(MR_TEX_STATS_SAL, g->sal_final);
+    glBindTextureUnit(MR_TEX_STATS_O, o);
+    glBindTextureUnit(MR_TEX_STATS_OA, adaptive ? g->oa : o);
+    glBindTextureUnit(MR_TEX_STATS_C, g->c);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MR_SSBO_STATS_SUMS, g->ssbo_sums);
     dispatch(g->w, g->h);
     GLuint s[6];
     glGetNamedBufferSubData(g->ssbo_sums, 0, sizeof s, s);
@@ -368,7 +368,7 @@ static void stage_stats(mr_ghost_state *g, GLuint o, bool adaptive, const mr_gho
 /* --------------------------------------------------------------- frame */
 
 /* Is any hidden-layer mesh's box (conservatively) inside the view? */
-static bool hidden_in_view(frame *f) {
+static bool hidden_in_view(const frame *f) {
     const mr_scene *s = f->r->scene;
     if (!s) return false;
     const mr_camera *c = &f->cam;
@@ -401,7 +401,7 @@ static bool hidden_in_view(frame *f) {
 
 static bool finite_in(float v, float lo, float hi) { return v >= lo && v <= hi; }
 
-bool mr_ghost_prepare(mr_renderer *r, const mr_ghost_params *gp, int w, int h, mr_error *err) {
+bool mr_ghost_check_params(const mr_ghost_params *gp, mr_error *err) {
     if (gp->mode == MR_GHOST_OFF) return true;
     if ((unsigned)gp->mode > MR_GHOST_ADAPTIVE || (unsigned)gp->importance > MR_GHOST_IMP_SALIENCY ||
         (unsigned)gp->saliency > MR_SALIENCY_GAUSS || (unsigned)gp->saliency_levels > MR_SAL_LEVELS_PRINTED)
@@ -413,38 +413,42 @@ bool mr_ghost_prepare(mr_renderer *r, const mr_ghost_params *gp, int w, int h, m
         return mr_fail(err, MR_ERR_INVALID, "ghost: parameters must be finite and not negative");
     if (!finite_in(gp->sigma_c, 0.1f, 64) || !finite_in(gp->sigma_d, 0.1f, 64))
         return mr_fail(err, MR_ERR_INVALID, "ghost: sigma_c and sigma_d must be in [0.1, 64] pixels");
-    mr_ghost_state *g = state(r, err);
-    return g && ensure_size(g, w, h, err);
+    return true;
 }
 
-bool mr_ghost_active(frame *f) {
-    if (f->ghost == 0) {
-        const mr_frame_params *p = f->p;
-        /* mr_ghost_prepare ran at the start of the frame (programs, targets). */
-        bool on = p->ghost.mode != MR_GHOST_OFF && !p->hide_hidden_layer && f->r->ghost && f->r->ghost->w == f->r->w &&
-                  f->r->ghost->h == f->r->h && hidden_in_view(f);
-        f->ghost = on ? 1 : -1;
-    }
-    return f->ghost > 0;
+/* This frame ghosts: a mode other than off, the hidden layer drawn, and
+ * hidden structure in view. */
+static bool ghosting(const frame *f) {
+    const mr_frame_params *p = f->p;
+    return p->ghost.mode != MR_GHOST_OFF && !p->hide_hidden_layer && hidden_in_view(f);
 }
 
-bool mr_pass_need_ghost(frame *f) { return mr_ghost_active(f); }
-bool mr_pass_need_ghost_curvature(frame *f) {
-    return mr_ghost_active(f) && f->p->ghost.importance != MR_GHOST_IMP_SALIENCY;
+static bool mr_pass_need_ghost(const frame *f) { return ghosting(f); }
+static bool mr_pass_need_ghost_curvature(const frame *f) {
+    return ghosting(f) && f->p->ghost.importance != MR_GHOST_IMP_SALIENCY;
 }
-bool mr_pass_need_ghost_adaptive(frame *f) { return mr_ghost_active(f) && f->p->ghost.mode == MR_GHOST_ADAPTIVE; }
+static bool mr_pass_need_ghost_adaptive(const frame *f) { return ghosting(f) && f->p->ghost.mode == MR_GHOST_ADAPTIVE; }
 
-void mr_pass_ghost_hidden(frame *f) {
+/* Programs (first use), targets (size changes) and D's AO state. */
+static bool mr_pass_prepare_ghost(frame *f, mr_error *err) {
+    mr_ghost_state *g = state(f->r, err);
+    return g && ensure_size(g, f->r->w, f->r->h, err) && mr_ao_hidden_prepare(f, err);
+}
+
+static void mr_pass_ghost_hidden(frame *f) {
     mr_renderer *r = f->r;
     mr_ghost_state *g = r->ghost;
     mr_gbuffer_begin(f, &g->hid);
-    mr_geometry_draw(f, 1u << MR_LAYER_HIDDEN);
+    mr_geo_view v = mr_frame_view(f, mr_gbuffer_program(f), 1u << MR_LAYER_HIDDEN);
+    mr_geometry_draw(r, &v, f->out);
     glDisable(GL_DEPTH_TEST);
-    GLuint keep = f->final_tex;
+    frame_put(f, RES_HIDDEN_DEPTH, g->hid.depth);
+    frame_put(f, RES_HIDDEN_NORMAL, g->hid.color[MR_OUT_GBUFFER_NORMAL]);
+    frame_put(f, RES_HIDDEN_IDS, g->hid.color[MR_OUT_GBUFFER_IDS]);
     /* D is shaded like the model, with its own AO when AO is on. */
-    f->hidden_ao = mr_pass_ao_for_hidden(f, &g->hid);
-    mr_shade_draw(f, &g->hid, &g->hid_shaded);
-    f->final_tex = keep;
+    GLuint ao = mr_ao_hidden_run(f, g->hid.depth, g->hid.color[MR_OUT_GBUFFER_NORMAL]);
+    mr_shade_draw(f, g->hid.color[MR_OUT_GBUFFER_ALBEDO], g->hid.color[MR_OUT_GBUFFER_NORMAL], ao, &g->hid_shaded);
+    frame_put(f, RES_HIDDEN_SHADED, g->hid_shaded.color[0]);
 }
 
 /* Per-vertex curvature as attribute 3 of the curvature program, laid out
@@ -460,12 +464,12 @@ static void ensure_curvature(mr_renderer *r, mr_ghost_state *g) {
         k[i] = malloc((size_t)(m->vertex_count ? m->vertex_count : 1) * sizeof **k);
         if (k[i]) mr_mesh_curvature(m, k[i]);
     }
-    mr_geometry_aux_create(r, k, 1, 3, &g->curv_aux);
+    mr_geometry_aux_create(r, k, 1, MR_ATTR_CURVATURE, &g->curv_aux);
     for (int32_t i = 0; i < s->mesh_count; i++) free(k[i]);
     free(k);
 }
 
-void mr_pass_ghost_curvature(frame *f) {
+static void mr_pass_ghost_curvature(frame *f) {
     mr_renderer *r = f->r;
     mr_ghost_state *g = r->ghost;
     ensure_curvature(r, g);
@@ -479,12 +483,10 @@ void mr_pass_ghost_curvature(frame *f) {
     static const float depth0 = 0.0f;
     glClearNamedFramebufferfv(g->curv.fbo, GL_COLOR, 0, zero4);
     glClearNamedFramebufferfv(g->curv.fbo, GL_DEPTH, 0, &depth0);
-    glUseProgram(g->prog_curv);
-    float proj[16];
-    mr_gl_projection(&f->cam, f->near_plane, proj);
-    glUniformMatrix4fv(2, 1, GL_FALSE, proj);
-    mr_geometry_aux_draw(f, &g->curv_aux, 1u << MR_LAYER_VISIBLE);
+    mr_geo_view v = mr_frame_view(f, g->prog_curv, 1u << MR_LAYER_VISIBLE);
+    mr_geometry_aux_draw(r, &v, &g->curv_aux);
     glDisable(GL_DEPTH_TEST);
+    frame_put(f, RES_CURVATURE, g->curv.color[0]);
 }
 
 static bool needs_saliency_of_o(const frame *f) {
@@ -492,41 +494,41 @@ static bool needs_saliency_of_o(const frame *f) {
     return im == MR_GHOST_IMP_SALIENCY || (im == MR_GHOST_IMP_AUTO && f->p->video != NULL);
 }
 
-void mr_pass_ghost_importance(frame *f) {
+static void mr_pass_ghost_importance(frame *f) {
     mr_renderer *r = f->r;
     mr_ghost_state *g = r->ghost;
     const mr_ghost_params *gp = &f->p->ghost;
-    g->o_tex = f->final_tex;
+    g->o_tex = frame_get(f, RES_IMAGE);
     bool sal = needs_saliency_of_o(f);
     if (sal) saliency(g, g->o_tex, g->sal_o, gp->saliency, gp->saliency_levels, gp->saliency_gain);
     static const GLuint zero = 0;
     glClearNamedBufferData(g->ssbo_stats, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glUseProgram(g->prog_imp);
-    glUniform1i(0, f->p->video != NULL);
-    glUniform1i(1, (int)gp->importance);
-    glUniform1f(2, gp->curv_scale);
-    glUniform1f(3, gp->curv_bias);
-    glUniform1f(4, (float)f->near_plane);
-    glUniform1f(5, (float)f->cam.fx);
-    glUniform1i(6, sal);
-    glBindTextureUnit(0, r->gbuf.depth);
-    glBindTextureUnit(1, r->gbuf.color[1]);
-    glBindTextureUnit(2, r->gbuf.color[2]);
-    glBindTextureUnit(3, g->hid.depth);
-    glBindTextureUnit(4, g->hid.color[2]);
-    glBindTextureUnit(5, g->curv.color[0]);
-    glBindTextureUnit(6, g->sal_o);
-    glBindImageTexture(0, g->mask, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(1, g->key, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, g->ssbo_stats);
+    glUniform1i(MR_LOC_IMP_VIDEO, f->p->video != NULL);
+    glUniform1i(MR_LOC_IMP_IMPORTANCE, (int)gp->importance);
+    glUniform1f(MR_LOC_IMP_SCALE, gp->curv_scale);
+    glUniform1f(MR_LOC_IMP_BIAS, gp->curv_bias);
+    glUniform1f(MR_LOC_IMP_NEAR, (float)f->near_plane);
+    glUniform1f(MR_LOC_IMP_FX, (float)f->cam.fx);
+    glUniform1i(MR_LOC_IMP_HAVE_SALIENCY, sal);
+    glBindTextureUnit(MR_TEX_IMP_DEPTH, frame_get(f, RES_DEPTH));
+    glBindTextureUnit(MR_TEX_IMP_NORMAL, frame_get(f, RES_NORMAL));
+    glBindTextureUnit(MR_TEX_IMP_IDS, frame_get(f, RES_IDS));
+    glBindTextureUnit(MR_TEX_IMP_HIDDEN_DEPTH, frame_get(f, RES_HIDDEN_DEPTH));
+    glBindTextureUnit(MR_TEX_IMP_HIDDEN_IDS, frame_get(f, RES_HIDDEN_IDS));
+    glBindTextureUnit(MR_TEX_IMP_CURVATURE, frame_get(f, RES_CURVATURE));
+    glBindTextureUnit(MR_TEX_IMP_SAL, g->sal_o);
+    glBindImageTexture(MR_IMG_IMP_MASK, g->mask, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(MR_IMG_IMP_KEY, g->key, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MR_SSBO_IMP_STATS, g->ssbo_stats);
     dispatch(g->w, g->h);
 }
 
-void mr_pass_ghost_g0(frame *f) {
+static void mr_pass_ghost_g0(frame *f) {
     mr_ghost_state *g = f->r->ghost;
-    stage_g0(g, g->o_tex, g->hid_shaded.color[0], &f->p->ghost);
+    stage_g0(g, g->o_tex, frame_get(f, RES_HIDDEN_SHADED), &f->p->ghost);
     g->layers_valid = true;
-    f->final_tex = g->out_view;
+    frame_put(f, RES_IMAGE, g->out_view);
     if (f->p->ghost.stats && f->p->ghost.mode != MR_GHOST_ADAPTIVE) {
         /* C is not computed outside adaptive mode: report zero missing. */
         static const float zero4[4] = {0, 0, 0, 0};
@@ -535,13 +537,13 @@ void mr_pass_ghost_g0(frame *f) {
     }
 }
 
-void mr_pass_ghost_analysis(frame *f) { stage_analysis(f->r->ghost, &f->p->ghost); }
+static void mr_pass_ghost_analysis(frame *f) { stage_analysis(f->r->ghost, &f->p->ghost); }
 
-void mr_pass_ghost_emphasis(frame *f) {
+static void mr_pass_ghost_emphasis(frame *f) {
     mr_ghost_state *g = f->r->ghost;
     uint32_t key_base = (uint32_t)(f->r->scene ? f->r->scene->node_count : 0) + 1;
-    stage_emphasis(g, g->o_tex, g->hid_shaded.color[0], &f->p->ghost, key_base, f->p->video != NULL);
-    f->final_tex = g->out_view;
+    stage_emphasis(g, g->o_tex, frame_get(f, RES_HIDDEN_SHADED), &f->p->ghost, key_base, f->p->video != NULL);
+    frame_put(f, RES_IMAGE, g->out_view);
     if (f->p->ghost.stats) stage_stats(g, g->o_tex, true, &f->p->ghost, &f->out->ghost);
 }
 
@@ -723,3 +725,28 @@ bool mr_ghost_read_layers(mr_renderer *r, mr_image *occluder, mr_image *hidden, 
     }
     return ok;
 }
+
+/* The rows of the registry (k_passes in renderer.c). Programs and targets
+ * are made by ghost_hidden's prepare for all of them. */
+#define GHOST_DESTROY .scene_changed = mr_ghost_scene_changed, .destroy = mr_ghost_free
+const pass_desc mr_pass_desc_ghost_hidden = {
+    .name = "ghost_hidden", .needed = mr_pass_need_ghost, .prepare = mr_pass_prepare_ghost,
+    .run = mr_pass_ghost_hidden, GHOST_DESTROY,
+    .writes = RES(RES_HIDDEN_DEPTH) | RES(RES_HIDDEN_NORMAL) | RES(RES_HIDDEN_IDS) | RES(RES_HIDDEN_SHADED)};
+const pass_desc mr_pass_desc_ghost_curvature = {
+    .name = "ghost_curvature", .needed = mr_pass_need_ghost_curvature, .run = mr_pass_ghost_curvature, GHOST_DESTROY,
+    .writes = RES(RES_CURVATURE)};
+const pass_desc mr_pass_desc_ghost_importance = {
+    .name = "ghost_importance", .needed = mr_pass_need_ghost, .run = mr_pass_ghost_importance, GHOST_DESTROY,
+    .reads = RES(RES_IMAGE) | RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_IDS) | RES(RES_HIDDEN_DEPTH) |
+             RES(RES_HIDDEN_IDS),
+    .uses = RES(RES_CURVATURE), .writes = RES(RES_GHOST_MASK)};
+const pass_desc mr_pass_desc_ghost_g0 = {
+    .name = "ghost_g0", .needed = mr_pass_need_ghost, .run = mr_pass_ghost_g0, GHOST_DESTROY,
+    .reads = RES(RES_IMAGE) | RES(RES_HIDDEN_SHADED) | RES(RES_GHOST_MASK), .writes = RES(RES_IMAGE)};
+const pass_desc mr_pass_desc_ghost_analysis = {
+    .name = "ghost_analysis", .needed = mr_pass_need_ghost_adaptive, .run = mr_pass_ghost_analysis, GHOST_DESTROY,
+    .reads = RES(RES_GHOST_MASK)};
+const pass_desc mr_pass_desc_ghost_emphasis = {
+    .name = "ghost_emphasis", .needed = mr_pass_need_ghost_adaptive, .run = mr_pass_ghost_emphasis, GHOST_DESTROY,
+    .reads = RES(RES_HIDDEN_SHADED) | RES(RES_GHOST_MASK), .writes = RES(RES_IMAGE)};

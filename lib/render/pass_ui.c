@@ -35,13 +35,14 @@ mr_draw2d *mr_draw2d_create(mr_gpu *gpu, mr_error *err) {
         return NULL;
     }
     glCreateVertexArrays(1, &d->vao);
-    glEnableVertexArrayAttrib(d->vao, 0);
-    glEnableVertexArrayAttrib(d->vao, 1);
-    glEnableVertexArrayAttrib(d->vao, 2);
-    glVertexArrayAttribFormat(d->vao, 0, 2, GL_FLOAT, GL_FALSE, (GLuint)offsetof(mr_draw2d_vertex, x));
-    glVertexArrayAttribFormat(d->vao, 1, 2, GL_FLOAT, GL_FALSE, (GLuint)offsetof(mr_draw2d_vertex, u));
-    glVertexArrayAttribFormat(d->vao, 2, 4, GL_UNSIGNED_BYTE, GL_TRUE, (GLuint)offsetof(mr_draw2d_vertex, rgba));
-    for (GLuint a = 0; a < 3; a++) glVertexArrayAttribBinding(d->vao, a, 0);
+    static const GLuint attrs[3] = {MR_ATTR_UI_POS, MR_ATTR_UI_UV, MR_ATTR_UI_COLOR};
+    for (int a = 0; a < 3; a++) {
+        glEnableVertexArrayAttrib(d->vao, attrs[a]);
+        glVertexArrayAttribBinding(d->vao, attrs[a], 0);
+    }
+    glVertexArrayAttribFormat(d->vao, MR_ATTR_UI_POS, 2, GL_FLOAT, GL_FALSE, (GLuint)offsetof(mr_draw2d_vertex, x));
+    glVertexArrayAttribFormat(d->vao, MR_ATTR_UI_UV, 2, GL_FLOAT, GL_FALSE, (GLuint)offsetof(mr_draw2d_vertex, u));
+    glVertexArrayAttribFormat(d->vao, MR_ATTR_UI_COLOR, 4, GL_UNSIGNED_BYTE, GL_TRUE, (GLuint)offsetof(mr_draw2d_vertex, rgba));
     /* A sampler object, so the renderer's textures keep their own (nearest)
      * filtering for its passes. */
     glCreateSamplers(1, &d->sampler);
@@ -95,9 +96,9 @@ static bool upload(GLuint *buf, size_t *have, const void *data, size_t bytes) {
 
 static void draw(mr_draw2d *d, int mode, GLuint tex, int index_count) {
     glUseProgram(d->prog);
-    glUniform2f(0, (float)d->fb_w, (float)d->fb_h);
-    glUniform1i(1, mode);
-    glBindTextureUnit(0, tex);
+    glUniform2f(MR_LOC_UI_FB_SIZE, (float)d->fb_w, (float)d->fb_h);
+    glUniform1i(MR_LOC_UI_MODE, mode);
+    glBindTextureUnit(MR_TEX_UI_TEX, tex);
     glVertexArrayVertexBuffer(d->vao, 0, d->vbo, 0, sizeof(mr_draw2d_vertex));
     glVertexArrayElementBuffer(d->vao, d->ibo);
     glBindVertexArray(d->vao);
@@ -116,9 +117,9 @@ bool mr_draw2d_frame(mr_draw2d *d, mr_renderer *r, float x, float y, float w, fl
     upload(&d->vbo, &d->vbo_bytes, v, sizeof v);
     upload(&d->ibo, &d->ibo_bytes, ix, sizeof ix);
     glDisable(GL_BLEND);
-    glBindSampler(0, d->sampler);
+    glBindSampler(MR_TEX_UI_TEX, d->sampler);
     draw(d, 1, r->last.tex, 6);
-    glBindSampler(0, 0);
+    glBindSampler(MR_TEX_UI_TEX, 0);
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x drawing the frame", e);
     return true;

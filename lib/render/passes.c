@@ -1,11 +1,103 @@
-/* The base passes: G-buffer, Lambert + ambient shading, video overlay. */
+/* The base passes: G-buffer, Lambert + ambient shading, video overlay.
+ *
+ *   gbuffer  writes depth, albedo, normal, ids (+ positions when a pass
+ *            this frame reads them); the hidden layer too unless the
+ *            ghosting makes hidden.* this frame
+ *   shade    reads albedo, normal (+ ao), writes shaded and image
+ *   overlay  reads image and the video, writes image */
 #include "render_internal.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
-bool mr_pass_need_always(frame *f) { (void)f; return true; }
-bool mr_pass_need_overlay(frame *f) { return f->p->video != NULL; }
+struct mr_base_state {
+    GLuint prog_gbuffer, prog_shade, prog_overlay;
+    int w, h;              /* size of the targets below */
+    target gbuf;           /* albedo (sRGB8), normal (RGBA16F), ids (RG32UI), positions (RGBA32F), depth (32F) */
+    target shaded;         /* sRGB8: the virtual image */
+    target composed;       /* sRGB8: virtual + video */
+    GLuint video_tex;
+    int video_w, video_h;
+};
+
+static void free_targets(struct mr_base_state *b) {
+    mr_gl_target_free(&b->gbuf);
+    mr_gl_target_free(&b->shaded);
+    mr_gl_target_free(&b->composed);
+    b->w = b->h = 0;
+}
+
+void mr_base_free(mr_renderer *r) {
+    struct mr_base_state *b = r->base;
+    if (!b) return;
+    free_targets(b);
+    glDeleteTextures(1, &b->video_tex);
+    glDeleteProgram(b->prog_gbuffer);
+    glDeleteProgram(b->prog_shade);
+    glDeleteProgram(b->prog_overlay);
+    free(b);
+    r->base = NULL;
+}
+
+/* Programs are built once, targets whenever the output size changes; each
+ * pass makes only what it writes. */
+static struct mr_base_state *base(frame *f, mr_error *err) {
+    mr_renderer *r = f->r;
+    if (!r->base && !(r->base = calloc(1, sizeof *r->base))) {
+        mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    struct mr_base_state *b = r->base;
+    if (b->w != r->w || b->h != r->h) {
+        free_targets(b);
+        b->w = r->w;
+        b->h = r->h;
+    }
+    return b;
+}
+
+static bool ensure_program(GLuint *prog, const char *vert, const char *frag, mr_error *err) {
+    const char *const files[] = {vert, frag, NULL};
+    return *prog || (*prog = mr_gl_program(files, err)) != 0;
+}
+
+static bool mr_pass_prepare_gbuffer(frame *f, mr_error *err) {
+    struct mr_base_state *b = base(f, err);
+    if (!b || !ensure_program(&b->prog_gbuffer, "gbuffer.vert.glsl", "gbuffer.frag.glsl", err)) return false;
+    /* albedo, view normal, ids, view-space position (written only when a
+     * frame's AO reads positions: see mr_pass_gbuffer) */
+    static const GLenum gfmt[MR_OUT_GBUFFER_COUNT] = {
+        [MR_OUT_GBUFFER_ALBEDO] = GL_SRGB8_ALPHA8, [MR_OUT_GBUFFER_NORMAL] = GL_RGBA16F,
+        [MR_OUT_GBUFFER_IDS] = GL_RG32UI, [MR_OUT_GBUFFER_POSITIONS] = GL_RGBA32F};
+    return b->gbuf.fbo || mr_gl_target_make(&b->gbuf, b->w, b->h, gfmt, MR_OUT_GBUFFER_COUNT, true, err);
+}
+
+static bool mr_pass_prepare_shade(frame *f, mr_error *err) {
+    struct mr_base_state *b = base(f, err);
+    if (!b || !ensure_program(&b->prog_shade, "fullscreen.vert.glsl", "shade.frag.glsl", err)) return false;
+    static const GLenum cfmt[1] = {GL_SRGB8_ALPHA8};
+    return b->shaded.fbo || mr_gl_target_make(&b->shaded, b->w, b->h, cfmt, 1, false, err);
+}
+
+static bool mr_pass_prepare_overlay(frame *f, mr_error *err) {
+    struct mr_base_state *b = base(f, err);
+    if (!b || !ensure_program(&b->prog_overlay, "fullscreen.vert.glsl", "overlay.frag.glsl", err)) return false;
+    static const GLenum cfmt[1] = {GL_SRGB8_ALPHA8};
+    if (!b->composed.fbo && !mr_gl_target_make(&b->composed, b->w, b->h, cfmt, 1, false, err)) return false;
+    const mr_image *v = f->p->video;
+    if (!b->video_tex || b->video_w != v->width || b->video_h != v->height) {
+        glDeleteTextures(1, &b->video_tex);
+        b->video_tex = mr_gl_make_tex(GL_SRGB8_ALPHA8, v->width, v->height, GL_LINEAR);
+        b->video_w = v->width;
+        b->video_h = v->height;
+    }
+    return true;
+}
+
+static bool mr_pass_need_overlay(const frame *f) { return f->p->video != NULL; }
+
+GLuint mr_gbuffer_program(const frame *f) { return f->r->base ? f->r->base->prog_gbuffer : 0; }
 
 void mr_gbuffer_begin(frame *f, const target *t) {
     glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
@@ -19,45 +111,54 @@ void mr_gbuffer_begin(frame *f, const target *t) {
     static const float zero4[4] = {0, 0, 0, 0};
     static const GLuint zero_u[4] = {0, 0, 0, 0};
     static const float depth0 = 0.0f; /* reversed Z: clear to infinity */
-    glClearNamedFramebufferfv(t->fbo, GL_COLOR, 0, zero4);
-    glClearNamedFramebufferfv(t->fbo, GL_COLOR, 1, zero4);
-    glClearNamedFramebufferuiv(t->fbo, GL_COLOR, 2, zero_u);
+    glClearNamedFramebufferfv(t->fbo, GL_COLOR, MR_OUT_GBUFFER_ALBEDO, zero4);
+    glClearNamedFramebufferfv(t->fbo, GL_COLOR, MR_OUT_GBUFFER_NORMAL, zero4);
+    glClearNamedFramebufferuiv(t->fbo, GL_COLOR, MR_OUT_GBUFFER_IDS, zero_u);
     glClearNamedFramebufferfv(t->fbo, GL_DEPTH, 0, &depth0);
 }
 
-void mr_pass_gbuffer(frame *f) {
-    mr_renderer *r = f->r;
+static void mr_pass_gbuffer(frame *f) {
+    struct mr_base_state *b = f->r->base;
     static const float zero4[4] = {0, 0, 0, 0};
-    mr_gbuffer_begin(f, &r->gbuf);
+    mr_gbuffer_begin(f, &b->gbuf);
     /* View-space positions are rasterised (not un-projected from depth) so
      * that AO also works where the projection cannot be inverted; the
      * attachment costs bandwidth, so it is written only when this frame's AO
      * reads positions. */
-    static const GLenum bufs[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
-                                   GL_COLOR_ATTACHMENT3};
-    bool want_pos = mr_pass_need_ao_positions(f);
-    glNamedFramebufferDrawBuffers(r->gbuf.fbo, want_pos ? 4 : 3, bufs);
-    if (want_pos) glClearNamedFramebufferfv(r->gbuf.fbo, GL_COLOR, 3, zero4);
+    static const GLenum bufs[MR_OUT_GBUFFER_COUNT] = {
+        GL_COLOR_ATTACHMENT0 + MR_OUT_GBUFFER_ALBEDO, GL_COLOR_ATTACHMENT0 + MR_OUT_GBUFFER_NORMAL,
+        GL_COLOR_ATTACHMENT0 + MR_OUT_GBUFFER_IDS, GL_COLOR_ATTACHMENT0 + MR_OUT_GBUFFER_POSITIONS};
+    bool want_pos = (f->reading & RES(RES_POSITIONS)) != 0;
+    glNamedFramebufferDrawBuffers(b->gbuf.fbo, want_pos ? MR_OUT_GBUFFER_COUNT : MR_OUT_GBUFFER_POSITIONS, bufs);
+    if (want_pos) glClearNamedFramebufferfv(b->gbuf.fbo, GL_COLOR, MR_OUT_GBUFFER_POSITIONS, zero4);
     uint32_t mask = 1u << MR_LAYER_VISIBLE;
     /* With ghosting, the hidden layer goes to its own target D (pass_ghost.c). */
-    if (!f->p->hide_hidden_layer && !mr_ghost_active(f)) mask |= 1u << MR_LAYER_HIDDEN;
-    mr_geometry_draw(f, mask);
+    if (!f->p->hide_hidden_layer && !(f->writing & RES(RES_HIDDEN_DEPTH))) mask |= 1u << MR_LAYER_HIDDEN;
+    mr_geo_view v = mr_frame_view(f, b->prog_gbuffer, mask);
+    mr_geometry_draw(f->r, &v, f->out);
     glDisable(GL_DEPTH_TEST);
+    frame_put(f, RES_DEPTH, b->gbuf.depth);
+    frame_put(f, RES_ALBEDO, b->gbuf.color[MR_OUT_GBUFFER_ALBEDO]);
+    frame_put(f, RES_NORMAL, b->gbuf.color[MR_OUT_GBUFFER_NORMAL]);
+    frame_put(f, RES_IDS, b->gbuf.color[MR_OUT_GBUFFER_IDS]);
+    if (want_pos) frame_put(f, RES_POSITIONS, b->gbuf.color[MR_OUT_GBUFFER_POSITIONS]);
 }
 
-void mr_pass_shade(frame *f) {
-    mr_shade_draw(f, &f->r->gbuf, &f->r->shaded);
-    f->final_tex = f->r->shaded.color[0];
+static void mr_pass_shade(frame *f) {
+    struct mr_base_state *b = f->r->base;
+    mr_shade_draw(f, frame_get(f, RES_ALBEDO), frame_get(f, RES_NORMAL), frame_get(f, RES_AO), &b->shaded);
+    frame_put(f, RES_SHADED, b->shaded.color[0]);
+    frame_put(f, RES_IMAGE, b->shaded.color[0]);
 }
 
-void mr_shade_draw(frame *f, const target *src, const target *dst) {
+void mr_shade_draw(frame *f, GLuint albedo, GLuint normal, GLuint ao, const target *dst) {
     mr_renderer *r = f->r;
     glBindFramebuffer(GL_FRAMEBUFFER, dst->fbo);
     glViewport(0, 0, r->w, r->h);
     glEnable(GL_FRAMEBUFFER_SRGB);
-    glUseProgram(r->prog_shade);
+    glUseProgram(r->base->prog_shade);
     const mr_scene *s = r->scene;
-    float dirs[8][3], cols[8][3];
+    float dirs[MR_SHADE_MAX_LIGHTS][3], cols[MR_SHADE_MAX_LIGHTS][3];
     int nl = 0;
     static const mr_light default_lights[2] = {
         {{0.4, 1.0, 0.25}, {0.55f, 0.55f, 0.52f}}, /* sun */
@@ -65,7 +166,7 @@ void mr_shade_draw(frame *f, const target *src, const target *dst) {
     };
     const mr_light *lights = s && s->light_count > 0 ? s->lights : default_lights;
     int count = s && s->light_count > 0 ? s->light_count : 2;
-    for (int i = 0; i < count && i < 8; i++) {
+    for (int i = 0; i < count && i < MR_SHADE_MAX_LIGHTS; i++) {
         /* World direction to camera axes with the pose's rotation only. */
         mr_dvec3 d = mr_v3_normalize(mr_m4_dir(&f->cam_from_world, mr_v3(lights[i].direction[0], lights[i].direction[1],
                                                                         lights[i].direction[2])));
@@ -73,64 +174,68 @@ void mr_shade_draw(frame *f, const target *src, const target *dst) {
         memcpy(cols[nl], lights[i].color, sizeof cols[nl]);
         nl++;
     }
-    glUniform1i(0, nl);
+    glUniform1i(MR_LOC_SHADE_LIGHT_COUNT, nl);
     if (nl) {
-        glUniform3fv(1, nl, &dirs[0][0]);
-        glUniform3fv(9, nl, &cols[0][0]);
+        glUniform3fv(MR_LOC_SHADE_LIGHT_DIR, nl, &dirs[0][0]);
+        glUniform3fv(MR_LOC_SHADE_LIGHT_COLOR, nl, &cols[0][0]);
     }
-    glUniform1f(17, s ? s->ambient : 0.35f);
+    glUniform1f(MR_LOC_SHADE_AMBIENT, s ? s->ambient : 0.35f);
     float bg[3];
     for (int i = 0; i < 3; i++) {
         float c = f->p->background[i];
         bg[i] = c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
     }
-    glUniform3fv(18, 1, bg);
-    glUniform1f(20, f->p->specular > 0 ? f->p->specular : 0.0f);
-    glUniform1f(21, f->p->shininess >= 1 ? f->p->shininess : 32.0f);
-    /* The main G-buffer's AO, or the hidden layer's own (pass_ghost.c). */
-    GLuint ao = src == &r->gbuf ? mr_pass_ao_texture(f) : f->hidden_ao; /* 0 when there is no AO */
-    glUniform1i(19, ao != 0);
-    glBindTextureUnit(0, src->color[0]);
-    glBindTextureUnit(1, src->color[1]);
-    glBindTextureUnit(2, ao);
+    glUniform3fv(MR_LOC_SHADE_BACKGROUND, 1, bg);
+    glUniform1f(MR_LOC_SHADE_SPECULAR, f->p->specular > 0 ? f->p->specular : 0.0f);
+    glUniform1f(MR_LOC_SHADE_SHININESS, f->p->shininess >= 1 ? f->p->shininess : MR_FRAME_DEFAULT_SHININESS);
+    glUniform1i(MR_LOC_SHADE_HAVE_AO, ao != 0);
+    glBindTextureUnit(MR_TEX_SHADE_ALBEDO, albedo);
+    glBindTextureUnit(MR_TEX_SHADE_NORMAL, normal);
+    glBindTextureUnit(MR_TEX_SHADE_AO, ao);
     glBindVertexArray(r->empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
 
-void mr_pass_overlay(frame *f) {
+static void mr_pass_overlay(frame *f) {
     mr_renderer *r = f->r;
+    struct mr_base_state *b = r->base;
     const mr_image *v = f->p->video;
     GLenum fmt = v->channels == 1 ? GL_RED : v->channels == 2 ? GL_RG : v->channels == 3 ? GL_RGB : GL_RGBA;
-    if (!r->video_tex || r->video_w != v->width || r->video_h != v->height) {
-        glDeleteTextures(1, &r->video_tex);
-        r->video_tex = mr_gl_make_tex(GL_SRGB8_ALPHA8, v->width, v->height, GL_LINEAR);
-        r->video_w = v->width;
-        r->video_h = v->height;
-    }
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTextureSubImage2D(r->video_tex, 0, 0, 0, v->width, v->height, fmt, GL_UNSIGNED_BYTE, v->data);
+    glTextureSubImage2D(b->video_tex, 0, 0, 0, v->width, v->height, fmt, GL_UNSIGNED_BYTE, v->data);
     /* Grey frames: replicate red into green and blue. */
     GLint swz[4] = {GL_RED, v->channels < 3 ? GL_RED : GL_GREEN, v->channels < 3 ? GL_RED : GL_BLUE, GL_ONE};
-    glTextureParameteriv(r->video_tex, GL_TEXTURE_SWIZZLE_RGBA, swz);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->composed.fbo);
+    glTextureParameteriv(b->video_tex, GL_TEXTURE_SWIZZLE_RGBA, swz);
+    glBindFramebuffer(GL_FRAMEBUFFER, b->composed.fbo);
     glViewport(0, 0, r->w, r->h);
     glEnable(GL_FRAMEBUFFER_SRGB);
-    glUseProgram(r->prog_overlay);
+    glUseProgram(b->prog_overlay);
     /* The view's camera describes the raw video frame at its own size. */
     mr_camera vc = mr_camera_resized(&f->view->camera, v->width, v->height);
-    glUniform4f(0, (float)f->cam.fx, (float)f->cam.fy, (float)f->cam.cx, (float)f->cam.cy);
-    glUniform4f(1, (float)vc.fx, (float)vc.fy, (float)vc.cx, (float)vc.cy);
-    glUniform2f(2, (float)v->width, (float)v->height);
+    glUniform4f(MR_LOC_OVERLAY_OUT_K, (float)f->cam.fx, (float)f->cam.fy, (float)f->cam.cx, (float)f->cam.cy);
+    glUniform4f(MR_LOC_OVERLAY_VIDEO_K, (float)vc.fx, (float)vc.fy, (float)vc.cx, (float)vc.cy);
+    glUniform2f(MR_LOC_OVERLAY_VIDEO_SIZE, (float)v->width, (float)v->height);
     float dist[5];
     for (int i = 0; i < 5; i++) dist[i] = (float)vc.dist[i];
-    glUniform1fv(3, 5, dist);
+    glUniform1fv(MR_LOC_OVERLAY_DIST, 5, dist);
     float a = f->p->alpha;
-    glUniform1f(8, a < 0 ? 0.0f : a > 1 ? 1.0f : a);
-    glBindTextureUnit(0, f->final_tex);
-    glBindTextureUnit(1, r->video_tex);
+    glUniform1f(MR_LOC_OVERLAY_ALPHA, a < 0 ? 0.0f : a > 1 ? 1.0f : a);
+    glBindTextureUnit(MR_TEX_OVERLAY_VIRTUAL, frame_get(f, RES_IMAGE));
+    glBindTextureUnit(MR_TEX_OVERLAY_VIDEO, b->video_tex);
     glBindVertexArray(r->empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
-    f->final_tex = r->composed.color[0];
+    frame_put(f, RES_IMAGE, b->composed.color[0]);
 }
 
+
+/* The rows of the registry (k_passes in renderer.c). */
+const pass_desc mr_pass_desc_gbuffer = {
+    .name = "gbuffer", .prepare = mr_pass_prepare_gbuffer, .run = mr_pass_gbuffer, .destroy = mr_base_free,
+    .writes = RES(RES_DEPTH) | RES(RES_ALBEDO) | RES(RES_NORMAL) | RES(RES_IDS) | RES(RES_POSITIONS)};
+const pass_desc mr_pass_desc_shade = {
+    .name = "shade", .prepare = mr_pass_prepare_shade, .run = mr_pass_shade, .destroy = mr_base_free,
+    .reads = RES(RES_ALBEDO) | RES(RES_NORMAL), .uses = RES(RES_AO), .writes = RES(RES_SHADED) | RES(RES_IMAGE)};
+const pass_desc mr_pass_desc_overlay = {
+    .name = "overlay", .needed = mr_pass_need_overlay, .prepare = mr_pass_prepare_overlay, .run = mr_pass_overlay,
+    .destroy = mr_base_free, .reads = RES(RES_IMAGE), .writes = RES(RES_IMAGE)};

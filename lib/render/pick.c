@@ -9,7 +9,7 @@
 bool mr_renderer_pick(mr_renderer *r, double x, double y, mr_pick *out, mr_error *err) {
     memset(out, 0, sizeof *out);
     out->node = -1;
-    if (!r || !r->last.valid || !r->gbuf.fbo) return mr_fail(err, MR_ERR_INVALID, "no frame has been rendered to pick from");
+    if (!r || !r->last.valid || !r->last.depth || !r->last.ids) return mr_fail(err, MR_ERR_INVALID, "no frame has been rendered to pick from");
     int px = (int)floor(x + 0.5), py = (int)floor(y + 0.5);
     if (!(isfinite(x) && isfinite(y)) || px < 0 || py < 0 || px >= r->w || py >= r->h)
         return mr_fail(err, MR_ERR_INVALID, "pick position (%g, %g) is outside the %dx%d frame", x, y, r->w, r->h);
@@ -17,8 +17,8 @@ bool mr_renderer_pick(mr_renderer *r, double x, double y, mr_pick *out, mr_error
     GLuint ids[2] = {0, 0};
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     /* Targets are stored top row first, so image row py is texture row py. */
-    glGetTextureSubImage(r->gbuf.depth, 0, px, py, 0, 1, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, sizeof d, &d);
-    glGetTextureSubImage(r->gbuf.color[2], 0, px, py, 0, 1, 1, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, sizeof ids, ids);
+    glGetTextureSubImage(r->last.depth, 0, px, py, 0, 1, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, sizeof d, &d);
+    glGetTextureSubImage(r->last.ids, 0, px, py, 0, 1, 1, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, sizeof ids, ids);
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x reading the pick pixel", e);
     if (!(d > 0)) return true; /* reversed Z: 0 is infinity, nothing there */

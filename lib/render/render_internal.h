@@ -1,17 +1,45 @@
-/* Private to lib/render: the renderer's state, the per-frame context and the
- * pass interface. A pass lives in its own file (passes.c, later pass_ao.c,
- * pass_ghost.c, ...) and is listed in k_passes in renderer.c with a predicate
- * saying when a frame needs it. Geometry (scene upload and drawing) lives in
- * geometry.c. */
+/* Private to lib/render: the renderer's state, the per-frame context, the
+ * pass registry's row type and the named resources passes exchange.
+ *
+ * A pass is a row of k_passes (renderer.c): a name, needed() (pure: says
+ * whether this frame runs it), prepare() (allocates and compiles), run(),
+ * scene_changed() and destroy() (for the state of its file), and the named
+ * resources it reads and writes. Passes hand textures to each other only
+ * through the frame's resource table (frame_put / frame_get). Geometry
+ * (scene upload and drawing through a view) lives in geometry.c. */
 #ifndef MR_RENDER_INTERNAL_H
 #define MR_RENDER_INTERNAL_H
 
 #include "gpu_internal.h"
+#include "mr_bindings.h" /* uniform locations and texture units, shared with the GLSL */
 
 /* A framebuffer with up to 4 colour textures and an optional depth texture. */
 typedef struct target {
     GLuint fbo, color[4], depth;
 } target;
+
+/* The named resources of a frame: textures written by one pass and read by
+ * later ones. k_resource_names (renderer.c) spells them. */
+typedef enum res_id {
+    RES_DEPTH = 0,      /* "depth": reversed-Z 32F depth of the G-buffer */
+    RES_ALBEDO,         /* "albedo": sRGB8 */
+    RES_NORMAL,         /* "normal": RGBA16F view normal, w = 1 where geometry */
+    RES_IDS,            /* "ids": RG32UI node index + 1, layer */
+    RES_POSITIONS,      /* "positions": RGBA32F view-space position (AO positions path) */
+    RES_AO_MASK,        /* "ao.mask": R16F outline count (corner masking) */
+    RES_AO,             /* "ao": R32F ambient visibility at the output size */
+    RES_HIDDEN_DEPTH,   /* "hidden.depth": the hidden layer D's G-buffer ... */
+    RES_HIDDEN_NORMAL,  /* "hidden.normal" */
+    RES_HIDDEN_IDS,     /* "hidden.ids" */
+    RES_HIDDEN_SHADED,  /* "hidden.shaded": D shaded alone (sRGB8) */
+    RES_SHADED,         /* "shaded": the virtual image (sRGB8) */
+    RES_IMAGE,          /* "image": the image so far; the frame's output is its last value */
+    RES_CURVATURE,      /* "curvature": R32F per-pixel curvature of the occluder's mesh */
+    RES_GHOST_MASK,     /* "ghost.mask": IM, region, silhouette (RGBA32F) */
+    RES_COUNT
+} res_id;
+#define RES(x) (1u << (x))
+extern const char *const mr_resource_names[RES_COUNT];
 
 struct mr_renderer {
     mr_gpu *gpu;
@@ -21,26 +49,24 @@ struct mr_renderer {
     mr_draw_stats stats;   /* of the current / last frame */
     GLuint *textures;
     int32_t texture_count;
-    GLuint prog_gbuffer, prog_shade, prog_overlay;
-    GLuint empty_vao;
-    int w, h;              /* current target size */
-    target gbuf;           /* albedo (sRGB8), normal (RGBA16F), ids (RG32UI), depth (32F) */
-    target shaded;         /* sRGB8: the virtual image */
-    target composed;       /* sRGB8: virtual + video */
-    GLuint video_tex;
-    int video_w, video_h;
+    GLuint empty_vao;      /* for full-screen triangles */
+    int w, h;              /* current output size */
     GLuint queries[MR_MAX_PASSES];
     /* The last finished frame, for showing it in a window and for picking. */
     struct {
         bool valid;
         GLuint tex;            /* texture holding the finished image */
+        GLuint depth, ids;     /* its G-buffer depth and ids (picking) */
         mr_camera cam;         /* at the output size */
         mr_dmat4 world_from_camera;
         double near_plane;
     } last;
-    struct mr_ao_state *ao; /* pass_ao.c: AO targets, programs, kernel, reuse cache */
+    /* The state of each pass file, owned by it (created in its prepare,
+     * freed by its destroy). */
+    struct mr_base_state *base;    /* passes.c: G-buffer, shading, overlay */
+    struct mr_ao_state *ao;        /* pass_ao.c: AO targets, programs, kernel, reuse cache */
     struct mr_ao_state *ao_hidden; /* the same for the ghosting's hidden layer D */
-    struct mr_ghost_state *ghost; /* pass_ghost.c: targets, programs, caches; NULL until first used */
+    struct mr_ghost_state *ghost;  /* pass_ghost.c: targets, programs, caches */
 };
 
 typedef struct frame {
@@ -51,17 +77,39 @@ typedef struct frame {
     mr_dmat4 cam_from_world;
     double near_plane;
     mr_frame_result *out;
-    GLuint final_tex;       /* the texture holding the finished image */
-    int ao_plan;            /* pass_ao.c: decided once per frame (off / reuse / run) */
-    GLuint hidden_ao;       /* AO of the hidden layer D (pass_ghost.c), 0 if none */
-    int ghost;              /* pass_ghost.c: 0 not decided yet, 1 ghosting runs, -1 it does not */
+    GLuint res[RES_COUNT];  /* the resource table: texture per name, 0 = not made this frame */
+    uint32_t reading;       /* RES() bits some pass this frame reads (decided before any runs) */
+    uint32_t writing;       /* RES() bits some pass this frame writes */
+    bool ao_reused;         /* pass_ao.c: the AO of an earlier frame stands in */
+    int ao_hidden_plan;     /* pass_ao.c: what the hidden layer's AO does this frame */
 } frame;
 
+static inline void frame_put(frame *f, res_id id, GLuint tex) { f->res[id] = tex; }
+static inline GLuint frame_get(const frame *f, res_id id) { return f->res[id]; }
+
 typedef struct pass_desc {
-    const char *name;
-    bool (*needed)(frame *f);
+    const char *name;                       /* in the frame's pass list (NULL: not listed) */
+    bool (*needed)(const frame *f);         /* no side effects; NULL = always */
+    bool (*prepare)(frame *f, mr_error *err); /* allocation and compilation; NULL = nothing */
     void (*run)(frame *f);
+    void (*scene_changed)(mr_renderer *r);  /* drops what was derived from the scene; NULL */
+    void (*destroy)(mr_renderer *r);        /* frees the file's state (idempotent); NULL */
+    uint32_t reads;                         /* RES() bits it needs an earlier pass to have written */
+    uint32_t uses;                          /* RES() bits it reads when some earlier pass made them */
+    uint32_t writes;                        /* RES() bits */
+    uint32_t (*reads_now)(const frame *f);  /* the part of `reads` this frame needs; NULL = all */
 } pass_desc;
+
+/* A way to draw the scene: from the frame's camera or any other eye. */
+typedef struct mr_geo_view {
+    mr_camera cam;              /* intrinsics at the target size */
+    mr_dmat4 cam_from_world, world_from_camera;
+    double near_plane;
+    GLuint program;             /* its MR_LOC_PROJECTION receives the projection */
+    uint32_t layers;            /* 1 << mr_layer of the nodes drawn */
+} mr_geo_view;
+/* The frame's camera with a program and layers. */
+mr_geo_view mr_frame_view(const frame *f, GLuint program, uint32_t layers);
 
 /* Helpers (renderer.c). */
 GLuint mr_gl_make_tex(GLenum fmt, int w, int h, GLenum filter);
@@ -73,10 +121,10 @@ void mr_gl_projection(const mr_camera *c, double near_plane, float out[16]);
 /* Geometry (geometry.c). */
 bool mr_geometry_upload(mr_renderer *r, const mr_scene *s, mr_error *err);
 void mr_geometry_free(mr_renderer *r);
-/* Draws the nodes whose layer bit (1 << layer) is in layer_mask with the
- * G-buffer program into the currently bound framebuffer, counting triangles
- * and draw calls into the frame result. */
-void mr_geometry_draw(frame *f, uint32_t layer_mask);
+/* Draws the view's layers with its program into the bound framebuffer
+ * (culling, LOD, instancing), counting triangles and draw calls into out
+ * (may be NULL). */
+void mr_geometry_draw(mr_renderer *r, const mr_geo_view *view, mr_frame_result *out);
 /* Resets the frame's draw statistics (called by mr_render_frame). */
 void mr_geometry_begin_frame(mr_renderer *r);
 
@@ -91,65 +139,46 @@ typedef struct mr_geo_aux {
 /* per_mesh[i]: comps floats per vertex of scene mesh i (NULL: zeros). */
 bool mr_geometry_aux_create(mr_renderer *r, float *const *per_mesh, int comps, GLuint attrib, mr_geo_aux *aux);
 void mr_geometry_aux_free(mr_geo_aux *aux);
-/* Draws every node of the layers at full detail, no culling, through the aux
- * VAOs with the bound program; sets uniform location 0 (model-view, camera
- * relative, composed in double) and 1 (its normal matrix) per instance. */
-void mr_geometry_aux_draw(frame *f, const mr_geo_aux *aux, uint32_t layer_mask);
+/* Draws every node of the view's layers at full detail, no culling, through
+ * the aux VAOs with the view's program (uniforms other than the matrices set
+ * by the caller); sets MR_LOC_PROJECTION, and per instance MR_LOC_MODELVIEW
+ * (camera relative, composed in double) and MR_LOC_NORMAL_MATRIX. */
+void mr_geometry_aux_draw(mr_renderer *r, const mr_geo_view *view, const mr_geo_aux *aux);
 
-/* Passes (passes.c). */
-bool mr_pass_need_always(frame *f);
-bool mr_pass_need_overlay(frame *f);
+/* The registry's rows: each pass file defines its descriptors, renderer.c
+ * lists them in order. */
+extern const pass_desc mr_pass_desc_gbuffer, mr_pass_desc_shade, mr_pass_desc_overlay;         /* passes.c */
+extern const pass_desc mr_pass_desc_ao_mask, mr_pass_desc_ao, mr_pass_desc_ao_blur, mr_pass_desc_ao_upsample,
+    mr_pass_desc_ao_reuse, mr_pass_desc_ao_external;                                            /* pass_ao.c */
+extern const pass_desc mr_pass_desc_ghost_hidden, mr_pass_desc_ghost_curvature, mr_pass_desc_ghost_importance,
+    mr_pass_desc_ghost_g0, mr_pass_desc_ghost_analysis, mr_pass_desc_ghost_emphasis;            /* pass_ghost.c */
+
+/* Helpers the pass files share. */
+
+/* passes.c */
+void mr_base_free(mr_renderer *r);
 /* Binds a G-buffer-layout target, clears it (depth to infinity) and sets
  * the depth state the geometry pass draws with. */
 void mr_gbuffer_begin(frame *f, const target *t);
-void mr_pass_gbuffer(frame *f);
-void mr_pass_shade(frame *f);
-void mr_pass_overlay(frame *f);
-/* Shades G-buffer `src` (albedo, normal) into `dst`'s first colour target
- * with the scene's lights (used for the main image and for the hidden
- * layer D of ghosted views). */
-void mr_shade_draw(frame *f, const target *src, const target *dst);
+/* The G-buffer program (for drawing another layer into a G-buffer). */
+GLuint mr_gbuffer_program(const frame *f);
+/* Shades albedo + normal (+ ao, 0 = none) into dst's first colour target
+ * with the scene's lights: the main image and the hidden layer D. */
+void mr_shade_draw(frame *f, GLuint albedo, GLuint normal, GLuint ao, const target *dst);
 
-/* Ghosted views (pass_ghost.c). mr_ghost_active: this frame ghosts (a mode
- * other than off, the hidden layer drawn, and hidden structure in view);
- * then the G-buffer pass leaves the hidden layer to the ghost passes. */
-bool mr_ghost_active(frame *f);
-bool mr_pass_need_ghost(frame *f);
-bool mr_pass_need_ghost_curvature(frame *f);
-bool mr_pass_need_ghost_adaptive(frame *f);
-void mr_pass_ghost_hidden(frame *f);
-void mr_pass_ghost_curvature(frame *f);
-void mr_pass_ghost_importance(frame *f);
-void mr_pass_ghost_g0(frame *f);
-void mr_pass_ghost_analysis(frame *f);
-void mr_pass_ghost_emphasis(frame *f);
-/* Checks the ghost parameters and builds programs and targets, before the
- * frame's passes run (so a failure fails the frame). */
-bool mr_ghost_prepare(mr_renderer *r, const mr_ghost_params *gp, int w, int h, mr_error *err);
-/* Drops what was derived from the scene (per-mesh curvature buffers). */
-void mr_ghost_scene_changed(mr_renderer *r);
-void mr_ghost_free(mr_renderer *r);
+/* pass_ghost.c: ghosted views. The G-buffer pass leaves the hidden layer
+ * out when "hidden.*" is made this frame. */
+bool mr_ghost_check_params(const mr_ghost_params *gp, mr_error *err);
 
-/* Ambient occlusion (pass_ao.c). */
+/* pass_ao.c: ambient occlusion. */
 typedef struct mr_ao_state mr_ao_state;
-bool mr_pass_need_ao_positions(frame *f);
-bool mr_pass_need_ao_mask(frame *f);
-bool mr_pass_need_ao(frame *f);
-bool mr_pass_need_ao_blur(frame *f);
-bool mr_pass_need_ao_upsample(frame *f);
-void mr_pass_ao_mask(frame *f);
-void mr_pass_ao(frame *f);
-void mr_pass_ao_blur(frame *f);
-void mr_pass_ao_upsample(frame *f);
-/* The finished AO texture of this frame (computed or reused), or 0. */
-GLuint mr_pass_ao_texture(frame *f);
-/* AO of another G-buffer-like target (the ghosting's hidden layer D) with
- * the frame's AO settings, in a state of its own (reuse works per target);
- * no corner mask, no positions path. Returns the AO texture or 0. */
-GLuint mr_pass_ao_for_hidden(frame *f, const target *src);
-/* Fills out->ao (if asked) and the mask statistics; reports a failed AO shader. */
+/* AO of the hidden layer D (depth, normal) with the frame's AO settings, in
+ * a state of its own (reuse works per target); no corner mask, no
+ * positions path. prepare before run; run returns the AO texture or 0. */
+bool mr_ao_hidden_prepare(frame *f, mr_error *err);
+GLuint mr_ao_hidden_run(frame *f, GLuint depth, GLuint normal);
+/* Fills out->ao (if asked) and the mask statistics. */
 bool mr_pass_ao_read_back(frame *f, mr_error *err);
-void mr_pass_ao_scene_changed(mr_renderer *r);
 void mr_pass_ao_free(mr_renderer *r);
 
 #endif

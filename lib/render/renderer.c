@@ -1,8 +1,11 @@
-/* The renderer: targets, scene hand-over and the frame's pass list.
+/* The renderer: scene hand-over and the frame's pass list.
  *
- * A frame is a list of passes, each with a predicate saying whether this
- * frame needs it; only the needed ones run and are reported (a frame without
- * video runs no overlay pass, and so on). New passes go into k_passes. */
+ * A frame is the registry k_passes, one row per pass, in order. Before any
+ * pass runs, every row's needed() is asked (a frame without video runs no
+ * overlay pass, a frozen camera no AO, and so on); the needed rows' reads
+ * and writes say which named resources this frame makes. Then each needed
+ * row is prepared (targets, programs) and run; the listed ones are
+ * reported. New passes go into k_passes. */
 #include "render_internal.h"
 
 #include <math.h>
@@ -23,7 +26,7 @@ GLuint mr_gl_make_tex(GLenum fmt, int w, int h, GLenum filter) {
 
 void mr_gl_target_free(target *t) {
     glDeleteFramebuffers(1, &t->fbo);
-    glDeleteTextures(3, t->color);
+    glDeleteTextures((GLsizei)(sizeof t->color / sizeof t->color[0]), t->color);
     glDeleteTextures(1, &t->depth);
     memset(t, 0, sizeof *t);
 }
@@ -48,24 +51,48 @@ bool mr_gl_target_make(target *t, int w, int h, const GLenum *fmts, int n, bool 
 }
 
 
-static bool ensure_targets(mr_renderer *r, int w, int h, mr_error *err) {
-    if (r->w == w && r->h == h) return true;
-    mr_gl_target_free(&r->gbuf);
-    mr_gl_target_free(&r->shaded);
-    mr_gl_target_free(&r->composed);
-    r->w = r->h = 0;
-    /* albedo, view normal, ids, view-space position (written only when a
-     * frame's AO reads positions: see mr_pass_gbuffer) */
-    static const GLenum gfmt[4] = {GL_SRGB8_ALPHA8, GL_RGBA16F, GL_RG32UI, GL_RGBA32F};
-    static const GLenum cfmt[1] = {GL_SRGB8_ALPHA8};
-    if (!mr_gl_target_make(&r->gbuf, w, h, gfmt, 4, true, err) || !mr_gl_target_make(&r->shaded, w, h, cfmt, 1, false, err) ||
-        !mr_gl_target_make(&r->composed, w, h, cfmt, 1, false, err))
-        return false;
-    r->w = w;
-    r->h = h;
-    return true;
-}
+const char *const mr_resource_names[RES_COUNT] = {
+    [RES_DEPTH] = "depth", [RES_ALBEDO] = "albedo", [RES_NORMAL] = "normal", [RES_IDS] = "ids",
+    [RES_POSITIONS] = "positions", [RES_AO_MASK] = "ao.mask", [RES_AO] = "ao",
+    [RES_HIDDEN_DEPTH] = "hidden.depth", [RES_HIDDEN_NORMAL] = "hidden.normal", [RES_HIDDEN_IDS] = "hidden.ids",
+    [RES_HIDDEN_SHADED] = "hidden.shaded", [RES_SHADED] = "shaded", [RES_IMAGE] = "image",
+    [RES_CURVATURE] = "curvature", [RES_GHOST_MASK] = "ghost.mask",
+};
 
+/* The registry: one row per pass, in the order they run; each row's
+ * descriptor lives in its pass's file. */
+static const pass_desc *const k_passes[] = {
+    &mr_pass_desc_gbuffer,
+    &mr_pass_desc_ao_mask,
+    &mr_pass_desc_ao,
+    &mr_pass_desc_ao_blur,
+    &mr_pass_desc_ao_upsample,
+    &mr_pass_desc_ao_reuse,
+    &mr_pass_desc_ao_external,
+    &mr_pass_desc_ghost_hidden,
+    &mr_pass_desc_shade,
+    &mr_pass_desc_overlay,
+    /* Ghosting after the overlay: with video, the occluder O is what the
+     * user sees in front of the hidden structure (the real wall). */
+    &mr_pass_desc_ghost_curvature,
+    &mr_pass_desc_ghost_importance,
+    &mr_pass_desc_ghost_g0,
+    &mr_pass_desc_ghost_analysis,
+    &mr_pass_desc_ghost_emphasis,
+};
+#define PASS_COUNT (sizeof k_passes / sizeof k_passes[0])
+
+mr_geo_view mr_frame_view(const frame *f, GLuint program, uint32_t layers) {
+    mr_geo_view v;
+    memset(&v, 0, sizeof v);
+    v.cam = f->cam;
+    v.cam_from_world = f->cam_from_world;
+    v.world_from_camera = f->view->world_from_camera;
+    v.near_plane = f->near_plane;
+    v.program = program;
+    v.layers = layers;
+    return v;
+}
 
 mr_renderer *mr_renderer_create(mr_gpu *gpu, mr_error *err) {
     if (!gpu) {
@@ -78,14 +105,8 @@ mr_renderer *mr_renderer_create(mr_gpu *gpu, mr_error *err) {
         return NULL;
     }
     r->gpu = gpu;
-    static const char *const gb[] = {"gbuffer.vert.glsl", "gbuffer.frag.glsl", NULL};
-    static const char *const sh[] = {"fullscreen.vert.glsl", "shade.frag.glsl", NULL};
-    static const char *const ov[] = {"fullscreen.vert.glsl", "overlay.frag.glsl", NULL};
-    if (!(r->prog_gbuffer = mr_gl_program(gb, err)) || !(r->prog_shade = mr_gl_program(sh, err)) ||
-        !(r->prog_overlay = mr_gl_program(ov, err))) {
-        mr_renderer_destroy(&r);
-        return NULL;
-    }
+    /* Programs and targets are made by the passes' prepare, when a frame
+     * first needs them. */
     glCreateVertexArrays(1, &r->empty_vao);
     glGenQueries(MR_MAX_PASSES, r->queries);
     /* Reversed-Z: depth = near / z, so 1 is the near plane and 0 infinity. */
@@ -97,16 +118,13 @@ mr_renderer *mr_renderer_create(mr_gpu *gpu, mr_error *err) {
 void mr_renderer_destroy(mr_renderer **rp) {
     if (!rp || !*rp) return;
     mr_renderer *r = *rp;
-    mr_pass_ao_free(r);
-    mr_ghost_free(r);
+    /* A deleted program that is still current lives on until another one
+     * is made current: let go of it, so destroy really frees. */
+    glUseProgram(0);
+    glBindVertexArray(0);
+    for (size_t i = 0; i < PASS_COUNT; i++)
+        if (k_passes[i]->destroy) k_passes[i]->destroy(r);
     mr_geometry_free(r);
-    mr_gl_target_free(&r->gbuf);
-    mr_gl_target_free(&r->shaded);
-    mr_gl_target_free(&r->composed);
-    glDeleteTextures(1, &r->video_tex);
-    glDeleteProgram(r->prog_gbuffer);
-    glDeleteProgram(r->prog_shade);
-    glDeleteProgram(r->prog_overlay);
     glDeleteVertexArrays(1, &r->empty_vao);
     glDeleteQueries(MR_MAX_PASSES, r->queries);
     free(r);
@@ -115,9 +133,9 @@ void mr_renderer_destroy(mr_renderer **rp) {
 
 
 bool mr_renderer_set_scene(mr_renderer *r, const mr_scene *s, mr_error *err) {
-    mr_ghost_scene_changed(r);
+    for (size_t i = 0; i < PASS_COUNT; i++)
+        if (k_passes[i]->scene_changed) k_passes[i]->scene_changed(r);
     mr_geometry_free(r);
-    mr_pass_ao_scene_changed(r);
     if (!s) return true;
     return mr_geometry_upload(r, s, err);
 }
@@ -157,41 +175,23 @@ void mr_gl_projection(const mr_camera *c, double near_plane, float out[16]) {
 }
 
 
-static const pass_desc k_passes[] = {
-    {"gbuffer", mr_pass_need_always, mr_pass_gbuffer},
-    {"ao_mask", mr_pass_need_ao_mask, mr_pass_ao_mask},
-    {"ao", mr_pass_need_ao, mr_pass_ao},
-    {"ao_blur", mr_pass_need_ao_blur, mr_pass_ao_blur},
-    {"ao_upsample", mr_pass_need_ao_upsample, mr_pass_ao_upsample},
-    {"ghost_hidden", mr_pass_need_ghost, mr_pass_ghost_hidden},
-    {"shade", mr_pass_need_always, mr_pass_shade},
-    {"overlay", mr_pass_need_overlay, mr_pass_overlay},
-    /* Ghosting after the overlay: with video, the occluder O is what the
-     * user sees in front of the hidden structure (the real wall). */
-    {"ghost_curvature", mr_pass_need_ghost_curvature, mr_pass_ghost_curvature},
-    {"ghost_importance", mr_pass_need_ghost, mr_pass_ghost_importance},
-    {"ghost_g0", mr_pass_need_ghost, mr_pass_ghost_g0},
-    {"ghost_analysis", mr_pass_need_ghost_adaptive, mr_pass_ghost_analysis},
-    {"ghost_emphasis", mr_pass_need_ghost_adaptive, mr_pass_ghost_emphasis},
-};
-
 static bool read_back(frame *f, mr_error *err) {
     mr_renderer *r = f->r;
     mr_frame_result *o = f->out;
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     if (!mr_image_alloc(&o->color, r->w, r->h, 3, MR_PIX_U8, err)) return false;
     /* Read the raw bytes of the sRGB texture: they are the encoded values. */
-    glGetTextureImage(f->final_tex, 0, GL_RGB, GL_UNSIGNED_BYTE, (GLsizei)mr_image_bytes(&o->color), o->color.data);
+    glGetTextureImage(frame_get(f, RES_IMAGE), 0, GL_RGB, GL_UNSIGNED_BYTE, (GLsizei)mr_image_bytes(&o->color), o->color.data);
     if (f->p->want_depth) {
         if (!mr_image_alloc(&o->depth, r->w, r->h, 1, MR_PIX_F32, err)) return false;
         float *d = o->depth.data;
-        glGetTextureImage(r->gbuf.depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, (GLsizei)mr_image_bytes(&o->depth), d);
+        glGetTextureImage(frame_get(f, RES_DEPTH), 0, GL_DEPTH_COMPONENT, GL_FLOAT, (GLsizei)mr_image_bytes(&o->depth), d);
         size_t n = (size_t)r->w * r->h;
         for (size_t i = 0; i < n; i++) d[i] = d[i] > 0 ? (float)(f->near_plane / d[i]) : 0.0f;
     }
     if (f->p->want_normals) {
         if (!mr_image_alloc(&o->normal, r->w, r->h, 3, MR_PIX_F32, err)) return false;
-        glGetTextureImage(r->gbuf.color[1], 0, GL_RGB, GL_FLOAT, (GLsizei)mr_image_bytes(&o->normal), o->normal.data);
+        glGetTextureImage(frame_get(f, RES_NORMAL), 0, GL_RGB, GL_FLOAT, (GLsizei)mr_image_bytes(&o->normal), o->normal.data);
     }
     return mr_pass_ao_read_back(f, err);
 }
@@ -213,8 +213,9 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
     int w = p->width > 0 ? p->width : view->camera.width;
     int h = p->height > 0 ? p->height : view->camera.height;
     if (w > 16384 || h > 16384) return mr_fail(err, MR_ERR_INVALID, "output size %dx%d too large", w, h);
-    if (!ensure_targets(r, w, h, err)) return false;
-    if (!mr_ghost_prepare(r, &p->ghost, w, h, err)) return false;
+    if (!mr_ghost_check_params(&p->ghost, err)) return false;
+    r->w = w;
+    r->h = h;
 
     frame f;
     memset(&f, 0, sizeof f);
@@ -229,15 +230,42 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
     f.near_plane = r->scene ? choose_near(r->scene, eye) : 1e-3;
     out->near_plane = f.near_plane;
 
-    for (size_t i = 0; i < sizeof k_passes / sizeof k_passes[0]; i++) {
-        if (!k_passes[i].needed(&f)) continue;
+    /* Which passes run is decided before any of them does, so needed()
+     * sees the state the frame started with. */
+    bool need[PASS_COUNT];
+    for (size_t i = 0; i < PASS_COUNT; i++) {
+        const pass_desc *d = k_passes[i];
+        need[i] = !d->needed || d->needed(&f);
+        if (!need[i]) continue;
+        uint32_t reads = d->reads_now ? d->reads_now(&f) & d->reads : d->reads;
+        /* A row that needs what no earlier row of this frame makes is a
+         * mistake in the registry (order or declarations), not in the input. */
+        uint32_t missing = reads & ~f.writing;
+        if (missing) {
+            int k = 0;
+            while (!(missing & RES(k))) k++;
+            return mr_fail(err, MR_ERR_GL, "pass %s reads \"%s\", which no earlier pass of this frame writes",
+                           d->name ? d->name : "(unlisted)", mr_resource_names[k]);
+        }
+        f.reading |= reads;
+        f.writing |= d->writes;
+    }
+    for (size_t i = 0; i < PASS_COUNT; i++)
+        if (need[i] && k_passes[i]->prepare && !k_passes[i]->prepare(&f, err)) return false;
+    for (size_t i = 0; i < PASS_COUNT; i++) {
+        if (!need[i]) continue;
+        const pass_desc *d = k_passes[i];
+        if (!d->name) {
+            d->run(&f);
+            continue;
+        }
         int k = out->pass_count;
         double t0 = mr_time_now();
         if (p->timing) glBeginQuery(GL_TIME_ELAPSED, r->queries[k]);
-        k_passes[i].run(&f);
+        d->run(&f);
         if (p->timing) glEndQuery(GL_TIME_ELAPSED);
         out->cpu_ms[k] = (mr_time_now() - t0) * 1e3;
-        out->passes[k] = k_passes[i].name;
+        out->passes[k] = d->name;
         out->pass_count++;
     }
     if (p->timing)
@@ -248,7 +276,9 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
         }
     bool ok = read_back(&f, err);
     r->last.valid = ok;
-    r->last.tex = f.final_tex;
+    r->last.tex = frame_get(&f, RES_IMAGE);
+    r->last.depth = frame_get(&f, RES_DEPTH);
+    r->last.ids = frame_get(&f, RES_IDS);
     r->last.cam = f.cam;
     r->last.world_from_camera = view->world_from_camera;
     r->last.near_plane = f.near_plane;

@@ -1,0 +1,215 @@
+/* mr_bindings.h — the interface between lib/render's C code and its GLSL:
+ * uniform locations (MR_LOC_*), sampler units (MR_TEX_*), image units
+ * (MR_IMG_*) and shader-storage bindings (MR_SSBO_*), grouped by program.
+ * Each number is written here only: the shaders include this file (through
+ * the shader embedder's one-level #include) and write
+ * `layout(location = MR_LOC_X)`, the C side calls glUniform*(MR_LOC_X, ...).
+ * Only #define lines and comments, so it is valid C and GLSL alike.
+ * Programs that share a group (the three full-screen AO shaders; every
+ * program that draws the scene through a view: MODELVIEW, NORMAL_MATRIX,
+ * PROJECTION) share its numbers, so one C helper serves all of them. */
+#ifndef MR_BINDINGS_H
+#define MR_BINDINGS_H
+
+/* Vertex attributes of the scene's geometry (geometry.c lays the buffers
+ * out; gbuffer.vert reads all, ao_outline.vert and ghost_curv.vert read the
+ * position and a stream of their own in a slot of the same numbering). */
+#define MR_ATTR_POSITION                   0
+#define MR_ATTR_NORMAL                     1
+#define MR_ATTR_UV                         2
+#define MR_ATTR_INSTANCE                   3  /* 9 slots: model-view (4), normal matrix (3), colour, ids */
+#define MR_ATTR_INST_MODELVIEW             MR_ATTR_INSTANCE
+#define MR_ATTR_INST_NORMAL0               (MR_ATTR_INSTANCE + 4)
+#define MR_ATTR_INST_NORMAL1               (MR_ATTR_INSTANCE + 5)
+#define MR_ATTR_INST_NORMAL2               (MR_ATTR_INSTANCE + 6)
+#define MR_ATTR_INST_COLOR                 (MR_ATTR_INSTANCE + 7)
+#define MR_ATTR_INST_IDS                   (MR_ATTR_INSTANCE + 8)
+#define MR_ATTR_INSTANCE_SLOTS             9
+#define MR_ATTR_OUTLINE_DIR                1  /* ao_outline: integrated normal */
+#define MR_ATTR_CURVATURE                  3  /* ghost_curv: per-vertex curvature */
+/* The UI's 2D vertices (pass_ui.c). */
+#define MR_ATTR_UI_POS                     0
+#define MR_ATTR_UI_UV                      1
+#define MR_ATTR_UI_COLOR                   2
+
+/* The G-buffer's colour outputs = its target's attachments (passes.c). */
+#define MR_OUT_GBUFFER_ALBEDO              0
+#define MR_OUT_GBUFFER_NORMAL              1
+#define MR_OUT_GBUFFER_IDS                 2
+#define MR_OUT_GBUFFER_POSITIONS           3
+#define MR_OUT_GBUFFER_COUNT               4
+
+/* The scene drawn through a view (gbuffer, ao_outline, ghost_curv). */
+#define MR_LOC_MODELVIEW                   0
+#define MR_LOC_NORMAL_MATRIX               1
+#define MR_LOC_PROJECTION                  2
+/* ao_main, ao_blur, ao_upsample (full screen) */
+#define MR_LOC_AO_INTR                     0
+#define MR_LOC_AO_FULL                     1
+#define MR_LOC_AO_STEP                     2
+#define MR_LOC_AO_NEAR                     3
+#define MR_LOC_AO_BLUR_DIR                 4
+#define MR_LOC_AO_BLUR_RADIUS              5
+#define MR_LOC_AO_SIZE                     6
+#define MR_TEX_AO_DEPTH                    0
+#define MR_TEX_AO_NORMAL                   1
+#define MR_TEX_AO_POSITIONS                2
+#define MR_TEX_AO_INPUT                    4
+
+#define MR_LOC_AO_METHOD                   4
+#define MR_LOC_AO_SAMPLES                  5
+#define MR_LOC_AO_RADIUS_MODE              6
+#define MR_LOC_AO_RADIUS                   7
+#define MR_LOC_AO_SCREEN_K                 8
+#define MR_LOC_AO_C                        9
+#define MR_LOC_AO_BIAS                     10
+#define MR_LOC_AO_STRENGTH                 11
+#define MR_LOC_AO_RADII                    12
+#define MR_LOC_AO_USE_POS                  13
+#define MR_LOC_AO_USE_MASK                 14
+#define MR_LOC_AO_MASK_STRENGTH            15
+#define MR_LOC_AO_KERNEL                   16
+#define MR_AO_KERNEL_SIZE                  64 /* = MR_AO_MAX_SAMPLES (checked in pass_ao.c) */
+#define MR_LOC_AO_KERNEL2                  (MR_LOC_AO_KERNEL + MR_AO_KERNEL_SIZE)
+#define MR_TEX_AO_MASK                     3
+
+/* ao_outline */
+#define MR_LOC_OUTLINE_RADIUS_MODE         3
+#define MR_LOC_OUTLINE_RADIUS              4
+#define MR_LOC_OUTLINE_SCREEN_K            5
+
+/* gbuffer */
+#define MR_TEX_GBUFFER_BASE_COLOR          0
+
+/* ghost_analysis */
+#define MR_LOC_ANA_TC_MIN                  0
+#define MR_LOC_ANA_GAMMA                   1
+#define MR_LOC_ANA_TC_SIL                  2
+#define MR_TEX_ANA_MASK                    0
+#define MR_TEX_ANA_SAL                     1
+#define MR_TEX_ANA_G0                      2
+#define MR_IMG_ANA_C                       0
+
+/* ghost_blur */
+#define MR_LOC_GBLUR_DIR                   0
+#define MR_LOC_GBLUR_SIGMA                 1
+#define MR_LOC_GBLUR_RADIUS                2
+#define MR_TEX_GBLUR_SRC                   0
+#define MR_IMG_GBLUR_DST                   0
+
+/* ghost_emphasis */
+#define MR_LOC_EMPH_STAGE                  0
+#define MR_LOC_EMPH_KEY_BASE               1
+#define MR_LOC_EMPH_GAIN                   2
+#define MR_TEX_EMPH_O                      0
+#define MR_TEX_EMPH_D                      1
+#define MR_TEX_EMPH_DGK                    2
+#define MR_TEX_EMPH_GKC                    3
+#define MR_TEX_EMPH_MASK                   4
+#define MR_TEX_EMPH_G0                     5
+#define MR_TEX_EMPH_KEY                    6
+#define MR_TEX_EMPH_LABEL                  7
+#define MR_IMG_EMPH_OUT                    0
+#define MR_IMG_EMPH_OA                     1
+#define MR_IMG_EMPH_GA                     2
+#define MR_SSBO_EMPH_VOTES                 1
+
+/* ghost_g0 */
+#define MR_LOC_G0_MODE                     0
+#define MR_LOC_G0_T                        1
+#define MR_TEX_G0_O                        0
+#define MR_TEX_G0_D                        1
+#define MR_TEX_G0_MASK                     2
+#define MR_IMG_G0_G0                       0
+#define MR_IMG_G0_OUT                      1
+#define MR_SSBO_G0_STATS                   0
+
+/* ghost_importance */
+#define MR_LOC_IMP_VIDEO                   0
+#define MR_LOC_IMP_IMPORTANCE              1
+#define MR_LOC_IMP_SCALE                   2
+#define MR_LOC_IMP_BIAS                    3
+#define MR_LOC_IMP_NEAR                    4
+#define MR_LOC_IMP_FX                      5
+#define MR_LOC_IMP_HAVE_SALIENCY           6
+#define MR_TEX_IMP_DEPTH                   0
+#define MR_TEX_IMP_NORMAL                  1
+#define MR_TEX_IMP_IDS                     2
+#define MR_TEX_IMP_HIDDEN_DEPTH            3
+#define MR_TEX_IMP_HIDDEN_IDS              4
+#define MR_TEX_IMP_CURVATURE               5
+#define MR_TEX_IMP_SAL                     6
+#define MR_IMG_IMP_MASK                    0
+#define MR_IMG_IMP_KEY                     1
+#define MR_SSBO_IMP_STATS                  0
+
+/* ghost_lab */
+#define MR_LOC_LAB_INVERSE                 0
+#define MR_TEX_LAB_SRC                     0
+#define MR_IMG_LAB_DST                     0
+
+/* ghost_label */
+#define MR_LOC_LABEL_INIT                  0
+#define MR_TEX_LABEL_MASK                  0
+#define MR_TEX_LABEL_KEY                   1
+#define MR_TEX_LABEL_SRC                   2
+#define MR_IMG_LABEL_DST                   0
+
+/* ghost_saliency */
+#define MR_LOC_SAL_IMPL                    0
+#define MR_LOC_SAL_GAIN                    1
+#define MR_LOC_SAL_MAX_LEVEL               2
+#define MR_LOC_SAL_PRINTED                 3
+#define MR_TEX_SAL_PYR                     0
+#define MR_TEX_SAL_SURROUND                1
+#define MR_IMG_SAL_DST                     0
+
+/* ghost_stats */
+#define MR_LOC_STATS_TC_MIN                0
+#define MR_LOC_STATS_GAMMA                 1
+#define MR_LOC_STATS_TC_SIL                2
+#define MR_TEX_STATS_MASK                  0
+#define MR_TEX_STATS_SAL                   1
+#define MR_TEX_STATS_O                     2
+#define MR_TEX_STATS_OA                    3
+#define MR_TEX_STATS_C                     4
+#define MR_SSBO_STATS_SUMS                 2
+
+/* overlay */
+#define MR_LOC_OVERLAY_OUT_K               0
+#define MR_LOC_OVERLAY_VIDEO_K             1
+#define MR_LOC_OVERLAY_VIDEO_SIZE          2
+#define MR_LOC_OVERLAY_DIST                3
+#define MR_LOC_OVERLAY_ALPHA               8
+#define MR_TEX_OVERLAY_VIRTUAL             0
+#define MR_TEX_OVERLAY_VIDEO               1
+
+/* shade */
+#define MR_LOC_SHADE_LIGHT_COUNT           0
+#define MR_LOC_SHADE_LIGHT_DIR             1
+#define MR_SHADE_MAX_LIGHTS                8
+#define MR_LOC_SHADE_LIGHT_COLOR           (MR_LOC_SHADE_LIGHT_DIR + MR_SHADE_MAX_LIGHTS)
+#define MR_LOC_SHADE_AMBIENT               (MR_LOC_SHADE_LIGHT_COLOR + MR_SHADE_MAX_LIGHTS)
+#define MR_LOC_SHADE_BACKGROUND            18
+#define MR_LOC_SHADE_HAVE_AO               19
+#define MR_LOC_SHADE_SPECULAR              20
+#define MR_LOC_SHADE_SHININESS             21
+#define MR_TEX_SHADE_ALBEDO                0
+#define MR_TEX_SHADE_NORMAL                1
+#define MR_TEX_SHADE_AO                    2
+
+/* ui */
+#define MR_LOC_UI_MODE                     1
+#define MR_TEX_UI_TEX                      0
+#define MR_LOC_UI_FB_SIZE                  0
+
+/* ao_main's method ids: mr_ao_method's values, and the standalone corner
+ * mask (pass_ao.c checks they agree). */
+#define MR_AO_METHOD_ID_SCHEER             1
+#define MR_AO_METHOD_ID_CRYTEK             2
+#define MR_AO_METHOD_ID_FILION             3
+#define MR_AO_METHOD_ID_HBAO               4
+#define MR_AO_METHOD_ID_ALCHEMY            5
+#define MR_AO_METHOD_MASK_STANDALONE       100
+
+#endif
