@@ -44,10 +44,6 @@ int app_errorf(const char *cmd, const char *fmt, ...)
 /* Sets the log level from --verbose / --quiet. */
 void app_log_level(const app_opt *opts);
 
-/* AprilTag images for the demo (tag36h11, ids 0..count-1), gray8 with the
- * white border; *border gets its width in pixels. In tags.c. */
-bool app_tag_images(int count, mr_image **out, int *border, mr_error *err);
-void app_tag_images_free(mr_image *imgs, int count);
 
 /* A headless GPU, a renderer and (optionally) a scene set on it. */
 typedef struct app_gfx {
@@ -83,19 +79,7 @@ bool app_ao_parse(const char *cmd, const app_opt *opts, mr_ao_params *ao, bool *
 /* Writes what --aux asks for: depth.pfm, normal.pfm, ao.pfm into dir. */
 bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err);
 
-/* A camera frame from n ideal pinhole renders (averaged: motion blur),
- * rendered with a margin of `margin` px per side at `scale` times the
- * resolution: lens distortion of cam, [1 2 1] optical blur, exposure gain,
- * Gaussian sensor noise (sigma in 8-bit levels). In demo_track.c. */
-bool app_synth_frame(const mr_camera *cam, const mr_image *ideal, int n, int margin, int scale, double gain,
-                     double noise, mr_rng *rng, mr_image *out, mr_error *err);
 
-/* The demo hall built in memory (tag images included), its camera and its
- * standing viewpoints. In cmd_demo.c. */
-bool app_demo_hall(mr_demo_hall *hall, mr_error *err);
-mr_camera app_demo_camera(void);
-int app_demo_view_count(void);
-mr_view app_demo_view(int i);
 
 /* The ghosting option rows, to splice into a command's option table. */
 #define APP_GHOST_OPTS                                                                                           \

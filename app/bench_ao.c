@@ -197,7 +197,7 @@ int bench_ao(int argc, char **argv) {
         if (!mr_view_load(app_get(opts, "tune-view"), &vd[0].view, &err)) return app_error(cmd, &err);
         snprintf(vd[0].name, sizeof vd[0].name, "%s", app_get(opts, "tune-view"));
     } else {
-        vd[0].view = app_demo_view(2);
+        vd[0].view = mr_demo_view(2);
         snprintf(vd[0].name, sizeof vd[0].name, "demo-tune(north wall)");
     }
     if (app_get(opts, "views")) {
@@ -212,7 +212,7 @@ int bench_ao(int argc, char **argv) {
         static const int idx[3] = {0, 1, 4};
         static const char *const names[3] = {"demo-near(partition)", "demo-mid(down the hall)", "demo-far(overview)"};
         for (nv = 0; nv < 3; nv++) {
-            vd[nv + 1].view = app_demo_view(idx[nv]);
+            vd[nv + 1].view = mr_demo_view(idx[nv]);
             snprintf(vd[nv + 1].name, sizeof vd[nv + 1].name, "%s", names[nv]);
         }
     }
@@ -222,7 +222,7 @@ int bench_ao(int argc, char **argv) {
     if (app_get(opts, "scene")) {
         if (!(scene = mr_scene_load(app_get(opts, "scene"), NULL, &err))) return app_error(cmd, &err);
     } else {
-        if (!app_demo_hall(&hall, &err)) return app_error(cmd, &err);
+        if (!mr_demo_build_tagged(NULL, 0, &hall, &err)) return app_error(cmd, &err);
         scene = hall.planned;
     }
     if (!(radius > 0)) {
@@ -444,7 +444,7 @@ int bench_ao(int argc, char **argv) {
         mr_scene *ts = gi < 3 ? terrain_scene(grid_n[gi], &err) : scene;
         if (!ts) { ok = false; break; }
         mr_view tv;
-        tv.camera = app_demo_camera();
+        tv.camera = mr_demo_camera();
         tv.world_from_camera = mr_m4_look_at_cv(mr_v3(-15, 6, -15), mr_v3(5, 0, 5), mr_v3(0, 1, 0));
         if (gi == 3) tv = vd[1].view;
         ok = mr_renderer_set_scene(gfx.renderer, ts, &err);

@@ -119,11 +119,11 @@ int app_bench_ghost(int argc, char **argv) {
     long frames = 5, view_index = 0;
     if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &w, &h)) return 2;
     if (app_get(opts, "frames") && !app_int("frames", app_get(opts, "frames"), 1, 100000, &frames)) return 2;
-    if (app_get(opts, "view") && !app_int("view", app_get(opts, "view"), 0, app_demo_view_count() - 1, &view_index))
+    if (app_get(opts, "view") && !app_int("view", app_get(opts, "view"), 0, mr_demo_view_count() - 1, &view_index))
         return 2;
     const char *out_dir = app_get(opts, "out") ? app_get(opts, "out") : "bench-out";
     mr_error err = {0};
-    mr_view view = app_demo_view((int)view_index);
+    mr_view view = mr_demo_view((int)view_index);
 
     static const char *const scenes[2] = {"conflict", "noconflict"};
     static const char *const imps[2] = {"curvature", "saliency"};

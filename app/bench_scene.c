@@ -228,7 +228,7 @@ int bench_scene(int argc, char **argv) {
         double mb = fsize / 1e6;
         for (int v = 0; v < MR_SYNTH_VIEW_COUNT && ok; v++) {
             mr_view view;
-            view.camera = app_demo_camera();
+            view.camera = mr_demo_camera();
             memset(view.camera.dist, 0, sizeof view.camera.dist);
             view.world_from_camera = mr_synth_viewpoint(&sp, v);
             for (int c = 0; c < N_CONFIGS && ok; c++) {

@@ -67,7 +67,7 @@ static int bench_frame(int argc, char **argv) {
     const char *out_dir = app_get(opts, "out") ? app_get(opts, "out") : "bench-out";
 
     mr_error err = {0};
-    mr_view view = app_demo_view(0);
+    mr_view view = mr_demo_view(0);
     if (app_get(opts, "view") && !mr_view_load(app_get(opts, "view"), &view, &err)) return app_error(cmd, &err);
     mr_scene *scene = NULL;
     mr_demo_hall hall;
@@ -77,7 +77,7 @@ static int bench_frame(int argc, char **argv) {
         scene = mr_scene_load(app_get(opts, "scene"), NULL, &err);
         if (!scene) return app_error(cmd, &err);
     } else {
-        if (!app_demo_hall(&hall, &err)) return app_error(cmd, &err);
+        if (!mr_demo_build_tagged(NULL, 0, &hall, &err)) return app_error(cmd, &err);
         scene = hall.planned;
     }
     double load_ms = (mr_time_now() - t0) * 1e3;
