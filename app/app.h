@@ -27,8 +27,6 @@ bool app_flag(const app_opt *opts, const char *name);
 bool app_double(const char *opt, const char *s, double lo, double hi, double *out);
 bool app_int(const char *opt, const char *s, long lo, long hi, long *out);
 bool app_size(const char *opt, const char *s, int *w, int *h);
-/* Median of v[0..n) (sorts v in place); 0 for n <= 0. For benches. */
-double app_median(double *v, int n);
 /* Exit status of a command that found no GPU device, GL context or display
  * (MR_ERR_NODEVICE): EX_UNAVAILABLE of sysexits.h. Tests skip on this status
  * only, never on the text of a message. */

@@ -78,7 +78,7 @@ static bool run_ao(mr_renderer *r, const mr_view *v, const mr_ao_params *ao, int
         }
         mr_frame_result_free(&res);
     }
-    *ms = app_median(t, n);
+    *ms = n > 0 ? mr_median(t, n) : 0; /* untimed runs report 0 ms */
     return true;
 }
 
@@ -471,8 +471,8 @@ int bench_ao(int argc, char **argv) {
             mr_frame_result_free(&res);
         }
         if (ok) {
-            tri_ms[ntri] = app_median(aoms, n);
-            tri_gb[ntri] = app_median(gbms, n);
+            tri_ms[ntri] = mr_median(aoms, n);
+            tri_gb[ntri] = mr_median(gbms, n);
             fprintf(tcsv, "%s,%llu,%.4f,%.4f,%d,%d,%d\n", gi < 3 ? "terrain" : "scene", (unsigned long long)tri_count[ntri],
                     tri_ms[ntri], tri_gb[ntri], w, h, n);
             ntri++;

@@ -182,9 +182,9 @@ int app_bench_ghost(int argc, char **argv) {
                         mr_frame_result_free(&res);
                     }
                     if (!ok) break;
-                    for (int k = 0; k < 6; k++) r->pass_ms[k] = app_median(&samples[(size_t)k * frames], (int)frames);
-                    r->ghost_ms = app_median(&samples[(size_t)6 * frames], (int)frames);
-                    r->frame_ms = app_median(&samples[(size_t)7 * frames], (int)frames);
+                    for (int k = 0; k < 6; k++) r->pass_ms[k] = mr_median(&samples[(size_t)k * frames], (int)frames);
+                    r->ghost_ms = mr_median(&samples[(size_t)6 * frames], (int)frames);
+                    r->frame_ms = mr_median(&samples[(size_t)7 * frames], (int)frames);
                     /* The measure, in one untimed frame (it adds GPU work). */
                     fp.timing = false;
                     fp.ghost.stats = true;

@@ -30,16 +30,6 @@ static const bench_config k_configs[] = {
 
 static const char *const k_view_names[MR_SYNTH_VIEW_COUNT] = {"floor", "aisle", "overview"};
 
-static int cmp_d(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double med(double *v, int n) {
-    qsort(v, (size_t)n, sizeof *v, cmp_d);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 typedef struct row {
     double tri_scene;
     int view, config;
@@ -265,9 +255,9 @@ int bench_scene(int argc, char **argv) {
                 r->tri_scene = (double)li.triangles;
                 r->view = v;
                 r->config = c;
-                r->frame_ms = med(ft, (int)frames);
-                r->cull_ms = med(ct, (int)frames);
-                r->gpu_ms = med(gt, (int)frames);
+                r->frame_ms = mr_median(ft, (int)frames);
+                r->cull_ms = mr_median(ct, (int)frames);
+                r->gpu_ms = mr_median(gt, (int)frames);
                 double rss = mr_peak_rss_bytes() / 1048576.0;
                 printf("%10llu %8d %9.1f %6.2f %6.2f %7.2f %8.0f %-9s %-9s %9.1f %8.2f %8.1f %11llu %6u %7u %7u\n",
                        (unsigned long long)li.triangles, (int)s->node_count, mb, parse_s, li.load_s, upload_s, rss,

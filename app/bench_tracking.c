@@ -23,19 +23,6 @@ typedef struct result {
     int frames;
 } result;
 
-static int cmp_d(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double quantile(double *v, int n, double q) {
-    if (n <= 0) return NAN;
-    qsort(v, (size_t)n, sizeof *v, cmp_d);
-    double pos = q * (n - 1);
-    int i = (int)pos;
-    return i + 1 < n ? v[i] + (pos - i) * (v[i + 1] - v[i]) : v[i];
-}
-
 /* Which tags the ground-truth camera sees: all corners in the image (2 px
  * margin), the tag facing the camera; shortest projected edge in *edge. */
 static bool gt_visible(const mr_camera *cam, const mr_marker_map *map, const mr_marker *m, const mr_dmat4 *gt, double *edge) {
@@ -182,16 +169,16 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
     }
     if (ok) {
         res->frames = nf;
-        res->det_ms_med = quantile(dms, nf, 0.5);
-        res->ms_med = quantile(ms, nf, 0.5);
-        res->ms_p95 = quantile(ms, nf, 0.95);
-        res->t_err_mm = quantile(te, nposes, 0.5);
+        res->det_ms_med = mr_quantile(dms, nf, 0.5);
+        res->ms_med = mr_quantile(ms, nf, 0.5);
+        res->ms_p95 = mr_quantile(ms, nf, 0.95);
+        res->t_err_mm = mr_quantile(te, nposes, 0.5);
         int np = 0;
         for (int i = 0; i < nposes; i++)
             if (isfinite(tp[i])) tp[np++] = tp[i];
-        res->t_err_pct = quantile(tp, np, 0.5);
-        res->r_err_deg = quantile(re, nposes, 0.5);
-        res->rms_px = quantile(rm, nposes, 0.5);
+        res->t_err_pct = mr_quantile(tp, np, 0.5);
+        res->r_err_deg = mr_quantile(re, nposes, 0.5);
+        res->rms_px = mr_quantile(rm, nposes, 0.5);
         res->det_rate = vis ? (double)vis_hit / vis : NAN;
         res->det_rate56 = vis56 ? (double)vis56_hit / vis56 : NAN;
         res->det_rate_still = vis_st ? (double)vis_st_hit / vis_st : NAN;

@@ -136,14 +136,14 @@ static int bench_frame(int argc, char **argv) {
                mr_gpu_description(gfx.gpu), w, h, frames, (unsigned long long)tris, draws, load_ms);
         printf("  %-10s %10s %10s\n", "pass", "GPU ms", "CPU ms");
         for (int k = 0; k < npass; k++) {
-            mg[k] = app_median(&gpu[(size_t)k * frames], (int)frames);
-            mc[k] = app_median(&cpu[(size_t)k * frames], (int)frames);
+            mg[k] = mr_median(&gpu[(size_t)k * frames], (int)frames);
+            mc[k] = mr_median(&cpu[(size_t)k * frames], (int)frames);
             gsum += mg[k];
             printf("  %-10s %10.2f %10.2f\n", names[k], mg[k], mc[k]);
             len += snprintf(csv + len, sizeof csv - (size_t)len, "%s,%.4f,%.4f,%ld,%d,%d,%llu,%u\n", names[k], mg[k], mc[k],
                             frames, w, h, (unsigned long long)tris, draws);
         }
-        double mt = app_median(total, (int)frames);
+        double mt = mr_median(total, (int)frames);
         printf("  %-10s %10.2f %10.2f   (frame incl. readback, wall clock)\n", "total", gsum, mt);
         len += snprintf(csv + len, sizeof csv - (size_t)len, "frame_wall,%.4f,%.4f,%ld,%d,%d,%llu,%u\n", gsum, mt, frames,
                         w, h, (unsigned long long)tris, draws);

@@ -117,6 +117,40 @@ bool mr_eval_saliency_ratio(const mr_image *final, const mr_image *region, doubl
 
 /* ------------------------------------------------------------ reports */
 
+/* The q-quantile (q in [0,1], clamped) of the values of v[0..n) that are not
+ * NaN, linearly interpolated between order statistics: q = 0.5 is the median
+ * (the mean of the two middle values for an even count). Reorders v. NaN
+ * when no value is left. The one median of every bench (report.c). */
+double mr_quantile(double *v, int n, double q);
+double mr_median(double *v, int n);
+
+/* A CSV table built in memory and written atomically (report.c): optional
+ * "# " comment lines, one header line, then rows of cells. Cell writers
+ * append one cell each; mr_csv_end_row ends the row. Errors (out of memory,
+ * a row whose cell count differs from the header's) are kept and reported
+ * by mr_csv_save, which writes nothing then. All calls accept NULL. */
+typedef struct mr_csv mr_csv;
+mr_csv *mr_csv_create(mr_error *err);
+void mr_csv_destroy(mr_csv **csv);
+/* Each line of text as a "# " line (before the header, or between rows). */
+void mr_csv_comment(mr_csv *csv, const char *text);
+/* The header: column names separated by commas, written as given. */
+void mr_csv_header(mr_csv *csv, const char *columns);
+/* Text: quoted (RFC 4180, inner quotes doubled) when it holds a comma, a
+ * quote or a line break, starts with '#' or has outer spaces. */
+void mr_csv_text(mr_csv *csv, const char *s);
+/* Text, always quoted (free-form names such as file paths). */
+void mr_csv_quoted(mr_csv *csv, const char *s);
+/* A number in the printf format fmt (one double conversion, e.g. "%.4f";
+ * NULL: "%.17g"); NaN is written "nan", infinities "inf" and "-inf". */
+void mr_csv_num(mr_csv *csv, const char *fmt, double v);
+void mr_csv_int(mr_csv *csv, long long v);
+void mr_csv_end_row(mr_csv *csv);
+/* The text so far (never NULL) and its length. */
+const char *mr_csv_data(const mr_csv *csv, size_t *len);
+bool mr_csv_save(const mr_csv *csv, const char *path, mr_error *err);
+
+
 typedef struct mr_plot_series {
     const char *name;
     const double *x, *y;

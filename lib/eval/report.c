@@ -1,0 +1,283 @@
+/* The renderer: targets, scene hand-over and the frame's pass list.
+ *
+ * A frame is a list of passes, each with a predicate saying whether this
+ * frame needs it; only the needed ones run and are reported (a frame without
+ * video runs no overlay pass, and so on). New passes go into k_passes. */
+#include "render_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+GLuint mr_gl_make_tex(GLenum fmt, int w, int h, GLenum filter) {
+    GLuint t;
+    glCreateTextures(GL_TEXTURE_2D, 1, &t);
+    glTextureStorage2D(t, 1, fmt, w, h);
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, filter);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, filter);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+
+void mr_gl_target_free(target *t) {
+    glDeleteFramebuffers(1, &t->fbo);
+    glDeleteTextures((GLsizei)(sizeof t->color / sizeof t->color[0]), t->color);
+    glDeleteTextures(1, &t->depth);
+    memset(t, 0, sizeof *t);
+}
+
+
+bool mr_gl_target_make(target *t, int w, int h, const GLenum *fmts, int n, bool depth, mr_error *err) {
+    glCreateFramebuffers(1, &t->fbo);
+    GLenum bufs[4];
+    for (int i = 0; i < n; i++) {
+        t->color[i] = mr_gl_make_tex(fmts[i], w, h, GL_NEAREST);
+        glNamedFramebufferTexture(t->fbo, GL_COLOR_ATTACHMENT0 + i, t->color[i], 0);
+        bufs[i] = GL_COLOR_ATTACHMENT0 + i;
+    }
+    glNamedFramebufferDrawBuffers(t->fbo, n, bufs);
+    if (depth) {
+        t->depth = mr_gl_make_tex(GL_DEPTH_COMPONENT32F, w, h, GL_NEAREST);
+        glNamedFramebufferTexture(t->fbo, GL_DEPTH_ATTACHMENT, t->depth, 0);
+    }
+    GLenum st = glCheckNamedFramebufferStatus(t->fbo, GL_FRAMEBUFFER);
+    if (st != GL_FRAMEBUFFER_COMPLETE) return mr_fail(err, MR_ERR_GL, "framebuffer incomplete (0x%x)", st);
+    return true;
+}
+
+
+static bool ensure_targets(mr_renderer *r, int w, int h, mr_error *err) {
+    if (r->w == w && r->h == h) return true;
+    mr_gl_target_free(&r->gbuf);
+    mr_gl_target_free(&r->shaded);
+    mr_gl_target_free(&r->composed);
+    r->w = r->h = 0;
+    /* albedo, view normal, ids, view-space position (written only when a
+     * frame's AO reads positions: see mr_pass_gbuffer) */
+    static const GLenum gfmt[4] = {GL_SRGB8_ALPHA8, GL_RGBA16F, GL_RG32UI, GL_RGBA32F};
+    static const GLenum cfmt[1] = {GL_SRGB8_ALPHA8};
+    if (!mr_gl_target_make(&r->gbuf, w, h, gfmt, 4, true, err) || !mr_gl_target_make(&r->shaded, w, h, cfmt, 1, false, err) ||
+        !mr_gl_target_make(&r->composed, w, h, cfmt, 1, false, err))
+        return false;
+    r->w = w;
+    r->h = h;
+    return true;
+}
+
+
+mr_renderer *mr_renderer_create(mr_gpu *gpu, mr_error *err) {
+    if (!gpu) {
+        mr_fail(err, MR_ERR_INVALID, "renderer needs a GPU context");
+        return NULL;
+    }
+    mr_renderer *r = calloc(1, sizeof *r);
+    if (!r) {
+        mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    r->gpu = gpu;
+    static const char *const gb[] = {"gbuffer.vert.glsl", "gbuffer.frag.glsl", NULL};
+    static const char *const sh[] = {"fullscreen.vert.glsl", "shade.frag.glsl", NULL};
+    static const char *const ov[] = {"fullscreen.vert.glsl", "overlay.frag.glsl", NULL};
+    if (!(r->prog_gbuffer = mr_gl_program(gb, err)) || !(r->prog_shade = mr_gl_program(sh, err)) ||
+        !(r->prog_overlay = mr_gl_program(ov, err))) {
+        mr_renderer_destroy(&r);
+        return NULL;
+    }
+    glCreateVertexArrays(1, &r->empty_vao);
+    glGenQueries(MR_MAX_PASSES, r->queries);
+    /* Reversed-Z: depth = near / z, so 1 is the near plane and 0 infinity. */
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    return r;
+}
+
+
+void mr_renderer_destroy(mr_renderer **rp) {
+    if (!rp || !*rp) return;
+    mr_renderer *r = *rp;
+    /* A deleted program that is still current lives on until another one
+     * is made current: let go of it, so destroy really frees. */
+    glUseProgram(0);
+    glBindVertexArray(0);
+    mr_pass_ao_free(r);
+    mr_ghost_free(r);
+    mr_geometry_free(r);
+    mr_gl_target_free(&r->gbuf);
+    mr_gl_target_free(&r->shaded);
+    mr_gl_target_free(&r->composed);
+    glDeleteTextures(1, &r->video_tex);
+    glDeleteProgram(r->prog_gbuffer);
+    glDeleteProgram(r->prog_shade);
+    glDeleteProgram(r->prog_overlay);
+    glDeleteVertexArrays(1, &r->empty_vao);
+    glDeleteQueries(MR_MAX_PASSES, r->queries);
+    free(r);
+    *rp = NULL;
+}
+
+
+bool mr_renderer_set_scene(mr_renderer *r, const mr_scene *s, mr_error *err) {
+    mr_ghost_scene_changed(r);
+    mr_geometry_free(r);
+    mr_pass_ao_scene_changed(r);
+    if (!s) return true;
+    return mr_geometry_upload(r, s, err);
+}
+
+/* Near plane: half the distance to the scene's bounding box, but never below
+ * 1e-6 of the scene's size (so it scales with the scene's units). Reversed
+ * float depth keeps precision at any distance, so only clipping matters. */
+static double choose_near(const mr_scene *s, mr_dvec3 eye) {
+    double d2 = 0, diag2 = 0;
+    for (int i = 0; i < 3; i++) {
+        const double *e = &eye.x;
+        double lo = s->bounds_min[i], hi = s->bounds_max[i];
+        double v = e[i] < lo ? lo - e[i] : e[i] > hi ? e[i] - hi : 0;
+        d2 += v * v;
+        diag2 += (hi - lo) * (hi - lo);
+    }
+    double diag = sqrt(diag2);
+    if (!(diag > 0) || !isfinite(diag)) diag = 1;
+    double n = 0.5 * sqrt(d2);
+    return n > 1e-6 * diag ? n : 1e-6 * diag;
+}
+
+
+/* OpenCV intrinsics to a GL projection. Rows of the image are stored top
+ * first, so image row v lands in framebuffer row v. Infinite far plane,
+ * reversed Z: z_clip = near, w_clip = z, depth = near / z. */
+void mr_gl_projection(const mr_camera *c, double near_plane, float out[16]) {
+    mr_dmat4 p;
+    memset(&p, 0, sizeof p);
+    p.m[0] = 2 * c->fx / c->width;
+    p.m[2] = 2 * (c->cx + 0.5) / c->width - 1;
+    p.m[5] = 2 * c->fy / c->height;
+    p.m[6] = 2 * (c->cy + 0.5) / c->height - 1;
+    p.m[11] = near_plane;
+    p.m[14] = 1;
+    mr_m4_to_gl(&p, out);
+}
+
+
+static const pass_desc k_passes[] = {
+    {"gbuffer", mr_pass_need_always, mr_pass_gbuffer},
+    {"ao_mask", mr_pass_need_ao_mask, mr_pass_ao_mask},
+    {"ao", mr_pass_need_ao, mr_pass_ao},
+    {"ao_blur", mr_pass_need_ao_blur, mr_pass_ao_blur},
+    {"ao_upsample", mr_pass_need_ao_upsample, mr_pass_ao_upsample},
+    {"ghost_hidden", mr_pass_need_ghost, mr_pass_ghost_hidden},
+    {"shade", mr_pass_need_always, mr_pass_shade},
+    {"overlay", mr_pass_need_overlay, mr_pass_overlay},
+    /* Ghosting after the overlay: with video, the occluder O is what the
+     * user sees in front of the hidden structure (the real wall). */
+    {"ghost_curvature", mr_pass_need_ghost_curvature, mr_pass_ghost_curvature},
+    {"ghost_importance", mr_pass_need_ghost, mr_pass_ghost_importance},
+    {"ghost_g0", mr_pass_need_ghost, mr_pass_ghost_g0},
+    {"ghost_analysis", mr_pass_need_ghost_adaptive, mr_pass_ghost_analysis},
+    {"ghost_emphasis", mr_pass_need_ghost_adaptive, mr_pass_ghost_emphasis},
+};
+
+static bool read_back(frame *f, mr_error *err) {
+    mr_renderer *r = f->r;
+    mr_frame_result *o = f->out;
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    if (!mr_image_alloc(&o->color, r->w, r->h, 3, MR_PIX_U8, err)) return false;
+    /* Read the raw bytes of the sRGB texture: they are the encoded values. */
+    glGetTextureImage(f->final_tex, 0, GL_RGB, GL_UNSIGNED_BYTE, (GLsizei)mr_image_bytes(&o->color), o->color.data);
+    if (f->p->want_depth) {
+        if (!mr_image_alloc(&o->depth, r->w, r->h, 1, MR_PIX_F32, err)) return false;
+        float *d = o->depth.data;
+        glGetTextureImage(r->gbuf.depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, (GLsizei)mr_image_bytes(&o->depth), d);
+        size_t n = (size_t)r->w * r->h;
+        for (size_t i = 0; i < n; i++) d[i] = d[i] > 0 ? (float)(f->near_plane / d[i]) : 0.0f;
+    }
+    if (f->p->want_normals) {
+        if (!mr_image_alloc(&o->normal, r->w, r->h, 3, MR_PIX_F32, err)) return false;
+        glGetTextureImage(r->gbuf.color[1], 0, GL_RGB, GL_FLOAT, (GLsizei)mr_image_bytes(&o->normal), o->normal.data);
+    }
+    return mr_pass_ao_read_back(f, err);
+}
+
+
+bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params *params, mr_frame_result *out,
+                     mr_error *err) {
+    memset(out, 0, sizeof *out);
+    r->last.valid = false; /* targets may be reallocated below */
+    mr_frame_params defaults = MR_FRAME_DEFAULTS;
+    const mr_frame_params *p = params ? params : &defaults;
+    if (!mr_camera_validate(&view->camera, err)) return false;
+    if (!mr_m4_is_rigid(&view->world_from_camera, 1e-5))
+        return mr_fail(err, MR_ERR_INVALID, "world_from_camera is not a rigid transform");
+    if (p->video && (!p->video->data || p->video->type != MR_PIX_U8 || p->video->channels < 1 ||
+                     p->video->channels > 4))
+        return mr_fail(err, MR_ERR_INVALID, "video frame must be an 8-bit image with 1-4 channels");
+    if (!(p->alpha >= 0 && p->alpha <= 1)) return mr_fail(err, MR_ERR_INVALID, "alpha must be in [0,1]");
+    int w = p->width > 0 ? p->width : view->camera.width;
+    int h = p->height > 0 ? p->height : view->camera.height;
+    if (w > 16384 || h > 16384) return mr_fail(err, MR_ERR_INVALID, "output size %dx%d too large", w, h);
+    if (!ensure_targets(r, w, h, err)) return false;
+    if (!mr_ghost_prepare(r, &p->ghost, w, h, err)) return false;
+
+    frame f;
+    memset(&f, 0, sizeof f);
+    mr_geometry_begin_frame(r);
+    f.r = r;
+    f.view = view;
+    f.p = p;
+    f.out = out;
+    f.cam = mr_camera_resized(&view->camera, w, h);
+    f.cam_from_world = mr_m4_invert_rigid(&view->world_from_camera);
+    mr_dvec3 eye = mr_v3(view->world_from_camera.m[3], view->world_from_camera.m[7], view->world_from_camera.m[11]);
+    f.near_plane = r->scene ? choose_near(r->scene, eye) : 1e-3;
+    out->near_plane = f.near_plane;
+
+    for (size_t i = 0; i < sizeof k_passes / sizeof k_passes[0]; i++) {
+        if (!k_passes[i].needed(&f)) continue;
+        int k = out->pass_count;
+        double t0 = mr_time_now();
+        if (p->timing) glBeginQuery(GL_TIME_ELAPSED, r->queries[k]);
+        k_passes[i].run(&f);
+        if (p->timing) glEndQuery(GL_TIME_ELAPSED);
+        out->cpu_ms[k] = (mr_time_now() - t0) * 1e3;
+        out->passes[k] = k_passes[i].name;
+        out->pass_count++;
+    }
+    if (p->timing)
+        for (int k = 0; k < out->pass_count; k++) {
+            GLuint64 ns = 0;
+            glGetQueryObjectui64v(r->queries[k], GL_QUERY_RESULT, &ns);
+            out->gpu_ms[k] = (double)ns * 1e-6;
+        }
+    bool ok = read_back(&f, err);
+    r->last.valid = ok;
+    r->last.tex = f.final_tex;
+    r->last.cam = f.cam;
+    r->last.world_from_camera = view->world_from_camera;
+    r->last.near_plane = f.near_plane;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    GLenum e = glGetError();
+    if (ok && e != GL_NO_ERROR) ok = mr_fail(err, MR_ERR_GL, "GL error 0x%x during the frame", e);
+    if (!ok) mr_frame_result_free(out);
+    return ok;
+}
+
+
+void mr_frame_result_free(mr_frame_result *res) {
+    if (!res) return;
+    mr_image_free(&res->color);
+    mr_image_free(&res->depth);
+    mr_image_free(&res->normal);
+    mr_image_free(&res->ao);
+    mr_image_free(&res->ao_mask);
+}
+
+
+void mr_frame_result_passes(const mr_frame_result *res, char *buf, size_t n) {
+    size_t len = 0;
+    buf[0] = 0;
+    for (int i = 0; i < res->pass_count && len < n; i++)
+        len += (size_t)snprintf(buf + len, n - len, "%s%s", i ? " " : "", res->passes[i]);
+}
+

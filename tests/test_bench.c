@@ -1,0 +1,164 @@
+/* The benches' shared reporting: the one median / quantile, the one CSV
+ * writer (quoting, non-finite numbers, comment lines, ragged rows, atomic
+ * write) and the one SVG plot writer. */
+#include "mr_eval.h"
+#include "mr_test.h"
+
+#include <string.h>
+#include <dirent.h>
+
+static void test_median(void) {
+    double odd[] = {5, 1, 4, 2, 3};
+    CHECK_MSG(mr_median(odd, 5) == 3, "median of 5,1,4,2,3 is %g, not 3", mr_median((double[]){5, 1, 4, 2, 3}, 5));
+    double even[] = {10, 1, 4, 2};
+    double m = mr_median(even, 4);
+    CHECK_MSG(m == 3, "median of an even count is the mean of the two middle values (2, 4): got %g", m);
+    double two[] = {7, -1};
+    CHECK_MSG(mr_median(two, 2) == 3, "median of 7,-1 must be 3, got %g", mr_median((double[]){7, -1}, 2));
+    double one[] = {42};
+    CHECK_MSG(mr_median(one, 1) == 42, "median of one value is that value");
+    /* NaN is not a value: skipped, wherever it lies in the array. */
+    double withnan[] = {NAN, 9, 1, NAN, 5};
+    m = mr_median(withnan, 5);
+    CHECK_MSG(m == 5, "median of NaN,9,1,NaN,5 skips the NaNs: want 5, got %g", m);
+    double withnan2[] = {2, NAN, 8, 4, NAN, 6};
+    m = mr_median(withnan2, 6);
+    CHECK_MSG(m == 5, "median of 2,NaN,8,4,NaN,6 (4 values) is 5, got %g", m);
+    double allnan[] = {NAN, NAN};
+    CHECK_MSG(isnan(mr_median(allnan, 2)), "median of no numbers is NaN, got %g", mr_median((double[]){NAN, NAN}, 2));
+    CHECK_MSG(isnan(mr_median(NULL, 0)), "median of an empty array is NaN");
+    /* Quantiles interpolate between order statistics. */
+    double q[] = {40, 10, 30, 20, 50};
+    CHECK_MSG(mr_quantile(q, 5, 0.0) == 10, "q=0 is the minimum 10, got %g", mr_quantile(q, 5, 0.0));
+    CHECK_MSG(mr_quantile(q, 5, 1.0) == 50, "q=1 is the maximum 50, got %g", mr_quantile(q, 5, 1.0));
+    double q95 = mr_quantile(q, 5, 0.95);
+    CHECK_MSG(fabs(q95 - 48) < 1e-12, "q=0.95 of 10..50 interpolates to 48, got %.17g", q95);
+    double q25 = mr_quantile(q, 5, 0.25);
+    CHECK_MSG(q25 == 20, "q=0.25 of 10..50 is 20, got %g", q25);
+    double q30 = mr_quantile(q, 5, 0.3);
+    CHECK_MSG(fabs(q30 - 22) < 1e-12, "q=0.3 of 10..50 is 22, got %.17g", q30);
+    CHECK_MSG(mr_quantile(q, 5, 2.0) == 50 && mr_quantile(q, 5, -1) == 10, "q outside [0,1] is clamped");
+}
+
+static char *slurp(const char *path, size_t *n) {
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    static char buf[65536];
+    *n = fread(buf, 1, sizeof buf - 1, f);
+    buf[*n] = 0;
+    fclose(f);
+    return buf;
+}
+
+static void test_csv(const char *tmp) {
+    mr_error err = {0};
+    mr_csv *c = mr_csv_create(&err);
+    CHECK_MSG(c != NULL, "mr_csv_create: %s", err.msg);
+    mr_csv_comment(c, "units: ms\nsecond line");
+    mr_csv_header(c, "name,value,count,path");
+    mr_csv_text(c, "plain");
+    mr_csv_num(c, "%.3f", 1.23456);
+    mr_csv_int(c, -7);
+    mr_csv_quoted(c, "a/b");
+    mr_csv_end_row(c);
+    mr_csv_text(c, "has,comma");
+    mr_csv_num(c, "%.4f", NAN);
+    mr_csv_int(c, 0);
+    mr_csv_text(c, "say \"hi\"");
+    mr_csv_end_row(c);
+    mr_csv_text(c, "line\nbreak");
+    mr_csv_num(c, "%.4f", -NAN);
+    mr_csv_num(c, "%g", INFINITY);
+    mr_csv_num(c, "%g", -INFINITY);
+    mr_csv_end_row(c);
+    mr_csv_text(c, "#not a comment");
+    mr_csv_text(c, " padded ");
+    mr_csv_text(c, "");
+    mr_csv_num(c, NULL, 0.1);
+    mr_csv_end_row(c);
+    const char *want = "# units: ms\n# second line\n"
+                       "name,value,count,path\n"
+                       "plain,1.235,-7,\"a/b\"\n"
+                       "\"has,comma\",nan,0,\"say \"\"hi\"\"\"\n"
+                       "\"line\nbreak\",nan,inf,-inf\n"
+                       "\"#not a comment\",\" padded \",,0.10000000000000001\n";
+    size_t n = 0;
+    const char *got = mr_csv_data(c, &n);
+    CHECK_MSG(strcmp(got, want) == 0 && n == strlen(want), "CSV text differs:\n--- got\n%s--- want\n%s", got, want);
+    char path[4096], tmpdir_file[4096];
+    mr_path_join(tmp, "test_bench.csv", path, sizeof path);
+    CHECK_MSG(mr_csv_save(c, path, &err), "mr_csv_save: %s", err.msg);
+    size_t fn = 0;
+    const char *file = slurp(path, &fn);
+    CHECK_MSG(file && fn == strlen(want) && memcmp(file, want, fn) == 0, "the saved file differs from the table");
+    mr_csv_destroy(&c);
+    CHECK_MSG(c == NULL, "mr_csv_destroy NULLs the handle");
+    mr_csv_destroy(&c); /* accepts NULL */
+
+    /* A ragged row: the save fails, names the row, and the file on disk
+     * keeps its old content (nothing half-written). */
+    c = mr_csv_create(&err);
+    mr_csv_header(c, "a,b,c");
+    mr_csv_int(c, 1);
+    mr_csv_int(c, 2);
+    mr_csv_int(c, 3);
+    mr_csv_end_row(c);
+    mr_csv_int(c, 4);
+    mr_csv_int(c, 5);
+    mr_csv_end_row(c);
+    memset(&err, 0, sizeof err);
+    bool ok = mr_csv_save(c, path, &err);
+    CHECK_MSG(!ok && err.code == MR_ERR_INVALID && strstr(err.msg, "row 2 has 2 cells, the header 3"),
+              "a row of 2 cells under a 3-column header must fail naming row 2: ok %d, '%s'", ok, err.msg);
+    file = slurp(path, &fn);
+    CHECK_MSG(file && fn == strlen(want) && memcmp(file, want, fn) == 0, "a failed save must leave the old file as it was");
+    mr_csv_destroy(&c);
+    /* Too many cells fail too; so does an unended last row. */
+    c = mr_csv_create(&err);
+    mr_csv_header(c, "a");
+    mr_csv_int(c, 1);
+    mr_csv_int(c, 2);
+    mr_csv_end_row(c);
+    memset(&err, 0, sizeof err);
+    CHECK_MSG(!mr_csv_save(c, path, &err) && strstr(err.msg, "row 1 has 2 cells, the header 1"),
+              "a row of 2 cells under a 1-column header must fail: '%s'", err.msg);
+    mr_csv_destroy(&c);
+    c = mr_csv_create(&err);
+    mr_csv_header(c, "a");
+    mr_csv_int(c, 1);
+    memset(&err, 0, sizeof err);
+    CHECK_MSG(!mr_csv_save(c, path, &err), "a row that was never ended must not be saved");
+    mr_csv_destroy(&c);
+    /* Atomic: a save into a missing folder fails and leaves no file or
+     * temporary behind. */
+    mr_path_join(tmp, "no_such_dir/x.csv", tmpdir_file, sizeof tmpdir_file);
+    c = mr_csv_create(&err);
+    mr_csv_header(c, "a");
+    memset(&err, 0, sizeof err);
+    CHECK_MSG(!mr_csv_save(c, tmpdir_file, &err) && err.code == MR_ERR_IO, "saving into a missing folder must fail with an I/O error");
+    mr_csv_destroy(&c);
+    DIR *d = opendir(tmp);
+    int leftovers = 0, files = 0;
+    for (struct dirent *e; d && (e = readdir(d));) {
+        if (e->d_name[0] == '.') continue;
+        files++;
+        leftovers += strstr(e->d_name, ".tmp") != NULL;
+    }
+    if (d) closedir(d);
+    CHECK_MSG(files == 1 && leftovers == 0, "the folder must hold only test_bench.csv: %d files, %d temporaries", files,
+              leftovers);
+}
+
+int main(void) {
+    const char *tmp = getenv("MR_TEST_TMP");
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s/test_bench", tmp ? tmp : "/tmp");
+    mr_error err = {0};
+    if (!mr_mkdirs(dir, &err)) {
+        fprintf(stderr, "test_bench: cannot make %s: %s\n", dir, err.msg);
+        return 1;
+    }
+    test_median();
+    test_csv(dir);
+    return mr_test_finish("test_bench");
+}
