@@ -1,283 +1,182 @@
-/* The renderer: targets, scene hand-over and the frame's pass list.
- *
- * A frame is a list of passes, each with a predicate saying whether this
- * frame needs it; only the needed ones run and are reported (a frame without
- * video runs no overlay pass, and so on). New passes go into k_passes. */
-#include "render_internal.h"
+/* The one median / quantile and the one CSV writer of every bench. */
+#include "mr_eval.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-GLuint mr_gl_make_tex(GLenum fmt, int w, int h, GLenum filter) {
-    GLuint t;
-    glCreateTextures(GL_TEXTURE_2D, 1, &t);
-    glTextureStorage2D(t, 1, fmt, w, h);
-    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, filter);
-    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, filter);
-    glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    return t;
+/* ------------------------------------------------------------ quantiles */
+
+static int cmp_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
 }
 
-
-void mr_gl_target_free(target *t) {
-    glDeleteFramebuffers(1, &t->fbo);
-    glDeleteTextures((GLsizei)(sizeof t->color / sizeof t->color[0]), t->color);
-    glDeleteTextures(1, &t->depth);
-    memset(t, 0, sizeof *t);
+double mr_quantile(double *v, int n, double q) {
+    /* NaN breaks qsort's ordering: move the numbers to the front first. */
+    int m = 0;
+    for (int i = 0; i < n; i++)
+        if (!isnan(v[i])) {
+            double t = v[m];
+            v[m++] = v[i];
+            v[i] = t;
+        }
+    if (m <= 0) return NAN;
+    qsort(v, (size_t)m, sizeof *v, cmp_double);
+    q = q < 0 ? 0 : q > 1 ? 1 : q;
+    double pos = q * (m - 1);
+    int i = (int)pos;
+    return i + 1 < m ? v[i] + (pos - i) * (v[i + 1] - v[i]) : v[i];
 }
 
+double mr_median(double *v, int n) { return mr_quantile(v, n, 0.5); }
 
-bool mr_gl_target_make(target *t, int w, int h, const GLenum *fmts, int n, bool depth, mr_error *err) {
-    glCreateFramebuffers(1, &t->fbo);
-    GLenum bufs[4];
-    for (int i = 0; i < n; i++) {
-        t->color[i] = mr_gl_make_tex(fmts[i], w, h, GL_NEAREST);
-        glNamedFramebufferTexture(t->fbo, GL_COLOR_ATTACHMENT0 + i, t->color[i], 0);
-        bufs[i] = GL_COLOR_ATTACHMENT0 + i;
-    }
-    glNamedFramebufferDrawBuffers(t->fbo, n, bufs);
-    if (depth) {
-        t->depth = mr_gl_make_tex(GL_DEPTH_COMPONENT32F, w, h, GL_NEAREST);
-        glNamedFramebufferTexture(t->fbo, GL_DEPTH_ATTACHMENT, t->depth, 0);
-    }
-    GLenum st = glCheckNamedFramebufferStatus(t->fbo, GL_FRAMEBUFFER);
-    if (st != GL_FRAMEBUFFER_COMPLETE) return mr_fail(err, MR_ERR_GL, "framebuffer incomplete (0x%x)", st);
-    return true;
-}
+/* ------------------------------------------------------------------ CSV */
 
-
-static bool ensure_targets(mr_renderer *r, int w, int h, mr_error *err) {
-    if (r->w == w && r->h == h) return true;
-    mr_gl_target_free(&r->gbuf);
-    mr_gl_target_free(&r->shaded);
-    mr_gl_target_free(&r->composed);
-    r->w = r->h = 0;
-    /* albedo, view normal, ids, view-space position (written only when a
-     * frame's AO reads positions: see mr_pass_gbuffer) */
-    static const GLenum gfmt[4] = {GL_SRGB8_ALPHA8, GL_RGBA16F, GL_RG32UI, GL_RGBA32F};
-    static const GLenum cfmt[1] = {GL_SRGB8_ALPHA8};
-    if (!mr_gl_target_make(&r->gbuf, w, h, gfmt, 4, true, err) || !mr_gl_target_make(&r->shaded, w, h, cfmt, 1, false, err) ||
-        !mr_gl_target_make(&r->composed, w, h, cfmt, 1, false, err))
-        return false;
-    r->w = w;
-    r->h = h;
-    return true;
-}
-
-
-mr_renderer *mr_renderer_create(mr_gpu *gpu, mr_error *err) {
-    if (!gpu) {
-        mr_fail(err, MR_ERR_INVALID, "renderer needs a GPU context");
-        return NULL;
-    }
-    mr_renderer *r = calloc(1, sizeof *r);
-    if (!r) {
-        mr_fail(err, MR_ERR_NOMEM, "out of memory");
-        return NULL;
-    }
-    r->gpu = gpu;
-    static const char *const gb[] = {"gbuffer.vert.glsl", "gbuffer.frag.glsl", NULL};
-    static const char *const sh[] = {"fullscreen.vert.glsl", "shade.frag.glsl", NULL};
-    static const char *const ov[] = {"fullscreen.vert.glsl", "overlay.frag.glsl", NULL};
-    if (!(r->prog_gbuffer = mr_gl_program(gb, err)) || !(r->prog_shade = mr_gl_program(sh, err)) ||
-        !(r->prog_overlay = mr_gl_program(ov, err))) {
-        mr_renderer_destroy(&r);
-        return NULL;
-    }
-    glCreateVertexArrays(1, &r->empty_vao);
-    glGenQueries(MR_MAX_PASSES, r->queries);
-    /* Reversed-Z: depth = near / z, so 1 is the near plane and 0 infinity. */
-    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    return r;
-}
-
-
-void mr_renderer_destroy(mr_renderer **rp) {
-    if (!rp || !*rp) return;
-    mr_renderer *r = *rp;
-    /* A deleted program that is still current lives on until another one
-     * is made current: let go of it, so destroy really frees. */
-    glUseProgram(0);
-    glBindVertexArray(0);
-    mr_pass_ao_free(r);
-    mr_ghost_free(r);
-    mr_geometry_free(r);
-    mr_gl_target_free(&r->gbuf);
-    mr_gl_target_free(&r->shaded);
-    mr_gl_target_free(&r->composed);
-    glDeleteTextures(1, &r->video_tex);
-    glDeleteProgram(r->prog_gbuffer);
-    glDeleteProgram(r->prog_shade);
-    glDeleteProgram(r->prog_overlay);
-    glDeleteVertexArrays(1, &r->empty_vao);
-    glDeleteQueries(MR_MAX_PASSES, r->queries);
-    free(r);
-    *rp = NULL;
-}
-
-
-bool mr_renderer_set_scene(mr_renderer *r, const mr_scene *s, mr_error *err) {
-    mr_ghost_scene_changed(r);
-    mr_geometry_free(r);
-    mr_pass_ao_scene_changed(r);
-    if (!s) return true;
-    return mr_geometry_upload(r, s, err);
-}
-
-/* Near plane: half the distance to the scene's bounding box, but never below
- * 1e-6 of the scene's size (so it scales with the scene's units). Reversed
- * float depth keeps precision at any distance, so only clipping matters. */
-static double choose_near(const mr_scene *s, mr_dvec3 eye) {
-    double d2 = 0, diag2 = 0;
-    for (int i = 0; i < 3; i++) {
-        const double *e = &eye.x;
-        double lo = s->bounds_min[i], hi = s->bounds_max[i];
-        double v = e[i] < lo ? lo - e[i] : e[i] > hi ? e[i] - hi : 0;
-        d2 += v * v;
-        diag2 += (hi - lo) * (hi - lo);
-    }
-    double diag = sqrt(diag2);
-    if (!(diag > 0) || !isfinite(diag)) diag = 1;
-    double n = 0.5 * sqrt(d2);
-    return n > 1e-6 * diag ? n : 1e-6 * diag;
-}
-
-
-/* OpenCV intrinsics to a GL projection. Rows of the image are stored top
- * first, so image row v lands in framebuffer row v. Infinite far plane,
- * reversed Z: z_clip = near, w_clip = z, depth = near / z. */
-void mr_gl_projection(const mr_camera *c, double near_plane, float out[16]) {
-    mr_dmat4 p;
-    memset(&p, 0, sizeof p);
-    p.m[0] = 2 * c->fx / c->width;
-    p.m[2] = 2 * (c->cx + 0.5) / c->width - 1;
-    p.m[5] = 2 * c->fy / c->height;
-    p.m[6] = 2 * (c->cy + 0.5) / c->height - 1;
-    p.m[11] = near_plane;
-    p.m[14] = 1;
-    mr_m4_to_gl(&p, out);
-}
-
-
-static const pass_desc k_passes[] = {
-    {"gbuffer", mr_pass_need_always, mr_pass_gbuffer},
-    {"ao_mask", mr_pass_need_ao_mask, mr_pass_ao_mask},
-    {"ao", mr_pass_need_ao, mr_pass_ao},
-    {"ao_blur", mr_pass_need_ao_blur, mr_pass_ao_blur},
-    {"ao_upsample", mr_pass_need_ao_upsample, mr_pass_ao_upsample},
-    {"ghost_hidden", mr_pass_need_ghost, mr_pass_ghost_hidden},
-    {"shade", mr_pass_need_always, mr_pass_shade},
-    {"overlay", mr_pass_need_overlay, mr_pass_overlay},
-    /* Ghosting after the overlay: with video, the occluder O is what the
-     * user sees in front of the hidden structure (the real wall). */
-    {"ghost_curvature", mr_pass_need_ghost_curvature, mr_pass_ghost_curvature},
-    {"ghost_importance", mr_pass_need_ghost, mr_pass_ghost_importance},
-    {"ghost_g0", mr_pass_need_ghost, mr_pass_ghost_g0},
-    {"ghost_analysis", mr_pass_need_ghost_adaptive, mr_pass_ghost_analysis},
-    {"ghost_emphasis", mr_pass_need_ghost_adaptive, mr_pass_ghost_emphasis},
+struct mr_csv {
+    char *buf;
+    size_t len, cap;
+    int columns;   /* cells in the header line; 0 before it */
+    int cells;     /* cells in the row being written */
+    int rows;      /* data rows ended */
+    mr_error fail; /* the first error (out of memory, a ragged row) */
 };
 
-static bool read_back(frame *f, mr_error *err) {
-    mr_renderer *r = f->r;
-    mr_frame_result *o = f->out;
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    if (!mr_image_alloc(&o->color, r->w, r->h, 3, MR_PIX_U8, err)) return false;
-    /* Read the raw bytes of the sRGB texture: they are the encoded values. */
-    glGetTextureImage(f->final_tex, 0, GL_RGB, GL_UNSIGNED_BYTE, (GLsizei)mr_image_bytes(&o->color), o->color.data);
-    if (f->p->want_depth) {
-        if (!mr_image_alloc(&o->depth, r->w, r->h, 1, MR_PIX_F32, err)) return false;
-        float *d = o->depth.data;
-        glGetTextureImage(r->gbuf.depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, (GLsizei)mr_image_bytes(&o->depth), d);
-        size_t n = (size_t)r->w * r->h;
-        for (size_t i = 0; i < n; i++) d[i] = d[i] > 0 ? (float)(f->near_plane / d[i]) : 0.0f;
-    }
-    if (f->p->want_normals) {
-        if (!mr_image_alloc(&o->normal, r->w, r->h, 3, MR_PIX_F32, err)) return false;
-        glGetTextureImage(r->gbuf.color[1], 0, GL_RGB, GL_FLOAT, (GLsizei)mr_image_bytes(&o->normal), o->normal.data);
-    }
-    return mr_pass_ao_read_back(f, err);
+mr_csv *mr_csv_create(mr_error *err) {
+    mr_csv *c = calloc(1, sizeof *c);
+    if (!c) mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    return c;
 }
 
+void mr_csv_destroy(mr_csv **csv) {
+    if (!csv || !*csv) return;
+    free((*csv)->buf);
+    free(*csv);
+    *csv = NULL;
+}
 
-bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params *params, mr_frame_result *out,
-                     mr_error *err) {
-    memset(out, 0, sizeof *out);
-    r->last.valid = false; /* targets may be reallocated below */
-    mr_frame_params defaults = MR_FRAME_DEFAULTS;
-    const mr_frame_params *p = params ? params : &defaults;
-    if (!mr_camera_validate(&view->camera, err)) return false;
-    if (!mr_m4_is_rigid(&view->world_from_camera, 1e-5))
-        return mr_fail(err, MR_ERR_INVALID, "world_from_camera is not a rigid transform");
-    if (p->video && (!p->video->data || p->video->type != MR_PIX_U8 || p->video->channels < 1 ||
-                     p->video->channels > 4))
-        return mr_fail(err, MR_ERR_INVALID, "video frame must be an 8-bit image with 1-4 channels");
-    if (!(p->alpha >= 0 && p->alpha <= 1)) return mr_fail(err, MR_ERR_INVALID, "alpha must be in [0,1]");
-    int w = p->width > 0 ? p->width : view->camera.width;
-    int h = p->height > 0 ? p->height : view->camera.height;
-    if (w > 16384 || h > 16384) return mr_fail(err, MR_ERR_INVALID, "output size %dx%d too large", w, h);
-    if (!ensure_targets(r, w, h, err)) return false;
-    if (!mr_ghost_prepare(r, &p->ghost, w, h, err)) return false;
-
-    frame f;
-    memset(&f, 0, sizeof f);
-    mr_geometry_begin_frame(r);
-    f.r = r;
-    f.view = view;
-    f.p = p;
-    f.out = out;
-    f.cam = mr_camera_resized(&view->camera, w, h);
-    f.cam_from_world = mr_m4_invert_rigid(&view->world_from_camera);
-    mr_dvec3 eye = mr_v3(view->world_from_camera.m[3], view->world_from_camera.m[7], view->world_from_camera.m[11]);
-    f.near_plane = r->scene ? choose_near(r->scene, eye) : 1e-3;
-    out->near_plane = f.near_plane;
-
-    for (size_t i = 0; i < sizeof k_passes / sizeof k_passes[0]; i++) {
-        if (!k_passes[i].needed(&f)) continue;
-        int k = out->pass_count;
-        double t0 = mr_time_now();
-        if (p->timing) glBeginQuery(GL_TIME_ELAPSED, r->queries[k]);
-        k_passes[i].run(&f);
-        if (p->timing) glEndQuery(GL_TIME_ELAPSED);
-        out->cpu_ms[k] = (mr_time_now() - t0) * 1e3;
-        out->passes[k] = k_passes[i].name;
-        out->pass_count++;
-    }
-    if (p->timing)
-        for (int k = 0; k < out->pass_count; k++) {
-            GLuint64 ns = 0;
-            glGetQueryObjectui64v(r->queries[k], GL_QUERY_RESULT, &ns);
-            out->gpu_ms[k] = (double)ns * 1e-6;
+static void put(mr_csv *c, const char *s, size_t n) {
+    if (c->fail.code) return;
+    if (c->len + n + 1 > c->cap) {
+        size_t cap = c->cap ? c->cap : 4096;
+        while (c->len + n + 1 > cap) cap *= 2;
+        char *b = realloc(c->buf, cap);
+        if (!b) {
+            mr_fail(&c->fail, MR_ERR_NOMEM, "CSV: out of memory");
+            return;
         }
-    bool ok = read_back(&f, err);
-    r->last.valid = ok;
-    r->last.tex = f.final_tex;
-    r->last.cam = f.cam;
-    r->last.world_from_camera = view->world_from_camera;
-    r->last.near_plane = f.near_plane;
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    GLenum e = glGetError();
-    if (ok && e != GL_NO_ERROR) ok = mr_fail(err, MR_ERR_GL, "GL error 0x%x during the frame", e);
-    if (!ok) mr_frame_result_free(out);
-    return ok;
+        c->buf = b;
+        c->cap = cap;
+    }
+    memcpy(c->buf + c->len, s, n);
+    c->len += n;
+    c->buf[c->len] = 0;
 }
 
+static void put_str(mr_csv *c, const char *s) { put(c, s, strlen(s)); }
 
-void mr_frame_result_free(mr_frame_result *res) {
-    if (!res) return;
-    mr_image_free(&res->color);
-    mr_image_free(&res->depth);
-    mr_image_free(&res->normal);
-    mr_image_free(&res->ao);
-    mr_image_free(&res->ao_mask);
+void mr_csv_comment(mr_csv *c, const char *text) {
+    if (!c) return;
+    /* Every line of the text becomes its own "# " line, so a newline in
+     * the text cannot start a data line. */
+    const char *s = text ? text : "";
+    do {
+        const char *nl = strchr(s, '\n');
+        size_t n = nl ? (size_t)(nl - s) : strlen(s);
+        put_str(c, "# ");
+        put(c, s, n);
+        put_str(c, "\n");
+        s = nl ? nl + 1 : NULL;
+    } while (s && *s);
 }
 
-
-void mr_frame_result_passes(const mr_frame_result *res, char *buf, size_t n) {
-    size_t len = 0;
-    buf[0] = 0;
-    for (int i = 0; i < res->pass_count && len < n; i++)
-        len += (size_t)snprintf(buf + len, n - len, "%s%s", i ? " " : "", res->passes[i]);
+void mr_csv_header(mr_csv *c, const char *columns) {
+    if (!c) return;
+    if (c->columns) {
+        if (!c->fail.code) mr_fail(&c->fail, MR_ERR_INVALID, "CSV: a second header line");
+        return;
+    }
+    int n = 1;
+    for (const char *s = columns; *s; s++) n += *s == ',';
+    c->columns = n;
+    put_str(c, columns);
+    put_str(c, "\n");
 }
 
+static void sep(mr_csv *c) {
+    if (c->cells++ > 0) put_str(c, ",");
+}
+
+static void quoted(mr_csv *c, const char *s) {
+    put_str(c, "\"");
+    for (const char *p = s; *p; p++) {
+        put(c, p, 1);
+        if (*p == '"') put(c, p, 1); /* a quote inside is doubled */
+    }
+    put_str(c, "\"");
+}
+
+void mr_csv_text(mr_csv *c, const char *s) {
+    if (!c) return;
+    sep(c);
+    s = s ? s : "";
+    size_t n = strlen(s);
+    /* RFC 4180: quote a field holding a separator, a quote or a line
+     * break; also one with outer spaces (readers trim them) or a leading
+     * '#' (in the first column it would read as a comment line). */
+    bool q = strpbrk(s, ",\"\r\n") != NULL || (n > 0 && (s[0] == ' ' || s[n - 1] == ' ' || s[0] == '#'));
+    if (q) quoted(c, s);
+    else put(c, s, n);
+}
+
+void mr_csv_quoted(mr_csv *c, const char *s) {
+    if (!c) return;
+    sep(c);
+    quoted(c, s ? s : "");
+}
+
+void mr_csv_num(mr_csv *c, const char *fmt, double v) {
+    if (!c) return;
+    sep(c);
+    /* One spelling for the non-finite values, whatever the format and the
+     * sign bit of a NaN: nan, inf, -inf. */
+    if (isnan(v)) put_str(c, "nan");
+    else if (isinf(v)) put_str(c, v > 0 ? "inf" : "-inf");
+    else {
+        char b[512];
+        int n = snprintf(b, sizeof b, fmt ? fmt : "%.17g", v);
+        if (n < 0 || (size_t)n >= sizeof b) {
+            if (!c->fail.code) mr_fail(&c->fail, MR_ERR_INVALID, "CSV: number cell too long");
+        } else put(c, b, (size_t)n);
+    }
+}
+
+void mr_csv_int(mr_csv *c, long long v) {
+    if (!c) return;
+    sep(c);
+    char b[32];
+    int n = snprintf(b, sizeof b, "%lld", v);
+    put(c, b, (size_t)n);
+}
+
+void mr_csv_end_row(mr_csv *c) {
+    if (!c) return;
+    if (c->columns && c->cells != c->columns && !c->fail.code)
+        mr_fail(&c->fail, MR_ERR_INVALID, "CSV: row %d has %d cells, the header %d", c->rows + 1, c->cells, c->columns);
+    put_str(c, "\n");
+    c->cells = 0;
+    c->rows++;
+}
+
+const char *mr_csv_data(const mr_csv *c, size_t *len) {
+    if (len) *len = c && c->buf ? c->len : 0;
+    return c && c->buf ? c->buf : "";
+}
+
+bool mr_csv_save(const mr_csv *c, const char *path, mr_error *err) {
+    if (!c) return mr_fail(err, MR_ERR_INVALID, "CSV: no table");
+    if (c->fail.code) return mr_fail(err, c->fail.code, "%s: %s", path, c->fail.msg);
+    if (c->cells) return mr_fail(err, MR_ERR_INVALID, "%s: CSV: the last row was not ended", path);
+    return mr_file_write_atomic(path, c->buf ? c->buf : "", c->len, err);
+}

@@ -1,0 +1,57 @@
+/* mr_bench.h — the `mrcheck bench` runners as library code: each takes a
+ * params struct (zero or the MR_BENCH_*_DEFAULTS designated initialisers
+ * mean the documented defaults), writes its CSV, SVG and summary files into
+ * out_dir, prints its table to `out` (NULL: nothing printed) and returns
+ * false with err set when it cannot run. Measurements only: nothing here
+ * passes or fails. The CSVs go through the one CSV writer, the medians
+ * through the one median (mr_csv_*, mr_median in mr_eval.h). */
+#ifndef MR_BENCH_H
+#define MR_BENCH_H
+
+#include <stdio.h>
+
+#include "mr_core.h"
+#include "mr_eval.h"
+#include "mr_render.h"
+#include "mr_scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------- frame */
+
+/* Per-pass GPU and CPU ms of the whole frame. */
+typedef struct mr_bench_frame_params {
+    const char *out_dir;    /* default "bench-out" */
+    const char *scene;      /* glTF/GLB or scene config; NULL: the demo hall as planned */
+    const mr_view *view;    /* NULL: the demo's first viewpoint */
+    int width, height;      /* px, default 1024x768 */
+    int frames;             /* timed frames after 3 warm-up frames, default 30 */
+    const mr_image *video;  /* camera frame to overlay; NULL: a synthetic one (seeded noise) */
+    bool no_video;          /* no overlay pass; default false */
+    FILE *out;              /* the table; NULL: silent */
+} mr_bench_frame_params;
+#define MR_BENCH_FRAME_DEFAULTS .out_dir = "bench-out", .width = 1024, .height = 768, .frames = 30
+bool mr_bench_frame(const mr_bench_frame_params *params, mr_error *err);
+
+/* ---------------------------------------------------------------- ghost */
+
+/* Ghosted views on the demo partition: per importance source, saliency
+ * implementation, eq. 9's levels and mode, the GPU ms of the ghosting passes
+ * against legibility measures (bench_ghost.csv, bench_ghost.svg). */
+typedef struct mr_bench_ghost_params {
+    const char *out_dir;    /* default "bench-out" */
+    int width, height;      /* px, default 640x480 (the demo camera) */
+    int frames;             /* timed frames per configuration after 2 warm-up frames, default 5 */
+    int view;               /* demo viewpoint 0..MR_DEMO_VIEWS-1, default 0 (the partition) */
+    bool progress;          /* "n/N configurations" on stderr; default false */
+    FILE *out;              /* the table; NULL: silent */
+} mr_bench_ghost_params;
+#define MR_BENCH_GHOST_DEFAULTS .out_dir = "bench-out", .width = 640, .height = 480, .frames = 5
+bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
