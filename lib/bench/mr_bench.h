@@ -51,6 +51,23 @@ typedef struct mr_bench_ghost_params {
 #define MR_BENCH_GHOST_DEFAULTS .out_dir = "bench-out", .width = 640, .height = 480, .frames = 5
 bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err);
 
+/* ------------------------------------------------------------- tracking */
+
+/* Error against run time of the tag detector settings (and OpenCV's aruco
+ * detector as the peer) on a recording with ground truth
+ * (bench_tracking.csv, bench_tracking.svg). */
+typedef struct mr_bench_tracking_params {
+    const char *out_dir;    /* default "bench-out" */
+    const char *recording;  /* recording folder with groundtruth.jsonl, default "recordings/demo" */
+    long max_frames;        /* use at most this many frames with ground truth; 0: all */
+    bool quick;             /* a few settings only; default false */
+    double min_cutoff;      /* One Euro cutoff at rest in Hz (also for rotation); 0: the filter's default 0.5 */
+    double beta;            /* One Euro speed coefficient; 0: the filter's default 2 */
+    FILE *out;              /* the table; NULL: silent */
+} mr_bench_tracking_params;
+#define MR_BENCH_TRACKING_DEFAULTS .out_dir = "bench-out", .recording = "recordings/demo"
+bool mr_bench_tracking(const mr_bench_tracking_params *params, mr_error *err);
+
 #ifdef __cplusplus
 }
 #endif
