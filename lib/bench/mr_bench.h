@@ -51,6 +51,24 @@ typedef struct mr_bench_ghost_params {
 #define MR_BENCH_GHOST_DEFAULTS .out_dir = "bench-out", .width = 640, .height = 480, .frames = 5
 bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err);
 
+/* ---------------------------------------------------------------- scene */
+
+/* Cost against scene size: synthetic factories written as .glb into out_dir
+ * and loaded back; load / upload / LOD times, peak memory, and per viewpoint
+ * and draw configuration the frame time and its parts (bench_scene.csv,
+ * bench_scene.svg). */
+#define MR_BENCH_SCENE_MAX_SIZES 8
+typedef struct mr_bench_scene_params {
+    const char *out_dir;    /* default "bench-out" */
+    double sizes[MR_BENCH_SCENE_MAX_SIZES]; /* drawn-triangle targets */
+    int size_count;         /* 0: 1M, 5M, 20M */
+    int width, height;      /* px, default 1024x768 */
+    int frames;             /* timed frames per case after one warm-up, default 3 */
+    FILE *out;              /* the table; NULL: silent */
+} mr_bench_scene_params;
+#define MR_BENCH_SCENE_DEFAULTS .out_dir = "bench-out", .width = 1024, .height = 768, .frames = 3
+bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err);
+
 /* ------------------------------------------------------------- tracking */
 
 /* Error against run time of the tag detector settings (and OpenCV's aruco
