@@ -19,6 +19,36 @@
 extern "C" {
 #endif
 
+/* ------------------------------------------------------------------- ao */
+
+/* Ambient occlusion, error against run time: every method over a grid of
+ * sample counts, full and half resolution, corner masking off and on, on
+ * the reported views, against two ray-traced references; parameters tuned
+ * on a view that is not reported (bench_ao.csv, bench_ao_tuning.csv,
+ * bench_ao_triangles.csv, bench_ao.svg, bench_ao_screen.svg,
+ * bench_ao_montage.png, bench_ao_shaded.png, bench_ao.md). */
+#define MR_BENCH_AO_MAX_VIEWS 16
+typedef struct mr_bench_ao_params {
+    const char *out_dir;         /* default "bench-out" */
+    const char *scene;           /* glTF/GLB or scene config; NULL: the demo hall as planned */
+    const mr_view *views;        /* view_count reported views; 0: the demo's near, mid-hall and far views */
+    const char *const *view_names; /* their names in the tables (e.g. the file names) */
+    int view_count;              /* at most MR_BENCH_AO_MAX_VIEWS */
+    const mr_view *tune_view;    /* NULL: a demo view that is not reported (the north wall) */
+    const char *tune_name;
+    int width, height;           /* px, default 320x240 */
+    int frames;                  /* timed frames per configuration (median), 1..64, default 5 */
+    int rays;                    /* ground-truth rays per pixel, default 256 */
+    double radius;               /* the fixed reference's R in scene units; 0: 2% of the scene diagonal */
+    double screen_radius;        /* the depth-scaled reference: fraction of the image height, default 0.05 */
+    bool quick;                  /* samples 8 and 32, full resolution only, 2-point tuning */
+    bool verbose;                /* print the tuned parameters */
+    bool progress;               /* "view i/n done" on stderr */
+    FILE *out;                   /* the tables; NULL: silent */
+} mr_bench_ao_params;
+#define MR_BENCH_AO_DEFAULTS .out_dir = "bench-out", .width = 320, .height = 240, .frames = 5, .rays = 256, .screen_radius = 0.05
+bool mr_bench_ao(const mr_bench_ao_params *params, mr_error *err);
+
 /* ---------------------------------------------------------------- frame */
 
 /* Per-pass GPU and CPU ms of the whole frame. */
