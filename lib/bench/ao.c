@@ -532,6 +532,7 @@ static bool ao_plots(ao_bench *b, mr_error *err) {
     bool ok = true;
     for (int ref = 0; ok && ref < 2; ref++) {
         mr_plot_series ser[2 * MAXC];
+        memset(ser, 0, sizeof ser); /* fields not set here take their defaults */
         static double xs[2 * MAXC][MAXS], ys[2 * MAXC][MAXS];
         static char names[2 * MAXC][64];
         int nser = 0;

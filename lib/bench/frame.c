@@ -7,37 +7,8 @@
 /* A horizontal bar chart of median GPU and CPU ms per pass. */
 static bool write_svg(const char *path, const char *title, int n, const char *const *names, const double *gpu,
                       const double *cpu, mr_error *err) {
-    double maxv = 1e-9;
-    for (int i = 0; i < n; i++) {
-        if (gpu[i] > maxv) maxv = gpu[i];
-        if (cpu[i] > maxv) maxv = cpu[i];
-    }
-    int W = 720, row = 44, top = 50, H = top + row * n + 40;
-    size_t cap = 8192 + (size_t)n * 1024;
-    char *s = malloc(cap);
-    if (!s) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    int len = snprintf(s, cap,
-                       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" font-family=\"sans-serif\" "
-                       "font-size=\"13\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n"
-                       "<text x=\"10\" y=\"22\" font-size=\"15\">%s</text>\n"
-                       "<rect x=\"470\" y=\"32\" width=\"12\" height=\"10\" fill=\"#3b6fb6\"/><text x=\"486\" y=\"42\">GPU ms (median)</text>\n"
-                       "<rect x=\"600\" y=\"32\" width=\"12\" height=\"10\" fill=\"#e08a2c\"/><text x=\"616\" y=\"42\">CPU ms</text>\n",
-                       W, H, title);
-    for (int i = 0; i < n; i++) {
-        int y = top + i * row;
-        double wg = 480.0 * gpu[i] / maxv, wc = 480.0 * cpu[i] / maxv;
-        len += snprintf(s + len, cap - (size_t)len,
-                        "<text x=\"10\" y=\"%d\">%s</text>\n"
-                        "<rect x=\"130\" y=\"%d\" width=\"%.1f\" height=\"14\" fill=\"#3b6fb6\"/>"
-                        "<text x=\"%.1f\" y=\"%d\">%.2f</text>\n"
-                        "<rect x=\"130\" y=\"%d\" width=\"%.1f\" height=\"14\" fill=\"#e08a2c\"/>"
-                        "<text x=\"%.1f\" y=\"%d\">%.2f</text>\n",
-                        y + 18, names[i], y, wg, 136 + wg, y + 12, gpu[i], y + 16, wc, 136 + wc, y + 28, cpu[i]);
-    }
-    len += snprintf(s + len, cap - (size_t)len, "</svg>\n");
-    bool ok = mr_file_write_atomic(path, s, (size_t)len, err);
-    free(s);
-    return ok;
+    const mr_plot_bar_set sets[2] = {{"GPU ms (median)", gpu, "#3b6fb6"}, {"CPU ms", cpu, "#e08a2c"}};
+    return mr_plot_bars(path, title, names, n, sets, 2, err);
 }
 
 static void csv_row(mr_csv *csv, const char *pass, double gpu_ms, double cpu_ms, long frames, int w, int h,

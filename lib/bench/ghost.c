@@ -39,62 +39,43 @@ typedef struct ghost_row {
 static const char *const k_pass_names[6] = {"ghost_hidden", "ghost_curvature", "ghost_importance",
                                             "ghost_g0",     "ghost_analysis",  "ghost_emphasis"};
 
-/* Legibility (y) against ghosting GPU ms (x), one marker per row: colour by
- * mode, filled for the conflict case, hollow for no conflict. */
+/* Legibility (y) against ghosting GPU ms (x), one marker per row of eq. 9's
+ * offset levels: colour by mode, filled for the conflict case, hollow for
+ * no conflict, circles for the mip-map pyramid, squares for two Gaussians. */
 static bool write_svg(const char *path, const char *title, const ghost_row *rows, int n, mr_error *err) {
     static const char *const colours[3] = {"#888888", "#3b6fb6", "#d0452c"};
-    double xmax = 1e-9;
-    for (int i = 0; i < n; i++) xmax = rows[i].ghost_ms > xmax ? rows[i].ghost_ms : xmax;
-    xmax *= 1.1;
-    const int W = 760, H = 460, L = 70, T = 50, PW = 520, PH = 340;
-    size_t cap = 16384 + (size_t)n * 512;
-    char *s = malloc(cap);
-    if (!s) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    int len = snprintf(s, cap,
-                       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" font-family=\"sans-serif\" "
-                       "font-size=\"12\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n"
-                       "<text x=\"10\" y=\"22\" font-size=\"14\">%s</text>\n"
-                       "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"black\"/>\n"
-                       "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">GPU ms of the ghosting passes (median)</text>\n"
-                       "<text x=\"18\" y=\"%d\" transform=\"rotate(-90 18 %d)\" text-anchor=\"middle\">legibility (edge transfer of D)</text>\n",
-                       W, H, title, L, T, PW, PH, L + PW / 2, T + PH + 36, T + PH / 2, T + PH / 2);
-    for (int k = 0; k <= 4; k++) {
-        double v = k / 4.0;
-        int y = T + PH - (int)(v * PH);
-        len += snprintf(s + len, cap - (size_t)len,
-                        "<text x=\"%d\" y=\"%d\" text-anchor=\"end\">%.2f</text>"
-                        "<line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"#ddd\"/>\n"
-                        "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">%.1f</text>\n",
-                        L - 6, y + 4, v, L, y, L + PW, y, L + (int)(k * PW / 4.0), T + PH + 16, xmax * k / 4.0);
-    }
-    for (int i = 0; i < n; i++) {
-        const ghost_row *r = &rows[i];
-        if (isnan(r->leg.legibility) || strcmp(r->levels, "offset") != 0) continue; /* nothing to plot; one level set */
-        double x = L + PW * r->ghost_ms / xmax, y = T + PH - PH * r->leg.legibility;
-        bool conflict = strcmp(r->scene, "conflict") == 0;
-        const char *c = colours[r->mode_index];
-        if (strcmp(r->saliency, "gauss") == 0)
-            len += snprintf(s + len, cap - (size_t)len,
-                            "<rect x=\"%.1f\" y=\"%.1f\" width=\"9\" height=\"9\" fill=\"%s\" stroke=\"%s\" stroke-width=\"2\"/>\n",
-                            x - 4.5, y - 4.5, conflict ? c : "white", c);
-        else
-            len += snprintf(s + len, cap - (size_t)len,
-                            "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"5\" fill=\"%s\" stroke=\"%s\" stroke-width=\"2\"/>\n", x, y,
-                            conflict ? c : "white", c);
-    }
     static const char *const mode_names[3] = {"alpha", "g0", "adaptive"};
-    for (int m = 0; m < 3; m++)
-        len += snprintf(s + len, cap - (size_t)len,
-                        "<circle cx=\"%d\" cy=\"%d\" r=\"5\" fill=\"%s\"/><text x=\"%d\" y=\"%d\">%s</text>\n", L + PW + 24,
-                        T + 14 + m * 20, colours[m], L + PW + 36, T + 18 + m * 20, mode_names[m]);
-    len += snprintf(s + len, cap - (size_t)len,
-                    "<text x=\"%d\" y=\"%d\">filled: conflict</text><text x=\"%d\" y=\"%d\">hollow: no conflict</text>\n"
-                    "<text x=\"%d\" y=\"%d\">circle: mip-map pyramid</text><text x=\"%d\" y=\"%d\">square: two Gaussians</text>\n"
-                    "</svg>\n",
-                    L + PW + 18, T + 90, L + PW + 18, T + 108, L + PW + 18, T + 132, L + PW + 18, T + 150);
-    bool ok = mr_file_write_atomic(path, s, (size_t)len, err);
-    free(s);
-    return ok;
+    enum { NS = 3 * 2 * 2 };
+    mr_plot_series ser[NS];
+    double xs[NS][2 * 2 * 2 * 2 * 3], ys[NS][2 * 2 * 2 * 2 * 3];
+    double xmax = 1e-9;
+    memset(ser, 0, sizeof ser);
+    for (int k = 0; k < NS; k++) {
+        int mode = k / 4;
+        bool conflict = (k / 2) % 2 == 0, gauss = k % 2 == 1;
+        ser[k].name = conflict && !gauss ? mode_names[mode] : NULL; /* one legend entry per mode */
+        ser[k].x = xs[k];
+        ser[k].y = ys[k];
+        ser[k].color = colours[mode];
+        ser[k].no_line = true;
+        ser[k].hollow = !conflict;
+        ser[k].mark = gauss ? MR_PLOT_MARK_SQUARE : MR_PLOT_MARK_CIRCLE;
+        for (int i = 0; i < n; i++) {
+            const ghost_row *r = &rows[i];
+            if (strcmp(r->levels, "offset") != 0 || r->mode_index != mode || (strcmp(r->scene, "conflict") == 0) != conflict ||
+                (strcmp(r->saliency, "gauss") == 0) != gauss)
+                continue;
+            xs[k][ser[k].count] = r->ghost_ms;
+            ys[k][ser[k].count++] = r->leg.legibility; /* NaN: not drawn */
+            if (isfinite(r->ghost_ms)) xmax = fmax(xmax, r->ghost_ms);
+        }
+    }
+    static const char *const notes[4] = {"filled: conflict", "hollow: no conflict", "circle: mip-map pyramid",
+                                         "square: two Gaussians"};
+    mr_plot_params pp = {.title = title, .xlabel = "GPU ms of the ghosting passes (median)",
+                         .ylabel = "legibility (edge transfer of D)", .x_min = 0, .x_max = 1.1 * xmax, .y_min = 0,
+                         .y_max = 1, .notes = notes, .note_count = 4};
+    return mr_plot_write(path, &pp, ser, NS, err);
 }
 
 /* The demo hall, with (conflict) or without the hidden pipes coloured like

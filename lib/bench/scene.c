@@ -36,68 +36,39 @@ typedef struct row {
     double frame_ms, cull_ms, gpu_ms;
 } row;
 
-/* Frame time (floor view, and overview dashed) against drawn scene
+/* Frame time (floor view solid, overview dashed) against drawn scene
  * triangles, log-log, one colour per configuration. */
-static bool write_plot(const char *path, const row *rows, int n, const double *sizes, int nsizes, mr_error *err) {
+static bool write_plot(const char *path, const row *rows, int n, mr_error *err) {
     static const char *const colours[N_CONFIGS] = {"#1b7837", "#c51b7d", "#e08214", "#4575b4", "#555555", "#8c510a"};
-    double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
-    for (int i = 0; i < n; i++) {
-        if (rows[i].view == MR_SYNTH_VIEW_AISLE) continue;
-        xmin = fmin(xmin, rows[i].tri_scene);
-        xmax = fmax(xmax, rows[i].tri_scene);
-        ymin = fmin(ymin, rows[i].frame_ms);
-        ymax = fmax(ymax, rows[i].frame_ms);
+    enum { NS = N_CONFIGS * 2 };
+    mr_plot_series ser[NS];
+    double *xs = calloc((size_t)NS * (n + 1), sizeof *xs), *ys = calloc((size_t)NS * (n + 1), sizeof *ys);
+    if (!xs || !ys) {
+        free(xs);
+        free(ys);
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory");
     }
-    if (!(xmax > xmin)) { xmin /= 2; xmax *= 2; }
-    ymin = fmax(ymin * 0.8, 0.1);
-    ymax = fmax(ymax * 1.25, ymin * 2);
-    double lx0 = log10(xmin) - 0.05, lx1 = log10(xmax) + 0.05, ly0 = log10(ymin), ly1 = log10(ymax);
-    const int W = 760, H = 480, L = 70, R = 170, T = 40, B = 50;
-    size_t cap = 65536;
-    char *s = malloc(cap);
-    if (!s) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    int len = snprintf(s, cap,
-                       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" font-family=\"sans-serif\" font-size=\"12\">\n"
-                       "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n"
-                       "<text x=\"10\" y=\"22\" font-size=\"15\">mrcheck bench scene: frame time vs scene size "
-                       "(solid: floor view, dashed: overview; log-log)</text>\n"
-                       "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"#999\"/>\n",
-                       W, H, L, T, W - L - R, H - T - B);
-#define PX(v) (L + (log10(v) - lx0) / (lx1 - lx0) * (W - L - R))
-#define PY(v) (H - B - (log10(v) - ly0) / (ly1 - ly0) * (H - T - B))
-    for (int i = 0; i < nsizes; i++)
-        len += snprintf(s + len, cap - (size_t)len, "<text x=\"%.1f\" y=\"%d\" text-anchor=\"middle\">%.1fM</text>\n",
-                        PX(sizes[i]), H - B + 16, sizes[i] / 1e6);
-    for (double d = pow(10, floor(ly0)); d <= ymax; d *= 10)
-        for (int m = 1; m <= 5; m += 4) {
-            double y = d * m;
-            if (y < ymin || y > ymax) continue;
-            len += snprintf(s + len, cap - (size_t)len,
-                            "<line x1=\"%d\" x2=\"%d\" y1=\"%.1f\" y2=\"%.1f\" stroke=\"#eee\"/><text x=\"%d\" y=\"%.1f\" "
-                            "text-anchor=\"end\">%g ms</text>\n",
-                            L, W - R, PY(y), PY(y), L - 4, PY(y) + 4, y);
-        }
-    len += snprintf(s + len, cap - (size_t)len, "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">triangles in the scene (drawn count, instances included)</text>\n",
-                    (L + W - R) / 2, H - 14);
-    for (int c = 0; c < N_CONFIGS; c++)
-        for (int v = 0; v < MR_SYNTH_VIEW_COUNT; v += 2) {
-            len += snprintf(s + len, cap - (size_t)len, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s points=\"",
-                            colours[c], v ? " stroke-dasharray=\"6 4\"" : "");
-            for (int i = 0; i < n; i++)
-                if (rows[i].config == c && rows[i].view == v)
-                    len += snprintf(s + len, cap - (size_t)len, "%.1f,%.1f ", PX(rows[i].tri_scene), PY(rows[i].frame_ms));
-            len += snprintf(s + len, cap - (size_t)len, "\"/>\n");
-        }
-    for (int c = 0; c < N_CONFIGS; c++)
-        len += snprintf(s + len, cap - (size_t)len,
-                        "<line x1=\"%d\" x2=\"%d\" y1=\"%d\" y2=\"%d\" stroke=\"%s\" stroke-width=\"3\"/><text x=\"%d\" y=\"%d\">%s</text>\n",
-                        W - R + 12, W - R + 36, T + 14 + 20 * c, T + 14 + 20 * c, colours[c], W - R + 42, T + 18 + 20 * c,
-                        k_configs[c].name);
-#undef PX
-#undef PY
-    len += snprintf(s + len, cap - (size_t)len, "</svg>\n");
-    bool ok = mr_file_write_atomic(path, s, (size_t)len, err);
-    free(s);
+    memset(ser, 0, sizeof ser);
+    for (int k = 0; k < NS; k++) {
+        int c = k / 2, v = k % 2 ? MR_SYNTH_VIEW_OVERVIEW : MR_SYNTH_VIEW_FLOOR;
+        ser[k].name = v == MR_SYNTH_VIEW_FLOOR ? k_configs[c].name : NULL;
+        ser[k].x = xs + (size_t)k * (n + 1);
+        ser[k].y = ys + (size_t)k * (n + 1);
+        ser[k].color = colours[c];
+        ser[k].dashed = v != MR_SYNTH_VIEW_FLOOR;
+        for (int i = 0; i < n; i++)
+            if (rows[i].config == c && rows[i].view == v) {
+                xs[(size_t)k * (n + 1) + ser[k].count] = rows[i].tri_scene;
+                ys[(size_t)k * (n + 1) + ser[k].count++] = rows[i].frame_ms;
+            }
+    }
+    static const char *const notes[1] = {"solid: floor, dashed: overview"};
+    mr_plot_params pp = {.title = "mrcheck bench scene: frame time vs scene size (log-log)",
+                         .xlabel = "triangles in the scene (drawn count, instances included)", .ylabel = "frame ms",
+                         .log_x = true, .log_y = true, .notes = notes, .note_count = 1};
+    bool ok = mr_plot_write(path, &pp, ser, NS, err);
+    free(xs);
+    free(ys);
     return ok;
 }
 
@@ -288,12 +259,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
         mr_path_join(out_dir, "bench_scene.csv", path, sizeof path);
         bool ok = mr_csv_save(csv, path, err);
         mr_path_join(out_dir, "bench_scene.svg", path, sizeof path);
-        double xs[8];
-        for (int i = 0; i < nsizes; i++) xs[i] = 0;
-        /* x positions: the drawn counts actually reached */
-        for (int i = 0, k = 0; i < nrows && k < nsizes; i++)
-            if (i == 0 || rows[i].tri_scene != rows[i - 1].tri_scene) xs[k++] = rows[i].tri_scene;
-        ok = ok && write_plot(path, rows, nrows, xs, nsizes, err);
+        ok = ok && write_plot(path, rows, nrows, err);
         if (!ok) failed = true;
         else BENCH_PRINT(out, "wrote %s/bench_scene.csv and bench_scene.svg\n", out_dir);
     }

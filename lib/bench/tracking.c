@@ -236,12 +236,8 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
 }
 
 /* Error against run time: median ms per frame (x) against median
- * translation error (y), both log scale, one numbered point per setting;
- * the legend on the right names the numbers. */
-static double log_pos(double v, double lo, double hi, double len) {
-    return len * log10(fmax(v, lo) / lo) / log10(hi / lo);
-}
-
+ * translation error (y), both log scale over whole decades, one numbered
+ * point per setting; the legend on the right names the numbers. */
 static bool write_svg(const char *path, const char *title, const setting *s, const result *r, int n, mr_error *err) {
     double xmin = 1e9, xmax = 0, ymin = 1e9, ymax = 0;
     for (int i = 0; i < n; i++) {
@@ -256,48 +252,33 @@ static bool write_svg(const char *path, const char *title, const setting *s, con
     xmax = pow(10, ceil(log10(fmax(xmax, xmin * 10))));
     ymin = pow(10, floor(log10(ymin)));
     ymax = pow(10, ceil(log10(fmax(ymax, ymin * 10))));
-    const int W = 960, H = 600, L = 80, R = 300, T = 50, B = 60, PW = W - R - L, PH = H - B - T;
-    size_t cap = 16384 + (size_t)n * 640;
-    char *o = malloc(cap);
-    if (!o) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    int len = snprintf(o, cap,
-                       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" font-family=\"sans-serif\" font-size=\"12\">\n"
-                       "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n<text x=\"%d\" y=\"24\" font-size=\"15\">%s</text>\n"
-                       "<text x=\"%d\" y=\"%d\">median ms per frame (detection + pose, log scale)</text>\n"
-                       "<text x=\"16\" y=\"%d\" transform=\"rotate(-90 16 %d)\">median translation error, mm (log scale)</text>\n",
-                       W, H, L, title, L + 150, H - 20, H / 2 + 90, H / 2 + 90);
-    for (double x = xmin; x <= xmax * 1.001; x *= 10) {
-        double px = L + log_pos(x, xmin, xmax, PW);
-        len += snprintf(o + len, cap - (size_t)len,
-                        "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#ccc\"/><text x=\"%.1f\" y=\"%d\">%g</text>\n",
-                        px, T, px, H - B, px - 8, H - B + 16, x);
+    mr_plot_series *ser = calloc((size_t)n + 1, sizeof *ser);
+    char (*names)[160] = calloc((size_t)n + 1, sizeof *names), (*nums)[8] = calloc((size_t)n + 1, sizeof *nums);
+    if (!ser || !names || !nums) {
+        free(ser);
+        free(names);
+        free(nums);
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory");
     }
-    for (double y = ymin; y <= ymax * 1.001; y *= 10) {
-        double py = H - B - log_pos(y, ymin, ymax, PH);
-        len += snprintf(o + len, cap - (size_t)len,
-                        "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#ccc\"/><text x=\"%d\" y=\"%.1f\">%g</text>\n",
-                        L, py, W - R, py, L - 45, py + 4, y);
-    }
-    len += snprintf(o + len, cap - (size_t)len,
-                    "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"black\"/>\n", L, T, PW, PH);
     for (int i = 0; i < n; i++) {
-        const char *col = s[i].aruco ? "#e08a2c" : s[i].threads > 1 ? "#2c8a3b" : "#3b6fb6";
-        len += snprintf(o + len, cap - (size_t)len,
-                        "<text x=\"%d\" y=\"%d\" fill=\"%s\" font-size=\"11\">%2d %s: %.2f ms, %.1f mm, %.2f%%, flip %.0f%%</text>\n",
-                        W - R + 10, T + 13 * i + 10, col, i + 1, s[i].name, r[i].ms_med, r[i].t_err_mm, r[i].t_err_pct,
-                        100 * r[i].flip_rate);
-        if (!isfinite(r[i].ms_med) || !isfinite(r[i].t_err_mm) || r[i].ms_med <= 0 || r[i].t_err_mm <= 0) continue;
-        double px = L + log_pos(r[i].ms_med, xmin, xmax, PW), py = H - B - log_pos(r[i].t_err_mm, ymin, ymax, PH);
-        len += snprintf(o + len, cap - (size_t)len,
-                        "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/><text x=\"%.1f\" y=\"%.1f\" fill=\"%s\" font-size=\"10\">%d</text>\n",
-                        px, py, col, px + 5, py - 4, col, i + 1);
+        snprintf(names[i], sizeof names[i], "%2d %.47s: %.2f ms, %.1f mm, %.2f%%, flip %.0f%%", i + 1, s[i].name, r[i].ms_med,
+                 r[i].t_err_mm, r[i].t_err_pct, 100 * r[i].flip_rate);
+        snprintf(nums[i], sizeof nums[i], "%d", i + 1);
+        ser[i] = (mr_plot_series){.name = names[i], .x = &r[i].ms_med, .y = &r[i].t_err_mm, .count = 1,
+                                  .color = s[i].aruco ? "#e08a2c" : s[i].threads > 1 ? "#2c8a3b" : "#3b6fb6",
+                                  .no_line = true, .point_label = nums[i]};
     }
-    len += snprintf(o + len, cap - (size_t)len,
-                    "<text x=\"%d\" y=\"%d\" fill=\"#3b6fb6\">apriltag, 1 thread</text><text x=\"%d\" y=\"%d\" fill=\"#2c8a3b\">apriltag, 2 threads</text>"
-                    "<text x=\"%d\" y=\"%d\" fill=\"#e08a2c\">OpenCV aruco DICT_APRILTAG_36h11</text>\n</svg>\n",
-                    L + 10, T + 16, L + 160, T + 16, L + 310, T + 16);
-    bool ok = mr_file_write_atomic(path, o, (size_t)len, err);
-    free(o);
+    static const char *const notes[3] = {"blue: apriltag, 1 thread", "green: apriltag, 2 threads",
+                                         "orange: OpenCV aruco DICT_APRILTAG_36h11"};
+    mr_plot_params pp = {.title = title, .xlabel = "median ms per frame (detection + pose, log scale)",
+                         .ylabel = "median translation error, mm (log scale)", .log_x = true, .log_y = true,
+                         .x_min = xmin, .x_max = xmax, .y_min = ymin, .y_max = ymax, .width = 1000,
+                         .height = 120 + 18 * (n + 3), .legend_width = 330, .notes = notes, .note_count = 3};
+    if (pp.height < 600) pp.height = 600;
+    bool ok = mr_plot_write(path, &pp, ser, n, err);
+    free(ser);
+    free(names);
+    free(nums);
     return ok;
 }
 
