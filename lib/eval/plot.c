@@ -108,8 +108,11 @@ bool mr_plot_write(const char *path, const mr_plot_params *params, const mr_plot
     if (!(x1 >= x0)) { x0 = 0; x1 = 1; }
     if (!(y1 > y0)) y1 = y0 + 1;
     if (x1 - x0 < 1e-9) { x0 -= 0.5; x1 += 0.5; }
-    if (ly) { y0 -= 0.05 * (y1 - y0); y1 += 0.05 * (y1 - y0); }
-    else y1 *= 1.05;
+    if (ly) { /* 5% margins on both sides of the decades */
+        double m = 0.05 * (y1 - y0);
+        y0 -= m;
+        y1 += m;
+    } else y1 *= 1.05;
     double fx0, fx1, fy0, fy1; /* fixed ranges, as axis values */
     if (p.x_max > p.x_min && axis_value(p.x_min, lx, &fx0) && axis_value(p.x_max, lx, &fx1)) x0 = fx0, x1 = fx1;
     if (p.y_max > p.y_min && axis_value(p.y_min, ly, &fy0) && axis_value(p.y_max, ly, &fy1)) y0 = fy0, y1 = fy1;
