@@ -32,29 +32,20 @@ int bench_ao(int argc, char **argv) {
         return 2;
     if (help) return 0;
     app_log_level(opts);
-    int w = 320, h = 240;
-    long frames = 5, rays = 256;
-    double radius = 0, screen_radius = 0.05;
-    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &w, &h)) return 2;
+    mr_bench_ao_params p = {MR_BENCH_AO_DEFAULTS};
+    long frames = p.frames, rays = p.rays;
+    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &p.width, &p.height)) return 2;
     if (app_get(opts, "frames") && !app_int("frames", app_get(opts, "frames"), 1, 64, &frames)) return 2;
     if (app_get(opts, "rays") && !app_int("rays", app_get(opts, "rays"), 1, 1 << 20, &rays)) return 2;
-    if (app_get(opts, "radius") && !app_double("radius", app_get(opts, "radius"), 1e-30, 1e30, &radius)) return 2;
-    if (app_get(opts, "screen-radius") && !app_double("screen-radius", app_get(opts, "screen-radius"), 1e-4, 1, &screen_radius))
+    if (app_get(opts, "radius") && !app_double("radius", app_get(opts, "radius"), 1e-30, 1e30, &p.radius)) return 2;
+    if (app_get(opts, "screen-radius") && !app_double("screen-radius", app_get(opts, "screen-radius"), 1e-4, 1, &p.screen_radius))
         return 2;
-    bool quick = app_flag(opts, "quick");
-    const char *out_dir = app_get(opts, "out") ? app_get(opts, "out") : "bench-out";
     if (npos > 0 && !app_get(opts, "views")) return app_errorf(cmd, "view files given without --views"), 2;
-
-    mr_bench_ao_params p = {MR_BENCH_AO_DEFAULTS};
-    p.out_dir = out_dir;
+    if (app_get(opts, "out")) p.out_dir = app_get(opts, "out");
     p.scene = app_get(opts, "scene");
-    p.width = w;
-    p.height = h;
     p.frames = (int)frames;
     p.rays = (int)rays;
-    p.radius = radius;
-    p.screen_radius = screen_radius;
-    p.quick = quick;
+    p.quick = app_flag(opts, "quick");
     p.verbose = app_flag(opts, "verbose");
     p.progress = !app_flag(opts, "quiet");
     p.out = stdout;

@@ -25,18 +25,13 @@ static int bench_frame(int argc, char **argv) {
         return 2;
     if (help) return 0;
     app_log_level(opts);
-    int w = 1024, h = 768;
-    long frames = 30;
-    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &w, &h)) return 2;
-    if (app_get(opts, "frames") && !app_int("frames", app_get(opts, "frames"), 1, 100000, &frames)) return 2;
-    const char *out_dir = app_get(opts, "out") ? app_get(opts, "out") : "bench-out";
-
     mr_bench_frame_params p = {MR_BENCH_FRAME_DEFAULTS};
-    p.out_dir = out_dir;
-    p.scene = app_get(opts, "scene");
-    p.width = w;
-    p.height = h;
+    long frames = p.frames;
+    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &p.width, &p.height)) return 2;
+    if (app_get(opts, "frames") && !app_int("frames", app_get(opts, "frames"), 1, 100000, &frames)) return 2;
+    if (app_get(opts, "out")) p.out_dir = app_get(opts, "out");
     p.frames = (int)frames;
+    p.scene = app_get(opts, "scene");
     p.no_video = app_flag(opts, "no-video");
     p.out = stdout;
     mr_error err = {0};
