@@ -105,6 +105,10 @@ int app_bench_ghost(int argc, char **argv);
 int cmd_demo(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
+/* Opens the headless GPU a bench renders with (close g with app_gfx_close,
+ * also after a failure). In cmd_bench.c. */
+typedef struct mr_bench_gpu mr_bench_gpu;
+bool app_bench_gpu(app_gfx *g, mr_bench_gpu *out, mr_error *err);
 int cmd_view(int argc, char **argv);
 int bench_ao(int argc, char **argv);
 

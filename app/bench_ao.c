@@ -65,5 +65,8 @@ int bench_ao(int argc, char **argv) {
         p.views = views;
         p.view_names = names;
     }
-    return mr_bench_ao(&p, &err) ? 0 : app_error(cmd, &err);
+    app_gfx g;
+    bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_ao(&p, &err);
+    app_gfx_close(&g);
+    return ok ? 0 : app_error(cmd, &err);
 }

@@ -40,5 +40,8 @@ int app_bench_ghost(int argc, char **argv) {
     p.progress = isatty(2) && !app_flag(opts, "quiet");
     p.out = stdout;
     mr_error err = {0};
-    return mr_bench_ghost(&p, &err) ? 0 : app_error(cmd, &err);
+    app_gfx g;
+    bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_ghost(&p, &err);
+    app_gfx_close(&g);
+    return ok ? 0 : app_error(cmd, &err);
 }

@@ -56,5 +56,8 @@ int bench_scene(int argc, char **argv) {
     p.frames = (int)frames;
     p.out = stdout;
     mr_error err = {0};
-    return mr_bench_scene(&p, &err) ? 0 : app_error(cmd, &err);
+    app_gfx g;
+    bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_scene(&p, &err);
+    app_gfx_close(&g);
+    return ok ? 0 : app_error(cmd, &err);
 }

@@ -6,6 +6,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+bool app_bench_gpu(app_gfx *g, mr_bench_gpu *out, mr_error *err) {
+    if (!app_gfx_open(g, err)) return false;
+    out->gpu = g->gpu;
+    out->renderer = g->renderer;
+    return true;
+}
+
 static int bench_frame(int argc, char **argv) {
     static const char *cmd = "bench frame";
     app_opt opts[] = {
@@ -45,7 +52,9 @@ static int bench_frame(int argc, char **argv) {
         if (!mr_image_load(app_get(opts, "video"), 3, &video, &err)) return app_error(cmd, &err);
         p.video = &video;
     }
-    bool ok = mr_bench_frame(&p, &err);
+    app_gfx g;
+    bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_frame(&p, &err);
+    app_gfx_close(&g);
     mr_image_free(&video);
     return ok ? 0 : app_error(cmd, &err);
 }

@@ -84,7 +84,7 @@ typedef struct ao_bench {
     int nsamp, nres, s16; /* s16: the reported sample count's index */
     mr_scene *scene;
     mr_demo_hall hall;
-    bench_gfx gfx;
+    mr_bench_gpu gfx; /* the caller's */
     mr_eval_gt *gt;
     double t0;
     int nv;
@@ -254,7 +254,7 @@ static bool ao_setup(ao_bench *b, mr_error *err) {
         for (int i = 0; i < 3; i++) d2 += (s->bounds_max[i] - s->bounds_min[i]) * (s->bounds_max[i] - s->bounds_min[i]);
         b->radius = d2 > 0 ? 0.02 * sqrt(d2) : 1;
     }
-    return mr_mkdirs(p->out_dir, err) && bench_gfx_open(&b->gfx, err) &&
+    return mr_mkdirs(p->out_dir, err) &&
            mr_renderer_set_scene(b->gfx.renderer, b->scene, err) && (b->gt = mr_eval_gt_create(b->scene, false, err));
 }
 
@@ -678,7 +678,7 @@ static void ao_free(ao_bench *b) {
     }
     mr_image_free(&b->ao);
     mr_eval_gt_destroy(&b->gt);
-    bench_gfx_close(&b->gfx);
+    if (b->gfx.renderer) mr_renderer_set_scene(b->gfx.renderer, NULL, NULL); /* the scene goes now */
     if (b->hall.planned) mr_demo_free(&b->hall);
     else mr_scene_destroy(&b->scene);
     free(b);
@@ -690,6 +690,11 @@ bool mr_bench_ao(const mr_bench_ao_params *params, mr_error *err) {
     if (!b) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
     b->p = params ? *params : dflt;
     mr_bench_ao_params *p = &b->p;
+    b->gfx = p->gfx;
+    if (!bench_gpu_check(&b->gfx, "bench ao", err)) {
+        free(b);
+        return false;
+    }
     if (!p->out_dir) p->out_dir = dflt.out_dir;
     if (p->width <= 0 || p->height <= 0) p->width = dflt.width, p->height = dflt.height;
     if (p->frames <= 0) p->frames = dflt.frames;

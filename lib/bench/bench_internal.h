@@ -10,12 +10,7 @@
         if (out) fprintf(out, __VA_ARGS__); \
     } while (0)
 
-/* A headless GPU and a renderer on it. */
-typedef struct bench_gfx {
-    mr_gpu *gpu;
-    mr_renderer *renderer;
-} bench_gfx;
-bool bench_gfx_open(bench_gfx *g, mr_error *err);
-void bench_gfx_close(bench_gfx *g);
+/* false with MR_ERR_INVALID when a bench was given no renderer. */
+bool bench_gpu_check(const mr_bench_gpu *g, const char *bench, mr_error *err);
 
 #endif

@@ -1,23 +1,6 @@
 /* What the bench runners share. */
 #include "bench_internal.h"
 
-#include <string.h>
-
-bool bench_gfx_open(bench_gfx *g, mr_error *err) {
-    memset(g, 0, sizeof *g);
-    mr_gpu_params gp = MR_GPU_DEFAULTS;
-    gp.debug = mr_log_get_level() >= MR_LOG_DEBUG;
-    g->gpu = mr_gpu_create_headless(&gp, err);
-    if (!g->gpu) return false;
-    g->renderer = mr_renderer_create(g->gpu, err);
-    if (!g->renderer) {
-        mr_gpu_destroy(&g->gpu);
-        return false;
-    }
-    return true;
-}
-
-void bench_gfx_close(bench_gfx *g) {
-    mr_renderer_destroy(&g->renderer);
-    mr_gpu_destroy(&g->gpu);
+bool bench_gpu_check(const mr_bench_gpu *g, const char *bench, mr_error *err) {
+    return g->gpu && g->renderer ? true : mr_fail(err, MR_ERR_INVALID, "%s: no GPU and renderer given", bench);
 }

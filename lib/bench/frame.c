@@ -35,6 +35,7 @@ bool mr_bench_frame(const mr_bench_frame_params *params, mr_error *err) {
     const long frames = p.frames;
     const char *out_dir = p.out_dir;
     FILE *out = p.out;
+    if (!bench_gpu_check(&p.gfx, "bench frame", err)) return false;
     mr_view view = p.view ? *p.view : mr_demo_view(0);
     mr_scene *scene = NULL;
     mr_demo_hall hall;
@@ -56,8 +57,8 @@ bool mr_bench_frame(const mr_bench_frame_params *params, mr_error *err) {
         mr_rng_seed(&rng, 7);
         for (size_t i = 0; ok && i < mr_image_bytes(&video); i++) ((unsigned char *)video.data)[i] = (unsigned char)(mr_rng_u64(&rng) >> 56);
     }
-    bench_gfx gfx = {0};
-    ok = ok && mr_mkdirs(out_dir, err) && bench_gfx_open(&gfx, err) && mr_renderer_set_scene(gfx.renderer, scene, err);
+    const mr_bench_gpu gfx = p.gfx;
+    ok = ok && mr_mkdirs(out_dir, err) && mr_renderer_set_scene(gfx.renderer, scene, err);
     int npass = 0;
     const char *names[MR_MAX_PASSES + 1];
     double *gpu = NULL, *cpu = NULL, *total = NULL;
@@ -125,7 +126,7 @@ bool mr_bench_frame(const mr_bench_frame_params *params, mr_error *err) {
     free(gpu);
     free(cpu);
     free(total);
-    bench_gfx_close(&gfx);
+    mr_renderer_set_scene(gfx.renderer, NULL, NULL); /* the scene goes now */
     mr_image_free(&video);
     if (hall.planned) mr_demo_free(&hall);
     else mr_scene_destroy(&scene);

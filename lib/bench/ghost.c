@@ -107,8 +107,8 @@ bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err) {
     enum { NROWS = 2 * 2 * 2 * 2 * 3 };
     ghost_row rows[NROWS];
     int nrows = 0;
-    bench_gfx gfx = {0};
-    bool ok = mr_mkdirs(out_dir, err) && bench_gfx_open(&gfx, err);
+    const mr_bench_gpu gfx = p.gfx;
+    bool ok = bench_gpu_check(&gfx, "bench ghost", err) && mr_mkdirs(out_dir, err);
     double *samples = ok ? calloc((size_t)frames * 8, sizeof *samples) : NULL;
     if (ok && !samples) ok = mr_fail(err, MR_ERR_NOMEM, "out of memory");
     for (int sc = 0; ok && sc < 2; sc++) {
@@ -246,6 +246,5 @@ bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err) {
         if (ok) BENCH_PRINT(out, "wrote %s/bench_ghost.csv and bench_ghost.svg\n", out_dir);
     }
     free(samples);
-    bench_gfx_close(&gfx);
     return ok;
 }

@@ -19,6 +19,14 @@
 extern "C" {
 #endif
 
+/* The GPU a rendering bench uses: a headless context and a renderer on it,
+ * made and destroyed by the caller. A bench sets its scenes on the renderer
+ * and leaves none set when it returns. Required by ao, frame, ghost, scene. */
+typedef struct mr_bench_gpu {
+    mr_gpu *gpu;
+    mr_renderer *renderer;
+} mr_bench_gpu;
+
 /* ------------------------------------------------------------------- ao */
 
 /* Ambient occlusion, error against run time: every method over a grid of
@@ -29,6 +37,7 @@ extern "C" {
  * bench_ao_montage.png, bench_ao_shaded.png, bench_ao.md). */
 #define MR_BENCH_AO_MAX_VIEWS 16
 typedef struct mr_bench_ao_params {
+    mr_bench_gpu gfx;           /* required */
     const char *out_dir;         /* default "bench-out" */
     const char *scene;           /* glTF/GLB or scene config; NULL: the demo hall as planned */
     const mr_view *views;        /* view_count reported views; 0: the demo's near, mid-hall and far views */
@@ -53,6 +62,7 @@ bool mr_bench_ao(const mr_bench_ao_params *params, mr_error *err);
 
 /* Per-pass GPU and CPU ms of the whole frame. */
 typedef struct mr_bench_frame_params {
+    mr_bench_gpu gfx;           /* required */
     const char *out_dir;    /* default "bench-out" */
     const char *scene;      /* glTF/GLB or scene config; NULL: the demo hall as planned */
     const mr_view *view;    /* NULL: the demo's first viewpoint */
@@ -71,6 +81,7 @@ bool mr_bench_frame(const mr_bench_frame_params *params, mr_error *err);
  * implementation, eq. 9's levels and mode, the GPU ms of the ghosting passes
  * against legibility measures (bench_ghost.csv, bench_ghost.svg). */
 typedef struct mr_bench_ghost_params {
+    mr_bench_gpu gfx;           /* required */
     const char *out_dir;    /* default "bench-out" */
     int width, height;      /* px, default 640x480 (the demo camera) */
     int frames;             /* timed frames per configuration after 2 warm-up frames, default 5 */
@@ -89,6 +100,7 @@ bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err);
  * bench_scene.svg). */
 #define MR_BENCH_SCENE_MAX_SIZES 8
 typedef struct mr_bench_scene_params {
+    mr_bench_gpu gfx;           /* required */
     const char *out_dir;    /* default "bench-out" */
     double sizes[MR_BENCH_SCENE_MAX_SIZES]; /* drawn-triangle targets */
     int size_count;         /* 0: 1M, 5M, 20M */

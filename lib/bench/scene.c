@@ -104,8 +104,8 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
     const long frames = p.frames;
     FILE *out = p.out;
     if (!mr_mkdirs(out_dir, err)) return false;
-    bench_gfx gfx;
-    if (!bench_gfx_open(&gfx, err)) return false;
+    const mr_bench_gpu gfx = p.gfx;
+    if (!bench_gpu_check(&gfx, "bench scene", err)) return false;
 
     mr_csv *csv = mr_csv_create(err);
     row *rows = calloc((size_t)nsizes * MR_SYNTH_VIEW_COUNT * N_CONFIGS + 1, sizeof *rows);
@@ -269,6 +269,6 @@ done:
     free(ft);
     free(ct);
     free(gt);
-    bench_gfx_close(&gfx);
+    mr_renderer_set_scene(gfx.renderer, NULL, NULL);
     return !failed;
 }
