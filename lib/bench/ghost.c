@@ -86,6 +86,77 @@ static bool build_hall(bool conflict, mr_demo_hall *hall, mr_error *err) {
     return mr_demo_build_tagged(&dp, 0, hall, err);
 }
 
+/* What every configuration's measurement shares. */
+typedef struct ghost_run {
+    const mr_bench_gpu *gfx;
+    const mr_view *view;
+    int w, h;
+    long frames;
+    double *samples; /* 8 x frames: the 6 passes, their sum, the frame's wall ms */
+} ghost_run;
+
+/* One configuration (importance im, saliency sa, levels lv, mode mo): the
+ * median GPU ms of the ghosting passes over the timed frames after 2
+ * warm-up frames, then the legibility measures in one untimed frame.
+ * *occ_ratio: the occluder's saliency ratio, measured once per hall. */
+static bool measure(const ghost_run *g, int im, int sa, int lv, int mo, ghost_row *r, double *occ_ratio, mr_error *err) {
+    bool ok = true;
+    mr_frame_params fp = MR_FRAME_DEFAULTS;
+    fp.width = g->w;
+    fp.height = g->h;
+    fp.timing = true;
+    fp.ghost.mode = (mr_ghost_mode)(MR_GHOST_ALPHA + mo);
+    fp.ghost.importance = im ? MR_GHOST_IMP_SALIENCY : MR_GHOST_IMP_CURVATURE;
+    fp.ghost.saliency = sa ? MR_SALIENCY_GAUSS : MR_SALIENCY_MIPMAP;
+    fp.ghost.saliency_levels = lv ? MR_SAL_LEVELS_PRINTED : MR_SAL_LEVELS_OFFSET;
+    for (long f = -2; ok && f < g->frames; f++) {
+        mr_frame_result res;
+        double t0 = mr_time_now();
+        ok = mr_render_frame(g->gfx->renderer, g->view, &fp, &res, err);
+        if (!ok || f < 0) {
+            if (ok) mr_frame_result_free(&res);
+            continue;
+        }
+        g->samples[(size_t)7 * g->frames + f] = (mr_time_now() - t0) * 1e3;
+        double tot = 0;
+        for (int k = 0; k < 6; k++) g->samples[(size_t)k * g->frames + f] = 0;
+        for (int q = 0; q < res.pass_count; q++)
+            for (int k = 0; k < 6; k++)
+                if (strcmp(res.passes[q], k_pass_names[k]) == 0) {
+                    g->samples[(size_t)k * g->frames + f] = res.gpu_ms[q];
+                    tot += res.gpu_ms[q];
+                }
+        g->samples[(size_t)6 * g->frames + f] = tot;
+        mr_frame_result_free(&res);
+    }
+    if (!ok) return false;
+    for (int k = 0; k < 6; k++) r->pass_ms[k] = mr_median(&g->samples[(size_t)k * g->frames], (int)g->frames);
+    r->ghost_ms = mr_median(&g->samples[(size_t)6 * g->frames], (int)g->frames);
+    r->frame_ms = mr_median(&g->samples[(size_t)7 * g->frames], (int)g->frames);
+    /* The measure, in one untimed frame (it adds GPU work). */
+    fp.timing = false;
+    fp.ghost.stats = true;
+    mr_frame_result res;
+    ok = mr_render_frame(g->gfx->renderer, g->view, &fp, &res, err);
+    if (ok) {
+        r->st = res.ghost;
+        mr_image o, d, reg;
+        ok = mr_ghost_read_layers(g->gfx->renderer, &o, &d, &reg, err);
+        if (ok) {
+            mr_ghost_legibility_images li = {&res.color, &o, &d, &reg};
+            ok = mr_eval_ghost_legibility(&li, NULL, &r->leg, err) &&
+                 mr_eval_saliency_ratio(&res.color, &reg, &r->sal_ratio, err) &&
+                 (!isnan(*occ_ratio) || mr_eval_saliency_ratio(&o, &reg, occ_ratio, err));
+            r->sal_ratio_occluder = *occ_ratio;
+        }
+        mr_image_free(&o);
+        mr_image_free(&d);
+        mr_image_free(&reg);
+        mr_frame_result_free(&res);
+    }
+    return ok;
+}
+
 bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err) {
     const mr_bench_ghost_params dflt = {MR_BENCH_GHOST_DEFAULTS};
     mr_bench_ghost_params p = params ? *params : dflt;
@@ -111,6 +182,7 @@ bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err) {
     bool ok = bench_gpu_check(&gfx, "bench ghost", err) && mr_mkdirs(out_dir, err);
     double *samples = ok ? calloc((size_t)frames * 8, sizeof *samples) : NULL;
     if (ok && !samples) ok = mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    const ghost_run run = {&gfx, &view, w, h, frames, samples};
     for (int sc = 0; ok && sc < 2; sc++) {
         mr_demo_hall hall;
         ok = build_hall(sc == 0, &hall, err) && mr_renderer_set_scene(gfx.renderer, hall.planned, err);
@@ -127,59 +199,7 @@ bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err) {
                     r->levels = levels[lv];
                     r->mode = modes[mo];
                     r->mode_index = mo;
-                    mr_frame_params fp = MR_FRAME_DEFAULTS;
-                    fp.width = w;
-                    fp.height = h;
-                    fp.timing = true;
-                    fp.ghost.mode = (mr_ghost_mode)(MR_GHOST_ALPHA + mo);
-                    fp.ghost.importance = im ? MR_GHOST_IMP_SALIENCY : MR_GHOST_IMP_CURVATURE;
-                    fp.ghost.saliency = sa ? MR_SALIENCY_GAUSS : MR_SALIENCY_MIPMAP;
-                    fp.ghost.saliency_levels = lv ? MR_SAL_LEVELS_PRINTED : MR_SAL_LEVELS_OFFSET;
-                    for (long f = -2; ok && f < frames; f++) {
-                        mr_frame_result res;
-                        double t0 = mr_time_now();
-                        ok = mr_render_frame(gfx.renderer, &view, &fp, &res, err);
-                        if (!ok || f < 0) {
-                            if (ok) mr_frame_result_free(&res);
-                            continue;
-                        }
-                        samples[(size_t)7 * frames + f] = (mr_time_now() - t0) * 1e3;
-                        double tot = 0;
-                        for (int k = 0; k < 6; k++) samples[(size_t)k * frames + f] = 0;
-                        for (int q = 0; q < res.pass_count; q++)
-                            for (int k = 0; k < 6; k++)
-                                if (strcmp(res.passes[q], k_pass_names[k]) == 0) {
-                                    samples[(size_t)k * frames + f] = res.gpu_ms[q];
-                                    tot += res.gpu_ms[q];
-                                }
-                        samples[(size_t)6 * frames + f] = tot;
-                        mr_frame_result_free(&res);
-                    }
-                    if (!ok) break;
-                    for (int k = 0; k < 6; k++) r->pass_ms[k] = mr_median(&samples[(size_t)k * frames], (int)frames);
-                    r->ghost_ms = mr_median(&samples[(size_t)6 * frames], (int)frames);
-                    r->frame_ms = mr_median(&samples[(size_t)7 * frames], (int)frames);
-                    /* The measure, in one untimed frame (it adds GPU work). */
-                    fp.timing = false;
-                    fp.ghost.stats = true;
-                    mr_frame_result res;
-                    ok = mr_render_frame(gfx.renderer, &view, &fp, &res, err);
-                    if (ok) {
-                        r->st = res.ghost;
-                        mr_image o, d, reg;
-                        ok = mr_ghost_read_layers(gfx.renderer, &o, &d, &reg, err);
-                        if (ok) {
-                            mr_ghost_legibility_images li = {&res.color, &o, &d, &reg};
-                            ok = mr_eval_ghost_legibility(&li, NULL, &r->leg, err) &&
-                                 mr_eval_saliency_ratio(&res.color, &reg, &r->sal_ratio, err) &&
-                                 (!isnan(occ_ratio) || mr_eval_saliency_ratio(&o, &reg, &occ_ratio, err));
-                            r->sal_ratio_occluder = occ_ratio;
-                        }
-                        mr_image_free(&o);
-                        mr_image_free(&d);
-                        mr_image_free(&reg);
-                        mr_frame_result_free(&res);
-                    }
+                    if (!(ok = measure(&run, im, sa, lv, mo, r, &occ_ratio, err))) break;
                     nrows++;
                     if (ok && p.progress)
                         fprintf(stderr, "\rbench ghost: %d/%d configurations", nrows, NROWS);
