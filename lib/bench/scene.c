@@ -90,6 +90,77 @@ static mr_scene *load_scene(const char *path, load_info *li, mr_error *err) {
     return s;
 }
 
+/* One case's timing: the median of `frames` frames after one warm-up of
+ * the whole frame (wall ms), the CPU culling and the G-buffer pass (GPU). */
+static bool time_case(const mr_bench_gpu *g, const mr_view *view, const mr_draw_params *dp, int w, int h, long frames,
+                      double *ft, double *ct, double *gt, row *r, mr_draw_stats *st, mr_error *err) {
+    mr_frame_params fp = MR_FRAME_DEFAULTS;
+    fp.width = w;
+    fp.height = h;
+    fp.timing = true;
+    memset(st, 0, sizeof *st);
+    bool ok = mr_renderer_set_draw_params(g->renderer, dp, err);
+    for (long f = -1; ok && f < frames; f++) {
+        mr_frame_result res;
+        double ts = mr_time_now();
+        ok = mr_render_frame(g->renderer, view, &fp, &res, err);
+        if (!ok) break;
+        if (f >= 0) {
+            ft[f] = (mr_time_now() - ts) * 1e3;
+            mr_renderer_draw_stats(g->renderer, st);
+            ct[f] = st->cull_ms;
+            gt[f] = 0;
+            for (int k = 0; k < res.pass_count; k++)
+                if (strcmp(res.passes[k], "gbuffer") == 0) gt[f] = res.gpu_ms[k];
+        }
+        mr_frame_result_free(&res);
+    }
+    if (!ok) return false;
+    r->frame_ms = mr_median(ft, (int)frames);
+    r->cull_ms = mr_median(ct, (int)frames);
+    r->gpu_ms = mr_median(gt, (int)frames);
+    return true;
+}
+
+/* The numbers of one scene size that each of its rows repeats. */
+typedef struct size_info {
+    load_info li;
+    int nodes;
+    double mb, parse_s, upload_s, lod_s;
+    bool from_cache;
+} size_info;
+
+/* One case: its line of the table and its CSV row. */
+static void report_row(FILE *out, mr_csv *csv, const size_info *z, int v, int c, const row *r, const mr_draw_stats *st) {
+    double rss = mr_peak_rss_bytes() / 1048576.0;
+    BENCH_PRINT(out, "%10llu %8d %9.1f %6.2f %6.2f %7.2f %8.0f %-9s %-9s %9.1f %8.2f %8.1f %11llu %6u %7u %7u\n",
+           (unsigned long long)z->li.triangles, z->nodes, z->mb, z->parse_s, z->li.load_s, z->upload_s, rss,
+           k_view_names[v], k_configs[c].name, r->frame_ms, r->cull_ms, r->gpu_ms,
+           (unsigned long long)st->triangles, st->gl_draw_calls, st->nodes_visible, st->nodes_occluded);
+    if (out) fflush(out);
+    mr_csv_int(csv, (long long)z->li.triangles);
+    mr_csv_int(csv, (long long)z->li.unique_triangles);
+    mr_csv_int(csv, z->nodes);
+    mr_csv_num(csv, "%.2f", z->mb);
+    mr_csv_num(csv, "%.4f", z->parse_s);
+    mr_csv_num(csv, "%.4f", z->li.load_s);
+    mr_csv_num(csv, "%.4f", z->upload_s);
+    mr_csv_num(csv, "%.1f", z->mb / (z->li.load_s + z->upload_s));
+    mr_csv_num(csv, "%.1f", z->mb / z->parse_s);
+    mr_csv_num(csv, "%.3f", z->lod_s);
+    mr_csv_int(csv, z->from_cache);
+    mr_csv_num(csv, "%.0f", rss);
+    mr_csv_text(csv, k_view_names[v]);
+    mr_csv_text(csv, k_configs[c].name);
+    mr_csv_num(csv, "%.3f", r->frame_ms);
+    mr_csv_num(csv, "%.3f", r->cull_ms);
+    mr_csv_num(csv, "%.3f", r->gpu_ms);
+    const uint64_t counts[] = {st->triangles,     st->gl_draw_calls,  st->commands,      st->nodes_visible,
+                               st->nodes_drawable, st->nodes_occluded, st->lod_instances};
+    for (int k = 0; k < 7; k++) mr_csv_int(csv, (long long)counts[k]);
+    mr_csv_end_row(csv);
+}
+
 bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
     const mr_bench_scene_params dflt = {MR_BENCH_SCENE_DEFAULTS};
     mr_bench_scene_params p = params ? *params : dflt;
@@ -184,63 +255,15 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                 dp.no_instancing = k_configs[c].no_instancing;
                 dp.no_lod = k_configs[c].no_lod;
                 dp.occlusion = k_configs[c].occlusion;
-                mr_frame_params fp = MR_FRAME_DEFAULTS;
-                fp.width = w;
-                fp.height = h;
-                fp.timing = true;
-                mr_draw_stats st;
-                memset(&st, 0, sizeof st);
-                ok = mr_renderer_set_draw_params(gfx.renderer, &dp, err);
-                for (long f = -1; ok && f < frames; f++) {
-                    mr_frame_result res;
-                    double ts = mr_time_now();
-                    ok = mr_render_frame(gfx.renderer, &view, &fp, &res, err);
-                    if (!ok) break;
-                    if (f >= 0) {
-                        ft[f] = (mr_time_now() - ts) * 1e3;
-                        mr_renderer_draw_stats(gfx.renderer, &st);
-                        ct[f] = st.cull_ms;
-                        gt[f] = 0;
-                        for (int k = 0; k < res.pass_count; k++)
-                            if (strcmp(res.passes[k], "gbuffer") == 0) gt[f] = res.gpu_ms[k];
-                    }
-                    mr_frame_result_free(&res);
-                }
-                if (!ok) break;
-                row *r = &rows[nrows++];
+                row *r = &rows[nrows];
                 r->tri_scene = (double)li.triangles;
                 r->view = v;
                 r->config = c;
-                r->frame_ms = mr_median(ft, (int)frames);
-                r->cull_ms = mr_median(ct, (int)frames);
-                r->gpu_ms = mr_median(gt, (int)frames);
-                double rss = mr_peak_rss_bytes() / 1048576.0;
-                BENCH_PRINT(out, "%10llu %8d %9.1f %6.2f %6.2f %7.2f %8.0f %-9s %-9s %9.1f %8.2f %8.1f %11llu %6u %7u %7u\n",
-                       (unsigned long long)li.triangles, (int)s->node_count, mb, parse_s, li.load_s, upload_s, rss,
-                       k_view_names[v], k_configs[c].name, r->frame_ms, r->cull_ms, r->gpu_ms,
-                       (unsigned long long)st.triangles, st.gl_draw_calls, st.nodes_visible, st.nodes_occluded);
-                if (out) fflush(out);
-                mr_csv_int(csv, (long long)li.triangles);
-                mr_csv_int(csv, (long long)li.unique_triangles);
-                mr_csv_int(csv, s->node_count);
-                mr_csv_num(csv, "%.2f", mb);
-                mr_csv_num(csv, "%.4f", parse_s);
-                mr_csv_num(csv, "%.4f", li.load_s);
-                mr_csv_num(csv, "%.4f", upload_s);
-                mr_csv_num(csv, "%.1f", mb / (li.load_s + upload_s));
-                mr_csv_num(csv, "%.1f", mb / parse_s);
-                mr_csv_num(csv, "%.3f", lod_s);
-                mr_csv_int(csv, linfo.from_cache);
-                mr_csv_num(csv, "%.0f", rss);
-                mr_csv_text(csv, k_view_names[v]);
-                mr_csv_text(csv, k_configs[c].name);
-                mr_csv_num(csv, "%.3f", r->frame_ms);
-                mr_csv_num(csv, "%.3f", r->cull_ms);
-                mr_csv_num(csv, "%.3f", r->gpu_ms);
-                const uint64_t counts[] = {st.triangles,     st.gl_draw_calls,  st.commands,      st.nodes_visible,
-                                           st.nodes_drawable, st.nodes_occluded, st.lod_instances};
-                for (int k = 0; k < 7; k++) mr_csv_int(csv, (long long)counts[k]);
-                mr_csv_end_row(csv);
+                mr_draw_stats st;
+                if (!(ok = time_case(&gfx, &view, &dp, w, h, frames, ft, ct, gt, r, &st, err))) break;
+                nrows++;
+                const size_info z = {li, (int)s->node_count, mb, parse_s, upload_s, lod_s, linfo.from_cache};
+                report_row(out, csv, &z, v, c, r, &st);
             }
         }
         BENCH_PRINT(out, "  load %.2f s + upload %.2f s = %.0f MB/s; tinygltf raw parse %.2f s = %.0f MB/s; LOD %.2f s (%s)\n",
