@@ -75,6 +75,25 @@ static bool hall_markers(const mr_demo_hall *hall, mr_marker_map *map, mr_error 
     return true;
 }
 
+/* The tracking of one synthetic frame, kept in this one function so that it
+ * can be swapped for lib/track's single tracker: detect, solve the pose
+ * seeded by the previous pose whenever that one is valid, One Euro filter
+ * it; fills fr's detections, pose and filtered pose (fr->t is the time). */
+static bool track_frame(mr_detector *det, mr_pose_filter *filt, const mr_camera *cam, const mr_marker_map *map,
+                        const mr_image *gray, mr_pose *prev, mr_frame_record *fr, mr_error *err) {
+    int n = 0;
+    const mr_detection *d = mr_detector_detect(det, gray, &n, err);
+    if (!d || !mr_pose_solve(cam, map, d, n, prev->valid ? prev : NULL, NULL, &fr->pose, err)) return false;
+    fr->detections = d;
+    fr->detection_count = n;
+    if (fr->pose.valid) {
+        *prev = fr->pose;
+        mr_pose_filter_update(filt, fr->t, &fr->pose.world_from_camera, &fr->filtered);
+        fr->has_filtered = true;
+    }
+    return true;
+}
+
 bool app_synth_recording(const char *dir, const app_synth_params *params, mr_error *err) {
     app_synth_params p = params ? *params : (app_synth_params)APP_SYNTH_DEFAULTS;
     if (p.frames < 1 || p.width < 64 || p.height < 48 || p.motion_blur < 1 || p.motion_blur > 16 || p.noise < 0 ||
@@ -155,18 +174,10 @@ bool app_synth_recording(const char *dir, const app_synth_params *params, mr_err
         /* Track it as `record` would, so frames.jsonl holds real results. */
         mr_frame_record fr = {0};
         fr.t = t;
-        int n = 0;
-        const mr_detection *d = ok ? mr_detector_detect(det, &gray, &n, err) : NULL;
-        ok = ok && d && mr_pose_solve(&cam, &map, d, n, prev.valid ? &prev : NULL, NULL, &fr.pose, err);
+        ok = ok && track_frame(det, filt, &cam, &map, &gray, &prev, &fr, err);
+        const int n = fr.detection_count;
         if (ok) {
-            fr.detections = d;
-            fr.detection_count = n;
-            if (fr.pose.valid) {
-                prev = fr.pose;
-                with_pose++;
-                mr_pose_filter_update(filt, t, &fr.pose.world_from_camera, &fr.filtered);
-                fr.has_filtered = true;
-            }
+            with_pose += fr.pose.valid;
             ok = mr_recorder_append(rec, &fr, &gray, err) && mr_recorder_ground_truth(rec, fr.index, t, &truth, still, err);
         }
         mr_image_free(&frame);
