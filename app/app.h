@@ -27,8 +27,6 @@ bool app_flag(const app_opt *opts, const char *name);
 bool app_double(const char *opt, const char *s, double lo, double hi, double *out);
 bool app_int(const char *opt, const char *s, long lo, long hi, long *out);
 bool app_size(const char *opt, const char *s, int *w, int *h);
-/* Median of v[0..n) (sorts v in place); 0 for n <= 0. For benches. */
-double app_median(double *v, int n);
 /* Exit status of a command that found no GPU device, GL context or display
  * (MR_ERR_NODEVICE): EX_UNAVAILABLE of sysexits.h. Tests skip on this status
  * only, never on the text of a message. */
@@ -44,10 +42,6 @@ int app_errorf(const char *cmd, const char *fmt, ...)
 /* Sets the log level from --verbose / --quiet. */
 void app_log_level(const app_opt *opts);
 
-/* AprilTag images for the demo (tag36h11, ids 0..count-1), gray8 with the
- * white border; *border gets its width in pixels. In tags.c. */
-bool app_tag_images(int count, mr_image **out, int *border, mr_error *err);
-void app_tag_images_free(mr_image *imgs, int count);
 
 /* A headless GPU, a renderer and (optionally) a scene set on it. */
 typedef struct app_gfx {
@@ -83,19 +77,7 @@ bool app_ao_parse(const char *cmd, const app_opt *opts, mr_ao_params *ao, bool *
 /* Writes what --aux asks for: depth.pfm, normal.pfm, ao.pfm into dir. */
 bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err);
 
-/* A camera frame from n ideal pinhole renders (averaged: motion blur),
- * rendered with a margin of `margin` px per side at `scale` times the
- * resolution: lens distortion of cam, [1 2 1] optical blur, exposure gain,
- * Gaussian sensor noise (sigma in 8-bit levels). In demo_track.c. */
-bool app_synth_frame(const mr_camera *cam, const mr_image *ideal, int n, int margin, int scale, double gain,
-                     double noise, mr_rng *rng, mr_image *out, mr_error *err);
 
-/* The demo hall built in memory (tag images included), its camera and its
- * standing viewpoints. In cmd_demo.c. */
-bool app_demo_hall(mr_demo_hall *hall, mr_error *err);
-mr_camera app_demo_camera(void);
-int app_demo_view_count(void);
-mr_view app_demo_view(int i);
 
 /* The ghosting option rows, to splice into a command's option table. */
 #define APP_GHOST_OPTS                                                                                           \
@@ -123,6 +105,10 @@ int app_bench_ghost(int argc, char **argv);
 int cmd_demo(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
+/* Opens the headless GPU a bench renders with (close g with app_gfx_close,
+ * also after a failure). In cmd_bench.c. */
+typedef struct mr_bench_gpu mr_bench_gpu;
+bool app_bench_gpu(app_gfx *g, mr_bench_gpu *out, mr_error *err);
 int cmd_view(int argc, char **argv);
 int bench_ao(int argc, char **argv);
 

@@ -133,14 +133,3 @@ void app_log_level(const app_opt *opts) {
     if (app_get(opts, "quiet")) mr_log_set_level(MR_LOG_ERROR);
     else if (app_get(opts, "verbose")) mr_log_set_level(MR_LOG_INFO);
 }
-
-static int cmp_double(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-double app_median(double *v, int n) {
-    if (n <= 0) return 0;
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}

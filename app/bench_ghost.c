@@ -1,102 +1,11 @@
-/* mrcheck bench ghost: ghosted views on the demo partition (pipes hidden
- * behind it), for the conflict case (pipes coloured like the partition) and
- * the no-conflict case: per importance source, saliency implementation,
- * eq. 9's levels and mode, the GPU ms of the ghosting passes against
- * measures that do not use the ghosting's own target:
- *  - legibility (mr_eval_ghost_legibility): the important edges of the
- *    hidden layer D alone (neighbour pairs touching the region with
- *    4 * dE*ab(D) / 100 > 0.5, above the curvature bias 0.35); per edge the
- *    contrast F adds over the occluder O, h_F = dF - dO, projected on what
- *    showing D in full would add, h_R; mean of clamp(h_F.h_R / |h_R|^2, 0, 1).
- *    0: only the occluder; 1: D in full; ~1 - alpha for alpha blending.
- *    With edge_contrast_dE (mean |h_F|) and full_contrast_dE (mean |h_R|).
- *  - cv_saliency_ratio: OpenCV contrib's spectral-residual saliency of the
- *    final image, mean over the region / mean elsewhere, beside the same for
- *    the occluder alone (cv_saliency_ratio_occluder: hidden structure
- *    invisible).
- *  - target_reached: the old measure, the fraction of pixels with IM > 0.3
- *    whose final saliency reaches C_desired: what the adaptive stage itself
- *    optimises, so only a diagnostic of the optimiser.
- * and the occluder's mean lightness change. Kalkofen et al. judge
- * legibility by a user study; these are proxies. CSV + SVG; never
- * pass/fail, never timed in tests. */
+/* mrcheck bench ghost: option parsing; the bench is mr_bench_ghost (lib/bench/ghost.c). */
 #include "app.h"
+#include "mr_bench.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-
-typedef struct ghost_row {
-    const char *scene, *importance, *saliency, *levels, *mode;
-    int mode_index;
-    double pass_ms[6]; /* ghost_hidden, ghost_curvature, ghost_importance, ghost_g0, ghost_analysis, ghost_emphasis */
-    double ghost_ms, frame_ms;
-    mr_ghost_stats st;
-    mr_legibility leg;
-    double sal_ratio, sal_ratio_occluder;
-} ghost_row;
-
-static const char *const k_pass_names[6] = {"ghost_hidden", "ghost_curvature", "ghost_importance",
-                                            "ghost_g0",     "ghost_analysis",  "ghost_emphasis"};
-
-/* Legibility (y) against ghosting GPU ms (x), one marker per row: colour by
- * mode, filled for the conflict case, hollow for no conflict. */
-static bool write_svg(const char *path, const char *title, const ghost_row *rows, int n, mr_error *err) {
-    static const char *const colours[3] = {"#888888", "#3b6fb6", "#d0452c"};
-    double xmax = 1e-9;
-    for (int i = 0; i < n; i++) xmax = rows[i].ghost_ms > xmax ? rows[i].ghost_ms : xmax;
-    xmax *= 1.1;
-    const int W = 760, H = 460, L = 70, T = 50, PW = 520, PH = 340;
-    size_t cap = 16384 + (size_t)n * 512;
-    char *s = malloc(cap);
-    if (!s) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    int len = snprintf(s, cap,
-                       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" font-family=\"sans-serif\" "
-                       "font-size=\"12\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n"
-                       "<text x=\"10\" y=\"22\" font-size=\"14\">%s</text>\n"
-                       "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"black\"/>\n"
-                       "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">GPU ms of the ghosting passes (median)</text>\n"
-                       "<text x=\"18\" y=\"%d\" transform=\"rotate(-90 18 %d)\" text-anchor=\"middle\">legibility (edge transfer of D)</text>\n",
-                       W, H, title, L, T, PW, PH, L + PW / 2, T + PH + 36, T + PH / 2, T + PH / 2);
-    for (int k = 0; k <= 4; k++) {
-        double v = k / 4.0;
-        int y = T + PH - (int)(v * PH);
-        len += snprintf(s + len, cap - (size_t)len,
-                        "<text x=\"%d\" y=\"%d\" text-anchor=\"end\">%.2f</text>"
-                        "<line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"#ddd\"/>\n"
-                        "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">%.1f</text>\n",
-                        L - 6, y + 4, v, L, y, L + PW, y, L + (int)(k * PW / 4.0), T + PH + 16, xmax * k / 4.0);
-    }
-    for (int i = 0; i < n; i++) {
-        const ghost_row *r = &rows[i];
-        if (isnan(r->leg.legibility) || strcmp(r->levels, "offset") != 0) continue; /* nothing to plot; one level set */
-        double x = L + PW * r->ghost_ms / xmax, y = T + PH - PH * r->leg.legibility;
-        bool conflict = strcmp(r->scene, "conflict") == 0;
-        const char *c = colours[r->mode_index];
-        if (strcmp(r->saliency, "gauss") == 0)
-            len += snprintf(s + len, cap - (size_t)len,
-                            "<rect x=\"%.1f\" y=\"%.1f\" width=\"9\" height=\"9\" fill=\"%s\" stroke=\"%s\" stroke-width=\"2\"/>\n",
-                            x - 4.5, y - 4.5, conflict ? c : "white", c);
-        else
-            len += snprintf(s + len, cap - (size_t)len,
-                            "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"5\" fill=\"%s\" stroke=\"%s\" stroke-width=\"2\"/>\n", x, y,
-                            conflict ? c : "white", c);
-    }
-    static const char *const mode_names[3] = {"alpha", "g0", "adaptive"};
-    for (int m = 0; m < 3; m++)
-        len += snprintf(s + len, cap - (size_t)len,
-                        "<circle cx=\"%d\" cy=\"%d\" r=\"5\" fill=\"%s\"/><text x=\"%d\" y=\"%d\">%s</text>\n", L + PW + 24,
-                        T + 14 + m * 20, colours[m], L + PW + 36, T + 18 + m * 20, mode_names[m]);
-    len += snprintf(s + len, cap - (size_t)len,
-                    "<text x=\"%d\" y=\"%d\">filled: conflict</text><text x=\"%d\" y=\"%d\">hollow: no conflict</text>\n"
-                    "<text x=\"%d\" y=\"%d\">circle: mip-map pyramid</text><text x=\"%d\" y=\"%d\">square: two Gaussians</text>\n"
-                    "</svg>\n",
-                    L + PW + 18, T + 90, L + PW + 18, T + 108, L + PW + 18, T + 132, L + PW + 18, T + 150);
-    bool ok = mr_file_write_atomic(path, s, (size_t)len, err);
-    free(s);
-    return ok;
-}
 
 int app_bench_ghost(int argc, char **argv) {
     static const char *cmd = "bench ghost";
@@ -119,157 +28,20 @@ int app_bench_ghost(int argc, char **argv) {
     long frames = 5, view_index = 0;
     if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &w, &h)) return 2;
     if (app_get(opts, "frames") && !app_int("frames", app_get(opts, "frames"), 1, 100000, &frames)) return 2;
-    if (app_get(opts, "view") && !app_int("view", app_get(opts, "view"), 0, app_demo_view_count() - 1, &view_index))
+    if (app_get(opts, "view") && !app_int("view", app_get(opts, "view"), 0, mr_demo_view_count() - 1, &view_index))
         return 2;
     const char *out_dir = app_get(opts, "out") ? app_get(opts, "out") : "bench-out";
+    mr_bench_ghost_params p = {MR_BENCH_GHOST_DEFAULTS};
+    p.out_dir = out_dir;
+    p.width = w;
+    p.height = h;
+    p.frames = (int)frames;
+    p.view = (int)view_index;
+    p.progress = isatty(2) && !app_flag(opts, "quiet");
+    p.out = stdout;
     mr_error err = {0};
-    mr_view view = app_demo_view((int)view_index);
-
-    static const char *const scenes[2] = {"conflict", "noconflict"};
-    static const char *const imps[2] = {"curvature", "saliency"};
-    static const char *const sals[2] = {"mipmap", "gauss"};
-    static const char *const modes[3] = {"alpha", "g0", "adaptive"};
-    static const char *const levels[2] = {"offset", "printed"};
-    enum { NROWS = 2 * 2 * 2 * 2 * 3 };
-    ghost_row rows[NROWS];
-    int nrows = 0;
-    app_gfx gfx = {0};
-    bool ok = mr_mkdirs(out_dir, &err) && app_gfx_open(&gfx, &err);
-    double *samples = ok ? calloc((size_t)frames * 8, sizeof *samples) : NULL;
-    if (ok && !samples) ok = mr_fail(&err, MR_ERR_NOMEM, "out of memory");
-    for (int sc = 0; ok && sc < 2; sc++) {
-        mr_demo_hall hall;
-        ok = app_demo_ghost_hall(sc == 0, &hall, &err) && mr_renderer_set_scene(gfx.renderer, hall.planned, &err);
-        double occ_ratio = NAN;
-        for (int im = 0; ok && im < 2; im++)
-            for (int sa = 0; ok && sa < 2; sa++)
-                for (int lv = 0; ok && lv < 2; lv++)
-                for (int mo = 0; ok && mo < 3; mo++) {
-                    ghost_row *r = &rows[nrows];
-                    memset(r, 0, sizeof *r);
-                    r->scene = scenes[sc];
-                    r->importance = imps[im];
-                    r->saliency = sals[sa];
-                    r->levels = levels[lv];
-                    r->mode = modes[mo];
-                    r->mode_index = mo;
-                    mr_frame_params fp = MR_FRAME_DEFAULTS;
-                    fp.width = w;
-                    fp.height = h;
-                    fp.timing = true;
-                    fp.ghost.mode = (mr_ghost_mode)(MR_GHOST_ALPHA + mo);
-                    fp.ghost.importance = im ? MR_GHOST_IMP_SALIENCY : MR_GHOST_IMP_CURVATURE;
-                    fp.ghost.saliency = sa ? MR_SALIENCY_GAUSS : MR_SALIENCY_MIPMAP;
-                    fp.ghost.saliency_levels = lv ? MR_SAL_LEVELS_PRINTED : MR_SAL_LEVELS_OFFSET;
-                    for (long f = -2; ok && f < frames; f++) {
-                        mr_frame_result res;
-                        double t0 = mr_time_now();
-                        ok = mr_render_frame(gfx.renderer, &view, &fp, &res, &err);
-                        if (!ok || f < 0) {
-                            if (ok) mr_frame_result_free(&res);
-                            continue;
-                        }
-                        samples[(size_t)7 * frames + f] = (mr_time_now() - t0) * 1e3;
-                        double tot = 0;
-                        for (int k = 0; k < 6; k++) samples[(size_t)k * frames + f] = 0;
-                        for (int p = 0; p < res.pass_count; p++)
-                            for (int k = 0; k < 6; k++)
-                                if (strcmp(res.passes[p], k_pass_names[k]) == 0) {
-                                    samples[(size_t)k * frames + f] = res.gpu_ms[p];
-                                    tot += res.gpu_ms[p];
-                                }
-                        samples[(size_t)6 * frames + f] = tot;
-                        mr_frame_result_free(&res);
-                    }
-                    if (!ok) break;
-                    for (int k = 0; k < 6; k++) r->pass_ms[k] = app_median(&samples[(size_t)k * frames], (int)frames);
-                    r->ghost_ms = app_median(&samples[(size_t)6 * frames], (int)frames);
-                    r->frame_ms = app_median(&samples[(size_t)7 * frames], (int)frames);
-                    /* The measure, in one untimed frame (it adds GPU work). */
-                    fp.timing = false;
-                    fp.ghost.stats = true;
-                    mr_frame_result res;
-                    ok = mr_render_frame(gfx.renderer, &view, &fp, &res, &err);
-                    if (ok) {
-                        r->st = res.ghost;
-                        mr_image o, d, reg;
-                        ok = mr_ghost_read_layers(gfx.renderer, &o, &d, &reg, &err);
-                        if (ok) {
-                            mr_ghost_legibility_images li = {&res.color, &o, &d, &reg};
-                            ok = mr_eval_ghost_legibility(&li, NULL, &r->leg, &err) &&
-                                 mr_eval_saliency_ratio(&res.color, &reg, &r->sal_ratio, &err) &&
-                                 (!isnan(occ_ratio) || mr_eval_saliency_ratio(&o, &reg, &occ_ratio, &err));
-                            r->sal_ratio_occluder = occ_ratio;
-                        }
-                        mr_image_free(&o);
-                        mr_image_free(&d);
-                        mr_image_free(&reg);
-                        mr_frame_result_free(&res);
-                    }
-                    nrows++;
-                    if (ok && isatty(2) && !app_flag(opts, "quiet"))
-                        fprintf(stderr, "\rbench ghost: %d/%d configurations", nrows, NROWS);
-                }
-        mr_renderer_set_scene(gfx.renderer, NULL, NULL);
-        mr_demo_free(&hall);
-    }
-    if (isatty(2)) fprintf(stderr, "\n");
-    int rc = 0;
-    if (ok) {
-        size_t cap = 4096 + (size_t)nrows * 512;
-        char *csv = malloc(cap);
-        if (!csv) ok = mr_fail(&err, MR_ERR_NOMEM, "out of memory");
-        int len = 0;
-        if (ok) {
-            len = snprintf(csv, cap,
-                           "# legibility_edge_transfer: mean over D's important edges (4 dE(D)/100 > 0.5) of the part "
-                           "of D's contrast over the occluder that the final image shows (0 occluder only, 1 D in full); "
-                           "edge_contrast_dE / full_contrast_dE: mean dE the final image / D in full adds over the "
-                           "occluder there; cv_saliency_ratio: OpenCV spectral-residual saliency, region mean / mean "
-                           "elsewhere (_occluder: of the occluder alone); target_reached: pixels reaching C_desired, the "
-                           "adaptive stage's own target (a diagnostic, not legibility)\n"
-                           "scene,importance,saliency,saliency_levels,mode");
-            for (int k = 0; k < 6; k++) len += snprintf(csv + len, cap - (size_t)len, ",%s_gpu_ms", k_pass_names[k]);
-            len += snprintf(csv + len, cap - (size_t)len,
-                            ",ghost_gpu_ms,frame_wall_ms,legibility_edge_transfer,edge_contrast_dE,full_contrast_dE,"
-                            "important_edge_fraction,cv_saliency_ratio,cv_saliency_ratio_occluder,target_reached,"
-                            "mean_abs_dL,region_fraction,mean_importance,mean_contrast_missing,width,height,frames\n");
-            printf("bench ghost: %s, %dx%d, demo view %ld, median of %ld frames\n", mr_gpu_description(gfx.gpu), w, h,
-                   view_index, frames);
-            printf("  %-10s %-9s %-6s %-7s %-8s %8s %8s %8s %8s %8s %8s %9s %10s %7s %7s %7s\n", "scene", "IM", "sal",
-                   "levels", "mode", "hidden", "curv", "import", "g0", "analys", "emph", "ghost ms", "legibility",
-                   "cv-sal", "target", "|dL*|");
-        }
-        for (int i = 0; ok && i < nrows; i++) {
-            const ghost_row *r = &rows[i];
-            len += snprintf(csv + len, cap - (size_t)len, "%s,%s,%s,%s,%s", r->scene, r->importance, r->saliency,
-                            r->levels, r->mode);
-            for (int k = 0; k < 6; k++) len += snprintf(csv + len, cap - (size_t)len, ",%.4f", r->pass_ms[k]);
-            len += snprintf(csv + len, cap - (size_t)len,
-                            ",%.4f,%.4f,%.4f,%.3f,%.3f,%.4f,%.3f,%.3f,%.4f,%.3f,%.4f,%.4f,%.4f,%d,%d,%ld\n", r->ghost_ms,
-                            r->frame_ms, r->leg.legibility, r->leg.edge_contrast, r->leg.full_contrast,
-                            r->leg.important_fraction, r->sal_ratio, r->sal_ratio_occluder, r->st.target_reached,
-                            r->st.mean_abs_dL, r->st.region_fraction, r->st.mean_importance, r->st.mean_contrast_missing, w,
-                            h, frames);
-            printf("  %-10s %-9s %-6s %-7s %-8s %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %9.2f %10.3f %7.2f %7.3f %7.2f\n",
-                   r->scene, r->importance, r->saliency, r->levels, r->mode, r->pass_ms[0], r->pass_ms[1], r->pass_ms[2],
-                   r->pass_ms[3], r->pass_ms[4], r->pass_ms[5], r->ghost_ms, r->leg.legibility, r->sal_ratio,
-                   r->st.target_reached, r->st.mean_abs_dL);
-        }
-        char path[4096], title[256];
-        if (ok) {
-            mr_path_join(out_dir, "bench_ghost.csv", path, sizeof path);
-            ok = mr_file_write_atomic(path, csv, (size_t)len, &err);
-        }
-        free(csv);
-        snprintf(title, sizeof title, "mrcheck bench ghost: legibility against run time, %dx%d, demo view %ld (eq. 9 levels: offset)", w, h,
-                 view_index);
-        mr_path_join(out_dir, "bench_ghost.svg", path, sizeof path);
-        ok = ok && write_svg(path, title, rows, nrows, &err);
-        if (ok) printf("wrote %s/bench_ghost.csv and bench_ghost.svg\n", out_dir);
-    }
-    if (!ok) rc = app_error(cmd, &err);
-    free(samples);
-    app_gfx_close(&gfx);
-    return rc;
+    app_gfx g;
+    bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_ghost(&p, &err);
+    app_gfx_close(&g);
+    return ok ? 0 : app_error(cmd, &err);
 }

@@ -1,115 +1,9 @@
-/* mrcheck bench scene: cost against scene size. For synthetic factories of
- * about 1M, 5M and 20M drawn triangles (by default), written as .glb and
- * loaded back like any scene: load and upload time and speed against
- * tinygltf's raw parse of the same file, peak memory, and from fixed
- * viewpoints (standing on the floor, down an aisle, overview) the frame time
- * and its parts (CPU culling, GPU geometry pass), triangles submitted, draw
- * calls and visible nodes, with culling, batching and LOD each switched
- * off in turn, and occlusion culling switched on. CSV + an SVG plot of frame time against scene size. Never
- * pass/fail. */
+/* mrcheck bench scene: option parsing; the bench is mr_bench_scene
+ * (lib/bench/scene.c). */
 #include "app.h"
+#include "mr_bench.h"
 
-#include <math.h>
 #include <stdlib.h>
-#include <string.h>
-
-typedef struct bench_config {
-    const char *name;
-    bool no_cull, no_batch, no_instancing, no_lod, occlusion;
-} bench_config;
-
-static const bench_config k_configs[] = {
-    {"all", false, false, false, false, false},
-    {"no-cull", true, false, false, false, false},
-    {"no-batch", false, true, true, false, false},
-    {"no-lod", false, false, false, true, false},
-    {"none", true, true, true, true, false},
-    {"all+occl", false, false, false, false, true},
-};
-#define N_CONFIGS (int)(sizeof k_configs / sizeof k_configs[0])
-
-static const char *const k_view_names[MR_SYNTH_VIEW_COUNT] = {"floor", "aisle", "overview"};
-
-static int cmp_d(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double med(double *v, int n) {
-    qsort(v, (size_t)n, sizeof *v, cmp_d);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-typedef struct row {
-    double tri_scene;
-    int view, config;
-    double frame_ms, cull_ms, gpu_ms;
-} row;
-
-/* Frame time (floor view, and overview dashed) against drawn scene
- * triangles, log-log, one colour per configuration. */
-static bool write_plot(const char *path, const row *rows, int n, const double *sizes, int nsizes, mr_error *err) {
-    static const char *const colours[N_CONFIGS] = {"#1b7837", "#c51b7d", "#e08214", "#4575b4", "#555555", "#8c510a"};
-    double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
-    for (int i = 0; i < n; i++) {
-        if (rows[i].view == MR_SYNTH_VIEW_AISLE) continue;
-        xmin = fmin(xmin, rows[i].tri_scene);
-        xmax = fmax(xmax, rows[i].tri_scene);
-        ymin = fmin(ymin, rows[i].frame_ms);
-        ymax = fmax(ymax, rows[i].frame_ms);
-    }
-    if (!(xmax > xmin)) { xmin /= 2; xmax *= 2; }
-    ymin = fmax(ymin * 0.8, 0.1);
-    ymax = fmax(ymax * 1.25, ymin * 2);
-    double lx0 = log10(xmin) - 0.05, lx1 = log10(xmax) + 0.05, ly0 = log10(ymin), ly1 = log10(ymax);
-    const int W = 760, H = 480, L = 70, R = 170, T = 40, B = 50;
-    size_t cap = 65536;
-    char *s = malloc(cap);
-    if (!s) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    int len = snprintf(s, cap,
-                       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" font-family=\"sans-serif\" font-size=\"12\">\n"
-                       "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n"
-                       "<text x=\"10\" y=\"22\" font-size=\"15\">mrcheck bench scene: frame time vs scene size "
-                       "(solid: floor view, dashed: overview; log-log)</text>\n"
-                       "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"#999\"/>\n",
-                       W, H, L, T, W - L - R, H - T - B);
-#define PX(v) (L + (log10(v) - lx0) / (lx1 - lx0) * (W - L - R))
-#define PY(v) (H - B - (log10(v) - ly0) / (ly1 - ly0) * (H - T - B))
-    for (int i = 0; i < nsizes; i++)
-        len += snprintf(s + len, cap - (size_t)len, "<text x=\"%.1f\" y=\"%d\" text-anchor=\"middle\">%.1fM</text>\n",
-                        PX(sizes[i]), H - B + 16, sizes[i] / 1e6);
-    for (double d = pow(10, floor(ly0)); d <= ymax; d *= 10)
-        for (int m = 1; m <= 5; m += 4) {
-            double y = d * m;
-            if (y < ymin || y > ymax) continue;
-            len += snprintf(s + len, cap - (size_t)len,
-                            "<line x1=\"%d\" x2=\"%d\" y1=\"%.1f\" y2=\"%.1f\" stroke=\"#eee\"/><text x=\"%d\" y=\"%.1f\" "
-                            "text-anchor=\"end\">%g ms</text>\n",
-                            L, W - R, PY(y), PY(y), L - 4, PY(y) + 4, y);
-        }
-    len += snprintf(s + len, cap - (size_t)len, "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">triangles in the scene (drawn count, instances included)</text>\n",
-                    (L + W - R) / 2, H - 14);
-    for (int c = 0; c < N_CONFIGS; c++)
-        for (int v = 0; v < MR_SYNTH_VIEW_COUNT; v += 2) {
-            len += snprintf(s + len, cap - (size_t)len, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s points=\"",
-                            colours[c], v ? " stroke-dasharray=\"6 4\"" : "");
-            for (int i = 0; i < n; i++)
-                if (rows[i].config == c && rows[i].view == v)
-                    len += snprintf(s + len, cap - (size_t)len, "%.1f,%.1f ", PX(rows[i].tri_scene), PY(rows[i].frame_ms));
-            len += snprintf(s + len, cap - (size_t)len, "\"/>\n");
-        }
-    for (int c = 0; c < N_CONFIGS; c++)
-        len += snprintf(s + len, cap - (size_t)len,
-                        "<line x1=\"%d\" x2=\"%d\" y1=\"%d\" y2=\"%d\" stroke=\"%s\" stroke-width=\"3\"/><text x=\"%d\" y=\"%d\">%s</text>\n",
-                        W - R + 12, W - R + 36, T + 14 + 20 * c, T + 14 + 20 * c, colours[c], W - R + 42, T + 18 + 20 * c,
-                        k_configs[c].name);
-#undef PX
-#undef PY
-    len += snprintf(s + len, cap - (size_t)len, "</svg>\n");
-    bool ok = mr_file_write_atomic(path, s, (size_t)len, err);
-    free(s);
-    return ok;
-}
 
 /* "1M,5M,20M" -> triangle targets. */
 static int parse_sizes(const char *spec, double *out, int max) {
@@ -148,178 +42,22 @@ int bench_scene(int argc, char **argv) {
     if (help) return 0;
     app_log_level(opts);
     const char *out_dir = app_get(opts, "out") ? app_get(opts, "out") : "bench-out";
-    double sizes[8];
-    int nsizes = parse_sizes(app_get(opts, "sizes") ? app_get(opts, "sizes") : "1M,5M,20M", sizes, 8);
+    mr_bench_scene_params p = {MR_BENCH_SCENE_DEFAULTS};
+    int nsizes = parse_sizes(app_get(opts, "sizes") ? app_get(opts, "sizes") : "1M,5M,20M", p.sizes, MR_BENCH_SCENE_MAX_SIZES);
     if (nsizes <= 0) return app_errorf(cmd, "--sizes must be a list like 1M,5M,20M (10k..1000M each)"), 2;
     int w = 1024, h = 768;
     long frames = 3;
     if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &w, &h)) return 2;
     if (app_get(opts, "frames") && !app_int("frames", app_get(opts, "frames"), 1, 1000, &frames)) return 2;
+    p.out_dir = out_dir;
+    p.size_count = nsizes;
+    p.width = w;
+    p.height = h;
+    p.frames = (int)frames;
+    p.out = stdout;
     mr_error err = {0};
-    if (!mr_mkdirs(out_dir, &err)) return app_error(cmd, &err);
-    app_gfx gfx;
-    if (!app_gfx_open(&gfx, &err)) return app_error(cmd, &err);
-
-    size_t csv_cap = 1 << 20;
-    char *csv = malloc(csv_cap);
-    row *rows = calloc((size_t)nsizes * MR_SYNTH_VIEW_COUNT * N_CONFIGS + 1, sizeof *rows);
-    double *ft = calloc((size_t)frames, sizeof *ft), *ct = calloc((size_t)frames, sizeof *ct), *gt = calloc((size_t)frames, sizeof *gt);
-    int nrows = 0, rc = 0;
-    if (!csv || !rows || !ft || !ct || !gt) {
-        rc = app_errorf(cmd, "out of memory");
-        goto done;
-    }
-    int len = snprintf(csv, csv_cap,
-                       "scene_triangles,stored_triangles,nodes,file_mb,raw_parse_s,load_s,upload_s,load_upload_mb_s,raw_parse_mb_s,"
-                       "lod_s,lod_from_cache,peak_rss_mb,view,config,frame_ms,cull_ms,gpu_geometry_ms,triangles_submitted,"
-                       "draw_calls,commands,nodes_visible,nodes_drawable,nodes_occluded,lod_instances\n");
-    printf("bench scene: %s, %dx%d, median of %ld frames\n", mr_gpu_description(gfx.gpu), w, h, frames);
-    printf("%10s %8s %9s %6s %6s %7s %8s %-9s %-9s %9s %8s %8s %11s %6s %7s %7s\n", "triangles", "nodes", "file MB", "parse",
-           "load", "upload", "RSS MB", "view", "config", "frame ms", "cull ms", "GPU ms", "submitted", "calls", "visible",
-           "occl");
-    char lod_cache[4096];
-    mr_path_join(out_dir, "synth.glb.mrlod", lod_cache, sizeof lod_cache); /* same parts at every size */
-    for (int si = 0; si < nsizes; si++) {
-        mr_synth_params sp = MR_SYNTH_DEFAULTS;
-        sp.halls = mr_synth_halls_for((uint64_t)sizes[si]);
-        char glb[4096], name[64];
-        snprintf(name, sizeof name, "synth_%dhalls.glb", sp.halls);
-        mr_path_join(out_dir, name, glb, sizeof glb);
-        mr_scene *s = mr_synth_build(&sp, &err);
-        bool ok = s && mr_scene_save_glb(s, glb, &err);
-        mr_scene_destroy(&s);
-        if (!ok) {
-            rc = app_error(cmd, &err);
-            goto done;
-        }
-        /* Raw parse reference, then our load and upload of the same file. */
-        size_t fsize = 0;
-        void *data = NULL;
-        double t0 = mr_time_now();
-        data = mr_file_read(glb, &fsize, 0, &err);
-        ok = data && mr_gltf_parse_only(data, fsize, &err);
-        double parse_s = mr_time_now() - t0;
-        free(data);
-        if (!ok) {
-            rc = app_error(cmd, &err);
-            goto done;
-        }
-        app_load_info li;
-        s = app_load_scene(glb, NULL, &li, &err);
-        if (!s) {
-            rc = app_error(cmd, &err);
-            goto done;
-        }
-        t0 = mr_time_now();
-        ok = mr_renderer_set_scene(gfx.renderer, s, &err);
-        double upload_s = mr_time_now() - t0;
-        mr_lod_params lp = MR_LOD_DEFAULTS;
-        mr_lod_info linfo;
-        t0 = mr_time_now();
-        mr_lod *lod = ok ? mr_lod_load_or_build(s, lod_cache, &lp, &linfo, &err) : NULL;
-        double lod_s = mr_time_now() - t0;
-        ok = lod && mr_renderer_set_lod(gfx.renderer, lod, &err);
-        if (!ok) {
-            rc = app_error(cmd, &err);
-            mr_lod_destroy(&lod);
-            mr_scene_destroy(&s);
-            goto done;
-        }
-        double mb = fsize / 1e6;
-        for (int v = 0; v < MR_SYNTH_VIEW_COUNT && ok; v++) {
-            mr_view view;
-            view.camera = app_demo_camera();
-            memset(view.camera.dist, 0, sizeof view.camera.dist);
-            view.world_from_camera = mr_synth_viewpoint(&sp, v);
-            for (int c = 0; c < N_CONFIGS && ok; c++) {
-                mr_draw_params dp = MR_DRAW_DEFAULTS;
-                dp.no_cull = k_configs[c].no_cull;
-                dp.no_batch = k_configs[c].no_batch;
-                dp.no_instancing = k_configs[c].no_instancing;
-                dp.no_lod = k_configs[c].no_lod;
-                dp.occlusion = k_configs[c].occlusion;
-                mr_frame_params fp = MR_FRAME_DEFAULTS;
-                fp.width = w;
-                fp.height = h;
-                fp.timing = true;
-                mr_draw_stats st;
-                memset(&st, 0, sizeof st);
-                ok = mr_renderer_set_draw_params(gfx.renderer, &dp, &err);
-                for (long f = -1; ok && f < frames; f++) {
-                    mr_frame_result res;
-                    double ts = mr_time_now();
-                    ok = mr_render_frame(gfx.renderer, &view, &fp, &res, &err);
-                    if (!ok) break;
-                    if (f >= 0) {
-                        ft[f] = (mr_time_now() - ts) * 1e3;
-                        mr_renderer_draw_stats(gfx.renderer, &st);
-                        ct[f] = st.cull_ms;
-                        gt[f] = 0;
-                        for (int k = 0; k < res.pass_count; k++)
-                            if (strcmp(res.passes[k], "gbuffer") == 0) gt[f] = res.gpu_ms[k];
-                    }
-                    mr_frame_result_free(&res);
-                }
-                if (!ok) break;
-                row *r = &rows[nrows++];
-                r->tri_scene = (double)li.triangles;
-                r->view = v;
-                r->config = c;
-                r->frame_ms = med(ft, (int)frames);
-                r->cull_ms = med(ct, (int)frames);
-                r->gpu_ms = med(gt, (int)frames);
-                double rss = mr_peak_rss_bytes() / 1048576.0;
-                printf("%10llu %8d %9.1f %6.2f %6.2f %7.2f %8.0f %-9s %-9s %9.1f %8.2f %8.1f %11llu %6u %7u %7u\n",
-                       (unsigned long long)li.triangles, (int)s->node_count, mb, parse_s, li.load_s, upload_s, rss,
-                       k_view_names[v], k_configs[c].name, r->frame_ms, r->cull_ms, r->gpu_ms,
-                       (unsigned long long)st.triangles, st.gl_draw_calls, st.nodes_visible, st.nodes_occluded);
-                fflush(stdout);
-                if ((size_t)len + 1024 > csv_cap) {
-                    char *bigger = realloc(csv, csv_cap * 2);
-                    if (!bigger) { ok = mr_fail(&err, MR_ERR_NOMEM, "out of memory"); break; }
-                    csv = bigger;
-                    csv_cap *= 2;
-                }
-                len += snprintf(csv + len, csv_cap - (size_t)len,
-                                "%llu,%llu,%d,%.2f,%.4f,%.4f,%.4f,%.1f,%.1f,%.3f,%d,%.0f,%s,%s,%.3f,%.3f,%.3f,%llu,%u,%u,%u,%u,%u,%u\n",
-                                (unsigned long long)li.triangles, (unsigned long long)li.unique_triangles, (int)s->node_count,
-                                mb, parse_s, li.load_s, upload_s, mb / (li.load_s + upload_s), mb / parse_s, lod_s,
-                                linfo.from_cache, rss, k_view_names[v], k_configs[c].name, r->frame_ms, r->cull_ms, r->gpu_ms,
-                                (unsigned long long)st.triangles, st.gl_draw_calls, st.commands, st.nodes_visible,
-                                st.nodes_drawable, st.nodes_occluded, st.lod_instances);
-            }
-        }
-        printf("  load %.2f s + upload %.2f s = %.0f MB/s; tinygltf raw parse %.2f s = %.0f MB/s; LOD %.2f s (%s)\n",
-               li.load_s, upload_s, mb / (li.load_s + upload_s), parse_s, mb / parse_s, lod_s,
-               linfo.from_cache ? "from the cache" : "built");
-        mr_renderer_set_scene(gfx.renderer, NULL, &err);
-        mr_lod_destroy(&lod);
-        mr_scene_destroy(&s);
-        if (!ok) {
-            rc = app_error(cmd, &err);
-            goto done;
-        }
-    }
-    {
-        char path[4096];
-        mr_path_join(out_dir, "bench_scene.csv", path, sizeof path);
-        bool ok = mr_file_write_atomic(path, csv, (size_t)len, &err);
-        mr_path_join(out_dir, "bench_scene.svg", path, sizeof path);
-        double xs[8];
-        for (int i = 0; i < nsizes; i++) xs[i] = 0;
-        /* x positions: the drawn counts actually reached */
-        for (int i = 0, k = 0; i < nrows && k < nsizes; i++)
-            if (i == 0 || rows[i].tri_scene != rows[i - 1].tri_scene) xs[k++] = rows[i].tri_scene;
-        ok = ok && write_plot(path, rows, nrows, xs, nsizes, &err);
-        if (!ok) rc = app_error(cmd, &err);
-        else printf("wrote %s/bench_scene.csv and bench_scene.svg\n", out_dir);
-    }
-done:
-    free(csv);
-    free(rows);
-    free(ft);
-    free(ct);
-    free(gt);
-    app_gfx_close(&gfx);
-    return rc;
+    app_gfx g;
+    bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_scene(&p, &err);
+    app_gfx_close(&g);
+    return ok ? 0 : app_error(cmd, &err);
 }

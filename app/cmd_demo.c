@@ -10,51 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define DEMO_TAGS 16
-
-/* The demo tablet camera: 640x480, ~65 degrees horizontal, mild barrel
- * distortion as a real tablet lens has. */
-mr_camera app_demo_camera(void) {
-    mr_camera c = {640, 480, 500.0, 500.0, 319.5, 239.5, {-0.10, 0.04, 0.0005, -0.0005, 0.0}};
-    return c;
-}
-
-/* Standing viewpoints at eye height, looking at different parts of the
- * hall (tags, machines, the partition with the pipes behind it). */
-static const double k_views[][6] = {
-    {-4.0, 1.6, -2.0, -14.0, 2.0, 8.0},  /* the partition: pipes hidden behind it */
-    {12.0, 1.7, 9.0, -4.0, 1.6, -9.0},   /* down the hall from the south-east */
-    {0.0, 1.6, 6.0, 0.0, 2.2, -12.0},    /* the north wall and its tags */
-    {16.0, 1.6, -9.0, -8.0, 1.5, 6.0},   /* under the suspended ceiling */
-    {-2.0, 7.5, -11.0, -8.0, 0.0, 6.0},  /* overview from high up */
-};
-#define DEMO_VIEWS (int)(sizeof k_views / sizeof k_views[0])
-
-int app_demo_view_count(void) { return DEMO_VIEWS; }
-
-mr_view app_demo_view(int i) {
-    mr_view v;
-    v.camera = app_demo_camera();
-    i = i < 0 ? 0 : i >= DEMO_VIEWS ? DEMO_VIEWS - 1 : i;
-    v.world_from_camera = mr_m4_look_at_cv(mr_v3(k_views[i][0], k_views[i][1], k_views[i][2]),
-                                           mr_v3(k_views[i][3], k_views[i][4], k_views[i][5]), mr_v3(0, 1, 0));
-    return v;
-}
-
-bool app_demo_hall(mr_demo_hall *hall, mr_error *err) {
-    mr_image *tags = NULL;
-    int border = 1;
-    memset(hall, 0, sizeof *hall);
-    if (!app_tag_images(DEMO_TAGS, &tags, &border, err)) return false;
-    mr_demo_params dp = MR_DEMO_DEFAULTS;
-    dp.tag_images = tags;
-    dp.tag_image_count = DEMO_TAGS;
-    dp.tag_border_px = border;
-    bool ok = mr_demo_build(&dp, hall, err);
-    app_tag_images_free(tags, DEMO_TAGS);
-    return ok;
-}
-
 static bool write_markers(const char *path, const mr_demo_hall *hall, mr_error *err) {
     cJSON *j = cJSON_CreateObject();
     cJSON_AddStringToObject(j, "family", "tag36h11");
@@ -97,12 +52,12 @@ static bool run_demo(const char *dir, mr_error *err) {
     }
 
     mr_demo_hall hall;
-    if (!app_demo_hall(&hall, err)) return false;
+    if (!mr_demo_build_tagged(NULL, 0, &hall, err)) return false;
     bool ok;
 
     /* Files: both halls as .glb through tinygltf, configs, markers, the
      * list of discrepancies, the camera and the views. */
-    mr_camera cam = app_demo_camera();
+    mr_camera cam = mr_demo_camera();
     mr_path_join(dir, "hall_planned.glb", path, sizeof path);
     ok = mr_scene_save_glb(hall.planned, path, err);
     mr_path_join(dir, "hall_built.glb", path, sizeof path);
@@ -119,9 +74,9 @@ static bool run_demo(const char *dir, mr_error *err) {
     mr_path_join(dir, "camera.json", path, sizeof path);
     ok = ok && mr_json_save(path, cj, err);
     cJSON_Delete(cj);
-    mr_view views[DEMO_VIEWS];
-    for (int i = 0; ok && i < DEMO_VIEWS; i++) {
-        views[i] = app_demo_view(i);
+    mr_view views[MR_DEMO_VIEWS];
+    for (int i = 0; ok && i < mr_demo_view_count(); i++) {
+        views[i] = mr_demo_view(i);
         cJSON *vj = mr_view_to_json(&views[i]);
         snprintf(sub, sizeof sub, "views/view_%03d.json", i);
         mr_path_join(dir, sub, path, sizeof path);
@@ -148,7 +103,7 @@ static bool run_demo(const char *dir, mr_error *err) {
     wide.cx += margin;
     wide.cy += margin;
     memset(wide.dist, 0, sizeof wide.dist);
-    for (int i = 0; ok && i < DEMO_VIEWS; i++) {
+    for (int i = 0; ok && i < mr_demo_view_count(); i++) {
         mr_frame_result res = {0};
         mr_rng rng;
         mr_rng_seed(&rng, 1000u + (uint64_t)i); /* a different noise pattern per frame, the same every run */
@@ -159,7 +114,7 @@ static bool run_demo(const char *dir, mr_error *err) {
         fp.height = wide.height * scale;
         mr_image frame = {0};
         ok = mr_renderer_set_scene(gfx.renderer, built, err) && mr_render_frame(gfx.renderer, &v, &fp, &res, err) &&
-             app_synth_frame(&cam, &res.color, 1, margin, scale, 1.0, 2.5, &rng, &frame, err);
+             mr_demo_camera_frame(&cam, &res.color, 1, margin, scale, 1.0, 2.5, &rng, &frame, err);
         mr_frame_result_free(&res);
         snprintf(sub, sizeof sub, "frames/frame_%03d.png", i);
         mr_path_join(dir, sub, path, sizeof path);
@@ -191,9 +146,9 @@ static bool run_demo(const char *dir, mr_error *err) {
     printf("demo hall: %llu triangles as planned, %d known discrepancies (%.1f s to build)\n", (unsigned long long)tri,
            discrepancy_count, t_build);
     printf("wrote %s/: hall_planned.glb hall_built.glb scene_*.json markers.json discrepancies.json camera.json\n", dir);
-    printf("  camera frames (as built):     %s/frames/frame_000..%03d.png\n", dir, DEMO_VIEWS - 1);
-    printf("  overlays (planned, alpha 0.5): %s/overlay/overlay_000..%03d.png\n", dir, DEMO_VIEWS - 1);
-    printf("  virtual only (planned):        %s/virtual/virtual_000..%03d.png\n", dir, DEMO_VIEWS - 1);
+    printf("  camera frames (as built):     %s/frames/frame_000..%03d.png\n", dir, mr_demo_view_count() - 1);
+    printf("  overlays (planned, alpha 0.5): %s/overlay/overlay_000..%03d.png\n", dir, mr_demo_view_count() - 1);
+    printf("  virtual only (planned):        %s/virtual/virtual_000..%03d.png\n", dir, mr_demo_view_count() - 1);
     if (!app_demo_track(dir, err)) return false; /* tracking: recording + calibration set (demo_track.c) */
     printf("done in %.1f s\n", mr_time_now() - t0);
     return true;

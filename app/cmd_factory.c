@@ -84,7 +84,7 @@ int cmd_factory(int argc, char **argv) {
         snprintf(file, sizeof file, "view_%s.json", names[v]);
         mr_path_join(views, file, path, sizeof path);
         mr_view view;
-        view.camera = app_demo_camera();
+        view.camera = mr_demo_camera();
         memset(view.camera.dist, 0, sizeof view.camera.dist); /* an ideal camera for renders */
         view.world_from_camera = mr_synth_viewpoint(&sp, v);
         cJSON *j = mr_view_to_json(&view);

@@ -7,21 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define GHOST_TAGS 16
-
 bool app_demo_ghost_hall(bool conflict, mr_demo_hall *hall, mr_error *err) {
-    mr_image *tags = NULL;
-    int border = 1;
-    memset(hall, 0, sizeof *hall);
-    if (!app_tag_images(GHOST_TAGS, &tags, &border, err)) return false;
     mr_demo_params dp = MR_DEMO_DEFAULTS;
-    dp.tag_images = tags;
-    dp.tag_image_count = GHOST_TAGS;
-    dp.tag_border_px = border;
     dp.pipes_like_partition = conflict;
-    bool ok = mr_demo_build(&dp, hall, err);
-    app_tag_images_free(tags, GHOST_TAGS);
-    return ok;
+    return mr_demo_build_tagged(&dp, 0, hall, err);
 }
 
 /* Pastes n RGB8 images of one size side by side with a 4-pixel white gap. */
@@ -46,7 +35,7 @@ bool app_demo_ghost(const char *dir, mr_error *err) {
     app_gfx gfx;
     if (!app_gfx_open(&gfx, err)) return false;
     bool ok = true;
-    mr_view view = app_demo_view(0); /* the partition with the pipes behind it */
+    mr_view view = mr_demo_view(0); /* the partition with the pipes behind it */
     for (int c = 0; ok && c < 2; c++) {
         mr_demo_hall hall;
         ok = app_demo_ghost_hall(c == 1, &hall, err) && mr_renderer_set_scene(gfx.renderer, hall.planned, err);

@@ -1,7 +1,6 @@
 /* Synthetic recordings of the demo hall with ground truth, and a synthetic
- * calibration set (tag-grid board). The camera-frame synthesis here
- * (app_synth_frame: lens distortion, [1 2 1] blur, noise, motion blur,
- * exposure) also makes the demo's camera frames. */
+ * calibration set (tag-grid board). The camera frames come from
+ * mr_demo_camera_frame (lib/scene). */
 #include "app_track.h"
 
 #include <math.h>
@@ -62,60 +61,6 @@ static mr_dmat4 path_pose(double s, bool *still) {
     return mr_m4_identity();
 }
 
-/* --------------------------------------------------------- frame synthesis */
-
-/* Camera frame from n ideal pinhole renders (sub-frames, averaged = motion
- * blur), rendered with a margin of `margin` px per side at `scale` times the
- * resolution: lens distortion of cam, [1 2 1] optical blur, exposure gain,
- * Gaussian sensor noise. */
-bool app_synth_frame(const mr_camera *cam, const mr_image *ideal, int n, int margin, int scale, double gain,
-                     double noise, mr_rng *rng, mr_image *out, mr_error *err) {
-    size_t np = (size_t)cam->width * cam->height;
-    float *acc = calloc(np * 3, sizeof *acc), *tmp = malloc(np * 3 * sizeof *tmp);
-    if (!acc || !tmp || !mr_image_alloc(out, cam->width, cam->height, 3, MR_PIX_U8, err)) {
-        free(acc);
-        free(tmp);
-        return err && err->code ? false : mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    }
-    for (int v = 0; v < cam->height; v++)
-        for (int u = 0; u < cam->width; u++) {
-            double x, y;
-            float sum[3] = {0, 0, 0};
-            if (mr_camera_undistort(cam, (u - cam->cx) / cam->fx, (v - cam->cy) / cam->fy, &x, &y)) {
-                double iu = (cam->fx * x + cam->cx + margin + 0.5) * scale - 0.5;
-                double iv = (cam->fy * y + cam->cy + margin + 0.5) * scale - 0.5;
-                for (int k = 0; k < n; k++) {
-                    float px[4] = {0, 0, 0, 0};
-                    mr_image_sample_bilinear(&ideal[k], iu, iv, px);
-                    for (int c = 0; c < 3; c++) sum[c] += px[c] / (float)n;
-                }
-            }
-            memcpy(&acc[((size_t)v * cam->width + u) * 3], sum, sizeof sum);
-        }
-    for (int pass = 0; pass < 2; pass++) {
-        const float *src = pass ? tmp : acc;
-        float *dst = pass ? acc : tmp;
-        int du = pass ? 0 : 1, dv = pass ? 1 : 0;
-        for (int v = 0; v < cam->height; v++)
-            for (int u = 0; u < cam->width; u++) {
-                int u0 = u - du < 0 ? u : u - du, u1 = u + du >= cam->width ? u : u + du;
-                int v0 = v - dv < 0 ? v : v - dv, v1 = v + dv >= cam->height ? v : v + dv;
-                for (int c = 0; c < 3; c++)
-                    dst[((size_t)v * cam->width + u) * 3 + c] = 0.25f * src[((size_t)v0 * cam->width + u0) * 3 + c] +
-                                                                0.5f * src[((size_t)v * cam->width + u) * 3 + c] +
-                                                                0.25f * src[((size_t)v1 * cam->width + u1) * 3 + c];
-            }
-    }
-    unsigned char *o = out->data;
-    for (size_t i = 0; i < np * 3; i++) {
-        double val = acc[i] * gain + noise * mr_rng_normal(rng);
-        o[i] = (unsigned char)(val < 0 ? 0 : val > 255 ? 255 : lrint(val));
-    }
-    free(acc);
-    free(tmp);
-    return true;
-}
-
 static bool hall_markers(const mr_demo_hall *hall, mr_marker_map *map, mr_error *err) {
     memset(map, 0, sizeof *map);
     snprintf(map->family, sizeof map->family, "tag36h11");
@@ -130,22 +75,41 @@ static bool hall_markers(const mr_demo_hall *hall, mr_marker_map *map, mr_error 
     return true;
 }
 
+/* The tracking of one synthetic frame, kept in this one function so that it
+ * can be swapped for lib/track's single tracker: detect, solve the pose
+ * seeded by the previous pose whenever that one is valid, One Euro filter
+ * it; fills fr's detections, pose and filtered pose (fr->t is the time). */
+static bool track_frame(mr_detector *det, mr_pose_filter *filt, const mr_camera *cam, const mr_marker_map *map,
+                        const mr_image *gray, mr_pose *prev, mr_frame_record *fr, mr_error *err) {
+    int n = 0;
+    const mr_detection *d = mr_detector_detect(det, gray, &n, err);
+    if (!d || !mr_pose_solve(cam, map, d, n, prev->valid ? prev : NULL, NULL, &fr->pose, err)) return false;
+    fr->detections = d;
+    fr->detection_count = n;
+    if (fr->pose.valid) {
+        *prev = fr->pose;
+        mr_pose_filter_update(filt, fr->t, &fr->pose.world_from_camera, &fr->filtered);
+        fr->has_filtered = true;
+    }
+    return true;
+}
+
 bool app_synth_recording(const char *dir, const app_synth_params *params, mr_error *err) {
     app_synth_params p = params ? *params : (app_synth_params)APP_SYNTH_DEFAULTS;
     if (p.frames < 1 || p.width < 64 || p.height < 48 || p.motion_blur < 1 || p.motion_blur > 16 || p.noise < 0 ||
         p.exposure < 0 || p.exposure >= 1 || p.fps <= 0)
         return mr_fail(err, MR_ERR_INVALID, "synth: parameters out of range");
     mr_demo_hall hall;
-    if (!app_demo_hall(&hall, err)) return false;
+    if (!mr_demo_build_tagged(NULL, 0, &hall, err)) return false;
     mr_marker_map map;
     /* The demo lens at another resolution: square pixels, the focal length
      * scaled with the width, so 1280x720 is a 16:9 crop of a 1280x960. */
-    mr_camera cam = app_demo_camera();
+    mr_camera cam = mr_demo_camera();
     double sc = (double)p.width / cam.width;
     cam.fx *= sc;
     cam.fy *= sc;
-    cam.cx = 0.5 * (p.width - 1) + (cam.cx - 0.5 * (app_demo_camera().width - 1)) * sc;
-    cam.cy = 0.5 * (p.height - 1) + (cam.cy - 0.5 * (app_demo_camera().height - 1)) * sc;
+    cam.cx = 0.5 * (p.width - 1) + (cam.cx - 0.5 * (mr_demo_camera().width - 1)) * sc;
+    cam.cy = 0.5 * (p.height - 1) + (cam.cy - 0.5 * (mr_demo_camera().height - 1)) * sc;
     cam.width = p.width;
     cam.height = p.height;
     bool ok = hall_markers(&hall, &map, err);
@@ -205,23 +169,15 @@ bool app_synth_recording(const char *dir, const app_synth_params *params, mr_err
         }
         double gain = 1.0 + p.exposure * sin(2 * M_PI * i / 40.0);
         mr_image frame = {0}, gray = {0};
-        ok = ok && app_synth_frame(&cam, ideal, p.motion_blur, margin, scale, gain, p.noise, &rng, &frame, err) &&
+        ok = ok && mr_demo_camera_frame(&cam, ideal, p.motion_blur, margin, scale, gain, p.noise, &rng, &frame, err) &&
              mr_image_to_gray(&frame, &gray, err);
         /* Track it as `record` would, so frames.jsonl holds real results. */
         mr_frame_record fr = {0};
         fr.t = t;
-        int n = 0;
-        const mr_detection *d = ok ? mr_detector_detect(det, &gray, &n, err) : NULL;
-        ok = ok && d && mr_pose_solve(&cam, &map, d, n, prev.valid ? &prev : NULL, NULL, &fr.pose, err);
+        ok = ok && track_frame(det, filt, &cam, &map, &gray, &prev, &fr, err);
+        const int n = fr.detection_count;
         if (ok) {
-            fr.detections = d;
-            fr.detection_count = n;
-            if (fr.pose.valid) {
-                prev = fr.pose;
-                with_pose++;
-                mr_pose_filter_update(filt, t, &fr.pose.world_from_camera, &fr.filtered);
-                fr.has_filtered = true;
-            }
+            with_pose += fr.pose.valid;
             ok = mr_recorder_append(rec, &fr, &gray, err) && mr_recorder_ground_truth(rec, fr.index, t, &truth, still, err);
         }
         mr_image_free(&frame);
@@ -323,9 +279,9 @@ bool app_synth_calibration(const char *dir, int images, mr_error *err) {
     /* The tag images for ids 100..123. */
     mr_image *all = NULL;
     int border = 1;
-    ok = ok && app_tag_images(BOARD_FIRST_ID + BOARD_COLS * BOARD_ROWS, &all, &border, err);
+    ok = ok && mr_demo_tag_images(BOARD_FIRST_ID + BOARD_COLS * BOARD_ROWS, &all, &border, err);
     if (!ok) return false;
-    mr_camera cam = app_demo_camera();
+    mr_camera cam = mr_demo_camera();
     mr_rng rng;
     mr_rng_seed(&rng, 77);
     double cxb = 0.5 * (BOARD_COLS - 1) * BOARD_PITCH, cyb = 0.5 * (BOARD_ROWS - 1) * BOARD_PITCH;
@@ -346,7 +302,7 @@ bool app_synth_calibration(const char *dir, int images, mr_error *err) {
         ok = ok && mr_image_save_png(path, &img, err);
         mr_image_free(&img);
     }
-    app_tag_images_free(all, BOARD_FIRST_ID + BOARD_COLS * BOARD_ROWS);
+    mr_demo_tag_images_free(all, BOARD_FIRST_ID + BOARD_COLS * BOARD_ROWS);
     return ok;
 }
 

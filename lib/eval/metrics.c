@@ -1,5 +1,5 @@
-/* Image metrics (RMSE, SSIM, signed bias) and report helpers (SVG line
- * plots, PNG montages). */
+/* Image metrics (RMSE, SSIM, signed bias) and PNG montages (the plots are
+ * in plot.c). */
 #include "mr_eval.h"
 
 #include <math.h>
@@ -96,77 +96,6 @@ bool mr_image_compare(const mr_image *a, const mr_image *ref, const mr_image *ma
     out->max_abs = mx;
     out->ssim = sc ? ss / sc : 1;
     return true;
-}
-
-/* ------------------------------------------------------------- plots */
-
-/* 16 distinguishable colours, so a plot with up to 16 series never repeats one. */
-static const char *const k_colors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
-                                       "#bcbd22", "#17becf", "#393b79", "#ad494a", "#637939", "#843c39", "#7b4173", "#000000"};
-
-bool mr_plot_svg(const char *path, const char *title, const char *xlabel, const char *ylabel,
-                 const mr_plot_series *series, int nseries, bool log_x, mr_error *err) {
-    double x0 = INFINITY, x1 = -INFINITY, y0 = 0, y1 = -INFINITY;
-    for (int s = 0; s < nseries; s++)
-        for (int i = 0; i < series[s].count; i++) {
-            double xv = series[s].x[i], yv = series[s].y[i];
-            if (!isfinite(xv) || !isfinite(yv) || (log_x && !(xv > 0))) continue;
-            if (log_x) xv = log10(xv);
-            if (xv < x0) x0 = xv;
-            if (xv > x1) x1 = xv;
-            if (yv > y1) y1 = yv;
-            if (yv < y0) y0 = yv;
-        }
-    if (!(x1 >= x0)) { x0 = 0; x1 = 1; }
-    if (!(y1 > y0)) y1 = y0 + 1;
-    if (x1 - x0 < 1e-9) { x0 -= 0.5; x1 += 0.5; }
-    y1 *= 1.05;
-    const int W = 760, H = 480, L = 70, R = 170, T = 40, B = 50;
-    double pw = W - L - R, ph = H - T - B;
-    size_t cap = 16384;
-    for (int s = 0; s < nseries; s++) cap += (size_t)series[s].count * 160 + 256;
-    char *o = malloc(cap);
-    if (!o) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    size_t len = 0;
-#define OUT(...) len += (size_t)snprintf(o + len, cap - len, __VA_ARGS__)
-    OUT("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" font-family=\"sans-serif\" font-size=\"12\">\n", W, H);
-    OUT("<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n<text x=\"%d\" y=\"22\" font-size=\"14\">%s</text>\n", L, title);
-    OUT("<rect x=\"%d\" y=\"%d\" width=\"%.0f\" height=\"%.0f\" fill=\"none\" stroke=\"#444\"/>\n", L, T, pw, ph);
-    for (int k = 0; k <= 4; k++) {
-        double fx = x0 + (x1 - x0) * k / 4, fy = y0 + (y1 - y0) * k / 4;
-        double px = L + pw * k / 4, py = T + ph - ph * k / 4;
-        OUT("<text x=\"%.1f\" y=\"%d\" text-anchor=\"middle\">%.3g</text>\n", px, H - B + 16, log_x ? pow(10, fx) : fx);
-        OUT("<text x=\"%d\" y=\"%.1f\" text-anchor=\"end\">%.3g</text>\n", L - 6, py + 4, fy);
-        OUT("<line x1=\"%d\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n", L, py, L + pw, py);
-    }
-    OUT("<text x=\"%.1f\" y=\"%d\" text-anchor=\"middle\">%s</text>\n", L + pw / 2, H - 12, xlabel);
-    OUT("<text x=\"16\" y=\"%.1f\" transform=\"rotate(-90 16 %.1f)\" text-anchor=\"middle\">%s</text>\n", T + ph / 2,
-        T + ph / 2, ylabel);
-    for (int s = 0; s < nseries; s++) {
-        const char *col = k_colors[s % 16];
-        OUT("<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1.5\" points=\"", col);
-        for (int i = 0; i < series[s].count; i++) {
-            double xv = series[s].x[i], yv = series[s].y[i];
-            if (!isfinite(xv) || !isfinite(yv) || (log_x && !(xv > 0))) continue;
-            if (log_x) xv = log10(xv);
-            OUT("%.1f,%.1f ", L + pw * (xv - x0) / (x1 - x0), T + ph - ph * (yv - y0) / (y1 - y0));
-        }
-        OUT("\"/>\n");
-        for (int i = 0; i < series[s].count; i++) {
-            double xv = series[s].x[i], yv = series[s].y[i];
-            if (!isfinite(xv) || !isfinite(yv) || (log_x && !(xv > 0))) continue;
-            if (log_x) xv = log10(xv);
-            OUT("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>\n", L + pw * (xv - x0) / (x1 - x0),
-                T + ph - ph * (yv - y0) / (y1 - y0), col);
-        }
-        OUT("<rect x=\"%.0f\" y=\"%d\" width=\"12\" height=\"10\" fill=\"%s\"/><text x=\"%.0f\" y=\"%d\">%s</text>\n",
-            L + pw + 14, T + 8 + 18 * s, col, L + pw + 30, T + 17 + 18 * s, series[s].name);
-    }
-    OUT("</svg>\n");
-#undef OUT
-    bool ok = len < cap ? mr_file_write_atomic(path, o, len, err) : mr_fail(err, MR_ERR_NOMEM, "plot too large");
-    free(o);
-    return ok;
 }
 
 bool mr_montage_png(const char *path, const mr_image *const *images, int count, int cols, int tile_w, int tile_h,

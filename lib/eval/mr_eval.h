@@ -117,16 +117,78 @@ bool mr_eval_saliency_ratio(const mr_image *final, const mr_image *region, doubl
 
 /* ------------------------------------------------------------ reports */
 
+/* The q-quantile (q in [0,1], clamped) of the values of v[0..n) that are not
+ * NaN, linearly interpolated between order statistics: q = 0.5 is the median
+ * (the mean of the two middle values for an even count). Reorders v. NaN
+ * when no value is left. The one median of every bench (report.c). */
+double mr_quantile(double *v, int n, double q);
+double mr_median(double *v, int n);
+
+/* A CSV table built in memory and written atomically (report.c): optional
+ * "# " comment lines, one header line, then rows of cells. Cell writers
+ * append one cell each; mr_csv_end_row ends the row. Errors (out of memory,
+ * a row whose cell count differs from the header's) are kept and reported
+ * by mr_csv_save, which writes nothing then. All calls accept NULL. */
+typedef struct mr_csv mr_csv;
+mr_csv *mr_csv_create(mr_error *err);
+void mr_csv_destroy(mr_csv **csv);
+/* Each line of text as a "# " line (before the header, or between rows). */
+void mr_csv_comment(mr_csv *csv, const char *text);
+/* The header: column names separated by commas, written as given. */
+void mr_csv_header(mr_csv *csv, const char *columns);
+/* Text: quoted (RFC 4180, inner quotes doubled) when it holds a comma, a
+ * quote or a line break, starts with '#' or has outer spaces. */
+void mr_csv_text(mr_csv *csv, const char *s);
+/* Text, always quoted (free-form names such as file paths). */
+void mr_csv_quoted(mr_csv *csv, const char *s);
+/* A number in the printf format fmt (one double conversion, e.g. "%.4f";
+ * NULL: "%.17g"); NaN is written "nan", infinities "inf" and "-inf". */
+void mr_csv_num(mr_csv *csv, const char *fmt, double v);
+void mr_csv_int(mr_csv *csv, long long v);
+void mr_csv_end_row(mr_csv *csv);
+/* The text so far (never NULL) and its length. */
+const char *mr_csv_data(const mr_csv *csv, size_t *len);
+bool mr_csv_save(const mr_csv *csv, const char *path, mr_error *err);
+
+
+/* The one SVG plot writer (plot.c), written atomically. Text is XML-escaped.
+ * A point whose x or y is not finite (or not positive on a log axis) is
+ * skipped: no marker, no line segment to it, no effect on the range. */
+typedef enum mr_plot_mark { MR_PLOT_MARK_CIRCLE = 0, MR_PLOT_MARK_SQUARE, MR_PLOT_MARK_NONE } mr_plot_mark;
 typedef struct mr_plot_series {
-    const char *name;
+    const char *name;        /* legend entry; NULL or "": none */
     const double *x, *y;
     int count;
+    const char *color;       /* "#rrggbb"; NULL: the palette's colour of this series' index */
+    bool no_line;            /* markers only (a scatter); default: a polyline through the points */
+    bool dashed;             /* the polyline dashed */
+    mr_plot_mark mark;       /* default circles */
+    bool hollow;             /* markers filled white, outlined in the colour */
+    const char *point_label; /* text beside each marker, or NULL */
 } mr_plot_series;
-
-/* A line plot (one polyline with markers per series, legend), written
- * atomically as SVG. log_x: logarithmic x axis. */
+typedef struct mr_plot_params {
+    const char *title, *xlabel, *ylabel;
+    bool log_x, log_y;       /* logarithmic axes */
+    double x_min, x_max;     /* a fixed x range when x_max > x_min; else the data's */
+    double y_min, y_max;     /* the same for y; else the data's (linear: from min(0, data), +5%) */
+    int width, height;       /* px, default 760x480 */
+    int legend_width;        /* px right of the plot, default 170 */
+    const char *const *notes; /* note_count lines under the legend */
+    int note_count;
+} mr_plot_params;
+bool mr_plot_write(const char *path, const mr_plot_params *params, const mr_plot_series *series, int nseries, mr_error *err);
+/* The x-y plot with lines and markers; log_x: logarithmic x axis. */
 bool mr_plot_svg(const char *path, const char *title, const char *xlabel, const char *ylabel,
                  const mr_plot_series *series, int nseries, bool log_x, mr_error *err);
+/* Horizontal bars: one row per category, one bar per set (v[count] each,
+ * non-finite values left out), scaled to the largest value. */
+typedef struct mr_plot_bar_set {
+    const char *name;        /* legend */
+    const double *v;
+    const char *color;       /* NULL: the palette's */
+} mr_plot_bar_set;
+bool mr_plot_bars(const char *path, const char *title, const char *const *categories, int count, const mr_plot_bar_set *sets,
+                  int nsets, mr_error *err);
 
 /* Tiles F32x1 images (values in [0,1]) and RGB8 images, each resized by
  * nearest neighbour to tile_w x tile_h, into a PNG (grey, or RGB when any

@@ -187,6 +187,31 @@ bool mr_mesh_outline_dirs(const mr_mesh *m, float *out, mr_error *err);
 bool mr_demo_build(const mr_demo_params *params, mr_demo_hall *out, mr_error *err);
 void mr_demo_free(mr_demo_hall *hall);
 
+/* The demo's camera side (demo_camera.c). */
+/* AprilTag images (tag36h11, ids 0..count-1; count is clamped to the
+ * family's size), gray8 with the white border; *border gets its width in
+ * pixels. Free with mr_demo_tag_images_free. */
+bool mr_demo_tag_images(int count, mr_image **out, int *border, mr_error *err);
+void mr_demo_tag_images_free(mr_image *imgs, int count);
+/* mr_demo_build with tag plates for ids 0..tag_count-1 (0: MR_DEMO_TAGS, the
+ * demo hall's 16; params may be NULL: MR_DEMO_DEFAULTS; its tag image
+ * fields are replaced). */
+#define MR_DEMO_TAGS 16
+bool mr_demo_build_tagged(const mr_demo_params *params, int tag_count, mr_demo_hall *hall, mr_error *err);
+/* The demo tablet camera (640x480, mild barrel distortion) and its standing
+ * viewpoints (i is clamped to 0..mr_demo_view_count()-1). */
+mr_camera mr_demo_camera(void);
+#define MR_DEMO_VIEWS 5
+int mr_demo_view_count(void); /* MR_DEMO_VIEWS */
+mr_view mr_demo_view(int i);
+/* A camera frame (RGB8, cam's size) from n ideal pinhole renders (averaged:
+ * motion blur), each rendered with a margin of `margin` px per side at
+ * `scale` times the resolution: lens distortion of cam, [1 2 1] optical
+ * blur, exposure gain, Gaussian sensor noise (sigma in 8-bit levels, drawn
+ * from rng). */
+bool mr_demo_camera_frame(const mr_camera *cam, const mr_image *ideal, int n, int margin, int scale, double gain,
+                          double noise, mr_rng *rng, mr_image *out, mr_error *err);
+
 /* ------------------------------------------------------------ curvature */
 
 /* Per-vertex maximum principal curvature magnitude |kappa_max| of a mesh in

@@ -1,0 +1,718 @@
+/* mrcheck bench ao (mr_bench_ao): ambient occlusion, error against run time.
+ *
+ * Every method runs over a grid of sample counts (8..64), full and half
+ * resolution, corner masking off and on, on the reported views; each row of
+ * the CSV has the GPU time of the AO passes (timer queries, median of N
+ * frames) and RMSE, SSIM and signed bias against two ray-traced references
+ * (Embree): a fixed radius R in scene units, and a radius that grows with
+ * depth exactly like scheer's (the reference a depth-scaled method aims at).
+ * Free parameters (radius, strength, bias, and scheer's attenuation c) are
+ * tuned once per method for the lowest RMSE on a tuning view that is not
+ * reported, then frozen. Each method runs twice: with its radius tuned, and
+ * with its radius at the reference's own (R, or the depth-scaled fraction
+ * of the height), only strength / bias / c tuned, so a method cannot win by
+ * choosing a radius the reference does not use. Scheer & Keutel's three
+ * renderings: D1 = no AO (AO = 1; the AO maps compared here do not depend
+ * on the shading model), D2 = scheer with its depth-scaled radius (tuned,
+ * and paper-pure: no cosine bias, whole-ball uniform kernel, c = 1, default
+ * strength, the reference's radius, nothing tuned), D3 = "standard SSAO
+ * with a decreasing size of the sample radius in depth" = crytek
+ * (Mittring) with a constant view-space radius; scheer with a constant
+ * radius is an extra row (scheer-view), not D3. A second table times the
+ * AO pass alone on scenes of very different triangle counts. Measurements
+ * only: nothing here passes or fails. */
+
+#include "bench_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_VIEWS MR_BENCH_AO_MAX_VIEWS
+enum { MAXC = 16, MAXS = 4 };
+
+/* The methods raced. role: Scheer & Keutel's rendering it stands for, or
+ * "-". radius: TUNE_RADIUS (tuned with the rest), REF_RADIUS (the
+ * reference's own; the rest tuned) or PAPER (the reference's radius and
+ * the paper's parameters; nothing tuned). */
+enum { TUNE_RADIUS, REF_RADIUS, PAPER };
+typedef struct contender {
+    const char *label, *role;
+    mr_ao_method method;
+    mr_ao_radius_mode mode;
+    int radius;
+    mr_ao_params tuned;
+} contender;
+
+static const char *const k_radius_policy[3] = {"tuned", "reference", "reference"};
+
+static const contender k_contenders[] = {
+    {"scheer", "D2", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
+    {"scheer@R", "D2", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
+    {"scheer-paper", "D2", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, PAPER, {0}},
+    {"crytek", "D3", MR_AO_CRYTEK, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"crytek@R", "D3", MR_AO_CRYTEK, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"scheer-view", "-", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"scheer-view@R", "-", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"filion", "-", MR_AO_FILION, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"filion@R", "-", MR_AO_FILION, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"hbao", "-", MR_AO_HBAO, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"hbao@R", "-", MR_AO_HBAO, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"alchemy", "-", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"alchemy@R", "-", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+};
+#define NC (int)(sizeof k_contenders / sizeof k_contenders[0])
+_Static_assert(NC <= MAXC, "MAXC bounds the contenders");
+
+typedef struct view_data {
+    char name[256];
+    mr_view view;
+    mr_image depth, normal, gt_fixed, gt_screen;
+} view_data;
+
+/* Means over views for the plot and the summary: [contender][samples][res][mask]. */
+typedef double agg_table[MAXC][MAXS][2][2];
+
+/* One run of the bench: the settings, the scene, the references per view,
+ * the tuned contenders and what the steps measured. vd[0] is the tuning
+ * view, vd[1..nv] the reported ones. */
+typedef struct ao_bench {
+    mr_bench_ao_params p;
+    int w, h;
+    double radius, screen_radius;
+    const int *samples;
+    int nsamp, nres, s16; /* s16: the reported sample count's index */
+    mr_scene *scene;
+    mr_demo_hall hall;
+    mr_bench_gpu gfx; /* the caller's */
+    mr_eval_gt *gt;
+    double t0;
+    int nv;
+    view_data vd[MAX_VIEWS + 1];
+    contender cs[NC];
+    agg_table agg_ms, agg_rf, agg_rs, agg_sf, agg_ss, agg_bf, agg_bs, agg_mf;
+    double pv_rf[MAX_VIEWS + 1][MAXC + 1], pv_rs[MAX_VIEWS + 1][MAXC + 1]; /* per view, reported samples, full, mask off */
+    double none_rf, none_rs, none_sf, none_ss, none_bf, none_bs;
+    mr_image *montage[MAX_VIEWS * 10];
+    bool owned[MAX_VIEWS * 10]; /* montage tiles this run allocated */
+    int nmont;
+    double tri_ms[4], tri_gb[4];
+    uint64_t tri_count[4];
+    int ntri;
+    mr_image ao; /* scratch: the last AO map */
+} ao_bench;
+
+/* Renders `frames` timed frames (plus one warm-up) and returns the median
+ * GPU ms of the AO passes (0 untimed); the last frame's AO goes to *ao. */
+static bool run_ao(mr_renderer *r, const mr_view *v, const mr_ao_params *ao, int w, int h, int frames, double *ms,
+                   mr_image *out_ao, double *masked, mr_error *err) {
+    mr_frame_params fp = MR_FRAME_DEFAULTS;
+    fp.width = w;
+    fp.height = h;
+    fp.timing = frames > 0;
+    fp.ao = *ao;
+    fp.ao.no_reuse = true;
+    fp.ao.want_ao = true;
+    double t[64];
+    int n = frames < 64 ? frames : 64;
+    for (int f = -1; f < (n > 0 ? n : 0); f++) {
+        mr_frame_result res;
+        if (!mr_render_frame(r, v, &fp, &res, err)) return false;
+        double s = 0;
+        for (int k = 0; k < res.pass_count; k++)
+            if (strncmp(res.passes[k], "ao", 2) == 0) s += res.gpu_ms[k];
+        if (f >= 0) t[f] = s;
+        if (f == n - 1 || n <= 0) {
+            mr_image_free(out_ao);
+            *out_ao = res.ao;
+            res.ao.data = NULL;
+            if (masked) *masked = res.ao_masked_fraction;
+        }
+        mr_frame_result_free(&res);
+    }
+    *ms = n > 0 ? mr_median(t, n) : 0; /* untimed runs report 0 ms */
+    return true;
+}
+
+static bool metrics(const mr_image *ao, const view_data *vd, mr_image_metrics *mf, mr_image_metrics *ms, mr_error *err) {
+    return mr_image_compare(ao, &vd->gt_fixed, &vd->depth, mf, err) &&
+           mr_image_compare(ao, &vd->gt_screen, &vd->depth, ms, err);
+}
+
+/* A wavy terrain of 2 n^2 triangles covering 40 x 40 units, plus 9 boxes of
+ * 12 triangles: the same picture at any n, so only the triangle count
+ * changes between the scenes of the triangle-count table. */
+static mr_scene *terrain_scene(int n, mr_error *err) {
+    mr_scene *s = mr_scene_create();
+    mr_mesh m;
+    memset(&m, 0, sizeof m);
+    snprintf(m.name, sizeof m.name, "terrain%d", n);
+    m.material = -1;
+    m.vertex_count = (uint32_t)((n + 1) * (n + 1));
+    m.index_count = (uint32_t)(6 * n * n);
+    m.positions = malloc((size_t)m.vertex_count * 3 * sizeof(float));
+    m.indices = malloc((size_t)m.index_count * sizeof(uint32_t));
+    if (!m.positions || !m.indices) {
+        free(m.positions);
+        free(m.indices);
+        mr_scene_destroy(&s);
+        mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    for (int j = 0; j <= n; j++)
+        for (int i = 0; i <= n; i++) {
+            float *p = m.positions + 3 * (size_t)(j * (n + 1) + i);
+            double x = -20 + 40.0 * i / n, z = -20 + 40.0 * j / n;
+            p[0] = (float)x;
+            p[1] = (float)(0.4 * sin(0.7 * x) * cos(0.5 * z));
+            p[2] = (float)z;
+        }
+    uint32_t *ix = m.indices;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            uint32_t a = (uint32_t)(j * (n + 1) + i), b = a + 1, c = a + (uint32_t)(n + 1), d = c + 1;
+            *ix++ = a; *ix++ = c; *ix++ = b;
+            *ix++ = b; *ix++ = c; *ix++ = d;
+        }
+    int32_t t = mr_scene_add_mesh(s, &m, err);
+    mr_node nd;
+    memset(&nd, 0, sizeof nd);
+    nd.parent = -1;
+    nd.world = mr_m4_identity();
+    nd.mesh_first = t;
+    nd.mesh_count = 1;
+    snprintf(nd.name, sizeof nd.name, "terrain");
+    if (t < 0 || mr_scene_add_node(s, &nd) < 0) {
+        mr_scene_destroy(&s);
+        return NULL;
+    }
+    mr_scene_update_bounds(s);
+    return s;
+}
+
+/* contender,role,radius_policy,tuned */
+static void csv_contender(mr_csv *csv, const contender *c) {
+    mr_csv_text(csv, c->label);
+    mr_csv_text(csv, c->role);
+    mr_csv_text(csv, k_radius_policy[c->radius]);
+    mr_csv_text(csv, c->radius == PAPER ? "no" : "yes");
+}
+
+/* radius_mode,radius,screen_radius,strength,bias,c,kernel,r_min,r_max */
+static void csv_params(mr_csv *csv, const mr_ao_params *p) {
+    mr_csv_text(csv, p->radius_mode == MR_AO_RADIUS_SCREEN ? "screen" : "view");
+    const double v[5] = {p->radius, p->screen_radius, p->strength, p->bias, p->c};
+    for (int k = 0; k < 5; k++) mr_csv_num(csv, "%g", v[k]);
+    mr_csv_text(csv, mr_ao_kernel_name(p->kernel));
+    mr_csv_num(csv, "%g", p->r_min);
+    mr_csv_num(csv, "%g", p->r_max);
+}
+
+static bool save_csv(mr_csv *csv, const char *dir, const char *name, mr_error *err) {
+    char path[4096];
+    mr_path_join(dir, name, path, sizeof path);
+    bool ok = mr_csv_save(csv, path, err);
+    mr_csv_destroy(&csv);
+    return ok;
+}
+
+/* Step 0: the tuning view vd[0], the reported views, the scene and the
+ * reference's fixed radius (2% of the scene diagonal unless given). */
+static bool ao_setup(ao_bench *b, mr_error *err) {
+    const mr_bench_ao_params *p = &b->p;
+    if (p->view_count > MAX_VIEWS) return mr_fail(err, MR_ERR_INVALID, "bench ao: at most %d views", MAX_VIEWS);
+    if (p->tune_view) {
+        b->vd[0].view = *p->tune_view;
+        snprintf(b->vd[0].name, sizeof b->vd[0].name, "%s", p->tune_name ? p->tune_name : "tune-view");
+    } else {
+        b->vd[0].view = mr_demo_view(2);
+        snprintf(b->vd[0].name, sizeof b->vd[0].name, "demo-tune(north wall)");
+    }
+    if (p->view_count > 0) {
+        for (b->nv = 0; b->nv < p->view_count; b->nv++) {
+            b->vd[b->nv + 1].view = p->views[b->nv];
+            snprintf(b->vd[b->nv + 1].name, sizeof b->vd[0].name, "%s",
+                     p->view_names && p->view_names[b->nv] ? p->view_names[b->nv] : "view");
+        }
+    } else {
+        static const int idx[3] = {0, 1, 4};
+        static const char *const names[3] = {"demo-near(partition)", "demo-mid(down the hall)", "demo-far(overview)"};
+        for (b->nv = 0; b->nv < 3; b->nv++) {
+            b->vd[b->nv + 1].view = mr_demo_view(idx[b->nv]);
+            snprintf(b->vd[b->nv + 1].name, sizeof b->vd[0].name, "%s", names[b->nv]);
+        }
+    }
+    if (p->scene) {
+        if (!(b->scene = mr_scene_load(p->scene, NULL, err))) return false;
+    } else {
+        if (!mr_demo_build_tagged(NULL, 0, &b->hall, err)) return false;
+        b->scene = b->hall.planned;
+    }
+    if (!(b->radius > 0)) {
+        const mr_scene *s = b->scene;
+        double d2 = 0;
+        for (int i = 0; i < 3; i++) d2 += (s->bounds_max[i] - s->bounds_min[i]) * (s->bounds_max[i] - s->bounds_min[i]);
+        b->radius = d2 > 0 ? 0.02 * sqrt(d2) : 1;
+    }
+    return mr_mkdirs(p->out_dir, err) &&
+           mr_renderer_set_scene(b->gfx.renderer, b->scene, err) && (b->gt = mr_eval_gt_create(b->scene, false, err));
+}
+
+/* Step 1: G-buffer and both ray-traced references for every view. */
+static bool ao_references(ao_bench *b, mr_error *err) {
+    bool ok = true;
+    for (int i = 0; ok && i <= b->nv; i++) {
+        view_data *vd = &b->vd[i];
+        mr_frame_params fp = MR_FRAME_DEFAULTS;
+        fp.width = b->w;
+        fp.height = b->h;
+        fp.want_depth = fp.want_normals = true;
+        mr_frame_result res;
+        if (!mr_render_frame(b->gfx.renderer, &vd->view, &fp, &res, err)) return false;
+        vd->depth = res.depth;
+        vd->normal = res.normal;
+        res.depth.data = res.normal.data = NULL;
+        mr_frame_result_free(&res);
+        mr_gt_params gp = MR_GT_DEFAULTS;
+        gp.rays = b->p.rays;
+        gp.radius = b->radius;
+        ok = mr_eval_ao_groundtruth(b->gt, &vd->view, &vd->depth, &vd->normal, &gp, &vd->gt_fixed, err);
+        gp.radius_mode = MR_AO_RADIUS_SCREEN;
+        gp.screen_radius = b->screen_radius;
+        ok = ok && mr_eval_ao_groundtruth(b->gt, &vd->view, &vd->depth, &vd->normal, &gp, &vd->gt_screen, err);
+    }
+    if (ok)
+        BENCH_PRINT(b->p.out, "bench ao: %s, %dx%d, %llu triangles; ground truth (%d rays, R = %g, screen %g) for %d views in %.1f s\n",
+                    mr_gpu_description(b->gfx.gpu), b->w, b->h, (unsigned long long)mr_scene_triangle_count(b->scene),
+                    b->p.rays, b->radius, b->screen_radius, b->nv + 1, mr_time_now() - b->t0);
+    return ok;
+}
+
+/* Step 2: tuning on vd[0]: radius (unless fixed at the reference's),
+ * strength, bias and (scheer) c for the lowest RMSE against the reference
+ * of the method's own radius mode (bench_ao_tuning.csv). */
+static bool ao_tune(ao_bench *b, mr_error *err) {
+    const bool quick = b->p.quick;
+    const double rscale[] = {1, 0.5, 2, 0.25}, strengths[] = {0.5, 1, 1.5, 2, 3, 4, 6, 8, 12}, biases[] = {0.02, 0.1},
+                 cvals[] = {1, 0.25, 4};
+    const int nr = quick ? 3 : 4, ns = quick ? 2 : 9, nb = quick ? 1 : 2;
+    const double qs[] = {1, 3};
+    const view_data *vd = &b->vd[0];
+    mr_csv *tune = mr_csv_create(err);
+    if (!tune) return false;
+    mr_csv_comment(tune, "rmse_own_reference: RMSE on the tuning view against the reference of the method's radius mode");
+    mr_csv_header(tune, "contender,role,radius_policy,tuned,radius_mode,radius,screen_radius,strength,bias,c,kernel,r_min,r_max,"
+                        "rmse_own_reference");
+    bool ok = true;
+    for (int c = 0; ok && c < NC; c++) {
+        contender *cs = &b->cs[c];
+        double best = INFINITY;
+        bool paper = cs->radius == PAPER;
+        /* The radius grid's first entry is the reference's own radius. */
+        int na = cs->radius == TUNE_RADIUS ? nr : 1, nbb = paper ? 1 : ns, nk = paper ? 1 : nb,
+            ncv = cs->method == MR_AO_SCHEER && !paper ? 3 : 1;
+        for (int a = 0; ok && a < na; a++)
+            for (int bi = 0; ok && bi < nbb; bi++)
+                for (int k = 0; ok && k < nk; k++)
+                    for (int cv = 0; ok && cv < ncv; cv++) {
+                        mr_ao_params p = MR_AO_DEFAULTS;
+                        p.method = cs->method;
+                        p.radius_mode = cs->mode;
+                        p.radius = b->radius * rscale[a];
+                        p.screen_radius = b->screen_radius * rscale[a];
+                        p.strength = (float)(quick ? qs[bi] : strengths[bi]);
+                        p.bias = (float)biases[k];
+                        p.c = (float)cvals[cv];
+                        if (paper) {
+                            /* Scheer & Keutel as printed: cosine weight without a
+                             * bias, offsets uniform in the ball (the hemisphere
+                             * after the flip), c = 1, the method's default strength. */
+                            p.strength = 0;
+                            p.bias = 0;
+                            p.c = 1;
+                            p.kernel = MR_AO_KERNEL_UNIFORM;
+                            p.r_min = 0;
+                            p.r_max = 1;
+                        }
+                        double ms;
+                        mr_image_metrics m;
+                        ok = run_ao(b->gfx.renderer, &vd->view, &p, b->w, b->h, 0, &ms, &b->ao, NULL, err) &&
+                             mr_image_compare(&b->ao, cs->mode == MR_AO_RADIUS_SCREEN ? &vd->gt_screen : &vd->gt_fixed,
+                                              &vd->depth, &m, err);
+                        if (!ok) break;
+                        csv_contender(tune, cs);
+                        csv_params(tune, &p);
+                        mr_csv_num(tune, "%.5f", m.rmse);
+                        mr_csv_end_row(tune);
+                        if (m.rmse < best) {
+                            best = m.rmse;
+                            cs->tuned = p;
+                        }
+                    }
+        if (ok && b->p.verbose)
+            BENCH_PRINT(b->p.out, "  tuned %-14s radius %g screen %g strength %g bias %g c %g: RMSE %.4f\n", cs->label,
+                        cs->tuned.radius, cs->tuned.screen_radius, cs->tuned.strength, cs->tuned.bias, cs->tuned.c, best);
+    }
+    if (!ok) {
+        mr_csv_destroy(&tune);
+        return false;
+    }
+    return save_csv(tune, b->p.out_dir, "bench_ao_tuning.csv", err);
+}
+
+/* One reported view of step 3: plain shading (D1: AO = 1 everywhere), then
+ * every contender over samples x resolution x mask. */
+static bool ao_grid_view(ao_bench *b, int v, mr_csv *csv, mr_error *err) {
+    view_data *vd = &b->vd[v];
+    const int nv = b->nv, w = b->w, h = b->h, frames = b->p.frames;
+    mr_ao_params p0 = MR_AO_DEFAULTS;
+    double ms = 0;
+    mr_image_metrics mf, msr;
+    if (!run_ao(b->gfx.renderer, &vd->view, &p0, w, h, 0, &ms, &b->ao, NULL, err) || !metrics(&b->ao, vd, &mf, &msr, err))
+        return false;
+    mr_csv_quoted(csv, vd->name);
+    static const char *const d1[] = {"none", "D1", "-", "no", "", "", "", "", "", "", "", "", "", "0", "full", "off"};
+    for (int k = 0; k < (int)(sizeof d1 / sizeof d1[0]); k++) mr_csv_text(csv, d1[k]);
+    mr_csv_int(csv, w);
+    mr_csv_int(csv, h);
+    mr_csv_int(csv, 0);
+    mr_csv_int(csv, 0);
+    const double d1m[6] = {mf.rmse, mf.ssim, mf.bias, msr.rmse, msr.ssim, msr.bias};
+    for (int k = 0; k < 6; k++) mr_csv_num(csv, "%.5f", d1m[k]);
+    mr_csv_int(csv, -1);
+    mr_csv_end_row(csv);
+    b->pv_rf[v][0] = mf.rmse;
+    b->pv_rs[v][0] = msr.rmse;
+    b->none_rf += mf.rmse / nv;
+    b->none_rs += msr.rmse / nv;
+    b->none_sf += mf.ssim / nv;
+    b->none_ss += msr.ssim / nv;
+    b->none_bf += mf.bias / nv;
+    b->none_bs += msr.bias / nv;
+    b->montage[b->nmont++] = &vd->gt_fixed;
+    b->montage[b->nmont++] = &vd->gt_screen;
+    for (int c = 0; c < NC; c++)
+        for (int si = 0; si < b->nsamp; si++)
+            for (int res = 0; res < b->nres; res++)
+                for (int mk = 0; mk < 2; mk++) {
+                    mr_ao_params p = b->cs[c].tuned;
+                    p.samples = b->samples[si];
+                    p.half_res = res == 1;
+                    p.mask = mk ? MR_AO_MASK_ON : MR_AO_MASK_OFF;
+                    double masked = -1;
+                    if (!run_ao(b->gfx.renderer, &vd->view, &p, w, h, frames, &ms, &b->ao, &masked, err) ||
+                        !metrics(&b->ao, vd, &mf, &msr, err))
+                        return false;
+                    mr_csv_quoted(csv, vd->name);
+                    csv_contender(csv, &b->cs[c]);
+                    csv_params(csv, &p);
+                    mr_csv_int(csv, p.samples);
+                    mr_csv_text(csv, res ? "half" : "full");
+                    mr_csv_text(csv, mk ? "on" : "off");
+                    mr_csv_int(csv, w);
+                    mr_csv_int(csv, h);
+                    mr_csv_num(csv, "%.4f", ms);
+                    mr_csv_int(csv, frames);
+                    const double m6[6] = {mf.rmse, mf.ssim, mf.bias, msr.rmse, msr.ssim, msr.bias};
+                    for (int k = 0; k < 6; k++) mr_csv_num(csv, "%.5f", m6[k]);
+                    mr_csv_num(csv, "%.4f", masked);
+                    mr_csv_end_row(csv);
+                    b->agg_ms[c][si][res][mk] += ms / nv;
+                    b->agg_rf[c][si][res][mk] += mf.rmse / nv;
+                    b->agg_rs[c][si][res][mk] += msr.rmse / nv;
+                    b->agg_sf[c][si][res][mk] += mf.ssim / nv;
+                    b->agg_ss[c][si][res][mk] += msr.ssim / nv;
+                    b->agg_bf[c][si][res][mk] += mf.bias / nv;
+                    b->agg_bs[c][si][res][mk] += msr.bias / nv;
+                    b->agg_mf[c][si][res][mk] += masked / nv;
+                    if (si == b->s16 && res == 0 && mk == 0) {
+                        b->pv_rf[v][c + 1] = mf.rmse;
+                        b->pv_rs[v][c + 1] = msr.rmse;
+                    }
+                    if (si == b->s16 && res == 0 && mk == 0 && b->nmont < MAX_VIEWS * 10) {
+                        mr_image *keep = malloc(sizeof *keep);
+                        if (keep) {
+                            *keep = b->ao;
+                            b->ao.data = NULL;
+                            b->owned[b->nmont] = true;
+                            b->montage[b->nmont++] = keep;
+                        }
+                    }
+                }
+    return true;
+}
+
+/* Step 3: the grid on the reported views (bench_ao.csv). */
+static bool ao_grid(ao_bench *b, mr_error *err) {
+    mr_csv *csv = mr_csv_create(err);
+    if (!csv) return false;
+    mr_csv_comment(csv, "role: Scheer & Keutel's D1 (no AO), D2 (scheer, depth-scaled radius), D3 (standard SSAO = crytek, "
+                        "constant radius) or -; radius_policy: tuned, or the reference's own radius; tuned: no = the paper's "
+                        "parameters; strength <= 0: the method's default; *_fixed: against ray-traced AO with fixed R, *_screen: with "
+                        "the depth-scaled R");
+    mr_csv_header(csv, "view,contender,role,radius_policy,tuned,radius_mode,radius,screen_radius,strength,bias,c,kernel,r_min,"
+                       "r_max,samples,resolution,mask,width,height,"
+                       "gpu_ms_median,frames,rmse_fixed,ssim_fixed,bias_fixed,rmse_screen,ssim_screen,bias_screen,masked_fraction");
+    for (int v = 1; v <= b->nv; v++) {
+        if (!ao_grid_view(b, v, csv, err)) {
+            mr_csv_destroy(&csv);
+            return false;
+        }
+        if (b->p.progress) fprintf(stderr, "bench ao: view %d/%d done (%.0f s)\n", v, b->nv, mr_time_now() - b->t0);
+    }
+    return save_csv(csv, b->p.out_dir, "bench_ao.csv", err);
+}
+
+/* Step 4: AO cost against triangle count (scheer, 16 samples, full
+ * resolution) on terrains of 128, 20k and 2M triangles and on the scene
+ * (bench_ao_triangles.csv). */
+static bool ao_triangles(ao_bench *b, mr_error *err) {
+    mr_csv *tcsv = mr_csv_create(err);
+    if (!tcsv) return false;
+    mr_csv_header(tcsv, "scene,triangles,ao_gpu_ms_median,gbuffer_gpu_ms_median,width,height,frames");
+    const int grid_n[] = {8, 100, 1000};
+    const int n = b->p.frames;
+    bool ok = true;
+    for (int gi = 0; ok && gi < 4; gi++) {
+        mr_scene *ts = gi < 3 ? terrain_scene(grid_n[gi], err) : b->scene;
+        if (!ts) { ok = false; break; }
+        mr_view tv;
+        tv.camera = mr_demo_camera();
+        tv.world_from_camera = mr_m4_look_at_cv(mr_v3(-15, 6, -15), mr_v3(5, 0, 5), mr_v3(0, 1, 0));
+        if (gi == 3) tv = b->vd[1].view;
+        ok = mr_renderer_set_scene(b->gfx.renderer, ts, err);
+        mr_frame_params fp = MR_FRAME_DEFAULTS;
+        fp.width = b->w;
+        fp.height = b->h;
+        fp.timing = true;
+        fp.ao = b->cs[0].tuned;
+        fp.ao.samples = 16;
+        fp.ao.no_reuse = true;
+        double aoms[64], gbms[64];
+        for (int f = -1; ok && f < n; f++) {
+            mr_frame_result res;
+            ok = mr_render_frame(b->gfx.renderer, &tv, &fp, &res, err);
+            if (!ok) break;
+            double a = 0, g = 0;
+            for (int k = 0; k < res.pass_count; k++) {
+                if (strncmp(res.passes[k], "ao", 2) == 0) a += res.gpu_ms[k];
+                if (strcmp(res.passes[k], "gbuffer") == 0) g += res.gpu_ms[k];
+            }
+            if (f >= 0) { aoms[f] = a; gbms[f] = g; }
+            b->tri_count[b->ntri] = res.triangles;
+            mr_frame_result_free(&res);
+        }
+        if (ok) {
+            b->tri_ms[b->ntri] = mr_median(aoms, n);
+            b->tri_gb[b->ntri] = mr_median(gbms, n);
+            mr_csv_text(tcsv, gi < 3 ? "terrain" : "scene");
+            mr_csv_int(tcsv, (long long)b->tri_count[b->ntri]);
+            mr_csv_num(tcsv, "%.4f", b->tri_ms[b->ntri]);
+            mr_csv_num(tcsv, "%.4f", b->tri_gb[b->ntri]);
+            mr_csv_int(tcsv, b->w);
+            mr_csv_int(tcsv, b->h);
+            mr_csv_int(tcsv, n);
+            mr_csv_end_row(tcsv);
+            b->ntri++;
+        }
+        mr_renderer_set_scene(b->gfx.renderer, NULL, NULL);
+        if (gi < 3) mr_scene_destroy(&ts);
+    }
+    if (!ok) {
+        mr_csv_destroy(&tcsv);
+        return false;
+    }
+    return save_csv(tcsv, b->p.out_dir, "bench_ao_triangles.csv", err);
+}
+
+/* Step 5: error against GPU time, one plot per reference (bench_ao.svg,
+ * bench_ao_screen.svg), and the AO montage (bench_ao_montage.png). */
+static bool ao_plots(ao_bench *b, mr_error *err) {
+    char path[4096];
+    bool ok = true;
+    for (int ref = 0; ok && ref < 2; ref++) {
+        mr_plot_series ser[2 * MAXC];
+        memset(ser, 0, sizeof ser); /* fields not set here take their defaults */
+        static double xs[2 * MAXC][MAXS], ys[2 * MAXC][MAXS];
+        static char names[2 * MAXC][64];
+        int nser = 0;
+        for (int c = 0; c < NC; c++)
+            for (int res = 0; res < b->nres; res++) {
+                for (int si = 0; si < b->nsamp; si++) {
+                    xs[nser][si] = b->agg_ms[c][si][res][0];
+                    ys[nser][si] = ref ? b->agg_rs[c][si][res][0] : b->agg_rf[c][si][res][0];
+                }
+                snprintf(names[nser], sizeof names[nser], "%s%s", b->cs[c].label, res ? " half" : "");
+                ser[nser].name = names[nser];
+                ser[nser].x = xs[nser];
+                ser[nser].y = ys[nser];
+                ser[nser].count = b->nsamp;
+                nser++;
+            }
+        char title[256];
+        snprintf(title, sizeof title, "AO error vs GPU time, %dx%d, samples %d..%d, mean of %d views; reference: %s", b->w, b->h,
+                 b->samples[0], b->samples[b->nsamp - 1], b->nv, ref ? "depth-scaled R" : "fixed R");
+        mr_path_join(b->p.out_dir, ref ? "bench_ao_screen.svg" : "bench_ao.svg", path, sizeof path);
+        ok = mr_plot_svg(path, title, "AO passes, GPU ms (median)", "RMSE against ray-traced AO", ser, nser, true, err);
+    }
+    mr_path_join(b->p.out_dir, "bench_ao_montage.png", path, sizeof path);
+    return ok && mr_montage_png(path, (const mr_image *const *)b->montage, b->nmont, 2 + NC, b->w, b->h, err);
+}
+
+/* Step 6: Scheer & Keutel's three renderings, shaded as in the paper (Phong
+ * with specular): D1 no AO, D2 scheer, D3 standard SSAO (crytek, constant
+ * radius), plus scheer-paper; 16 samples, one row per view
+ * (bench_ao_shaded.png). */
+static bool ao_shaded(ao_bench *b, mr_error *err) {
+    const int shaded_c[3] = {0, 3, 2};
+    mr_image shots[MAX_VIEWS * 4];
+    const mr_image *tiles[MAX_VIEWS * 4];
+    int nshot = 0;
+    bool ok = mr_renderer_set_scene(b->gfx.renderer, b->scene, err); /* step 4 changed it */
+    for (int v = 1; ok && v <= b->nv; v++)
+        for (int k = 0; ok && k < 4; k++) {
+            mr_frame_params fp = MR_FRAME_DEFAULTS;
+            fp.width = b->w;
+            fp.height = b->h;
+            fp.specular = 0.35f;
+            if (k > 0) {
+                fp.ao = b->cs[shaded_c[k - 1]].tuned;
+                fp.ao.samples = 16;
+                fp.ao.no_reuse = true;
+            }
+            mr_frame_result res;
+            ok = mr_render_frame(b->gfx.renderer, &b->vd[v].view, &fp, &res, err);
+            if (!ok) break;
+            shots[nshot] = res.color;
+            res.color.data = NULL;
+            tiles[nshot] = &shots[nshot];
+            nshot++;
+            mr_frame_result_free(&res);
+        }
+    char path[4096];
+    mr_path_join(b->p.out_dir, "bench_ao_shaded.png", path, sizeof path);
+    if (ok) ok = mr_montage_png(path, tiles, nshot, 4, b->w, b->h, err);
+    for (int i = 0; i < nshot; i++) mr_image_free(&shots[i]);
+    return ok;
+}
+
+/* Step 7: the summary table (bench_ao.md, also printed). */
+static bool ao_summary(ao_bench *b, mr_error *err) {
+    char path[4096];
+    bool ok;
+    static char md[65536];
+    size_t len = 0;
+    len += (size_t)snprintf(md + len, sizeof md - len,
+                            "AO at %dx%d, %d samples (%s), mean over %d views; tuned on '%s'\n\n"
+                            "D1 = no AO, D2 = scheer (depth-scaled radius), D3 = standard SSAO (crytek, constant "
+                            "radius), as Scheer & Keutel name them. `@R`: the radius is the reference's own (R = %g "
+                            "units, or %g of the height), only strength / bias / c tuned; `scheer-paper`: the "
+                            "paper's parameters (bias 0, whole-ball uniform kernel, c 1, default strength), nothing "
+                            "tuned.\n\n"
+                            "| method | role | radius | strength | bias | c | kernel | res | mask | GPU ms | RMSE fixed R | SSIM fixed | bias fixed | RMSE depth-scaled R | SSIM d-s | bias d-s | masked |\n"
+                            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+                            b->w, b->h, b->samples[b->p.quick ? 0 : 1], "GPU ms: median of timer queries", b->nv, b->vd[0].name, b->radius,
+                            b->screen_radius);
+    len += (size_t)snprintf(md + len, sizeof md - len, "| none | D1 | - | - | - | - | - | full | off | 0 | %.4f | %.3f | %+.4f | %.4f | %.3f | %+.4f | - |\n",
+                            b->none_rf, b->none_sf, b->none_bf, b->none_rs, b->none_ss, b->none_bs);
+    const int s16 = b->s16;
+    for (int c = 0; c < NC; c++)
+        for (int res = 0; res < b->nres; res++)
+            for (int mk = 0; mk < 2; mk++) {
+                char rad[64];
+                if (b->cs[c].mode == MR_AO_RADIUS_SCREEN) snprintf(rad, sizeof rad, "%.3g of height", b->cs[c].tuned.screen_radius);
+                else snprintf(rad, sizeof rad, "%.3g units", b->cs[c].tuned.radius);
+                if (b->cs[c].radius != TUNE_RADIUS) snprintf(rad + strlen(rad), sizeof rad - strlen(rad), " (ref.)");
+                char kern[64], strength[32] = "default";
+                if (b->cs[c].tuned.strength > 0) snprintf(strength, sizeof strength, "%g", b->cs[c].tuned.strength);
+                snprintf(kern, sizeof kern, "%s [%g,%g]", mr_ao_kernel_name(b->cs[c].tuned.kernel), b->cs[c].tuned.r_min,
+                         b->cs[c].tuned.r_max);
+                char masked[32] = "-";
+                if (mk) snprintf(masked, sizeof masked, "%.3f", b->agg_mf[c][s16][res][mk]);
+                len += (size_t)snprintf(md + len, sizeof md - len,
+                                        "| %s | %s | %s | %s | %g | %g | %s | %s | %s | %.2f | %.4f | %.3f | %+.4f | %.4f | %.3f | %+.4f | %s |\n",
+                                        b->cs[c].label, b->cs[c].role, rad, strength, b->cs[c].tuned.bias,
+                                        b->cs[c].tuned.c, kern, res ? "half" : "full",
+                                        mk ? "on" : "off", b->agg_ms[c][s16][res][mk], b->agg_rf[c][s16][res][mk],
+                                        b->agg_sf[c][s16][res][mk], b->agg_bf[c][s16][res][mk], b->agg_rs[c][s16][res][mk],
+                                        b->agg_ss[c][s16][res][mk], b->agg_bs[c][s16][res][mk], masked);
+            }
+    len += (size_t)snprintf(md + len, sizeof md - len, "\nRMSE per view (fixed R / depth-scaled R), %d samples, full resolution, mask off:\n\n| view | none |",
+                            b->samples[s16]);
+    for (int c = 0; c < NC; c++) len += (size_t)snprintf(md + len, sizeof md - len, " %s |", b->cs[c].label);
+    len += (size_t)snprintf(md + len, sizeof md - len, "\n|---|---|");
+    for (int c = 0; c < NC; c++) len += (size_t)snprintf(md + len, sizeof md - len, "---|");
+    for (int v = 1; v <= b->nv; v++) {
+        len += (size_t)snprintf(md + len, sizeof md - len, "\n| %s |", b->vd[v].name);
+        for (int c = 0; c <= NC; c++)
+            len += (size_t)snprintf(md + len, sizeof md - len, " %.4f / %.4f |", b->pv_rf[v][c], b->pv_rs[v][c]);
+    }
+    len += (size_t)snprintf(md + len, sizeof md - len, "\n");
+    len += (size_t)snprintf(md + len, sizeof md - len, "\nAO passes against triangle count (scheer, 16 samples, %dx%d):\n\n"
+                                                       "| triangles | AO GPU ms | G-buffer GPU ms |\n|---|---|---|\n", b->w, b->h);
+    for (int i = 0; i < b->ntri; i++)
+        len += (size_t)snprintf(md + len, sizeof md - len, "| %llu | %.2f | %.2f |\n", (unsigned long long)b->tri_count[i],
+                                b->tri_ms[i], b->tri_gb[i]);
+    if (b->p.out) fputs(md, b->p.out);
+    mr_path_join(b->p.out_dir, "bench_ao.md", path, sizeof path);
+    ok = mr_file_write_atomic(path, md, len, err);
+    if (ok) BENCH_PRINT(b->p.out, "\nwrote %s/bench_ao.csv, bench_ao_tuning.csv, bench_ao_triangles.csv, bench_ao.svg, bench_ao_screen.svg, "
+                   "bench_ao_montage.png (rows: views; columns: reference fixed R, reference depth-scaled R, then "
+                   "%d methods at %d samples), bench_ao_shaded.png (Phong-shaded D1, D2, D3, scheer-paper), "
+                   "bench_ao.md in %.0f s\n", b->p.out_dir, NC, b->samples[b->p.quick ? 0 : 1], mr_time_now() - b->t0);
+    return ok;
+}
+
+
+static void ao_free(ao_bench *b) {
+    for (int i = 0; i < b->nmont; i++)
+        if (b->owned[i]) {
+            mr_image_free(b->montage[i]);
+            free(b->montage[i]);
+        }
+    for (int i = 0; i <= b->nv; i++) {
+        mr_image_free(&b->vd[i].depth);
+        mr_image_free(&b->vd[i].normal);
+        mr_image_free(&b->vd[i].gt_fixed);
+        mr_image_free(&b->vd[i].gt_screen);
+    }
+    mr_image_free(&b->ao);
+    mr_eval_gt_destroy(&b->gt);
+    if (b->gfx.renderer) mr_renderer_set_scene(b->gfx.renderer, NULL, NULL); /* the scene goes now */
+    if (b->hall.planned) mr_demo_free(&b->hall);
+    else mr_scene_destroy(&b->scene);
+    free(b);
+}
+
+bool mr_bench_ao(const mr_bench_ao_params *params, mr_error *err) {
+    const mr_bench_ao_params dflt = {MR_BENCH_AO_DEFAULTS};
+    ao_bench *b = calloc(1, sizeof *b);
+    if (!b) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    b->p = params ? *params : dflt;
+    mr_bench_ao_params *p = &b->p;
+    b->gfx = p->gfx;
+    if (!bench_gpu_check(&b->gfx, "bench ao", err)) {
+        free(b);
+        return false;
+    }
+    if (!p->out_dir) p->out_dir = dflt.out_dir;
+    if (p->width <= 0 || p->height <= 0) p->width = dflt.width, p->height = dflt.height;
+    if (p->frames <= 0) p->frames = dflt.frames;
+    if (p->frames > 64) p->frames = 64; /* run_ao keeps at most 64 samples */
+    if (p->rays <= 0) p->rays = dflt.rays;
+    b->w = p->width;
+    b->h = p->height;
+    b->radius = p->radius;
+    b->screen_radius = p->screen_radius > 0 ? p->screen_radius : dflt.screen_radius;
+    static const int samples_full[] = {8, 16, 32, 64}, samples_quick[] = {8, 32};
+    b->samples = p->quick ? samples_quick : samples_full;
+    b->nsamp = p->quick ? 2 : 4;
+    b->nres = p->quick ? 1 : 2;
+    b->s16 = p->quick ? 0 : 1;
+    memcpy(b->cs, k_contenders, sizeof b->cs);
+    b->t0 = mr_time_now();
+    bool ok = ao_setup(b, err) && ao_references(b, err) && ao_tune(b, err) && ao_grid(b, err) && ao_triangles(b, err) &&
+              ao_plots(b, err) && ao_shaded(b, err) && ao_summary(b, err);
+    ao_free(b);
+    return ok;
+}

@@ -1,0 +1,134 @@
+/* mr_bench.h — the `mrcheck bench` runners as library code: each takes a
+ * params struct (zero or the MR_BENCH_*_DEFAULTS designated initialisers
+ * mean the documented defaults), writes its CSV, SVG and summary files into
+ * out_dir, prints its table to `out` (NULL: nothing printed) and returns
+ * false with err set when it cannot run. Measurements only: nothing here
+ * passes or fails. The CSVs go through the one CSV writer, the medians
+ * through the one median (mr_csv_*, mr_median in mr_eval.h). */
+#ifndef MR_BENCH_H
+#define MR_BENCH_H
+
+#include <stdio.h>
+
+#include "mr_core.h"
+#include "mr_eval.h"
+#include "mr_render.h"
+#include "mr_scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The GPU a rendering bench uses: a headless context and a renderer on it,
+ * made and destroyed by the caller. A bench sets its scenes on the renderer
+ * and leaves none set when it returns. Required by ao, frame, ghost, scene. */
+typedef struct mr_bench_gpu {
+    mr_gpu *gpu;
+    mr_renderer *renderer;
+} mr_bench_gpu;
+
+/* ------------------------------------------------------------------- ao */
+
+/* Ambient occlusion, error against run time: every method over a grid of
+ * sample counts, full and half resolution, corner masking off and on, on
+ * the reported views, against two ray-traced references; parameters tuned
+ * on a view that is not reported (bench_ao.csv, bench_ao_tuning.csv,
+ * bench_ao_triangles.csv, bench_ao.svg, bench_ao_screen.svg,
+ * bench_ao_montage.png, bench_ao_shaded.png, bench_ao.md). */
+#define MR_BENCH_AO_MAX_VIEWS 16
+typedef struct mr_bench_ao_params {
+    mr_bench_gpu gfx;           /* required */
+    const char *out_dir;         /* default "bench-out" */
+    const char *scene;           /* glTF/GLB or scene config; NULL: the demo hall as planned */
+    const mr_view *views;        /* view_count reported views; 0: the demo's near, mid-hall and far views */
+    const char *const *view_names; /* their names in the tables (e.g. the file names) */
+    int view_count;              /* at most MR_BENCH_AO_MAX_VIEWS */
+    const mr_view *tune_view;    /* NULL: a demo view that is not reported (the north wall) */
+    const char *tune_name;
+    int width, height;           /* px, default 320x240 */
+    int frames;                  /* timed frames per configuration (median), 1..64, default 5 */
+    int rays;                    /* ground-truth rays per pixel, default 256 */
+    double radius;               /* the fixed reference's R in scene units; 0: 2% of the scene diagonal */
+    double screen_radius;        /* the depth-scaled reference: fraction of the image height, default 0.05 */
+    bool quick;                  /* samples 8 and 32, full resolution only, 2-point tuning */
+    bool verbose;                /* print the tuned parameters */
+    bool progress;               /* "view i/n done" on stderr */
+    FILE *out;                   /* the tables; NULL: silent */
+} mr_bench_ao_params;
+#define MR_BENCH_AO_DEFAULTS .out_dir = "bench-out", .width = 320, .height = 240, .frames = 5, .rays = 256, .screen_radius = 0.05
+bool mr_bench_ao(const mr_bench_ao_params *params, mr_error *err);
+
+/* ---------------------------------------------------------------- frame */
+
+/* Per-pass GPU and CPU ms of the whole frame. */
+typedef struct mr_bench_frame_params {
+    mr_bench_gpu gfx;           /* required */
+    const char *out_dir;    /* default "bench-out" */
+    const char *scene;      /* glTF/GLB or scene config; NULL: the demo hall as planned */
+    const mr_view *view;    /* NULL: the demo's first viewpoint */
+    int width, height;      /* px, default 1024x768 */
+    int frames;             /* timed frames after 3 warm-up frames, default 30 */
+    const mr_image *video;  /* camera frame to overlay; NULL: a synthetic one (seeded noise) */
+    bool no_video;          /* no overlay pass; default false */
+    FILE *out;              /* the table; NULL: silent */
+} mr_bench_frame_params;
+#define MR_BENCH_FRAME_DEFAULTS .out_dir = "bench-out", .width = 1024, .height = 768, .frames = 30
+bool mr_bench_frame(const mr_bench_frame_params *params, mr_error *err);
+
+/* ---------------------------------------------------------------- ghost */
+
+/* Ghosted views on the demo partition: per importance source, saliency
+ * implementation, eq. 9's levels and mode, the GPU ms of the ghosting passes
+ * against legibility measures (bench_ghost.csv, bench_ghost.svg). */
+typedef struct mr_bench_ghost_params {
+    mr_bench_gpu gfx;           /* required */
+    const char *out_dir;    /* default "bench-out" */
+    int width, height;      /* px, default 640x480 (the demo camera) */
+    int frames;             /* timed frames per configuration after 2 warm-up frames, default 5 */
+    int view;               /* demo viewpoint 0..MR_DEMO_VIEWS-1, default 0 (the partition) */
+    bool progress;          /* "n/N configurations" on stderr; default false */
+    FILE *out;              /* the table; NULL: silent */
+} mr_bench_ghost_params;
+#define MR_BENCH_GHOST_DEFAULTS .out_dir = "bench-out", .width = 640, .height = 480, .frames = 5
+bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err);
+
+/* ---------------------------------------------------------------- scene */
+
+/* Cost against scene size: synthetic factories written as .glb into out_dir
+ * and loaded back; load / upload / LOD times, peak memory, and per viewpoint
+ * and draw configuration the frame time and its parts (bench_scene.csv,
+ * bench_scene.svg). */
+#define MR_BENCH_SCENE_MAX_SIZES 8
+typedef struct mr_bench_scene_params {
+    mr_bench_gpu gfx;           /* required */
+    const char *out_dir;    /* default "bench-out" */
+    double sizes[MR_BENCH_SCENE_MAX_SIZES]; /* drawn-triangle targets */
+    int size_count;         /* 0: 1M, 5M, 20M */
+    int width, height;      /* px, default 1024x768 */
+    int frames;             /* timed frames per case after one warm-up, default 3 */
+    FILE *out;              /* the table; NULL: silent */
+} mr_bench_scene_params;
+#define MR_BENCH_SCENE_DEFAULTS .out_dir = "bench-out", .width = 1024, .height = 768, .frames = 3
+bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err);
+
+/* ------------------------------------------------------------- tracking */
+
+/* Error against run time of the tag detector settings (and OpenCV's aruco
+ * detector as the peer) on a recording with ground truth
+ * (bench_tracking.csv, bench_tracking.svg). */
+typedef struct mr_bench_tracking_params {
+    const char *out_dir;    /* default "bench-out" */
+    const char *recording;  /* recording folder with groundtruth.jsonl, default "recordings/demo" */
+    long max_frames;        /* use at most this many frames with ground truth; 0: all */
+    bool quick;             /* a few settings only; default false */
+    double min_cutoff;      /* One Euro cutoff at rest in Hz (also for rotation); 0: the filter's default 0.5 */
+    double beta;            /* One Euro speed coefficient; 0: the filter's default 2 */
+    FILE *out;              /* the table; NULL: silent */
+} mr_bench_tracking_params;
+#define MR_BENCH_TRACKING_DEFAULTS .out_dir = "bench-out", .recording = "recordings/demo"
+bool mr_bench_tracking(const mr_bench_tracking_params *params, mr_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

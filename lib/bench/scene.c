@@ -1,0 +1,297 @@
+/* mrcheck bench scene (mr_bench_scene): cost against scene size. For synthetic factories of
+ * about 1M, 5M and 20M drawn triangles (by default), written as .glb and
+ * loaded back like any scene: load and upload time and speed against
+ * tinygltf's raw parse of the same file, peak memory, and from fixed
+ * viewpoints (standing on the floor, down an aisle, overview) the frame time
+ * and its parts (CPU culling, GPU geometry pass), triangles submitted, draw
+ * calls and visible nodes, with culling, batching and LOD each switched
+ * off in turn, and occlusion culling switched on. CSV + an SVG plot of frame time against scene size. Never
+ * pass/fail. */
+#include "bench_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct bench_config {
+    const char *name;
+    bool no_cull, no_batch, no_instancing, no_lod, occlusion;
+} bench_config;
+
+static const bench_config k_configs[] = {
+    {"all", false, false, false, false, false},
+    {"no-cull", true, false, false, false, false},
+    {"no-batch", false, true, true, false, false},
+    {"no-lod", false, false, false, true, false},
+    {"none", true, true, true, true, false},
+    {"all+occl", false, false, false, false, true},
+};
+#define N_CONFIGS (int)(sizeof k_configs / sizeof k_configs[0])
+
+static const char *const k_view_names[MR_SYNTH_VIEW_COUNT] = {"floor", "aisle", "overview"};
+
+typedef struct row {
+    double tri_scene;
+    int view, config;
+    double frame_ms, cull_ms, gpu_ms;
+} row;
+
+/* Frame time (floor view solid, overview dashed) against drawn scene
+ * triangles, log-log, one colour per configuration. */
+static bool write_plot(const char *path, const row *rows, int n, mr_error *err) {
+    static const char *const colours[N_CONFIGS] = {"#1b7837", "#c51b7d", "#e08214", "#4575b4", "#555555", "#8c510a"};
+    enum { NS = N_CONFIGS * 2 };
+    mr_plot_series ser[NS];
+    double *xs = calloc((size_t)NS * (n + 1), sizeof *xs), *ys = calloc((size_t)NS * (n + 1), sizeof *ys);
+    if (!xs || !ys) {
+        free(xs);
+        free(ys);
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    }
+    memset(ser, 0, sizeof ser);
+    for (int k = 0; k < NS; k++) {
+        int c = k / 2, v = k % 2 ? MR_SYNTH_VIEW_OVERVIEW : MR_SYNTH_VIEW_FLOOR;
+        ser[k].name = v == MR_SYNTH_VIEW_FLOOR ? k_configs[c].name : NULL;
+        ser[k].x = xs + (size_t)k * (n + 1);
+        ser[k].y = ys + (size_t)k * (n + 1);
+        ser[k].color = colours[c];
+        ser[k].dashed = v != MR_SYNTH_VIEW_FLOOR;
+        for (int i = 0; i < n; i++)
+            if (rows[i].config == c && rows[i].view == v) {
+                xs[(size_t)k * (n + 1) + ser[k].count] = rows[i].tri_scene;
+                ys[(size_t)k * (n + 1) + ser[k].count++] = rows[i].frame_ms;
+            }
+    }
+    static const char *const notes[1] = {"solid: floor, dashed: overview"};
+    mr_plot_params pp = {.title = "mrcheck bench scene: frame time vs scene size (log-log)",
+                         .xlabel = "triangles in the scene (drawn count, instances included)", .ylabel = "frame ms",
+                         .log_x = true, .log_y = true, .notes = notes, .note_count = 1};
+    bool ok = mr_plot_write(path, &pp, ser, NS, err);
+    free(xs);
+    free(ys);
+    return ok;
+}
+
+/* A scene loaded as any user's would be, with the wall-clock time and the
+ * drawn (instances counted each time) and stored triangle counts. */
+typedef struct load_info {
+    double load_s;
+    uint64_t triangles, unique_triangles;
+} load_info;
+
+static mr_scene *load_scene(const char *path, load_info *li, mr_error *err) {
+    memset(li, 0, sizeof *li);
+    double t0 = mr_time_now();
+    mr_scene *s = mr_scene_load(path, NULL, err);
+    if (!s) return NULL;
+    li->load_s = mr_time_now() - t0;
+    li->triangles = mr_scene_triangle_count(s);
+    for (int32_t i = 0; i < s->mesh_count; i++) li->unique_triangles += s->meshes[i].index_count / 3;
+    return s;
+}
+
+/* One case's timing: the median of `frames` frames after one warm-up of
+ * the whole frame (wall ms), the CPU culling and the G-buffer pass (GPU). */
+static bool time_case(const mr_bench_gpu *g, const mr_view *view, const mr_draw_params *dp, int w, int h, long frames,
+                      double *ft, double *ct, double *gt, row *r, mr_draw_stats *st, mr_error *err) {
+    mr_frame_params fp = MR_FRAME_DEFAULTS;
+    fp.width = w;
+    fp.height = h;
+    fp.timing = true;
+    memset(st, 0, sizeof *st);
+    bool ok = mr_renderer_set_draw_params(g->renderer, dp, err);
+    for (long f = -1; ok && f < frames; f++) {
+        mr_frame_result res;
+        double ts = mr_time_now();
+        ok = mr_render_frame(g->renderer, view, &fp, &res, err);
+        if (!ok) break;
+        if (f >= 0) {
+            ft[f] = (mr_time_now() - ts) * 1e3;
+            mr_renderer_draw_stats(g->renderer, st);
+            ct[f] = st->cull_ms;
+            gt[f] = 0;
+            for (int k = 0; k < res.pass_count; k++)
+                if (strcmp(res.passes[k], "gbuffer") == 0) gt[f] = res.gpu_ms[k];
+        }
+        mr_frame_result_free(&res);
+    }
+    if (!ok) return false;
+    r->frame_ms = mr_median(ft, (int)frames);
+    r->cull_ms = mr_median(ct, (int)frames);
+    r->gpu_ms = mr_median(gt, (int)frames);
+    return true;
+}
+
+/* The numbers of one scene size that each of its rows repeats. */
+typedef struct size_info {
+    load_info li;
+    int nodes;
+    double mb, parse_s, upload_s, lod_s;
+    bool from_cache;
+} size_info;
+
+/* One case: its line of the table and its CSV row. */
+static void report_row(FILE *out, mr_csv *csv, const size_info *z, int v, int c, const row *r, const mr_draw_stats *st) {
+    double rss = mr_peak_rss_bytes() / 1048576.0;
+    BENCH_PRINT(out, "%10llu %8d %9.1f %6.2f %6.2f %7.2f %8.0f %-9s %-9s %9.1f %8.2f %8.1f %11llu %6u %7u %7u\n",
+           (unsigned long long)z->li.triangles, z->nodes, z->mb, z->parse_s, z->li.load_s, z->upload_s, rss,
+           k_view_names[v], k_configs[c].name, r->frame_ms, r->cull_ms, r->gpu_ms,
+           (unsigned long long)st->triangles, st->gl_draw_calls, st->nodes_visible, st->nodes_occluded);
+    if (out) fflush(out);
+    mr_csv_int(csv, (long long)z->li.triangles);
+    mr_csv_int(csv, (long long)z->li.unique_triangles);
+    mr_csv_int(csv, z->nodes);
+    mr_csv_num(csv, "%.2f", z->mb);
+    mr_csv_num(csv, "%.4f", z->parse_s);
+    mr_csv_num(csv, "%.4f", z->li.load_s);
+    mr_csv_num(csv, "%.4f", z->upload_s);
+    mr_csv_num(csv, "%.1f", z->mb / (z->li.load_s + z->upload_s));
+    mr_csv_num(csv, "%.1f", z->mb / z->parse_s);
+    mr_csv_num(csv, "%.3f", z->lod_s);
+    mr_csv_int(csv, z->from_cache);
+    mr_csv_num(csv, "%.0f", rss);
+    mr_csv_text(csv, k_view_names[v]);
+    mr_csv_text(csv, k_configs[c].name);
+    mr_csv_num(csv, "%.3f", r->frame_ms);
+    mr_csv_num(csv, "%.3f", r->cull_ms);
+    mr_csv_num(csv, "%.3f", r->gpu_ms);
+    const uint64_t counts[] = {st->triangles,     st->gl_draw_calls,  st->commands,      st->nodes_visible,
+                               st->nodes_drawable, st->nodes_occluded, st->lod_instances};
+    for (int k = 0; k < 7; k++) mr_csv_int(csv, (long long)counts[k]);
+    mr_csv_end_row(csv);
+}
+
+bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
+    const mr_bench_scene_params dflt = {MR_BENCH_SCENE_DEFAULTS};
+    mr_bench_scene_params p = params ? *params : dflt;
+    const char *out_dir = p.out_dir ? p.out_dir : dflt.out_dir;
+    if (p.width <= 0 || p.height <= 0) p.width = dflt.width, p.height = dflt.height;
+    if (p.frames <= 0) p.frames = dflt.frames;
+    double sizes[MR_BENCH_SCENE_MAX_SIZES];
+    int nsizes = p.size_count > 0 ? p.size_count : 3;
+    if (nsizes > MR_BENCH_SCENE_MAX_SIZES) return mr_fail(err, MR_ERR_INVALID, "bench scene: at most %d sizes", MR_BENCH_SCENE_MAX_SIZES);
+    for (int i = 0; i < nsizes; i++) sizes[i] = p.size_count > 0 ? p.sizes[i] : (const double[]){1e6, 5e6, 20e6}[i];
+    const int w = p.width, h = p.height;
+    const long frames = p.frames;
+    FILE *out = p.out;
+    if (!mr_mkdirs(out_dir, err)) return false;
+    const mr_bench_gpu gfx = p.gfx;
+    if (!bench_gpu_check(&gfx, "bench scene", err)) return false;
+
+    mr_csv *csv = mr_csv_create(err);
+    row *rows = calloc((size_t)nsizes * MR_SYNTH_VIEW_COUNT * N_CONFIGS + 1, sizeof *rows);
+    double *ft = calloc((size_t)frames, sizeof *ft), *ct = calloc((size_t)frames, sizeof *ct), *gt = calloc((size_t)frames, sizeof *gt);
+    int nrows = 0;
+    bool failed = false;
+    if (!csv || !rows || !ft || !ct || !gt) {
+        failed = !mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    mr_csv_header(csv, "scene_triangles,stored_triangles,nodes,file_mb,raw_parse_s,load_s,upload_s,load_upload_mb_s,"
+                       "raw_parse_mb_s,lod_s,lod_from_cache,peak_rss_mb,view,config,frame_ms,cull_ms,gpu_geometry_ms,"
+                       "triangles_submitted,draw_calls,commands,nodes_visible,nodes_drawable,nodes_occluded,lod_instances");
+    BENCH_PRINT(out, "bench scene: %s, %dx%d, median of %ld frames\n", mr_gpu_description(gfx.gpu), w, h, frames);
+    BENCH_PRINT(out, "%10s %8s %9s %6s %6s %7s %8s %-9s %-9s %9s %8s %8s %11s %6s %7s %7s\n", "triangles", "nodes", "file MB", "parse",
+           "load", "upload", "RSS MB", "view", "config", "frame ms", "cull ms", "GPU ms", "submitted", "calls", "visible",
+           "occl");
+    char lod_cache[4096];
+    mr_path_join(out_dir, "synth.glb.mrlod", lod_cache, sizeof lod_cache); /* same parts at every size */
+    for (int si = 0; si < nsizes; si++) {
+        mr_synth_params sp = MR_SYNTH_DEFAULTS;
+        sp.halls = mr_synth_halls_for((uint64_t)sizes[si]);
+        char glb[4096], name[64];
+        snprintf(name, sizeof name, "synth_%dhalls.glb", sp.halls);
+        mr_path_join(out_dir, name, glb, sizeof glb);
+        mr_scene *s = mr_synth_build(&sp, err);
+        bool ok = s && mr_scene_save_glb(s, glb, err);
+        mr_scene_destroy(&s);
+        if (!ok) {
+            failed = true;
+            goto done;
+        }
+        /* Raw parse reference, then our load and upload of the same file. */
+        size_t fsize = 0;
+        void *data = NULL;
+        double t0 = mr_time_now();
+        data = mr_file_read(glb, &fsize, 0, err);
+        ok = data && mr_gltf_parse_only(data, fsize, err);
+        double parse_s = mr_time_now() - t0;
+        free(data);
+        if (!ok) {
+            failed = true;
+            goto done;
+        }
+        load_info li;
+        s = load_scene(glb, &li, err);
+        if (!s) {
+            failed = true;
+            goto done;
+        }
+        t0 = mr_time_now();
+        ok = mr_renderer_set_scene(gfx.renderer, s, err);
+        double upload_s = mr_time_now() - t0;
+        mr_lod_params lp = MR_LOD_DEFAULTS;
+        mr_lod_info linfo;
+        t0 = mr_time_now();
+        mr_lod *lod = ok ? mr_lod_load_or_build(s, lod_cache, &lp, &linfo, err) : NULL;
+        double lod_s = mr_time_now() - t0;
+        ok = lod && mr_renderer_set_lod(gfx.renderer, lod, err);
+        if (!ok) {
+            failed = true;
+            mr_lod_destroy(&lod);
+            mr_scene_destroy(&s);
+            goto done;
+        }
+        double mb = fsize / 1e6;
+        for (int v = 0; v < MR_SYNTH_VIEW_COUNT && ok; v++) {
+            mr_view view;
+            view.camera = mr_demo_camera();
+            memset(view.camera.dist, 0, sizeof view.camera.dist);
+            view.world_from_camera = mr_synth_viewpoint(&sp, v);
+            for (int c = 0; c < N_CONFIGS && ok; c++) {
+                mr_draw_params dp = MR_DRAW_DEFAULTS;
+                dp.no_cull = k_configs[c].no_cull;
+                dp.no_batch = k_configs[c].no_batch;
+                dp.no_instancing = k_configs[c].no_instancing;
+                dp.no_lod = k_configs[c].no_lod;
+                dp.occlusion = k_configs[c].occlusion;
+                row *r = &rows[nrows];
+                r->tri_scene = (double)li.triangles;
+                r->view = v;
+                r->config = c;
+                mr_draw_stats st;
+                if (!(ok = time_case(&gfx, &view, &dp, w, h, frames, ft, ct, gt, r, &st, err))) break;
+                nrows++;
+                const size_info z = {li, (int)s->node_count, mb, parse_s, upload_s, lod_s, linfo.from_cache};
+                report_row(out, csv, &z, v, c, r, &st);
+            }
+        }
+        BENCH_PRINT(out, "  load %.2f s + upload %.2f s = %.0f MB/s; tinygltf raw parse %.2f s = %.0f MB/s; LOD %.2f s (%s)\n",
+               li.load_s, upload_s, mb / (li.load_s + upload_s), parse_s, mb / parse_s, lod_s,
+               linfo.from_cache ? "from the cache" : "built");
+        mr_renderer_set_scene(gfx.renderer, NULL, err);
+        mr_lod_destroy(&lod);
+        mr_scene_destroy(&s);
+        if (!ok) {
+            failed = true;
+            goto done;
+        }
+    }
+    {
+        char path[4096];
+        mr_path_join(out_dir, "bench_scene.csv", path, sizeof path);
+        bool ok = mr_csv_save(csv, path, err);
+        mr_path_join(out_dir, "bench_scene.svg", path, sizeof path);
+        ok = ok && write_plot(path, rows, nrows, err);
+        if (!ok) failed = true;
+        else BENCH_PRINT(out, "wrote %s/bench_scene.csv and bench_scene.svg\n", out_dir);
+    }
+done:
+    mr_csv_destroy(&csv);
+    free(rows);
+    free(ft);
+    free(ct);
+    free(gt);
+    mr_renderer_set_scene(gfx.renderer, NULL, NULL);
+    return !failed;
+}
