@@ -75,22 +75,17 @@ static bool hall_markers(const mr_demo_hall *hall, mr_marker_map *map, mr_error 
     return true;
 }
 
-/* The tracking of one synthetic frame, kept in this one function so that it
- * can be swapped for lib/track's single tracker: detect, solve the pose
- * seeded by the previous pose whenever that one is valid, One Euro filter
- * it; fills fr's detections, pose and filtered pose (fr->t is the time). */
-static bool track_frame(mr_detector *det, mr_pose_filter *filt, const mr_camera *cam, const mr_marker_map *map,
-                        const mr_image *gray, mr_pose *prev, mr_frame_record *fr, mr_error *err) {
-    int n = 0;
-    const mr_detection *d = mr_detector_detect(det, gray, &n, err);
-    if (!d || !mr_pose_solve(cam, map, d, n, prev->valid ? prev : NULL, NULL, &fr->pose, err)) return false;
-    fr->detections = d;
-    fr->detection_count = n;
-    if (fr->pose.valid) {
-        *prev = fr->pose;
-        mr_pose_filter_update(filt, fr->t, &fr->pose.world_from_camera, &fr->filtered);
-        fr->has_filtered = true;
-    }
+/* Tracks one synthetic frame as `record` would (lib/track's one tracker),
+ * so frames.jsonl holds real results: fills fr's detections, raw pose and
+ * filtered pose (fr->t is the time). */
+static bool track_frame(mr_tracker *trk, const mr_image *gray, mr_frame_record *fr, mr_error *err) {
+    mr_tracker_result r;
+    if (!mr_tracker_frame(trk, gray, fr->t, &r, err)) return false;
+    fr->detections = r.detections;
+    fr->detection_count = r.detection_count;
+    fr->pose = r.pose;
+    fr->has_filtered = r.has_filtered;
+    if (r.has_filtered) fr->filtered = r.filtered;
     return true;
 }
 
@@ -126,9 +121,11 @@ bool app_synth_recording(const char *dir, const app_synth_params *params, mr_err
         rec = mr_recorder_create(dir, &rp, err);
         ok = rec != NULL;
     }
-    mr_detector *det = ok ? mr_detector_create(NULL, err) : NULL;
-    mr_pose_filter *filt = det ? mr_pose_filter_create(NULL, err) : NULL;
-    ok = ok && det && filt;
+    mr_tracker_params tp = MR_TRACKER_DEFAULTS;
+    tp.camera = &cam;
+    tp.markers = &map;
+    mr_tracker *trk = ok ? mr_tracker_create(&tp, err) : NULL;
+    ok = ok && trk;
     const int margin = 48 * p.width / 640 + 8, scale = 2;
     mr_camera wide = cam;
     wide.width += 2 * margin;
@@ -141,7 +138,6 @@ bool app_synth_recording(const char *dir, const app_synth_params *params, mr_err
     mr_rng rng;
     mr_rng_seed(&rng, p.seed);
     int total = path_frames();
-    mr_pose prev = {0};
     int with_pose = 0;
     for (int i = 0; ok && i < p.frames; i++) {
         /* Spread the requested frames over the whole path. */
@@ -171,10 +167,9 @@ bool app_synth_recording(const char *dir, const app_synth_params *params, mr_err
         mr_image frame = {0}, gray = {0};
         ok = ok && mr_demo_camera_frame(&cam, ideal, p.motion_blur, margin, scale, gain, p.noise, &rng, &frame, err) &&
              mr_image_to_gray(&frame, &gray, err);
-        /* Track it as `record` would, so frames.jsonl holds real results. */
         mr_frame_record fr = {0};
         fr.t = t;
-        ok = ok && track_frame(det, filt, &cam, &map, &gray, &prev, &fr, err);
+        ok = ok && track_frame(trk, &gray, &fr, err);
         const int n = fr.detection_count;
         if (ok) {
             with_pose += fr.pose.valid;
@@ -189,8 +184,7 @@ bool app_synth_recording(const char *dir, const app_synth_params *params, mr_err
     for (int k = 0; k < 16; k++) mr_image_free(&ideal[k]);
     if (ok) mr_log(MR_LOG_INFO, "synth: %d frames, %d with a pose", p.frames, with_pose);
     mr_recorder_close(&rec);
-    mr_pose_filter_destroy(&filt);
-    mr_detector_destroy(&det);
+    mr_tracker_destroy(&trk);
     app_gfx_close(&gfx);
     mr_marker_map_free(&map);
     mr_demo_free(&hall);

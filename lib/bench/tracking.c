@@ -65,41 +65,37 @@ static void jitter_segment(const mr_dmat4 *p, int n, jitter_acc *acc) {
     }
 }
 
-/* The tracking of one frame, kept in this one function so that it can be
- * swapped for lib/track's single tracker: detect (AprilTag, or OpenCV aruco
- * as the peer), solve the pose seeded by the previous pose whenever that
- * one is valid, and One Euro filter it. ms: detection + pose (the filter is
- * not timed). */
+/* The tracking of one frame: detection by the setting under test
+ * (AprilTag, or OpenCV aruco as the peer), timed on its own, then
+ * everything after detection by lib/track's one tracker (undistortion, the
+ * solve with its previous-pose policy, the One Euro filter), so the bench
+ * measures what `track` and `view` run. ms: detection + pose + filter. */
 typedef struct tracker {
     mr_detector *det; /* or */
     mr_aruco *ar;
-    mr_pose_filter *filt;
-    mr_pose prev;
+    mr_tracker *trk;
 } tracker;
 typedef struct track_out {
     const mr_detection *dets;
     int count;
     mr_pose pose;     /* raw */
-    mr_dmat4 filtered; /* = the raw pose when it is not valid */
+    mr_dmat4 filtered; /* = the raw pose when there is no filtered one */
     double detect_ms, ms;
 } track_out;
 
-static bool track_step(tracker *t, const mr_camera *cam, const mr_marker_map *map, const mr_image *img, double ts,
-                       track_out *o, mr_error *err) {
+static bool track_step(tracker *t, const mr_image *img, double ts, track_out *o, mr_error *err) {
     double t0 = mr_time_now();
     o->count = 0;
     o->dets = t->ar ? mr_aruco_detect(t->ar, img, &o->count, err) : mr_detector_detect(t->det, img, &o->count, err);
     double t1 = mr_time_now();
     if (!o->dets) return false;
-    bool ok = mr_pose_solve(cam, map, o->dets, o->count, t->prev.valid ? &t->prev : NULL, NULL, &o->pose, err);
+    mr_tracker_result r;
+    bool ok = mr_tracker_detections(t->trk, o->dets, o->count, img->width, img->height, ts, &r, err);
     double t2 = mr_time_now();
     o->ms = (t2 - t0) * 1e3;
     o->detect_ms = (t1 - t0) * 1e3;
-    o->filtered = o->pose.world_from_camera;
-    if (ok && o->pose.valid) {
-        t->prev = o->pose;
-        mr_pose_filter_update(t->filt, ts, &o->pose.world_from_camera, &o->filtered);
-    }
+    o->pose = r.pose;
+    o->filtered = ok && r.has_filtered ? r.filtered : r.pose.world_from_camera;
     return ok;
 }
 
@@ -120,16 +116,21 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
         det = mr_detector_create(&dp, err);
         if (!det) return false;
     }
-    mr_pose_filter *filt = mr_pose_filter_create(fparams, err);
+    mr_tracker_params trp = MR_TRACKER_DEFAULTS;
+    trp.camera = &rec->camera;
+    trp.markers = &rec->markers;
+    trp.detector.family = rec->markers.family;
+    trp.filter = *fparams;
+    mr_tracker *trk = mr_tracker_create(&trp, err);
     double *ms = calloc((size_t)nf, sizeof *ms), *dms = calloc((size_t)nf, sizeof *dms);
     double *te = calloc((size_t)nf, sizeof *te), *tp = calloc((size_t)nf, sizeof *tp), *re = calloc((size_t)nf, sizeof *re);
     double *rm = calloc((size_t)nf, sizeof *rm);
     mr_dmat4 *seg_raw = calloc((size_t)nf, sizeof *seg_raw), *seg_f = calloc((size_t)nf, sizeof *seg_f);
-    bool ok = filt && ms && dms && te && tp && re && rm && seg_raw && seg_f;
-    if (!ok) mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    bool ok = trk && ms && dms && te && tp && re && rm && seg_raw && seg_f;
+    if (!ok && trk) mr_fail(err, MR_ERR_NOMEM, "out of memory");
     int nposes = 0, nflip = 0, vis = 0, vis_hit = 0, vis56 = 0, vis56_hit = 0, vis_st = 0, vis_st_hit = 0, seg_n = 0;
     jitter_acc jr = {0}, jf = {0};
-    tracker tk = {det, ar, filt, {0}};
+    tracker tk = {det, ar, trk};
     /* one untimed warm-up frame: thread pools, first allocations */
     int wn;
     if (ok && nf > 0) {
@@ -140,7 +141,7 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
         const mr_rec_frame *f = &rec->frames[fidx[i]];
         mr_camera cam = mr_camera_resized(&rec->camera, imgs[i].width, imgs[i].height);
         track_out tr;
-        if (!(ok = track_step(&tk, &cam, &rec->markers, &imgs[i], f->t, &tr, err))) break;
+        if (!(ok = track_step(&tk, &imgs[i], f->t, &tr, err))) break;
         const mr_detection *d = tr.dets;
         const int n = tr.count;
         const mr_pose pose = tr.pose;
@@ -229,7 +230,7 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
     free(rm);
     free(seg_raw);
     free(seg_f);
-    mr_pose_filter_destroy(&filt);
+    mr_tracker_destroy(&trk);
     mr_detector_destroy(&det);
     mr_aruco_destroy(&ar);
     return ok;
