@@ -46,7 +46,6 @@ bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, cons
 void app_tracker_free(app_tracker *t);
 
 /* JSON helpers for the line formats. */
-cJSON *app_detections_json(const mr_detection *d, int n);
 cJSON *app_pose_line(int64_t frame, double t, const mr_tracker_result *r);
 
 /* Synthetic recordings of the demo hall (demo_track.c). */

@@ -106,7 +106,7 @@ int cmd_track(int argc, char **argv) {
         if (print_det) {
             cJSON *o = cJSON_CreateObject();
             cJSON_AddNumberToObject(o, "frame", (double)f.index);
-            cJSON_AddItemToObject(o, "detections", app_detections_json(r.detections, r.detection_count));
+            cJSON_AddItemToObject(o, "detections", mr_detections_json(r.detections, r.detection_count, 1e-3));
             /* with camera and markers the line also carries the pose */
             if (want_pose) cJSON_AddItemToObject(o, "pose", app_pose_line(f.index, f.timestamp, &r));
             char *s = cJSON_PrintUnformatted(o);

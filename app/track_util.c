@@ -125,23 +125,6 @@ void app_tracker_free(app_tracker *t) {
     memset(t, 0, sizeof *t);
 }
 
-cJSON *app_detections_json(const mr_detection *d, int n) {
-    cJSON *a = cJSON_CreateArray();
-    for (int i = 0; i < n; i++) {
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddNumberToObject(o, "id", d[i].id);
-        cJSON_AddNumberToObject(o, "hamming", d[i].hamming);
-        cJSON *c = cJSON_AddArrayToObject(o, "corners");
-        for (int k = 0; k < 4; k++) {
-            /* 1/1000 px is far below the detector's accuracy. */
-            double p[2] = {round(d[i].corners[k][0] * 1e3) / 1e3, round(d[i].corners[k][1] * 1e3) / 1e3};
-            cJSON_AddItemToArray(c, mr_json_from_doubles(p, 2));
-        }
-        cJSON_AddItemToArray(a, o);
-    }
-    return a;
-}
-
 cJSON *app_pose_line(int64_t frame, double t, const mr_tracker_result *r) {
     cJSON *o = cJSON_CreateObject();
     cJSON_AddNumberToObject(o, "frame", (double)frame);

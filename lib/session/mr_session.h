@@ -67,6 +67,11 @@ mr_recorder *mr_recorder_create(const char *dir, const mr_recorder_params *param
  * rec->index is assigned by the recorder (0, 1, ...) and rec->image is
  * filled. */
 bool mr_recorder_append(mr_recorder *r, mr_frame_record *rec, const mr_image *image, mr_error *err);
+/* Detections as the line formats write them: [{"id", "hamming", "corners":
+ * [[x, y] x 4]}]. quantum_px > 0 rounds the corners to multiples of it (the
+ * `track` output uses 1/1000 px, far below the detector's accuracy); 0
+ * keeps them exact (recordings, which are read back). */
+cJSON *mr_detections_json(const mr_detection *d, int n, double quantum_px);
 /* Appends a ground-truth line (recorders created with ground_truth). */
 bool mr_recorder_ground_truth(mr_recorder *r, int64_t index, double t, const mr_dmat4 *world_from_camera, bool still,
                               mr_error *err);

@@ -90,14 +90,21 @@ mr_recorder *mr_recorder_create(const char *dir, const mr_recorder_params *param
     return r;
 }
 
-static cJSON *detections_json(const mr_detection *d, int n) {
+cJSON *mr_detections_json(const mr_detection *d, int n, double quantum_px) {
     cJSON *a = cJSON_CreateArray();
     for (int i = 0; i < n; i++) {
         cJSON *o = cJSON_CreateObject();
         cJSON_AddNumberToObject(o, "id", d[i].id);
         cJSON_AddNumberToObject(o, "hamming", d[i].hamming);
         cJSON *c = cJSON_AddArrayToObject(o, "corners");
-        for (int k = 0; k < 4; k++) cJSON_AddItemToArray(c, mr_json_from_doubles(d[i].corners[k], 2));
+        for (int k = 0; k < 4; k++) {
+            double p[2] = {d[i].corners[k][0], d[i].corners[k][1]};
+            if (quantum_px > 0) {
+                double inv = 1.0 / quantum_px; /* 1000 exactly for 1e-3 */
+                for (int j = 0; j < 2; j++) p[j] = round(p[j] * inv) / inv;
+            }
+            cJSON_AddItemToArray(c, mr_json_from_doubles(p, 2));
+        }
         cJSON_AddItemToArray(a, o);
     }
     return a;
@@ -121,7 +128,7 @@ bool mr_recorder_append(mr_recorder *r, mr_frame_record *rec, const mr_image *im
     cJSON_AddNumberToObject(o, "frame", (double)rec->index);
     cJSON_AddNumberToObject(o, "t", rec->t);
     cJSON_AddStringToObject(o, "image", rec->image);
-    cJSON_AddItemToObject(o, "detections", detections_json(rec->detections, rec->detection_count));
+    cJSON_AddItemToObject(o, "detections", mr_detections_json(rec->detections, rec->detection_count, 0));
     cJSON *p = cJSON_AddObjectToObject(o, "pose");
     cJSON_AddBoolToObject(p, "valid", rec->pose.valid);
     if (rec->pose.valid) cJSON_AddItemToObject(p, "world_from_camera", mr_json_from_dmat4(&rec->pose.world_from_camera));
