@@ -155,29 +155,36 @@ static void walk_table(const char *name, const mr_opt *table, size_t size, const
     }
 }
 
-/* Which field each option drives: written here a second time on purpose, so
- * a row pointing at the wrong field fails. */
+/* Which field each option drives and what it accepts (its range, or its
+ * names in value order): written here a second time on purpose, as the
+ * command line's contract, so that a row pointing at the wrong field or a
+ * range off by one fails. */
 typedef struct expect {
     const char *key;
     size_t offset;
+    double lo, hi;     /* numbers */
+    const char *names; /* enums: space-separated */
 } expect;
 
-static void check_fields(const char *name, const mr_opt *table, const expect *ex, int n) {
+static void check_rows(const char *name, const mr_opt *table, const expect *ex, int n) {
     CHECK_MSG(mr_opt_count(table) == n, "%s has %d rows, expected %d", name, mr_opt_count(table), n);
     for (int i = 0; i < n; i++) {
         const mr_opt *o = mr_opt_find(table, ex[i].key);
         CHECK_MSG(o, "%s has no row '%s'", name, ex[i].key);
-        if (o)
-            CHECK_MSG(o->offset == ex[i].offset, "%s.%s drives the field at offset %zu, expected %zu", name, ex[i].key,
-                      o->offset, ex[i].offset);
+        if (!o) continue;
+        CHECK_MSG(o->offset == ex[i].offset, "%s.%s drives the field at offset %zu, expected %zu", name, ex[i].key,
+                  o->offset, ex[i].offset);
+        if (o->type == MR_OPT_ENUM) {
+            char got[256] = "";
+            for (int k = 0; k < mr_opt_enum_count(o); k++)
+                snprintf(got + strlen(got), sizeof got - strlen(got), "%s%s", k ? " " : "", o->names[k]);
+            CHECK_MSG(ex[i].names && strcmp(got, ex[i].names) == 0, "%s.%s names '%s', expected '%s'", name, ex[i].key,
+                      got, ex[i].names ? ex[i].names : "(not an enum)");
+        } else if (o->type != MR_OPT_BOOL) {
+            CHECK_MSG(o->lo == ex[i].lo && o->hi == ex[i].hi, "%s.%s accepts [%g, %g], expected [%g, %g]", name,
+                      ex[i].key, o->lo, o->hi, ex[i].lo, ex[i].hi);
+        }
     }
-}
-
-/* Ranges tied to a limit elsewhere (a shader's array, a fraction). */
-static void check_range(const mr_opt *table, const char *key, double lo, double hi) {
-    const mr_opt *o = mr_opt_find(table, key);
-    CHECK_MSG(o && o->lo == lo && o->hi == hi, "%s: range [%g, %g], expected [%g, %g]", key, o ? o->lo : NAN,
-              o ? o->hi : NAN, lo, hi);
 }
 
 static void test_tables(void) {
@@ -188,37 +195,50 @@ static void test_tables(void) {
     walk_table("mr_ghost_opts", mr_ghost_opts, sizeof gh, &gh);
     walk_table("mr_view_settings_opts", mr_view_settings_opts, sizeof vs, &vs);
 
-#define F(t, k, f) {k, offsetof(t, f)}
+#define E(t, k, f, names) {k, offsetof(t, f), 0, 0, names}
+#define N(t, k, f, lo, hi) {k, offsetof(t, f), lo, hi, NULL}
     const expect ex_ao[] = {
-        F(mr_ao_params, "", method), F(mr_ao_params, "radius-mode", radius_mode), F(mr_ao_params, "radius", radius),
-        F(mr_ao_params, "screen-radius", screen_radius), F(mr_ao_params, "samples", samples),
-        F(mr_ao_params, "kernel", kernel), F(mr_ao_params, "rmin", r_min), F(mr_ao_params, "rmax", r_max),
-        F(mr_ao_params, "radii", radii), F(mr_ao_params, "c", c), F(mr_ao_params, "bias", bias),
-        F(mr_ao_params, "strength", strength), F(mr_ao_params, "blur", blur_radius), F(mr_ao_params, "half", half_res),
-        F(mr_ao_params, "positions", positions), F(mr_ao_params, "mask", mask),
-        F(mr_ao_params, "mask-strength", mask_strength),
+        E(mr_ao_params, "", method, "none scheer crytek filion hbao alchemy"),
+        E(mr_ao_params, "radius-mode", radius_mode, "screen view"),
+        N(mr_ao_params, "radius", radius, 1e-30, 1e30),
+        N(mr_ao_params, "screen-radius", screen_radius, 1e-6, 10),
+        N(mr_ao_params, "samples", samples, 1, MR_AO_MAX_SAMPLES),
+        E(mr_ao_params, "kernel", kernel, "uniform stratified latin poisson"),
+        N(mr_ao_params, "rmin", r_min, 0, 1),
+        N(mr_ao_params, "rmax", r_max, 1e-3, 1),
+        N(mr_ao_params, "radii", radii, 1, MR_AO_MAX_RADII),
+        N(mr_ao_params, "c", c, 0, 1e7),
+        N(mr_ao_params, "bias", bias, 0, 0.5),
+        N(mr_ao_params, "strength", strength, 0.01, 10),
+        N(mr_ao_params, "blur", blur_radius, 0, 32),
+        N(mr_ao_params, "half", half_res, 0, 1),
+        N(mr_ao_params, "positions", positions, 0, 1),
+        E(mr_ao_params, "mask", mask, "off on standalone"),
+        N(mr_ao_params, "mask-strength", mask_strength, 1e-3, 1),
     };
     const expect ex_gh[] = {
-        F(mr_ghost_params, "", mode), F(mr_ghost_params, "importance", importance),
-        F(mr_ghost_params, "saliency", saliency), F(mr_ghost_params, "t", t),
-        F(mr_ghost_params, "curv-scale", curv_scale), F(mr_ghost_params, "curv-bias", curv_bias),
-        F(mr_ghost_params, "tc-min", tc_minimal), F(mr_ghost_params, "gamma", gamma),
-        F(mr_ghost_params, "tc-sil", tc_silhouette),
+        E(mr_ghost_params, "", mode, "off alpha g0 adaptive"),
+        E(mr_ghost_params, "importance", importance, "auto curvature saliency"),
+        E(mr_ghost_params, "saliency", saliency, "mipmap gauss"),
+        N(mr_ghost_params, "t", t, 0, 1),
+        N(mr_ghost_params, "curv-scale", curv_scale, 0, 1e3),
+        N(mr_ghost_params, "curv-bias", curv_bias, -1, 1),
+        N(mr_ghost_params, "tc-min", tc_minimal, 0, 4),
+        N(mr_ghost_params, "gamma", gamma, 0, 100),
+        N(mr_ghost_params, "tc-sil", tc_silhouette, 0, 4),
     };
     const expect ex_vs[] = {
-        F(mr_view_settings, "alpha", alpha), F(mr_view_settings, "show_video", show_video),
-        F(mr_view_settings, "hide_hidden_layer", hide_hidden), F(mr_view_settings, "ao", ao),
-        F(mr_view_settings, "ghost", ghost),
+        N(mr_view_settings, "alpha", alpha, 0, 1),
+        N(mr_view_settings, "show_video", show_video, 0, 1),
+        N(mr_view_settings, "hide_hidden_layer", hide_hidden, 0, 1),
+        E(mr_view_settings, "ao", ao, "none scheer crytek filion hbao alchemy"),
+        E(mr_view_settings, "ghost", ghost, "off alpha g0 adaptive"),
     };
-#undef F
-    check_fields("mr_ao_opts", mr_ao_opts, ex_ao, (int)(sizeof ex_ao / sizeof ex_ao[0]));
-    check_fields("mr_ghost_opts", mr_ghost_opts, ex_gh, (int)(sizeof ex_gh / sizeof ex_gh[0]));
-    check_fields("mr_view_settings_opts", mr_view_settings_opts, ex_vs, (int)(sizeof ex_vs / sizeof ex_vs[0]));
-    check_range(mr_ao_opts, "samples", 1, MR_AO_MAX_SAMPLES);
-    check_range(mr_ao_opts, "radii", 1, MR_AO_MAX_RADII);
-    check_range(mr_ao_opts, "rmin", 0, 1);
-    check_range(mr_ghost_opts, "t", 0, 1);
-    check_range(mr_view_settings_opts, "alpha", 0, 1);
+#undef E
+#undef N
+    check_rows("mr_ao_opts", mr_ao_opts, ex_ao, (int)(sizeof ex_ao / sizeof ex_ao[0]));
+    check_rows("mr_ghost_opts", mr_ghost_opts, ex_gh, (int)(sizeof ex_gh / sizeof ex_gh[0]));
+    check_rows("mr_view_settings_opts", mr_view_settings_opts, ex_vs, (int)(sizeof ex_vs / sizeof ex_vs[0]));
     /* The enums' names in their value order, for every value. */
     const mr_opt *m = mr_opt_find(mr_ao_opts, "");
     CHECK_MSG(m && mr_opt_enum_count(m) == MR_AO_METHOD_COUNT, "the AO method row does not name every method");
