@@ -2,7 +2,6 @@
 #include "app.h"
 
 #include <errno.h>
-#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -164,18 +163,19 @@ const char *app_get(const app_opt *opts, const char *name) {
 
 bool app_flag(const app_opt *opts, const char *name) { return app_get(opts, name) != NULL; }
 
+/* Through a one-row option table, so the number rules and the message are
+ * those of every table option. */
 bool app_double(const char *opt, const char *s, double lo, double hi, double *out) {
-    char *end = NULL;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (!s[0] || *end || errno || !isfinite(v) || v < lo || v > hi) {
-        fprintf(stderr, "mrcheck: --%s must be a number in [%g, %g], got '%s'\n", opt, lo, hi, s);
+    const mr_opt row = {opt, MR_OPT_DOUBLE, 0, lo, hi, lo, NULL, "", 0};
+    mr_error err = {0};
+    if (!mr_opt_set_row(&row, out, s, &err)) {
+        fprintf(stderr, "mrcheck: --%s\n", err.msg);
         return false;
     }
-    *out = v;
     return true;
 }
 
+/* Whole numbers stay here: their ranges reach beyond an int (--from). */
 bool app_int(const char *opt, const char *s, long lo, long hi, long *out) {
     char *end = NULL;
     errno = 0;
