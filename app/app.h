@@ -16,6 +16,26 @@ typedef struct app_opt {
     const char *value;  /* filled by app_parse: the value, "1" for a set flag, or NULL */
 } app_opt;
 
+/* A params struct whose option table is spliced into a command's options:
+ * --PREFIX (the table's "" row) and --PREFIX-KEY for each other row, with
+ * their help lines made from the table. Values are checked and written into
+ * params (which holds its defaults) after the whole line was read, so that
+ * --help always wins. */
+#define APP_TABLE_MAX 32
+typedef struct app_table {
+    const char *prefix;       /* "ao", "ghost" */
+    const mr_opt *table;      /* at most APP_TABLE_MAX rows */
+    void *params;
+    const char *extra;        /* one more value --PREFIX accepts beyond the table's
+                                 names (--ao groundtruth), or NULL */
+    bool extra_given;         /* filled: --PREFIX EXTRA was given */
+    const char *values[APP_TABLE_MAX]; /* filled: the text given for each row, or NULL */
+} app_table;
+/* True if the row `key` of t was on the command line. */
+bool app_table_given(const app_table *t, const char *key);
+/* app_parse with tables: rows of opts first, then each table's rows. */
+bool app_parse_tables(int argc, char **argv, int first, app_opt *opts, app_table *tables, int ntables,
+                      const char **pos, int max_pos, int *npos, const char *usage, bool *help_shown);
 /* Parses argv[first..argc) into opts (terminated by a NULL name); positional
  * arguments go to *pos (up to max_pos). --help prints usage and returns 0 via
  * *done. Returns false (after printing one line) on a bad argument. */
@@ -50,49 +70,22 @@ typedef struct app_gfx {
 } app_gfx;
 bool app_gfx_open(app_gfx *g, mr_error *err);
 void app_gfx_close(app_gfx *g);
-/* The AO option rows, to splice into a command's option table. */
-#define APP_AO_OPTS                                                                                                 \
-    {"ao", "METHOD", "ambient occlusion: none, scheer, crytek, filion, hbao, alchemy, groundtruth (default none)", NULL}, \
-    {"ao-radius-mode", "MODE", "screen (radius grows with depth, default) or view (constant radius)", NULL},              \
-    {"ao-radius", "R", "view-space radius in scene units (implies --ao-radius-mode view; default 2% of the scene)", NULL}, \
-    {"ao-screen-radius", "F", "screen mode: projected radius as a fraction of the image height (default 0.05)", NULL},  \
-    {"ao-samples", "N", "samples per pixel, 1..64 (default 16)", NULL},                                                  \
-    {"ao-kernel", "K", "sample kernel: uniform, stratified, latin, poisson (default uniform)", NULL},                    \
-    {"ao-rmin", "F", "kernel inner radius as a fraction of the radius (default 0.8; 0 = the whole ball)", NULL},          \
-    {"ao-rmax", "F", "kernel outer radius as a fraction of the radius (default 1)", NULL},                                \
-    {"ao-radii", "K", "multi-radius: K radii R, R/2, .., K in 1..5; the darkest wins (default 1)", NULL},                  \
-    {"ao-c", "C", "scheer attenuation c in [0,1e7] (default 1)", NULL},                                                    \
-    {"ao-bias", "B", "bias (cosine / depth fraction of the radius, default 0.05)", NULL},                                  \
-    {"ao-strength", "S", "AO = 1 - S * occlusion (default per method, e.g. scheer 3)", NULL},                                                      \
-    {"ao-blur", "PX", "bilateral blur half-width in AO pixels, 0 = off (default 4)", NULL},                              \
-    {"ao-half", NULL, "AO at half resolution with a joint bilateral upsample", NULL},                                    \
-    {"ao-positions", NULL, "AO from a view-space positions texture", NULL},                                              \
-    {"ao-mask", "M", "corner masking: off, on, standalone (default off)", NULL},                                          \
-    {"ao-mask-strength", "S", "standalone mask: AO = 1 - S in the corners before the blur, S in (0,1] (default 0.5)", NULL}, \
-    {"ao-rays", "N", "groundtruth: rays per pixel (default 256)", NULL}
-/* Reads the APP_AO_OPTS values into ao (and gt for --ao groundtruth);
- * prints one line and returns false on a bad value. */
-bool app_ao_parse(const char *cmd, const app_opt *opts, mr_ao_params *ao, bool *groundtruth, mr_gt_params *gt);
+/* The AO rows beyond mr_ao_opts, to splice into a command's option table:
+ * the ground truth's rays (its params live in lib/eval). */
+#define APP_AO_OPTS {"ao-rays", "N", "groundtruth: rays per pixel (default 256)", NULL}
+/* The AO and ghosting tables of a command (fill .params, then parse). */
+#define APP_AO_TABLE(p) {.prefix = "ao", .table = mr_ao_opts, .params = (p), .extra = "groundtruth"}
+#define APP_GHOST_TABLE(p) {.prefix = "ghost", .table = mr_ghost_opts, .params = (p)}
+/* The checks of the AO table's values that are not a plain range (--ao-radius
+ * only in view mode, --ao-rmin <= --ao-rmax, --ao-mask-strength only for the
+ * standalone mask), --ao groundtruth and --ao-rays into gt; prints one line
+ * and returns false on a bad value. */
+bool app_ao_check(const char *cmd, const app_table *t, const app_opt *opts, bool *groundtruth, mr_gt_params *gt);
 
 /* Writes what --aux asks for: depth.pfm, normal.pfm, ao.pfm into dir. */
 bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err);
 
 
-
-/* The ghosting option rows, to splice into a command's option table. */
-#define APP_GHOST_OPTS                                                                                           \
-    {"ghost", "MODE", "ghosted views of the hidden layer: off|alpha|g0|adaptive (default off)", NULL},            \
-    {"ghost-importance", "SRC", "importance map: curvature|saliency|auto (default auto)", NULL},                  \
-    {"ghost-saliency", "IMPL", "saliency pyramid: mipmap|gauss (default mipmap)", NULL},                         \
-    {"ghost-t", "T", "user transparency t in [0,1]: alpha = t * IM (default 1)", NULL},                          \
-    {"ghost-curv-scale", "S", "curvature (rad/px) to importance scale (default 2)", NULL},                        \
-    {"ghost-curv-bias", "B", "importance bias: higher = denser occluder (default 0.35)", NULL},                  \
-    {"ghost-tc-min", "C", "minimal desired contrast tc_minimal (default 0.1)", NULL},                            \
-    {"ghost-gamma", "G", "multiplier of IM in C_desired (default 0.5)", NULL},                                   \
-    {"ghost-tc-sil", "C", "extra desired contrast on hidden silhouettes (default 0.15)", NULL}
-/* Fills gp from the --ghost, --ghost-importance, --ghost-saliency and
- * --ghost-* number options present in opts; one line + false if bad. */
-bool app_ghost_options(const app_opt *opts, mr_ghost_params *gp);
 
 /* The demo hall with (conflict) or without the hidden pipes coloured like
  * the partition, and the ghosting triptychs of `mrcheck demo`. In

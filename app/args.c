@@ -2,29 +2,116 @@
 #include "app.h"
 
 #include <errno.h>
-#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
-static void print_usage(const char *usage, const app_opt *opts) {
-    printf("%s\n\noptions:\n", usage);
-    for (const app_opt *o = opts; o->name; o++) {
-        char left[64];
-        snprintf(left, sizeof left, "--%s%s%s", o->name, o->arg ? " " : "", o->arg ? o->arg : "");
-        printf("  %-24s %s\n", left, o->help);
+static void print_row(const char *name, const char *arg, const char *help) {
+    char left[96];
+    snprintf(left, sizeof left, "--%s%s%s", name, arg ? " " : "", arg ? arg : "");
+    printf("  %-24s %s\n", left, help);
+}
+
+/* The command-line name of a table row: prefix, or prefix-key. */
+static void row_name(const app_table *t, const mr_opt *o, char *out, size_t n) {
+    snprintf(out, n, "%s%s%s", t->prefix, o->key[0] ? "-" : "", o->key);
+}
+
+static const char *row_arg(const mr_opt *o) {
+    switch (o->type) {
+    case MR_OPT_BOOL: return NULL;
+    case MR_OPT_ENUM: return "NAME";
+    case MR_OPT_INT: return "N";
+    default: return "X";
     }
+}
+
+static void print_usage(const char *usage, const app_opt *opts, const app_table *tables, int ntables) {
+    printf("%s\n\noptions:\n", usage);
+    for (const app_opt *o = opts; o->name; o++) print_row(o->name, o->arg, o->help);
+    for (int i = 0; i < ntables; i++)
+        for (const mr_opt *o = tables[i].table; o->key; o++) {
+            char name[64], desc[320], help[512];
+            row_name(&tables[i], o, name, sizeof name);
+            mr_opt_describe(o, desc, sizeof desc);
+            const char *sep = o->type == MR_OPT_BOOL ? " " : "; ";
+            if (!o->key[0] && tables[i].extra)
+                snprintf(help, sizeof help, "%s%s%s; or %s", o->help, sep, desc, tables[i].extra);
+            else snprintf(help, sizeof help, "%s%s%s", o->help, sep, desc);
+            print_row(name, row_arg(o), help);
+        }
     printf("  %-24s %s\n", "--help", "show this help");
+}
+
+bool app_table_given(const app_table *t, const char *key) {
+    const mr_opt *o = mr_opt_find(t->table, key);
+    return o && t->values[o - t->table] != NULL;
+}
+
+/* Finds --name among the table rows. */
+static bool find_table_row(app_table *tables, int ntables, const char *name, size_t nlen, app_table **tab,
+                           const mr_opt **row) {
+    for (int i = 0; i < ntables; i++)
+        for (const mr_opt *o = tables[i].table; o->key; o++) {
+            char full[64];
+            row_name(&tables[i], o, full, sizeof full);
+            if (strlen(full) == nlen && strncmp(full, name, nlen) == 0) {
+                *tab = &tables[i];
+                *row = o;
+                return true;
+            }
+        }
+    return false;
+}
+
+/* Writes the given table values into their params; one line on error. */
+static bool apply_tables(app_table *tables, int ntables) {
+    for (int i = 0; i < ntables; i++) {
+        app_table *t = &tables[i];
+        for (const mr_opt *o = t->table; o->key; o++) {
+            const char *v = t->values[o - t->table];
+            bool extra_row = !o->key[0] && t->extra;
+            if (!v) continue;
+            if (extra_row && strcmp(v, t->extra) == 0) {
+                t->extra_given = true;
+                continue;
+            }
+            mr_error err = {0};
+            if (mr_opt_set_row(o, t->params, v, &err)) continue;
+            /* err.msg starts with the key: print the option's full name instead. */
+            char name[64];
+            row_name(t, o, name, sizeof name);
+            const char *rest = err.msg + strlen(o->key), *got = extra_row ? strstr(rest, ", got '") : NULL;
+            if (got)
+                fprintf(stderr, "mrcheck: --%s%.*s (or %s)%s\n", name, (int)(got - rest), rest, t->extra, got);
+            else fprintf(stderr, "mrcheck: --%s%s\n", name, rest);
+            return false;
+        }
+    }
+    return true;
 }
 
 bool app_parse(int argc, char **argv, int first, app_opt *opts, const char **pos, int max_pos, int *npos,
                const char *usage, bool *help_shown) {
+    return app_parse_tables(argc, argv, first, opts, NULL, 0, pos, max_pos, npos, usage, help_shown);
+}
+
+bool app_parse_tables(int argc, char **argv, int first, app_opt *opts, app_table *tables, int ntables,
+                      const char **pos, int max_pos, int *npos, const char *usage, bool *help_shown) {
     *help_shown = false;
     if (npos) *npos = 0;
+    for (int i = 0; i < ntables; i++) {
+        if (mr_opt_count(tables[i].table) > APP_TABLE_MAX) {
+            fprintf(stderr, "mrcheck: the --%s table has more than %d rows\n", tables[i].prefix, APP_TABLE_MAX);
+            return false;
+        }
+        tables[i].extra_given = false;
+        memset(tables[i].values, 0, sizeof tables[i].values);
+    }
     for (int i = first; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            print_usage(usage, opts);
+            print_usage(usage, opts, tables, ntables);
             *help_shown = true;
             return true;
         }
@@ -42,26 +129,30 @@ bool app_parse(int argc, char **argv, int first, app_opt *opts, const char **pos
         app_opt *o = opts;
         for (; o->name; o++)
             if (strlen(o->name) == nlen && strncmp(o->name, name, nlen) == 0) break;
-        if (!o->name) {
+        app_table *tab = NULL;
+        const mr_opt *row = NULL;
+        if (!o->name && !find_table_row(tables, ntables, name, nlen, &tab, &row)) {
             fprintf(stderr, "mrcheck: unknown option '--%.*s' (see --help)\n", (int)nlen, name);
             return false;
         }
-        if (!o->arg) {
+        const char **slot = tab ? &tab->values[row - tab->table] : &o->value;
+        const char *arg = tab ? row_arg(row) : o->arg;
+        if (!arg) {
             if (eq) {
-                fprintf(stderr, "mrcheck: option '--%s' takes no value\n", o->name);
+                fprintf(stderr, "mrcheck: option '--%.*s' takes no value\n", (int)nlen, name);
                 return false;
             }
-            o->value = "1";
+            *slot = "1";
         } else if (eq) {
-            o->value = eq + 1;
+            *slot = eq + 1;
         } else if (i + 1 < argc) {
-            o->value = argv[++i];
+            *slot = argv[++i];
         } else {
-            fprintf(stderr, "mrcheck: option '--%s' needs a value (%s)\n", o->name, o->arg);
+            fprintf(stderr, "mrcheck: option '--%.*s' needs a value (%s)\n", (int)nlen, name, arg);
             return false;
         }
     }
-    return true;
+    return apply_tables(tables, ntables);
 }
 
 const char *app_get(const app_opt *opts, const char *name) {
@@ -72,18 +163,19 @@ const char *app_get(const app_opt *opts, const char *name) {
 
 bool app_flag(const app_opt *opts, const char *name) { return app_get(opts, name) != NULL; }
 
+/* Through a one-row option table, so the number rules and the message are
+ * those of every table option. */
 bool app_double(const char *opt, const char *s, double lo, double hi, double *out) {
-    char *end = NULL;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (!s[0] || *end || errno || !isfinite(v) || v < lo || v > hi) {
-        fprintf(stderr, "mrcheck: --%s must be a number in [%g, %g], got '%s'\n", opt, lo, hi, s);
+    const mr_opt row = {opt, MR_OPT_DOUBLE, 0, lo, hi, lo, NULL, "", 0};
+    mr_error err = {0};
+    if (!mr_opt_set_row(&row, out, s, &err)) {
+        fprintf(stderr, "mrcheck: --%s\n", err.msg);
         return false;
     }
-    *out = v;
     return true;
 }
 
+/* Whole numbers stay here: their ranges reach beyond an int (--from). */
 bool app_int(const char *opt, const char *s, long lo, long hi, long *out) {
     char *end = NULL;
     errno = 0;

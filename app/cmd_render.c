@@ -41,46 +41,6 @@ bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err) {
     return true;
 }
 
-/* Reads the --ghost* options (declared by the caller's option table). */
-bool app_ghost_options(const app_opt *opts, mr_ghost_params *gp) {
-    const char *m = app_get(opts, "ghost"), *im = app_get(opts, "ghost-importance"), *sal = app_get(opts, "ghost-saliency");
-    if (m) {
-        static const char *const names[] = {"off", "alpha", "g0", "adaptive"};
-        int k = -1;
-        for (int i = 0; i < 4; i++)
-            if (strcmp(m, names[i]) == 0) k = i;
-        if (k < 0) return fprintf(stderr, "mrcheck: " "--ghost must be off, alpha, g0 or adaptive, got '%s'" "\n", m), false;
-        gp->mode = (mr_ghost_mode)k;
-    }
-    if (im) {
-        if (strcmp(im, "auto") == 0) gp->importance = MR_GHOST_IMP_AUTO;
-        else if (strcmp(im, "curvature") == 0) gp->importance = MR_GHOST_IMP_CURVATURE;
-        else if (strcmp(im, "saliency") == 0) gp->importance = MR_GHOST_IMP_SALIENCY;
-        else return fprintf(stderr, "mrcheck: " "--ghost-importance must be curvature, saliency or auto, got '%s'" "\n", im), false;
-    }
-    if (sal) {
-        if (strcmp(sal, "mipmap") == 0) gp->saliency = MR_SALIENCY_MIPMAP;
-        else if (strcmp(sal, "gauss") == 0) gp->saliency = MR_SALIENCY_GAUSS;
-        else return fprintf(stderr, "mrcheck: " "--ghost-saliency must be mipmap or gauss, got '%s'" "\n", sal), false;
-    }
-    static const struct { const char *name; double lo, hi; size_t off; } nums[] = {
-        {"ghost-t", 0, 1, offsetof(mr_ghost_params, t)},
-        {"ghost-curv-scale", 0, 1e3, offsetof(mr_ghost_params, curv_scale)},
-        {"ghost-curv-bias", -1, 1, offsetof(mr_ghost_params, curv_bias)},
-        {"ghost-tc-min", 0, 4, offsetof(mr_ghost_params, tc_minimal)},
-        {"ghost-gamma", 0, 100, offsetof(mr_ghost_params, gamma)},
-        {"ghost-tc-sil", 0, 4, offsetof(mr_ghost_params, tc_silhouette)},
-    };
-    for (size_t i = 0; i < sizeof nums / sizeof nums[0]; i++) {
-        const char *v = app_get(opts, nums[i].name);
-        double d;
-        if (!v) continue;
-        if (!app_double(nums[i].name, v, nums[i].lo, nums[i].hi, &d)) return false;
-        *(float *)((char *)gp + nums[i].off) = (float)d;
-    }
-    return true;
-}
-
 /* --ao groundtruth: ray-trace the AO of the surface points the first frame
  * saw, then render again shading with it (no AO pass runs). */
 static bool render_groundtruth(mr_renderer *r, const mr_scene *scene, const mr_view *view, mr_frame_params *fp,
@@ -119,15 +79,16 @@ int cmd_render(int argc, char **argv) {
         {"hidden", "GLOB", "extra node-name glob for the hidden layer", NULL},
         {"hide-hidden", NULL, "leave the hidden layer out", NULL},
         APP_AO_OPTS,
-        APP_GHOST_OPTS,
         APP_DRAW_OPTS,
         {"lod-cache", "on|off", "read/write LOD levels in <scene>.mrlod (default on)", NULL},
         {"verbose", NULL, "print the passes that ran and more", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
+    mr_frame_params fp = MR_FRAME_DEFAULTS;
+    app_table tables[] = {APP_AO_TABLE(&fp.ao), APP_GHOST_TABLE(&fp.ghost)};
     bool help;
-    if (!app_parse(argc, argv, 2, opts, NULL, 0, NULL,
+    if (!app_parse_tables(argc, argv, 2, opts, tables, 2, NULL, 0, NULL,
                    "usage: mrcheck render --scene FILE --view VIEW.json --out OUT.png [--size WxH] "
                    "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive]",
                    &help))
@@ -137,8 +98,6 @@ int cmd_render(int argc, char **argv) {
     const char *scene_path = app_get(opts, "scene"), *view_path = app_get(opts, "view"), *out = app_get(opts, "out");
     if (!scene_path || !view_path || !out) return app_errorf(cmd, "--scene, --view and --out are required"), 2;
 
-    mr_frame_params fp = MR_FRAME_DEFAULTS;
-    if (!app_ghost_options(opts, &fp.ghost)) return 2;
     if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &fp.width, &fp.height)) return 2;
     double alpha = 0.5;
     if (app_get(opts, "alpha") && !app_double("alpha", app_get(opts, "alpha"), 0, 1, &alpha)) return 2;
@@ -153,7 +112,7 @@ int cmd_render(int argc, char **argv) {
     fp.want_depth = fp.want_normals = aux != NULL;
     bool groundtruth = false;
     mr_gt_params gtp = MR_GT_DEFAULTS;
-    if (!app_ao_parse(cmd, opts, &fp.ao, &groundtruth, &gtp)) return 2;
+    if (!app_ao_check(cmd, &tables[0], opts, &groundtruth, &gtp)) return 2;
     fp.ao.want_ao = aux != NULL;
 
     /* Everything that can be checked without a GPU is checked first, so a

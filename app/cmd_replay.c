@@ -19,15 +19,17 @@ int cmd_replay(int argc, char **argv) {
         {"raw", NULL, "use the raw pose instead of the filtered one", NULL},
         {"video", "FILE.avi", "also write the overlays as a Motion-JPEG AVI at the recording's rate", NULL},
         APP_AO_OPTS,
-        APP_GHOST_OPTS,
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
     const char *pos[1];
     int npos = 0;
+    /* Depth cues as on render: the same option tables and checks. */
+    mr_frame_params base = MR_FRAME_DEFAULTS;
+    app_table tables[] = {APP_AO_TABLE(&base.ao), APP_GHOST_TABLE(&base.ghost)};
     bool help;
-    if (!app_parse(argc, argv, 2, opts, pos, 1, &npos,
+    if (!app_parse_tables(argc, argv, 2, opts, tables, 2, pos, 1, &npos,
                    "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] [--raw] "
                    "[--video F.avi] [--ao METHOD ...] [--ghost MODE ...]",
                    &help))
@@ -45,11 +47,9 @@ int cmd_replay(int argc, char **argv) {
     if (to >= 0 && to < from) return app_errorf(cmd, "--to %ld is before --from %ld", to, from), 2;
     const char *out = app_get(opts, "out");
     bool raw = app_flag(opts, "raw");
-    /* Depth cues as on render: the same option tables and parsers. */
-    mr_frame_params base = MR_FRAME_DEFAULTS;
     bool groundtruth = false;
     mr_gt_params gtp = MR_GT_DEFAULTS;
-    if (!app_ao_parse(cmd, opts, &base.ao, &groundtruth, &gtp) || !app_ghost_options(opts, &base.ghost)) return 2;
+    if (!app_ao_check(cmd, &tables[0], opts, &groundtruth, &gtp)) return 2;
     if (groundtruth) return app_errorf(cmd, "--ao groundtruth is for single frames (mrcheck render), not replays"), 2;
 
     mr_error err = {0};

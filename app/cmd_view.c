@@ -581,21 +581,19 @@ static void poll_scene_load(view_app *a) {
     a->need_render = true;
 }
 
-/* --ao and --ghost, checked before any window opens; -1 where not given. */
+/* --ao and --ghost, checked before any window opens through the settings
+ * file's rows (so the names are the ones A and G cycle); -1 where not given. */
 static int parse_start_modes(const app_opt *opts, int *ao, int *ghost) {
-    *ao = *ghost = -1;
-    if (app_get(opts, "ao")) {
-        mr_ao_method m;
-        if (!mr_ao_method_parse(app_get(opts, "ao"), &m) || m >= MR_AO_METHOD_COUNT)
-            return app_errorf(k_cmd, "--ao must be none, scheer, crytek, filion, hbao or alchemy, got '%s'",
-                              app_get(opts, "ao"));
-        *ao = (int)m;
-    }
-    mr_ghost_mode g;
-    if (app_get(opts, "ghost")) {
-        if (!mr_view_ghost_parse(app_get(opts, "ghost"), &g))
-            return app_errorf(k_cmd, "--ghost must be off, alpha, g0 or adaptive, got '%s'", app_get(opts, "ghost"));
-        *ghost = (int)g;
+    int *out[2] = {ao, ghost};
+    static const char *const keys[2] = {"ao", "ghost"};
+    for (int i = 0; i < 2; i++) {
+        const mr_opt *o = mr_opt_find(mr_view_settings_opts, keys[i]);
+        mr_view_settings s = MR_VIEW_SETTINGS_DEFAULTS;
+        mr_error err = {0};
+        *out[i] = -1;
+        if (!app_get(opts, keys[i])) continue;
+        if (!mr_opt_set_row(o, &s, app_get(opts, keys[i]), &err)) return app_errorf(k_cmd, "--%s", err.msg);
+        *out[i] = (int)mr_opt_get(o, &s);
     }
     return 0;
 }
@@ -690,6 +688,13 @@ static int start_capture(view_app *a, const app_opt *opts, const char *input, co
 }
 
 int cmd_view(int argc, char **argv) {
+    /* The names and defaults of --ao and --ghost from the settings table. */
+    char ao_help[400], ghost_help[400], desc[256];
+    mr_opt_describe(mr_opt_find(mr_view_settings_opts, "ao"), desc, sizeof desc);
+    snprintf(ao_help, sizeof ao_help, "start with this AO method instead of the saved one (the A key cycles): %s", desc);
+    mr_opt_describe(mr_opt_find(mr_view_settings_opts, "ghost"), desc, sizeof desc);
+    snprintf(ghost_help, sizeof ghost_help, "start with this ghosting mode instead of the saved one (the G key cycles): %s",
+             desc);
     app_opt opts[] = {
         {"scene", "FILE", "glTF/GLB or scene config JSON (required)", NULL},
         {"input", "PATH", "live input: /dev/videoN, a video file, an image or a folder of images", NULL},
@@ -706,8 +711,8 @@ int cmd_view(int argc, char **argv) {
         {"retrack", NULL, "replay: track the frames again instead of using the recorded poses", NULL},
         {"script", "FILE", "timed input events (tests, demos): see lib/view/mr_view.h", NULL},
         {"stats", NULL, "print the frame-time split on exit", NULL},
-        {"ao", "METHOD", "start with this AO method (none, scheer, crytek, filion, hbao, alchemy); the A key cycles", NULL},
-        {"ghost", "MODE", "start with this ghosting mode (off, alpha, g0, adaptive); the G key cycles", NULL},
+        {"ao", "METHOD", ao_help, NULL},
+        {"ghost", "MODE", ghost_help, NULL},
         {"verbose", NULL, "more log output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},

@@ -44,7 +44,7 @@ overlay_p1_p2_swapped|shaders/overlay.frag.glsl|p1 = u_dist[2], p2 = u_dist[3]|p
 overlay_p2_sign|shaders/overlay.frag.glsl|2.0 * p1 * xy.x * xy.y + p2 * (r2|2.0 * p1 * xy.x * xy.y - p2 * (r2|^test_render$
 view_act_on_press|lib/ui/widgets.c|bool clicked = enabled && ui->released && ui->active == id && over;|bool clicked = enabled && ui->pressed && over;|^test_view$
 view_slide_off_acts|lib/ui/widgets.c|bool clicked = enabled && ui->released && ui->active == id && over;|bool clicked = enabled && ui->released && ui->active == id;|^test_view$
-view_ao_cycle_backwards|lib/view/controller.c|v->s.ao = (mr_ao_method)((v->s.ao + 1) % MR_AO_METHOD_COUNT);|v->s.ao = (mr_ao_method)((v->s.ao + MR_AO_METHOD_COUNT - 1) % MR_AO_METHOD_COUNT);|^test_view$
+view_ao_cycle_backwards|lib/view/controller.c|v->s.ao = (mr_ao_method)mr_opt_enum_next(mr_opt_find(mr_view_settings_opts, "ao"), (int)v->s.ao);|v->s.ao = (mr_ao_method)((v->s.ao + MR_AO_METHOD_COUNT - 1) % MR_AO_METHOD_COUNT);|^test_view$
 view_settings_in_place|lib/view/settings.c|    bool ok = (!dir[0] |    FILE *fo = fopen(path, "wb");\n    char *txt = cJSON_Print(j);\n    if (fo && txt) fputs(txt, fo);\n    if (fo) fclose(fo);\n    free(txt);\n    bool ok = true;\n    if (0) ok = (!dir[0] |^test_view$
 view_lost_fades_to_model|lib/view/controller.c|1.0f - (1.0f - s->alpha) * 0.35f|s->alpha * 0.35f|^test_view$
 view_layout_drops_first|lib/view/controller.c|        if (i >= shown) {|        if (i < n - shown) {|^test_view$
@@ -53,6 +53,13 @@ gl_target_leaks_positions|lib/render/renderer.c|glDeleteTextures((GLsizei)(sizeo
 ao_reuse_never|lib/render/pass_ao.c|return memcmp(&key, &s->last, sizeof key) == 0 ? AO_PLAN_REUSE : AO_PLAN_RUN;|(void)key; return AO_PLAN_RUN;|^test_ao$
 registry_gbuffer_skipped|lib/render/passes.c|.name = "gbuffer", .prepare|.name = "gbuffer", .needed = mr_pass_need_overlay, .prepare|^test_render$
 ghost_hidden_in_gbuffer|lib/render/passes.c|!(f->writing & RES(RES_HIDDEN_DEPTH))|true|^test_ghost$
+opt_default_outside_range|lib/render/options.c|1, MR_AO_MAX_SAMPLES, MR_AO_DEFAULT_SAMPLES|1, MR_AO_MAX_SAMPLES, 0|^test_options$
+opt_default_not_the_macro|lib/render/options.c|GH(tc_silhouette), 0, 4, MR_GHOST_DEFAULT_TC_SILHOUETTE|GH(tc_silhouette), 0, 4, MR_GHOST_DEFAULT_TC_MINIMAL|^test_options$
+opt_wrong_offset|lib/render/options.c|{"rmin", MR_OPT_FLOAT, AO(r_min)|{"rmin", MR_OPT_FLOAT, AO(r_max)|^test_options$
+opt_wrong_offset_untabled|lib/render/options.c|GH(curv_scale)|GH(saliency_gain)|^test_options$
+opt_range_off_by_one|lib/render/options.c|AO(blur_radius), 0, 32,|AO(blur_radius), 0, 33,|^test_options$
+opt_upper_bound_exclusive|lib/core/options.c|v > o->hi) return range_fail(o, text, err);\n        store(o, params, (double)v);|v >= o->hi) return range_fail(o, text, err);\n        store(o, params, (double)v);|^test_options$
+opt_cli_value_ignored|app/args.c|if (mr_opt_set_row(o, t->params, v, &err)) continue;|if (mr_opt_set_row(o, t->params, v, &err) + 1) continue;|^cli_options$
 LIST
 )
 

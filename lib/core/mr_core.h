@@ -211,6 +211,69 @@ bool mr_image_load_pfm(const char *path, mr_image *img, mr_error *err);
  * img->channels values in [0,255]; false if outside. */
 bool mr_image_sample_bilinear(const mr_image *img, double x, double y, float *out);
 
+/* --------------------------------------------------------------- options */
+
+/* A declared option table: one row per tunable field of a params struct,
+ * so that a default and a range are written once and the command line,
+ * --help, settings files and UI cycling all read them from here. A table is
+ * an array ended by a row with key NULL. Values are checked against
+ * [lo, hi] (enums: against their names). */
+typedef enum mr_opt_type {
+    MR_OPT_INT = 0, /* int field */
+    MR_OPT_DOUBLE,  /* double field */
+    MR_OPT_FLOAT,   /* float field */
+    MR_OPT_BOOL,    /* bool field; a flag on the command line */
+    MR_OPT_ENUM,    /* enum field (int-sized): the index into names */
+} mr_opt_type;
+
+/* 0 is the default and means "chosen at run time" (e.g. 2% of the scene):
+ * it may lie outside [lo, hi], which bounds what a user may set. */
+#define MR_OPT_ZERO_AUTO 1u
+
+typedef struct mr_opt {
+    const char *key;          /* file / UI name; on the command line prefix + key,
+                                 and "" names the prefix itself (--ao) */
+    mr_opt_type type;
+    size_t offset;            /* offsetof the field in its params struct */
+    double lo, hi;            /* accepted range (numbers) */
+    double def;               /* default (enums: the index) */
+    const char *const *names; /* enums: names by value, NULL-terminated */
+    const char *help;         /* one line, no default or range (added from the row) */
+    unsigned flags;           /* MR_OPT_ZERO_AUTO */
+} mr_opt;
+
+/* The row named key; NULL if none. */
+const mr_opt *mr_opt_find(const mr_opt *table, const char *key);
+/* Number of rows. */
+int mr_opt_count(const mr_opt *table);
+/* Parses text into the field of `key` (bool: 1/0, true/false, on/off;
+ * enum: a name). On a bad value: false and one line in err that starts with
+ * the key and names the range or the names and the value, e.g.
+ * "samples must be a whole number in [1, 64], got '0'". */
+bool mr_opt_set(const mr_opt *table, void *params, const char *key, const char *text, mr_error *err);
+/* The same for one row. */
+bool mr_opt_set_row(const mr_opt *o, void *params, const char *text, mr_error *err);
+/* Sets a row from a JSON value (number, bool, or enum name); same checks. */
+bool mr_opt_set_json(const mr_opt *o, void *params, const cJSON *item, mr_error *err);
+/* The field as a double (bool 0/1, enum its index). */
+double mr_opt_get(const mr_opt *o, const void *params);
+/* The field as text ("%g", "true"/"false", the enum's name) into out. */
+void mr_opt_format(const mr_opt *o, const void *params, char *out, size_t n);
+/* The row's default and range as text: "N in [1, 64] (default 16)",
+ * "one of a, b, c (default a)", "(default off)"; for --help. */
+void mr_opt_describe(const mr_opt *o, char *out, size_t n);
+/* Writes every row's default into params (other fields untouched). */
+void mr_opt_defaults(const mr_opt *table, void *params);
+/* Adds each row to obj (number, bool or enum name) under its key. */
+bool mr_opt_to_json(const mr_opt *table, const void *params, cJSON *obj);
+/* Enum rows: the name of value v (NULL if out of range), the value of a
+ * name (-1 if unknown), the number of names, and the next value after v
+ * (cycling back to the first). */
+const char *mr_opt_enum_name(const mr_opt *o, int v);
+int mr_opt_enum_value(const mr_opt *o, const char *name);
+int mr_opt_enum_count(const mr_opt *o);
+int mr_opt_enum_next(const mr_opt *o, int v);
+
 /* ------------------------------------------------------------------- RNG */
 
 /* Deterministic generator (splitmix64 seeded xoshiro256**), so that demo

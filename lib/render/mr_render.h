@@ -148,6 +148,13 @@ typedef struct mr_ao_params {
                         .blur_radius = MR_AO_DEFAULT_BLUR_RADIUS, .mask = MR_AO_MASK_OFF, \
                         .mask_strength = MR_AO_DEFAULT_MASK_STRENGTH}
 
+/* The option table of mr_ao_params (lib/render/options.c): on the command
+ * line "--ao" + "-" + key ("" is --ao itself, the method). Its rows cover the
+ * user's tunables; want_*, no_reuse and external are for programs. */
+extern const mr_opt mr_ao_opts[];
+/* "none", "scheer", ..., NULL: the method names by value. */
+extern const char *const mr_ao_method_names[MR_AO_METHOD_COUNT + 1];
+
 /* Names used on the command line ("none", "scheer", ...); NULL if out of range. */
 const char *mr_ao_method_name(mr_ao_method m);
 /* Parses a method name; false if unknown. */
@@ -238,6 +245,13 @@ typedef struct mr_ghost_params {
                            .tc_silhouette = MR_GHOST_DEFAULT_TC_SILHOUETTE, \
                            .emphasis_gain = MR_GHOST_DEFAULT_EMPHASIS_GAIN, .sigma_c = MR_GHOST_DEFAULT_SIGMA_C, \
                            .sigma_d = MR_GHOST_DEFAULT_SIGMA_D, .saliency_levels = MR_SAL_LEVELS_OFFSET}
+
+/* The option table of mr_ghost_params (--ghost, --ghost-KEY): the mode,
+ * importance, saliency and the numbers a user tunes; the rest (gains,
+ * sigmas, levels, stats) keep their MR_GHOST_DEFAULTS. */
+extern const mr_opt mr_ghost_opts[];
+/* "off", "alpha", "g0", "adaptive", NULL: the ghosting modes by value. */
+extern const char *const mr_ghost_mode_names[];
 
 /* Legibility of a ghosted frame (when mr_ghost_params.stats). */
 typedef struct mr_ghost_stats {

@@ -59,35 +59,6 @@ struct mr_ao_state {
     float screen_k;
 };
 
-/* ------------------------------------------------------------ names */
-
-static const char *const k_method_names[MR_AO_METHOD_COUNT] = {"none", "scheer", "crytek", "filion", "hbao", "alchemy"};
-static const char *const k_kernel_names[4] = {"uniform", "stratified", "latin", "poisson"};
-
-const char *mr_ao_method_name(mr_ao_method m) {
-    return (int)m >= 0 && m < MR_AO_METHOD_COUNT ? k_method_names[m] : NULL;
-}
-
-bool mr_ao_method_parse(const char *name, mr_ao_method *out) {
-    for (int i = 0; i < MR_AO_METHOD_COUNT; i++)
-        if (name && strcmp(name, k_method_names[i]) == 0) {
-            *out = (mr_ao_method)i;
-            return true;
-        }
-    return false;
-}
-
-const char *mr_ao_kernel_name(mr_ao_kernel k) { return (int)k >= 0 && k < 4 ? k_kernel_names[k] : NULL; }
-
-bool mr_ao_kernel_parse(const char *name, mr_ao_kernel *out) {
-    for (int i = 0; i < 4; i++)
-        if (name && strcmp(name, k_kernel_names[i]) == 0) {
-            *out = (mr_ao_kernel)i;
-            return true;
-        }
-    return false;
-}
-
 /* ------------------------------------------------------------ kernels */
 
 static void shuffle(mr_rng *rng, int *perm, int n) {

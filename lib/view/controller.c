@@ -300,14 +300,15 @@ static void set_rate(mr_viewer *v, int i, mr_view_actions *out) {
     vw_emit(out, MR_VA_RATE)->x = mr_view_rates[i];
 }
 
-/* AO and ghosting cycle through every method in their enum order. */
+/* AO and ghosting cycle through the names of their settings rows, in
+ * their order (the enums' order). */
 static void next_ao(mr_viewer *v, mr_view_actions *out) {
-    v->s.ao = (mr_ao_method)((v->s.ao + 1) % MR_AO_METHOD_COUNT);
+    v->s.ao = (mr_ao_method)mr_opt_enum_next(mr_opt_find(mr_view_settings_opts, "ao"), (int)v->s.ao);
     changed(v, out);
 }
 
 static void next_ghost(mr_viewer *v, mr_view_actions *out) {
-    v->s.ghost = (mr_ghost_mode)((v->s.ghost + 1) % (MR_GHOST_ADAPTIVE + 1));
+    v->s.ghost = (mr_ghost_mode)mr_opt_enum_next(mr_opt_find(mr_view_settings_opts, "ghost"), (int)v->s.ghost);
     changed(v, out);
 }
 

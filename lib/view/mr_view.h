@@ -10,7 +10,7 @@
  *
  * Depends on: lib/core, lib/ui, and from lib/render only plain types and
  * names (mr_event, MR_KEY_*, mr_ao_method, mr_ghost_mode,
- * mr_ao_method_name/parse): no GL or GLFW call. One way only: nothing
+ * mr_ao_method_name/parse, the option tables' enum names): no GL or GLFW call. One way only: nothing
  * below lib/view includes this header.
  */
 #ifndef MR_VIEW_CTL_H
@@ -42,9 +42,17 @@ typedef struct mr_view_settings {
     mr_ao_method ao;      /* default MR_AO_NONE */
     mr_ghost_mode ghost;  /* default MR_GHOST_OFF */
 } mr_view_settings;
-#define MR_VIEW_SETTINGS_DEFAULTS {0.5f, true, false, 2, MR_AO_NONE, MR_GHOST_OFF}
+#define MR_VIEW_DEFAULT_ALPHA 0.5f
+#define MR_VIEW_DEFAULT_RATE_I 2
+#define MR_VIEW_SETTINGS_DEFAULTS {.alpha = MR_VIEW_DEFAULT_ALPHA, .show_video = true, .hide_hidden = false, \
+                                   .rate_i = MR_VIEW_DEFAULT_RATE_I, .ao = MR_AO_NONE, .ghost = MR_GHOST_OFF}
+/* The option table of the settings file (keys alpha, show_video,
+ * hide_hidden_layer, ao, ghost); the A and G keys cycle through the ao and
+ * ghost rows' names. The rate is stored as a rate, not as rate_i, so it is
+ * read and written beside the table. */
+extern const mr_opt mr_view_settings_opts[];
 
-/* "off", "alpha", "g0", "adaptive". */
+/* "off", "alpha", "g0", "adaptive" (mr_ghost_mode_names); "off" if out of range. */
 const char *mr_view_ghost_name(mr_ghost_mode m);
 bool mr_view_ghost_parse(const char *name, mr_ghost_mode *out);
 /* $XDG_CONFIG_HOME/mrcheck/view.json, else ~/.config/mrcheck/view.json,

@@ -2,26 +2,34 @@
 #include "mr_view.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
 const double mr_view_rates[MR_VIEW_RATE_COUNT] = {0.25, 0.5, 1.0, 2.0, 4.0};
 const char *const mr_view_notes[MR_VIEW_NOTE_COUNT] = {"missing", "extra", "moved", "wrong size", "clash", "other"};
 
-static const char *const k_ghost_names[] = {"off", "alpha", "g0", "adaptive"};
-#define GHOST_COUNT (int)(sizeof k_ghost_names / sizeof k_ghost_names[0])
+#define VS(f) offsetof(mr_view_settings, f)
+const mr_opt mr_view_settings_opts[] = {
+    {"alpha", MR_OPT_FLOAT, VS(alpha), 0, 1, MR_VIEW_DEFAULT_ALPHA, NULL,
+     "video transparency: 0 model only, 1 video only", 0},
+    {"show_video", MR_OPT_BOOL, VS(show_video), 0, 1, 1, NULL, "show the camera image", 0},
+    {"hide_hidden_layer", MR_OPT_BOOL, VS(hide_hidden), 0, 1, 0, NULL, "leave the hidden layer out", 0},
+    {"ao", MR_OPT_ENUM, VS(ao), 0, 0, MR_AO_NONE, mr_ao_method_names, "ambient occlusion method", 0},
+    {"ghost", MR_OPT_ENUM, VS(ghost), 0, 0, MR_GHOST_OFF, mr_ghost_mode_names, "ghosting mode", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef VS
 
 const char *mr_view_ghost_name(mr_ghost_mode m) {
-    return (int)m >= 0 && (int)m < GHOST_COUNT ? k_ghost_names[m] : "off";
+    const char *n = mr_opt_enum_name(mr_opt_find(mr_view_settings_opts, "ghost"), (int)m);
+    return n ? n : "off";
 }
 
 bool mr_view_ghost_parse(const char *name, mr_ghost_mode *out) {
-    for (int i = 0; name && i < GHOST_COUNT; i++)
-        if (strcmp(name, k_ghost_names[i]) == 0) {
-            *out = (mr_ghost_mode)i;
-            return true;
-        }
-    return false;
+    int v = mr_opt_enum_value(mr_opt_find(mr_view_settings_opts, "ghost"), name);
+    if (v >= 0) *out = (mr_ghost_mode)v;
+    return v >= 0;
 }
 
 void mr_view_default_config_path(char *out, size_t n) {
@@ -51,11 +59,12 @@ void mr_view_settings_load(const char *path, mr_view_settings *s, char *warn, si
         cJSON_Delete(j);
         return;
     }
-    const cJSON *it = cJSON_GetObjectItemCaseSensitive(j, "alpha");
-    if (it && !(cJSON_IsNumber(it) && it->valuedouble >= 0 && it->valuedouble <= 1))
-        warn_add(warn, warn_n, "alpha must be a number in [0, 1]");
-    else if (it) s->alpha = (float)it->valuedouble;
-    it = cJSON_GetObjectItemCaseSensitive(j, "rate");
+    for (const mr_opt *o = mr_view_settings_opts; o->key; o++) {
+        const cJSON *it = cJSON_GetObjectItemCaseSensitive(j, o->key);
+        mr_error e = {0};
+        if (it && !mr_opt_set_json(o, s, it, &e)) warn_add(warn, warn_n, e.msg);
+    }
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(j, "rate");
     if (it) {
         int k = -1;
         for (int i = 0; cJSON_IsNumber(it) && i < MR_VIEW_RATE_COUNT; i++)
@@ -63,22 +72,6 @@ void mr_view_settings_load(const char *path, mr_view_settings *s, char *warn, si
         if (k < 0) warn_add(warn, warn_n, "rate must be 0.25, 0.5, 1, 2 or 4");
         else s->rate_i = k;
     }
-    it = cJSON_GetObjectItemCaseSensitive(j, "show_video");
-    if (it && !cJSON_IsBool(it)) warn_add(warn, warn_n, "show_video must be true or false");
-    else if (it) s->show_video = cJSON_IsTrue(it);
-    it = cJSON_GetObjectItemCaseSensitive(j, "hide_hidden_layer");
-    if (it && !cJSON_IsBool(it)) warn_add(warn, warn_n, "hide_hidden_layer must be true or false");
-    else if (it) s->hide_hidden = cJSON_IsTrue(it);
-    it = cJSON_GetObjectItemCaseSensitive(j, "ao");
-    mr_ao_method m;
-    if (it && !(cJSON_IsString(it) && mr_ao_method_parse(it->valuestring, &m) && m < MR_AO_METHOD_COUNT))
-        warn_add(warn, warn_n, "ao is not a known AO method");
-    else if (it) s->ao = m;
-    it = cJSON_GetObjectItemCaseSensitive(j, "ghost");
-    mr_ghost_mode g;
-    if (it && !(cJSON_IsString(it) && mr_view_ghost_parse(it->valuestring, &g)))
-        warn_add(warn, warn_n, "ghost must be off, alpha, g0 or adaptive");
-    else if (it) s->ghost = g;
     cJSON_Delete(j);
 }
 
@@ -88,12 +81,10 @@ bool mr_view_settings_save(const char *path, const mr_view_settings *s, mr_error
     cJSON *j = cJSON_CreateObject();
     if (!j) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
     int ri = s->rate_i < 0 || s->rate_i >= MR_VIEW_RATE_COUNT ? 2 : s->rate_i;
-    cJSON_AddNumberToObject(j, "alpha", s->alpha);
-    cJSON_AddBoolToObject(j, "show_video", s->show_video);
-    cJSON_AddBoolToObject(j, "hide_hidden_layer", s->hide_hidden);
-    cJSON_AddNumberToObject(j, "rate", mr_view_rates[ri]);
-    cJSON_AddStringToObject(j, "ao", mr_ao_method_name(s->ao));
-    cJSON_AddStringToObject(j, "ghost", mr_view_ghost_name(s->ghost));
+    if (!mr_opt_to_json(mr_view_settings_opts, s, j) || !cJSON_AddNumberToObject(j, "rate", mr_view_rates[ri])) {
+        cJSON_Delete(j);
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    }
     /* mr_json_save writes a temporary file and renames it. */
     bool ok = (!dir[0] || mr_mkdirs(dir, err)) && mr_json_save(path, j, err);
     cJSON_Delete(j);

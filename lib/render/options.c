@@ -1,0 +1,87 @@
+/* The option tables of the renderer's params (mr_ao_opts, mr_ghost_opts):
+ * key, type, field, range, default and help of every tunable the command
+ * line, --help, settings files and the view's cycling expose. Defaults are
+ * the MR_*_DEFAULT_* macros of mr_render.h, so each is written once. */
+#include "mr_render.h"
+
+#include <stddef.h>
+
+const char *const mr_ao_method_names[MR_AO_METHOD_COUNT + 1] = {"none", "scheer", "crytek", "filion",
+                                                                "hbao", "alchemy", NULL};
+static const char *const k_radius_mode_names[] = {"screen", "view", NULL};
+static const char *const k_kernel_names[] = {"uniform", "stratified", "latin", "poisson", NULL};
+static const char *const k_mask_names[] = {"off", "on", "standalone", NULL};
+
+#define AO(f) offsetof(mr_ao_params, f)
+const mr_opt mr_ao_opts[] = {
+    {"", MR_OPT_ENUM, AO(method), 0, 0, MR_AO_NONE, mr_ao_method_names, "ambient occlusion", 0},
+    {"radius-mode", MR_OPT_ENUM, AO(radius_mode), 0, 0, MR_AO_RADIUS_SCREEN, k_radius_mode_names,
+     "screen: the radius grows with depth; view: a constant radius", 0},
+    /* The radius in scene units has no fixed scale: any positive length. */
+    {"radius", MR_OPT_DOUBLE, AO(radius), 1e-30, 1e30, 0, NULL,
+     "view-space radius in scene units (implies --ao-radius-mode view; auto: 2% of the scene)", MR_OPT_ZERO_AUTO},
+    {"screen-radius", MR_OPT_DOUBLE, AO(screen_radius), 1e-6, 10, MR_AO_DEFAULT_SCREEN_RADIUS, NULL,
+     "screen mode: projected radius as a fraction of the image height", 0},
+    {"samples", MR_OPT_INT, AO(samples), 1, MR_AO_MAX_SAMPLES, MR_AO_DEFAULT_SAMPLES, NULL, "samples per pixel", 0},
+    {"kernel", MR_OPT_ENUM, AO(kernel), 0, 0, MR_AO_KERNEL_UNIFORM, k_kernel_names, "sample kernel", 0},
+    {"rmin", MR_OPT_FLOAT, AO(r_min), 0, 1, MR_AO_DEFAULT_R_MIN, NULL,
+     "kernel inner radius as a fraction of the radius (0 = the whole ball)", 0},
+    {"rmax", MR_OPT_FLOAT, AO(r_max), 1e-3, 1, MR_AO_DEFAULT_R_MAX, NULL,
+     "kernel outer radius as a fraction of the radius", 0},
+    {"radii", MR_OPT_INT, AO(radii), 1, MR_AO_MAX_RADII, MR_AO_DEFAULT_RADII, NULL,
+     "multi-radius: K radii R, R/2, ..; the darkest wins", 0},
+    {"c", MR_OPT_FLOAT, AO(c), 0, 1e7, MR_AO_DEFAULT_C, NULL, "scheer attenuation c", 0},
+    {"bias", MR_OPT_FLOAT, AO(bias), 0, 0.5, MR_AO_DEFAULT_BIAS, NULL,
+     "bias (cosine / depth fraction of the radius)", 0},
+    {"strength", MR_OPT_FLOAT, AO(strength), 0.01, 10, 0, NULL,
+     "AO = 1 - S * occlusion (auto: per method, e.g. scheer 3)", MR_OPT_ZERO_AUTO},
+    {"blur", MR_OPT_INT, AO(blur_radius), 0, 32, MR_AO_DEFAULT_BLUR_RADIUS, NULL,
+     "bilateral blur half-width in AO pixels, 0 = off", 0},
+    {"half", MR_OPT_BOOL, AO(half_res), 0, 1, 0, NULL, "AO at half resolution with a joint bilateral upsample", 0},
+    {"positions", MR_OPT_BOOL, AO(positions), 0, 1, 0, NULL, "AO from a view-space positions texture", 0},
+    {"mask", MR_OPT_ENUM, AO(mask), 0, 0, MR_AO_MASK_OFF, k_mask_names, "corner masking", 0},
+    {"mask-strength", MR_OPT_FLOAT, AO(mask_strength), 1e-3, 1, MR_AO_DEFAULT_MASK_STRENGTH, NULL,
+     "standalone mask: AO = 1 - S in the corners before the blur", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef AO
+
+const char *const mr_ghost_mode_names[] = {"off", "alpha", "g0", "adaptive", NULL};
+static const char *const k_importance_names[] = {"auto", "curvature", "saliency", NULL};
+static const char *const k_saliency_names[] = {"mipmap", "gauss", NULL};
+
+#define GH(f) offsetof(mr_ghost_params, f)
+const mr_opt mr_ghost_opts[] = {
+    {"", MR_OPT_ENUM, GH(mode), 0, 0, MR_GHOST_OFF, mr_ghost_mode_names, "ghosted views of the hidden layer", 0},
+    {"importance", MR_OPT_ENUM, GH(importance), 0, 0, MR_GHOST_IMP_AUTO, k_importance_names, "importance map", 0},
+    {"saliency", MR_OPT_ENUM, GH(saliency), 0, 0, MR_SALIENCY_MIPMAP, k_saliency_names, "saliency pyramid", 0},
+    {"t", MR_OPT_FLOAT, GH(t), 0, 1, MR_GHOST_DEFAULT_T, NULL, "user transparency t: alpha = t * IM", 0},
+    {"curv-scale", MR_OPT_FLOAT, GH(curv_scale), 0, 1e3, MR_GHOST_DEFAULT_CURV_SCALE, NULL,
+     "curvature (rad/px) to importance scale", 0},
+    {"curv-bias", MR_OPT_FLOAT, GH(curv_bias), -1, 1, MR_GHOST_DEFAULT_CURV_BIAS, NULL,
+     "importance bias: higher = denser occluder", 0},
+    {"tc-min", MR_OPT_FLOAT, GH(tc_minimal), 0, 4, MR_GHOST_DEFAULT_TC_MINIMAL, NULL,
+     "minimal desired contrast tc_minimal", 0},
+    {"gamma", MR_OPT_FLOAT, GH(gamma), 0, 100, MR_GHOST_DEFAULT_GAMMA, NULL, "multiplier of IM in C_desired", 0},
+    {"tc-sil", MR_OPT_FLOAT, GH(tc_silhouette), 0, 4, MR_GHOST_DEFAULT_TC_SILHOUETTE, NULL,
+     "extra desired contrast on hidden silhouettes", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef GH
+
+/* The names the AO pass and the command line share, through the table. */
+const char *mr_ao_method_name(mr_ao_method m) { return mr_opt_enum_name(mr_opt_find(mr_ao_opts, ""), (int)m); }
+
+bool mr_ao_method_parse(const char *name, mr_ao_method *out) {
+    int v = mr_opt_enum_value(mr_opt_find(mr_ao_opts, ""), name);
+    if (v >= 0) *out = (mr_ao_method)v;
+    return v >= 0;
+}
+
+const char *mr_ao_kernel_name(mr_ao_kernel k) { return mr_opt_enum_name(mr_opt_find(mr_ao_opts, "kernel"), (int)k); }
+
+bool mr_ao_kernel_parse(const char *name, mr_ao_kernel *out) {
+    int v = mr_opt_enum_value(mr_opt_find(mr_ao_opts, "kernel"), name);
+    if (v >= 0) *out = (mr_ao_kernel)v;
+    return v >= 0;
+}

@@ -1,0 +1,320 @@
+/* The declared option tables (mr_opt, lib/core/options.c) and every table
+ * the libraries declare: mr_ao_opts, mr_ghost_opts (lib/render) and
+ * mr_view_settings_opts (lib/view). Each table is walked: keys unique,
+ * offsets inside the struct, aligned and not overlapping, each default in
+ * its range (or the documented 0 = auto), enum defaults valid names,
+ * mr_opt_defaults equal to the MR_*_DEFAULTS macro field by field, and
+ * every numeric option accepts its bounds and rejects a value just outside
+ * them with one line naming the option, the range and the value. */
+#include "mr_core.h"
+#include "mr_render.h"
+#include "mr_test.h"
+#include "mr_view.h"
+
+#include <float.h>
+#include <string.h>
+
+/* The enum fields are written through an int. */
+_Static_assert(sizeof(mr_ao_method) == sizeof(int), "mr_ao_method is int-sized");
+_Static_assert(sizeof(mr_ao_radius_mode) == sizeof(int), "mr_ao_radius_mode is int-sized");
+_Static_assert(sizeof(mr_ao_kernel) == sizeof(int), "mr_ao_kernel is int-sized");
+_Static_assert(sizeof(mr_ao_mask) == sizeof(int), "mr_ao_mask is int-sized");
+_Static_assert(sizeof(mr_ghost_mode) == sizeof(int), "mr_ghost_mode is int-sized");
+_Static_assert(sizeof(mr_ghost_importance) == sizeof(int), "mr_ghost_importance is int-sized");
+_Static_assert(sizeof(mr_saliency_impl) == sizeof(int), "mr_saliency_impl is int-sized");
+
+static size_t type_size(mr_opt_type t) {
+    switch (t) {
+    case MR_OPT_INT:
+    case MR_OPT_ENUM: return sizeof(int);
+    case MR_OPT_DOUBLE: return sizeof(double);
+    case MR_OPT_FLOAT: return sizeof(float);
+    case MR_OPT_BOOL: return sizeof(bool);
+    }
+    return 0;
+}
+
+/* One line: non-empty, no newline, starts with the key, names the value. */
+static bool one_line(const mr_error *e, const char *key, const char *value) {
+    return e->msg[0] && !strchr(e->msg, '\n') && strncmp(e->msg, key, strlen(key)) == 0 && strstr(e->msg, value);
+}
+
+/* Sets text on a copy of params; true if accepted. On rejection checks the
+ * message and that the field was left alone. */
+static bool try_set(const char *table, const mr_opt *o, const void *params, size_t size, const char *text) {
+    unsigned char buf[1024], before[1024];
+    memcpy(buf, params, size);
+    memcpy(before, params, size);
+    mr_error e = {0};
+    bool ok = mr_opt_set_row(o, buf, text, &e);
+    if (!ok) {
+        CHECK_MSG(one_line(&e, o->key, text), "%s.%s rejected '%s' without one line naming it and the value: '%s'",
+                  table, o->key, text, e.msg);
+        CHECK_MSG(memcmp(buf, before, size) == 0, "%s.%s: the rejected '%s' still changed the struct", table, o->key,
+                  text);
+    }
+    return ok;
+}
+
+static void walk_table(const char *name, const mr_opt *table, size_t size, const void *macro) {
+    int n = mr_opt_count(table);
+    CHECK_MSG(n > 0, "%s is empty", name);
+    for (int i = 0; i < n; i++) {
+        const mr_opt *o = &table[i];
+        size_t fs = type_size(o->type);
+        CHECK_MSG(fs && o->offset + fs <= size, "%s.%s: offset %zu + %zu bytes lies outside the struct (%zu bytes)", name,
+                  o->key, o->offset, fs, size);
+        CHECK_MSG(fs && o->offset % fs == 0, "%s.%s: offset %zu is not aligned for its type", name, o->key, o->offset);
+        CHECK_MSG(o->help && o->help[0] && !strchr(o->help, '\n'), "%s.%s has no one-line help", name, o->key);
+        CHECK_MSG(mr_opt_find(table, o->key) == o, "%s.%s: key not unique (found row %d first)", name, o->key,
+                  (int)(mr_opt_find(table, o->key) - table));
+        for (int j = 0; j < i; j++) {
+            const mr_opt *p = &table[j];
+            bool overlap = o->offset < p->offset + type_size(p->type) && p->offset < o->offset + fs;
+            CHECK_MSG(!overlap, "%s.%s and %s.%s write the same bytes (offsets %zu and %zu)", name, o->key, name, p->key,
+                      o->offset, p->offset);
+        }
+        char def[64];
+        mr_opt_format(o, macro, def, sizeof def);
+        if (o->type == MR_OPT_ENUM) {
+            int count = mr_opt_enum_count(o);
+            CHECK_MSG(count > 0, "%s.%s: an enum without names", name, o->key);
+            CHECK_MSG(o->def == (int)o->def && o->def >= 0 && o->def < count,
+                      "%s.%s: default %g is not one of its %d names", name, o->key, o->def, count);
+            for (int k = 0; k < count; k++) {
+                CHECK_MSG(mr_opt_enum_value(o, o->names[k]) == k, "%s.%s: name '%s' is not unique", name, o->key,
+                          o->names[k]);
+                CHECK_MSG(try_set(name, o, macro, size, o->names[k]), "%s.%s refused its own name '%s'", name, o->key,
+                          o->names[k]);
+            }
+            CHECK_MSG(!try_set(name, o, macro, size, "no-such-name"), "%s.%s accepted an unknown name", name, o->key);
+            /* Cycling visits every name once and comes back. */
+            int v = (int)o->def, seen = 0;
+            for (int k = 0; k < count; k++) {
+                seen |= 1 << v;
+                v = mr_opt_enum_next(o, v);
+            }
+            CHECK_MSG(v == (int)o->def && seen == (1 << count) - 1, "%s.%s: cycling does not visit the %d names", name,
+                      o->key, count);
+        } else if (o->type == MR_OPT_BOOL) {
+            CHECK_MSG(o->def == 0 || o->def == 1, "%s.%s: bool default %g", name, o->key, o->def);
+            CHECK_MSG(try_set(name, o, macro, size, "1") && !try_set(name, o, macro, size, "maybe"),
+                      "%s.%s: a bool must take 1 and refuse 'maybe'", name, o->key);
+        } else {
+            bool in = o->def >= o->lo && o->def <= o->hi;
+            bool automatic = (o->flags & MR_OPT_ZERO_AUTO) && o->def == 0;
+            CHECK_MSG(o->lo <= o->hi, "%s.%s: empty range [%g, %g]", name, o->key, o->lo, o->hi);
+            CHECK_MSG(in || automatic, "%s.%s: default %g outside its range [%g, %g]", name, o->key, o->def, o->lo,
+                      o->hi);
+            char t[64];
+            if (o->type == MR_OPT_INT) {
+                CHECK_MSG(o->lo == (long)o->lo && o->hi == (long)o->hi && o->def == (long)o->def,
+                          "%s.%s: a whole-number row with fractional range or default", name, o->key);
+                const long probe[4] = {(long)o->lo, (long)o->hi, (long)o->lo - 1, (long)o->hi + 1};
+                for (int k = 0; k < 4; k++) {
+                    snprintf(t, sizeof t, "%ld", probe[k]);
+                    CHECK_MSG(try_set(name, o, macro, size, t) == (k < 2), "%s.%s: '%s' %s (range [%g, %g])", name,
+                              o->key, t, k < 2 ? "refused" : "accepted", o->lo, o->hi);
+                }
+                CHECK_MSG(!try_set(name, o, macro, size, "1.5"), "%s.%s accepted a fraction", name, o->key);
+            } else {
+                /* The bounds and the nearest doubles outside them. */
+                const double probe[4] = {o->lo, o->hi, nextafter(o->lo, -INFINITY), nextafter(o->hi, INFINITY)};
+                for (int k = 0; k < 4; k++) {
+                    snprintf(t, sizeof t, "%.17g", probe[k]);
+                    CHECK_MSG(try_set(name, o, macro, size, t) == (k < 2), "%s.%s: '%s' %s (range [%g, %g])", name,
+                              o->key, t, k < 2 ? "refused" : "accepted", o->lo, o->hi);
+                }
+                CHECK_MSG(!try_set(name, o, macro, size, "nan") && !try_set(name, o, macro, size, "1x"),
+                          "%s.%s accepted 'nan' or '1x'", name, o->key);
+            }
+            CHECK_MSG(!try_set(name, o, macro, size, ""), "%s.%s accepted an empty value", name, o->key);
+        }
+        /* The default, formatted from the macro's struct, reads back to the same bytes. */
+        unsigned char a[1024];
+        memcpy(a, macro, size);
+        mr_error e = {0};
+        bool back = o->type == MR_OPT_ENUM || o->type == MR_OPT_BOOL || !(o->flags & MR_OPT_ZERO_AUTO) || o->def != 0;
+        if (back) {
+            bool ok = mr_opt_set_row(o, a, o->type == MR_OPT_BOOL ? (o->def ? "1" : "0") : def, &e);
+            CHECK_MSG(ok && memcmp(a, macro, size) == 0, "%s.%s: the default '%s' does not read back (%s)", name, o->key,
+                      def, e.msg);
+        }
+    }
+    /* mr_opt_defaults gives the macro's value in every field the table names,
+     * whatever was there before. */
+    unsigned char d[1024];
+    memset(d, 0xA5, size);
+    mr_opt_defaults(table, d);
+    for (const mr_opt *o = table; o->key; o++) {
+        char got[64], want[64];
+        mr_opt_format(o, d, got, sizeof got);
+        mr_opt_format(o, macro, want, sizeof want);
+        CHECK_MSG(memcmp(d + o->offset, (const char *)macro + o->offset, type_size(o->type)) == 0,
+                  "%s.%s: mr_opt_defaults gives %s, the DEFAULTS macro %s", name, o->key, got, want);
+    }
+}
+
+/* Which field each option drives and what it accepts (its range, or its
+ * names in value order): written here a second time on purpose, as the
+ * command line's contract, so that a row pointing at the wrong field or a
+ * range off by one fails. */
+typedef struct expect {
+    const char *key;
+    size_t offset;
+    double lo, hi;     /* numbers */
+    const char *names; /* enums: space-separated */
+} expect;
+
+static void check_rows(const char *name, const mr_opt *table, const expect *ex, int n) {
+    CHECK_MSG(mr_opt_count(table) == n, "%s has %d rows, expected %d", name, mr_opt_count(table), n);
+    for (int i = 0; i < n; i++) {
+        const mr_opt *o = mr_opt_find(table, ex[i].key);
+        CHECK_MSG(o, "%s has no row '%s'", name, ex[i].key);
+        if (!o) continue;
+        CHECK_MSG(o->offset == ex[i].offset, "%s.%s drives the field at offset %zu, expected %zu", name, ex[i].key,
+                  o->offset, ex[i].offset);
+        if (o->type == MR_OPT_ENUM) {
+            char got[256] = "";
+            for (int k = 0; k < mr_opt_enum_count(o); k++)
+                snprintf(got + strlen(got), sizeof got - strlen(got), "%s%s", k ? " " : "", o->names[k]);
+            CHECK_MSG(ex[i].names && strcmp(got, ex[i].names) == 0, "%s.%s names '%s', expected '%s'", name, ex[i].key,
+                      got, ex[i].names ? ex[i].names : "(not an enum)");
+        } else if (o->type != MR_OPT_BOOL) {
+            CHECK_MSG(o->lo == ex[i].lo && o->hi == ex[i].hi, "%s.%s accepts [%g, %g], expected [%g, %g]", name,
+                      ex[i].key, o->lo, o->hi, ex[i].lo, ex[i].hi);
+        }
+    }
+}
+
+static void test_tables(void) {
+    const mr_ao_params ao = MR_AO_DEFAULTS;
+    const mr_ghost_params gh = MR_GHOST_DEFAULTS;
+    const mr_view_settings vs = MR_VIEW_SETTINGS_DEFAULTS;
+    walk_table("mr_ao_opts", mr_ao_opts, sizeof ao, &ao);
+    walk_table("mr_ghost_opts", mr_ghost_opts, sizeof gh, &gh);
+    walk_table("mr_view_settings_opts", mr_view_settings_opts, sizeof vs, &vs);
+
+#define E(t, k, f, names) {k, offsetof(t, f), 0, 0, names}
+#define N(t, k, f, lo, hi) {k, offsetof(t, f), lo, hi, NULL}
+    const expect ex_ao[] = {
+        E(mr_ao_params, "", method, "none scheer crytek filion hbao alchemy"),
+        E(mr_ao_params, "radius-mode", radius_mode, "screen view"),
+        N(mr_ao_params, "radius", radius, 1e-30, 1e30),
+        N(mr_ao_params, "screen-radius", screen_radius, 1e-6, 10),
+        N(mr_ao_params, "samples", samples, 1, MR_AO_MAX_SAMPLES),
+        E(mr_ao_params, "kernel", kernel, "uniform stratified latin poisson"),
+        N(mr_ao_params, "rmin", r_min, 0, 1),
+        N(mr_ao_params, "rmax", r_max, 1e-3, 1),
+        N(mr_ao_params, "radii", radii, 1, MR_AO_MAX_RADII),
+        N(mr_ao_params, "c", c, 0, 1e7),
+        N(mr_ao_params, "bias", bias, 0, 0.5),
+        N(mr_ao_params, "strength", strength, 0.01, 10),
+        N(mr_ao_params, "blur", blur_radius, 0, 32),
+        N(mr_ao_params, "half", half_res, 0, 1),
+        N(mr_ao_params, "positions", positions, 0, 1),
+        E(mr_ao_params, "mask", mask, "off on standalone"),
+        N(mr_ao_params, "mask-strength", mask_strength, 1e-3, 1),
+    };
+    const expect ex_gh[] = {
+        E(mr_ghost_params, "", mode, "off alpha g0 adaptive"),
+        E(mr_ghost_params, "importance", importance, "auto curvature saliency"),
+        E(mr_ghost_params, "saliency", saliency, "mipmap gauss"),
+        N(mr_ghost_params, "t", t, 0, 1),
+        N(mr_ghost_params, "curv-scale", curv_scale, 0, 1e3),
+        N(mr_ghost_params, "curv-bias", curv_bias, -1, 1),
+        N(mr_ghost_params, "tc-min", tc_minimal, 0, 4),
+        N(mr_ghost_params, "gamma", gamma, 0, 100),
+        N(mr_ghost_params, "tc-sil", tc_silhouette, 0, 4),
+    };
+    const expect ex_vs[] = {
+        N(mr_view_settings, "alpha", alpha, 0, 1),
+        N(mr_view_settings, "show_video", show_video, 0, 1),
+        N(mr_view_settings, "hide_hidden_layer", hide_hidden, 0, 1),
+        E(mr_view_settings, "ao", ao, "none scheer crytek filion hbao alchemy"),
+        E(mr_view_settings, "ghost", ghost, "off alpha g0 adaptive"),
+    };
+#undef E
+#undef N
+    check_rows("mr_ao_opts", mr_ao_opts, ex_ao, (int)(sizeof ex_ao / sizeof ex_ao[0]));
+    check_rows("mr_ghost_opts", mr_ghost_opts, ex_gh, (int)(sizeof ex_gh / sizeof ex_gh[0]));
+    check_rows("mr_view_settings_opts", mr_view_settings_opts, ex_vs, (int)(sizeof ex_vs / sizeof ex_vs[0]));
+    /* The enums' names in their value order, for every value. */
+    const mr_opt *m = mr_opt_find(mr_ao_opts, "");
+    CHECK_MSG(m && mr_opt_enum_count(m) == MR_AO_METHOD_COUNT, "the AO method row does not name every method");
+    const mr_opt *g = mr_opt_find(mr_ghost_opts, "");
+    CHECK_MSG(g && mr_opt_enum_count(g) == MR_GHOST_ADAPTIVE + 1, "the ghost mode row does not name every mode");
+    CHECK_MSG(mr_opt_find(mr_view_settings_opts, "ao")->names == mr_ao_method_names &&
+                  mr_opt_find(mr_view_settings_opts, "ghost")->names == mr_ghost_mode_names,
+              "the view's settings do not share the renderer's names");
+}
+
+/* The facility itself, on a small struct of its own. */
+typedef struct toy {
+    int n;
+    double d;
+    float f;
+    bool b;
+    int e;
+} toy;
+static const char *const k_toy_names[] = {"red", "green", "blue", NULL};
+static const mr_opt k_toy[] = {
+    {"n", MR_OPT_INT, offsetof(toy, n), -3, 7, 2, NULL, "a count", 0},
+    {"d", MR_OPT_DOUBLE, offsetof(toy, d), 0, 1, 0, NULL, "a fraction", MR_OPT_ZERO_AUTO},
+    {"f", MR_OPT_FLOAT, offsetof(toy, f), -1, 1, 0.25, NULL, "a float", 0},
+    {"b", MR_OPT_BOOL, offsetof(toy, b), 0, 1, 1, NULL, "a flag", 0},
+    {"e", MR_OPT_ENUM, offsetof(toy, e), 0, 0, 1, k_toy_names, "a colour", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+
+static void test_facility(void) {
+    toy t;
+    memset(&t, 0x5A, sizeof t);
+    mr_opt_defaults(k_toy, &t);
+    CHECK_MSG(t.n == 2 && t.d == 0 && t.f == 0.25f && t.b && t.e == 1, "defaults: n %d d %g f %g b %d e %d", t.n, t.d,
+              t.f, t.b, t.e);
+    mr_error e = {0};
+    CHECK_MSG(mr_opt_set(k_toy, &t, "n", "-3", &e) && t.n == -3, "n -3: %s", e.msg);
+    CHECK_MSG(!mr_opt_set(k_toy, &t, "n", "8", &e) && t.n == -3, "n 8 accepted or changed n");
+    CHECK_MSG(strcmp(e.msg, "n must be a whole number in [-3, 7], got '8'") == 0, "int message: '%s'", e.msg);
+    CHECK_MSG(!mr_opt_set(k_toy, &t, "f", "1.5", &e), "f 1.5 accepted");
+    CHECK_MSG(strcmp(e.msg, "f must be a number in [-1, 1], got '1.5'") == 0, "number message: '%s'", e.msg);
+    CHECK_MSG(!mr_opt_set(k_toy, &t, "e", "pink", &e), "e pink accepted");
+    CHECK_MSG(strcmp(e.msg, "e must be red, green or blue, got 'pink'") == 0, "enum message: '%s'", e.msg);
+    CHECK_MSG(!mr_opt_set(k_toy, &t, "zz", "1", &e) && strstr(e.msg, "zz"), "an unknown key: '%s'", e.msg);
+    CHECK_MSG(mr_opt_set(k_toy, &t, "e", "blue", &e) && t.e == 2 && mr_opt_get(mr_opt_find(k_toy, "e"), &t) == 2,
+              "e blue: %d", t.e);
+    CHECK_MSG(mr_opt_enum_next(mr_opt_find(k_toy, "e"), 2) == 0, "cycling after the last name is not the first");
+    CHECK_MSG(mr_opt_set(k_toy, &t, "b", "off", &e) && !t.b, "b off");
+    CHECK_MSG(mr_opt_set(k_toy, &t, "d", "0.125", &e) && t.d == 0.125, "d 0.125");
+    char s[128];
+    mr_opt_format(mr_opt_find(k_toy, "e"), &t, s, sizeof s);
+    CHECK_MSG(strcmp(s, "blue") == 0, "format of e: '%s'", s);
+    mr_opt_describe(mr_opt_find(k_toy, "n"), s, sizeof s);
+    CHECK_MSG(strcmp(s, "-3..7 (default 2)") == 0, "describe n: '%s'", s);
+    mr_opt_describe(mr_opt_find(k_toy, "d"), s, sizeof s);
+    CHECK_MSG(strcmp(s, "in [0, 1] (default auto)") == 0, "describe d: '%s'", s);
+    mr_opt_describe(mr_opt_find(k_toy, "e"), s, sizeof s);
+    CHECK_MSG(strcmp(s, "red, green or blue (default green)") == 0, "describe e: '%s'", s);
+    /* JSON round trip: every row comes back as it went out. */
+    cJSON *j = cJSON_CreateObject();
+    CHECK(mr_opt_to_json(k_toy, &t, j));
+    toy u;
+    mr_opt_defaults(k_toy, &u);
+    for (const mr_opt *o = k_toy; o->key; o++) {
+        CHECK_MSG(mr_opt_set_json(o, &u, cJSON_GetObjectItemCaseSensitive(j, o->key), &e), "json %s: %s", o->key, e.msg);
+        CHECK_MSG(mr_opt_get(o, &u) == mr_opt_get(o, &t), "json %s: %g back, %g out", o->key, mr_opt_get(o, &u),
+                  mr_opt_get(o, &t));
+    }
+    cJSON *bad = cJSON_CreateString("3");
+    CHECK_MSG(!mr_opt_set_json(mr_opt_find(k_toy, "n"), &u, bad, &e) && strncmp(e.msg, "n ", 2) == 0,
+              "json: a string for a number accepted ('%s')", e.msg);
+    cJSON_Delete(bad);
+    cJSON_Delete(j);
+}
+
+int main(void) {
+    test_facility();
+    test_tables();
+    return mr_test_finish("test_options");
+}
