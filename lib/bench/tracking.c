@@ -254,7 +254,7 @@ static bool write_svg(const char *path, const char *title, const setting *s, con
     ymin = pow(10, floor(log10(ymin)));
     ymax = pow(10, ceil(log10(fmax(ymax, ymin * 10))));
     mr_plot_series *ser = calloc((size_t)n + 1, sizeof *ser);
-    char (*names)[160] = calloc((size_t)n + 1, sizeof *names), (*nums)[8] = calloc((size_t)n + 1, sizeof *nums);
+    char (*names)[160] = calloc((size_t)n + 1, sizeof *names), (*nums)[12] = calloc((size_t)n + 1, sizeof *nums);
     if (!ser || !names || !nums) {
         free(ser);
         free(names);
