@@ -484,6 +484,57 @@ static void test_annotations_reader(void) {
     free(good);
 }
 
+/* The camera and marker map of a replay folder: inline in meta.json, named
+ * by it (relative paths), or camera.json / markers.json beside the frames;
+ * what the caller already has is kept; no map is fine, a broken file is not. */
+static void test_replay_meta(void) {
+    char dir[1100], path[1200];
+    mr_error err = {0};
+    mr_camera given = {32, 24, 20, 20, 15.5, 11.5, {0, 0, 0, 0, 0}};
+    mr_camera cam = {64, 48, 50, 51, 31.5, 23.5, {0.1, 0, 0, 0, 0}};
+    cJSON *cj = mr_camera_to_json(&cam);
+    char *ctext = cJSON_PrintUnformatted(cj);
+    const char *map_text = "{\"family\": \"tag36h11\", \"tag_size\": 0.2, \"tags\": [{\"id\": 3, "
+                           "\"world_from_tag\": [1,0,0,0, 0,1,0,0, 0,0,1,2, 0,0,0,1]}]}";
+    /* 1. inline camera, the map named by a relative path */
+    tmp_path("meta_inline", dir, sizeof dir);
+    CHECK(mr_mkdirs(dir, &err));
+    char meta[4096];
+    snprintf(meta, sizeof meta, "{\"camera\": %s, \"markers\": \"map.json\"}", ctext);
+    snprintf(path, sizeof path, "%s/meta.json", dir);
+    write_text(path, meta);
+    snprintf(path, sizeof path, "%s/map.json", dir);
+    write_text(path, map_text);
+    mr_camera got = given;
+    mr_marker_map map = {0};
+    bool have_map = false;
+    CHECK_MSG(mr_replay_meta_load(dir, &got, false, &map, &have_map, &err), "inline meta: %s", err.msg);
+    CHECK_MSG(got.fx == 50 && got.fy == 51 && got.width == 64 && got.dist[0] == 0.1, "inline camera not read (fx %g)", got.fx);
+    CHECK_MSG(have_map && map.count == 1 && map.tags[0].id == 3 && map.tags[0].world_from_tag.m[11] == 2,
+              "map named by meta.json not read (have %d, count %d)", have_map, map.count);
+    mr_marker_map_free(&map);
+    /* the caller's camera and map win */
+    got = given;
+    have_map = true;
+    CHECK(mr_replay_meta_load(dir, &got, true, &map, &have_map, &err) && got.fx == 20 && map.count == 0);
+    /* 2. no meta.json: camera.json beside the frames, no map (not an error) */
+    tmp_path("meta_beside", dir, sizeof dir);
+    CHECK(mr_mkdirs(dir, &err));
+    snprintf(path, sizeof path, "%s/camera.json", dir);
+    write_text(path, ctext);
+    got = given;
+    have_map = false;
+    CHECK_MSG(mr_replay_meta_load(dir, &got, false, &map, &have_map, &err) && got.fx == 50 && !have_map,
+              "camera.json beside the frames: %s (fx %g, map %d)", err.msg, got.fx, have_map);
+    /* 3. a damaged meta.json fails with a message */
+    snprintf(path, sizeof path, "%s/meta.json", dir);
+    write_text(path, "{\"camera\": ");
+    err.msg[0] = 0;
+    CHECK_MSG(!mr_replay_meta_load(dir, &got, false, &map, &have_map, &err) && err.msg[0], "a damaged meta.json was accepted");
+    free(ctext);
+    cJSON_Delete(cj);
+}
+
 int main(void) {
     const char *t = getenv("MR_TEST_TMP");
     snprintf(g_tmp, sizeof g_tmp, "%s/test_session", t ? t : "/tmp/mrcheck-test");
@@ -498,6 +549,7 @@ int main(void) {
     test_round_trip();
     test_mutations();
     test_replay();
+    test_replay_meta();
     test_annotation_append();
     test_annotations_reader();
     return mr_test_finish("test_session");

@@ -165,6 +165,14 @@ int64_t mr_replay_seek_time(const mr_replay *r, double t);
 bool mr_replay_load_image(const mr_replay *r, int64_t i, bool gray, mr_image *img, mr_error *err);
 /* The recording behind it (NULL for a plain folder). */
 const mr_recording *mr_replay_recording(const mr_replay *r);
+/* The camera and marker map a replay folder names, for what the caller was
+ * not given: a recording's meta.json (the map is moved into *map); for a
+ * plain folder a meta.json whose "camera" / "markers" (or "marker_map")
+ * are inline objects or paths relative to the folder, else camera.json and
+ * markers.json next to the frames. No marker map is not an error (the
+ * frames may carry their poses): *have_map says whether one was found. */
+bool mr_replay_meta_load(const char *dir, mr_camera *cam, bool have_cam, mr_marker_map *map, bool *have_map,
+                         mr_error *err);
 
 /* ------------------------------------------------------------ annotations */
 

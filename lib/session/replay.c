@@ -170,3 +170,49 @@ bool mr_replay_load_image(const mr_replay *r, int64_t i, bool gray, mr_image *im
 }
 
 const mr_recording *mr_replay_recording(const mr_replay *r) { return r->rec; }
+
+/* ------------------------------------------------- camera and markers */
+
+bool mr_replay_meta_load(const char *dir, mr_camera *cam, bool have_cam, mr_marker_map *map, bool *have_map,
+                         mr_error *err) {
+    char path[4096], sub[8192];
+    if (mr_is_recording(dir)) {
+        mr_recording *rec = mr_recording_open(dir, err);
+        if (!rec) return false;
+        if (!have_cam) *cam = rec->camera;
+        if (!*have_map && rec->has_markers) {
+            /* Take the map over; the recording is closed right after. */
+            *map = rec->markers;
+            memset(&rec->markers, 0, sizeof rec->markers);
+            rec->has_markers = false;
+            *have_map = true;
+        }
+        mr_recording_close(&rec);
+        return true;
+    }
+    mr_path_join(dir, "meta.json", path, sizeof path);
+    cJSON *meta = mr_file_exists(path) ? mr_json_load(path, err) : NULL;
+    if (mr_file_exists(path) && !meta) return false;
+    bool ok = true;
+    if (!have_cam) {
+        const cJSON *c = meta ? cJSON_GetObjectItemCaseSensitive(meta, "camera") : NULL;
+        if (cJSON_IsObject(c)) ok = mr_camera_from_json(c, cam, err);
+        else {
+            mr_path_join(dir, cJSON_IsString(c) ? c->valuestring : "camera.json", sub, sizeof sub);
+            ok = mr_camera_load(sub, cam, err);
+        }
+    }
+    if (ok && !*have_map) {
+        const cJSON *m = meta ? cJSON_GetObjectItemCaseSensitive(meta, "markers") : NULL;
+        if (!m && meta) m = cJSON_GetObjectItemCaseSensitive(meta, "marker_map");
+        if (cJSON_IsObject(m)) *have_map = mr_marker_map_from_json(m, map, err);
+        else {
+            mr_path_join(dir, cJSON_IsString(m) ? m->valuestring : "markers.json", sub, sizeof sub);
+            if (mr_file_exists(sub)) *have_map = mr_marker_map_load(sub, map, err);
+        }
+        /* No marker map is fine when frames.jsonl carries the poses. */
+        if (!*have_map) err->msg[0] = 0;
+    }
+    cJSON_Delete(meta);
+    return ok;
+}
