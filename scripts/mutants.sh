@@ -60,7 +60,7 @@ opt_wrong_offset_untabled|lib/render/options.c|GH(curv_scale)|GH(saliency_gain)|
 opt_range_off_by_one|lib/render/options.c|AO(blur_radius), 0, 32,|AO(blur_radius), 0, 33,|^test_options$
 opt_upper_bound_exclusive|lib/core/options.c|v > o->hi) return range_fail(o, text, err);\n        store(o, params, (double)v);|v >= o->hi) return range_fail(o, text, err);\n        store(o, params, (double)v);|^test_options$
 opt_cli_value_ignored|app/args.c|if (mr_opt_set_row(o, t->params, v, &err)) continue;|if (mr_opt_set_row(o, t->params, v, &err) + 1) continue;|^cli_options$
-replay_meta_markers_key|lib/session/replay.c|cJSON_GetObjectItemCaseSensitive(meta, "markers");|cJSON_GetObjectItemCaseSensitive(meta, "marker");|^test_session$
+replay_meta_markers_key|lib/session/replay.c|cJSON_GetObjectItemCaseSensitive(meta, "markers") : NULL;|cJSON_GetObjectItemCaseSensitive(meta, "marker") : NULL;|^test_session$
 LIST
 )
 
