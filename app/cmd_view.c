@@ -170,34 +170,36 @@ static void begin_mark(view_app *a, double x, double y) {
                         (float)((a->mark_py + 0.5) / a->camera.height));
 }
 
-/* The annotation line of a finished mark. */
+/* The annotation line of a finished mark (the format is lib/session's). */
 static cJSON *mark_line(view_app *a, int note) {
-    cJSON *line = cJSON_CreateObject();
-    cJSON_AddStringToObject(line, "type", "discrepancy");
-    cJSON_AddNumberToObject(line, "time_unix", (double)time(NULL));
-    cJSON_AddNumberToObject(line, "frame_index", (double)a->mark_frame.index);
-    cJSON_AddNumberToObject(line, "timestamp", a->mark_frame.timestamp);
-    cJSON_AddStringToObject(line, "note", mr_view_notes[note]);
-    double px[2] = {a->mark_px, a->mark_py};
-    cJSON_AddItemToObject(line, "pixel", mr_json_from_doubles(px, 2));
-    cJSON_AddBoolToObject(line, "hit", a->mark_pick.hit);
-    if (a->mark_pick.hit) {
-        double w[3] = {a->mark_pick.world.x, a->mark_pick.world.y, a->mark_pick.world.z};
-        cJSON_AddItemToObject(line, "world", mr_json_from_doubles(w, 3));
-        cJSON_AddNumberToObject(line, "depth", a->mark_pick.depth);
-    } else {
-        cJSON_AddNullToObject(line, "world");
-    }
+    mr_annotation m;
+    memset(&m, 0, sizeof m);
+    snprintf(m.type, sizeof m.type, "discrepancy");
+    m.time_unix = (double)time(NULL);
+    m.frame_index = a->mark_frame.index;
+    m.timestamp = a->mark_frame.timestamp;
+    snprintf(m.note, sizeof m.note, "%s", mr_view_notes[note]);
+    m.has_pixel = true;
+    m.pixel[0] = a->mark_px;
+    m.pixel[1] = a->mark_py;
+    m.hit = a->mark_pick.hit;
+    m.world[0] = a->mark_pick.world.x;
+    m.world[1] = a->mark_pick.world.y;
+    m.world[2] = a->mark_pick.world.z;
+    m.depth = a->mark_pick.depth;
     const mr_scene *sc = a->scene;
+    m.node_index = -1;
     if (a->mark_pick.node >= 0 && sc && a->mark_pick.node < sc->node_count) {
-        cJSON_AddStringToObject(line, "node", sc->nodes[a->mark_pick.node].name);
-        cJSON_AddNumberToObject(line, "node_index", a->mark_pick.node);
-        cJSON_AddStringToObject(line, "layer", a->mark_pick.layer == MR_LAYER_HIDDEN ? "hidden" : "visible");
-    } else {
-        cJSON_AddNullToObject(line, "node");
+        m.node_index = a->mark_pick.node;
+        snprintf(m.node, sizeof m.node, "%s", sc->nodes[a->mark_pick.node].name);
+        snprintf(m.layer, sizeof m.layer, "%s", a->mark_pick.layer == MR_LAYER_HIDDEN ? "hidden" : "visible");
     }
-    cJSON_AddItemToObject(line, "pose", pose_json(&a->mark_frame));
-    return line;
+    m.has_pose = true;
+    m.pose_valid = a->mark_frame.pose_valid;
+    m.world_from_camera = a->mark_frame.pose;
+    m.pose_tags_seen = a->mark_frame.tags_seen;
+    m.pose_rms_px = a->mark_frame.rms_px;
+    return mr_annotation_to_json(&m);
 }
 
 static void finish_mark(view_app *a, int note) {

@@ -535,6 +535,75 @@ static void test_replay_meta(void) {
     cJSON_Delete(cj);
 }
 
+/* The writer and the reader of annotation lines agree: every field comes
+ * back, a mark without a hit or a node writes nulls, and the line the
+ * writer makes is what the view has always written (key order). */
+static void test_annotation_round_trip(void) {
+    mr_annotation m;
+    memset(&m, 0, sizeof m);
+    snprintf(m.type, sizeof m.type, "discrepancy");
+    m.time_unix = 1764600000;
+    m.frame_index = 42;
+    m.timestamp = 1.4;
+    snprintf(m.note, sizeof m.note, "pipe moved");
+    m.pixel[0] = 120.5;
+    m.pixel[1] = 80.25;
+    m.hit = true;
+    m.world[0] = 1e7 + 0.125;
+    m.world[1] = -2;
+    m.world[2] = 3.5;
+    m.depth = 4.75;
+    m.node_index = 7;
+    snprintf(m.node, sizeof m.node, "Pipe_3");
+    snprintf(m.layer, sizeof m.layer, "hidden");
+    m.pose_valid = true;
+    m.world_from_camera = mr_m4_translate(1, 2, 3);
+    m.pose_tags_seen = 2;
+    m.pose_rms_px = 0.5;
+    for (int variant = 0; variant < 2; variant++) {
+        if (variant == 1) {
+            m.hit = false;
+            m.node_index = -1;
+        }
+        cJSON *o = mr_annotation_to_json(&m);
+        char *text = cJSON_PrintUnformatted(o);
+        size_t n = strlen(text);
+        char *line = malloc(n + 2);
+        memcpy(line, text, n);
+        line[n] = '\n';
+        line[n + 1] = 0;
+        if (variant == 0)
+            CHECK_MSG(strncmp(text, "{\"type\":\"discrepancy\",\"time_unix\":1764600000,\"frame_index\":42,\"timestamp\":1.4,"
+                                  "\"note\":\"pipe moved\",\"pixel\":[120.5,80.25],\"hit\":true,\"world\":[",
+                              110) == 0,
+                      "annotation line starts differently: %.200s", text);
+        mr_annotations got = {0};
+        mr_error err = {0};
+        CHECK(mr_annotations_parse(line, n + 1, &got, &err) && got.count == 1 && got.bad_lines == 0);
+        if (got.count == 1) {
+            const mr_annotation *g = &got.items[0];
+            CHECK_MSG(strcmp(g->type, m.type) == 0 && g->time_unix == m.time_unix && g->frame_index == 42 &&
+                          g->timestamp == m.timestamp && strcmp(g->note, m.note) == 0 && g->has_pixel &&
+                          g->pixel[0] == m.pixel[0] && g->pixel[1] == m.pixel[1] && g->hit == m.hit,
+                      "variant %d: the mark's header fields do not come back: %s", variant, text);
+            if (m.hit)
+                CHECK_MSG(g->world[0] == m.world[0] && g->world[1] == -2 && g->world[2] == 3.5 && g->depth == 4.75,
+                          "the picked point does not come back: %s", text);
+            CHECK_MSG(g->node_index == m.node_index && strcmp(g->node, variant ? "" : "Pipe_3") == 0 &&
+                          strcmp(g->layer, variant ? "" : "hidden") == 0,
+                      "variant %d: node %d '%s' layer '%s' back, want %d", variant, g->node_index, g->node, g->layer,
+                      m.node_index);
+            CHECK_MSG(g->has_pose && g->pose_valid && same_m4(&g->world_from_camera, &m.world_from_camera) &&
+                          g->pose_tags_seen == 2 && g->pose_rms_px == 0.5,
+                      "the pose does not come back: %s", text);
+        }
+        mr_annotations_free(&got);
+        free(line);
+        cJSON_free(text);
+        cJSON_Delete(o);
+    }
+}
+
 int main(void) {
     const char *t = getenv("MR_TEST_TMP");
     snprintf(g_tmp, sizeof g_tmp, "%s/test_session", t ? t : "/tmp/mrcheck-test");
@@ -552,5 +621,6 @@ int main(void) {
     test_replay_meta();
     test_annotation_append();
     test_annotations_reader();
+    test_annotation_round_trip();
     return mr_test_finish("test_session");
 }

@@ -71,9 +71,43 @@ static bool get_vec(const cJSON *o, const char *key, double *out, int n, bool *h
     return true;
 }
 
+cJSON *mr_annotation_to_json(const mr_annotation *a) {
+    cJSON *line = cJSON_CreateObject();
+    if (!line) return NULL;
+    cJSON_AddStringToObject(line, "type", a->type);
+    cJSON_AddNumberToObject(line, "time_unix", a->time_unix);
+    cJSON_AddNumberToObject(line, "frame_index", (double)a->frame_index);
+    cJSON_AddNumberToObject(line, "timestamp", a->timestamp);
+    cJSON_AddStringToObject(line, "note", a->note);
+    cJSON_AddItemToObject(line, "pixel", mr_json_from_doubles(a->pixel, 2));
+    cJSON_AddBoolToObject(line, "hit", a->hit);
+    if (a->hit) {
+        cJSON_AddItemToObject(line, "world", mr_json_from_doubles(a->world, 3));
+        cJSON_AddNumberToObject(line, "depth", a->depth);
+    } else {
+        cJSON_AddNullToObject(line, "world");
+    }
+    if (a->node_index >= 0) {
+        cJSON_AddStringToObject(line, "node", a->node);
+        cJSON_AddNumberToObject(line, "node_index", a->node_index);
+        cJSON_AddStringToObject(line, "layer", a->layer);
+    } else {
+        cJSON_AddNullToObject(line, "node");
+    }
+    cJSON *p = cJSON_AddObjectToObject(line, "pose");
+    cJSON_AddBoolToObject(p, "valid", a->pose_valid);
+    cJSON_AddItemToObject(p, "world_from_camera", mr_json_from_dmat4(&a->world_from_camera));
+    cJSON_AddNumberToObject(p, "tags_seen", a->pose_tags_seen);
+    cJSON_AddNumberToObject(p, "rms_px", a->pose_rms_px);
+    return line;
+}
+
 static bool parse_annotation(const cJSON *o, mr_annotation *a) {
     memset(a, 0, sizeof *a);
     a->frame_index = -1;
+    a->node_index = -1;
+    a->pose_tags_seen = -1;
+    a->pose_rms_px = -1;
     a->world_from_camera = mr_m4_identity();
     if (!cJSON_IsObject(o) || !get_str(o, "type", a->type, sizeof a->type, true) || !a->type[0]) return false;
     double fi = -1;
@@ -87,6 +121,9 @@ static bool parse_annotation(const cJSON *o, mr_annotation *a) {
         !get_str(o, "layer", a->layer, sizeof a->layer, false) || !get_vec(o, "pixel", a->pixel, 2, &a->has_pixel) ||
         !get_vec(o, "world", a->world, 3, &has_world))
         return false;
+    double ni = -1;
+    if (!get_num(o, "node_index", &ni) || !(ni == -1 || (ni >= 0 && ni < 2147483647.0 && ni == floor(ni)))) return false;
+    a->node_index = (int32_t)ni;
     a->hit = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(o, "hit"));
     if (a->hit && !has_world) return false; /* a hit names its point */
     const cJSON *p = cJSON_GetObjectItemCaseSensitive(o, "pose");
@@ -99,6 +136,9 @@ static bool parse_annotation(const cJSON *o, mr_annotation *a) {
             a->has_pose = true;
         }
         a->pose_valid = a->has_pose && cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(p, "valid"));
+        double ts = -1;
+        if (!get_num(p, "tags_seen", &ts) || !get_num(p, "rms_px", &a->pose_rms_px)) return false;
+        a->pose_tags_seen = ts >= 0 && ts < 1e6 ? (int)ts : -1;
     }
     return true;
 }

@@ -196,12 +196,25 @@ typedef struct mr_annotation {
     double world[3];                /* the picked point (hit only), scene units */
     double depth;                   /* distance along the view ray (hit only) */
     char node[256];                 /* picked node name, "" none */
+    int32_t node_index;             /* its index in the scene, -1 none */
     char layer[16];                 /* "visible" / "hidden" / "" */
     bool has_pose;                  /* pose.world_from_camera present */
     bool pose_valid;
     mr_dmat4 world_from_camera;
-    cJSON *json;                    /* the whole line (owned) */
+    int pose_tags_seen;             /* -1 unknown */
+    double pose_rms_px;             /* -1 unknown */
+    cJSON *json;                    /* the whole line (owned); NULL for one
+                                       not read from a file */
 } mr_annotation;
+
+/* The line of a mark, as `mrcheck view` writes it and the reader reads it
+ * back (one place for the format): type, time_unix, frame_index,
+ * timestamp, note, pixel, hit, world (null when no hit), depth (hit only),
+ * node (null when none; then node_index and layer), pose {valid,
+ * world_from_camera, tags_seen, rms_px}. The caller may add fields (the
+ * view adds "snapshot") before mr_annotation_append. NULL when out of
+ * memory. */
+cJSON *mr_annotation_to_json(const mr_annotation *a);
 
 typedef struct mr_annotations {
     mr_annotation *items;
