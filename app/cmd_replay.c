@@ -68,15 +68,7 @@ int cmd_replay(int argc, char **argv) {
         int n = 0;
         for (int i = 1; dt && i < rec->frame_count; i++)
             if (rec->frames[i].t > rec->frames[i - 1].t) dt[n++] = rec->frames[i].t - rec->frames[i - 1].t;
-        if (n > 0) {
-            for (int i = 1; i < n; i++)
-                for (int j = i; j > 0 && dt[j] < dt[j - 1]; j--) {
-                    double x = dt[j];
-                    dt[j] = dt[j - 1];
-                    dt[j - 1] = x;
-                }
-            fps = 1.0 / dt[n / 2] / (double)every;
-        }
+        if (n > 0) fps = 1.0 / mr_median(dt, n) / (double)every;
         free(dt);
     }
     for (int i = 0; ok && i < rec->frame_count; i++) {
