@@ -48,22 +48,6 @@ void app_tracker_free(app_tracker *t);
 /* JSON helpers for the line formats. */
 cJSON *app_pose_line(int64_t frame, double t, const mr_tracker_result *r);
 
-/* Synthetic recordings of the demo hall (demo_track.c). */
-typedef struct app_synth_params {
-    int frames;          /* spread over the path; default 120 (one per step) */
-    int width, height;   /* default 640x480 (the demo camera) */
-    double noise;        /* sensor noise sigma in grey levels, default 2.0 */
-    int motion_blur;     /* sub-frames averaged per frame (1 = none), default 3 */
-    double exposure;     /* relative exposure swing along the path, default 0.25 */
-    int jpeg_quality;    /* default 90 */
-    uint64_t seed;       /* default 1 */
-    double fps;          /* default 10 */
-} app_synth_params;
-#define APP_SYNTH_DEFAULTS {120, 640, 480, 2.0, 3, 0.25, 90, 1, 10.0}
-
-bool app_synth_recording(const char *dir, const app_synth_params *p, mr_error *err);
-/* The calibration board (tag grid) and images of it rendered on the CPU. */
-bool app_synth_calibration(const char *dir, int images, mr_error *err);
 /* Called once by `mrcheck demo`: writes DIR/recording and DIR/calib. */
 bool app_demo_track(const char *dir, mr_error *err);
 

@@ -128,6 +128,37 @@ typedef struct mr_bench_tracking_params {
 #define MR_BENCH_TRACKING_DEFAULTS .out_dir = "bench-out", .recording = "recordings/demo"
 bool mr_bench_tracking(const mr_bench_tracking_params *params, mr_error *err);
 
+/* ------------------------------------------------------ synthetic data */
+
+/* A synthetic recording of the demo hall (as built) along a walking path
+ * with pauses (synth_recording.c): each frame rendered on gfx's renderer
+ * (left with no scene), made a camera frame by mr_demo_camera_frame,
+ * tracked by lib/track's tracker, written by lib/session's recorder with
+ * groundtruth.jsonl into dir (never overwritten). The demo camera scaled to
+ * width x height (square pixels, focal length with the width). What the
+ * tracking bench reads. params NULL: MR_SYNTH_RECORDING_DEFAULTS; otherwise every
+ * field is taken as given (noise, exposure and seed 0 are meaningful), out
+ * of range: MR_ERR_INVALID. */
+typedef struct mr_synth_recording_params {
+    int frames;       /* spread over the path, >= 1; default 120 (one per path step) */
+    int width, height; /* px, at least 64x48; default 640x480 (the demo camera) */
+    double noise;     /* sensor noise sigma in grey levels, >= 0; default 2 */
+    int motion_blur;  /* sub-frames averaged per frame, 1 (none)..16; default 3 */
+    double exposure;  /* relative exposure swing along the path, 0..<1; default 0.25 */
+    int jpeg_quality; /* of the stored frames; default 90 */
+    uint64_t seed;    /* noise seed; default 1 */
+    double fps;       /* frame rate of the timestamps, > 0; default 10 */
+    bool progress;    /* "synth: frame i/n" on stderr */
+} mr_synth_recording_params;
+#define MR_SYNTH_RECORDING_DEFAULTS \
+    .frames = 120, .width = 640, .height = 480, .noise = 2.0, .motion_blur = 3, .exposure = 0.25, .jpeg_quality = 90, \
+    .seed = 1, .fps = 10.0
+bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params, const mr_bench_gpu *gfx, mr_error *err);
+/* The calibration set: dir/board.json (the board of mr_demo_board_tag as a
+ * marker map) and dir/images/board_NN.png, `images` (>= 1) views of it from
+ * around, rendered on the CPU through the demo camera. */
+bool mr_synth_calibration(const char *dir, int images, mr_error *err);
+
 #ifdef __cplusplus
 }
 #endif

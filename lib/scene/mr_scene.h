@@ -212,6 +212,24 @@ mr_view mr_demo_view(int i);
 bool mr_demo_camera_frame(const mr_camera *cam, const mr_image *ideal, int n, int margin, int scale, double gain,
                           double noise, mr_rng *rng, mr_image *out, mr_error *err);
 
+/* The synthetic calibration board (demo_board.c): tag36h11 ids
+ * MR_DEMO_BOARD_FIRST_ID.. in a COLS x ROWS grid on a plane; board frame =
+ * tag frame convention (x right, y down, z into the board), origin at the
+ * top-left tag's centre; a white board one pitch beyond the outer tags. */
+#define MR_DEMO_BOARD_COLS 6
+#define MR_DEMO_BOARD_ROWS 4
+#define MR_DEMO_BOARD_FIRST_ID 100
+#define MR_DEMO_BOARD_TAG 0.04   /* m, the black square */
+#define MR_DEMO_BOARD_PITCH 0.06 /* m between tag centres */
+/* Tag i's (0..COLS*ROWS-1, row-major) id; its pose into *board_from_tag. */
+int mr_demo_board_tag(int i, mr_dmat4 *board_from_tag);
+/* The board seen by cam (gray8, cam's size, lens distortion exact): ray
+ * cast, 3x3 supersampled, dark grey background, Gaussian noise of 1.5
+ * levels from rng. tag_imgs: the board's COLS*ROWS tag images in tag order
+ * (mr_demo_tag_images from FIRST_ID on). */
+bool mr_demo_board_render(const mr_camera *cam, const mr_dmat4 *board_from_camera, const mr_image *tag_imgs,
+                          mr_rng *rng, mr_image *out, mr_error *err);
+
 /* ------------------------------------------------------------ curvature */
 
 /* Per-vertex maximum principal curvature magnitude |kappa_max| of a mesh in

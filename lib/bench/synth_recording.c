@@ -1,0 +1,251 @@
+/* Synthetic recordings of the demo hall with ground truth, and the
+ * synthetic calibration set: what `mrcheck synth` and `mrcheck demo` write.
+ * Here, not in app/, because it needs render + session + track at once and
+ * lib/bench is the lowest library that may (the tracking bench reads these
+ * recordings). The camera frames come from mr_demo_camera_frame and the
+ * board images from mr_demo_board_render (lib/scene). */
+#include "bench_internal.h"
+#include "mr_session.h"
+#include "mr_track.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------ the path */
+
+/* Keyframes of a walk along the east side of the hall: eye, look-at target
+ * and how many frames to pause there (the camera is still: jitter is
+ * measured there) before walking `walk` frames to the next keyframe. Chosen
+ * so that most frames see one tag at 3-5 m and some see two. */
+typedef struct keyframe { double eye[3], at[3]; int pause, walk; } keyframe;
+static const keyframe k_path[] = {
+    {{12.5, 1.60, -5.5}, {12.5, 2.0, -12.0}, 8, 16},  /* tags 2 and 12, far */
+    {{15.0, 1.60, -8.0}, {16.0, 1.9, -12.0}, 8, 16},  /* tag 12 close */
+    {{16.0, 1.55, -6.5}, {20.0, 2.0, -6.0}, 8, 14},   /* tag 3 */
+    {{16.0, 1.60, -2.0}, {20.0, 2.2, -1.0}, 8, 14},   /* tag 13 */
+    {{15.5, 1.65, 2.5}, {20.0, 2.0, 2.5}, 8, 12},     /* tags 13 and 4 */
+    {{16.5, 1.60, 5.3}, {20.0, 1.7, 5.0}, 8, 0},      /* tag 4 close */
+};
+#define PATH_KEYS (int)(sizeof k_path / sizeof k_path[0])
+
+static int path_frames(void) {
+    int n = 0;
+    for (int i = 0; i < PATH_KEYS; i++) n += k_path[i].pause + k_path[i].walk;
+    return n;
+}
+
+/* Pose at path position s in [0, path_frames()) (fractional), and whether
+ * the camera stands still there. */
+static mr_dmat4 path_pose(double s, bool *still) {
+    int base = 0;
+    for (int i = 0; i < PATH_KEYS; i++) {
+        const keyframe *k = &k_path[i];
+        if (s < base + k->pause || i == PATH_KEYS - 1 || k->walk == 0) {
+            if (still) *still = true;
+            return mr_m4_look_at_cv(mr_v3(k->eye[0], k->eye[1], k->eye[2]), mr_v3(k->at[0], k->at[1], k->at[2]),
+                                    mr_v3(0, 1, 0));
+        }
+        if (s < base + k->pause + k->walk) {
+            const keyframe *n = &k_path[i + 1];
+            /* walk frames end one step before the next pause */
+            double u = (s - base - k->pause + 1) / (k->walk + 1);
+            u = u * u * (3 - 2 * u); /* ease in and out */
+            double e[3], a[3];
+            for (int c = 0; c < 3; c++) {
+                e[c] = k->eye[c] + u * (n->eye[c] - k->eye[c]);
+                a[c] = k->at[c] + u * (n->at[c] - k->at[c]);
+            }
+            if (still) *still = false;
+            return mr_m4_look_at_cv(mr_v3(e[0], e[1], e[2]), mr_v3(a[0], a[1], a[2]), mr_v3(0, 1, 0));
+        }
+        base += k->pause + k->walk;
+    }
+    if (still) *still = true;
+    return mr_m4_identity();
+}
+
+static bool hall_markers(const mr_demo_hall *hall, mr_marker_map *map, mr_error *err) {
+    memset(map, 0, sizeof *map);
+    snprintf(map->family, sizeof map->family, "tag36h11");
+    map->tag_size = hall->tag_size;
+    map->tags = calloc((size_t)hall->tag_count, sizeof *map->tags);
+    if (!map->tags) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    map->count = hall->tag_count;
+    for (int i = 0; i < hall->tag_count; i++) {
+        map->tags[i].id = hall->tags[i].id;
+        map->tags[i].world_from_tag = hall->tags[i].world_from_tag;
+    }
+    return true;
+}
+
+/* Tracks one synthetic frame as `record` would (lib/track's one tracker),
+ * so frames.jsonl holds real results: fills fr's detections, raw pose and
+ * filtered pose (fr->t is the time). */
+static bool track_frame(mr_tracker *trk, const mr_image *gray, mr_frame_record *fr, mr_error *err) {
+    mr_tracker_result r;
+    if (!mr_tracker_frame(trk, gray, fr->t, &r, err)) return false;
+    fr->detections = r.detections;
+    fr->detection_count = r.detection_count;
+    fr->pose = r.pose;
+    fr->has_filtered = r.has_filtered;
+    if (r.has_filtered) fr->filtered = r.filtered;
+    return true;
+}
+
+bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params, const mr_bench_gpu *gfx, mr_error *err) {
+    mr_synth_recording_params p = params ? *params : (mr_synth_recording_params){MR_SYNTH_RECORDING_DEFAULTS};
+    if (!bench_gpu_check(gfx, "synth", err)) return false;
+    if (p.frames < 1 || p.width < 64 || p.height < 48 || p.motion_blur < 1 || p.motion_blur > 16 || p.noise < 0 ||
+        p.exposure < 0 || p.exposure >= 1 || p.fps <= 0)
+        return mr_fail(err, MR_ERR_INVALID, "synth: parameters out of range");
+    mr_demo_hall hall;
+    if (!mr_demo_build_tagged(NULL, 0, &hall, err)) return false;
+    mr_marker_map map;
+    /* The demo lens at another resolution: square pixels, the focal length
+     * scaled with the width, so 1280x720 is a 16:9 crop of a 1280x960. */
+    mr_camera cam = mr_demo_camera();
+    double sc = (double)p.width / cam.width;
+    cam.fx *= sc;
+    cam.fy *= sc;
+    cam.cx = 0.5 * (p.width - 1) + (cam.cx - 0.5 * (mr_demo_camera().width - 1)) * sc;
+    cam.cy = 0.5 * (p.height - 1) + (cam.cy - 0.5 * (mr_demo_camera().height - 1)) * sc;
+    cam.width = p.width;
+    cam.height = p.height;
+    bool ok = hall_markers(&hall, &map, err);
+    ok = ok && mr_renderer_set_scene(gfx->renderer, hall.built, err);
+    mr_recorder *rec = NULL;
+    if (ok) {
+        mr_recorder_params rp = MR_RECORDER_DEFAULTS;
+        rp.camera = &cam;
+        rp.markers = &map;
+        rp.source = "synthetic: mrcheck demo hall (as built) along a walking path";
+        rp.jpeg_quality = p.jpeg_quality;
+        rp.ground_truth = true;
+        rec = mr_recorder_create(dir, &rp, err);
+        ok = rec != NULL;
+    }
+    mr_tracker_params tp = MR_TRACKER_DEFAULTS;
+    tp.camera = &cam;
+    tp.markers = &map;
+    mr_tracker *trk = ok ? mr_tracker_create(&tp, err) : NULL;
+    ok = ok && trk;
+    const int margin = 48 * p.width / 640 + 8, scale = 2;
+    mr_camera wide = cam;
+    wide.width += 2 * margin;
+    wide.height += 2 * margin;
+    wide.cx += margin;
+    wide.cy += margin;
+    memset(wide.dist, 0, sizeof wide.dist);
+    mr_image ideal[16];
+    memset(ideal, 0, sizeof ideal);
+    mr_rng rng;
+    mr_rng_seed(&rng, p.seed);
+    int total = path_frames();
+    int with_pose = 0;
+    for (int i = 0; ok && i < p.frames; i++) {
+        /* Spread the requested frames over the whole path. */
+        double s = p.frames > 1 ? (double)i * (total - 1) / (p.frames - 1) : 0;
+        double step = p.frames > 1 ? (double)(total - 1) / (p.frames - 1) : 1;
+        bool still = false;
+        mr_dmat4 truth = path_pose(s, &still);
+        double t = i / p.fps;
+        /* Sub-frames over an open shutter of a quarter of the frame
+         * interval (1/40 s at 10 fps, an indoor auto-exposure). */
+        for (int k = 0; ok && k < p.motion_blur; k++) {
+            double sk = p.motion_blur > 1 ? s - 0.25 * step * (double)k / (p.motion_blur - 1) : s;
+            mr_view v = {wide, path_pose(sk < 0 ? 0 : sk, NULL)};
+            mr_frame_params fp = MR_FRAME_DEFAULTS;
+            fp.width = wide.width * scale;
+            fp.height = wide.height * scale;
+            mr_frame_result res;
+            ok = mr_render_frame(gfx->renderer, &v, &fp, &res, err);
+            if (ok) {
+                mr_image_free(&ideal[k]);
+                ideal[k] = res.color;
+                res.color.data = NULL;
+                mr_frame_result_free(&res);
+            }
+        }
+        double gain = 1.0 + p.exposure * sin(2 * M_PI * i / 40.0);
+        mr_image frame = {0}, gray = {0};
+        ok = ok && mr_demo_camera_frame(&cam, ideal, p.motion_blur, margin, scale, gain, p.noise, &rng, &frame, err) &&
+             mr_image_to_gray(&frame, &gray, err);
+        mr_frame_record fr = {0};
+        fr.t = t;
+        ok = ok && track_frame(trk, &gray, &fr, err);
+        const int n = fr.detection_count;
+        if (ok) {
+            with_pose += fr.pose.valid;
+            ok = mr_recorder_append(rec, &fr, &gray, err) && mr_recorder_ground_truth(rec, fr.index, t, &truth, still, err);
+        }
+        mr_image_free(&frame);
+        mr_image_free(&gray);
+        if (ok && i % 10 == 0) mr_log(MR_LOG_INFO, "synth: frame %d/%d, %d tags", i, p.frames, n);
+        if (ok && p.progress) fprintf(stderr, "\rsynth: frame %d/%d", i + 1, p.frames);
+    }
+    if (p.progress) fprintf(stderr, "\r\033[K");
+    for (int k = 0; k < 16; k++) mr_image_free(&ideal[k]);
+    if (ok) mr_log(MR_LOG_INFO, "synth: %d frames, %d with a pose", p.frames, with_pose);
+    mr_recorder_close(&rec);
+    mr_tracker_destroy(&trk);
+    mr_renderer_set_scene(gfx->renderer, NULL, NULL); /* the caller's renderer keeps no scene of ours */
+    mr_marker_map_free(&map);
+    mr_demo_free(&hall);
+    return ok;
+}
+
+/* ------------------------------------------------------- calibration set */
+
+bool mr_synth_calibration(const char *dir, int images, mr_error *err) {
+    if (images < 1) return mr_fail(err, MR_ERR_INVALID, "synth calibration: need at least one image");
+    enum { n_tags = MR_DEMO_BOARD_COLS * MR_DEMO_BOARD_ROWS };
+    char path[4096], sub[4096];
+    mr_path_join(dir, "images", sub, sizeof sub);
+    if (!mr_mkdirs(sub, err)) return false;
+    /* Written as a marker map, so calibrate reads the same format. */
+    mr_marker tags[n_tags];
+    mr_marker_map map;
+    memset(&map, 0, sizeof map);
+    snprintf(map.family, sizeof map.family, "tag36h11");
+    map.tag_size = MR_DEMO_BOARD_TAG;
+    map.tags = tags;
+    map.count = n_tags;
+    for (int i = 0; i < n_tags; i++) {
+        memset(&tags[i], 0, sizeof tags[i]);
+        tags[i].id = mr_demo_board_tag(i, &tags[i].world_from_tag);
+    }
+    cJSON *j = mr_marker_map_to_json(&map);
+    cJSON_AddStringToObject(j, "description", "calibration board: 6x4 tag36h11 grid, ids 100..123, 40 mm tags at 60 mm pitch");
+    mr_path_join(dir, "board.json", path, sizeof path);
+    bool ok = mr_json_save(path, j, err);
+    cJSON_Delete(j);
+    /* The tag images for ids 100..123. */
+    mr_image *all = NULL;
+    int border = 1;
+    ok = ok && mr_demo_tag_images(MR_DEMO_BOARD_FIRST_ID + n_tags, &all, &border, err);
+    if (!ok) return false;
+    mr_camera cam = mr_demo_camera();
+    mr_rng rng;
+    mr_rng_seed(&rng, 77);
+    double cxb = 0.5 * (MR_DEMO_BOARD_COLS - 1) * MR_DEMO_BOARD_PITCH, cyb = 0.5 * (MR_DEMO_BOARD_ROWS - 1) * MR_DEMO_BOARD_PITCH;
+    for (int i = 0; ok && i < images; i++) {
+        /* Views from around the board: tilts up to ~35 degrees, the board
+         * filling different parts of the image. */
+        double a = 2 * M_PI * i / images;
+        double tilt = 0.25 + 0.35 * (i % 3) / 2.0;
+        double dist = 0.45 + 0.1 * (i % 2);
+        mr_dvec3 eye = mr_v3(cxb + dist * sin(tilt) * cos(a), cyb + dist * sin(tilt) * sin(a), -dist * cos(tilt));
+        mr_dvec3 at = mr_v3(cxb + 0.04 * cos(3 * a), cyb + 0.03 * sin(2 * a), 0);
+        /* board frame: y down, z into the board; "up" for the camera is -y */
+        mr_dmat4 bfc = mr_m4_look_at_cv(eye, at, mr_v3(0, -1, 0));
+        mr_image img;
+        ok = mr_demo_board_render(&cam, &bfc, all + MR_DEMO_BOARD_FIRST_ID, &rng, &img, err);
+        snprintf(sub, sizeof sub, "images/board_%02d.png", i);
+        mr_path_join(dir, sub, path, sizeof path);
+        ok = ok && mr_image_save_png(path, &img, err);
+        mr_image_free(&img);
+    }
+    mr_demo_tag_images_free(all, MR_DEMO_BOARD_FIRST_ID + n_tags);
+    return ok;
+}
