@@ -27,7 +27,7 @@ ambiguity_ratio_10|lib/track/pose.c|p.ambiguity_ratio : 2.5;|p.ambiguity_ratio :
 rot_beta_dropped|lib/track/filter.c|f->p.rot_min_cutoff + f->p.rot_beta * f->dr_hat|f->p.rot_min_cutoff|^test_track
 beta_dropped|lib/track/filter.c|f->p.min_cutoff + f->p.beta * sqrt(speed)|f->p.min_cutoff|^test_track
 rot_jump_reset_removed|lib/track/filter.c|mr_pose_angle_deg(raw, &f->raw_last) > f->p.jump_deg|0|^test_track
-rot_jump_40deg|lib/track/filter.c|p.jump_deg = or_default(p.jump_deg, 20.0);|p.jump_deg = or_default(p.jump_deg, 40.0);|^test_track
+rot_jump_40deg|lib/track/filter.c|p.jump_deg = or_default(p.jump_deg, MR_FILTER_DEFAULT_JUMP_DEG);|p.jump_deg = or_default(p.jump_deg, 40.0);|^test_track
 gap_reset_removed|lib/track/filter.c|dt > f->p.max_gap_s)) reset = true;|dt > 1e9)) reset = true;|^test_track
 prev_pose_age_inclusive|lib/track/tracker.c|age >= 0 && age < t->prev_max_age_s|age >= 0 && age <= t->prev_max_age_s|^test_track
 prev_pose_always|lib/track/tracker.c|t->prev.valid && age >= 0 && age < t->prev_max_age_s|t->prev.valid && age == age|^test_track
