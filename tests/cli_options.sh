@@ -97,7 +97,20 @@ walk_rows "$tmp/track_rows.txt"
 # decimate, threads, refine-edges and sharpening today.
 [ $numbers -ge 4 ] && ok || bad "only $numbers numeric tracker options in track --help"
 for row in '--decimate X ' '--threads N ' '--refine-edges N ' '--sharpening X '; do
-  grep -q -- "$row" "$tmp/track_rows.txt" && ok || bad "track --help lacks the table row '$row'"
+  grep -q -- "^  $row" "$tmp/track_rows.txt" && ok || bad "track --help lacks the table row '$row'"
+done
+
+# Each parsed value reaches the detector: on the shipped recording's first
+# 12 frames (frame 10 is the first that sharpening changes) a non-default
+# value changes the detections, and the default given by hand changes
+# nothing. The user's 0 is "off" (stored as -1), not "the default".
+rec=$(cd "$(dirname "$0")/.." && pwd)/recordings/demo
+detections() { "$mr" track --input "$rec" --max-frames 12 --print-detections "$@" 2>"$tmp/det.err" | md5sum; }
+base=$(detections)
+for pair in "decimate 1 2" "refine-edges 0 1" "sharpening 0 0.25"; do
+  read -r name other def <<<"$pair"
+  [ "$(detections "--$name" "$other")" != "$base" ] && ok || bad "track --$name $other detects the same as the default: the value does not reach the detector"
+  [ "$(detections "--$name" "$def")" = "$base" ] && ok || bad "track --$name $def (the default) changes the detections"
 done
 # The user's 0 is "off", not "the default": --refine-edges 0 still parses.
 accepted refine-edges 0

@@ -199,7 +199,8 @@ static void walk_table(const char *name, const mr_opt *table, size_t size, const
         mr_opt_format(o, d, got, sizeof got);
         mr_opt_format(o, macro, want, sizeof want);
         CHECK_MSG(memcmp(d + o->offset, (const char *)macro + o->offset, type_size(o->type)) == 0,
-                  "%s.%s: mr_opt_defaults gives %s, the DEFAULTS macro %s", name, o->key, got, want);
+                  "%s.%s: mr_opt_defaults gives %s, the DEFAULTS macro %s (read through the row; the fields differ)",
+                  name, o->key, got, want);
     }
 }
 
