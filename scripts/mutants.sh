@@ -58,7 +58,7 @@ opt_default_not_the_macro|lib/render/options.c|GH(tc_silhouette), 0, 4, MR_GHOST
 opt_wrong_offset|lib/render/options.c|{"rmin", MR_OPT_FLOAT, AO(r_min)|{"rmin", MR_OPT_FLOAT, AO(r_max)|^test_options$
 opt_wrong_offset_untabled|lib/render/options.c|GH(curv_scale)|GH(saliency_gain)|^test_options$
 opt_range_off_by_one|lib/render/options.c|AO(blur_radius), 0, 32,|AO(blur_radius), 0, 33,|^test_options$
-opt_upper_bound_exclusive|lib/core/options.c|v > o->hi) return range_fail(o, text, err);\n        store(o, params, (double)v);|v >= o->hi) return range_fail(o, text, err);\n        store(o, params, (double)v);|^test_options$
+opt_upper_bound_exclusive|lib/core/options.c|v > o->hi) return range_fail(o, text, err);\n        store(o, params, to_field(o, (double)v));|v >= o->hi) return range_fail(o, text, err);\n        store(o, params, to_field(o, (double)v));|^test_options$
 opt_cli_value_ignored|app/args.c|if (mr_opt_set_row(o, t->params, v, &err)) continue;|if (mr_opt_set_row(o, t->params, v, &err) + 1) continue;|^cli_options$
 opt_zero_default_user_zero_is_default|lib/core/options.c|(o->flags & MR_OPT_ZERO_DEFAULT) && v == 0 ? -1 : v;|(o->flags & MR_OPT_ZERO_DEFAULT) && v < 0 ? -1 : v;|^test_options$
 opt_detector_refine_default_off|lib/track/options.c|DT(refine_edges), 0, 1, 1,|DT(refine_edges), 0, 1, 0,|^test_options$
