@@ -8,20 +8,22 @@
 #include "mr_session.h"
 #include "mr_track.h"
 
-/* The detector / pose / filter options every tracking command takes. */
+/* The input, camera, marker and filter options every tracking command
+ * takes; the detector's numbers come with APP_TRACK_TABLE. */
 #define APP_TRACK_OPTS                                                                                  \
     {"camera", "CAMERA.json", "camera intrinsics (default: the recording's, if the input is one)", NULL}, \
     {"markers", "MARKERS.json", "marker map (default: the recording's, if the input is one)", NULL},      \
     {"family", "F", "tag family (default: the marker map's, else tag36h11)", NULL},                       \
-    {"decimate", "D", "detector decimation >= 1 (default 2)", NULL},                                      \
-    {"threads", "N", "detector threads (default 1)", NULL},                                               \
-    {"refine-edges", "0|1", "edge refinement (default 1)", NULL},                                         \
-    {"sharpening", "S", "decode sharpening (default 0.25)", NULL},                                        \
     {"no-filter", NULL, "no One Euro filtering of the pose", NULL},                                       \
     {"freeze", NULL, "freeze the filtered pose at the first valid one (still-image check)", NULL},     \
     {"size", "WxH", "V4L2: requested frame size (default 1280x720)", NULL},                               \
     {"fps", "F", "V4L2: requested frame rate; image folders: timestamp rate (default 30)", NULL},          \
     {"pixel-format", "YUYV|MJPG", "V4L2: pixel format (default: YUYV if offered, else MJPG)", NULL}
+
+/* The detector rows (--decimate, --threads, --refine-edges, --sharpening)
+ * from mr_detector_opts, parsed into *dp (an mr_detector_params holding its
+ * defaults) by app_parse_tables. */
+#define APP_TRACK_TABLE(dp) {"", mr_detector_opts, (dp), NULL, false, {0}}
 
 /* A command's tracker: the one mr_tracker (lib/track) set up from the
  * options, plus what was loaded for it. */
@@ -40,9 +42,12 @@ mr_source *app_open_input(const char *uri, bool gray, mr_recording **rec_info, m
 bool app_open_input_opts(const char *cmd, const app_opt *opts, bool gray, mr_recording **rec_info, mr_source **src,
                          mr_error *err);
 
-/* Sets up the tracker from the options; rec (may be NULL) supplies the
- * camera and markers by default. Prints one line and returns false on error. */
-bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, const mr_recording *rec);
+/* Sets up the tracker from the options and the detector params parsed from
+ * APP_TRACK_TABLE (--family fills in its family); rec (may be NULL)
+ * supplies the camera and markers by default. Prints one line and returns
+ * false on error. */
+bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, const mr_detector_params *dp,
+                      const mr_recording *rec);
 void app_tracker_free(app_tracker *t);
 
 /* JSON helpers for the line formats. */

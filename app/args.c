@@ -12,9 +12,10 @@ static void print_row(const char *name, const char *arg, const char *help) {
     printf("  %-24s %s\n", left, help);
 }
 
-/* The command-line name of a table row: prefix, or prefix-key. */
+/* The command-line name of a table row: prefix, or prefix-key; a table
+ * without a prefix (the tracker's) names its rows by their keys. */
 static void row_name(const app_table *t, const mr_opt *o, char *out, size_t n) {
-    snprintf(out, n, "%s%s%s", t->prefix, o->key[0] ? "-" : "", o->key);
+    snprintf(out, n, "%s%s%s", t->prefix, t->prefix[0] && o->key[0] ? "-" : "", o->key);
 }
 
 static const char *row_arg(const mr_opt *o) {

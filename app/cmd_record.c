@@ -28,8 +28,10 @@ int cmd_record(int argc, char **argv) {
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
+    mr_detector_params dp = MR_DETECTOR_DEFAULTS;
+    app_table tables[] = {APP_TRACK_TABLE(&dp)};
     bool help;
-    if (!app_parse(argc, argv, 2, opts, NULL, 0, NULL,
+    if (!app_parse_tables(argc, argv, 2, opts, tables, 1, NULL, 0, NULL,
                    "usage: mrcheck record --input /dev/videoN|VIDEO --camera C --markers M --out DIR\n"
                    "Writes meta.json, frames/NNNNNN.jpg and frames.jsonl (detections, raw and filtered pose,\n"
                    "quality) as it goes; every line is flushed and synced, so a crash loses at most one frame.",
@@ -51,7 +53,7 @@ int cmd_record(int argc, char **argv) {
     if (!app_open_input_opts(cmd, opts, app_flag(opts, "gray"), &rec_in, &src, &err)) return 2;
     if (!src) return app_error(cmd, &err);
     app_tracker t;
-    bool ok = app_tracker_init(&t, cmd, opts, rec_in);
+    bool ok = app_tracker_init(&t, cmd, opts, &dp, rec_in);
     mr_recording_close(&rec_in);
     if (!ok) {
         mr_source_close(&src);

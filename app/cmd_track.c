@@ -36,8 +36,10 @@ int cmd_track(int argc, char **argv) {
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
+    mr_detector_params dp = MR_DETECTOR_DEFAULTS;
+    app_table tables[] = {APP_TRACK_TABLE(&dp)};
     bool help;
-    if (!app_parse(argc, argv, 2, opts, NULL, 0, NULL,
+    if (!app_parse_tables(argc, argv, 2, opts, tables, 1, NULL, 0, NULL,
                    "usage: mrcheck track --input PATH|/dev/videoN [--camera C] [--markers M] [--family F] [--decimate D]\n"
                    "                     [--threads N] [--refine-edges 0|1] [--out poses.jsonl] [--print-detections]\n"
                    "Detects AprilTags per frame (corners in pixels, OpenCV convention: centre of the top-left pixel\n"
@@ -60,7 +62,7 @@ int cmd_track(int argc, char **argv) {
     if (!app_open_input_opts(cmd, opts, true, &rec, &src, &err)) return 2;
     if (!src) return app_error(cmd, &err);
     app_tracker t;
-    bool ok = app_tracker_init(&t, cmd, opts, rec);
+    bool ok = app_tracker_init(&t, cmd, opts, &dp, rec);
     mr_recording_close(&rec);
     if (!ok) {
         mr_source_close(&src);

@@ -61,7 +61,8 @@ bool app_open_input_opts(const char *cmd, const app_opt *opts, bool gray, mr_rec
     return true;
 }
 
-bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, const mr_recording *rec) {
+bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, const mr_detector_params *dp,
+                      const mr_recording *rec) {
     memset(t, 0, sizeof *t);
     mr_error err = {0};
     mr_camera cam;
@@ -81,26 +82,9 @@ bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, cons
         tp.markers = &rec->markers;
     }
     const char *family = app_get(opts, "family");
+    tp.detector = *dp;
     tp.detector.family = family;
-    double v;
-    long l;
     bool ok = false;
-    if (app_get(opts, "decimate")) {
-        if (!app_double("decimate", app_get(opts, "decimate"), 1, 16, &v)) goto done;
-        tp.detector.decimate = v;
-    }
-    if (app_get(opts, "threads")) {
-        if (!app_int("threads", app_get(opts, "threads"), 1, 64, &l)) goto done;
-        tp.detector.threads = (int)l;
-    }
-    if (app_get(opts, "refine-edges")) {
-        if (!app_int("refine-edges", app_get(opts, "refine-edges"), 0, 1, &l)) goto done;
-        tp.detector.refine_edges = l ? 1 : -1;
-    }
-    if (app_get(opts, "sharpening")) {
-        if (!app_double("sharpening", app_get(opts, "sharpening"), 0, 10, &v)) goto done;
-        tp.detector.sharpening = v > 0 ? v : -1;
-    }
     tp.no_filter = app_flag(opts, "no-filter");
     tp.freeze_first = app_flag(opts, "freeze");
     t->tracker = mr_tracker_create(&tp, &err);

@@ -27,7 +27,7 @@ ambiguity_ratio_10|lib/track/pose.c|p.ambiguity_ratio : 2.5;|p.ambiguity_ratio :
 rot_beta_dropped|lib/track/filter.c|f->p.rot_min_cutoff + f->p.rot_beta * f->dr_hat|f->p.rot_min_cutoff|^test_track
 beta_dropped|lib/track/filter.c|f->p.min_cutoff + f->p.beta * sqrt(speed)|f->p.min_cutoff|^test_track
 rot_jump_reset_removed|lib/track/filter.c|mr_pose_angle_deg(raw, &f->raw_last) > f->p.jump_deg|0|^test_track
-rot_jump_40deg|lib/track/filter.c|p.jump_deg = or_default(p.jump_deg, 20.0);|p.jump_deg = or_default(p.jump_deg, 40.0);|^test_track
+rot_jump_40deg|lib/track/filter.c|p.jump_deg = or_default(p.jump_deg, MR_FILTER_DEFAULT_JUMP_DEG);|p.jump_deg = or_default(p.jump_deg, 40.0);|^test_track
 gap_reset_removed|lib/track/filter.c|dt > f->p.max_gap_s)) reset = true;|dt > 1e9)) reset = true;|^test_track
 prev_pose_age_inclusive|lib/track/tracker.c|age >= 0 && age < t->prev_max_age_s|age >= 0 && age <= t->prev_max_age_s|^test_track
 prev_pose_always|lib/track/tracker.c|t->prev.valid && age >= 0 && age < t->prev_max_age_s|t->prev.valid && age == age|^test_track
@@ -58,9 +58,12 @@ opt_default_not_the_macro|lib/render/options.c|GH(tc_silhouette), 0, 4, MR_GHOST
 opt_wrong_offset|lib/render/options.c|{"rmin", MR_OPT_FLOAT, AO(r_min)|{"rmin", MR_OPT_FLOAT, AO(r_max)|^test_options$
 opt_wrong_offset_untabled|lib/render/options.c|GH(curv_scale)|GH(saliency_gain)|^test_options$
 opt_range_off_by_one|lib/render/options.c|AO(blur_radius), 0, 32,|AO(blur_radius), 0, 33,|^test_options$
-opt_upper_bound_exclusive|lib/core/options.c|v > o->hi) return range_fail(o, text, err);\n        store(o, params, (double)v);|v >= o->hi) return range_fail(o, text, err);\n        store(o, params, (double)v);|^test_options$
+opt_upper_bound_exclusive|lib/core/options.c|v > o->hi) return range_fail(o, text, err);\n        store(o, params, to_field(o, (double)v));|v >= o->hi) return range_fail(o, text, err);\n        store(o, params, to_field(o, (double)v));|^test_options$
 opt_cli_value_ignored|app/args.c|if (mr_opt_set_row(o, t->params, v, &err)) continue;|if (mr_opt_set_row(o, t->params, v, &err) + 1) continue;|^cli_options$
 replay_meta_markers_key|lib/session/replay.c|cJSON_GetObjectItemCaseSensitive(meta, "markers") : NULL;|cJSON_GetObjectItemCaseSensitive(meta, "marker") : NULL;|^test_session$
+opt_zero_default_user_zero_is_default|lib/core/options.c|(o->flags & MR_OPT_ZERO_DEFAULT) && v == 0 ? -1 : v;|(o->flags & MR_OPT_ZERO_DEFAULT) && v < 0 ? -1 : v;|^test_options$
+opt_detector_refine_default_off|lib/track/options.c|DT(refine_edges), 0, 1, 1,|DT(refine_edges), 0, 1, 0,|^test_options$
+track_opts_only_threads|app/track_util.c|tp.detector = *dp;|tp.detector.threads = dp->threads;|^cli_options$
 LIST
 )
 

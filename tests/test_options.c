@@ -1,6 +1,7 @@
 /* The declared option tables (mr_opt, lib/core/options.c) and every table
- * the libraries declare: mr_ao_opts, mr_ghost_opts (lib/render) and
- * mr_view_settings_opts (lib/view). Each table is walked: keys unique,
+ * the libraries declare: mr_ao_opts, mr_ghost_opts (lib/render),
+ * mr_view_settings_opts (lib/view), mr_detector_opts and mr_filter_opts
+ * (lib/track). Each table is walked: keys unique,
  * offsets inside the struct, aligned and not overlapping, each default in
  * its range (or the documented 0 = auto), enum defaults valid names,
  * mr_opt_defaults equal to the MR_*_DEFAULTS macro field by field, and
@@ -9,6 +10,7 @@
 #include "mr_core.h"
 #include "mr_render.h"
 #include "mr_test.h"
+#include "mr_track.h"
 #include "mr_view.h"
 
 #include <float.h>
@@ -54,6 +56,46 @@ static bool try_set(const char *table, const mr_opt *o, const void *params, size
                   text);
     }
     return ok;
+}
+
+/* A MR_OPT_ZERO_DEFAULT row: the macro's field is 0 and reads as the
+ * row's default; every accepted user value is stored as a non-zero field
+ * (never mistaken for "the default") and reads back as itself, the user's
+ * 0 as a negative field ("off"). */
+/* The int or double field itself, without the row's mapping. */
+static double raw_field(const mr_opt *o, const void *params) {
+    const char *f = (const char *)params + o->offset;
+    if (o->type == MR_OPT_INT) return *(const int *)f;
+    double d;
+    memcpy(&d, f, sizeof d);
+    return d;
+}
+
+static void zero_default_row(const char *name, const mr_opt *o, size_t size, const void *macro) {
+    unsigned char a[1024];
+    CHECK_MSG(o->type == MR_OPT_INT || o->type == MR_OPT_DOUBLE, "%s.%s: a zero-default row must be int or double",
+              name, o->key);
+    CHECK_MSG(raw_field(o, macro) == 0, "%s.%s: the DEFAULTS macro's field is %g, not 0", name, o->key,
+              raw_field(o, macro));
+    CHECK_MSG(mr_opt_get(o, macro) == o->def, "%s.%s: the macro's 0 reads as %g, not the default %g", name, o->key,
+              mr_opt_get(o, macro), o->def);
+    CHECK_MSG(o->lo >= 0, "%s.%s: a zero-default row with negative values [%g, %g]", name, o->key, o->lo, o->hi);
+    const double probe[3] = {o->lo, o->hi, o->type == MR_OPT_INT ? (double)(long)((o->lo + o->hi) / 2)
+                                                                : (o->lo + o->hi) / 2};
+    for (int k = 0; k < 3; k++) {
+        char t[64];
+        if (o->type == MR_OPT_INT) snprintf(t, sizeof t, "%ld", (long)probe[k]);
+        else snprintf(t, sizeof t, "%.17g", probe[k]);
+        memcpy(a, macro, size);
+        mr_error e = {0};
+        bool ok = mr_opt_set_row(o, a, t, &e);
+        double field = raw_field(o, a);
+        CHECK_MSG(ok && mr_opt_get(o, a) == probe[k], "%s.%s: '%s' reads back as %g (%s)", name, o->key, t,
+                  mr_opt_get(o, a), e.msg);
+        CHECK_MSG(probe[k] == 0 ? field < 0 : field == probe[k],
+                  "%s.%s: the user's '%s' is stored as %g in the field (0 -> < 0 'off', else itself)", name, o->key, t,
+                  field);
+    }
 }
 
 static void walk_table(const char *name, const mr_opt *table, size_t size, const void *macro) {
@@ -130,12 +172,18 @@ static void walk_table(const char *name, const mr_opt *table, size_t size, const
             }
             CHECK_MSG(!try_set(name, o, macro, size, ""), "%s.%s accepted an empty value", name, o->key);
         }
+        if (o->flags & MR_OPT_ZERO_DEFAULT) zero_default_row(name, o, size, macro);
         /* The default, formatted from the macro's struct, reads back to the same bytes. */
         unsigned char a[1024];
         memcpy(a, macro, size);
         mr_error e = {0};
         bool back = o->type == MR_OPT_ENUM || o->type == MR_OPT_BOOL || !(o->flags & MR_OPT_ZERO_AUTO) || o->def != 0;
-        if (back) {
+        if (back && (o->flags & MR_OPT_ZERO_DEFAULT)) {
+            /* The default given by hand is the default the 0 stands for. */
+            bool ok = mr_opt_set_row(o, a, def, &e);
+            CHECK_MSG(ok && mr_opt_get(o, a) == mr_opt_get(o, macro), "%s.%s: the default '%s' reads back as %g (%s)",
+                      name, o->key, def, mr_opt_get(o, a), e.msg);
+        } else if (back) {
             bool ok = mr_opt_set_row(o, a, o->type == MR_OPT_BOOL ? (o->def ? "1" : "0") : def, &e);
             CHECK_MSG(ok && memcmp(a, macro, size) == 0, "%s.%s: the default '%s' does not read back (%s)", name, o->key,
                       def, e.msg);
@@ -151,7 +199,8 @@ static void walk_table(const char *name, const mr_opt *table, size_t size, const
         mr_opt_format(o, d, got, sizeof got);
         mr_opt_format(o, macro, want, sizeof want);
         CHECK_MSG(memcmp(d + o->offset, (const char *)macro + o->offset, type_size(o->type)) == 0,
-                  "%s.%s: mr_opt_defaults gives %s, the DEFAULTS macro %s", name, o->key, got, want);
+                  "%s.%s: mr_opt_defaults gives %s, the DEFAULTS macro %s (read through the row; the fields differ)",
+                  name, o->key, got, want);
     }
 }
 
@@ -194,6 +243,10 @@ static void test_tables(void) {
     walk_table("mr_ao_opts", mr_ao_opts, sizeof ao, &ao);
     walk_table("mr_ghost_opts", mr_ghost_opts, sizeof gh, &gh);
     walk_table("mr_view_settings_opts", mr_view_settings_opts, sizeof vs, &vs);
+    const mr_detector_params dp = MR_DETECTOR_DEFAULTS;
+    const mr_filter_params fp = MR_FILTER_DEFAULTS;
+    walk_table("mr_detector_opts", mr_detector_opts, sizeof dp, &dp);
+    walk_table("mr_filter_opts", mr_filter_opts, sizeof fp, &fp);
 
 #define E(t, k, f, names) {k, offsetof(t, f), 0, 0, names}
 #define N(t, k, f, lo, hi) {k, offsetof(t, f), lo, hi, NULL}
@@ -234,8 +287,35 @@ static void test_tables(void) {
         E(mr_view_settings, "ao", ao, "none scheer crytek filion hbao alchemy"),
         E(mr_view_settings, "ghost", ghost, "off alpha g0 adaptive"),
     };
+    const expect ex_dt[] = {
+        N(mr_detector_params, "decimate", decimate, 1, 16),
+        N(mr_detector_params, "threads", threads, 1, 64),
+        N(mr_detector_params, "refine-edges", refine_edges, 0, 1),
+        N(mr_detector_params, "sharpening", sharpening, 0, 10),
+    };
+    const expect ex_fi[] = {
+        N(mr_filter_params, "min-cutoff", min_cutoff, 1e-3, 100),
+        N(mr_filter_params, "beta", beta, 1e-6, 1000),
+        N(mr_filter_params, "d-cutoff", d_cutoff, 1e-3, 100),
+        N(mr_filter_params, "rot-min-cutoff", rot_min_cutoff, 1e-3, 100),
+        N(mr_filter_params, "rot-beta", rot_beta, 1e-6, 1000),
+        N(mr_filter_params, "jump-dist", jump_dist, 1e-6, 1e6),
+        N(mr_filter_params, "jump-deg", jump_deg, 1e-3, 180),
+        N(mr_filter_params, "max-gap", max_gap_s, 1e-3, 3600),
+    };
 #undef E
 #undef N
+    check_rows("mr_detector_opts", mr_detector_opts, ex_dt, (int)(sizeof ex_dt / sizeof ex_dt[0]));
+    check_rows("mr_filter_opts", mr_filter_opts, ex_fi, (int)(sizeof ex_fi / sizeof ex_fi[0]));
+    /* The defaults the 0s stand for, written a second time as the contract:
+     * the same as the detector's and the filter's own (test_track). */
+    const double want_dt[] = {2.0, 1, 1, 0.25}, want_fi[] = {0.5, 2.0, 1.0, 0.5, 1.0, 0.5, 20.0, 0.5};
+    for (int i = 0; i < 4; i++)
+        CHECK_MSG(mr_detector_opts[i].def == want_dt[i], "mr_detector_opts.%s: default %g, expected %g",
+                  mr_detector_opts[i].key, mr_detector_opts[i].def, want_dt[i]);
+    for (int i = 0; i < 8; i++)
+        CHECK_MSG(mr_filter_opts[i].def == want_fi[i], "mr_filter_opts.%s: default %g, expected %g",
+                  mr_filter_opts[i].key, mr_filter_opts[i].def, want_fi[i]);
     check_rows("mr_ao_opts", mr_ao_opts, ex_ao, (int)(sizeof ex_ao / sizeof ex_ao[0]));
     check_rows("mr_ghost_opts", mr_ghost_opts, ex_gh, (int)(sizeof ex_gh / sizeof ex_gh[0]));
     check_rows("mr_view_settings_opts", mr_view_settings_opts, ex_vs, (int)(sizeof ex_vs / sizeof ex_vs[0]));
@@ -256,6 +336,7 @@ typedef struct toy {
     float f;
     bool b;
     int e;
+    int z;
 } toy;
 static const char *const k_toy_names[] = {"red", "green", "blue", NULL};
 static const mr_opt k_toy[] = {
@@ -264,6 +345,7 @@ static const mr_opt k_toy[] = {
     {"f", MR_OPT_FLOAT, offsetof(toy, f), -1, 1, 0.25, NULL, "a float", 0},
     {"b", MR_OPT_BOOL, offsetof(toy, b), 0, 1, 1, NULL, "a flag", 0},
     {"e", MR_OPT_ENUM, offsetof(toy, e), 0, 0, 1, k_toy_names, "a colour", 0},
+    {"z", MR_OPT_INT, offsetof(toy, z), 0, 3, 2, NULL, "0 = default 2, < 0 = off", MR_OPT_ZERO_DEFAULT},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 
@@ -274,6 +356,21 @@ static void test_facility(void) {
     CHECK_MSG(t.n == 2 && t.d == 0 && t.f == 0.25f && t.b && t.e == 1, "defaults: n %d d %g f %g b %d e %d", t.n, t.d,
               t.f, t.b, t.e);
     mr_error e = {0};
+    /* The zero-default row: the field keeps 0 = default and < 0 = off. */
+    const mr_opt *z = mr_opt_find(k_toy, "z");
+    CHECK_MSG(t.z == 0 && mr_opt_get(z, &t) == 2, "zero-default: defaults give field %d reading %g", t.z,
+              mr_opt_get(z, &t));
+    CHECK_MSG(mr_opt_set(k_toy, &t, "z", "0", &e) && t.z < 0 && mr_opt_get(z, &t) == 0,
+              "zero-default: the user's 0 gives field %d reading %g (want < 0, 0)", t.z, mr_opt_get(z, &t));
+    char zs[32];
+    mr_opt_format(z, &t, zs, sizeof zs);
+    CHECK_MSG(strcmp(zs, "0") == 0, "zero-default: 'off' formats as '%s'", zs);
+    CHECK_MSG(mr_opt_set(k_toy, &t, "z", "3", &e) && t.z == 3 && mr_opt_get(z, &t) == 3, "zero-default: 3 gives %d",
+              t.z);
+    CHECK_MSG(!mr_opt_set(k_toy, &t, "z", "-1", &e) && t.z == 3, "zero-default: -1 accepted");
+    mr_opt_describe(z, zs, sizeof zs);
+    CHECK_MSG(strcmp(zs, "0..3 (default 2)") == 0, "describe z: '%s'", zs);
+    t.z = 0;
     CHECK_MSG(mr_opt_set(k_toy, &t, "n", "-3", &e) && t.n == -3, "n -3: %s", e.msg);
     CHECK_MSG(!mr_opt_set(k_toy, &t, "n", "8", &e) && t.n == -3, "n 8 accepted or changed n");
     CHECK_MSG(strcmp(e.msg, "n must be a whole number in [-3, 7], got '8'") == 0, "int message: '%s'", e.msg);

@@ -44,15 +44,17 @@ static int track_in_process(const char *dir, track_line *lines, char **printed) 
         {"quiet", NULL, "", NULL},
         {NULL, NULL, NULL, NULL},
     };
+    mr_detector_params dp = MR_DETECTOR_DEFAULTS;
+    app_table tables[] = {APP_TRACK_TABLE(&dp)};
     bool help = false;
-    CHECK(app_parse(5, argv, 2, opts, NULL, 0, NULL, "", &help) && !help);
+    CHECK(app_parse_tables(5, argv, 2, opts, tables, 1, NULL, 0, NULL, "", &help) && !help);
     mr_error err = {0};
     mr_recording *rec = NULL;
     mr_source *src = NULL;
     CHECK(app_open_input_opts("track", opts, true, &rec, &src, &err));
     CHECK_MSG(src != NULL, "track input: %s", err.msg);
     app_tracker t;
-    bool ok = src && app_tracker_init(&t, "track", opts, rec);
+    bool ok = src && app_tracker_init(&t, "track", opts, &dp, rec);
     mr_recording_close(&rec);
     CHECK_MSG(ok && t.has_camera && t.has_markers, "track's tracker did not set up from the recording");
     if (!ok) {

@@ -229,6 +229,15 @@ typedef enum mr_opt_type {
 /* 0 is the default and means "chosen at run time" (e.g. 2% of the scene):
  * it may lie outside [lo, hi], which bounds what a user may set. */
 #define MR_OPT_ZERO_AUTO 1u
+/* lib/track's convention: the field's 0 stands for the default (so a
+ * zero-initialised struct is the defaults) and a negative field for "off".
+ * The row speaks the user's values: a value v is stored as v, the user's 0
+ * as -1 ("off"), and the field reads back (mr_opt_get, format, JSON) as def
+ * for 0 and as 0 for < 0; mr_opt_defaults writes 0. Rows with this flag have
+ * lo >= 0, so that no user value is negative. A plain range row cannot
+ * express this mapping (e.g. --refine-edges 0 -> -1), and changing the
+ * fields' meaning would break every zero-initialised params struct. */
+#define MR_OPT_ZERO_DEFAULT 2u
 
 typedef struct mr_opt {
     const char *key;          /* file / UI name; on the command line prefix + key,
@@ -239,7 +248,7 @@ typedef struct mr_opt {
     double def;               /* default (enums: the index) */
     const char *const *names; /* enums: names by value, NULL-terminated */
     const char *help;         /* one line, no default or range (added from the row) */
-    unsigned flags;           /* MR_OPT_ZERO_AUTO */
+    unsigned flags;           /* MR_OPT_ZERO_AUTO, MR_OPT_ZERO_DEFAULT */
 } mr_opt;
 
 /* The row named key; NULL if none. */

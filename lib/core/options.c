@@ -64,7 +64,8 @@ static void store(const mr_opt *o, void *params, double v) {
     }
 }
 
-double mr_opt_get(const mr_opt *o, const void *params) {
+/* The field's own value (without the MR_OPT_ZERO_DEFAULT mapping). */
+static double load(const mr_opt *o, const void *params) {
     const char *f = (const char *)params + o->offset;
     switch (o->type) {
     case MR_OPT_INT:
@@ -74,6 +75,15 @@ double mr_opt_get(const mr_opt *o, const void *params) {
     case MR_OPT_BOOL: return *(const bool *)f;
     }
     return 0;
+}
+
+/* The user's value v as the field stores it, and back. */
+static double to_field(const mr_opt *o, double v) { return (o->flags & MR_OPT_ZERO_DEFAULT) && v == 0 ? -1 : v; }
+
+double mr_opt_get(const mr_opt *o, const void *params) {
+    double v = load(o, params);
+    if (!(o->flags & MR_OPT_ZERO_DEFAULT)) return v;
+    return v == 0 ? o->def : v < 0 ? 0 : v;
 }
 
 static bool range_fail(const mr_opt *o, const char *text, mr_error *err) {
@@ -91,14 +101,14 @@ bool mr_opt_set_row(const mr_opt *o, void *params, const char *text, mr_error *e
     case MR_OPT_INT: {
         long v = strtol(text, &end, 10);
         if (!text[0] || *end || errno || v < o->lo || v > o->hi) return range_fail(o, text, err);
-        store(o, params, (double)v);
+        store(o, params, to_field(o, (double)v));
         return true;
     }
     case MR_OPT_DOUBLE:
     case MR_OPT_FLOAT: {
         double v = strtod(text, &end);
         if (!text[0] || *end || errno || !isfinite(v) || v < o->lo || v > o->hi) return range_fail(o, text, err);
-        store(o, params, v);
+        store(o, params, to_field(o, v));
         return true;
     }
     case MR_OPT_BOOL:
@@ -183,7 +193,7 @@ void mr_opt_describe(const mr_opt *o, char *out, size_t n) {
 }
 
 void mr_opt_defaults(const mr_opt *table, void *params) {
-    for (const mr_opt *o = table; o->key; o++) store(o, params, o->def);
+    for (const mr_opt *o = table; o->key; o++) store(o, params, (o->flags & MR_OPT_ZERO_DEFAULT) ? 0 : o->def);
 }
 
 bool mr_opt_to_json(const mr_opt *table, const void *params, cJSON *obj) {

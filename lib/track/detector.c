@@ -52,12 +52,12 @@ mr_detector *mr_detector_create(const mr_detector_params *params, mr_error *err)
         mr_fail(err, MR_ERR_UNSUPPORTED, "unknown tag family '%.40s'", family);
         return NULL;
     }
-    double decimate = p.decimate == 0 ? 2.0 : p.decimate;
+    double decimate = p.decimate == 0 ? MR_DETECTOR_DEFAULT_DECIMATE : p.decimate;
     if (!isfinite(decimate) || decimate < 1.0 || decimate > 16.0) {
         mr_fail(err, MR_ERR_INVALID, "decimation must be in [1, 16] (got %g)", decimate);
         return NULL;
     }
-    int threads = p.threads == 0 ? 1 : p.threads;
+    int threads = p.threads == 0 ? MR_DETECTOR_DEFAULT_THREADS : p.threads;
     if (threads < 1 || threads > 256) {
         mr_fail(err, MR_ERR_INVALID, "threads must be in [1, 256] (got %d)", threads);
         return NULL;
@@ -89,7 +89,7 @@ mr_detector *mr_detector_create(const mr_detector_params *params, mr_error *err)
     d->td->quad_decimate = (float)decimate;
     d->td->nthreads = threads;
     d->td->refine_edges = p.refine_edges >= 0;
-    d->td->decode_sharpening = p.sharpening == 0 ? 0.25 : p.sharpening < 0 ? 0.0 : p.sharpening;
+    d->td->decode_sharpening = p.sharpening == 0 ? MR_DETECTOR_DEFAULT_SHARPENING : p.sharpening < 0 ? 0.0 : p.sharpening;
     d->td->quad_sigma = (float)p.blur;
     d->td->debug = false;
     return d;

@@ -29,14 +29,14 @@ mr_pose_filter *mr_pose_filter_create(const mr_filter_params *params, mr_error *
         mr_fail(err, MR_ERR_INVALID, "filter parameters must be finite and >= 0");
         return NULL;
     }
-    p.min_cutoff = or_default(p.min_cutoff, 0.5);
-    p.beta = or_default(p.beta, 2.0);
-    p.d_cutoff = or_default(p.d_cutoff, 1.0);
-    p.rot_min_cutoff = or_default(p.rot_min_cutoff, 0.5);
-    p.rot_beta = or_default(p.rot_beta, 1.0);
-    p.jump_dist = or_default(p.jump_dist, 0.5);
-    p.jump_deg = or_default(p.jump_deg, 20.0);
-    p.max_gap_s = or_default(p.max_gap_s, 0.5);
+    p.min_cutoff = or_default(p.min_cutoff, MR_FILTER_DEFAULT_MIN_CUTOFF);
+    p.beta = or_default(p.beta, MR_FILTER_DEFAULT_BETA);
+    p.d_cutoff = or_default(p.d_cutoff, MR_FILTER_DEFAULT_D_CUTOFF);
+    p.rot_min_cutoff = or_default(p.rot_min_cutoff, MR_FILTER_DEFAULT_ROT_MIN_CUTOFF);
+    p.rot_beta = or_default(p.rot_beta, MR_FILTER_DEFAULT_ROT_BETA);
+    p.jump_dist = or_default(p.jump_dist, MR_FILTER_DEFAULT_JUMP_DIST);
+    p.jump_deg = or_default(p.jump_deg, MR_FILTER_DEFAULT_JUMP_DEG);
+    p.max_gap_s = or_default(p.max_gap_s, MR_FILTER_DEFAULT_MAX_GAP_S);
     mr_pose_filter *f = calloc(1, sizeof *f);
     if (!f) {
         mr_fail(err, MR_ERR_NOMEM, "out of memory");

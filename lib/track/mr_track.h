@@ -78,6 +78,14 @@ typedef struct mr_detector_params {
                                 0 = default 1, < 0 = 0 */
 } mr_detector_params;
 #define MR_DETECTOR_DEFAULTS {NULL, 0.0, 0, 0, 0.0, 0.0, 0}
+/* What the 0s above stand for (detector.c and mr_detector_opts read these). */
+#define MR_DETECTOR_DEFAULT_DECIMATE 2.0
+#define MR_DETECTOR_DEFAULT_THREADS 1
+#define MR_DETECTOR_DEFAULT_SHARPENING 0.25
+/* The command line's detector options (--decimate, --threads, --refine-edges,
+ * --sharpening), in the user's values: the fields' "0 = default, < 0 = off"
+ * through MR_OPT_ZERO_DEFAULT (mr_core.h). The family is a name, not a row. */
+extern const mr_opt mr_detector_opts[];
 
 /* Frames smaller than this on either side are refused: the apriltag 3.3
  * library crashes on 1x1 images, and no tag fits in fewer pixels anyway. */
@@ -156,6 +164,19 @@ typedef struct mr_filter_params {
     double max_gap_s;        /* reset after a gap longer than this; default 0.5 s */
 } mr_filter_params;
 #define MR_FILTER_DEFAULTS {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}
+/* What the 0s above stand for (filter.c and mr_filter_opts read these). */
+#define MR_FILTER_DEFAULT_MIN_CUTOFF 0.5
+#define MR_FILTER_DEFAULT_BETA 2.0
+#define MR_FILTER_DEFAULT_D_CUTOFF 1.0
+#define MR_FILTER_DEFAULT_ROT_MIN_CUTOFF 0.5
+#define MR_FILTER_DEFAULT_ROT_BETA 1.0
+#define MR_FILTER_DEFAULT_JUMP_DIST 0.5
+#define MR_FILTER_DEFAULT_JUMP_DEG 20.0
+#define MR_FILTER_DEFAULT_MAX_GAP_S 0.5
+/* The One Euro filter's tunables (settings files, benches), in the user's
+ * values; every field's 0 is its default (MR_OPT_ZERO_DEFAULT), so each
+ * range starts above 0. */
+extern const mr_opt mr_filter_opts[];
 
 typedef struct mr_pose_filter mr_pose_filter;
 mr_pose_filter *mr_pose_filter_create(const mr_filter_params *params, mr_error *err);

@@ -1,0 +1,49 @@
+/* The option tables of the tracker's params (mr_detector_opts,
+ * mr_filter_opts): key, type, field, range, default and help of each
+ * tunable, for the command line, --help and settings files. Defaults are
+ * the MR_*_DEFAULT_* macros of mr_track.h, which detector.c and filter.c
+ * substitute for a 0 field, so each is written once. Every row is
+ * MR_OPT_ZERO_DEFAULT: the params keep "0 = default" (zero-initialised
+ * structs, MR_TRACKER_DEFAULTS' nested params) while a row speaks the
+ * user's values. */
+#include "mr_track.h"
+
+#include <stddef.h>
+
+#define DT(f) offsetof(mr_detector_params, f)
+const mr_opt mr_detector_opts[] = {
+    {"decimate", MR_OPT_DOUBLE, DT(decimate), 1, 16, MR_DETECTOR_DEFAULT_DECIMATE, NULL, "detector decimation",
+     MR_OPT_ZERO_DEFAULT},
+    /* The detector takes up to 256; the command line has always stopped at 64. */
+    {"threads", MR_OPT_INT, DT(threads), 1, 64, MR_DETECTOR_DEFAULT_THREADS, NULL, "detector threads",
+     MR_OPT_ZERO_DEFAULT},
+    /* 0/1 rather than a flag: the default is on, and 0 must be sayable. */
+    {"refine-edges", MR_OPT_INT, DT(refine_edges), 0, 1, 1, NULL, "edge refinement, 0 = off", MR_OPT_ZERO_DEFAULT},
+    {"sharpening", MR_OPT_DOUBLE, DT(sharpening), 0, 10, MR_DETECTOR_DEFAULT_SHARPENING, NULL,
+     "decode sharpening, 0 = none", MR_OPT_ZERO_DEFAULT},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef DT
+
+/* filter.c replaces any field <= 0 by its default, so no range holds 0. */
+#define FI(f) offsetof(mr_filter_params, f)
+const mr_opt mr_filter_opts[] = {
+    {"min-cutoff", MR_OPT_DOUBLE, FI(min_cutoff), 1e-3, 100, MR_FILTER_DEFAULT_MIN_CUTOFF, NULL,
+     "One Euro cutoff at rest, Hz", MR_OPT_ZERO_DEFAULT},
+    {"beta", MR_OPT_DOUBLE, FI(beta), 1e-6, 1000, MR_FILTER_DEFAULT_BETA, NULL,
+     "cutoff increase per unit speed (1/scene unit)", MR_OPT_ZERO_DEFAULT},
+    {"d-cutoff", MR_OPT_DOUBLE, FI(d_cutoff), 1e-3, 100, MR_FILTER_DEFAULT_D_CUTOFF, NULL,
+     "cutoff of the speed estimate, Hz", MR_OPT_ZERO_DEFAULT},
+    {"rot-min-cutoff", MR_OPT_DOUBLE, FI(rot_min_cutoff), 1e-3, 100, MR_FILTER_DEFAULT_ROT_MIN_CUTOFF, NULL,
+     "rotation cutoff at rest, Hz", MR_OPT_ZERO_DEFAULT},
+    {"rot-beta", MR_OPT_DOUBLE, FI(rot_beta), 1e-6, 1000, MR_FILTER_DEFAULT_ROT_BETA, NULL,
+     "rotation cutoff increase per rad/s", MR_OPT_ZERO_DEFAULT},
+    {"jump-dist", MR_OPT_DOUBLE, FI(jump_dist), 1e-6, 1e6, MR_FILTER_DEFAULT_JUMP_DIST, NULL,
+     "reset when the raw pose moves more than this between frames, scene units", MR_OPT_ZERO_DEFAULT},
+    {"jump-deg", MR_OPT_DOUBLE, FI(jump_deg), 1e-3, 180, MR_FILTER_DEFAULT_JUMP_DEG, NULL,
+     "reset when the raw pose turns more than this between frames, degrees", MR_OPT_ZERO_DEFAULT},
+    {"max-gap", MR_OPT_DOUBLE, FI(max_gap_s), 1e-3, 3600, MR_FILTER_DEFAULT_MAX_GAP_S, NULL,
+     "reset after a gap longer than this, seconds", MR_OPT_ZERO_DEFAULT},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef FI
