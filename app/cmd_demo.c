@@ -97,12 +97,7 @@ static bool run_demo(const char *dir, mr_error *err) {
     app_gfx gfx = {0};
     ok = planned && app_gfx_open(&gfx, err);
     const int margin = 48, scale = 2;
-    mr_camera wide = cam;
-    wide.width += 2 * margin;
-    wide.height += 2 * margin;
-    wide.cx += margin;
-    wide.cy += margin;
-    memset(wide.dist, 0, sizeof wide.dist);
+    mr_camera wide = mr_demo_wide_camera(&cam, margin);
     for (int i = 0; ok && i < mr_demo_view_count(); i++) {
         mr_frame_result res = {0};
         mr_rng rng;

@@ -131,12 +131,7 @@ bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params
     mr_tracker *trk = ok ? mr_tracker_create(&tp, err) : NULL;
     ok = ok && trk;
     const int margin = 48 * p.width / 640 + 8, scale = 2;
-    mr_camera wide = cam;
-    wide.width += 2 * margin;
-    wide.height += 2 * margin;
-    wide.cx += margin;
-    wide.cy += margin;
-    memset(wide.dist, 0, sizeof wide.dist);
+    mr_camera wide = mr_demo_wide_camera(&cam, margin);
     mr_image ideal[16];
     memset(ideal, 0, sizeof ideal);
     mr_rng rng;

@@ -143,3 +143,13 @@ bool mr_demo_camera_frame(const mr_camera *cam, const mr_image *ideal, int n, in
     free(tmp);
     return true;
 }
+
+mr_camera mr_demo_wide_camera(const mr_camera *cam, int margin) {
+    mr_camera wide = *cam;
+    wide.width += 2 * margin;
+    wide.height += 2 * margin;
+    wide.cx += margin;
+    wide.cy += margin;
+    memset(wide.dist, 0, sizeof wide.dist);
+    return wide;
+}

@@ -211,6 +211,10 @@ mr_view mr_demo_view(int i);
  * from rng). */
 bool mr_demo_camera_frame(const mr_camera *cam, const mr_image *ideal, int n, int margin, int scale, double gain,
                           double noise, mr_rng *rng, mr_image *out, mr_error *err);
+/* The pinhole camera the ideal renders for mr_demo_camera_frame use: cam
+ * grown by `margin` px per side, without distortion (render it at `scale`
+ * times its size). */
+mr_camera mr_demo_wide_camera(const mr_camera *cam, int margin);
 
 /* The synthetic calibration board (demo_board.c): tag36h11 ids
  * MR_DEMO_BOARD_FIRST_ID.. in a COLS x ROWS grid on a plane; board frame =
