@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "mr_core.h"
 
@@ -26,6 +27,22 @@ static inline int mr_test_finish(const char *name) {
     return mr_test_failures ? 1 : 0;
 }
 #define MR_TEST_SKIP 77
+
+/* An empty scratch folder $MR_TEST_TMP/name (default /tmp/mrcheck-test/name)
+ * into out; false (with a message) if it cannot be made. */
+static inline bool mr_test_fresh_dir(const char *name, char *out, size_t n) {
+    const char *t = getenv("MR_TEST_TMP");
+    snprintf(out, n, "%s/%s", t ? t : "/tmp/mrcheck-test", name);
+    char cmd[4200];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", out);
+    mr_error err;
+    memset(&err, 0, sizeof err);
+    if (system(cmd) != 0 || !mr_mkdirs(out, &err)) {
+        fprintf(stderr, "%s: cannot make a fresh folder: %s\n", out, err.msg);
+        return false;
+    }
+    return true;
+}
 
 /* Under AddressSanitizer no shared library is unloaded in a test. Mesa's GL
  * driver (swrast_dri.so, dlopen'ed through libglvnd) keeps ~240 bytes in its

@@ -232,16 +232,7 @@ static int test_recording(void) {
 }
 
 int main(void) {
-    const char *t = getenv("MR_TEST_TMP");
-    snprintf(g_tmp, sizeof g_tmp, "%s/test_synth", t ? t : "/tmp/mrcheck-test");
-    char cmd[1200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_tmp);
-    if (system(cmd) != 0) return 1;
-    mr_error err = {0};
-    if (!mr_mkdirs(g_tmp, &err)) {
-        fprintf(stderr, "%s\n", err.msg);
-        return 1;
-    }
+    if (!mr_test_fresh_dir("test_synth", g_tmp, sizeof g_tmp)) return 1;
     test_board();
     test_calibration_set();
     int rc = test_recording();
