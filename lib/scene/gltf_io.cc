@@ -711,6 +711,30 @@ struct JsonGuard {
     ~JsonGuard() { cJSON_Delete(j); }
 };
 
+// "demo": "planned" | "built": the procedural demo hall (with its tag
+// plates), built in memory, so the shipped configs work on a fresh clone
+// without the files `mrcheck demo` writes. The hall marks its pipes and
+// trays hidden itself; the config's globs hide more (a node whose name or an
+// ancestor's name matches).
+mr_scene *demo_scene(const cJSON *d, const char *path, const std::vector<std::string> &globs) {
+    bool built = cJSON_IsString(d) && std::strcmp(d->valuestring, "built") == 0;
+    if (!built && !(cJSON_IsString(d) && std::strcmp(d->valuestring, "planned") == 0))
+        fail(MR_ERR_INVALID, "%s: 'demo' must be \"planned\" or \"built\"", path);
+    mr_demo_hall hall;
+    mr_error e;
+    if (!mr_demo_build_tagged(nullptr, 0, &hall, &e)) throw Fail{e.code, e.msg};
+    mr_scene *s = built ? hall.built : hall.planned;
+    (built ? hall.built : hall.planned) = nullptr;
+    mr_demo_free(&hall);
+    for (int32_t i = 0; i < s->node_count; i++) {
+        mr_node &n = s->nodes[i];
+        bool hide = n.parent >= 0 && n.parent < i && s->nodes[n.parent].layer == MR_LAYER_HIDDEN;
+        for (const std::string &g : globs) hide = hide || mr_glob_match(g.c_str(), n.name);
+        if (hide) n.layer = MR_LAYER_HIDDEN;
+    }
+    return s;
+}
+
 mr_scene *load_config(const cJSON *cfg, const char *path, const mr_scene_params *params,
                       std::vector<std::string> globs) {
     const cJSON *hidden = cJSON_GetObjectItemCaseSensitive(cfg, "hidden");
@@ -752,10 +776,15 @@ mr_scene *load_config(const cJSON *cfg, const char *path, const mr_scene_params 
         if (ambient < 0 || ambient > 1) fail(MR_ERR_INVALID, "%s: 'ambient' must be in [0,1]", path);
     }
     const cJSON *g = cJSON_GetObjectItemCaseSensitive(cfg, "gltf");
-    char dir[4096], gpath[4096];
-    mr_path_dir(path, dir, sizeof dir);
-    mr_path_join(dir, g->valuestring, gpath, sizeof gpath);
-    mr_scene *s = load_path(gpath, params, globs, false);  // throws with the glTF's own message
+    mr_scene *s;
+    if (cJSON_IsString(g)) {
+        char dir[4096], gpath[4096];
+        mr_path_dir(path, dir, sizeof dir);
+        mr_path_join(dir, g->valuestring, gpath, sizeof gpath);
+        s = load_path(gpath, params, globs, false);  // throws with the glTF's own message
+    } else {
+        s = demo_scene(cJSON_GetObjectItemCaseSensitive(cfg, "demo"), path, globs);
+    }
     std::memcpy(s->lights, lights, sizeof lights);
     s->light_count = nlights;
     if (ambient >= 0) s->ambient = (float)ambient;
@@ -788,7 +817,7 @@ mr_scene *load_path(const char *path, const mr_scene_params *params, const std::
             const cJSON *g = cJSON_GetObjectItemCaseSensitive(j.j, "gltf");
             if (cJSON_GetObjectItemCaseSensitive(j.j, "asset")) {
                 s = load_memory(data, size, dir, params, extra_globs, path);
-            } else if (cJSON_IsString(g)) {
+            } else if (cJSON_IsString(g) || cJSON_GetObjectItemCaseSensitive(j.j, "demo")) {
                 if (!allow_config) fail(MR_ERR_INVALID, "%s: a scene config cannot point to another scene config", path);
                 s = load_config(j.j, path, params, extra_globs);
             } else {
