@@ -5,9 +5,9 @@
  *
  * Wiring only: the controller (lib/view: modes, settings, key map, layout,
  * scripts) takes the window's events and says what to do; this file opens
- * the window, starts capture (view_capture.c, threads) and carries the
+ * the window, starts capture (lib/session/capture.c, threads) and carries the
  * actions out: renders with lib/render, writes snapshots and annotations. */
-#include "view.h"
+#include "app.h"
 
 #include "mr_session.h"
 #include "mr_ui.h"
@@ -47,13 +47,13 @@ typedef struct view_app {
     char scene_msg[600];
     mr_scene_loader *loader; /* the scene loads on a thread; the window stays live meanwhile */
     /* frames */
-    vw_capture *cap;
-    vw_frame frame;
+    mr_capture *cap;
+    mr_capture_frame frame;
     bool have_frame;
     /* marks and snapshots */
     mr_pick mark_pick;
     double mark_px, mark_py;       /* camera image pixel (ideal pinhole) */
-    vw_frame mark_frame;           /* the frame the mark was made on */
+    mr_capture_frame mark_frame;           /* the frame the mark was made on */
     mr_image mark_screen;
     bool mark_grab_screen, snap_request;
     char session_dir[4096];
@@ -76,7 +76,7 @@ typedef struct view_app {
     int64_t fps_frames;
 } view_app;
 
-static cJSON *pose_json(const vw_frame *f) {
+static cJSON *pose_json(const mr_capture_frame *f) {
     cJSON *p = cJSON_CreateObject();
     cJSON_AddBoolToObject(p, "valid", f->pose_valid);
     cJSON_AddItemToObject(p, "world_from_camera", mr_json_from_dmat4(&f->pose));
@@ -87,7 +87,7 @@ static cJSON *pose_json(const vw_frame *f) {
 
 /* snapshots/<stem>_screen.png, <stem>_frame.png, <stem>.json, each written
  * atomically; rel gets the three paths relative to the session folder. */
-static bool write_snapshot(view_app *a, const char *stem, const mr_image *screen, const vw_frame *f, cJSON *rel,
+static bool write_snapshot(view_app *a, const char *stem, const mr_image *screen, const mr_capture_frame *f, cJSON *rel,
                            mr_error *err) {
     char dir[4096], path[8192], name[256];
     mr_path_join(a->session_dir, "snapshots", dir, sizeof dir);
@@ -159,7 +159,7 @@ static void begin_mark(view_app *a, double x, double y) {
     /* Store the pixel in the camera's own resolution (ideal pinhole). */
     a->mark_px = (u + 0.5) * a->camera.width / a->rw - 0.5;
     a->mark_py = (v + 0.5) * a->camera.height / a->rh - 0.5;
-    vw_frame_free(&a->mark_frame);
+    mr_capture_frame_free(&a->mark_frame);
     a->mark_frame = a->frame;
     memset(&a->mark_frame.image, 0, sizeof a->mark_frame.image);
     if (a->frame.image.data && mr_image_alloc(&a->mark_frame.image, a->frame.image.width, a->frame.image.height,
@@ -206,7 +206,7 @@ static void finish_mark(view_app *a, int note) {
     if (note < 0 || note >= MR_VIEW_NOTE_COUNT) {
         mr_viewer_toast(a->vc, "mark cancelled");
         mr_image_free(&a->mark_screen);
-        vw_frame_free(&a->mark_frame);
+        mr_capture_frame_free(&a->mark_frame);
         return;
     }
     mr_error err = {0};
@@ -224,7 +224,7 @@ static void finish_mark(view_app *a, int note) {
     /* The line goes out even if the snapshot failed: the mark matters more. */
     mr_error aerr = {0};
     const mr_scene *sc = a->scene;
-    if (!mr_mkdirs(a->session_dir, &aerr) || !vw_append_line(path, line, &aerr))
+    if (!mr_mkdirs(a->session_dir, &aerr) || !mr_annotation_append(path, line, &aerr))
         mr_viewer_toast(a->vc, "MARK NOT SAVED: %s", aerr.msg);
     else if (!ok) mr_viewer_toast(a->vc, "mark %d saved (snapshot failed: %s)", a->mark_count, err.msg);
     else
@@ -233,16 +233,16 @@ static void finish_mark(view_app *a, int note) {
                         a->mark_pick.node >= 0 && sc ? sc->nodes[a->mark_pick.node].name : "");
     cJSON_Delete(line);
     mr_image_free(&a->mark_screen);
-    vw_frame_free(&a->mark_frame);
+    mr_capture_frame_free(&a->mark_frame);
 }
 
 static void set_frozen(view_app *a, bool on) {
-    if (a->cap) vw_capture_freeze(a->cap, on);
+    if (a->cap) mr_capture_freeze(a->cap, on);
 }
 
 /* Carries out what the controller asked for. */
 static void carry_out(view_app *a, const mr_view_actions *acts) {
-    bool seekable = a->cap && vw_capture_seekable(a->cap);
+    bool seekable = a->cap && mr_capture_seekable(a->cap);
     for (int i = 0; i < acts->count; i++) {
         const mr_view_action *x = &acts->a[i];
         switch (x->type) {
@@ -252,10 +252,10 @@ static void carry_out(view_app *a, const mr_view_actions *acts) {
         case MR_VA_SNAPSHOT: a->snap_request = true; break;
         case MR_VA_MARK_AT: begin_mark(a, x->x, x->y); break;
         case MR_VA_MARK_FINISH: finish_mark(a, (int)x->i); break;
-        case MR_VA_PLAY: if (seekable) vw_capture_play(a->cap, x->on); break;
-        case MR_VA_STEP: if (seekable) vw_capture_step(a->cap, (int)x->i); break;
-        case MR_VA_SEEK: if (a->cap) vw_capture_seek(a->cap, x->i); break;
-        case MR_VA_RATE: if (a->cap) vw_capture_rate(a->cap, x->x); break;
+        case MR_VA_PLAY: if (seekable) mr_capture_play(a->cap, x->on); break;
+        case MR_VA_STEP: if (seekable) mr_capture_step(a->cap, (int)x->i); break;
+        case MR_VA_SEEK: if (a->cap) mr_capture_seek(a->cap, x->i); break;
+        case MR_VA_RATE: if (a->cap) mr_capture_rate(a->cap, x->x); break;
         case MR_VA_FULLSCREEN: mr_window_set_fullscreen(a->win, !mr_window_fullscreen(a->win)); break;
         case MR_VA_RESIZE: mr_window_set_size(a->win, (int)x->x, (int)x->y); break;
         case MR_VA_SHOT: snprintf(a->shot_path, sizeof a->shot_path, "%s", x->path); break;
@@ -318,8 +318,8 @@ static double mean_abs_diff(const mr_image *x, const mr_image *y) {
     return n ? s / (double)n : 0;
 }
 
-static const char *source_state_name(vw_state st) {
-    return st == VW_RUNNING ? "running" : st == VW_NO_CAMERA ? "no_camera" : st == VW_ENDED ? "ended" : "starting";
+static const char *source_state_name(mr_capture_status st) {
+    return st == MR_CAPTURE_RUNNING ? "running" : st == MR_CAPTURE_NO_CAMERA ? "no_camera" : st == MR_CAPTURE_ENDED ? "ended" : "starting";
 }
 
 /* `state` in a script: what a test needs to check, as JSON: the
@@ -332,7 +332,7 @@ static void write_state(view_app *a, const mr_image *screen) {
     cJSON_AddNumberToObject(j, "marks", a->mark_count);
     cJSON_AddNumberToObject(j, "snapshots", a->snap_count);
     char msg[512] = "";
-    vw_state st = a->cap ? vw_capture_state(a->cap, msg, sizeof msg) : VW_STARTING;
+    mr_capture_status st = a->cap ? mr_capture_state(a->cap, msg, sizeof msg) : MR_CAPTURE_STARTING;
     cJSON_AddStringToObject(j, "source_state", source_state_name(st));
     cJSON_AddStringToObject(j, "source_message", msg);
     cJSON_AddStringToObject(j, "scene_message", a->scene_msg);
@@ -419,11 +419,11 @@ static mr_viewer_frame frame_info(view_app *a, char *state_msg, size_t n) {
     f.count = a->frame.count;
     f.tags_seen = a->frame.tags_seen;
     f.rms_px = a->frame.rms_px;
-    f.seekable = a->cap && vw_capture_seekable(a->cap);
-    f.playing = f.seekable && vw_capture_playing(a->cap);
+    f.seekable = a->cap && mr_capture_seekable(a->cap);
+    f.playing = f.seekable && mr_capture_playing(a->cap);
     f.source_desc = a->source_desc;
-    vw_state st = a->cap ? vw_capture_state(a->cap, state_msg, n) : VW_STARTING;
-    f.source_msg = st == VW_NO_CAMERA ? state_msg : NULL;
+    mr_capture_status st = a->cap ? mr_capture_state(a->cap, state_msg, n) : MR_CAPTURE_STARTING;
+    f.source_msg = st == MR_CAPTURE_NO_CAMERA ? state_msg : NULL;
     f.scene_msg = a->scene_msg;
     f.have_image = a->have_res;
     f.image_rect = a->image_rect;
@@ -445,7 +445,7 @@ static void frame_tick(view_app *a) {
     if (a->fb_w <= 0 || a->fb_h <= 0) return; /* minimised */
 
     uint64_t old_seq = a->frame.seq;
-    if (a->cap && !mr_viewer_frozen(a->vc) && !mr_viewer_note_is_open(a->vc) && vw_capture_latest(a->cap, &a->frame)) {
+    if (a->cap && !mr_viewer_frozen(a->vc) && !mr_viewer_note_is_open(a->vc) && mr_capture_latest(a->cap, &a->frame)) {
         /* Newest wins: frames that arrived while we were busy are skipped. */
         if (old_seq > 0 && a->frame.seq > old_seq + 1) a->frames_skipped += (int64_t)(a->frame.seq - old_seq - 1);
         a->have_frame = true;
@@ -497,7 +497,7 @@ static void print_stats(view_app *a) {
     double wall = mr_time_now() - a->t_start;
     int64_t nread = 0, ntracked = 0, ndropped = 0;
     double track_sum = 0;
-    if (a->cap) vw_capture_counts(a->cap, &nread, &ntracked, &ndropped, &track_sum);
+    if (a->cap) mr_capture_counts(a->cap, &nread, &ntracked, &ndropped, &track_sum);
     int64_t nf = a->frames_drawn > 0 ? a->frames_drawn : 1;
     printf("mrcheck view --stats: %lld frames drawn in %.1f s (%.1f fps), %lld 3D renders; "
            "%lld camera frames read, %lld tracked, newest wins: %lld skipped before tracking, %lld before drawing\n",
@@ -624,7 +624,7 @@ static int open_window(view_app *a, const app_opt *opts, int ww, int wh, int ao,
 
 static int start_capture(view_app *a, const app_opt *opts, const char *input, const char *replay) {
     mr_error err = {0};
-    vw_capture_params cp = {0};
+    mr_capture_params cp = {0};
     cp.input = input;
     cp.replay_dir = replay;
     cp.camera = &a->camera;
@@ -635,10 +635,10 @@ static int start_capture(view_app *a, const app_opt *opts, const char *input, co
     if (cp.retrack && !a->have_markers) return app_errorf(k_cmd, "--retrack needs a marker map");
     cp.wake = wake_window;
     cp.wake_ctx = a->win;
-    a->cap = vw_capture_start(&cp, &err);
+    a->cap = mr_capture_start(&cp, &err);
     if (!a->cap) return app_error(k_cmd, &err);
-    vw_capture_rate(a->cap, mr_view_rates[mr_viewer_settings(a->vc)->rate_i]);
-    if (app_flag(opts, "paused")) vw_capture_play(a->cap, false);
+    mr_capture_rate(a->cap, mr_view_rates[mr_viewer_settings(a->vc)->rate_i]);
+    if (app_flag(opts, "paused")) mr_capture_play(a->cap, false);
     return 0;
 }
 
@@ -744,9 +744,9 @@ done:
         mr_error ignored = {0};
         a->scene = mr_scene_loader_finish(&a->loader, &ignored); /* waits for the thread */
     }
-    vw_capture_stop(&a->cap);
-    vw_frame_free(&a->frame);
-    vw_frame_free(&a->mark_frame);
+    mr_capture_stop(&a->cap);
+    mr_capture_frame_free(&a->frame);
+    mr_capture_frame_free(&a->mark_frame);
     mr_image_free(&a->mark_screen);
     mr_frame_result_free(&a->res);
     mr_viewer_destroy(&a->vc);

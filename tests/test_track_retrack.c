@@ -9,7 +9,7 @@
  * exactly the lines app_pose_line makes of these results (cJSON prints
  * doubles to ~1e-15, not bit for bit, so the bits are compared in
  * process). The view side is the
- * view's own capture code, app/view_capture.c, compiled into this test:
+ * view's own capture code, lib/session/capture.c (mr_capture_*):
  * its replay reader and tracking thread run with --retrack's parameters
  * (the recording's camera and marker map, as cmd_view.c passes them), and
  * the test steps through the recording one frame at a time, waiting for
@@ -18,7 +18,6 @@
  * RMS and filtered pose must be the same doubles. */
 #include "app_track.h"
 #include "mr_test.h"
-#include "view.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -111,9 +110,9 @@ static char *run_track(const char *mrcheck, const char *dir) {
 }
 
 /* Waits (up to 20 s) for the capture to publish frame `index`. */
-static bool wait_frame(vw_capture *c, vw_frame *f, int64_t index) {
+static bool wait_frame(mr_capture *c, mr_capture_frame *f, int64_t index) {
     for (int k = 0; k < 4000; k++) {
-        if (vw_capture_latest(c, f) && f->index == index) return true;
+        if (mr_capture_latest(c, f) && f->index == index) return true;
         struct timespec ts = {0, 5000000};
         nanosleep(&ts, NULL);
     }
@@ -143,23 +142,23 @@ static void compare(const char *dir, const char *mrcheck, bool with_cli, const c
     }
     free(printed);
 
-    vw_capture_params cp = {0};
+    mr_capture_params cp = {0};
     cp.replay_dir = dir;
     cp.camera = &rec->camera;
     cp.markers = &rec->markers;
     cp.retrack = true;
     cp.start_paused = true;
-    vw_capture *c = vw_capture_start(&cp, &err);
+    mr_capture *c = mr_capture_start(&cp, &err);
     CHECK_MSG(c != NULL, "%s: view capture did not start: %s", what, err.msg);
     if (!c) {
         mr_recording_close(&rec);
         return;
     }
-    vw_frame f;
+    mr_capture_frame f;
     memset(&f, 0, sizeof f);
     int valid = 0, same = 0, first_bad = -1;
     for (int i = 0; i < nframes; i++) {
-        if (i > 0) vw_capture_step(c, 1);
+        if (i > 0) mr_capture_step(c, 1);
         bool got = wait_frame(c, &f, i);
         CHECK_MSG(got, "%s: the view's capture never delivered frame %d", what, i);
         if (!got) break;
@@ -183,9 +182,9 @@ static void compare(const char *dir, const char *mrcheck, bool with_cli, const c
     }
     int64_t read = 0, tracked = 0, dropped = 0;
     double ms = 0;
-    vw_capture_counts(c, &read, &tracked, &dropped, &ms);
-    vw_frame_free(&f);
-    vw_capture_stop(&c);
+    mr_capture_counts(c, &read, &tracked, &dropped, &ms);
+    mr_capture_frame_free(&f);
+    mr_capture_stop(&c);
     CHECK_MSG(dropped == 0 && tracked == nframes, "%s: the view tracked %lld frames and dropped %lld (want %d, 0)", what,
               (long long)tracked, (long long)dropped, nframes);
     CHECK_MSG(valid >= nframes / 2, "%s: only %d of %d frames have a pose: not a meaningful comparison", what, valid,

@@ -233,6 +233,72 @@ bool mr_annotations_parse(const char *text, size_t size, mr_annotations *out, mr
 bool mr_annotations_load(const char *path, mr_annotations *out, mr_error *err);
 void mr_annotations_free(mr_annotations *a); /* zeroes it */
 
+/* -------------------------------------------------------------- capture
+ * capture.c: `mrcheck view`'s capture and tracking off the render thread.
+ * A reader thread (live source, or a recording replayed with mr_replay) and
+ * a tracker thread (mr_tracker), with a one-frame mailbox each, newest frame
+ * wins; the render thread only swaps pointers. */
+
+/* One camera frame as the render thread gets it. */
+typedef struct mr_capture_frame {
+    mr_image image;           /* raw (distorted) camera frame, 8-bit, owned */
+    double timestamp;         /* seconds, source clock */
+    int64_t index;            /* frame number in the source */
+    int64_t count;            /* frames in the source, -1 if unknown (live) */
+    bool pose_valid;          /* tracking found a pose in this frame */
+    bool have_pose;           /* pose holds this or an earlier good pose */
+    mr_dmat4 pose;            /* filtered world_from_camera */
+    int tags_seen, tags_used;
+    double rms_px;            /* reprojection RMS of the pose, pixels */
+    double track_ms;          /* detection + pose + filter for this frame */
+    uint64_t seq;             /* increases with every published frame */
+} mr_capture_frame;
+
+typedef enum mr_capture_status {
+    MR_CAPTURE_STARTING = 0,
+    MR_CAPTURE_RUNNING,
+    MR_CAPTURE_NO_CAMERA,             /* cannot open the input; retrying */
+    MR_CAPTURE_ENDED,                 /* the video or recording ran out */
+} mr_capture_status;
+
+typedef struct mr_capture_params {
+    const char *input;        /* /dev/videoN, a video file, an image or a folder */
+    const char *replay_dir;   /* or a recording folder (frames/ + poses) */
+    const mr_camera *camera;  /* intrinsics of the raw frames (required) */
+    const mr_marker_map *markers; /* for tracking; NULL: poses must come from
+                                     the recording or fixed_pose */
+    const mr_dmat4 *fixed_pose; /* a still with a known view: no tracking */
+    bool retrack;             /* replay: detect and solve again instead of
+                                 using the recorded poses */
+    bool start_paused;        /* replay: start paused on the first frame
+                                 (nothing is read past it until asked) */
+    double retry_s;           /* between attempts to reopen a lost camera */
+    void (*wake)(void *ctx);  /* called after a new frame is published */
+    void *wake_ctx;
+} mr_capture_params;
+
+typedef struct mr_capture mr_capture;
+
+mr_capture *mr_capture_start(const mr_capture_params *p, mr_error *err);
+void mr_capture_stop(mr_capture **c);
+/* Swaps in the newest frame if it is newer than f->seq (f->image is reused).
+ * Returns true if f changed. */
+bool mr_capture_latest(mr_capture *c, mr_capture_frame *f);
+void mr_capture_frame_free(mr_capture_frame *f);
+mr_capture_status mr_capture_state(mr_capture *c, char *msg, size_t n);
+bool mr_capture_seekable(mr_capture *c);   /* replay: seek, step, rate */
+/* Replay controls (ignored for live input). */
+void mr_capture_play(mr_capture *c, bool playing);
+bool mr_capture_playing(mr_capture *c);
+void mr_capture_step(mr_capture *c, int delta);
+void mr_capture_seek(mr_capture *c, int64_t index);
+void mr_capture_rate(mr_capture *c, double rate);
+/* Freeze: the reader pauses (replay) and the pose filter holds its pose. */
+void mr_capture_freeze(mr_capture *c, bool frozen);
+/* Totals for --stats: frames read, frames tracked, frames dropped because a
+ * newer one arrived first (newest wins), tracking time sum in ms. */
+void mr_capture_counts(mr_capture *c, int64_t *read, int64_t *tracked, int64_t *dropped, double *track_ms_sum);
+
 #ifdef __cplusplus
 }
 #endif
