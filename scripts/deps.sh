@@ -9,6 +9,7 @@ pkgs=(
   libglfw3-dev xvfb xauth xdotool fonts-dejavu-core
   libembree-dev
   libopencv-dev libopencv-contrib-dev
+  libceres-dev libzip-dev
 )
 missing=()
 for p in "${pkgs[@]}"; do
