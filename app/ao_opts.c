@@ -4,32 +4,32 @@
  * truth (whose params live in lib/eval). */
 #include "app.h"
 
-bool app_ao_check(const char *cmd, const app_table *t, const app_opt *opts, bool *groundtruth, mr_gt_params *gt) {
+bool app_ao_check(const char *cmd, const mr_cli_table *t, const mr_cli_opt *opts, bool *groundtruth, mr_gt_params *gt) {
     mr_ao_params *ao = t->params;
-    bool mode_named = app_table_given(t, "radius-mode");
+    bool mode_named = mr_cli_table_given(t, "radius-mode");
     *groundtruth = t->extra_given;
     if (*groundtruth) ao->method = MR_AO_NONE;
-    if (app_table_given(t, "radius")) {
+    if (mr_cli_table_given(t, "radius")) {
         /* In screen mode the radius is a fraction of the image, not a length:
          * silently ignoring a length would hide a mistake. */
         if (mode_named && ao->radius_mode == MR_AO_RADIUS_SCREEN)
-            return app_errorf(cmd, "--ao-radius is a length for --ao-radius-mode view; screen mode takes --ao-screen-radius"),
+            return mr_cli_errorf(cmd, "--ao-radius is a length for --ao-radius-mode view; screen mode takes --ao-screen-radius"),
                    false;
         /* A radius in scene units asks for the constant one unless the mode is named. */
         if (!mode_named) ao->radius_mode = MR_AO_RADIUS_VIEW;
     }
-    if (ao->r_min > ao->r_max) return app_errorf(cmd, "--ao-rmin must not exceed --ao-rmax"), false;
+    if (ao->r_min > ao->r_max) return mr_cli_errorf(cmd, "--ao-rmin must not exceed --ao-rmax"), false;
     /* Only the standalone mask has a strength of its own: silently ignoring
      * it elsewhere would hide a mistake. */
-    if (app_table_given(t, "mask-strength") && ao->mask != MR_AO_MASK_STANDALONE)
-        return app_errorf(cmd, "--ao-mask-strength applies to --ao-mask standalone only"), false;
+    if (mr_cli_table_given(t, "mask-strength") && ao->mask != MR_AO_MASK_STANDALONE)
+        return mr_cli_errorf(cmd, "--ao-mask-strength applies to --ao-mask standalone only"), false;
     gt->radius_mode = ao->radius_mode;
     gt->radius = ao->radius;
     gt->screen_radius = ao->screen_radius;
-    const char *v = app_get(opts, "ao-rays");
+    const char *v = mr_cli_get(opts, "ao-rays");
     long l;
     if (v) {
-        if (!app_int("ao-rays", v, 1, 1 << 20, &l)) return false;
+        if (!mr_cli_int("ao-rays", v, 1, 1 << 20, &l)) return false;
         gt->rays = (int)l;
     }
     /* Ground truth defaults to the fixed radius unless a mode is named. */

@@ -8,61 +8,6 @@
 #include "mr_render.h"
 #include "mr_scene.h"
 
-/* A declared option table: name, whether it takes a value, help text. */
-typedef struct app_opt {
-    const char *name;   /* without the leading "--" */
-    const char *arg;    /* value placeholder, or NULL for a flag */
-    const char *help;
-    const char *value;  /* filled by app_parse: the value, "1" for a set flag, or NULL */
-} app_opt;
-
-/* A params struct whose option table is spliced into a command's options:
- * --PREFIX (the table's "" row) and --PREFIX-KEY for each other row, with
- * their help lines made from the table. Values are checked and written into
- * params (which holds its defaults) after the whole line was read, so that
- * --help always wins. */
-#define APP_TABLE_MAX 32
-typedef struct app_table {
-    const char *prefix;       /* "ao", "ghost" */
-    const mr_opt *table;      /* at most APP_TABLE_MAX rows */
-    void *params;
-    const char *extra;        /* one more value --PREFIX accepts beyond the table's
-                                 names (--ao groundtruth), or NULL */
-    bool extra_given;         /* filled: --PREFIX EXTRA was given */
-    const char *values[APP_TABLE_MAX]; /* filled: the text given for each row, or NULL */
-} app_table;
-/* True if the row `key` of t was on the command line. */
-bool app_table_given(const app_table *t, const char *key);
-/* app_parse with tables: rows of opts first, then each table's rows. */
-bool app_parse_tables(int argc, char **argv, int first, app_opt *opts, app_table *tables, int ntables,
-                      const char **pos, int max_pos, int *npos, const char *usage, bool *help_shown);
-/* Parses argv[first..argc) into opts (terminated by a NULL name); positional
- * arguments go to *pos (up to max_pos). --help prints usage and returns 0 via
- * *done. Returns false (after printing one line) on a bad argument. */
-bool app_parse(int argc, char **argv, int first, app_opt *opts, const char **pos, int max_pos, int *npos,
-               const char *usage, bool *help_shown);
-const char *app_get(const app_opt *opts, const char *name);
-bool app_flag(const app_opt *opts, const char *name);
-/* Number parsing with range checks; print one line and return false on error. */
-bool app_double(const char *opt, const char *s, double lo, double hi, double *out);
-bool app_int(const char *opt, const char *s, long lo, long hi, long *out);
-bool app_size(const char *opt, const char *s, int *w, int *h);
-/* Exit status of a command that found no GPU device, GL context or display
- * (MR_ERR_NODEVICE): EX_UNAVAILABLE of sysexits.h. Tests skip on this status
- * only, never on the text of a message. */
-#define APP_EXIT_NODEVICE 69
-/* Prints "mrcheck: <cmd>: <message>" on stderr and returns 1, or
- * APP_EXIT_NODEVICE for MR_ERR_NODEVICE. */
-int app_error(const char *cmd, const mr_error *err);
-int app_errorf(const char *cmd, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-/* Sets the log level from --verbose / --quiet. */
-void app_log_level(const app_opt *opts);
-
-
 /* A headless GPU, a renderer and (optionally) a scene set on it. */
 typedef struct app_gfx {
     mr_gpu *gpu;
@@ -80,7 +25,7 @@ void app_gfx_close(app_gfx *g);
  * only in view mode, --ao-rmin <= --ao-rmax, --ao-mask-strength only for the
  * standalone mask), --ao groundtruth and --ao-rays into gt; prints one line
  * and returns false on a bad value. */
-bool app_ao_check(const char *cmd, const app_table *t, const app_opt *opts, bool *groundtruth, mr_gt_params *gt);
+bool app_ao_check(const char *cmd, const mr_cli_table *t, const mr_cli_opt *opts, bool *groundtruth, mr_gt_params *gt);
 
 /* Writes what --aux asks for: depth.pfm, normal.pfm, ao.pfm into dir. */
 bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err);
@@ -120,10 +65,10 @@ mr_lod *app_load_lod(const mr_scene *s, const char *scene_path, bool use_cache, 
 /* Reads --cull --batch --instancing --lod --occlusion (on|off),
  * --lod-tolerance and --lod-pixels; prints one line and returns false on a
  * bad value. */
-bool app_draw_params(const app_opt *opts, mr_draw_params *dp);
+bool app_draw_params(const mr_cli_opt *opts, mr_draw_params *dp);
 /* --lod auto (the default): levels only for scenes that draw at least
  * APP_LOD_AUTO_TRIANGLES, where simplifying pays for its one-off cost. */
-bool app_lod_auto(const app_opt *opts);
+bool app_lod_auto(const mr_cli_opt *opts);
 #define APP_LOD_AUTO_TRIANGLES 500000u
 #define APP_DRAW_OPTS                                                                                          \
     {"cull", "on|off", "BVH frustum culling (default on)", NULL},                                              \

@@ -22,7 +22,7 @@
 
 /* The detector rows (--decimate, --threads, --refine-edges, --sharpening)
  * from mr_detector_opts, parsed into *dp (an mr_detector_params holding its
- * defaults) by app_parse_tables. */
+ * defaults) by mr_cli_parse_tables. */
 #define APP_TRACK_TABLE(dp) {"", mr_detector_opts, (dp), NULL, false, {0}}
 
 /* A command's tracker: the one mr_tracker (lib/track) set up from the
@@ -39,14 +39,14 @@ typedef struct app_tracker {
 mr_source *app_open_input(const char *uri, bool gray, mr_recording **rec_info, mr_error *err);
 /* The same with --size/--fps/--pixel-format from opts (false: a bad value,
  * already reported; *src NULL + err: the input could not be opened). */
-bool app_open_input_opts(const char *cmd, const app_opt *opts, bool gray, mr_recording **rec_info, mr_source **src,
+bool app_open_input_opts(const char *cmd, const mr_cli_opt *opts, bool gray, mr_recording **rec_info, mr_source **src,
                          mr_error *err);
 
 /* Sets up the tracker from the options and the detector params parsed from
  * APP_TRACK_TABLE (--family fills in its family); rec (may be NULL)
  * supplies the camera and markers by default. Prints one line and returns
  * false on error. */
-bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, const mr_detector_params *dp,
+bool app_tracker_init(app_tracker *t, const char *cmd, const mr_cli_opt *opts, const mr_detector_params *dp,
                       const mr_recording *rec);
 void app_tracker_free(app_tracker *t);
 

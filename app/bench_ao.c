@@ -7,7 +7,7 @@
 
 int bench_ao(int argc, char **argv) {
     static const char *cmd = "bench ao";
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"scene", "FILE", "glTF/GLB or scene config (default: the demo hall as planned)", NULL},
         {"views", "V.json", "a reported view; more view files may follow as plain arguments (default: the demo "
                             "hall's near, mid-hall and far views)", NULL},
@@ -26,47 +26,47 @@ int bench_ao(int argc, char **argv) {
     const char *pos[MAX_VIEWS];
     int npos = 0;
     bool help;
-    if (!app_parse(argc, argv, 3, opts, pos, MAX_VIEWS - 1, &npos,
+    if (!mr_cli_parse(argc, argv, 3, opts, pos, MAX_VIEWS - 1, &npos,
                    "usage: mrcheck bench ao [--scene S] [--views V1.json [V2.json ...]] [--tune-view T.json] [--size WxH] [--out DIR]",
                    &help))
         return 2;
     if (help) return 0;
-    app_log_level(opts);
+    mr_cli_log_level(opts);
     mr_bench_ao_params p = {MR_BENCH_AO_DEFAULTS};
     long frames = p.frames, rays = p.rays;
-    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &p.width, &p.height)) return 2;
-    if (app_get(opts, "frames") && !app_int("frames", app_get(opts, "frames"), 1, 64, &frames)) return 2;
-    if (app_get(opts, "rays") && !app_int("rays", app_get(opts, "rays"), 1, 1 << 20, &rays)) return 2;
-    if (app_get(opts, "radius") && !app_double("radius", app_get(opts, "radius"), 1e-30, 1e30, &p.radius)) return 2;
-    if (app_get(opts, "screen-radius") && !app_double("screen-radius", app_get(opts, "screen-radius"), 1e-4, 1, &p.screen_radius))
+    if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &p.width, &p.height)) return 2;
+    if (mr_cli_get(opts, "frames") && !mr_cli_int("frames", mr_cli_get(opts, "frames"), 1, 64, &frames)) return 2;
+    if (mr_cli_get(opts, "rays") && !mr_cli_int("rays", mr_cli_get(opts, "rays"), 1, 1 << 20, &rays)) return 2;
+    if (mr_cli_get(opts, "radius") && !mr_cli_double("radius", mr_cli_get(opts, "radius"), 1e-30, 1e30, &p.radius)) return 2;
+    if (mr_cli_get(opts, "screen-radius") && !mr_cli_double("screen-radius", mr_cli_get(opts, "screen-radius"), 1e-4, 1, &p.screen_radius))
         return 2;
-    if (npos > 0 && !app_get(opts, "views")) return app_errorf(cmd, "view files given without --views"), 2;
-    if (app_get(opts, "out")) p.out_dir = app_get(opts, "out");
-    p.scene = app_get(opts, "scene");
+    if (npos > 0 && !mr_cli_get(opts, "views")) return mr_cli_errorf(cmd, "view files given without --views"), 2;
+    if (mr_cli_get(opts, "out")) p.out_dir = mr_cli_get(opts, "out");
+    p.scene = mr_cli_get(opts, "scene");
     p.frames = (int)frames;
     p.rays = (int)rays;
-    p.quick = app_flag(opts, "quick");
-    p.verbose = app_flag(opts, "verbose");
-    p.progress = !app_flag(opts, "quiet");
+    p.quick = mr_cli_flag(opts, "quick");
+    p.verbose = mr_cli_flag(opts, "verbose");
+    p.progress = !mr_cli_flag(opts, "quiet");
     p.out = stdout;
     mr_error err = {0};
     mr_view tune, views[MAX_VIEWS];
     const char *names[MAX_VIEWS];
-    if (app_get(opts, "tune-view")) {
-        if (!mr_view_load(app_get(opts, "tune-view"), &tune, &err)) return app_error(cmd, &err);
+    if (mr_cli_get(opts, "tune-view")) {
+        if (!mr_view_load(mr_cli_get(opts, "tune-view"), &tune, &err)) return mr_cli_error(cmd, &err);
         p.tune_view = &tune;
-        p.tune_name = app_get(opts, "tune-view");
+        p.tune_name = mr_cli_get(opts, "tune-view");
     }
-    if (app_get(opts, "views")) {
-        names[p.view_count++] = app_get(opts, "views");
+    if (mr_cli_get(opts, "views")) {
+        names[p.view_count++] = mr_cli_get(opts, "views");
         for (int i = 0; i < npos; i++) names[p.view_count++] = pos[i];
         for (int i = 0; i < p.view_count; i++)
-            if (!mr_view_load(names[i], &views[i], &err)) return app_error(cmd, &err);
+            if (!mr_view_load(names[i], &views[i], &err)) return mr_cli_error(cmd, &err);
         p.views = views;
         p.view_names = names;
     }
     app_gfx g;
     bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_ao(&p, &err);
     app_gfx_close(&g);
-    return ok ? 0 : app_error(cmd, &err);
+    return ok ? 0 : mr_cli_error(cmd, &err);
 }

@@ -26,7 +26,7 @@ static int parse_sizes(const char *spec, double *out, int max) {
 
 int bench_scene(int argc, char **argv) {
     static const char *cmd = "bench scene";
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"out", "DIR", "write bench_scene.csv, bench_scene.svg and the scenes there (default bench-out)", NULL},
         {"sizes", "LIST", "drawn-triangle targets (default 1M,5M,20M)", NULL},
         {"size", "WxH", "frame size (default 1024x768)", NULL},
@@ -36,19 +36,19 @@ int bench_scene(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     bool help;
-    if (!app_parse(argc, argv, 3, opts, NULL, 0, NULL,
+    if (!mr_cli_parse(argc, argv, 3, opts, NULL, 0, NULL,
                    "usage: mrcheck bench scene [--out DIR] [--sizes 1M,5M,20M] [--size WxH] [--frames N]", &help))
         return 2;
     if (help) return 0;
-    app_log_level(opts);
-    const char *out_dir = app_get(opts, "out") ? app_get(opts, "out") : "bench-out";
+    mr_cli_log_level(opts);
+    const char *out_dir = mr_cli_get(opts, "out") ? mr_cli_get(opts, "out") : "bench-out";
     mr_bench_scene_params p = {MR_BENCH_SCENE_DEFAULTS};
-    int nsizes = parse_sizes(app_get(opts, "sizes") ? app_get(opts, "sizes") : "1M,5M,20M", p.sizes, MR_BENCH_SCENE_MAX_SIZES);
-    if (nsizes <= 0) return app_errorf(cmd, "--sizes must be a list like 1M,5M,20M (10k..1000M each)"), 2;
+    int nsizes = parse_sizes(mr_cli_get(opts, "sizes") ? mr_cli_get(opts, "sizes") : "1M,5M,20M", p.sizes, MR_BENCH_SCENE_MAX_SIZES);
+    if (nsizes <= 0) return mr_cli_errorf(cmd, "--sizes must be a list like 1M,5M,20M (10k..1000M each)"), 2;
     int w = 1024, h = 768;
     long frames = 3;
-    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &w, &h)) return 2;
-    if (app_get(opts, "frames") && !app_int("frames", app_get(opts, "frames"), 1, 1000, &frames)) return 2;
+    if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &w, &h)) return 2;
+    if (mr_cli_get(opts, "frames") && !mr_cli_int("frames", mr_cli_get(opts, "frames"), 1, 1000, &frames)) return 2;
     p.out_dir = out_dir;
     p.size_count = nsizes;
     p.width = w;
@@ -59,5 +59,5 @@ int bench_scene(int argc, char **argv) {
     app_gfx g;
     bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_scene(&p, &err);
     app_gfx_close(&g);
-    return ok ? 0 : app_error(cmd, &err);
+    return ok ? 0 : mr_cli_error(cmd, &err);
 }

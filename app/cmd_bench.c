@@ -15,7 +15,7 @@ bool app_bench_gpu(app_gfx *g, mr_bench_gpu *out, mr_error *err) {
 
 static int bench_frame(int argc, char **argv) {
     static const char *cmd = "bench frame";
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"scene", "FILE", "glTF/GLB or scene config (default: the demo hall as planned)", NULL},
         {"view", "VIEW.json", "view (default: the demo's first viewpoint)", NULL},
         {"size", "WxH", "output size (default 1024x768)", NULL},
@@ -28,35 +28,35 @@ static int bench_frame(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     bool help;
-    if (!app_parse(argc, argv, 3, opts, NULL, 0, NULL, "usage: mrcheck bench frame [--scene S] [--view V] [--size WxH] [--frames N] [--out DIR]", &help))
+    if (!mr_cli_parse(argc, argv, 3, opts, NULL, 0, NULL, "usage: mrcheck bench frame [--scene S] [--view V] [--size WxH] [--frames N] [--out DIR]", &help))
         return 2;
     if (help) return 0;
-    app_log_level(opts);
+    mr_cli_log_level(opts);
     mr_bench_frame_params p = {MR_BENCH_FRAME_DEFAULTS};
     long frames = p.frames;
-    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &p.width, &p.height)) return 2;
-    if (app_get(opts, "frames") && !app_int("frames", app_get(opts, "frames"), 1, 100000, &frames)) return 2;
-    if (app_get(opts, "out")) p.out_dir = app_get(opts, "out");
+    if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &p.width, &p.height)) return 2;
+    if (mr_cli_get(opts, "frames") && !mr_cli_int("frames", mr_cli_get(opts, "frames"), 1, 100000, &frames)) return 2;
+    if (mr_cli_get(opts, "out")) p.out_dir = mr_cli_get(opts, "out");
     p.frames = (int)frames;
-    p.scene = app_get(opts, "scene");
-    p.no_video = app_flag(opts, "no-video");
+    p.scene = mr_cli_get(opts, "scene");
+    p.no_video = mr_cli_flag(opts, "no-video");
     p.out = stdout;
     mr_error err = {0};
     mr_view view;
-    if (app_get(opts, "view")) {
-        if (!mr_view_load(app_get(opts, "view"), &view, &err)) return app_error(cmd, &err);
+    if (mr_cli_get(opts, "view")) {
+        if (!mr_view_load(mr_cli_get(opts, "view"), &view, &err)) return mr_cli_error(cmd, &err);
         p.view = &view;
     }
     mr_image video = {0};
-    if (app_get(opts, "video")) {
-        if (!mr_image_load(app_get(opts, "video"), 3, &video, &err)) return app_error(cmd, &err);
+    if (mr_cli_get(opts, "video")) {
+        if (!mr_image_load(mr_cli_get(opts, "video"), 3, &video, &err)) return mr_cli_error(cmd, &err);
         p.video = &video;
     }
     app_gfx g;
     bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_frame(&p, &err);
     app_gfx_close(&g);
     mr_image_free(&video);
-    return ok ? 0 : app_error(cmd, &err);
+    return ok ? 0 : mr_cli_error(cmd, &err);
 }
 
 int cmd_bench(int argc, char **argv) {

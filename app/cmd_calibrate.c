@@ -7,7 +7,7 @@
 
 int cmd_calibrate(int argc, char **argv) {
     static const char *cmd = "calibrate";
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"images", "DIR", "folder of board images (png, jpg, ...)", NULL},
         {"board", "BOARD.json", "the board as a marker map: tag poses in the board frame (z = 0 plane)", NULL},
         {"out", "CAMERA.json", "camera file to write", NULL},
@@ -17,29 +17,29 @@ int cmd_calibrate(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     bool help;
-    if (!app_parse(argc, argv, 2, opts, NULL, 0, NULL,
+    if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
                    "usage: mrcheck calibrate --images DIR --board BOARD.json --out CAMERA.json\n"
                    "Detects the board's AprilTags in every image and calibrates fx fy cx cy and k1 k2 p1 p2\n"
                    "(k3 = 0) with OpenCV; prints the RMS reprojection error.",
                    &help))
         return 2;
     if (help) return 0;
-    app_log_level(opts);
-    const char *dir = app_get(opts, "images"), *board = app_get(opts, "board"), *out = app_get(opts, "out");
-    if (!dir || !board || !out) return app_errorf(cmd, "--images, --board and --out are required (see --help)"), 2;
+    mr_cli_log_level(opts);
+    const char *dir = mr_cli_get(opts, "images"), *board = mr_cli_get(opts, "board"), *out = mr_cli_get(opts, "out");
+    if (!dir || !board || !out) return mr_cli_errorf(cmd, "--images, --board and --out are required (see --help)"), 2;
     long min_tags = 4;
-    if (app_get(opts, "min-tags") && !app_int("min-tags", app_get(opts, "min-tags"), 1, 10000, &min_tags)) return 2;
+    if (mr_cli_get(opts, "min-tags") && !mr_cli_int("min-tags", mr_cli_get(opts, "min-tags"), 1, 10000, &min_tags)) return 2;
 
     mr_error err = {0};
     mr_marker_map map;
-    if (!mr_marker_map_load(board, &map, &err)) return app_error(cmd, &err);
+    if (!mr_marker_map_load(board, &map, &err)) return mr_cli_error(cmd, &err);
     for (int i = 0; i < map.count; i++) {
         mr_dvec3 c[4];
         mr_marker_corners_world(&map, &map.tags[i], c);
         for (int k = 0; k < 4; k++)
             if (fabs(c[k].z) > 1e-9 * (1 + map.tag_size)) {
                 mr_marker_map_free(&map);
-                return app_errorf(cmd, "%s: the board must be planar (all tags in the z = 0 plane)", board);
+                return mr_cli_errorf(cmd, "%s: the board must be planar (all tags in the z = 0 plane)", board);
             }
     }
     mr_source_params sp = MR_SOURCE_DEFAULTS;
@@ -52,7 +52,7 @@ int cmd_calibrate(int argc, char **argv) {
     if (!det) {
         mr_source_close(&src);
         mr_marker_map_free(&map);
-        return app_error(cmd, &err);
+        return mr_cli_error(cmd, &err);
     }
     int cap = 0, nv = 0, width = 0, height = 0, skipped = 0;
     mr_calib_view *views = NULL;
@@ -154,5 +154,5 @@ int cmd_calibrate(int argc, char **argv) {
     mr_detector_destroy(&det);
     mr_source_close(&src);
     mr_marker_map_free(&map);
-    return ok ? 0 : app_error(cmd, &err);
+    return ok ? 0 : mr_cli_error(cmd, &err);
 }

@@ -150,18 +150,18 @@ static bool run_demo(const char *dir, mr_error *err) {
 }
 
 int cmd_demo(int argc, char **argv) {
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"out", "DIR", "output folder (default: demo-out)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
     bool help;
-    if (!app_parse(argc, argv, 2, opts, NULL, 0, NULL, "usage: mrcheck demo [--out DIR]", &help)) return 2;
+    if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL, "usage: mrcheck demo [--out DIR]", &help)) return 2;
     if (help) return 0;
-    app_log_level(opts);
-    const char *dir = app_get(opts, "out") ? app_get(opts, "out") : "demo-out";
+    mr_cli_log_level(opts);
+    const char *dir = mr_cli_get(opts, "out") ? mr_cli_get(opts, "out") : "demo-out";
     mr_error err = {0};
-    if (!run_demo(dir, &err)) return app_error("demo", &err);
+    if (!run_demo(dir, &err)) return mr_cli_error("demo", &err);
     return 0;
 }

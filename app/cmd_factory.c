@@ -19,7 +19,7 @@ static bool parse_count(const char *s, uint64_t *out) {
 
 int cmd_factory(int argc, char **argv) {
     static const char *cmd = "factory";
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"out", "FILE.glb", "output scene (required)", NULL},
         {"triangles", "N", "drawn triangles to aim for, e.g. 1M, 5M, 20M (default 1M)", NULL},
         {"halls", "N", "number of halls instead (about 0.8M triangles and 2300 nodes each)", NULL},
@@ -31,42 +31,42 @@ int cmd_factory(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     bool help;
-    if (!app_parse(argc, argv, 2, opts, NULL, 0, NULL,
+    if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
                    "usage: mrcheck factory --out FILE.glb [--triangles N | --halls N] [--seed S] [--views DIR]", &help))
         return 2;
     if (help) return 0;
-    app_log_level(opts);
-    const char *out = app_get(opts, "out");
-    if (!out) return app_errorf(cmd, "--out is required"), 2;
+    mr_cli_log_level(opts);
+    const char *out = mr_cli_get(opts, "out");
+    if (!out) return mr_cli_errorf(cmd, "--out is required"), 2;
     mr_synth_params sp = MR_SYNTH_DEFAULTS;
-    if (app_get(opts, "halls") && app_get(opts, "triangles")) return app_errorf(cmd, "give --halls or --triangles, not both"), 2;
-    if (app_get(opts, "halls")) {
+    if (mr_cli_get(opts, "halls") && mr_cli_get(opts, "triangles")) return mr_cli_errorf(cmd, "give --halls or --triangles, not both"), 2;
+    if (mr_cli_get(opts, "halls")) {
         long h;
-        if (!app_int("halls", app_get(opts, "halls"), 1, 4096, &h)) return 2;
+        if (!mr_cli_int("halls", mr_cli_get(opts, "halls"), 1, 4096, &h)) return 2;
         sp.halls = (int)h;
     } else {
         uint64_t tri = 1000000;
-        if (app_get(opts, "triangles") && !parse_count(app_get(opts, "triangles"), &tri))
-            return app_errorf(cmd, "--triangles: '%s' is not a count like 5M", app_get(opts, "triangles")), 2;
+        if (mr_cli_get(opts, "triangles") && !parse_count(mr_cli_get(opts, "triangles"), &tri))
+            return mr_cli_errorf(cmd, "--triangles: '%s' is not a count like 5M", mr_cli_get(opts, "triangles")), 2;
         sp.halls = mr_synth_halls_for(tri);
     }
-    if (app_get(opts, "seed")) {
+    if (mr_cli_get(opts, "seed")) {
         long seed;
-        if (!app_int("seed", app_get(opts, "seed"), 0, 2147483647L, &seed)) return 2;
+        if (!mr_cli_int("seed", mr_cli_get(opts, "seed"), 0, 2147483647L, &seed)) return 2;
         sp.seed = (uint64_t)seed;
     }
-    if (app_get(opts, "offset")) {
+    if (mr_cli_get(opts, "offset")) {
         char *e1 = NULL, *e2 = NULL;
-        const char *v = app_get(opts, "offset");
+        const char *v = mr_cli_get(opts, "offset");
         sp.origin[0] = strtod(v, &e1);
         if (e1 == v || *e1 != ',' || (sp.origin[2] = strtod(e1 + 1, &e2), e2 == e1 + 1 || *e2) || !isfinite(sp.origin[0]) ||
             !isfinite(sp.origin[2]) || fabs(sp.origin[0]) > 1e9 || fabs(sp.origin[2]) > 1e9)
-            return app_errorf(cmd, "--offset must be X,Z (finite, |v| <= 1e9)"), 2;
+            return mr_cli_errorf(cmd, "--offset must be X,Z (finite, |v| <= 1e9)"), 2;
     }
     mr_error err = {0};
     double t0 = mr_time_now();
     mr_scene *s = mr_synth_build(&sp, &err);
-    if (!s) return app_error(cmd, &err);
+    if (!s) return mr_cli_error(cmd, &err);
     uint64_t uniq = 0;
     for (int32_t i = 0; i < s->mesh_count; i++) uniq += s->meshes[i].index_count / 3;
     printf("factory: %d halls, %d nodes, %d meshes, %llu triangles drawn (%llu stored), built in %.2f s\n", sp.halls,
@@ -76,7 +76,7 @@ int cmd_factory(int argc, char **argv) {
     mr_path_dir(out, dir, sizeof dir);
     bool ok = mr_mkdirs(dir, &err) && mr_scene_save_glb(s, out, &err);
     mr_scene_destroy(&s);
-    const char *views = app_get(opts, "views");
+    const char *views = mr_cli_get(opts, "views");
     static const char *const names[MR_SYNTH_VIEW_COUNT] = {"floor", "aisle", "overview"};
     for (int v = 0; ok && views && v < MR_SYNTH_VIEW_COUNT; v++) {
         char path[4096], file[64];
@@ -91,7 +91,7 @@ int cmd_factory(int argc, char **argv) {
         ok = ok && j && mr_json_save(path, j, &err);
         cJSON_Delete(j);
     }
-    if (!ok) return app_error(cmd, &err);
+    if (!ok) return mr_cli_error(cmd, &err);
     printf("wrote %s%s%s\n", out, views ? " and views in " : "", views ? views : "");
     return 0;
 }

@@ -15,7 +15,7 @@ static void sleep_until(double t_target) {
 
 int cmd_record(int argc, char **argv) {
     static const char *cmd = "record";
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"input", "DEV|VIDEO", "/dev/videoN, a video file, images, or a recording", NULL},
         {"out", "DIR", "recording folder to create (an existing recording is never overwritten)", NULL},
         APP_TRACK_OPTS,
@@ -29,29 +29,29 @@ int cmd_record(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_detector_params dp = MR_DETECTOR_DEFAULTS;
-    app_table tables[] = {APP_TRACK_TABLE(&dp)};
+    mr_cli_table tables[] = {APP_TRACK_TABLE(&dp)};
     bool help;
-    if (!app_parse_tables(argc, argv, 2, opts, tables, 1, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 1, NULL, 0, NULL,
                    "usage: mrcheck record --input /dev/videoN|VIDEO --camera C --markers M --out DIR\n"
                    "Writes meta.json, frames/NNNNNN.jpg and frames.jsonl (detections, raw and filtered pose,\n"
                    "quality) as it goes; every line is flushed and synced, so a crash loses at most one frame.",
                    &help))
         return 2;
     if (help) return 0;
-    app_log_level(opts);
-    const char *input = app_get(opts, "input"), *out = app_get(opts, "out");
-    if (!input || !out) return app_errorf(cmd, "--input and --out are required (see --help)"), 2;
+    mr_cli_log_level(opts);
+    const char *input = mr_cli_get(opts, "input"), *out = mr_cli_get(opts, "out");
+    if (!input || !out) return mr_cli_errorf(cmd, "--input and --out are required (see --help)"), 2;
     long max_frames = -1, q = 90;
     double rate = 0;
-    if (app_get(opts, "max-frames") && !app_int("max-frames", app_get(opts, "max-frames"), 1, 1L << 40, &max_frames)) return 2;
-    if (app_get(opts, "rate") && !app_double("rate", app_get(opts, "rate"), 0.01, 10000, &rate)) return 2;
-    if (app_get(opts, "jpeg") && !app_int("jpeg", app_get(opts, "jpeg"), 1, 100, &q)) return 2;
+    if (mr_cli_get(opts, "max-frames") && !mr_cli_int("max-frames", mr_cli_get(opts, "max-frames"), 1, 1L << 40, &max_frames)) return 2;
+    if (mr_cli_get(opts, "rate") && !mr_cli_double("rate", mr_cli_get(opts, "rate"), 0.01, 10000, &rate)) return 2;
+    if (mr_cli_get(opts, "jpeg") && !mr_cli_int("jpeg", mr_cli_get(opts, "jpeg"), 1, 100, &q)) return 2;
 
     mr_error err = {0};
     mr_recording *rec_in = NULL;
     mr_source *src = NULL;
-    if (!app_open_input_opts(cmd, opts, app_flag(opts, "gray"), &rec_in, &src, &err)) return 2;
-    if (!src) return app_error(cmd, &err);
+    if (!app_open_input_opts(cmd, opts, mr_cli_flag(opts, "gray"), &rec_in, &src, &err)) return 2;
+    if (!src) return mr_cli_error(cmd, &err);
     app_tracker t;
     bool ok = app_tracker_init(&t, cmd, opts, &dp, rec_in);
     mr_recording_close(&rec_in);
@@ -62,19 +62,19 @@ int cmd_record(int argc, char **argv) {
     if (!t.has_camera || !t.has_markers) {
         app_tracker_free(&t);
         mr_source_close(&src);
-        return app_errorf(cmd, "--camera and --markers are required (unless the input is a recording)");
+        return mr_cli_errorf(cmd, "--camera and --markers are required (unless the input is a recording)");
     }
     mr_recorder_params rp = MR_RECORDER_DEFAULTS;
     rp.camera = t.camera;
     rp.markers = t.markers;
     rp.source = input;
     rp.jpeg_quality = (int)q;
-    rp.frame_ext = app_flag(opts, "png") ? ".png" : ".jpg";
+    rp.frame_ext = mr_cli_flag(opts, "png") ? ".png" : ".jpg";
     mr_recorder *rec = mr_recorder_create(out, &rp, &err);
     if (!rec) {
         app_tracker_free(&t);
         mr_source_close(&src);
-        return app_error(cmd, &err);
+        return mr_cli_error(cmd, &err);
     }
     app_catch_signals();
     int rc = 0;
@@ -85,7 +85,7 @@ int cmd_record(int argc, char **argv) {
         mr_read_status st = mr_source_read(src, &f, &err);
         if (st == MR_READ_END) break;
         if (st == MR_READ_ERROR) {
-            rc = app_error(cmd, &err);
+            rc = mr_cli_error(cmd, &err);
             break;
         }
         if (frames == 0) t_first = f.timestamp;
@@ -106,7 +106,7 @@ int cmd_record(int argc, char **argv) {
             fprintf(stderr, "mrcheck: record: warning: frame %lld: %s\n", (long long)f.index, fe.msg);
         }
         if (!mr_recorder_append(rec, &fr, &f.image, &err)) {
-            rc = app_error(cmd, &err);
+            rc = mr_cli_error(cmd, &err);
             break;
         }
         frames++;

@@ -68,7 +68,7 @@ static bool render_groundtruth(mr_renderer *r, const mr_scene *scene, const mr_v
 
 int cmd_render(int argc, char **argv) {
     static const char *cmd = "render";
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"scene", "FILE", "glTF/GLB file or scene config JSON (required)", NULL},
         {"view", "VIEW.json", "camera + world_from_camera (required)", NULL},
         {"out", "OUT.png", "output image (required)", NULL},
@@ -86,29 +86,29 @@ int cmd_render(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_frame_params fp = MR_FRAME_DEFAULTS;
-    app_table tables[] = {APP_AO_TABLE(&fp.ao), APP_GHOST_TABLE(&fp.ghost)};
+    mr_cli_table tables[] = {APP_AO_TABLE(&fp.ao), APP_GHOST_TABLE(&fp.ghost)};
     bool help;
-    if (!app_parse_tables(argc, argv, 2, opts, tables, 2, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 2, NULL, 0, NULL,
                    "usage: mrcheck render --scene FILE --view VIEW.json --out OUT.png [--size WxH] "
                    "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive]",
                    &help))
         return 2;
     if (help) return 0;
-    app_log_level(opts);
-    const char *scene_path = app_get(opts, "scene"), *view_path = app_get(opts, "view"), *out = app_get(opts, "out");
-    if (!scene_path || !view_path || !out) return app_errorf(cmd, "--scene, --view and --out are required"), 2;
+    mr_cli_log_level(opts);
+    const char *scene_path = mr_cli_get(opts, "scene"), *view_path = mr_cli_get(opts, "view"), *out = mr_cli_get(opts, "out");
+    if (!scene_path || !view_path || !out) return mr_cli_errorf(cmd, "--scene, --view and --out are required"), 2;
 
-    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &fp.width, &fp.height)) return 2;
+    if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &fp.width, &fp.height)) return 2;
     double alpha = 0.5;
-    if (app_get(opts, "alpha") && !app_double("alpha", app_get(opts, "alpha"), 0, 1, &alpha)) return 2;
+    if (mr_cli_get(opts, "alpha") && !mr_cli_double("alpha", mr_cli_get(opts, "alpha"), 0, 1, &alpha)) return 2;
     fp.alpha = (float)alpha;
-    fp.hide_hidden_layer = app_flag(opts, "hide-hidden");
+    fp.hide_hidden_layer = mr_cli_flag(opts, "hide-hidden");
     mr_draw_params dp;
     if (!app_draw_params(opts, &dp)) return 2;
-    const char *lod_cache = app_get(opts, "lod-cache");
+    const char *lod_cache = mr_cli_get(opts, "lod-cache");
     if (lod_cache && strcmp(lod_cache, "on") != 0 && strcmp(lod_cache, "off") != 0)
-        return app_errorf(cmd, "--lod-cache must be 'on' or 'off'"), 2;
-    const char *aux = app_get(opts, "aux");
+        return mr_cli_errorf(cmd, "--lod-cache must be 'on' or 'off'"), 2;
+    const char *aux = mr_cli_get(opts, "aux");
     fp.want_depth = fp.want_normals = aux != NULL;
     bool groundtruth = false;
     mr_gt_params gtp = MR_GT_DEFAULTS;
@@ -119,42 +119,42 @@ int cmd_render(int argc, char **argv) {
      * bad input never costs a context. */
     mr_error err = {0};
     mr_view view;
-    if (!mr_view_load(view_path, &view, &err)) return app_error(cmd, &err);
+    if (!mr_view_load(view_path, &view, &err)) return mr_cli_error(cmd, &err);
     mr_image video = {0};
-    if (app_get(opts, "video")) {
-        if (!mr_image_load(app_get(opts, "video"), 3, &video, &err)) return app_error(cmd, &err);
+    if (mr_cli_get(opts, "video")) {
+        if (!mr_image_load(mr_cli_get(opts, "video"), 3, &video, &err)) return mr_cli_error(cmd, &err);
         fp.video = &video;
     }
-    const char *globs[1] = {app_get(opts, "hidden")};
+    const char *globs[1] = {mr_cli_get(opts, "hidden")};
     mr_scene_params sp = MR_SCENE_DEFAULTS;
     sp.hidden_globs = globs;
     sp.hidden_glob_count = globs[0] ? 1 : 0;
     mr_scene *scene = app_load_scene(scene_path, &sp, NULL, &err);
     if (!scene) {
         mr_image_free(&video);
-        return app_error(cmd, &err);
+        return mr_cli_error(cmd, &err);
     }
     mr_lod *lod = NULL;
     if (app_lod_auto(opts) && mr_scene_triangle_count(scene) < APP_LOD_AUTO_TRIANGLES) dp.no_lod = true;
     if (!dp.no_lod && !(lod = app_load_lod(scene, scene->source, !lod_cache || strcmp(lod_cache, "on") == 0, &err))) {
         mr_scene_destroy(&scene);
         mr_image_free(&video);
-        return app_error(cmd, &err);
+        return mr_cli_error(cmd, &err);
     }
 
     int rc = 0;
     app_gfx gfx;
     mr_frame_result res = {0};
     if (!app_gfx_open(&gfx, &err)) {
-        rc = app_error(cmd, &err);
+        rc = mr_cli_error(cmd, &err);
     } else {
         if (!mr_renderer_set_draw_params(gfx.renderer, &dp, &err) || !mr_renderer_set_scene(gfx.renderer, scene, &err) ||
             !mr_renderer_set_lod(gfx.renderer, lod, &err) || !mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||
             (groundtruth && !render_groundtruth(gfx.renderer, scene, &view, &fp, &gtp, &res, &err)))
-            rc = app_error(cmd, &err);
+            rc = mr_cli_error(cmd, &err);
         else if (!mr_image_save_png(out, &res.color, &err) || (aux && !app_write_aux(aux, &res, &err)))
-            rc = app_error(cmd, &err);
-        if (rc == 0 && app_flag(opts, "verbose")) {
+            rc = mr_cli_error(cmd, &err);
+        if (rc == 0 && mr_cli_flag(opts, "verbose")) {
             char passes[256];
             mr_frame_result_passes(&res, passes, sizeof passes);
             fprintf(stderr, "mrcheck: render: passes: %s; %u draw calls, %llu triangles, near plane %g\n", passes,

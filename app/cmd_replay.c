@@ -9,7 +9,7 @@
 
 int cmd_replay(int argc, char **argv) {
     static const char *cmd = "replay";
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"scene", "S", "glTF/GLB or scene config of the plan (required)", NULL},
         {"out", "OUTDIR", "where overlay_NNNNNN.png and replay.jsonl go (required)", NULL},
         {"alpha", "A", "video transparency: 0 = virtual only, 1 = video only (default 0.5)", NULL},
@@ -27,35 +27,35 @@ int cmd_replay(int argc, char **argv) {
     int npos = 0;
     /* Depth cues as on render: the same option tables and checks. */
     mr_frame_params base = MR_FRAME_DEFAULTS;
-    app_table tables[] = {APP_AO_TABLE(&base.ao), APP_GHOST_TABLE(&base.ghost)};
+    mr_cli_table tables[] = {APP_AO_TABLE(&base.ao), APP_GHOST_TABLE(&base.ghost)};
     bool help;
-    if (!app_parse_tables(argc, argv, 2, opts, tables, 2, pos, 1, &npos,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 2, pos, 1, &npos,
                    "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] [--raw] "
                    "[--video F.avi] [--ao METHOD ...] [--ghost MODE ...]",
                    &help))
         return 2;
     if (help) return 0;
-    app_log_level(opts);
-    if (npos != 1 || !app_get(opts, "scene") || !app_get(opts, "out"))
-        return app_errorf(cmd, "needs a recording folder, --scene and --out (see --help)"), 2;
+    mr_cli_log_level(opts);
+    if (npos != 1 || !mr_cli_get(opts, "scene") || !mr_cli_get(opts, "out"))
+        return mr_cli_errorf(cmd, "needs a recording folder, --scene and --out (see --help)"), 2;
     double alpha = 0.5;
     long every = 1, from = 0, to = -1;
-    if (app_get(opts, "alpha") && !app_double("alpha", app_get(opts, "alpha"), 0, 1, &alpha)) return 2;
-    if (app_get(opts, "every") && !app_int("every", app_get(opts, "every"), 1, 1L << 30, &every)) return 2;
-    if (app_get(opts, "from") && !app_int("from", app_get(opts, "from"), 0, 1L << 40, &from)) return 2;
-    if (app_get(opts, "to") && !app_int("to", app_get(opts, "to"), 0, 1L << 40, &to)) return 2;
-    if (to >= 0 && to < from) return app_errorf(cmd, "--to %ld is before --from %ld", to, from), 2;
-    const char *out = app_get(opts, "out");
-    bool raw = app_flag(opts, "raw");
+    if (mr_cli_get(opts, "alpha") && !mr_cli_double("alpha", mr_cli_get(opts, "alpha"), 0, 1, &alpha)) return 2;
+    if (mr_cli_get(opts, "every") && !mr_cli_int("every", mr_cli_get(opts, "every"), 1, 1L << 30, &every)) return 2;
+    if (mr_cli_get(opts, "from") && !mr_cli_int("from", mr_cli_get(opts, "from"), 0, 1L << 40, &from)) return 2;
+    if (mr_cli_get(opts, "to") && !mr_cli_int("to", mr_cli_get(opts, "to"), 0, 1L << 40, &to)) return 2;
+    if (to >= 0 && to < from) return mr_cli_errorf(cmd, "--to %ld is before --from %ld", to, from), 2;
+    const char *out = mr_cli_get(opts, "out");
+    bool raw = mr_cli_flag(opts, "raw");
     bool groundtruth = false;
     mr_gt_params gtp = MR_GT_DEFAULTS;
     if (!app_ao_check(cmd, &tables[0], opts, &groundtruth, &gtp)) return 2;
-    if (groundtruth) return app_errorf(cmd, "--ao groundtruth is for single frames (mrcheck render), not replays"), 2;
+    if (groundtruth) return mr_cli_errorf(cmd, "--ao groundtruth is for single frames (mrcheck render), not replays"), 2;
 
     mr_error err = {0};
     mr_recording *rec = mr_recording_open(pos[0], &err);
-    if (!rec) return app_error(cmd, &err);
-    mr_scene *scene = mr_scene_load(app_get(opts, "scene"), NULL, &err);
+    if (!rec) return mr_cli_error(cmd, &err);
+    mr_scene *scene = mr_scene_load(mr_cli_get(opts, "scene"), NULL, &err);
     app_gfx gfx = {0};
     bool ok = scene && mr_mkdirs(out, &err) && app_gfx_open(&gfx, &err) && mr_renderer_set_scene(gfx.renderer, scene, &err);
     cJSON *log = cJSON_CreateArray();
@@ -94,15 +94,15 @@ int cmd_replay(int argc, char **argv) {
             fp.alpha = (float)alpha;
             mr_frame_result res;
             ok = mr_render_frame(gfx.renderer, &view, &fp, &res, &err) && mr_image_save_png(path, &res.color, &err);
-            if (ok && app_get(opts, "video") && !vw) vw = mr_video_writer_open(app_get(opts, "video"), res.color.width, res.color.height, fps, &err);
-            if (ok && app_get(opts, "video")) ok = vw && mr_video_writer_add(vw, &res.color, &err);
+            if (ok && mr_cli_get(opts, "video") && !vw) vw = mr_video_writer_open(mr_cli_get(opts, "video"), res.color.width, res.color.height, fps, &err);
+            if (ok && mr_cli_get(opts, "video")) ok = vw && mr_video_writer_add(vw, &res.color, &err);
             if (ok) mr_frame_result_free(&res);
             rendered++;
         } else {
             /* No pose: the camera frame alone keeps the sequence complete. */
             ok = mr_image_save_png(path, &img, &err);
-            if (ok && app_get(opts, "video") && !vw) vw = mr_video_writer_open(app_get(opts, "video"), img.width, img.height, fps, &err);
-            if (ok && app_get(opts, "video")) ok = vw && mr_video_writer_add(vw, &img, &err);
+            if (ok && mr_cli_get(opts, "video") && !vw) vw = mr_video_writer_open(mr_cli_get(opts, "video"), img.width, img.height, fps, &err);
+            if (ok && mr_cli_get(opts, "video")) ok = vw && mr_video_writer_add(vw, &img, &err);
             plain++;
         }
         mr_image_free(&img);
@@ -148,7 +148,7 @@ int cmd_replay(int argc, char **argv) {
     app_gfx_close(&gfx);
     mr_scene_destroy(&scene);
     mr_recording_close(&rec);
-    if (!ok) return app_error(cmd, &err);
+    if (!ok) return mr_cli_error(cmd, &err);
     printf("replayed %d frames to %s/: %d overlays, %d without a pose (camera frame only)\n", rendered + plain, out,
            rendered, plain);
     return 0;

@@ -26,7 +26,7 @@ static bool sb_add(strbuf *b, const char *s) {
 
 int cmd_track(int argc, char **argv) {
     static const char *cmd = "track";
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"input", "PATH", "recording folder, /dev/videoN, video file, image or folder of images", NULL},
         APP_TRACK_OPTS,
         {"out", "POSES.jsonl", "write one pose line per frame there (written when the run ends)", NULL},
@@ -37,9 +37,9 @@ int cmd_track(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_detector_params dp = MR_DETECTOR_DEFAULTS;
-    app_table tables[] = {APP_TRACK_TABLE(&dp)};
+    mr_cli_table tables[] = {APP_TRACK_TABLE(&dp)};
     bool help;
-    if (!app_parse_tables(argc, argv, 2, opts, tables, 1, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 1, NULL, 0, NULL,
                    "usage: mrcheck track --input PATH|/dev/videoN [--camera C] [--markers M] [--family F] [--decimate D]\n"
                    "                     [--threads N] [--refine-edges 0|1] [--out poses.jsonl] [--print-detections]\n"
                    "Detects AprilTags per frame (corners in pixels, OpenCV convention: centre of the top-left pixel\n"
@@ -47,20 +47,20 @@ int cmd_track(int argc, char **argv) {
                    &help))
         return 2;
     if (help) return 0;
-    app_log_level(opts);
-    const char *input = app_get(opts, "input");
-    if (!input) return app_errorf(cmd, "--input is required (see --help)"), 2;
+    mr_cli_log_level(opts);
+    const char *input = mr_cli_get(opts, "input");
+    if (!input) return mr_cli_errorf(cmd, "--input is required (see --help)"), 2;
     long max_frames = -1;
-    if (app_get(opts, "max-frames") && !app_int("max-frames", app_get(opts, "max-frames"), 1, 1L << 40, &max_frames))
+    if (mr_cli_get(opts, "max-frames") && !mr_cli_int("max-frames", mr_cli_get(opts, "max-frames"), 1, 1L << 40, &max_frames))
         return 2;
-    const char *out = app_get(opts, "out");
-    bool print_det = app_flag(opts, "print-detections");
+    const char *out = mr_cli_get(opts, "out");
+    bool print_det = mr_cli_flag(opts, "print-detections");
 
     mr_error err = {0};
     mr_recording *rec = NULL;
     mr_source *src = NULL;
     if (!app_open_input_opts(cmd, opts, true, &rec, &src, &err)) return 2;
-    if (!src) return app_error(cmd, &err);
+    if (!src) return mr_cli_error(cmd, &err);
     app_tracker t;
     bool ok = app_tracker_init(&t, cmd, opts, &dp, rec);
     mr_recording_close(&rec);
@@ -72,7 +72,7 @@ int cmd_track(int argc, char **argv) {
     if (out && !want_pose) {
         app_tracker_free(&t);
         mr_source_close(&src);
-        return app_errorf(cmd, "--out needs --camera and --markers (or a recording as input)");
+        return mr_cli_errorf(cmd, "--out needs --camera and --markers (or a recording as input)");
     }
     app_catch_signals();
     strbuf poses = {0};
@@ -86,7 +86,7 @@ int cmd_track(int argc, char **argv) {
         mr_read_status st = mr_source_read(src, &f, &err);
         if (st == MR_READ_END) break;
         if (st == MR_READ_ERROR) {
-            rc = app_error(cmd, &err);
+            rc = mr_cli_error(cmd, &err);
             break;
         }
         frames++;
@@ -122,7 +122,7 @@ int cmd_track(int argc, char **argv) {
             cJSON_Delete(o);
             if (!s || (out && !sb_add(&poses, s))) {
                 free(s);
-                rc = app_errorf(cmd, "out of memory");
+                rc = mr_cli_errorf(cmd, "out of memory");
                 break;
             }
             if (!out && !print_det) puts(s);
@@ -130,10 +130,10 @@ int cmd_track(int argc, char **argv) {
         }
         fflush(stdout);
     }
-    if (rc == 0 && frames == 0) rc = app_errorf(cmd, "%s: no frames", input);
+    if (rc == 0 && frames == 0) rc = mr_cli_errorf(cmd, "%s: no frames", input);
     else if (rc == 0 && failed == frames)
-        rc = app_errorf(cmd, "no frame could be processed (%ld failed; %s)", failed, held[0] ? held : "see above");
-    if (rc == 0 && out && !mr_file_write_atomic(out, poses.s ? poses.s : "", poses.len, &err)) rc = app_error(cmd, &err);
+        rc = mr_cli_errorf(cmd, "no frame could be processed (%ld failed; %s)", failed, held[0] ? held : "see above");
+    if (rc == 0 && out && !mr_file_write_atomic(out, poses.s ? poses.s : "", poses.len, &err)) rc = mr_cli_error(cmd, &err);
     if (rc == 0 && mr_log_get_level() >= MR_LOG_INFO)
         fprintf(stderr, "track: %ld frames, %ld with tags, %ld with a pose, %ld failed\n", frames, with_tags, with_pose,
                 failed);

@@ -538,7 +538,7 @@ static void poll_scene_load(view_app *a) {
 
 /* --ao and --ghost, checked before any window opens through the settings
  * file's rows (so the names are the ones A and G cycle); -1 where not given. */
-static int parse_start_modes(const app_opt *opts, int *ao, int *ghost) {
+static int parse_start_modes(const mr_cli_opt *opts, int *ao, int *ghost) {
     int *out[2] = {ao, ghost};
     static const char *const keys[2] = {"ao", "ghost"};
     for (int i = 0; i < 2; i++) {
@@ -546,28 +546,28 @@ static int parse_start_modes(const app_opt *opts, int *ao, int *ghost) {
         mr_view_settings s = MR_VIEW_SETTINGS_DEFAULTS;
         mr_error err = {0};
         *out[i] = -1;
-        if (!app_get(opts, keys[i])) continue;
-        if (!mr_opt_set_row(o, &s, app_get(opts, keys[i]), &err)) return app_errorf(k_cmd, "--%s", err.msg);
+        if (!mr_cli_get(opts, keys[i])) continue;
+        if (!mr_opt_set_row(o, &s, mr_cli_get(opts, keys[i]), &err)) return mr_cli_errorf(k_cmd, "--%s", err.msg);
         *out[i] = (int)mr_opt_get(o, &s);
     }
     return 0;
 }
 
 /* Camera, marker map and fixed pose from the flags (or the recording). */
-static int load_inputs(view_app *a, const app_opt *opts, const char *input, const char *replay) {
+static int load_inputs(view_app *a, const mr_cli_opt *opts, const char *input, const char *replay) {
     mr_error err = {0};
     bool have_cam = false;
-    if (app_get(opts, "camera")) {
-        if (!mr_camera_load(app_get(opts, "camera"), &a->camera, &err)) return app_error(k_cmd, &err);
+    if (mr_cli_get(opts, "camera")) {
+        if (!mr_camera_load(mr_cli_get(opts, "camera"), &a->camera, &err)) return mr_cli_error(k_cmd, &err);
         have_cam = true;
     }
-    if (app_get(opts, "markers")) {
-        if (!mr_marker_map_load(app_get(opts, "markers"), &a->markers, &err)) return app_error(k_cmd, &err);
+    if (mr_cli_get(opts, "markers")) {
+        if (!mr_marker_map_load(mr_cli_get(opts, "markers"), &a->markers, &err)) return mr_cli_error(k_cmd, &err);
         a->have_markers = true;
     }
-    if (app_get(opts, "view")) {
+    if (mr_cli_get(opts, "view")) {
         mr_view v;
-        if (!mr_view_load(app_get(opts, "view"), &v, &err)) return app_error(k_cmd, &err);
+        if (!mr_view_load(mr_cli_get(opts, "view"), &v, &err)) return mr_cli_error(k_cmd, &err);
         a->fixed_pose = v.world_from_camera;
         a->have_fixed_pose = true;
         if (!have_cam) {
@@ -578,41 +578,41 @@ static int load_inputs(view_app *a, const app_opt *opts, const char *input, cons
     if (replay) {
         if (!mr_replay_meta_load(replay, &a->camera, have_cam, &a->markers, &a->have_markers, &err)) {
             mr_error_prefix(&err, "%s: ", replay);
-            return app_error(k_cmd, &err);
+            return mr_cli_error(k_cmd, &err);
         }
         snprintf(a->source_desc, sizeof a->source_desc, "replay");
     } else {
-        if (!have_cam) return app_errorf(k_cmd, "--input needs --camera (or --view)");
-        if (!a->have_markers && !a->have_fixed_pose) return app_errorf(k_cmd, "--input needs --markers (or --view)");
+        if (!have_cam) return mr_cli_errorf(k_cmd, "--input needs --camera (or --view)");
+        if (!a->have_markers && !a->have_fixed_pose) return mr_cli_errorf(k_cmd, "--input needs --markers (or --view)");
         snprintf(a->source_desc, sizeof a->source_desc, "live %.200s", input);
     }
     return 0;
 }
 
 /* The window, the renderer and the controller (with the settings file). */
-static int open_window(view_app *a, const app_opt *opts, int ww, int wh, int ao, int ghost,
+static int open_window(view_app *a, const mr_cli_opt *opts, int ww, int wh, int ao, int ghost,
                        mr_view_script **script) {
     mr_error err = {0};
     mr_window_params wp = MR_WINDOW_DEFAULTS;
     wp.width = ww;
     wp.height = wh;
-    wp.fullscreen = app_flag(opts, "fullscreen");
+    wp.fullscreen = mr_cli_flag(opts, "fullscreen");
     wp.title = "mrcheck view";
     wp.debug = mr_log_get_level() >= MR_LOG_DEBUG;
     a->win = mr_window_create(&wp, &err);
-    if (!a->win) return app_error(k_cmd, &err);
+    if (!a->win) return mr_cli_error(k_cmd, &err);
     a->rend = mr_renderer_create(mr_window_gpu(a->win), &err);
     a->d2 = a->rend ? mr_draw2d_create(mr_window_gpu(a->win), &err) : NULL;
-    if (!a->d2) return app_error(k_cmd, &err);
+    if (!a->d2) return mr_cli_error(k_cmd, &err);
     char config[4096];
-    if (app_get(opts, "config")) snprintf(config, sizeof config, "%s", app_get(opts, "config"));
+    if (mr_cli_get(opts, "config")) snprintf(config, sizeof config, "%s", mr_cli_get(opts, "config"));
     else mr_view_default_config_path(config, sizeof config);
     mr_viewer_params vp = MR_VIEWER_DEFAULTS;
     vp.px_per_mm = mr_window_px_per_mm(a->win) * a->ui_scale;
     vp.config_path = config;
     vp.now = a->t_start;
     a->vc = mr_viewer_create(&vp, &err);
-    if (!a->vc) return app_error(k_cmd, &err);
+    if (!a->vc) return mr_cli_error(k_cmd, &err);
     /* Flags win over the saved settings for this run. */
     mr_view_settings s = *mr_viewer_settings(a->vc);
     if (ao >= 0) s.ao = (mr_ao_method)ao;
@@ -622,7 +622,7 @@ static int open_window(view_app *a, const app_opt *opts, int ww, int wh, int ao,
     return 0;
 }
 
-static int start_capture(view_app *a, const app_opt *opts, const char *input, const char *replay) {
+static int start_capture(view_app *a, const mr_cli_opt *opts, const char *input, const char *replay) {
     mr_error err = {0};
     mr_capture_params cp = {0};
     cp.input = input;
@@ -631,14 +631,14 @@ static int start_capture(view_app *a, const app_opt *opts, const char *input, co
     cp.markers = a->have_markers ? &a->markers : NULL;
     cp.fixed_pose = a->have_fixed_pose ? &a->fixed_pose : NULL;
     cp.retry_s = 1.0;
-    cp.retrack = app_flag(opts, "retrack");
-    if (cp.retrack && !a->have_markers) return app_errorf(k_cmd, "--retrack needs a marker map");
+    cp.retrack = mr_cli_flag(opts, "retrack");
+    if (cp.retrack && !a->have_markers) return mr_cli_errorf(k_cmd, "--retrack needs a marker map");
     cp.wake = wake_window;
     cp.wake_ctx = a->win;
     a->cap = mr_capture_start(&cp, &err);
-    if (!a->cap) return app_error(k_cmd, &err);
+    if (!a->cap) return mr_cli_error(k_cmd, &err);
     mr_capture_rate(a->cap, mr_view_rates[mr_viewer_settings(a->vc)->rate_i]);
-    if (app_flag(opts, "paused")) mr_capture_play(a->cap, false);
+    if (mr_cli_flag(opts, "paused")) mr_capture_play(a->cap, false);
     return 0;
 }
 
@@ -650,7 +650,7 @@ int cmd_view(int argc, char **argv) {
     mr_opt_describe(mr_opt_find(mr_view_settings_opts, "ghost"), desc, sizeof desc);
     snprintf(ghost_help, sizeof ghost_help, "start with this ghosting mode instead of the saved one (the G key cycles): %s",
              desc);
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"scene", "FILE", "glTF/GLB or scene config JSON (required)", NULL},
         {"input", "PATH", "live input: /dev/videoN, a video file, an image or a folder of images", NULL},
         {"camera", "C.json", "camera intrinsics of the input (required with --input)", NULL},
@@ -673,38 +673,38 @@ int cmd_view(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     bool help;
-    if (!app_parse(argc, argv, 2, opts, NULL, 0, NULL,
+    if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
                    "usage: mrcheck view --scene S (--input /dev/videoN|VIDEO --camera C --markers M | --replay DIR) "
                    "[--out DIR] [--fullscreen] [--stats]",
                    &help))
         return 2;
     if (help) return 0;
-    app_log_level(opts);
-    const char *scene_path = app_get(opts, "scene"), *input = app_get(opts, "input"), *replay = app_get(opts, "replay");
-    if (!scene_path) return app_errorf(k_cmd, "--scene is required"), 2;
-    if (!input == !replay) return app_errorf(k_cmd, "give either --input or --replay"), 2;
+    mr_cli_log_level(opts);
+    const char *scene_path = mr_cli_get(opts, "scene"), *input = mr_cli_get(opts, "input"), *replay = mr_cli_get(opts, "replay");
+    if (!scene_path) return mr_cli_errorf(k_cmd, "--scene is required"), 2;
+    if (!input == !replay) return mr_cli_errorf(k_cmd, "give either --input or --replay"), 2;
 
     view_app *a = calloc(1, sizeof *a);
-    if (!a) return app_errorf(k_cmd, "out of memory");
+    if (!a) return mr_cli_errorf(k_cmd, "out of memory");
     a->t_start = a->fps_t0 = mr_time_now();
-    a->stats = app_flag(opts, "stats");
+    a->stats = mr_cli_flag(opts, "stats");
     a->ui_scale = 1.0;
     mr_view_script *script = NULL;
     int rc = 0, ao = -1, ghost = -1;
     mr_error err = {0};
     int ww = 960, wh = 720;
     /* Inputs that can be checked without a window are checked first. */
-    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &ww, &wh)) { rc = 2; goto done; }
-    if (app_get(opts, "ui-scale") && !app_double("ui-scale", app_get(opts, "ui-scale"), 0.25, 8, &a->ui_scale)) {
+    if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &ww, &wh)) { rc = 2; goto done; }
+    if (mr_cli_get(opts, "ui-scale") && !mr_cli_double("ui-scale", mr_cli_get(opts, "ui-scale"), 0.25, 8, &a->ui_scale)) {
         rc = 2;
         goto done;
     }
     if ((rc = load_inputs(a, opts, input, replay)) != 0) goto done;
-    if (app_get(opts, "script") && !(script = mr_view_script_load(app_get(opts, "script"), &err))) {
-        rc = app_error(k_cmd, &err);
+    if (mr_cli_get(opts, "script") && !(script = mr_view_script_load(mr_cli_get(opts, "script"), &err))) {
+        rc = mr_cli_error(k_cmd, &err);
         goto done;
     }
-    if (app_get(opts, "out")) snprintf(a->session_dir, sizeof a->session_dir, "%s", app_get(opts, "out"));
+    if (mr_cli_get(opts, "out")) snprintf(a->session_dir, sizeof a->session_dir, "%s", mr_cli_get(opts, "out"));
     else if (replay) snprintf(a->session_dir, sizeof a->session_dir, "%s", replay);
     else snprintf(a->session_dir, sizeof a->session_dir, "mrcheck-session");
     if ((rc = parse_start_modes(opts, &ao, &ghost)) != 0) goto done;

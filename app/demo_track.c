@@ -40,7 +40,7 @@ bool app_demo_track(const char *dir, mr_error *err) {
 
 int cmd_synth(int argc, char **argv) {
     static const char *cmd = "synth";
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"out", "DIR", "recording folder to create (required; never overwritten)", NULL},
         {"frames", "N", "frames spread over the walking path (default 120: one per path step)", NULL},
         {"size", "WxH", "frame size (default 640x480, the demo camera scaled)", NULL},
@@ -56,56 +56,56 @@ int cmd_synth(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     bool help;
-    if (!app_parse(argc, argv, 2, opts, NULL, 0, NULL,
+    if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
                    "usage: mrcheck synth --out DIR [--frames N] [--size WxH] [--noise S] [--motion-blur N] [--exposure A] [--jpeg Q]\n"
                    "Renders the as-built demo hall along a walking path with pauses and writes a tracked recording\n"
                    "with groundtruth.jsonl (needs EGL).",
                    &help))
         return 2;
     if (help) return 0;
-    app_log_level(opts);
+    mr_cli_log_level(opts);
     mr_error err = {0};
-    if (app_get(opts, "calibration")) {
-        if (!mr_synth_calibration(app_get(opts, "calibration"), 12, &err)) return app_error(cmd, &err);
-        printf("wrote %s/board.json and %s/images/\n", app_get(opts, "calibration"), app_get(opts, "calibration"));
+    if (mr_cli_get(opts, "calibration")) {
+        if (!mr_synth_calibration(mr_cli_get(opts, "calibration"), 12, &err)) return mr_cli_error(cmd, &err);
+        printf("wrote %s/board.json and %s/images/\n", mr_cli_get(opts, "calibration"), mr_cli_get(opts, "calibration"));
         return 0;
     }
-    if (!app_get(opts, "out")) return app_errorf(cmd, "--out is required (see --help)"), 2;
+    if (!mr_cli_get(opts, "out")) return mr_cli_errorf(cmd, "--out is required (see --help)"), 2;
     mr_synth_recording_params p = {MR_SYNTH_RECORDING_DEFAULTS};
     long l;
     double v;
-    if (app_get(opts, "frames")) {
-        if (!app_int("frames", app_get(opts, "frames"), 1, 100000, &l)) return 2;
+    if (mr_cli_get(opts, "frames")) {
+        if (!mr_cli_int("frames", mr_cli_get(opts, "frames"), 1, 100000, &l)) return 2;
         p.frames = (int)l;
     }
-    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &p.width, &p.height)) return 2;
-    if (p.width < 64 || p.height < 48) return app_errorf(cmd, "--size must be at least 64x48"), 2;
-    if (app_get(opts, "noise")) {
-        if (!app_double("noise", app_get(opts, "noise"), 0, 100, &v)) return 2;
+    if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &p.width, &p.height)) return 2;
+    if (p.width < 64 || p.height < 48) return mr_cli_errorf(cmd, "--size must be at least 64x48"), 2;
+    if (mr_cli_get(opts, "noise")) {
+        if (!mr_cli_double("noise", mr_cli_get(opts, "noise"), 0, 100, &v)) return 2;
         p.noise = v;
     }
-    if (app_get(opts, "motion-blur")) {
-        if (!app_int("motion-blur", app_get(opts, "motion-blur"), 1, 16, &l)) return 2;
+    if (mr_cli_get(opts, "motion-blur")) {
+        if (!mr_cli_int("motion-blur", mr_cli_get(opts, "motion-blur"), 1, 16, &l)) return 2;
         p.motion_blur = (int)l;
     }
-    if (app_get(opts, "exposure")) {
-        if (!app_double("exposure", app_get(opts, "exposure"), 0, 0.9, &v)) return 2;
+    if (mr_cli_get(opts, "exposure")) {
+        if (!mr_cli_double("exposure", mr_cli_get(opts, "exposure"), 0, 0.9, &v)) return 2;
         p.exposure = v;
     }
-    if (app_get(opts, "jpeg")) {
-        if (!app_int("jpeg", app_get(opts, "jpeg"), 1, 100, &l)) return 2;
+    if (mr_cli_get(opts, "jpeg")) {
+        if (!mr_cli_int("jpeg", mr_cli_get(opts, "jpeg"), 1, 100, &l)) return 2;
         p.jpeg_quality = (int)l;
     }
-    if (app_get(opts, "seed")) {
-        if (!app_int("seed", app_get(opts, "seed"), 0, 1L << 40, &l)) return 2;
+    if (mr_cli_get(opts, "seed")) {
+        if (!mr_cli_int("seed", mr_cli_get(opts, "seed"), 0, 1L << 40, &l)) return 2;
         p.seed = (uint64_t)l;
     }
-    if (app_get(opts, "fps")) {
-        if (!app_double("fps", app_get(opts, "fps"), 0.1, 1000, &v)) return 2;
+    if (mr_cli_get(opts, "fps")) {
+        if (!mr_cli_double("fps", mr_cli_get(opts, "fps"), 0.1, 1000, &v)) return 2;
         p.fps = v;
     }
     double t0 = mr_time_now();
-    if (!synth_recording(app_get(opts, "out"), &p, &err)) return app_error(cmd, &err);
-    printf("wrote %s/ (%d frames, %dx%d) in %.1f s\n", app_get(opts, "out"), p.frames, p.width, p.height, mr_time_now() - t0);
+    if (!synth_recording(mr_cli_get(opts, "out"), &p, &err)) return mr_cli_error(cmd, &err);
+    printf("wrote %s/ (%d frames, %dx%d) in %.1f s\n", mr_cli_get(opts, "out"), p.frames, p.width, p.height, mr_time_now() - t0);
     return 0;
 }

@@ -76,26 +76,26 @@ static bool on_off(const char *opt, const char *v, bool *off) {
     if (!v) return true;
     if (strcmp(v, "on") == 0) *off = false;
     else if (strcmp(v, "off") == 0) *off = true;
-    else return app_errorf("render", "--%s must be 'on' or 'off'%s, not '%s'", opt, strcmp(opt, "lod") ? "" : " or 'auto'", v), false;
+    else return mr_cli_errorf("render", "--%s must be 'on' or 'off'%s, not '%s'", opt, strcmp(opt, "lod") ? "" : " or 'auto'", v), false;
     return true;
 }
 
-bool app_lod_auto(const app_opt *opts) {
-    const char *v = app_get(opts, "lod");
+bool app_lod_auto(const mr_cli_opt *opts) {
+    const char *v = mr_cli_get(opts, "lod");
     return !v || strcmp(v, "auto") == 0;
 }
 
-bool app_draw_params(const app_opt *opts, mr_draw_params *dp) {
+bool app_draw_params(const mr_cli_opt *opts, mr_draw_params *dp) {
     mr_draw_params d = MR_DRAW_DEFAULTS;
     bool occl_off = true;
-    if (!on_off("cull", app_get(opts, "cull"), &d.no_cull) || !on_off("batch", app_get(opts, "batch"), &d.no_batch) ||
-        !on_off("instancing", app_get(opts, "instancing"), &d.no_instancing) ||
-        !on_off("lod", app_lod_auto(opts) ? NULL : app_get(opts, "lod"), &d.no_lod) || !on_off("occlusion", app_get(opts, "occlusion"), &occl_off))
+    if (!on_off("cull", mr_cli_get(opts, "cull"), &d.no_cull) || !on_off("batch", mr_cli_get(opts, "batch"), &d.no_batch) ||
+        !on_off("instancing", mr_cli_get(opts, "instancing"), &d.no_instancing) ||
+        !on_off("lod", app_lod_auto(opts) ? NULL : mr_cli_get(opts, "lod"), &d.no_lod) || !on_off("occlusion", mr_cli_get(opts, "occlusion"), &occl_off))
         return false;
     d.occlusion = !occl_off;
-    if (app_get(opts, "lod-tolerance") && !app_double("lod-tolerance", app_get(opts, "lod-tolerance"), 1e-12, 1e12, &d.lod_tolerance))
+    if (mr_cli_get(opts, "lod-tolerance") && !mr_cli_double("lod-tolerance", mr_cli_get(opts, "lod-tolerance"), 1e-12, 1e12, &d.lod_tolerance))
         return false;
-    if (app_get(opts, "lod-pixels") && !app_double("lod-pixels", app_get(opts, "lod-pixels"), 1e-3, 1e4, &d.lod_pixels))
+    if (mr_cli_get(opts, "lod-pixels") && !mr_cli_double("lod-pixels", mr_cli_get(opts, "lod-pixels"), 1e-3, 1e4, &d.lod_pixels))
         return false;
     *dp = d;
     return true;

@@ -48,48 +48,48 @@ mr_source *app_open_input(const char *uri, bool gray, mr_recording **rec_info, m
     return open_input(uri, &sp, rec_info, err);
 }
 
-bool app_open_input_opts(const char *cmd, const app_opt *opts, bool gray, mr_recording **rec_info, mr_source **src,
+bool app_open_input_opts(const char *cmd, const mr_cli_opt *opts, bool gray, mr_recording **rec_info, mr_source **src,
                          mr_error *err) {
     (void)cmd;
     *src = NULL;
     mr_source_params sp = MR_SOURCE_DEFAULTS;
     sp.gray = gray;
-    if (app_get(opts, "size") && !app_size("size", app_get(opts, "size"), &sp.width, &sp.height)) return false;
-    if (app_get(opts, "fps") && !app_double("fps", app_get(opts, "fps"), 0.1, 1000, &sp.fps)) return false;
-    sp.pixel_format = app_get(opts, "pixel-format");
-    *src = open_input(app_get(opts, "input"), &sp, rec_info, err);
+    if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &sp.width, &sp.height)) return false;
+    if (mr_cli_get(opts, "fps") && !mr_cli_double("fps", mr_cli_get(opts, "fps"), 0.1, 1000, &sp.fps)) return false;
+    sp.pixel_format = mr_cli_get(opts, "pixel-format");
+    *src = open_input(mr_cli_get(opts, "input"), &sp, rec_info, err);
     return true;
 }
 
-bool app_tracker_init(app_tracker *t, const char *cmd, const app_opt *opts, const mr_detector_params *dp,
+bool app_tracker_init(app_tracker *t, const char *cmd, const mr_cli_opt *opts, const mr_detector_params *dp,
                       const mr_recording *rec) {
     memset(t, 0, sizeof *t);
     mr_error err = {0};
     mr_camera cam;
     mr_marker_map loaded = {0};
     mr_tracker_params tp = MR_TRACKER_DEFAULTS;
-    const char *cam_path = app_get(opts, "camera"), *mk = app_get(opts, "markers");
+    const char *cam_path = mr_cli_get(opts, "camera"), *mk = mr_cli_get(opts, "markers");
     if (cam_path) {
-        if (!mr_camera_load(cam_path, &cam, &err)) return app_error(cmd, &err), false;
+        if (!mr_camera_load(cam_path, &cam, &err)) return mr_cli_error(cmd, &err), false;
         tp.camera = &cam;
     } else if (rec) {
         tp.camera = &rec->camera;
     }
     if (mk) {
-        if (!mr_marker_map_load(mk, &loaded, &err)) return app_error(cmd, &err), false;
+        if (!mr_marker_map_load(mk, &loaded, &err)) return mr_cli_error(cmd, &err), false;
         tp.markers = &loaded;
     } else if (rec && rec->has_markers) {
         tp.markers = &rec->markers;
     }
-    const char *family = app_get(opts, "family");
+    const char *family = mr_cli_get(opts, "family");
     tp.detector = *dp;
     tp.detector.family = family;
     bool ok = false;
-    tp.no_filter = app_flag(opts, "no-filter");
-    tp.freeze_first = app_flag(opts, "freeze");
+    tp.no_filter = mr_cli_flag(opts, "no-filter");
+    tp.freeze_first = mr_cli_flag(opts, "freeze");
     t->tracker = mr_tracker_create(&tp, &err);
     if (!t->tracker) {
-        app_error(cmd, &err);
+        mr_cli_error(cmd, &err);
         goto done;
     }
     t->camera = mr_tracker_camera(t->tracker);

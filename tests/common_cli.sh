@@ -5,7 +5,7 @@
 # exits 0 (all passed), 1 (a check failed) or 77 (skipped: ctest reports it,
 # and scripts/test.sh fails on it where the dependencies are installed).
 # Skipping is decided by an exit status only, never by matching the text of
-# a message: mrcheck exits APP_EXIT_NODEVICE (69) when it finds no GL device,
+# a message: mrcheck exits MR_CLI_EXIT_NODEVICE (69) when it finds no GL device,
 # context or display, and nothing else exits 69. A part of a script that is
 # skipped makes the whole script a skip (77), not a pass.
 if [ "${BASH_SOURCE[0]}" = "$0" ]; then

@@ -37,16 +37,16 @@ typedef struct track_line {
  * frame number and their printed pose lines; returns the frame count. */
 static int track_in_process(const char *dir, track_line *lines, char **printed) {
     char *argv[] = {"mrcheck", "track", "--input", (char *)dir, "--quiet", NULL};
-    app_opt opts[] = {
+    mr_cli_opt opts[] = {
         {"input", "PATH", "", NULL},
         APP_TRACK_OPTS,
         {"quiet", NULL, "", NULL},
         {NULL, NULL, NULL, NULL},
     };
     mr_detector_params dp = MR_DETECTOR_DEFAULTS;
-    app_table tables[] = {APP_TRACK_TABLE(&dp)};
+    mr_cli_table tables[] = {APP_TRACK_TABLE(&dp)};
     bool help = false;
-    CHECK(app_parse_tables(5, argv, 2, opts, tables, 1, NULL, 0, NULL, "", &help) && !help);
+    CHECK(mr_cli_parse_tables(5, argv, 2, opts, tables, 1, NULL, 0, NULL, "", &help) && !help);
     mr_error err = {0};
     mr_recording *rec = NULL;
     mr_source *src = NULL;

@@ -283,6 +283,67 @@ int mr_opt_enum_value(const mr_opt *o, const char *name);
 int mr_opt_enum_count(const mr_opt *o);
 int mr_opt_enum_next(const mr_opt *o, int v);
 
+/* ------------------------------------------------------------ command line */
+
+/* mrcheck's subcommands: a command declares its own options (mr_cli_opt)
+ * and splices in the option tables of the params structs it fills
+ * (mr_cli_table), so the flags, their --help lines and range checks come
+ * from the tables. Messages are one line on stderr, "mrcheck: ...". */
+/* A command's own option: name, whether it takes a value, help text. */
+typedef struct mr_cli_opt {
+    const char *name;   /* without the leading "--" */
+    const char *arg;    /* value placeholder, or NULL for a flag */
+    const char *help;
+    const char *value;  /* filled by mr_cli_parse: the value, "1" for a set flag, or NULL */
+} mr_cli_opt;
+
+/* A params struct whose option table is spliced into a command's options:
+ * --PREFIX (the table's "" row) and --PREFIX-KEY for each other row, with
+ * their help lines made from the table. Values are checked and written into
+ * params (which holds its defaults) after the whole line was read, so that
+ * --help always wins. */
+#define MR_CLI_TABLE_MAX 32
+typedef struct mr_cli_table {
+    const char *prefix;       /* "ao", "ghost" */
+    const mr_opt *table;      /* at most MR_CLI_TABLE_MAX rows */
+    void *params;
+    const char *extra;        /* one more value --PREFIX accepts beyond the table's
+                                 names (--ao groundtruth), or NULL */
+    bool extra_given;         /* filled: --PREFIX EXTRA was given */
+    const char *values[MR_CLI_TABLE_MAX]; /* filled: the text given for each row, or NULL */
+} mr_cli_table;
+/* True if the row `key` of t was on the command line. */
+bool mr_cli_table_given(const mr_cli_table *t, const char *key);
+/* mr_cli_parse with tables: rows of opts first, then each table's rows. */
+bool mr_cli_parse_tables(int argc, char **argv, int first, mr_cli_opt *opts, mr_cli_table *tables, int ntables,
+                         const char **pos, int max_pos, int *npos, const char *usage, bool *help_shown);
+/* Parses argv[first..argc) into opts (terminated by a NULL name); positional
+ * arguments go to *pos (up to max_pos). --help prints the usage and the
+ * options' help, sets *help_shown and returns true. Returns false (after
+ * printing one line) on a bad argument. */
+bool mr_cli_parse(int argc, char **argv, int first, mr_cli_opt *opts, const char **pos, int max_pos, int *npos,
+                  const char *usage, bool *help_shown);
+const char *mr_cli_get(const mr_cli_opt *opts, const char *name);
+bool mr_cli_flag(const mr_cli_opt *opts, const char *name);
+/* Number parsing with range checks; print one line and return false on error. */
+bool mr_cli_double(const char *opt, const char *s, double lo, double hi, double *out);
+bool mr_cli_int(const char *opt, const char *s, long lo, long hi, long *out);
+bool mr_cli_size(const char *opt, const char *s, int *w, int *h);
+/* Exit status of a command that found no GPU device, GL context or display
+ * (MR_ERR_NODEVICE): EX_UNAVAILABLE of sysexits.h. Tests skip on this status
+ * only, never on the text of a message. */
+#define MR_CLI_EXIT_NODEVICE 69
+/* Prints "mrcheck: <cmd>: <message>" on stderr and returns 1, or
+ * MR_CLI_EXIT_NODEVICE for MR_ERR_NODEVICE. */
+int mr_cli_error(const char *cmd, const mr_error *err);
+int mr_cli_errorf(const char *cmd, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Sets the log level from --verbose / --quiet. */
+void mr_cli_log_level(const mr_cli_opt *opts);
+
 /* ------------------------------------------------------------------- RNG */
 
 /* Deterministic generator (splitmix64 seeded xoshiro256**), so that demo

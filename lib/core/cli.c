@@ -1,5 +1,6 @@
-/* Argument parsing shared by the subcommands. */
-#include "app.h"
+/* The command line from declared option tables: mrcheck's subcommands parse
+ * their arguments, print --help and report bad values here. */
+#include "mr_core.h"
 
 #include <errno.h>
 #include <stdarg.h>
@@ -14,7 +15,7 @@ static void print_row(const char *name, const char *arg, const char *help) {
 
 /* The command-line name of a table row: prefix, or prefix-key; a table
  * without a prefix (the tracker's) names its rows by their keys. */
-static void row_name(const app_table *t, const mr_opt *o, char *out, size_t n) {
+static void row_name(const mr_cli_table *t, const mr_opt *o, char *out, size_t n) {
     snprintf(out, n, "%s%s%s", t->prefix, t->prefix[0] && o->key[0] ? "-" : "", o->key);
 }
 
@@ -27,9 +28,9 @@ static const char *row_arg(const mr_opt *o) {
     }
 }
 
-static void print_usage(const char *usage, const app_opt *opts, const app_table *tables, int ntables) {
+static void print_usage(const char *usage, const mr_cli_opt *opts, const mr_cli_table *tables, int ntables) {
     printf("%s\n\noptions:\n", usage);
-    for (const app_opt *o = opts; o->name; o++) print_row(o->name, o->arg, o->help);
+    for (const mr_cli_opt *o = opts; o->name; o++) print_row(o->name, o->arg, o->help);
     for (int i = 0; i < ntables; i++)
         for (const mr_opt *o = tables[i].table; o->key; o++) {
             char name[64], desc[320], help[512];
@@ -44,13 +45,13 @@ static void print_usage(const char *usage, const app_opt *opts, const app_table 
     printf("  %-24s %s\n", "--help", "show this help");
 }
 
-bool app_table_given(const app_table *t, const char *key) {
+bool mr_cli_table_given(const mr_cli_table *t, const char *key) {
     const mr_opt *o = mr_opt_find(t->table, key);
     return o && t->values[o - t->table] != NULL;
 }
 
 /* Finds --name among the table rows. */
-static bool find_table_row(app_table *tables, int ntables, const char *name, size_t nlen, app_table **tab,
+static bool find_table_row(mr_cli_table *tables, int ntables, const char *name, size_t nlen, mr_cli_table **tab,
                            const mr_opt **row) {
     for (int i = 0; i < ntables; i++)
         for (const mr_opt *o = tables[i].table; o->key; o++) {
@@ -66,9 +67,9 @@ static bool find_table_row(app_table *tables, int ntables, const char *name, siz
 }
 
 /* Writes the given table values into their params; one line on error. */
-static bool apply_tables(app_table *tables, int ntables) {
+static bool apply_tables(mr_cli_table *tables, int ntables) {
     for (int i = 0; i < ntables; i++) {
-        app_table *t = &tables[i];
+        mr_cli_table *t = &tables[i];
         for (const mr_opt *o = t->table; o->key; o++) {
             const char *v = t->values[o - t->table];
             bool extra_row = !o->key[0] && t->extra;
@@ -92,18 +93,18 @@ static bool apply_tables(app_table *tables, int ntables) {
     return true;
 }
 
-bool app_parse(int argc, char **argv, int first, app_opt *opts, const char **pos, int max_pos, int *npos,
+bool mr_cli_parse(int argc, char **argv, int first, mr_cli_opt *opts, const char **pos, int max_pos, int *npos,
                const char *usage, bool *help_shown) {
-    return app_parse_tables(argc, argv, first, opts, NULL, 0, pos, max_pos, npos, usage, help_shown);
+    return mr_cli_parse_tables(argc, argv, first, opts, NULL, 0, pos, max_pos, npos, usage, help_shown);
 }
 
-bool app_parse_tables(int argc, char **argv, int first, app_opt *opts, app_table *tables, int ntables,
+bool mr_cli_parse_tables(int argc, char **argv, int first, mr_cli_opt *opts, mr_cli_table *tables, int ntables,
                       const char **pos, int max_pos, int *npos, const char *usage, bool *help_shown) {
     *help_shown = false;
     if (npos) *npos = 0;
     for (int i = 0; i < ntables; i++) {
-        if (mr_opt_count(tables[i].table) > APP_TABLE_MAX) {
-            fprintf(stderr, "mrcheck: the --%s table has more than %d rows\n", tables[i].prefix, APP_TABLE_MAX);
+        if (mr_opt_count(tables[i].table) > MR_CLI_TABLE_MAX) {
+            fprintf(stderr, "mrcheck: the --%s table has more than %d rows\n", tables[i].prefix, MR_CLI_TABLE_MAX);
             return false;
         }
         tables[i].extra_given = false;
@@ -127,10 +128,10 @@ bool app_parse_tables(int argc, char **argv, int first, app_opt *opts, app_table
         const char *name = a + 2;
         const char *eq = strchr(name, '=');
         size_t nlen = eq ? (size_t)(eq - name) : strlen(name);
-        app_opt *o = opts;
+        mr_cli_opt *o = opts;
         for (; o->name; o++)
             if (strlen(o->name) == nlen && strncmp(o->name, name, nlen) == 0) break;
-        app_table *tab = NULL;
+        mr_cli_table *tab = NULL;
         const mr_opt *row = NULL;
         if (!o->name && !find_table_row(tables, ntables, name, nlen, &tab, &row)) {
             fprintf(stderr, "mrcheck: unknown option '--%.*s' (see --help)\n", (int)nlen, name);
@@ -156,17 +157,17 @@ bool app_parse_tables(int argc, char **argv, int first, app_opt *opts, app_table
     return apply_tables(tables, ntables);
 }
 
-const char *app_get(const app_opt *opts, const char *name) {
-    for (const app_opt *o = opts; o->name; o++)
+const char *mr_cli_get(const mr_cli_opt *opts, const char *name) {
+    for (const mr_cli_opt *o = opts; o->name; o++)
         if (strcmp(o->name, name) == 0) return o->value;
     return NULL;
 }
 
-bool app_flag(const app_opt *opts, const char *name) { return app_get(opts, name) != NULL; }
+bool mr_cli_flag(const mr_cli_opt *opts, const char *name) { return mr_cli_get(opts, name) != NULL; }
 
 /* Through a one-row option table, so the number rules and the message are
  * those of every table option. */
-bool app_double(const char *opt, const char *s, double lo, double hi, double *out) {
+bool mr_cli_double(const char *opt, const char *s, double lo, double hi, double *out) {
     const mr_opt row = {opt, MR_OPT_DOUBLE, 0, lo, hi, lo, NULL, "", 0};
     mr_error err = {0};
     if (!mr_opt_set_row(&row, out, s, &err)) {
@@ -177,7 +178,7 @@ bool app_double(const char *opt, const char *s, double lo, double hi, double *ou
 }
 
 /* Whole numbers stay here: their ranges reach beyond an int (--from). */
-bool app_int(const char *opt, const char *s, long lo, long hi, long *out) {
+bool mr_cli_int(const char *opt, const char *s, long lo, long hi, long *out) {
     char *end = NULL;
     errno = 0;
     long v = strtol(s, &end, 10);
@@ -189,7 +190,7 @@ bool app_int(const char *opt, const char *s, long lo, long hi, long *out) {
     return true;
 }
 
-bool app_size(const char *opt, const char *s, int *w, int *h) {
+bool mr_cli_size(const char *opt, const char *s, int *w, int *h) {
     char *end = NULL;
     long a = strtol(s, &end, 10), b = 0;
     bool ok = end != s && (*end == 'x' || *end == 'X');
@@ -207,12 +208,12 @@ bool app_size(const char *opt, const char *s, int *w, int *h) {
     return true;
 }
 
-int app_error(const char *cmd, const mr_error *err) {
+int mr_cli_error(const char *cmd, const mr_error *err) {
     fprintf(stderr, "mrcheck: %s: %s\n", cmd, err->msg[0] ? err->msg : "failed");
-    return err->code == MR_ERR_NODEVICE ? APP_EXIT_NODEVICE : 1;
+    return err->code == MR_ERR_NODEVICE ? MR_CLI_EXIT_NODEVICE : 1;
 }
 
-int app_errorf(const char *cmd, const char *fmt, ...) {
+int mr_cli_errorf(const char *cmd, const char *fmt, ...) {
     char buf[1024];
     va_list ap;
     va_start(ap, fmt);
@@ -222,7 +223,7 @@ int app_errorf(const char *cmd, const char *fmt, ...) {
     return 1;
 }
 
-void app_log_level(const app_opt *opts) {
-    if (app_get(opts, "quiet")) mr_log_set_level(MR_LOG_ERROR);
-    else if (app_get(opts, "verbose")) mr_log_set_level(MR_LOG_INFO);
+void mr_cli_log_level(const mr_cli_opt *opts) {
+    if (mr_cli_get(opts, "quiet")) mr_log_set_level(MR_LOG_ERROR);
+    else if (mr_cli_get(opts, "verbose")) mr_log_set_level(MR_LOG_INFO);
 }
