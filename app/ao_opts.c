@@ -4,7 +4,7 @@
  * truth (whose params live in lib/eval). */
 #include "app.h"
 
-bool app_ao_check(const char *cmd, const mr_cli_table *t, const mr_cli_opt *opts, bool *groundtruth, mr_gt_params *gt) {
+bool app_ao_check(const char *cmd, const mr_cli_table *t, bool *groundtruth, mr_gt_params *gt) {
     mr_ao_params *ao = t->params;
     bool mode_named = mr_cli_table_given(t, "radius-mode");
     *groundtruth = t->extra_given;
@@ -26,12 +26,6 @@ bool app_ao_check(const char *cmd, const mr_cli_table *t, const mr_cli_opt *opts
     gt->radius_mode = ao->radius_mode;
     gt->radius = ao->radius;
     gt->screen_radius = ao->screen_radius;
-    const char *v = mr_cli_get(opts, "ao-rays");
-    long l;
-    if (v) {
-        if (!mr_cli_int("ao-rays", v, 1, 1 << 20, &l)) return false;
-        gt->rays = (int)l;
-    }
     /* Ground truth defaults to the fixed radius unless a mode is named. */
     if (*groundtruth && !mode_named) gt->radius_mode = MR_AO_RADIUS_VIEW;
     return true;

@@ -15,17 +15,16 @@ typedef struct app_gfx {
 } app_gfx;
 bool app_gfx_open(app_gfx *g, mr_error *err);
 void app_gfx_close(app_gfx *g);
-/* The AO rows beyond mr_ao_opts, to splice into a command's option table:
- * the ground truth's rays (its params live in lib/eval). */
-#define APP_AO_OPTS {"ao-rays", "N", "groundtruth: rays per pixel (default 256)", NULL}
 /* The AO and ghosting tables of a command (fill .params, then parse). */
 #define APP_AO_TABLE(p) {.prefix = "ao", .table = mr_ao_opts, .params = (p), .extra = "groundtruth"}
+/* The ground truth's rays, --ao-rays (its params live in lib/eval). */
+#define APP_GT_TABLE(p) {.prefix = "ao", .table = mr_gt_opts, .params = (p)}
 #define APP_GHOST_TABLE(p) {.prefix = "ghost", .table = mr_ghost_opts, .params = (p)}
 /* The checks of the AO table's values that are not a plain range (--ao-radius
  * only in view mode, --ao-rmin <= --ao-rmax, --ao-mask-strength only for the
- * standalone mask), --ao groundtruth and --ao-rays into gt; prints one line
+ * standalone mask), --ao groundtruth and the AO radius into gt; prints one line
  * and returns false on a bad value. */
-bool app_ao_check(const char *cmd, const mr_cli_table *t, const mr_cli_opt *opts, bool *groundtruth, mr_gt_params *gt);
+bool app_ao_check(const char *cmd, const mr_cli_table *t, bool *groundtruth, mr_gt_params *gt);
 
 /* Writes what --aux asks for: depth.pfm, normal.pfm, ao.pfm into dir. */
 bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err);

@@ -13,11 +13,6 @@ int bench_ao(int argc, char **argv) {
                             "hall's near, mid-hall and far views)", NULL},
         {"tune-view", "V.json", "view the parameters are tuned on, not reported (default: a demo view not reported)", NULL},
         {"size", "WxH", "resolution (default 320x240)", NULL},
-        {"frames", "N", "timed frames per configuration, median reported (default 5)", NULL},
-        {"rays", "N", "ground-truth rays per pixel (default 256)", NULL},
-        {"radius", "R", "ground truth's fixed radius in scene units (default 2% of the scene diagonal)", NULL},
-        {"screen-radius", "F", "depth-scaled reference: radius as a fraction of image height at each depth (default 0.05)", NULL},
-        {"quick", NULL, "a reduced grid (samples 8 and 32, full resolution only, 2-point tuning)", NULL},
         {"out", "DIR", "output folder (default bench-out)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
@@ -25,27 +20,19 @@ int bench_ao(int argc, char **argv) {
     };
     const char *pos[MAX_VIEWS];
     int npos = 0;
+    mr_bench_ao_params p = {MR_BENCH_AO_DEFAULTS};
+    mr_cli_table table = {"", mr_bench_ao_opts, &p, NULL, false, {0}};
     bool help;
-    if (!mr_cli_parse(argc, argv, 3, opts, pos, MAX_VIEWS - 1, &npos,
+    if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, pos, MAX_VIEWS - 1, &npos,
                    "usage: mrcheck bench ao [--scene S] [--views V1.json [V2.json ...]] [--tune-view T.json] [--size WxH] [--out DIR]",
                    &help))
         return 2;
     if (help) return 0;
     mr_cli_log_level(opts);
-    mr_bench_ao_params p = {MR_BENCH_AO_DEFAULTS};
-    long frames = p.frames, rays = p.rays;
     if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &p.width, &p.height)) return 2;
-    if (mr_cli_get(opts, "frames") && !mr_cli_int("frames", mr_cli_get(opts, "frames"), 1, 64, &frames)) return 2;
-    if (mr_cli_get(opts, "rays") && !mr_cli_int("rays", mr_cli_get(opts, "rays"), 1, 1 << 20, &rays)) return 2;
-    if (mr_cli_get(opts, "radius") && !mr_cli_double("radius", mr_cli_get(opts, "radius"), 1e-30, 1e30, &p.radius)) return 2;
-    if (mr_cli_get(opts, "screen-radius") && !mr_cli_double("screen-radius", mr_cli_get(opts, "screen-radius"), 1e-4, 1, &p.screen_radius))
-        return 2;
     if (npos > 0 && !mr_cli_get(opts, "views")) return mr_cli_errorf(cmd, "view files given without --views"), 2;
     if (mr_cli_get(opts, "out")) p.out_dir = mr_cli_get(opts, "out");
     p.scene = mr_cli_get(opts, "scene");
-    p.frames = (int)frames;
-    p.rays = (int)rays;
-    p.quick = mr_cli_flag(opts, "quick");
     p.verbose = mr_cli_flag(opts, "verbose");
     p.progress = !mr_cli_flag(opts, "quiet");
     p.out = stdout;

@@ -30,30 +30,23 @@ int bench_scene(int argc, char **argv) {
         {"out", "DIR", "write bench_scene.csv, bench_scene.svg and the scenes there (default bench-out)", NULL},
         {"sizes", "LIST", "drawn-triangle targets (default 1M,5M,20M)", NULL},
         {"size", "WxH", "frame size (default 1024x768)", NULL},
-        {"frames", "N", "timed frames per case after one warm-up (default 3)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
+    mr_bench_scene_params p = {MR_BENCH_SCENE_DEFAULTS};
+    mr_cli_table table = {"", mr_bench_scene_opts, &p, NULL, false, {0}};
     bool help;
-    if (!mr_cli_parse(argc, argv, 3, opts, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck bench scene [--out DIR] [--sizes 1M,5M,20M] [--size WxH] [--frames N]", &help))
         return 2;
     if (help) return 0;
     mr_cli_log_level(opts);
-    const char *out_dir = mr_cli_get(opts, "out") ? mr_cli_get(opts, "out") : "bench-out";
-    mr_bench_scene_params p = {MR_BENCH_SCENE_DEFAULTS};
+    if (mr_cli_get(opts, "out")) p.out_dir = mr_cli_get(opts, "out");
     int nsizes = parse_sizes(mr_cli_get(opts, "sizes") ? mr_cli_get(opts, "sizes") : "1M,5M,20M", p.sizes, MR_BENCH_SCENE_MAX_SIZES);
     if (nsizes <= 0) return mr_cli_errorf(cmd, "--sizes must be a list like 1M,5M,20M (10k..1000M each)"), 2;
-    int w = 1024, h = 768;
-    long frames = 3;
-    if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &w, &h)) return 2;
-    if (mr_cli_get(opts, "frames") && !mr_cli_int("frames", mr_cli_get(opts, "frames"), 1, 1000, &frames)) return 2;
-    p.out_dir = out_dir;
+    if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &p.width, &p.height)) return 2;
     p.size_count = nsizes;
-    p.width = w;
-    p.height = h;
-    p.frames = (int)frames;
     p.out = stdout;
     mr_error err = {0};
     app_gfx g;

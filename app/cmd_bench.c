@@ -19,27 +19,22 @@ static int bench_frame(int argc, char **argv) {
         {"scene", "FILE", "glTF/GLB or scene config (default: the demo hall as planned)", NULL},
         {"view", "VIEW.json", "view (default: the demo's first viewpoint)", NULL},
         {"size", "WxH", "output size (default 1024x768)", NULL},
-        {"frames", "N", "frames to time after 3 warm-up frames (default 30)", NULL},
         {"video", "IMG", "camera frame to overlay (default: a synthetic frame, so the overlay pass runs)", NULL},
-        {"no-video", NULL, "no overlay pass", NULL},
         {"out", "DIR", "write bench_frame.csv and bench_frame.svg there (default bench-out)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
+    mr_bench_frame_params p = {MR_BENCH_FRAME_DEFAULTS};
+    mr_cli_table table = {"", mr_bench_frame_opts, &p, NULL, false, {0}};
     bool help;
-    if (!mr_cli_parse(argc, argv, 3, opts, NULL, 0, NULL, "usage: mrcheck bench frame [--scene S] [--view V] [--size WxH] [--frames N] [--out DIR]", &help))
+    if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL, "usage: mrcheck bench frame [--scene S] [--view V] [--size WxH] [--frames N] [--out DIR]", &help))
         return 2;
     if (help) return 0;
     mr_cli_log_level(opts);
-    mr_bench_frame_params p = {MR_BENCH_FRAME_DEFAULTS};
-    long frames = p.frames;
     if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &p.width, &p.height)) return 2;
-    if (mr_cli_get(opts, "frames") && !mr_cli_int("frames", mr_cli_get(opts, "frames"), 1, 100000, &frames)) return 2;
     if (mr_cli_get(opts, "out")) p.out_dir = mr_cli_get(opts, "out");
-    p.frames = (int)frames;
     p.scene = mr_cli_get(opts, "scene");
-    p.no_video = mr_cli_flag(opts, "no-video");
     p.out = stdout;
     mr_error err = {0};
     mr_view view;

@@ -78,7 +78,6 @@ int cmd_render(int argc, char **argv) {
         {"aux", "DIR", "also write depth.pfm (linear view depth), normal.pfm and ao.pfm (1 = unoccluded)", NULL},
         {"hidden", "GLOB", "extra node-name glob for the hidden layer", NULL},
         {"hide-hidden", NULL, "leave the hidden layer out", NULL},
-        APP_AO_OPTS,
         APP_DRAW_OPTS,
         {"lod-cache", "on|off", "read/write LOD levels in <scene>.mrlod (default on)", NULL},
         {"verbose", NULL, "print the passes that ran and more", NULL},
@@ -86,9 +85,10 @@ int cmd_render(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_frame_params fp = MR_FRAME_DEFAULTS;
-    mr_cli_table tables[] = {APP_AO_TABLE(&fp.ao), APP_GHOST_TABLE(&fp.ghost)};
+    mr_gt_params gtp = MR_GT_DEFAULTS;
+    mr_cli_table tables[] = {APP_AO_TABLE(&fp.ao), APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&fp.ghost)};
     bool help;
-    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 2, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 3, NULL, 0, NULL,
                    "usage: mrcheck render --scene FILE --view VIEW.json --out OUT.png [--size WxH] "
                    "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive]",
                    &help))
@@ -111,8 +111,7 @@ int cmd_render(int argc, char **argv) {
     const char *aux = mr_cli_get(opts, "aux");
     fp.want_depth = fp.want_normals = aux != NULL;
     bool groundtruth = false;
-    mr_gt_params gtp = MR_GT_DEFAULTS;
-    if (!app_ao_check(cmd, &tables[0], opts, &groundtruth, &gtp)) return 2;
+    if (!app_ao_check(cmd, &tables[0], &groundtruth, &gtp)) return 2;
     fp.ao.want_ao = aux != NULL;
 
     /* Everything that can be checked without a GPU is checked first, so a

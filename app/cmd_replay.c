@@ -18,7 +18,6 @@ int cmd_replay(int argc, char **argv) {
         {"to", "T", "last frame number (default: the last)", NULL},
         {"raw", NULL, "use the raw pose instead of the filtered one", NULL},
         {"video", "FILE.avi", "also write the overlays as a Motion-JPEG AVI at the recording's rate", NULL},
-        APP_AO_OPTS,
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -27,9 +26,10 @@ int cmd_replay(int argc, char **argv) {
     int npos = 0;
     /* Depth cues as on render: the same option tables and checks. */
     mr_frame_params base = MR_FRAME_DEFAULTS;
-    mr_cli_table tables[] = {APP_AO_TABLE(&base.ao), APP_GHOST_TABLE(&base.ghost)};
+    mr_gt_params gtp = MR_GT_DEFAULTS;
+    mr_cli_table tables[] = {APP_AO_TABLE(&base.ao), APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&base.ghost)};
     bool help;
-    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 2, pos, 1, &npos,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 3, pos, 1, &npos,
                    "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] [--raw] "
                    "[--video F.avi] [--ao METHOD ...] [--ghost MODE ...]",
                    &help))
@@ -48,8 +48,7 @@ int cmd_replay(int argc, char **argv) {
     const char *out = mr_cli_get(opts, "out");
     bool raw = mr_cli_flag(opts, "raw");
     bool groundtruth = false;
-    mr_gt_params gtp = MR_GT_DEFAULTS;
-    if (!app_ao_check(cmd, &tables[0], opts, &groundtruth, &gtp)) return 2;
+    if (!app_ao_check(cmd, &tables[0], &groundtruth, &gtp)) return 2;
     if (groundtruth) return mr_cli_errorf(cmd, "--ao groundtruth is for single frames (mrcheck render), not replays"), 2;
 
     mr_error err = {0};

@@ -1,13 +1,16 @@
 /* The declared option tables (mr_opt, lib/core/options.c) and every table
  * the libraries declare: mr_ao_opts, mr_ghost_opts (lib/render),
  * mr_view_settings_opts (lib/view), mr_detector_opts and mr_filter_opts
- * (lib/track). Each table is walked: keys unique,
+ * (lib/track), mr_gt_opts (lib/eval) and the benches' mr_bench_*_opts
+ * (lib/bench). Each table is walked: keys unique,
  * offsets inside the struct, aligned and not overlapping, each default in
  * its range (or the documented 0 = auto), enum defaults valid names,
  * mr_opt_defaults equal to the MR_*_DEFAULTS macro field by field, and
  * every numeric option accepts its bounds and rejects a value just outside
  * them with one line naming the option, the range and the value. */
+#include "mr_bench.h"
 #include "mr_core.h"
+#include "mr_eval.h"
 #include "mr_render.h"
 #include "mr_test.h"
 #include "mr_track.h"
@@ -247,6 +250,18 @@ static void test_tables(void) {
     const mr_filter_params fp = MR_FILTER_DEFAULTS;
     walk_table("mr_detector_opts", mr_detector_opts, sizeof dp, &dp);
     walk_table("mr_filter_opts", mr_filter_opts, sizeof fp, &fp);
+    const mr_gt_params gt = MR_GT_DEFAULTS;
+    walk_table("mr_gt_opts", mr_gt_opts, sizeof gt, &gt);
+    const mr_bench_ao_params bao = {MR_BENCH_AO_DEFAULTS};
+    const mr_bench_frame_params bfr = {MR_BENCH_FRAME_DEFAULTS};
+    const mr_bench_ghost_params bgh = {MR_BENCH_GHOST_DEFAULTS};
+    const mr_bench_scene_params bsc = {MR_BENCH_SCENE_DEFAULTS};
+    const mr_bench_tracking_params btr = {MR_BENCH_TRACKING_DEFAULTS};
+    walk_table("mr_bench_ao_opts", mr_bench_ao_opts, sizeof bao, &bao);
+    walk_table("mr_bench_frame_opts", mr_bench_frame_opts, sizeof bfr, &bfr);
+    walk_table("mr_bench_ghost_opts", mr_bench_ghost_opts, sizeof bgh, &bgh);
+    walk_table("mr_bench_scene_opts", mr_bench_scene_opts, sizeof bsc, &bsc);
+    walk_table("mr_bench_tracking_opts", mr_bench_tracking_opts, sizeof btr, &btr);
 
 #define E(t, k, f, names) {k, offsetof(t, f), 0, 0, names}
 #define N(t, k, f, lo, hi) {k, offsetof(t, f), lo, hi, NULL}
@@ -303,8 +318,35 @@ static void test_tables(void) {
         N(mr_filter_params, "jump-deg", jump_deg, 1e-3, 180),
         N(mr_filter_params, "max-gap", max_gap_s, 1e-3, 3600),
     };
+    const expect ex_gt[] = {N(mr_gt_params, "rays", rays, 1, 1 << 20)};
+    const expect ex_bao[] = {
+        N(mr_bench_ao_params, "frames", frames, 1, 64),
+        N(mr_bench_ao_params, "rays", rays, 1, 1 << 20),
+        N(mr_bench_ao_params, "radius", radius, 1e-30, 1e30),
+        N(mr_bench_ao_params, "screen-radius", screen_radius, 1e-4, 1),
+        N(mr_bench_ao_params, "quick", quick, 0, 1),
+    };
+    const expect ex_bfr[] = {N(mr_bench_frame_params, "frames", frames, 1, 100000),
+                             N(mr_bench_frame_params, "no-video", no_video, 0, 1)};
+    const expect ex_bgh[] = {N(mr_bench_ghost_params, "frames", frames, 1, 100000),
+                             N(mr_bench_ghost_params, "view", view, 0, MR_DEMO_VIEWS - 1)};
+    const expect ex_bsc[] = {N(mr_bench_scene_params, "frames", frames, 1, 1000)};
+    const expect ex_btr[] = {
+        N(mr_bench_tracking_params, "frames", max_frames, 1, 1 << 30),
+        N(mr_bench_tracking_params, "quick", quick, 0, 1),
+        N(mr_bench_tracking_params, "min-cutoff", min_cutoff, 1e-3, 100),
+        N(mr_bench_tracking_params, "beta", beta, 1e-6, 1000),
+    };
 #undef E
 #undef N
+#define ROWS(t, ex) check_rows(#t, t, ex, (int)(sizeof ex / sizeof ex[0]))
+    ROWS(mr_gt_opts, ex_gt);
+    ROWS(mr_bench_ao_opts, ex_bao);
+    ROWS(mr_bench_frame_opts, ex_bfr);
+    ROWS(mr_bench_ghost_opts, ex_bgh);
+    ROWS(mr_bench_scene_opts, ex_bsc);
+    ROWS(mr_bench_tracking_opts, ex_btr);
+#undef ROWS
     check_rows("mr_detector_opts", mr_detector_opts, ex_dt, (int)(sizeof ex_dt / sizeof ex_dt[0]));
     check_rows("mr_filter_opts", mr_filter_opts, ex_fi, (int)(sizeof ex_fi / sizeof ex_fi[0]));
     /* The defaults the 0s stand for, written a second time as the contract:

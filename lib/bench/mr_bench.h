@@ -57,6 +57,9 @@ typedef struct mr_bench_ao_params {
 } mr_bench_ao_params;
 #define MR_BENCH_AO_DEFAULTS .out_dir = "bench-out", .width = 320, .height = 240, .frames = 5, .rays = 256, .screen_radius = 0.05
 bool mr_bench_ao(const mr_bench_ao_params *params, mr_error *err);
+/* Option table of the numbers and switches above (frames, rays, radius,
+ * screen-radius, quick); lib/bench/options.c. */
+extern const mr_opt mr_bench_ao_opts[];
 
 /* ---------------------------------------------------------------- frame */
 
@@ -74,6 +77,7 @@ typedef struct mr_bench_frame_params {
 } mr_bench_frame_params;
 #define MR_BENCH_FRAME_DEFAULTS .out_dir = "bench-out", .width = 1024, .height = 768, .frames = 30
 bool mr_bench_frame(const mr_bench_frame_params *params, mr_error *err);
+extern const mr_opt mr_bench_frame_opts[]; /* frames, no-video */
 
 /* ---------------------------------------------------------------- ghost */
 
@@ -91,6 +95,7 @@ typedef struct mr_bench_ghost_params {
 } mr_bench_ghost_params;
 #define MR_BENCH_GHOST_DEFAULTS .out_dir = "bench-out", .width = 640, .height = 480, .frames = 5
 bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err);
+extern const mr_opt mr_bench_ghost_opts[]; /* frames, view */
 
 /* ---------------------------------------------------------------- scene */
 
@@ -110,6 +115,7 @@ typedef struct mr_bench_scene_params {
 } mr_bench_scene_params;
 #define MR_BENCH_SCENE_DEFAULTS .out_dir = "bench-out", .width = 1024, .height = 768, .frames = 3
 bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err);
+extern const mr_opt mr_bench_scene_opts[]; /* frames */
 
 /* ------------------------------------------------------------- tracking */
 
@@ -119,7 +125,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err);
 typedef struct mr_bench_tracking_params {
     const char *out_dir;    /* default "bench-out" */
     const char *recording;  /* recording folder with groundtruth.jsonl, default "recordings/demo" */
-    long max_frames;        /* use at most this many frames with ground truth; 0: all */
+    int max_frames;         /* use at most this many frames with ground truth; 0: all */
     bool quick;             /* a few settings only; default false */
     double min_cutoff;      /* One Euro cutoff at rest in Hz (also for rotation); 0: the filter's default 0.5 */
     double beta;            /* One Euro speed coefficient; 0: the filter's default 2 */
@@ -127,6 +133,7 @@ typedef struct mr_bench_tracking_params {
 } mr_bench_tracking_params;
 #define MR_BENCH_TRACKING_DEFAULTS .out_dir = "bench-out", .recording = "recordings/demo"
 bool mr_bench_tracking(const mr_bench_tracking_params *params, mr_error *err);
+extern const mr_opt mr_bench_tracking_opts[]; /* frames, quick, min-cutoff, beta */
 
 /* ------------------------------------------------------ synthetic data */
 

@@ -38,7 +38,12 @@ typedef struct mr_gt_params {
     uint64_t seed;                 /* 0 = 1 */
     int threads;                   /* 0 = one per online CPU */
 } mr_gt_params;
-#define MR_GT_DEFAULTS {MR_AO_RADIUS_VIEW, 0.0, 0.05, 256, 1, 0}
+#define MR_GT_DEFAULT_RAYS 256
+#define MR_GT_DEFAULTS {.radius_mode = MR_AO_RADIUS_VIEW, .radius = 0.0, .screen_radius = 0.05, \
+                        .rays = MR_GT_DEFAULT_RAYS, .seed = 1, .threads = 0}
+/* The option table of what a user sets directly: rays (`--ao-rays` on
+ * render, spliced with the "ao" prefix); the radius follows the AO options. */
+extern const mr_opt mr_gt_opts[];
 
 /* Ambient visibility (fraction of cosine-weighted rays of length R that
  * escape; 1 = unoccluded, 1 where depth is 0) for each pixel of a rendered

@@ -1,0 +1,54 @@
+/* The benches' option tables: the numbers and switches of each
+ * mr_bench_*_params (files, folders and the frame size stay the command's
+ * own options). The command line, --help and the range checks of
+ * `mrcheck bench NAME` come from here. */
+#include "mr_bench.h"
+
+#include <stddef.h>
+
+#define AO(f) offsetof(mr_bench_ao_params, f)
+const mr_opt mr_bench_ao_opts[] = {
+    {"frames", MR_OPT_INT, AO(frames), 1, 64, 5, NULL, "timed frames per configuration, median reported", 0},
+    {"rays", MR_OPT_INT, AO(rays), 1, 1 << 20, 256, NULL, "ground-truth rays per pixel", 0},
+    {"radius", MR_OPT_DOUBLE, AO(radius), 1e-30, 1e30, 0, NULL,
+     "the fixed reference's radius in scene units (auto: 2% of the scene diagonal)", MR_OPT_ZERO_AUTO},
+    {"screen-radius", MR_OPT_DOUBLE, AO(screen_radius), 1e-4, 1, 0.05, NULL,
+     "depth-scaled reference: radius as a fraction of the image height at each depth", 0},
+    {"quick", MR_OPT_BOOL, AO(quick), 0, 1, 0, NULL, "a reduced grid (samples 8 and 32, full resolution only, 2-point tuning)", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef AO
+
+const mr_opt mr_bench_frame_opts[] = {
+    {"frames", MR_OPT_INT, offsetof(mr_bench_frame_params, frames), 1, 100000, 30, NULL,
+     "frames to time after 3 warm-up frames", 0},
+    {"no-video", MR_OPT_BOOL, offsetof(mr_bench_frame_params, no_video), 0, 1, 0, NULL, "no overlay pass", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+
+const mr_opt mr_bench_ghost_opts[] = {
+    {"frames", MR_OPT_INT, offsetof(mr_bench_ghost_params, frames), 1, 100000, 5, NULL,
+     "frames to time per configuration after 2 warm-up frames", 0},
+    {"view", MR_OPT_INT, offsetof(mr_bench_ghost_params, view), 0, MR_DEMO_VIEWS - 1, 0, NULL,
+     "demo viewpoint (0: the partition with the pipes behind it)", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+
+const mr_opt mr_bench_scene_opts[] = {
+    {"frames", MR_OPT_INT, offsetof(mr_bench_scene_params, frames), 1, 1000, 3, NULL,
+     "timed frames per case after one warm-up", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+
+#define TR(f) offsetof(mr_bench_tracking_params, f)
+const mr_opt mr_bench_tracking_opts[] = {
+    {"frames", MR_OPT_INT, TR(max_frames), 1, 1 << 30, 0, NULL, "use at most N frames with ground truth (auto: all)",
+     MR_OPT_ZERO_AUTO},
+    {"quick", MR_OPT_BOOL, TR(quick), 0, 1, 0, NULL, "a few settings only", 0},
+    /* 0 in the field is the filter's own default, as mr_filter_params reads it. */
+    {"min-cutoff", MR_OPT_DOUBLE, TR(min_cutoff), 1e-3, 100, 0.5, NULL, "One Euro filter cutoff at rest, Hz",
+     MR_OPT_ZERO_DEFAULT},
+    {"beta", MR_OPT_DOUBLE, TR(beta), 1e-6, 1000, 2.0, NULL, "One Euro filter speed coefficient", MR_OPT_ZERO_DEFAULT},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef TR
