@@ -50,9 +50,6 @@ bool app_tracker_init(app_tracker *t, const char *cmd, const mr_cli_opt *opts, c
                       const mr_recording *rec);
 void app_tracker_free(app_tracker *t);
 
-/* JSON helpers for the line formats. */
-cJSON *app_pose_line(int64_t frame, double t, const mr_tracker_result *r);
-
 /* Called once by `mrcheck demo`: writes DIR/recording and DIR/calib. */
 bool app_demo_track(const char *dir, mr_error *err);
 

@@ -1,22 +1,13 @@
 /* mrcheck replay: headless overlays of a recording's frames with the
- * planned model at their recorded poses. Deterministic: the same recording
- * gives the same poses and the same images. */
+ * planned model at their recorded poses (mr_batch_replay, lib/batch). */
 #include "app_track.h"
-
-#include <stdlib.h>
-#include <string.h>
-#include <unistd.h>
+#include "mr_batch.h"
 
 int cmd_replay(int argc, char **argv) {
     static const char *cmd = "replay";
     mr_cli_opt opts[] = {
         {"scene", "S", "glTF/GLB or scene config of the plan (required)", NULL},
         {"out", "OUTDIR", "where overlay_NNNNNN.png and replay.jsonl go (required)", NULL},
-        {"alpha", "A", "video transparency: 0 = virtual only, 1 = video only (default 0.5)", NULL},
-        {"every", "N", "every Nth frame (default 1)", NULL},
-        {"from", "F", "first frame number (default 0)", NULL},
-        {"to", "T", "last frame number (default: the last)", NULL},
-        {"raw", NULL, "use the raw pose instead of the filtered one", NULL},
         {"video", "FILE.avi", "also write the overlays as a Motion-JPEG AVI at the recording's rate", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
@@ -24,131 +15,42 @@ int cmd_replay(int argc, char **argv) {
     };
     const char *pos[1];
     int npos = 0;
+    mr_batch_replay_params p = MR_BATCH_REPLAY_DEFAULTS;
     /* Depth cues as on render: the same option tables and checks. */
-    mr_frame_params base = MR_FRAME_DEFAULTS;
     mr_gt_params gtp = MR_GT_DEFAULTS;
-    mr_cli_table tables[] = {APP_AO_TABLE(&base.ao), APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&base.ghost)};
+    mr_cli_table tables[] = {{"", mr_batch_replay_opts, &p, NULL, false, {0}}, APP_AO_TABLE(&p.frame.ao),
+                             APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&p.frame.ghost)};
     bool help;
-    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 3, pos, 1, &npos,
-                   "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] [--raw] "
-                   "[--video F.avi] [--ao METHOD ...] [--ghost MODE ...]",
-                   &help))
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 4, pos, 1, &npos,
+                             "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] "
+                             "[--raw] [--video F.avi] [--ao METHOD ...] [--ghost MODE ...]",
+                             &help))
         return 2;
     if (help) return 0;
     mr_cli_log_level(opts);
     if (npos != 1 || !mr_cli_get(opts, "scene") || !mr_cli_get(opts, "out"))
         return mr_cli_errorf(cmd, "needs a recording folder, --scene and --out (see --help)"), 2;
-    double alpha = 0.5;
-    long every = 1, from = 0, to = -1;
-    if (mr_cli_get(opts, "alpha") && !mr_cli_double("alpha", mr_cli_get(opts, "alpha"), 0, 1, &alpha)) return 2;
-    if (mr_cli_get(opts, "every") && !mr_cli_int("every", mr_cli_get(opts, "every"), 1, 1L << 30, &every)) return 2;
-    if (mr_cli_get(opts, "from") && !mr_cli_int("from", mr_cli_get(opts, "from"), 0, 1L << 40, &from)) return 2;
-    if (mr_cli_get(opts, "to") && !mr_cli_int("to", mr_cli_get(opts, "to"), 0, 1L << 40, &to)) return 2;
-    if (to >= 0 && to < from) return mr_cli_errorf(cmd, "--to %ld is before --from %ld", to, from), 2;
-    const char *out = mr_cli_get(opts, "out");
-    bool raw = mr_cli_flag(opts, "raw");
     bool groundtruth = false;
-    if (!app_ao_check(cmd, &tables[0], &groundtruth, &gtp)) return 2;
+    if (!app_ao_check(cmd, &tables[1], &groundtruth, &gtp)) return 2;
     if (groundtruth) return mr_cli_errorf(cmd, "--ao groundtruth is for single frames (mrcheck render), not replays"), 2;
-
+    p.out_dir = mr_cli_get(opts, "out");
+    p.video_path = mr_cli_get(opts, "video");
+    p.progress = true;
     mr_error err = {0};
+    /* Everything that can be checked without a GPU is checked first. */
+    if (!mr_batch_replay_check(&p, &err)) return mr_cli_error(cmd, &err), 2;
     mr_recording *rec = mr_recording_open(pos[0], &err);
     if (!rec) return mr_cli_error(cmd, &err);
+    p.recording = rec;
     mr_scene *scene = mr_scene_load(mr_cli_get(opts, "scene"), NULL, &err);
     app_gfx gfx = {0};
-    bool ok = scene && mr_mkdirs(out, &err) && app_gfx_open(&gfx, &err) && mr_renderer_set_scene(gfx.renderer, scene, &err);
-    cJSON *log = cJSON_CreateArray();
-    int rendered = 0, plain = 0, selected = 0;
-    mr_video_writer *vw = NULL;
-    /* the video's rate: the recording's median frame interval */
-    double fps = 10;
-    if (rec->frame_count > 1) {
-        double *dt = malloc((size_t)rec->frame_count * sizeof *dt);
-        int n = 0;
-        for (int i = 1; dt && i < rec->frame_count; i++)
-            if (rec->frames[i].t > rec->frames[i - 1].t) dt[n++] = rec->frames[i].t - rec->frames[i - 1].t;
-        if (n > 0) fps = 1.0 / mr_median(dt, n) / (double)every;
-        free(dt);
-    }
-    for (int i = 0; ok && i < rec->frame_count; i++) {
-        const mr_rec_frame *f = &rec->frames[i];
-        if (f->index < from || (to >= 0 && f->index > to) || (f->index - from) % every != 0) continue;
-        selected++;
-        if (isatty(2)) fprintf(stderr, "\rreplay: frame %lld", (long long)f->index);
-        mr_image img;
-        mr_error fe = {0};
-        if (!mr_recording_load_image(rec, i, false, &img, &fe)) {
-            fprintf(stderr, "mrcheck: replay: warning: frame %lld: %s\n", (long long)f->index, fe.msg);
-            continue;
-        }
-        bool has_pose = (!raw && f->has_filtered) || f->pose.valid;
-        mr_dmat4 pose = !raw && f->has_filtered ? f->filtered : f->pose.world_from_camera;
-        char name[64], path[4096];
-        snprintf(name, sizeof name, "overlay_%06lld.png", (long long)f->index);
-        mr_path_join(out, name, path, sizeof path);
-        if (has_pose) {
-            mr_view view = {mr_camera_resized(&rec->camera, img.width, img.height), pose};
-            mr_frame_params fp = base;
-            fp.video = &img;
-            fp.alpha = (float)alpha;
-            mr_frame_result res;
-            ok = mr_render_frame(gfx.renderer, &view, &fp, &res, &err) && mr_image_save_png(path, &res.color, &err);
-            if (ok && mr_cli_get(opts, "video") && !vw) vw = mr_video_writer_open(mr_cli_get(opts, "video"), res.color.width, res.color.height, fps, &err);
-            if (ok && mr_cli_get(opts, "video")) ok = vw && mr_video_writer_add(vw, &res.color, &err);
-            if (ok) mr_frame_result_free(&res);
-            rendered++;
-        } else {
-            /* No pose: the camera frame alone keeps the sequence complete. */
-            ok = mr_image_save_png(path, &img, &err);
-            if (ok && mr_cli_get(opts, "video") && !vw) vw = mr_video_writer_open(mr_cli_get(opts, "video"), img.width, img.height, fps, &err);
-            if (ok && mr_cli_get(opts, "video")) ok = vw && mr_video_writer_add(vw, &img, &err);
-            plain++;
-        }
-        mr_image_free(&img);
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddNumberToObject(o, "frame", (double)f->index);
-        cJSON_AddNumberToObject(o, "t", f->t);
-        cJSON_AddStringToObject(o, "image", name);
-        cJSON_AddBoolToObject(o, "overlay", has_pose);
-        if (has_pose) cJSON_AddItemToObject(o, "world_from_camera", mr_json_from_dmat4(&pose));
-        cJSON_AddItemToArray(log, o);
-    }
-    if (isatty(2) && selected) fprintf(stderr, "\r\033[K");
-    if (ok && selected == 0) ok = mr_fail(&err, MR_ERR_INVALID, "no recorded frame in the selected range");
-    if (ok) {
-        /* replay.jsonl: one line per written image, written atomically. */
-        size_t cap = 1024, len = 0;
-        char *buf = malloc(cap);
-        cJSON *o;
-        cJSON_ArrayForEach(o, log) {
-            char *s = cJSON_PrintUnformatted(o);
-            size_t n = s ? strlen(s) : 0;
-            if (buf && len + n + 2 > cap) {
-                while (len + n + 2 > cap) cap *= 2;
-                char *nb = realloc(buf, cap);
-                if (!nb) free(buf);
-                buf = nb;
-            }
-            if (buf && s) {
-                memcpy(buf + len, s, n);
-                len += n;
-                buf[len++] = '\n';
-            }
-            free(s);
-        }
-        char path[4096];
-        mr_path_join(out, "replay.jsonl", path, sizeof path);
-        ok = buf ? mr_file_write_atomic(path, buf, len, &err) : mr_fail(&err, MR_ERR_NOMEM, "out of memory");
-        free(buf);
-    }
-    cJSON_Delete(log);
-    if (ok && vw) ok = mr_video_writer_close(&vw, &err);
-    mr_video_writer_abort(&vw); /* after a failure: no half-written video */
+    mr_batch_replay_stats st;
+    bool ok = scene && app_gfx_open(&gfx, &err) && mr_batch_replay(&p, gfx.renderer, scene, &st, &err);
     app_gfx_close(&gfx);
     mr_scene_destroy(&scene);
     mr_recording_close(&rec);
     if (!ok) return mr_cli_error(cmd, &err);
-    printf("replayed %d frames to %s/: %d overlays, %d without a pose (camera frame only)\n", rendered + plain, out,
-           rendered, plain);
+    printf("replayed %d frames to %s/: %d overlays, %d without a pose (camera frame only)\n", st.overlays + st.plain,
+           p.out_dir, st.overlays, st.plain);
     return 0;
 }

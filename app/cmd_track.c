@@ -4,26 +4,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A growing text buffer for the poses file, written atomically at the end. */
-typedef struct strbuf { char *s; size_t len, cap; } strbuf;
-
-static bool sb_add(strbuf *b, const char *s) {
-    size_t n = strlen(s);
-    if (b->len + n + 2 > b->cap) {
-        size_t cap = b->cap ? b->cap * 2 : 65536;
-        while (cap < b->len + n + 2) cap *= 2;
-        char *ns = realloc(b->s, cap);
-        if (!ns) return false;
-        b->s = ns;
-        b->cap = cap;
-    }
-    memcpy(b->s + b->len, s, n);
-    b->len += n;
-    b->s[b->len++] = '\n';
-    b->s[b->len] = 0;
-    return true;
-}
-
 int cmd_track(int argc, char **argv) {
     static const char *cmd = "track";
     mr_cli_opt opts[] = {
@@ -75,7 +55,7 @@ int cmd_track(int argc, char **argv) {
         return mr_cli_errorf(cmd, "--out needs --camera and --markers (or a recording as input)");
     }
     app_catch_signals();
-    strbuf poses = {0};
+    mr_jsonl poses = {0};
     long frames = 0, failed = 0, with_tags = 0, with_pose = 0;
     int rc = 0;
     /* The first bad frame's message is held back: if no frame at all can be
@@ -110,22 +90,23 @@ int cmd_track(int argc, char **argv) {
             cJSON_AddNumberToObject(o, "frame", (double)f.index);
             cJSON_AddItemToObject(o, "detections", mr_detections_json(r.detections, r.detection_count, 1e-3));
             /* with camera and markers the line also carries the pose */
-            if (want_pose) cJSON_AddItemToObject(o, "pose", app_pose_line(f.index, f.timestamp, &r));
+            if (want_pose) cJSON_AddItemToObject(o, "pose", mr_pose_line_json(f.index, f.timestamp, &r));
             char *s = cJSON_PrintUnformatted(o);
             cJSON_Delete(o);
             if (s) puts(s);
             free(s);
         }
         if (want_pose) {
-            cJSON *o = app_pose_line(f.index, f.timestamp, &r);
-            char *s = cJSON_PrintUnformatted(o);
+            cJSON *o = mr_pose_line_json(f.index, f.timestamp, &r);
+            char *s = out || print_det ? NULL : cJSON_PrintUnformatted(o);
+            bool added = !out || mr_jsonl_add(&poses, o);
             cJSON_Delete(o);
-            if (!s || (out && !sb_add(&poses, s))) {
+            if (!added || (!out && !print_det && !s)) {
                 free(s);
                 rc = mr_cli_errorf(cmd, "out of memory");
                 break;
             }
-            if (!out && !print_det) puts(s);
+            if (s) puts(s);
             free(s);
         }
         fflush(stdout);
@@ -133,11 +114,11 @@ int cmd_track(int argc, char **argv) {
     if (rc == 0 && frames == 0) rc = mr_cli_errorf(cmd, "%s: no frames", input);
     else if (rc == 0 && failed == frames)
         rc = mr_cli_errorf(cmd, "no frame could be processed (%ld failed; %s)", failed, held[0] ? held : "see above");
-    if (rc == 0 && out && !mr_file_write_atomic(out, poses.s ? poses.s : "", poses.len, &err)) rc = mr_cli_error(cmd, &err);
+    if (rc == 0 && out && !mr_jsonl_save(&poses, out, &err)) rc = mr_cli_error(cmd, &err);
     if (rc == 0 && mr_log_get_level() >= MR_LOG_INFO)
         fprintf(stderr, "track: %ld frames, %ld with tags, %ld with a pose, %ld failed\n", frames, with_tags, with_pose,
                 failed);
-    free(poses.s);
+    mr_jsonl_free(&poses);
     app_tracker_free(&t);
     mr_source_close(&src);
     return rc;

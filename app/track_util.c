@@ -108,17 +108,3 @@ void app_tracker_free(app_tracker *t) {
     mr_tracker_destroy(&t->tracker);
     memset(t, 0, sizeof *t);
 }
-
-cJSON *app_pose_line(int64_t frame, double t, const mr_tracker_result *r) {
-    cJSON *o = cJSON_CreateObject();
-    cJSON_AddNumberToObject(o, "frame", (double)frame);
-    cJSON_AddNumberToObject(o, "t", t);
-    cJSON_AddBoolToObject(o, "valid", r->pose.valid);
-    if (r->pose.valid) cJSON_AddItemToObject(o, "world_from_camera", mr_json_from_dmat4(&r->pose.world_from_camera));
-    if (r->has_filtered) cJSON_AddItemToObject(o, "filtered", mr_json_from_dmat4(&r->filtered));
-    cJSON_AddNumberToObject(o, "tags_seen", r->pose.tags_seen);
-    cJSON_AddNumberToObject(o, "tags_used", r->pose.tags_used);
-    cJSON_AddNumberToObject(o, "rms_px", r->pose.rms_px);
-    cJSON_AddBoolToObject(o, "ambiguous", r->pose.ambiguous);
-    return o;
-}

@@ -8,6 +8,7 @@
  * mr_opt_defaults equal to the MR_*_DEFAULTS macro field by field, and
  * every numeric option accepts its bounds and rejects a value just outside
  * them with one line naming the option, the range and the value. */
+#include "mr_batch.h"
 #include "mr_bench.h"
 #include "mr_core.h"
 #include "mr_eval.h"
@@ -147,7 +148,7 @@ static void walk_table(const char *name, const mr_opt *table, size_t size, const
                       "%s.%s: a bool must take 1 and refuse 'maybe'", name, o->key);
         } else {
             bool in = o->def >= o->lo && o->def <= o->hi;
-            bool automatic = (o->flags & MR_OPT_ZERO_AUTO) && o->def == 0;
+            bool automatic = ((o->flags & MR_OPT_ZERO_AUTO) && o->def == 0) || ((o->flags & MR_OPT_NEG_AUTO) && o->def < 0);
             CHECK_MSG(o->lo <= o->hi, "%s.%s: empty range [%g, %g]", name, o->key, o->lo, o->hi);
             CHECK_MSG(in || automatic, "%s.%s: default %g outside its range [%g, %g]", name, o->key, o->def, o->lo,
                       o->hi);
@@ -180,7 +181,8 @@ static void walk_table(const char *name, const mr_opt *table, size_t size, const
         unsigned char a[1024];
         memcpy(a, macro, size);
         mr_error e = {0};
-        bool back = o->type == MR_OPT_ENUM || o->type == MR_OPT_BOOL || !(o->flags & MR_OPT_ZERO_AUTO) || o->def != 0;
+        bool back = o->type == MR_OPT_ENUM || o->type == MR_OPT_BOOL ||
+                    !(((o->flags & MR_OPT_ZERO_AUTO) && o->def == 0) || ((o->flags & MR_OPT_NEG_AUTO) && o->def < 0));
         if (back && (o->flags & MR_OPT_ZERO_DEFAULT)) {
             /* The default given by hand is the default the 0 stands for. */
             bool ok = mr_opt_set_row(o, a, def, &e);
@@ -262,6 +264,8 @@ static void test_tables(void) {
     walk_table("mr_bench_ghost_opts", mr_bench_ghost_opts, sizeof bgh, &bgh);
     walk_table("mr_bench_scene_opts", mr_bench_scene_opts, sizeof bsc, &bsc);
     walk_table("mr_bench_tracking_opts", mr_bench_tracking_opts, sizeof btr, &btr);
+    const mr_batch_replay_params rp = MR_BATCH_REPLAY_DEFAULTS;
+    walk_table("mr_batch_replay_opts", mr_batch_replay_opts, sizeof rp, &rp);
 
 #define E(t, k, f, names) {k, offsetof(t, f), 0, 0, names}
 #define N(t, k, f, lo, hi) {k, offsetof(t, f), lo, hi, NULL}
@@ -337,10 +341,18 @@ static void test_tables(void) {
         N(mr_bench_tracking_params, "min-cutoff", min_cutoff, 1e-3, 100),
         N(mr_bench_tracking_params, "beta", beta, 1e-6, 1000),
     };
+    const expect ex_rp[] = {
+        N(mr_batch_replay_params, "alpha", alpha, 0, 1),
+        N(mr_batch_replay_params, "every", every, 1, 1 << 30),
+        N(mr_batch_replay_params, "from", from, 0, 2147483647),
+        N(mr_batch_replay_params, "to", to, 0, 2147483647),
+        N(mr_batch_replay_params, "raw", raw, 0, 1),
+    };
 #undef E
 #undef N
 #define ROWS(t, ex) check_rows(#t, t, ex, (int)(sizeof ex / sizeof ex[0]))
     ROWS(mr_gt_opts, ex_gt);
+    ROWS(mr_batch_replay_opts, ex_rp);
     ROWS(mr_bench_ao_opts, ex_bao);
     ROWS(mr_bench_frame_opts, ex_bfr);
     ROWS(mr_bench_ghost_opts, ex_bgh);

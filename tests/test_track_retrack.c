@@ -6,7 +6,7 @@
  * `track --input DIR` parses to, frames read and tracked as cmd_track's
  * loop does. That it is what the command does is checked too: the real
  * `mrcheck track --input DIR` (MR_MRCHECK names the binary) must print
- * exactly the lines app_pose_line makes of these results (cJSON prints
+ * exactly the lines mr_pose_line_json makes of these results (cJSON prints
  * doubles to ~1e-15, not bit for bit, so the bits are compared in
  * process). The view side is the
  * view's own capture code, lib/session/capture.c (mr_capture_*):
@@ -76,7 +76,7 @@ static int track_in_process(const char *dir, track_line *lines, char **printed) 
         l->tags_seen = r.pose.tags_seen;
         l->tags_used = r.pose.tags_used;
         l->rms_px = r.pose.rms_px;
-        cJSON *o = app_pose_line(f.index, f.timestamp, &r);
+        cJSON *o = mr_pose_line_json(f.index, f.timestamp, &r);
         char *s = cJSON_PrintUnformatted(o);
         cJSON_Delete(o);
         size_t k = s ? strlen(s) : 0;

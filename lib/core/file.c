@@ -110,3 +110,37 @@ void mr_path_join(const char *dir, const char *rel, char *out, size_t n) {
     if (rel[0] == '/' || !dir || !dir[0] || strcmp(dir, ".") == 0) snprintf(out, n, "%s", rel);
     else snprintf(out, n, "%s/%s", dir, rel);
 }
+
+bool mr_jsonl_add(mr_jsonl *b, const cJSON *item) {
+    char *s = b->failed ? NULL : cJSON_PrintUnformatted(item);
+    size_t n = s ? strlen(s) : 0;
+    if (s && b->len + n + 2 > b->cap) {
+        size_t cap = b->cap ? b->cap : 4096;
+        while (cap < b->len + n + 2) cap *= 2;
+        char *t = realloc(b->text, cap);
+        if (t) {
+            b->text = t;
+            b->cap = cap;
+        } else {
+            free(s);
+            s = NULL;
+        }
+    }
+    if (!s) return !(b->failed = true);
+    memcpy(b->text + b->len, s, n);
+    b->len += n;
+    b->text[b->len++] = '\n';
+    b->text[b->len] = 0;
+    free(s);
+    return true;
+}
+
+bool mr_jsonl_save(const mr_jsonl *b, const char *path, mr_error *err) {
+    if (b->failed) return mr_fail(err, MR_ERR_NOMEM, "%s: out of memory", path);
+    return mr_file_write_atomic(path, b->text ? b->text : "", b->len, err);
+}
+
+void mr_jsonl_free(mr_jsonl *b) {
+    free(b->text);
+    memset(b, 0, sizeof *b);
+}

@@ -178,6 +178,20 @@ void *mr_file_read(const char *path, size_t *size, size_t max_bytes, mr_error *e
 /* Writes data to path.tmp.<pid> then renames over path, so a reader never
  * sees a half-written file. */
 bool mr_file_write_atomic(const char *path, const void *data, size_t size, mr_error *err);
+/* JSON Lines gathered in memory and written at once with
+ * mr_file_write_atomic: for outputs that are whole only when a run ends
+ * (poses.jsonl, replay.jsonl), so an interrupted run leaves no half file.
+ * Zero-initialise; an allocation failure is remembered and reported by
+ * mr_jsonl_save. */
+typedef struct mr_jsonl {
+    char *text;
+    size_t len, cap;
+    bool failed;
+} mr_jsonl;
+/* Appends one line (the item unformatted); false if memory ran out. */
+bool mr_jsonl_add(mr_jsonl *b, const cJSON *item);
+bool mr_jsonl_save(const mr_jsonl *b, const char *path, mr_error *err);
+void mr_jsonl_free(mr_jsonl *b);
 bool mr_file_exists(const char *path);
 bool mr_mkdirs(const char *path, mr_error *err); /* mkdir -p */
 /* Directory part of a path ("." if none), into out (size n). */
@@ -238,6 +252,9 @@ typedef enum mr_opt_type {
  * express this mapping (e.g. --refine-edges 0 -> -1), and changing the
  * fields' meaning would break every zero-initialised params struct. */
 #define MR_OPT_ZERO_DEFAULT 2u
+/* The default is negative and means "chosen at run time" (--to: the last
+ * frame); a user sets values in [lo, hi] only. */
+#define MR_OPT_NEG_AUTO 4u
 
 typedef struct mr_opt {
     const char *key;          /* file / UI name; on the command line prefix + key,
@@ -248,7 +265,7 @@ typedef struct mr_opt {
     double def;               /* default (enums: the index) */
     const char *const *names; /* enums: names by value, NULL-terminated */
     const char *help;         /* one line, no default or range (added from the row) */
-    unsigned flags;           /* MR_OPT_ZERO_AUTO, MR_OPT_ZERO_DEFAULT */
+    unsigned flags;           /* MR_OPT_ZERO_AUTO, MR_OPT_ZERO_DEFAULT, MR_OPT_NEG_AUTO */
 } mr_opt;
 
 /* The row named key; NULL if none. */

@@ -176,7 +176,8 @@ void mr_opt_format(const mr_opt *o, const void *params, char *out, size_t n) {
 
 void mr_opt_describe(const mr_opt *o, char *out, size_t n) {
     char def[64];
-    if ((o->flags & MR_OPT_ZERO_AUTO) && o->def == 0) snprintf(def, sizeof def, "auto");
+    if (((o->flags & MR_OPT_ZERO_AUTO) && o->def == 0) || ((o->flags & MR_OPT_NEG_AUTO) && o->def < 0))
+        snprintf(def, sizeof def, "auto");
     else format_value(o, o->def, def, sizeof def);
     switch (o->type) {
     case MR_OPT_BOOL: snprintf(out, n, "(default %s)", o->def != 0 ? "on" : "off"); break;

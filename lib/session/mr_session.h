@@ -72,6 +72,10 @@ bool mr_recorder_append(mr_recorder *r, mr_frame_record *rec, const mr_image *im
  * `track` output uses 1/1000 px, far below the detector's accuracy); 0
  * keeps them exact (recordings, which are read back). */
 cJSON *mr_detections_json(const mr_detection *d, int n, double quantum_px);
+/* One line of `track`'s poses.jsonl: {"frame", "t", "valid",
+ * "world_from_camera" (if valid), "filtered" (if any), "tags_seen",
+ * "tags_used", "rms_px", "ambiguous"}. */
+cJSON *mr_pose_line_json(int64_t frame, double t, const mr_tracker_result *r);
 /* Appends a ground-truth line (recorders created with ground_truth). */
 bool mr_recorder_ground_truth(mr_recorder *r, int64_t index, double t, const mr_dmat4 *world_from_camera, bool still,
                               mr_error *err);

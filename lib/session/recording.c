@@ -110,6 +110,20 @@ cJSON *mr_detections_json(const mr_detection *d, int n, double quantum_px) {
     return a;
 }
 
+cJSON *mr_pose_line_json(int64_t frame, double t, const mr_tracker_result *r) {
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "frame", (double)frame);
+    cJSON_AddNumberToObject(o, "t", t);
+    cJSON_AddBoolToObject(o, "valid", r->pose.valid);
+    if (r->pose.valid) cJSON_AddItemToObject(o, "world_from_camera", mr_json_from_dmat4(&r->pose.world_from_camera));
+    if (r->has_filtered) cJSON_AddItemToObject(o, "filtered", mr_json_from_dmat4(&r->filtered));
+    cJSON_AddNumberToObject(o, "tags_seen", r->pose.tags_seen);
+    cJSON_AddNumberToObject(o, "tags_used", r->pose.tags_used);
+    cJSON_AddNumberToObject(o, "rms_px", r->pose.rms_px);
+    cJSON_AddBoolToObject(o, "ambiguous", r->pose.ambiguous);
+    return o;
+}
+
 bool mr_recorder_append(mr_recorder *r, mr_frame_record *rec, const mr_image *image, mr_error *err) {
     rec->index = r->next;
     rec->image[0] = 0;

@@ -1,0 +1,64 @@
+/* mr_batch.h — headless runs of the libraries over a whole recording: what
+ * `mrcheck replay` does, as library code with a params struct and an option
+ * table, so the command is argument parsing and one call.
+ *
+ * Depends on: lib/render (the frame), lib/scene, lib/session (recordings),
+ * lib/eval (the median),
+ * lib/track (the video writer), lib/core. Nothing below includes it.
+ */
+#ifndef MR_BATCH_H
+#define MR_BATCH_H
+
+#include "mr_core.h"
+#include "mr_render.h"
+#include "mr_scene.h"
+#include "mr_session.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Overlays of a recording's frames with the planned model at their
+ * recorded poses: out_dir/overlay_NNNNNN.png per selected frame (the camera
+ * frame alone where the frame has no pose, so the sequence stays complete),
+ * out_dir/replay.jsonl ({"frame", "t", "image", "overlay",
+ * "world_from_camera"} per written image, written atomically at the end),
+ * and optionally a Motion-JPEG AVI at the recording's median frame rate
+ * divided by `every` (no half-written video after a failure).
+ * Deterministic: the same recording gives the same images. */
+typedef struct mr_batch_replay_params {
+    const mr_recording *recording; /* required (mr_recording_open) */
+    const char *out_dir;        /* required; created */
+    const char *video_path;     /* the AVI, or NULL */
+    mr_frame_params frame;      /* depth cues (AO, ghosting, ...); video and alpha are set per frame */
+    float alpha;                /* video transparency: 0 model only, 1 video only; default 0.5 */
+    int every;                  /* every Nth frame counted from `from`; default 1 */
+    int from;                   /* first frame number; default 0 */
+    int to;                     /* last frame number; < 0 (the default): the last */
+    bool raw;                   /* the raw pose, not the filtered one */
+    bool progress;              /* "replay: frame N" on a terminal */
+} mr_batch_replay_params;
+#define MR_BATCH_REPLAY_DEFAULT_ALPHA 0.5f
+#define MR_BATCH_REPLAY_DEFAULTS                                                                   \
+    {.frame = MR_FRAME_DEFAULTS, .alpha = MR_BATCH_REPLAY_DEFAULT_ALPHA, .every = 1, .from = 0, .to = -1}
+/* alpha, every, from, to, raw. */
+extern const mr_opt mr_batch_replay_opts[];
+
+typedef struct mr_batch_replay_stats {
+    int overlays;               /* frames rendered with the model */
+    int plain;                  /* frames written without a pose (camera frame only) */
+} mr_batch_replay_stats;
+
+/* The checks that need neither the recording nor a GPU: a folder is given,
+ * to is not before from. False + one line in err. */
+bool mr_batch_replay_check(const mr_batch_replay_params *p, mr_error *err);
+/* Sets scene on r, renders, and leaves no scene set. A frame whose image
+ * cannot be read is skipped with a warning on stderr; no frame in the
+ * range or a failed write: false + err. */
+bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_scene *scene,
+                     mr_batch_replay_stats *stats, mr_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,120 @@
+/* mr_batch_replay: a recording's frames rendered with the plan at their
+ * recorded poses (`mrcheck replay`). */
+#include "mr_batch.h"
+
+#include "mr_eval.h"
+#include "mr_track.h"
+
+#include <stddef.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#define RP(f) offsetof(mr_batch_replay_params, f)
+const mr_opt mr_batch_replay_opts[] = {
+    {"alpha", MR_OPT_FLOAT, RP(alpha), 0, 1, MR_BATCH_REPLAY_DEFAULT_ALPHA, NULL,
+     "video transparency: 0 = virtual only, 1 = video only", 0},
+    {"every", MR_OPT_INT, RP(every), 1, 1 << 30, 1, NULL, "every Nth frame", 0},
+    {"from", MR_OPT_INT, RP(from), 0, 2147483647, 0, NULL, "first frame number", 0},
+    {"to", MR_OPT_INT, RP(to), 0, 2147483647, -1, NULL, "last frame number (auto: the last)", MR_OPT_NEG_AUTO},
+    {"raw", MR_OPT_BOOL, RP(raw), 0, 1, 0, NULL, "use the raw pose instead of the filtered one", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef RP
+
+bool mr_batch_replay_check(const mr_batch_replay_params *p, mr_error *err) {
+    if (!p->out_dir) return mr_fail(err, MR_ERR_INVALID, "replay needs an output folder");
+    if (p->to >= 0 && p->to < p->from)
+        return mr_fail(err, MR_ERR_INVALID, "--to %d is before --from %d", p->to, p->from);
+    return true;
+}
+
+/* The video's rate: the recording's median frame interval. */
+static double recording_fps(const mr_recording *rec, int every) {
+    double fps = 10;
+    if (rec->frame_count < 2) return fps;
+    double *dt = malloc((size_t)rec->frame_count * sizeof *dt);
+    int n = 0;
+    for (int i = 1; dt && i < rec->frame_count; i++)
+        if (rec->frames[i].t > rec->frames[i - 1].t) dt[n++] = rec->frames[i].t - rec->frames[i - 1].t;
+    if (n > 0) fps = 1.0 / mr_median(dt, n) / (double)every;
+    free(dt);
+    return fps;
+}
+
+/* The AVI gets every written image; opened at the first one's size. */
+static bool video_add(const mr_batch_replay_params *p, mr_video_writer **vw, const mr_image *img, double fps,
+                      mr_error *err) {
+    if (!p->video_path) return true;
+    if (!*vw) *vw = mr_video_writer_open(p->video_path, img->width, img->height, fps, err);
+    return *vw && mr_video_writer_add(*vw, img, err);
+}
+
+bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_scene *scene,
+                     mr_batch_replay_stats *stats, mr_error *err) {
+    mr_batch_replay_stats st = {0};
+    if (stats) *stats = st;
+    if (!mr_batch_replay_check(p, err)) return false;
+    if (!p->recording) return mr_fail(err, MR_ERR_INVALID, "replay needs a recording");
+    const int every = p->every > 0 ? p->every : 1;
+    const mr_recording *rec = p->recording;
+    bool ok = mr_mkdirs(p->out_dir, err) && mr_renderer_set_scene(r, scene, err);
+    mr_jsonl log = {0};
+    mr_video_writer *vw = NULL;
+    const double fps = recording_fps(rec, every);
+    const bool tty = p->progress && isatty(2);
+    int selected = 0;
+    for (int i = 0; ok && i < rec->frame_count; i++) {
+        const mr_rec_frame *f = &rec->frames[i];
+        if (f->index < p->from || (p->to >= 0 && f->index > p->to) || (f->index - p->from) % every != 0) continue;
+        selected++;
+        if (tty) fprintf(stderr, "\rreplay: frame %lld", (long long)f->index);
+        mr_image img;
+        mr_error fe = {0};
+        if (!mr_recording_load_image(rec, i, false, &img, &fe)) {
+            fprintf(stderr, "mrcheck: replay: warning: frame %lld: %s\n", (long long)f->index, fe.msg);
+            continue;
+        }
+        bool has_pose = (!p->raw && f->has_filtered) || f->pose.valid;
+        mr_dmat4 pose = !p->raw && f->has_filtered ? f->filtered : f->pose.world_from_camera;
+        char name[64], path[4096];
+        snprintf(name, sizeof name, "overlay_%06lld.png", (long long)f->index);
+        mr_path_join(p->out_dir, name, path, sizeof path);
+        if (has_pose) {
+            mr_view view = {mr_camera_resized(&rec->camera, img.width, img.height), pose};
+            mr_frame_params fp = p->frame;
+            fp.video = &img;
+            fp.alpha = p->alpha;
+            mr_frame_result res;
+            ok = mr_render_frame(r, &view, &fp, &res, err) && mr_image_save_png(path, &res.color, err) &&
+                 video_add(p, &vw, &res.color, fps, err);
+            if (ok) mr_frame_result_free(&res);
+            st.overlays++;
+        } else {
+            /* No pose: the camera frame alone keeps the sequence complete. */
+            ok = mr_image_save_png(path, &img, err) && video_add(p, &vw, &img, fps, err);
+            st.plain++;
+        }
+        mr_image_free(&img);
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "frame", (double)f->index);
+        cJSON_AddNumberToObject(o, "t", f->t);
+        cJSON_AddStringToObject(o, "image", name);
+        cJSON_AddBoolToObject(o, "overlay", has_pose);
+        if (has_pose) cJSON_AddItemToObject(o, "world_from_camera", mr_json_from_dmat4(&pose));
+        mr_jsonl_add(&log, o);
+        cJSON_Delete(o);
+    }
+    if (tty && selected) fprintf(stderr, "\r\033[K");
+    if (ok && selected == 0) ok = mr_fail(err, MR_ERR_INVALID, "no recorded frame in the selected range");
+    if (ok) {
+        char path[4096];
+        mr_path_join(p->out_dir, "replay.jsonl", path, sizeof path);
+        ok = mr_jsonl_save(&log, path, err);
+    }
+    mr_jsonl_free(&log);
+    if (ok && vw) ok = mr_video_writer_close(&vw, err);
+    mr_video_writer_abort(&vw); /* after a failure: no half-written video */
+    mr_renderer_set_scene(r, NULL, &(mr_error){0});
+    if (stats) *stats = st;
+    return ok;
+}
