@@ -76,61 +76,18 @@ typedef struct view_app {
     int64_t fps_frames;
 } view_app;
 
-static cJSON *pose_json(const mr_capture_frame *f) {
-    cJSON *p = cJSON_CreateObject();
-    cJSON_AddBoolToObject(p, "valid", f->pose_valid);
-    cJSON_AddItemToObject(p, "world_from_camera", mr_json_from_dmat4(&f->pose));
-    cJSON_AddNumberToObject(p, "tags_seen", f->tags_seen);
-    cJSON_AddNumberToObject(p, "rms_px", f->rms_px);
-    return p;
-}
-
-/* snapshots/<stem>_screen.png, <stem>_frame.png, <stem>.json, each written
- * atomically; rel gets the three paths relative to the session folder. */
-static bool write_snapshot(view_app *a, const char *stem, const mr_image *screen, const mr_capture_frame *f, cJSON *rel,
-                           mr_error *err) {
-    char dir[4096], path[8192], name[256];
-    mr_path_join(a->session_dir, "snapshots", dir, sizeof dir);
-    if (!mr_mkdirs(dir, err)) return false;
-    snprintf(name, sizeof name, "%s_screen.png", stem);
-    mr_path_join(dir, name, path, sizeof path);
-    if (!mr_image_save_png(path, screen, err)) return false;
-    if (rel) cJSON_AddItemToObject(rel, "screen", cJSON_CreateString(path + strlen(a->session_dir) + 1));
-    if (f && f->image.data) {
-        snprintf(name, sizeof name, "%s_frame.png", stem);
-        mr_path_join(dir, name, path, sizeof path);
-        if (!mr_image_save_png(path, &f->image, err)) return false;
-        if (rel) cJSON_AddItemToObject(rel, "frame", cJSON_CreateString(path + strlen(a->session_dir) + 1));
-    }
-    cJSON *j = cJSON_CreateObject();
-    cJSON_AddItemToObject(j, "camera", mr_camera_to_json(&a->camera));
-    if (f) {
-        cJSON_AddNumberToObject(j, "frame_index", (double)f->index);
-        cJSON_AddNumberToObject(j, "timestamp", f->timestamp);
-        cJSON_AddItemToObject(j, "pose", pose_json(f));
-    }
-    cJSON_AddNumberToObject(j, "alpha", mr_viewer_settings(a->vc)->alpha);
-    cJSON_AddStringToObject(j, "passes", a->passes);
-    snprintf(name, sizeof name, "%s.json", stem);
-    mr_path_join(dir, name, path, sizeof path);
-    bool ok = mr_json_save(path, j, err);
-    cJSON_Delete(j);
-    if (ok && rel) cJSON_AddItemToObject(rel, "pose", cJSON_CreateString(path + strlen(a->session_dir) + 1));
-    return ok;
+/* What a snapshot of this frame's screen records. */
+static mr_snapshot snapshot_of(const view_app *a, const mr_image *screen, const mr_capture_frame *f) {
+    mr_snapshot sn = {screen, f, &a->camera, mr_viewer_settings(a->vc)->alpha, a->passes};
+    return sn;
 }
 
 static void do_snapshot(view_app *a, const mr_image *screen) {
     char stem[64];
-    snprintf(stem, sizeof stem, "snap_%04d", ++a->snap_count);
-    /* Never overwrite an earlier session's files. */
-    char probe[8192];
-    for (;;) {
-        snprintf(probe, sizeof probe, "%s/snapshots/%s.json", a->session_dir, stem);
-        if (!mr_file_exists(probe)) break;
-        snprintf(stem, sizeof stem, "snap_%04d", ++a->snap_count);
-    }
+    mr_snapshot_next_stem(a->session_dir, "snap", &a->snap_count, stem, sizeof stem);
     mr_error err = {0};
-    if (write_snapshot(a, stem, screen, a->have_frame ? &a->frame : NULL, NULL, &err))
+    mr_snapshot sn = snapshot_of(a, screen, a->have_frame ? &a->frame : NULL);
+    if (mr_snapshot_write(a->session_dir, stem, &sn, NULL, &err))
         mr_viewer_toast(a->vc, "snapshot saved: snapshots/%s_*", stem);
     else mr_viewer_toast(a->vc, "snapshot failed: %s", err.msg);
 }
@@ -215,9 +172,8 @@ static void finish_mark(view_app *a, int note) {
     snprintf(stem, sizeof stem, "mark_%ld_%04d", (long)time(NULL), a->mark_count);
     cJSON *line = mark_line(a, note);
     cJSON *snap = cJSON_CreateObject();
-    bool ok = a->mark_screen.data != NULL &&
-              write_snapshot(a, stem, &a->mark_screen, &a->mark_frame, snap, &err);
-    if (!ok && !err.msg[0]) snprintf(err.msg, sizeof err.msg, "no screen image");
+    mr_snapshot sn = snapshot_of(a, &a->mark_screen, &a->mark_frame);
+    bool ok = mr_snapshot_write(a->session_dir, stem, &sn, snap, &err);
     cJSON_AddItemToObject(line, "snapshot", snap);
     char path[8192];
     mr_path_join(a->session_dir, "annotations.jsonl", path, sizeof path);
@@ -308,16 +264,6 @@ static void render_3d(view_app *a) {
     if (a->res.ao_reused) strncat(a->passes, " (ao reused)", sizeof a->passes - strlen(a->passes) - 1);
 }
 
-/* Mean absolute difference between two RGB8 images of one size (0..255). */
-static double mean_abs_diff(const mr_image *x, const mr_image *y) {
-    if (!x->data || !y->data || x->width != y->width || x->height != y->height) return -1;
-    const uint8_t *p = x->data, *q = y->data;
-    size_t n = mr_image_bytes(x);
-    double s = 0;
-    for (size_t i = 0; i < n; i++) s += abs((int)p[i] - (int)q[i]);
-    return n ? s / (double)n : 0;
-}
-
 static const char *source_state_name(mr_capture_status st) {
     return st == MR_CAPTURE_RUNNING ? "running" : st == MR_CAPTURE_NO_CAMERA ? "no_camera" : st == MR_CAPTURE_ENDED ? "ended" : "starting";
 }
@@ -338,16 +284,10 @@ static void write_state(view_app *a, const mr_image *screen) {
     cJSON_AddStringToObject(j, "scene_message", a->scene_msg);
     if (screen && screen->data) {
         /* Spread of the screen's pixel values: a blank window has none. */
-        const uint8_t *p = screen->data;
-        size_t n = mr_image_bytes(screen);
-        double sum = 0, s2 = 0;
-        for (size_t i = 0; i < n; i++) {
-            sum += p[i];
-            s2 += (double)p[i] * p[i];
-        }
-        double mean = n ? sum / n : 0;
+        double mean, std;
+        mr_image_u8_stats(screen, &mean, &std);
         cJSON_AddNumberToObject(j, "screen_mean", mean);
-        cJSON_AddNumberToObject(j, "screen_std", n ? sqrt(fmax(0, s2 / n - mean * mean)) : 0);
+        cJSON_AddNumberToObject(j, "screen_std", std);
     }
     if (a->have_res && a->have_frame && a->frame.have_pose) {
         cJSON_AddNumberToObject(j, "render_width", a->rw);
@@ -368,7 +308,7 @@ static void write_state(view_app *a, const mr_image *screen) {
             mr_frame_result r;
             mr_error err = {0};
             if (mr_render_frame(a->rend, &view, &fp, &r, &err)) {
-                d[k] = mean_abs_diff(&a->res.color, &r.color);
+                d[k] = mr_image_u8_mean_abs_diff(&a->res.color, &r.color);
                 mr_frame_result_free(&r);
             }
         }

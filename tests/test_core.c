@@ -432,6 +432,55 @@ static void test_rng_and_errors(void) {
     CHECK(!mr_fail(NULL, MR_ERR_IO, "ignored")); /* NULL err is allowed */
 }
 
+/* The view's state numbers (screen spread, distance between renderings)
+ * and the JSON Lines buffer of track and replay. */
+static void test_image_stats_and_jsonl(void) {
+    mr_image a = {0}, b = {0}, f = {0};
+    mr_error err = {0};
+    CHECK(mr_image_alloc(&a, 4, 2, 3, MR_PIX_U8, &err) && mr_image_alloc(&b, 4, 2, 3, MR_PIX_U8, &err));
+    memset(a.data, 10, mr_image_bytes(&a));
+    memset(b.data, 10, mr_image_bytes(&b));
+    double mean = -1, sd = -1;
+    mr_image_u8_stats(&a, &mean, &sd);
+    CHECK(mean == 10 && sd == 0); /* a blank picture has no spread */
+    ((uint8_t *)a.data)[0] = 250;  /* one sample of 24 differs by 240 */
+    mr_image_u8_stats(&a, &mean, &sd);
+    CHECK(fabs(mean - 20) < 1e-12 && fabs(sd - sqrt((240.0 * 240 * 23 / 24) / 24)) < 1e-9);
+    CHECK(fabs(mr_image_u8_mean_abs_diff(&a, &b) - 10) < 1e-12);
+    CHECK(mr_image_u8_mean_abs_diff(&a, &b) == mr_image_u8_mean_abs_diff(&b, &a));
+    CHECK(mr_image_alloc(&f, 4, 2, 3, MR_PIX_F32, &err));
+    CHECK(mr_image_u8_mean_abs_diff(&a, &f) == -1); /* not comparable */
+    mr_image_free(&b);
+    CHECK(mr_image_alloc(&b, 2, 4, 3, MR_PIX_U8, &err));
+    CHECK(mr_image_u8_mean_abs_diff(&a, &b) == -1);
+    mr_image_free(&a);
+    mr_image_free(&b);
+    mr_image_free(&f);
+
+    mr_jsonl l = {0};
+    for (int i = 0; i < 3000; i++) { /* past the first few growths */
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "frame", i);
+        CHECK(mr_jsonl_add(&l, o));
+        cJSON_Delete(o);
+    }
+    char path[4200];
+    snprintf(path, sizeof path, "%s/lines.jsonl", g_tmp);
+    CHECK(mr_jsonl_save(&l, path, &err));
+    size_t n = 0;
+    char *text = mr_file_read(path, &n, 0, &err);
+    CHECK(text && n == l.len && strncmp(text, "{\"frame\":0}\n{\"frame\":1}\n", 24) == 0);
+    int lines = 0;
+    for (size_t i = 0; text && i < n; i++) lines += text[i] == '\n';
+    CHECK(lines == 3000 && text && strstr(text, "{\"frame\":2999}\n") == text + n - 15);
+    free(text);
+    l.failed = true; /* an earlier allocation failure is reported, nothing written */
+    snprintf(path, sizeof path, "%s/lines_failed.jsonl", g_tmp);
+    CHECK(!mr_jsonl_save(&l, path, &err) && err.code == MR_ERR_NOMEM && !mr_file_exists(path));
+    mr_jsonl_free(&l);
+    CHECK(l.text == NULL && l.len == 0);
+}
+
 int main(void) {
     const char *tmp = getenv("MR_TEST_TMP");
     snprintf(g_tmp, sizeof g_tmp, "%s/core", tmp ? tmp : "/tmp/mrcheck-test");
@@ -447,5 +496,6 @@ int main(void) {
     test_atomic_writes();
     test_images();
     test_rng_and_errors();
+    test_image_stats_and_jsonl();
     return mr_test_finish("test_core");
 }

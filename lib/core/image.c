@@ -157,3 +157,29 @@ bool mr_image_sample_bilinear(const mr_image *img, double x, double y, float *ou
     }
     return true;
 }
+
+void mr_image_u8_stats(const mr_image *img, double *mean, double *std) {
+    *mean = *std = 0;
+    if (!img->data || img->type != MR_PIX_U8) return;
+    const uint8_t *p = img->data;
+    size_t n = mr_image_bytes(img);
+    double sum = 0, s2 = 0;
+    for (size_t i = 0; i < n; i++) {
+        sum += p[i];
+        s2 += (double)p[i] * p[i];
+    }
+    if (!n) return;
+    *mean = sum / (double)n;
+    *std = sqrt(fmax(0, s2 / (double)n - *mean * *mean));
+}
+
+double mr_image_u8_mean_abs_diff(const mr_image *a, const mr_image *b) {
+    if (!a->data || !b->data || a->type != MR_PIX_U8 || b->type != MR_PIX_U8 || a->width != b->width ||
+        a->height != b->height || a->channels != b->channels)
+        return -1;
+    const uint8_t *p = a->data, *q = b->data;
+    size_t n = mr_image_bytes(a);
+    double s = 0;
+    for (size_t i = 0; i < n; i++) s += abs((int)p[i] - (int)q[i]);
+    return n ? s / (double)n : 0;
+}

@@ -214,6 +214,12 @@ typedef struct mr_image {
 bool mr_image_alloc(mr_image *img, int width, int height, int channels, mr_pixel_type type, mr_error *err);
 void mr_image_free(mr_image *img); /* frees data, zeroes the struct */
 size_t mr_image_bytes(const mr_image *img);
+/* 8-bit images: mean and standard deviation of all sample values (0..255);
+ * a blank picture has no spread. 0, 0 for an empty or non-8-bit image. */
+void mr_image_u8_stats(const mr_image *img, double *mean, double *std);
+/* 8-bit images of one size and layout: mean absolute difference of their
+ * samples (0..255); -1 if they cannot be compared. */
+double mr_image_u8_mean_abs_diff(const mr_image *a, const mr_image *b);
 /* Loads PNG/JPEG/etc. (stb_image) as 8-bit with `channels` channels (0 =
  * as stored). */
 bool mr_image_load(const char *path, int channels, mr_image *img, mr_error *err);

@@ -94,12 +94,18 @@ cJSON *mr_annotation_to_json(const mr_annotation *a) {
     } else {
         cJSON_AddNullToObject(line, "node");
     }
-    cJSON *p = cJSON_AddObjectToObject(line, "pose");
-    cJSON_AddBoolToObject(p, "valid", a->pose_valid);
-    cJSON_AddItemToObject(p, "world_from_camera", mr_json_from_dmat4(&a->world_from_camera));
-    cJSON_AddNumberToObject(p, "tags_seen", a->pose_tags_seen);
-    cJSON_AddNumberToObject(p, "rms_px", a->pose_rms_px);
+    cJSON_AddItemToObject(line, "pose",
+                          mr_sess_pose_json(a->pose_valid, &a->world_from_camera, a->pose_tags_seen, a->pose_rms_px));
     return line;
+}
+
+cJSON *mr_sess_pose_json(bool valid, const mr_dmat4 *world_from_camera, int tags_seen, double rms_px) {
+    cJSON *p = cJSON_CreateObject();
+    cJSON_AddBoolToObject(p, "valid", valid);
+    cJSON_AddItemToObject(p, "world_from_camera", mr_json_from_dmat4(world_from_camera));
+    cJSON_AddNumberToObject(p, "tags_seen", tags_seen);
+    cJSON_AddNumberToObject(p, "rms_px", rms_px);
+    return p;
 }
 
 static bool parse_annotation(const cJSON *o, mr_annotation *a) {

@@ -303,6 +303,28 @@ void mr_capture_freeze(mr_capture *c, bool frozen);
  * newer one arrived first (newest wins), tracking time sum in ms. */
 void mr_capture_counts(mr_capture *c, int64_t *read, int64_t *tracked, int64_t *dropped, double *track_ms_sum);
 
+/* ------------------------------------------------------------ snapshots
+ * snapshot.c: what the view writes when the planner freezes a picture or
+ * marks a discrepancy. */
+
+typedef struct mr_snapshot {
+    const mr_image *screen;          /* required: the picture as shown */
+    const mr_capture_frame *frame;   /* the camera frame it was drawn from, or NULL */
+    const mr_camera *camera;         /* required */
+    double alpha;                    /* the video transparency it was shown with */
+    const char *passes;              /* the frame's pass list, or NULL */
+} mr_snapshot;
+
+/* session_dir/snapshots/<stem>_screen.png, <stem>_frame.png (when the frame
+ * has an image) and <stem>.json ({camera, frame_index, timestamp, pose,
+ * alpha, passes}; pose as in annotation lines), each written atomically.
+ * rel (may be NULL) gets "screen", "frame" and "pose": the written paths
+ * relative to session_dir, for an annotation line to point at. */
+bool mr_snapshot_write(const char *session_dir, const char *stem, const mr_snapshot *s, cJSON *rel, mr_error *err);
+/* The next "<prefix>_NNNN" (counting on from *counter, which it advances)
+ * whose <stem>.json no earlier session wrote, into stem: never overwrite. */
+void mr_snapshot_next_stem(const char *session_dir, const char *prefix, int *counter, char *stem, size_t n);
+
 #ifdef __cplusplus
 }
 #endif

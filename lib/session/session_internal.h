@@ -23,4 +23,8 @@ char *mr_sess_json_line(const cJSON *obj, size_t *n);
  * from now on, or NULL when out of memory (items is then left as it was). */
 void *mr_sess_grow(void *items, int count, int *cap, int first, size_t elem);
 
+/* The pose object annotation lines and snapshot files share:
+ * {valid, world_from_camera, tags_seen, rms_px}. */
+cJSON *mr_sess_pose_json(bool valid, const mr_dmat4 *world_from_camera, int tags_seen, double rms_px);
+
 #endif
