@@ -368,6 +368,28 @@ typedef struct mr_calib_view {
 bool mr_calibrate(const mr_calib_view *views, int nviews, int width, int height, mr_camera *out, double *rms_px,
                   double *per_view_rms, mr_error *err);
 
+/* `mrcheck calibrate`: a folder of images of a planar tag board (a marker
+ * map whose tags all lie in its z = 0 plane), each detected at full
+ * resolution; images of another size than the first, or with fewer than
+ * min_tags board tags, are skipped (with a warning on stderr for the
+ * former and unreadable ones); then mr_calibrate over the rest. */
+typedef struct mr_board_calib_params {
+    const char *images;           /* folder (png, jpg, ...); required */
+    const mr_marker_map *board;   /* required */
+    const char *board_name;       /* for messages (its file), or NULL */
+    int min_tags;                 /* 0 = 4 */
+} mr_board_calib_params;
+#define MR_BOARD_CALIB_DEFAULT_MIN_TAGS 4
+typedef struct mr_board_calib {
+    mr_camera camera;
+    double rms_px;                /* RMS reprojection error over all views */
+    int views, skipped;           /* images used and left out */
+    char (*names)[256];           /* the used images' names, views of them */
+    double *view_rms_px;          /* their own RMS, views of them */
+} mr_board_calib;
+bool mr_calibrate_board(const mr_board_calib_params *p, mr_board_calib *out, mr_error *err);
+void mr_board_calib_free(mr_board_calib *c);
+
 /* ------------------------------------------------------- video writing */
 
 /* Motion-JPEG AVI through OpenCV, written to a temporary file and renamed
