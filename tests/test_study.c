@@ -162,6 +162,267 @@ static void test_disconnected(void) {
     CHECK_NEAR(s.theta[0], s.theta[1], 1e-9);
 }
 
+
+/* ------------------------------------------------------- plan and votes */
+
+static bool write_png(const char *dir, const char *method, const char *stim, int grey) {
+    char path[8300], d[4200];
+    snprintf(d, sizeof d, "%s/%s", dir, method);
+    mr_error err = {0};
+    if (!mr_mkdirs(d, &err)) return false;
+    snprintf(path, sizeof path, "%s/%s.png", d, stim);
+    mr_image img = {0};
+    if (!mr_image_alloc(&img, 4, 4, 3, MR_PIX_U8, &err)) return false;
+    memset(img.data, grey, mr_image_bytes(&img));
+    bool ok = mr_image_save_png(path, &img, &err);
+    mr_image_free(&img);
+    return ok;
+}
+
+/* DIR with methods a, b, c, reference and stimuli s1, s2 (c also has s3). */
+static bool make_stimuli(char *dir, size_t n, bool reference) {
+    if (!mr_test_fresh_dir(reference ? "study_stimuli" : "study_stimuli_noref", dir, n)) return false;
+    const char *methods[4] = {"a", "b", "c", "reference"};
+    bool ok = true;
+    for (int m = 0; m < (reference ? 4 : 3); m++)
+        for (int s = 0; s < 2; s++) ok = ok && write_png(dir, methods[m], s ? "s2" : "s1", 40 * m + s);
+    return ok && write_png(dir, "c", "s3", 9);
+}
+
+static void test_plan(void) {
+    char dir[4096];
+    CHECK(make_stimuli(dir, sizeof dir, true));
+    mr_error err = {0};
+    mr_study_set set;
+    CHECK(mr_study_scan(dir, &set, &err));
+    CHECK(set.method_count == 4 && set.reference == 3 && set.stimulus_count == 2);
+    CHECK(strcmp(set.stimuli[0], "s1") == 0 && strcmp(set.stimuli[1], "s2") == 0); /* s3 left out */
+    unsigned mask = 0;
+    CHECK(mr_study_blocks_parse("I,III", &mask, &err) && mask == 5u);
+    CHECK(!mr_study_blocks_parse("I,IV", &mask, &err));
+    CHECK(!mr_study_blocks_parse("II,II", &mask, &err));
+    mr_study_plan_params pp = MR_STUDY_PLAN_DEFAULTS;
+    pp.seed = 7;
+    mr_study_plan a, b, c;
+    CHECK(mr_study_plan_make(dir, &set, &pp, &a, &err));
+    CHECK(a.blocks == 7u);
+    CHECK(a.trial_count == 3 * 2 * (6 + 1));
+    /* Per block and stimulus: every unordered pair once, one identical pair;
+     * blocks in order; sides not all the same. */
+    int lefts_low = 0;
+    for (int blk = 1; blk <= 3; blk++)
+        for (int st = 0; st < 2; st++) {
+            int seen[16] = {0}, identical = 0;
+            for (int k = 0; k < a.trial_count; k++) {
+                const mr_study_trial *t = &a.trials[k];
+                if (t->block != blk || t->stimulus != st) continue;
+                CHECK(k >= (blk - 1) * 14 && k < blk * 14);
+                if (t->left == t->right) identical++;
+                else {
+                    int lo = t->left < t->right ? t->left : t->right, hi = t->left ^ t->right ^ lo;
+                    seen[lo * 4 + hi]++;
+                    lefts_low += t->left < t->right;
+                }
+            }
+            CHECK(identical == 1);
+            for (int i = 0; i < 4; i++)
+                for (int j = i + 1; j < 4; j++) CHECK(seen[i * 4 + j] == 1);
+        }
+    CHECK(lefts_low > 0 && lefts_low < 36);
+    /* Reproducible from the seed; another seed gives another order. */
+    CHECK(mr_study_plan_make(dir, &set, &pp, &b, &err));
+    CHECK(strcmp(a.id, b.id) == 0 && memcmp(a.trials, b.trials, sizeof *a.trials * (size_t)a.trial_count) == 0);
+    pp.seed = 8;
+    CHECK(mr_study_plan_make(dir, &set, &pp, &c, &err));
+    CHECK(strcmp(a.id, c.id) != 0);
+    mr_study_plan_free(&b);
+    mr_study_plan_free(&c);
+    /* Save and load. */
+    char path[4200];
+    snprintf(path, sizeof path, "%s/plan.json", dir);
+    CHECK(mr_study_plan_save(path, &a, &err));
+    CHECK(mr_study_plan_load(path, &b, &err));
+    CHECK(strcmp(a.id, b.id) == 0 && b.trial_count == a.trial_count && b.fixation_ms == 2000);
+    CHECK(memcmp(a.trials, b.trials, sizeof *a.trials * (size_t)a.trial_count) == 0);
+    mr_study_plan_free(&b);
+    /* An edited plan is refused. */
+    size_t size;
+    char *text = mr_file_read(path, &size, 0, &err);
+    char *hit = text ? strstr(text, "\"left\":\t\"a\"") : NULL;
+    if (!hit && text) hit = strstr(text, "\"left\": \"a\"");
+    CHECK(hit != NULL);
+    if (hit) {
+        char *q = strchr(hit + 7, 'a');
+        *q = 'b';
+        CHECK(mr_file_write_atomic(path, text, size, &err));
+        CHECK(!mr_study_plan_load(path, &b, &err));
+        CHECK(strstr(err.msg, "edited") != NULL);
+    }
+    free(text);
+    /* Block II needs a reference. */
+    char dir2[4096];
+    mr_study_set set2;
+    CHECK(make_stimuli(dir2, sizeof dir2, false));
+    CHECK(mr_study_scan(dir2, &set2, &err));
+    pp.blocks = 2u;
+    CHECK(!mr_study_plan_make(dir2, &set2, &pp, &b, &err));
+    pp.blocks = 0;
+    CHECK(mr_study_plan_make(dir2, &set2, &pp, &b, &err) && b.blocks == 1u && b.trial_count == 2 * (3 + 1));
+    mr_study_plan_free(&b);
+    mr_study_set_free(&set2);
+    mr_study_plan_free(&a);
+    mr_study_set_free(&set);
+}
+
+static mr_study_vote vote_of(const mr_study_plan *p, const char *who, int k, mr_study_answer a) {
+    mr_study_vote v;
+    memset(&v, 0, sizeof v);
+    const mr_study_trial *t = &p->trials[k];
+    snprintf(v.plan, sizeof v.plan, "%s", p->id);
+    snprintf(v.participant, sizeof v.participant, "%s", who);
+    v.block = t->block;
+    v.trial = k;
+    snprintf(v.stimulus, sizeof v.stimulus, "%s", p->set.stimuli[t->stimulus]);
+    snprintf(v.left, sizeof v.left, "%s", p->set.methods[t->left]);
+    snprintf(v.right, sizeof v.right, "%s", p->set.methods[t->right]);
+    v.answer = a;
+    v.slider = a;
+    v.ms = 100;
+    return v;
+}
+
+static void test_votes(void) {
+    char dir[4096], path[4200];
+    CHECK(make_stimuli(dir, sizeof dir, true));
+    mr_error err = {0};
+    mr_study_set set;
+    mr_study_plan plan;
+    mr_study_plan_params pp = MR_STUDY_PLAN_DEFAULTS;
+    CHECK(mr_study_scan(dir, &set, &err) && mr_study_plan_make(dir, &set, &pp, &plan, &err));
+    snprintf(path, sizeof path, "%s/votes.jsonl", dir);
+    for (int k = 0; k < 3; k++) {
+        mr_study_vote v = vote_of(&plan, "p1", k, MR_STUDY_LEFT);
+        CHECK(mr_study_vote_append(path, &v, &err));
+    }
+    mr_study_votes vs = {0};
+    CHECK(mr_study_votes_read(path, false, &vs, &err));
+    CHECK(vs.count == 3 && vs.bad_lines == 0 && !vs.torn_tail);
+    CHECK(vs.v[2].trial == 2 && vs.v[2].answer == MR_STUDY_LEFT && strcmp(vs.v[1].participant, "p1") == 0);
+    bool *answered = calloc((size_t)plan.trial_count, 1);
+    CHECK(mr_study_resume(&plan, &vs, "p1", answered, &err) == 3);
+    CHECK(answered[0] && answered[2] && !answered[3]);
+    CHECK(mr_study_resume(&plan, &vs, "p2", answered, &err) == 0);
+    mr_study_votes_free(&vs);
+    /* A torn last line (killed mid-write): skipped, sealed, appended after. */
+    int fd = open(path, O_WRONLY | O_APPEND);
+    CHECK(fd >= 0 && write(fd, "{\"plan\":\"", 9) == 9);
+    close(fd);
+    CHECK(mr_study_votes_read(path, false, &vs, &err));
+    CHECK(vs.count == 3 && vs.bad_lines == 1 && vs.torn_tail);
+    mr_study_votes_free(&vs);
+    CHECK(mr_study_votes_seal(path, &err));
+    CHECK(mr_study_votes_seal(path, &err)); /* sealed once only */
+    mr_study_vote v = vote_of(&plan, "p1", 3, MR_STUDY_NEUTRAL);
+    CHECK(mr_study_vote_append(path, &v, &err));
+    /* The same trial answered twice: the first answer is kept. */
+    v.answer = MR_STUDY_RIGHT;
+    CHECK(mr_study_vote_append(path, &v, &err));
+    CHECK(mr_study_votes_read(path, false, &vs, &err));
+    CHECK(vs.count == 4 && vs.bad_lines == 1 && vs.duplicates == 1 && !vs.torn_tail);
+    CHECK(vs.v[3].answer == MR_STUDY_NEUTRAL);
+    CHECK(mr_study_resume(&plan, &vs, "p1", answered, &err) == 4);
+    size_t size;
+    char *text = mr_file_read(path, &size, 0, &err);
+    CHECK(text && strstr(text, "{\"plan\":\"\n") != NULL); /* what was written stays */
+    free(text);
+    mr_study_votes_free(&vs);
+    /* The same participant's votes of another plan in this log: an error. */
+    mr_study_plan other;
+    pp.seed = 99;
+    CHECK(mr_study_plan_make(dir, &set, &pp, &other, &err));
+    CHECK(mr_study_votes_read(path, false, &vs, &err));
+    CHECK(mr_study_resume(&other, &vs, "p1", answered, &err) == -1 && strstr(err.msg, "another plan"));
+    CHECK(mr_study_resume(&other, &vs, "p9", answered, &err) == 0);
+    mr_study_votes_free(&vs);
+    CHECK(mr_study_votes_read("/nonexistent/votes.jsonl", true, &vs, &err) && vs.count == 0);
+    CHECK(!mr_study_votes_read("/nonexistent/votes.jsonl", false, &vs, &err));
+    free(answered);
+    mr_study_plan_free(&other);
+    mr_study_plan_free(&plan);
+    mr_study_set_free(&set);
+}
+
+/* Five participants who all rank reference > c > b > a, answer every
+ * identical pair with "no preference" except p5 once. */
+static void test_analyze(void) {
+    char dir[4096], out[4200], path[4400];
+    CHECK(make_stimuli(dir, sizeof dir, true));
+    mr_error err = {0};
+    mr_study_set set;
+    mr_study_plan plan;
+    mr_study_plan_params pp = MR_STUDY_PLAN_DEFAULTS;
+    pp.blocks = 1u;
+    CHECK(mr_study_scan(dir, &set, &err) && mr_study_plan_make(dir, &set, &pp, &plan, &err));
+    mr_study_votes vs = {0};
+    int rank[4] = {0, 1, 2, 3}; /* a < b < c < reference */
+    for (int p = 0; p < 5; p++) {
+        char who[8];
+        snprintf(who, sizeof who, "p%d", p + 1);
+        for (int k = 0; k < plan.trial_count; k++) {
+            const mr_study_trial *t = &plan.trials[k];
+            mr_study_answer a = t->left == t->right ? (p == 4 && t->stimulus == 0 ? MR_STUDY_LEFT : MR_STUDY_NEUTRAL)
+                                : rank[t->left] > rank[t->right] ? MR_STUDY_LEFT : MR_STUDY_RIGHT;
+            mr_study_vote v = vote_of(&plan, who, k, a);
+            if (vs.count == vs.cap) {
+                vs.cap = vs.cap ? 2 * vs.cap : 64;
+                vs.v = realloc(vs.v, (size_t)vs.cap * sizeof *vs.v);
+            }
+            vs.v[vs.count++] = v;
+        }
+    }
+    snprintf(out, sizeof out, "%s/analysis", dir);
+    mr_study_analyze_params ap = MR_STUDY_ANALYZE_DEFAULTS;
+    CHECK(mr_study_analyze(&vs, &plan, &ap, out, &err));
+    const char *files[] = {"pairs.csv", "scores.csv", "consistence.csv", "participants.csv", "agreement.csv",
+                           "identical.csv", "chart_I.svg", "summary.md"};
+    for (int i = 0; i < 8; i++) {
+        snprintf(path, sizeof path, "%s/%s", out, files[i]);
+        CHECK_MSG(mr_file_exists(path), "%s", files[i]);
+    }
+    size_t size;
+    snprintf(path, sizeof path, "%s/pairs.csv", out);
+    char *text = mr_file_read(path, &size, 0, &err);
+    /* Pooled: 10 votes per pair, all for the better method; k(10) = 9. */
+    CHECK(text && strstr(text, "\nI,all,a,b,10,0,10,0,0,10,9,1,b,"));
+    CHECK(text && strstr(text, "\nI,s1,c,reference,5,0,5,0,0,5,6,-1,,")); /* n = 5 is too few */
+    free(text);
+    snprintf(path, sizeof path, "%s/agreement.csv", out);
+    text = mr_file_read(path, &size, 0, &err);
+    CHECK(text && strstr(text, "\nI,s1,1.000000,0.000000,1,0,30,4,5\n")); /* total agreement, p5 saw a difference */
+    free(text);
+    snprintf(path, sizeof path, "%s/participants.csv", out);
+    text = mr_file_read(path, &size, 0, &err);
+    CHECK(text && strstr(text, "\np5,14,2,1.000000,1.000000,0,2,1\n"));
+    free(text);
+    /* Everyone agrees: the graph is not strongly connected, the scores are
+     * still finite and ordered, and the summary says so. */
+    snprintf(path, sizeof path, "%s/summary.md", out);
+    text = mr_file_read(path, &size, 0, &err);
+    CHECK(text && strstr(text, "not strongly connected") && strstr(text, "reference > a"));
+    free(text);
+    snprintf(path, sizeof path, "%s/scores.csv", out);
+    text = mr_file_read(path, &size, 0, &err);
+    CHECK(text && !strstr(text, "nan") && strstr(text, "\nI,all,davidson,reference,0.000000,0.000000,"));
+    free(text);
+    /* Votes of an unknown plan are left out. */
+    for (int i = 0; i < 3; i++) snprintf(vs.v[i].plan, sizeof vs.v[i].plan, "%s", "0123456789abcdef");
+    CHECK(mr_study_analyze(&vs, &plan, &ap, out, &err));
+    mr_study_votes_free(&vs);
+    CHECK(!mr_study_analyze(&vs, &plan, &ap, out, &err)); /* no votes */
+    mr_study_plan_free(&plan);
+    mr_study_set_free(&set);
+}
+
 int main(void) {
     test_consistence_table51();
     test_agreement_tables();
@@ -170,5 +431,8 @@ int main(void) {
     test_bt_known();
     test_davidson_known();
     test_disconnected();
+    test_plan();
+    test_votes();
+    test_analyze();
     return mr_test_finish("test_study");
 }
