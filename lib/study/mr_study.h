@@ -73,7 +73,6 @@ typedef struct mr_study_family {
     const char *help;
     const char *const *methods; /* NULL-terminated folder names */
     bool has_reference;       /* also renders DIR/reference/ */
-    bool needs_hidden;        /* the stimuli are views of hidden structure */
     /* Sets fp up for method m (index into methods). */
     void (*setup)(mr_frame_params *fp, int m);
 } mr_study_family;
@@ -299,9 +298,10 @@ typedef struct mr_study_run_params {
                                      instead of three buttons; default false */
     double px_per_mm;             /* 0 = 96 dpi */
     const char *font_path;        /* NULL = a system sans font */
+    int image_w, image_h;         /* stimulus size in pixels (for the aspect); 0 = 4:3 */
     double now;                   /* clock at start, seconds */
 } mr_study_run_params;
-#define MR_STUDY_RUN_DEFAULTS {NULL, NULL, 0, NULL, false, 0.0, NULL, 0.0}
+#define MR_STUDY_RUN_DEFAULTS {NULL, NULL, 0, NULL, false, 0.0, NULL, 0, 0, 0.0}
 /* Slider values within this distance of the centre snap to 0 (neutral). */
 #define MR_STUDY_SNAP 0.08
 
