@@ -102,6 +102,12 @@ static void test_bt_known(void) {
     CHECK(mr_study_bt_fit(two, 2, &p, &s, &err));
     CHECK_NEAR(s.theta[0], log(3.0), 1e-9);
     CHECK_NEAR(s.se[0], sqrt(1.0 / (4 * 0.75 * 0.25)), 1e-7);
+    /* Centred (no reference): theta = +-d/2, so each se is half of d's. */
+    p.reference = -1;
+    CHECK(mr_study_bt_fit(two, 2, &p, &s, &err));
+    CHECK_NEAR(s.theta[0], log(3.0) / 2, 1e-9);
+    CHECK_NEAR(s.se[0], sqrt(1.0 / (4 * 0.75 * 0.25)) / 2, 1e-7);
+    CHECK_NEAR(s.se[1], s.se[0], 1e-12);
 }
 
 static void test_davidson_known(void) {
@@ -128,6 +134,21 @@ static void test_davidson_known(void) {
         CHECK_NEAR(s.log_nu, k == 0 ? 0.0 : 0.693147, 1e-6);
         for (int i = 0; i < 3; i++) CHECK(s.se[i] > 0 && isfinite(s.se[i]));
         CHECK(s.se_log_nu > 0 && isfinite(s.se_log_nu));
+    }
+    /* Two methods, 3 : 1 with 2 ties (saturated, so by hand): theta = log 3,
+     * nu = 2/sqrt(3); the information n Cov(f) with p = (1/2, 1/6, 1/3) is
+     * [[5/6, -1/3], [-1/3, 4/3]] (determinant 1), whose inverse gives
+     * var theta = 4/3 and var log nu = 5/6. */
+    {
+        double w2[4] = {0, 3, 1, 0}, t2[4] = {0, 2, 2, 0};
+        mr_study_fit_params p = MR_STUDY_FIT_DEFAULTS;
+        p.reference = 1;
+        mr_study_scores s;
+        CHECK(mr_study_davidson_fit(w2, t2, 2, &p, &s, &err));
+        CHECK_NEAR(s.theta[0], log(3.0), 1e-8);
+        CHECK_NEAR(s.log_nu, log(2.0 / sqrt(3.0)), 1e-8);
+        CHECK_NEAR(s.se[0], sqrt(4.0 / 3.0), 1e-7);
+        CHECK_NEAR(s.se_log_nu, sqrt(5.0 / 6.0), 1e-7);
     }
     /* No ties at all: the same as Bradley-Terry. */
     double v[9] = {0, 2, 4, 1, 0, 2, 1, 1, 0}, z[9] = {0};
@@ -229,6 +250,10 @@ static void test_plan(void) {
                 for (int j = i + 1; j < 4; j++) CHECK(seen[i * 4 + j] == 1);
         }
     CHECK(lefts_low > 0 && lefts_low < 36);
+    /* Shuffled within each block: the stimuli are not in generation order. */
+    int changes = 0;
+    for (int k = 1; k < 14; k++) changes += a.trials[k].stimulus != a.trials[k - 1].stimulus;
+    CHECK(changes > 1);
     /* Reproducible from the seed; another seed gives another order. */
     CHECK(mr_study_plan_make(dir, &set, &pp, &b, &err));
     CHECK(strcmp(a.id, b.id) == 0 && memcmp(a.trials, b.trials, sizeof *a.trials * (size_t)a.trial_count) == 0);
@@ -423,6 +448,68 @@ static void test_analyze(void) {
     mr_study_set_free(&set);
 }
 
+/* The run controller without a window: fixation, the pair, a key answer,
+ * block II's reference, a vote that could not be stored. */
+static void test_runner(void) {
+    char dir[4096];
+    CHECK(make_stimuli(dir, sizeof dir, true));
+    mr_error err = {0};
+    mr_study_set set;
+    mr_study_plan plan;
+    mr_study_plan_params pp = MR_STUDY_PLAN_DEFAULTS;
+    pp.fixation_ms = 500;
+    pp.blocks = 2u; /* block II only */
+    CHECK(mr_study_scan(dir, &set, &err) && mr_study_plan_make(dir, &set, &pp, &plan, &err));
+    bool *answered = calloc((size_t)plan.trial_count, 1);
+    answered[0] = answered[1] = true;
+    mr_study_run_params rp = MR_STUDY_RUN_DEFAULTS;
+    rp.plan = &plan;
+    rp.participant = "p7";
+    rp.first_trial = 0;
+    rp.answered = answered;
+    rp.image_w = 4, rp.image_h = 4;
+    rp.now = 10.0;
+    mr_study_runner *r = mr_study_runner_create(&rp, &err);
+    if (!r) {
+        printf("test_runner: skipped (%s)\n", err.msg); /* no system font */
+        free(answered);
+        mr_study_plan_free(&plan);
+        mr_study_set_free(&set);
+        return;
+    }
+    mr_study_frame f;
+    mr_study_vote v;
+    mr_event key = {MR_EVENT_KEY, 0, 0, MR_KEY_RIGHT};
+    mr_study_runner_push_event(r, &key);
+    mr_study_runner_frame(r, 10.2, 800, 600, &f, &v);
+    CHECK(f.fixation && f.image_count == 0 && !f.vote); /* a key during the cross does nothing */
+    mr_study_runner_frame(r, 10.6, 800, 600, &f, &v);
+    CHECK(!f.fixation && f.trial == 2 && f.image_count == 3); /* answered trials skipped */
+    CHECK(f.image_method[0] == plan.set.reference);
+    CHECK(f.image_rect[0].y < f.image_rect[1].y && f.image_rect[1].x < f.image_rect[2].x);
+    mr_study_runner_push_event(r, &key);
+    mr_study_runner_frame(r, 11.1, 800, 600, &f, &v);
+    CHECK(f.vote && v.trial == 2 && v.answer == MR_STUDY_RIGHT && v.slider == 1 && v.block == 2);
+    CHECK_NEAR(v.ms, 500, 1e-6);
+    CHECK(strcmp(v.participant, "p7") == 0 && strcmp(v.plan, plan.id) == 0);
+    CHECK(strcmp(v.left, plan.set.methods[plan.trials[2].left]) == 0);
+    /* Not stored: the same trial again, at once. */
+    mr_study_runner_vote_failed(r, "disk full");
+    mr_study_runner_frame(r, 11.2, 800, 600, &f, &v);
+    CHECK(!f.fixation && f.trial == 2 && !f.vote);
+    CHECK(mr_study_runner_answered(r) == 0);
+    mr_study_runner_push_event(r, &key);
+    mr_study_runner_frame(r, 11.3, 800, 600, &f, &v);
+    CHECK(f.vote && v.trial == 2);
+    mr_study_runner_frame(r, 11.4, 800, 600, &f, &v);
+    CHECK(f.fixation && mr_study_runner_answered(r) == 1);
+    mr_study_runner_destroy(&r);
+    CHECK(r == NULL);
+    free(answered);
+    mr_study_plan_free(&plan);
+    mr_study_set_free(&set);
+}
+
 int main(void) {
     test_consistence_table51();
     test_agreement_tables();
@@ -434,5 +521,6 @@ int main(void) {
     test_plan();
     test_votes();
     test_analyze();
+    test_runner();
     return mr_test_finish("test_study");
 }
