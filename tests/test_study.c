@@ -135,20 +135,21 @@ static void test_davidson_known(void) {
         for (int i = 0; i < 3; i++) CHECK(s.se[i] > 0 && isfinite(s.se[i]));
         CHECK(s.se_log_nu > 0 && isfinite(s.se_log_nu));
     }
-    /* Two methods, 3 : 1 with 2 ties (saturated, so by hand): theta = log 3,
-     * nu = 2/sqrt(3); the information n Cov(f) with p = (1/2, 1/6, 1/3) is
-     * [[5/6, -1/3], [-1/3, 4/3]] (determinant 1), whose inverse gives
-     * var theta = 4/3 and var log nu = 5/6. */
+    /* Two methods, 4 : 1 with 1 tie (saturated, so by hand): theta = log 4,
+     * nu = 1/sqrt(4 * 1); the information n Cov(f) with p = (2/3, 1/6, 1/6)
+     * and f = (1, 0), (0, 0), (1/2, 1) is [[7/8, -1/4], [-1/4, 5/6]]
+     * (determinant 2/3), whose inverse gives var theta = 5/4 and
+     * var log nu = 21/16. */
     {
-        double w2[4] = {0, 3, 1, 0}, t2[4] = {0, 2, 2, 0};
+        double w2[4] = {0, 4, 1, 0}, t2[4] = {0, 1, 1, 0};
         mr_study_fit_params p = MR_STUDY_FIT_DEFAULTS;
         p.reference = 1;
         mr_study_scores s;
         CHECK(mr_study_davidson_fit(w2, t2, 2, &p, &s, &err));
-        CHECK_NEAR(s.theta[0], log(3.0), 1e-8);
-        CHECK_NEAR(s.log_nu, log(2.0 / sqrt(3.0)), 1e-8);
-        CHECK_NEAR(s.se[0], sqrt(4.0 / 3.0), 1e-7);
-        CHECK_NEAR(s.se_log_nu, sqrt(5.0 / 6.0), 1e-7);
+        CHECK_NEAR(s.theta[0], log(4.0), 1e-8);
+        CHECK_NEAR(s.log_nu, log(0.5), 1e-8);
+        CHECK_NEAR(s.se[0], sqrt(5.0 / 4.0), 1e-7);
+        CHECK_NEAR(s.se_log_nu, sqrt(21.0 / 16.0), 1e-7);
     }
     /* No ties at all: the same as Bradley-Terry. */
     double v[9] = {0, 2, 4, 1, 0, 2, 1, 1, 0}, z[9] = {0};
