@@ -12,7 +12,7 @@
 const mr_opt mr_study_analyze_opts[] = {
     {"alpha", MR_OPT_DOUBLE, offsetof(mr_study_analyze_params, alpha), 1e-6, 0.5, 0.025, NULL,
      "binomial test level per tail (the thesis's 0.025)", 0},
-    {"min-consistence", MR_OPT_DOUBLE, offsetof(mr_study_analyze_params, min_consistence), 0, 1, 0.5, NULL,
+    {"min-consistence", MR_OPT_DOUBLE, offsetof(mr_study_analyze_params, min_consistence), 0, 1, 0.3, NULL,
      "flag participants whose mean coefficient of consistence is below this", 0},
     {"pseudo", MR_OPT_DOUBLE, offsetof(mr_study_analyze_params, pseudo), 1e-6, 10, 0.5, NULL,
      "pseudo-wins added each way to every pair when the comparison graph is not strongly connected", 0},
@@ -300,15 +300,18 @@ static bool write_chart(const char *path, const tally *T, int block, const cell 
                     sb_printf(&b, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#d00\" stroke-width=\"2\"/>\n",
                               x, y, x, y + 22);
                 }
-                const char *mark = wi + ti / 2 >= k ? "* left" : wj + ti / 2 >= k ? "* right" : "";
+                char mark[MR_STUDY_NAME_MAX + 4] = "";
+                if (wi + ti / 2 >= k || wj + ti / 2 >= k)
+                    snprintf(mark, sizeof mark, "* %s", wi + ti / 2 >= k ? T->methods.v[i] : T->methods.v[j]);
                 svg_text(&b, left + bar_w + 6, y + 15, "start", 12, "#d00", mark);
             }
             char pct[32];
             snprintf(pct, sizeof pct, "%.0f%%", 100 * share);
             svg_text(&b, left + 4, y + 15, "start", 11, "#fff", pct);
         }
-    svg_text(&b, left, top + pairs * row_h + 18, "start", 11, "#4e79a7", "left method preferred");
-    svg_text(&b, left + bar_w, top + pairs * row_h + 18, "end", 11, "#f28e2b", "right method preferred");
+    svg_text(&b, left, top + pairs * row_h + 18, "start", 11, "#4e79a7", "first method preferred");
+    svg_text(&b, left + bar_w, top + pairs * row_h + 18, "end", 11, "#f28e2b", "second method preferred");
+    svg_text(&b, left + bar_w + 6, top + pairs * row_h + 18, "start", 11, "#d00", "* significant");
     /* Scores panel. */
     const mr_study_scores *s = cs->have_dav ? &cs->dav : cs->have_bt ? &cs->bt : NULL;
     double px0 = 640, pw = 320;

@@ -263,11 +263,11 @@ bool mr_study_davidson_fit(const double *w, const double *ties, int t, const mr_
 
 typedef struct mr_study_analyze_params {
     double alpha;             /* binomial test, per tail; default 0.025 */
-    double min_consistence;   /* participants whose mean xi is below are flagged; default 0.5 */
+    double min_consistence;   /* participants whose mean xi is below are flagged; default 0.3 */
     double pseudo;            /* see mr_study_fit_params; default 0.5 */
     double z;                 /* confidence interval theta +- z se; default 1.96 */
 } mr_study_analyze_params;
-#define MR_STUDY_ANALYZE_DEFAULTS {.alpha = 0.025, .min_consistence = 0.5, .pseudo = 0.5, .z = 1.96}
+#define MR_STUDY_ANALYZE_DEFAULTS {.alpha = 0.025, .min_consistence = 0.3, .pseudo = 0.5, .z = 1.96}
 extern const mr_opt mr_study_analyze_opts[];   /* alpha, min-consistence, pseudo, z */
 
 /* Writes into out_dir: pairs.csv, scores.csv, consistence.csv,
