@@ -370,6 +370,19 @@ static void test_votes(void) {
     CHECK(mr_study_resume(&other, &vs, "p1", answered, &err) == -1 && strstr(err.msg, "another plan"));
     CHECK(mr_study_resume(&other, &vs, "p9", answered, &err) == 0);
     mr_study_votes_free(&vs);
+    /* Numbers that are not finite, or a slider outside [-1, 1]: not a vote. */
+    char bad_path[4300];
+    snprintf(bad_path, sizeof bad_path, "%s/bad_votes.jsonl", dir);
+    const char *bad_text = "{\"plan\":\"x\",\"participant\":\"p\",\"block\":\"I\",\"trial\":0,\"stimulus\":\"s\","
+                           "\"left\":\"a\",\"right\":\"b\",\"answer\":\"left\",\"ms\":1e999}\n"
+                           "{\"plan\":\"x\",\"participant\":\"p\",\"block\":\"I\",\"trial\":1,\"stimulus\":\"s\","
+                           "\"left\":\"a\",\"right\":\"b\",\"answer\":\"left\",\"slider\":3}\n"
+                           "{\"plan\":\"x\",\"participant\":\"p\",\"block\":\"I\",\"trial\":2,\"stimulus\":\"s\","
+                           "\"left\":\"a\",\"right\":\"b\",\"answer\":\"left\"}\n";
+    CHECK(mr_file_write_atomic(bad_path, bad_text, strlen(bad_text), &err));
+    CHECK(mr_study_votes_read(bad_path, false, &vs, &err));
+    CHECK(vs.count == 1 && vs.bad_lines == 2 && vs.v[0].trial == 2);
+    mr_study_votes_free(&vs);
     CHECK(mr_study_votes_read("/nonexistent/votes.jsonl", true, &vs, &err) && vs.count == 0);
     CHECK(!mr_study_votes_read("/nonexistent/votes.jsonl", false, &vs, &err));
     free(answered);

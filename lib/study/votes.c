@@ -5,6 +5,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -58,11 +59,16 @@ static bool parse_vote(const cJSON *o, mr_study_vote *v) {
     else if (!strcmp(answer, "right")) v->answer = MR_STUDY_RIGHT;
     else if (!strcmp(answer, "neutral")) v->answer = MR_STUDY_NEUTRAL;
     else return false;
-    const cJSON *x;
-    if (cJSON_IsNumber(x = cJSON_GetObjectItemCaseSensitive(o, "slider"))) v->slider = x->valuedouble;
-    if (cJSON_IsNumber(x = cJSON_GetObjectItemCaseSensitive(o, "ms"))) v->ms = x->valuedouble;
-    if (cJSON_IsNumber(x = cJSON_GetObjectItemCaseSensitive(o, "time_unix"))) v->time_unix = x->valuedouble;
-    return true;
+    /* Optional numbers; present ones must be finite (1e999 parses as inf). */
+    const char *keys[3] = {"slider", "ms", "time_unix"};
+    double *dst[3] = {&v->slider, &v->ms, &v->time_unix};
+    for (int k = 0; k < 3; k++) {
+        const cJSON *x = cJSON_GetObjectItemCaseSensitive(o, keys[k]);
+        if (!x) continue;
+        if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble)) return false;
+        *dst[k] = x->valuedouble;
+    }
+    return v->slider >= -1 && v->slider <= 1;
 }
 
 static bool push(mr_study_votes *out, const mr_study_vote *v) {
