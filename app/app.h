@@ -78,6 +78,9 @@ bool app_lod_auto(const mr_cli_opt *opts);
     {"lod-pixels", "PX", "largest projected error of a level in pixels (default 1)", NULL},                    \
     {"occlusion", "on|off", "occlusion culling (default off)", NULL}
 
+/* mrcheck study {stimuli,plan,run,analyze} (cmd_study.c). */
+int cmd_study(int argc, char **argv);
+
 int cmd_synth(int argc, char **argv);
 int cmd_factory(int argc, char **argv);
 int bench_scene(int argc, char **argv);

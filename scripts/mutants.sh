@@ -64,6 +64,18 @@ replay_meta_markers_key|lib/session/replay.c|cJSON_GetObjectItemCaseSensitive(me
 opt_zero_default_user_zero_is_default|lib/core/options.c|(o->flags & MR_OPT_ZERO_DEFAULT) && v == 0 ? -1 : v;|(o->flags & MR_OPT_ZERO_DEFAULT) && v < 0 ? -1 : v;|^test_options$
 opt_detector_refine_default_off|lib/track/options.c|DT(refine_edges), 0, 1, 1,|DT(refine_edges), 0, 1, 0,|^test_options$
 track_opts_only_threads|app/track_util.c|tp.detector = *dp;|tp.detector.threads = dp->threads;|^cli_options$
+study_consistence_half|lib/study/stats.c|- ss / 2.0;|- ss / 3.0;|^test_study$
+study_agreement_offset|lib/study/stats.c|return 2.0 * tau / max_tau - 1.0;|return 2.0 * tau / max_tau;|^test_study$
+study_binom_threshold|lib/study/stats.c|if (mr_study_binom_upper_tail(n, k) < alpha) return k;|if (mr_study_binom_upper_tail(n, k + 1) < alpha) return k;|^test_study$
+study_davidson_tie_feature|lib/study/stats.c|{0.5, 0.5, 1}};|{1.0, 0.5, 1}};|^test_study$
+study_mm_update|lib/study/stats.c|ng[i] = d > 0 ? W[i] / d : g[i];|ng[i] = d > 0 ? (W[i] + 0.1) / d : g[i];|^test_study$
+study_no_pseudo_count|lib/study/stats.c|    if (mr_study_graph_connected(w, ties, t, &who)) return;|    if (1) return;|^test_study$
+study_se_not_centred|lib/study/stats.c|S[i * t + i] - 2 * row[i] + tot|S[i * t + i]|^test_study$
+study_no_indifference_baseline|lib/study/stats.c|return fmin(1.0, have ? num / den : num);|return fmin(1.0, num);|^test_study$
+study_plan_not_shuffled|lib/study/plan.c|for (int i = k - 1; i > first; i--) {|for (int i = k - 1; i > k; i--) {|^test_study$
+study_repeat_answer_kept|lib/study/votes.c|} else if (seen(out, &v)) {|} else if (seen(out, &v) && 0) {|^test_study$
+study_resume_skips_one|lib/study/votes.c|        if (!answered[k]) return k;|        if (!answered[k]) return k + 1;|^test_study$
+study_no_fixation|lib/study/run.c|>= plan->fixation_ms|>= 0|^test_study$
 LIST
 )
 

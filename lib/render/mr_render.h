@@ -432,6 +432,12 @@ bool mr_draw2d_frame(mr_draw2d *d, mr_renderer *r, float x, float y, float w, fl
 bool mr_draw2d_list_draw(mr_draw2d *d, const mr_draw2d_list *list, mr_error *err);
 /* What is in the framebuffer now (before the swap), RGB8, top row first. */
 bool mr_draw2d_read(mr_draw2d *d, mr_image *out, mr_error *err);
+/* An 8-bit sRGB image (1, 3 or 4 channels) as a texture of the 2D layer,
+ * drawn scaled into a rectangle (the study window's stimuli). */
+typedef struct mr_draw2d_image mr_draw2d_image;
+mr_draw2d_image *mr_draw2d_image_create(mr_draw2d *d, const mr_image *img, mr_error *err);
+void mr_draw2d_image_destroy(mr_draw2d_image **im);
+bool mr_draw2d_image_draw(mr_draw2d *d, const mr_draw2d_image *im, float x, float y, float w, float h, mr_error *err);
 /* ------------------------------------------------- ghosting, image level
  * The stages of the ghosting passes on plain images, with the same shaders
  * the frame uses: for tests, benches and tools. Colour images are F32 with 3

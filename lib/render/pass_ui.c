@@ -125,6 +125,66 @@ bool mr_draw2d_frame(mr_draw2d *d, mr_renderer *r, float x, float y, float w, fl
     return true;
 }
 
+struct mr_draw2d_image {
+    GLuint tex;
+};
+
+mr_draw2d_image *mr_draw2d_image_create(mr_draw2d *d, const mr_image *img, mr_error *err) {
+    if (!d || !img || !img->data || img->type != MR_PIX_U8 || img->width <= 0 || img->height <= 0 ||
+        !(img->channels == 1 || img->channels == 3 || img->channels == 4)) {
+        mr_fail(err, MR_ERR_INVALID, "2D image: needs an 8-bit image with 1, 3 or 4 channels");
+        return NULL;
+    }
+    mr_draw2d_image *im = calloc(1, sizeof *im);
+    if (!im) {
+        mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    /* sRGB storage: the 2D program decodes on sampling and re-encodes, so
+     * the pixels reach the window as they are in the file. */
+    im->tex = mr_gl_make_tex(GL_SRGB8_ALPHA8, img->width, img->height, GL_LINEAR);
+    static const GLenum fmts[5] = {0, GL_RED, 0, GL_RGB, GL_RGBA};
+    if (img->channels == 1) {
+        const GLint swz[4] = {GL_RED, GL_RED, GL_RED, GL_ONE};
+        glTextureParameteriv(im->tex, GL_TEXTURE_SWIZZLE_RGBA, swz);
+    }
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    /* Images are top row first and so is the 2D layer's v. */
+    glTextureSubImage2D(im->tex, 0, 0, 0, img->width, img->height, fmts[img->channels], GL_UNSIGNED_BYTE, img->data);
+    GLenum e = glGetError();
+    if (e != GL_NO_ERROR) {
+        mr_draw2d_image_destroy(&im);
+        mr_fail(err, MR_ERR_GL, "GL error 0x%x uploading a 2D image", e);
+        return NULL;
+    }
+    return im;
+}
+
+void mr_draw2d_image_destroy(mr_draw2d_image **im) {
+    if (!im || !*im) return;
+    glDeleteTextures(1, &(*im)->tex);
+    free(*im);
+    *im = NULL;
+}
+
+bool mr_draw2d_image_draw(mr_draw2d *d, const mr_draw2d_image *im, float x, float y, float w, float h, mr_error *err) {
+    if (!im) return mr_fail(err, MR_ERR_INVALID, "no 2D image to draw");
+    const mr_draw2d_vertex v[4] = {
+        {x, y, 0, 0, 0xffffffffu}, {x + w, y, 1, 0, 0xffffffffu},
+        {x + w, y + h, 1, 1, 0xffffffffu}, {x, y + h, 0, 1, 0xffffffffu},
+    };
+    static const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
+    upload(&d->vbo, &d->vbo_bytes, v, sizeof v);
+    upload(&d->ibo, &d->ibo_bytes, ix, sizeof ix);
+    glDisable(GL_BLEND);
+    glBindSampler(MR_TEX_UI_TEX, d->sampler);
+    draw(d, 1, im->tex, 6);
+    glBindSampler(MR_TEX_UI_TEX, 0);
+    GLenum e = glGetError();
+    if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x drawing a 2D image", e);
+    return true;
+}
+
 bool mr_draw2d_list_draw(mr_draw2d *d, const mr_draw2d_list *l, mr_error *err) {
     if (!l || l->index_count <= 0) return true;
     if (!l->atlas || l->atlas_w <= 0 || l->atlas_h <= 0) return mr_fail(err, MR_ERR_INVALID, "2D list without an atlas");

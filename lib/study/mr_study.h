@@ -1,0 +1,344 @@
+/* mr_study.h — pairwise comparison studies of rendering methods, designed
+ * and analysed as in Hecher's soft-shadow study (thesis ch. 4.3 and 5):
+ * stimuli (one image per method and stimulus), a plan (all pairs plus one
+ * identical pair per stimulus, random order and sides, blocks I-III, block
+ * II with the reference), a durable vote log that a killed run resumes
+ * from, the statistics (consistence, agreement, indifference, binomial
+ * tests, Bradley-Terry and Davidson scores) and the run window's controller.
+ *
+ * A stimulus folder is DIR/<method>/<stimulus>.png; the method folder named
+ * "reference" (MR_STUDY_REFERENCE) is the ground truth: a method like the
+ * others in the pairs, shown above the pair in block II, fixed at theta = 0
+ * in the scores.
+ *
+ * Depends on: lib/core; lib/session (the durable line append); lib/ui (the
+ * run controller's widgets); lib/eval (CSV, SVG plots, ray-traced AO); lib/render
+ * and lib/scene for the stimuli and plain types (mr_event). One way only.
+ */
+#ifndef MR_STUDY_H
+#define MR_STUDY_H
+
+#include "mr_core.h"
+#include "mr_render.h"
+#include "mr_ui.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define MR_STUDY_REFERENCE "reference"
+#define MR_STUDY_NAME_MAX 64      /* method, stimulus and participant names, with the NUL */
+#define MR_STUDY_MAX_METHODS 16
+#define MR_STUDY_MAX_BLOCKS 3     /* I, II, III */
+
+/* "I", "II", "III" for blocks 1..3; "?" otherwise. */
+const char *mr_study_block_name(int block);
+/* "I,II,III" (any subset, any order, no repeats) into a mask: bit b-1 for
+ * block b. false + err naming the bad item. */
+bool mr_study_blocks_parse(const char *text, unsigned *mask, mr_error *err);
+
+/* ------------------------------------------------------------- stimuli */
+
+/* What a stimulus folder holds: the methods (sorted, "reference" among them
+ * when present) and the stimuli every method has. A stimulus missing for
+ * some method is left out with a warning (in the log). */
+typedef struct mr_study_set {
+    int method_count;
+    char methods[MR_STUDY_MAX_METHODS][MR_STUDY_NAME_MAX];
+    int reference;            /* index of "reference", or -1 */
+    int stimulus_count;
+    char (*stimuli)[MR_STUDY_NAME_MAX]; /* sorted */
+} mr_study_set;
+
+/* Scans DIR/<method>/<stimulus>.png. Needs at least two methods (the
+ * reference counts) and one stimulus they all have; names are
+ * [A-Za-z0-9_.-]+ (others are skipped with a warning). */
+bool mr_study_scan(const char *dir, mr_study_set *out, mr_error *err);
+void mr_study_set_free(mr_study_set *s);
+
+/* The families `study stimuli --family` renders, one row each, so a family
+ * (shadows) is one more row. Each renders the demo hall (lib/scene) from
+ * `views` of its standing viewpoints through mr_render_frame. */
+typedef struct mr_study_stimuli_params {
+    int family;               /* index into mr_study_families; default 0 (ao) */
+    int width, height;        /* image size, px; default 320x240 */
+    int views;                /* demo viewpoints, 1..MR_DEMO_VIEWS; default 3 */
+    int gt_rays;              /* reference AO: rays per pixel; default 128 */
+} mr_study_stimuli_params;
+#define MR_STUDY_STIMULI_DEFAULTS {.family = 0, .width = 320, .height = 240, .views = 3, .gt_rays = 128}
+extern const mr_opt mr_study_stimuli_opts[];   /* family, width, height, views, gt-rays */
+
+typedef struct mr_study_family {
+    const char *name;         /* "ao", "ghost" */
+    const char *help;
+    const char *const *methods; /* NULL-terminated folder names */
+    bool has_reference;       /* also renders DIR/reference/ */
+    /* Sets fp up for method m (index into methods). */
+    void (*setup)(mr_frame_params *fp, int m);
+} mr_study_family;
+extern const mr_study_family mr_study_families[];
+extern const int mr_study_family_count;
+/* NULL-terminated family names, for the option table's enum row. */
+extern const char *const mr_study_family_names[];
+
+/* Renders every method (and the reference) for every stimulus into
+ * DIR/<method>/<stimulus>.png (each written atomically) with the caller's
+ * renderer (a headless GPU). *count gets the images written. */
+bool mr_study_stimuli_render(mr_renderer *r, const mr_study_stimuli_params *p, const char *dir, int *count,
+                             mr_error *err);
+
+/* ---------------------------------------------------------------- plan */
+
+typedef struct mr_study_trial {
+    int block;                /* 1..3 */
+    int stimulus;             /* index into the plan's stimuli */
+    int left, right;          /* method indices; equal for an identical pair */
+} mr_study_trial;
+
+typedef struct mr_study_plan_params {
+    int seed;                 /* default 1 */
+    int fixation_ms;          /* fixation cross before each trial; default 2000 */
+    unsigned blocks;          /* mask (bit b-1: block b); 0 = I,II,III with a reference, I without */
+} mr_study_plan_params;
+#define MR_STUDY_PLAN_DEFAULTS {.seed = 1, .fixation_ms = 2000, .blocks = 0}
+extern const mr_opt mr_study_plan_opts[];      /* seed, fixation-ms */
+
+typedef struct mr_study_plan {
+    char id[17];              /* 16 hex digits: FNV-1a of the plan's content */
+    char dir[4096];           /* the stimulus folder (as given) */
+    mr_study_set set;
+    int seed, fixation_ms;
+    unsigned blocks;
+    int trial_count;
+    mr_study_trial *trials;   /* in presentation order; the trial number is the index */
+} mr_study_plan;
+
+/* Per block in order I, II, III: for each stimulus all C(t,2) pairs plus
+ * one identical pair of a random method, each with a random side, shuffled
+ * (Fisher-Yates) — all from the one seeded RNG, so a seed gives the same
+ * plan on every machine. Block II needs a reference. */
+bool mr_study_plan_make(const char *dir, const mr_study_set *set, const mr_study_plan_params *p, mr_study_plan *out,
+                        mr_error *err);
+bool mr_study_plan_save(const char *path, const mr_study_plan *plan, mr_error *err);
+/* Checks the id against the content (an edited plan is an error) and
+ * resolves dir as given, else relative to the plan file's folder. */
+bool mr_study_plan_load(const char *path, mr_study_plan *plan, mr_error *err);
+void mr_study_plan_free(mr_study_plan *plan);
+/* DIR/<method>/<stimulus>.png of a trial's method m. */
+void mr_study_plan_image(const mr_study_plan *plan, int stimulus, int method, char *out, size_t n);
+
+/* --------------------------------------------------------------- votes */
+
+typedef enum mr_study_answer { MR_STUDY_LEFT = -1, MR_STUDY_NEUTRAL = 0, MR_STUDY_RIGHT = 1 } mr_study_answer;
+
+/* One line of votes.jsonl: {"plan","participant","block":"II","trial",
+ * "stimulus","left","right","answer":"left|neutral|right","slider","ms",
+ * "time_unix"}. */
+typedef struct mr_study_vote {
+    char plan[17];
+    char participant[MR_STUDY_NAME_MAX];
+    int block;                /* 1..3 */
+    int trial;                /* index in the plan */
+    char stimulus[MR_STUDY_NAME_MAX], left[MR_STUDY_NAME_MAX], right[MR_STUDY_NAME_MAX];
+    mr_study_answer answer;
+    double slider;            /* [-1, 1]: -1 left, 0 neutral, +1 right */
+    double ms;                /* response time from the pair's appearance */
+    double time_unix;
+} mr_study_vote;
+
+/* Appends one vote durably (lib/session's append: one O_APPEND write +
+ * fsync), so a kill -9 right after loses nothing. */
+bool mr_study_vote_append(const char *path, const mr_study_vote *v, mr_error *err);
+
+typedef struct mr_study_votes {
+    mr_study_vote *v;
+    int count, cap;
+    int bad_lines;            /* lines that did not parse (a torn last line among them) */
+    int duplicates;           /* a participant's second answer to a trial: dropped */
+    bool torn_tail;           /* the file does not end with a newline */
+} mr_study_votes;
+
+/* Reads a votes file and adds its votes to *out (tolerant: a line that
+ * does not parse is counted and skipped with a warning in the log, a torn
+ * last line too; a participant's second answer to the same trial of the
+ * same plan is dropped with a warning, the first kept). A missing file is
+ * no error when missing_ok. false + err only for an unreadable file. */
+bool mr_study_votes_read(const char *path, bool missing_ok, mr_study_votes *out, mr_error *err);
+void mr_study_votes_free(mr_study_votes *v);
+/* Ends a torn last line with a newline (one appended byte, fsync'd) so the
+ * next append starts a line of its own; what was written stays as it is. */
+bool mr_study_votes_seal(const char *path, mr_error *err);
+
+/* Where a participant's run of a plan resumes: answered[k] is set for each
+ * trial k they answered (plan->trial_count entries, caller's array); the
+ * return value is the first unanswered trial (trial_count when done), or
+ * -1 + err when the log holds this participant's votes for another plan
+ * or votes that do not match the plan's trials. */
+int mr_study_resume(const mr_study_plan *plan, const mr_study_votes *votes, const char *participant, bool *answered,
+                    mr_error *err);
+
+/* ---------------------------------------------------------- statistics */
+
+/* All matrices are t x t, row-major, m[i*t + j]; w[i*t+j] = times i was
+ * preferred over j, ties[i*t+j] = ties[j*t+i] = no-preference answers.
+ * A = w + ties/2 (the no-preference answers split half to each side,
+ * thesis sec. 5.2). */
+void mr_study_split_ties(const double *w, const double *ties, int t, double *A);
+
+/* Coefficient of consistence of one participant's (complete) comparison
+ * matrix A (eq. 5.1-5.2): a_i the row sums, c = t(t^2-1)/24 - sum (a_i -
+ * mean)^2 / 2 (Kendall's count of circular triads, continuous with split
+ * ties), xi = 1 - 24c/(t(t^2-1)) (the thesis's normalisation, for every t).
+ * xi_kendall normalises by Kendall's true maximum, (t^3-t)/24 for odd t and
+ * (t^3-4t)/24 for even t; with split ties c can exceed it for even t, so
+ * xi_kendall is clamped to [0, 1]. */
+typedef struct mr_study_consistence {
+    double c, xi, xi_kendall;
+} mr_study_consistence;
+mr_study_consistence mr_study_consistence_of(const double *A, int t);
+
+/* Coefficient of agreement (eq. 5.3-5.5): tau = sum_{i!=j} C(A_ij, 2) with
+ * C(a,2) = a(a-1)/2 (the continuous form, exact for whole numbers),
+ * u = 2 tau / sum_{i<j} C(n_ij, 2) - 1 with n_ij = A_ij + A_ji (which is
+ * C(t,2) C(N,2) when every pair has N answers). NaN when no pair has two
+ * answers. */
+double mr_study_agreement(const double *A, int t);
+
+/* Degree of indifference (eq. 5.6) normalised to [0, 1]: the fraction of
+ * no-preference answers among the distinct pairs (sum_{i<j} A0_ij / sum
+ * n_ij, i.e. eq. 5.6's numerator over C(t,2)) divided by the fraction among
+ * the identical pairs (the eq.'s denominator), clamped to 1. Without an
+ * identical-pair baseline (none shown, or never answered "no preference")
+ * the denominator is taken as 1 and *baseline is false. */
+double mr_study_indifference(double neutral_distinct, double n_distinct, double neutral_identical,
+                             double n_identical, bool *baseline);
+
+/* Exact binomial test (p = 1/2): P(X >= k) for X ~ B(n, 1/2). */
+double mr_study_binom_upper_tail(int n, int k);
+/* The smallest k with P(X >= k) < alpha (alpha per tail; the thesis's
+ * 0.025): i is preferred significantly over j when A_ij >= k; the lower
+ * threshold is n - k. n + 1 when no k is (n too small). */
+int mr_study_binom_threshold(int n, double alpha);
+
+/* Bradley-Terry scores. */
+typedef struct mr_study_scores {
+    int t;
+    double theta[MR_STUDY_MAX_METHODS];  /* log strength; the reference's is 0, else centred (mean 0) */
+    double se[MR_STUDY_MAX_METHODS];     /* standard error from the inverse Hessian (0 for the reference) */
+    double p[MR_STUDY_MAX_METHODS];      /* e^theta_i / sum_k e^theta_k */
+    bool has_nu;                         /* Davidson with ties seen */
+    double log_nu, se_log_nu;            /* Davidson's tie parameter */
+    int iterations;
+    bool converged;
+    bool pseudo;                         /* the pseudo-count was added */
+    int isolated;                        /* then: a method the others never beat or tie, else -1 */
+    char note[256];                      /* one line when pseudo (which method was never beaten, ...) */
+} mr_study_scores;
+
+typedef struct mr_study_fit_params {
+    int reference;            /* method fixed at theta = 0, or -1: centred */
+    double pseudo;            /* added to w both ways for every pair when the comparison
+                                 graph is not strongly connected; default 0.5 */
+    int max_iter;             /* default 10000 (MM), 100 (Newton) */
+    double tol;               /* default 1e-10 */
+} mr_study_fit_params;
+#define MR_STUDY_FIT_DEFAULTS {.reference = -1, .pseudo = 0.5, .max_iter = 0, .tol = 0.0}
+
+/* Is the comparison graph (edge i -> j where i beat j, or they tied)
+ * strongly connected? If not, *who gets a method that no other beats or
+ * ties (a source component), or -1. */
+bool mr_study_graph_connected(const double *w, const double *ties, int t, int *who);
+
+/* Bradley-Terry without ties by Hunter's MM (2004): gamma_i <- W_i /
+ * sum_j n_ij / (gamma_i + gamma_j). Fits w as given (callers wanting ties
+ * in pass w from mr_study_split_ties). */
+bool mr_study_bt_fit(const double *w, int t, const mr_study_fit_params *p, mr_study_scores *out, mr_error *err);
+/* Davidson (1970) with ties: P(i) = pi_i / D, P(tie) = nu sqrt(pi_i pi_j) / D,
+ * by Newton's method with step halving on the concave log-likelihood in
+ * (theta, log nu). Without any tie it is mr_study_bt_fit (has_nu false). */
+bool mr_study_davidson_fit(const double *w, const double *ties, int t, const mr_study_fit_params *p,
+                           mr_study_scores *out, mr_error *err);
+
+/* ------------------------------------------------------------ analysis */
+
+typedef struct mr_study_analyze_params {
+    double alpha;             /* binomial test, per tail; default 0.025 */
+    double min_consistence;   /* participants whose mean xi is below are flagged; default 0.3 */
+    double pseudo;            /* see mr_study_fit_params; default 0.5 */
+    double z;                 /* confidence interval theta +- z se; default 1.96 */
+} mr_study_analyze_params;
+#define MR_STUDY_ANALYZE_DEFAULTS {.alpha = 0.025, .min_consistence = 0.3, .pseudo = 0.5, .z = 1.96}
+extern const mr_opt mr_study_analyze_opts[];   /* alpha, min-consistence, pseudo, z */
+
+/* Writes into out_dir: pairs.csv, scores.csv, consistence.csv,
+ * participants.csv, agreement.csv, identical.csv, chart_<block>.svg and
+ * summary.md. plan may be NULL (methods from the votes); when given, votes
+ * of another plan are left out with a warning. Lines for the user (warnings,
+ * the not-connected note) go to the log. */
+bool mr_study_analyze(const mr_study_votes *votes, const mr_study_plan *plan, const mr_study_analyze_params *p,
+                      const char *out_dir, mr_error *err);
+
+/* ------------------------------------------------------------- run window */
+
+/* The run's controller, without a window: the caller feeds events and the
+ * clock, draws the images where it says, draws its draw list on top, and
+ * appends the votes it hands out. Script commands (`T COMMAND ARGS`, T in
+ * seconds from the start; a command also waits until its widget is on
+ * screen and the previous one's input was taken):
+ *   tap @left|@neutral|@right|@vote | tap X Y | drag @slider F0 F1
+ *   key K (left, right, down/space = neutral, enter = vote) | shot OUT.png | state OUT.json | quit */
+typedef struct mr_study_runner mr_study_runner;
+
+typedef struct mr_study_run_params {
+    const mr_study_plan *plan;    /* outlives the runner */
+    const char *participant;
+    int first_trial;              /* where to start (mr_study_resume) */
+    const bool *answered;         /* plan->trial_count entries (skipped trials), or NULL */
+    bool slider;                  /* a slider (centre snaps to neutral) + a vote button
+                                     instead of three buttons; default false */
+    double px_per_mm;             /* 0 = 96 dpi */
+    const char *font_path;        /* NULL = a system sans font */
+    int image_w, image_h;         /* stimulus size in pixels (for the aspect); 0 = 4:3 */
+    double now;                   /* clock at start, seconds */
+} mr_study_run_params;
+#define MR_STUDY_RUN_DEFAULTS {NULL, NULL, 0, NULL, false, 0.0, NULL, 0, 0, 0.0}
+/* Slider values within this distance of the centre snap to 0 (neutral). */
+#define MR_STUDY_SNAP 0.08
+
+typedef struct mr_study_script mr_study_script;
+mr_study_script *mr_study_script_load(const char *path, mr_error *err);
+void mr_study_script_destroy(mr_study_script **s);
+
+mr_study_runner *mr_study_runner_create(const mr_study_run_params *p, mr_error *err);
+void mr_study_runner_destroy(mr_study_runner **r);
+/* The runner owns the script from then on (*s = NULL). */
+void mr_study_runner_set_script(mr_study_runner *r, mr_study_script **s);
+void mr_study_runner_push_event(mr_study_runner *r, const mr_event *e);
+
+/* What to draw this frame and what happened. */
+typedef struct mr_study_frame {
+    int trial;                    /* shown trial, -1 during fixation / when done */
+    bool fixation, done;
+    int image_count;              /* 0..3 */
+    int image_method[3];          /* method index of each placed image */
+    mr_ui_rect image_rect[3];     /* where (framebuffer px) */
+    bool vote;                    /* a vote was cast this frame: *vote_out is filled */
+    bool quit;                    /* the script or Esc asked to stop */
+    char shot_path[1024], state_path[1024]; /* scripts: save the screen / the state (empty: none) */
+} mr_study_frame;
+
+/* One frame: script, input, layout, widgets. fb_w x fb_h framebuffer px.
+ * Returns the draw list (valid until the next call). */
+const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, float fb_w, float fb_h,
+                                             mr_study_frame *out, mr_study_vote *vote_out);
+/* The caller could not store the vote: the runner stays on that trial. */
+void mr_study_runner_vote_failed(mr_study_runner *r, const char *msg);
+/* Trials answered in this run, the next trial, and a state JSON for tests. */
+int mr_study_runner_answered(const mr_study_runner *r);
+cJSON *mr_study_runner_state_json(const mr_study_runner *r);
+bool mr_study_runner_wants_input(const mr_study_runner *r);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
