@@ -73,7 +73,11 @@ expect_fail record_needs_camera "" -- "$mr" record --input "$rec/frames" --out "
 
 "$mr" record --input "$rec" --out "$tmp/killed" --rate 25 >/dev/null 2>&1 &
 pid=$!
-sleep 2
+# Killed mid-run once a few frames are in (a loaded machine is slow to start).
+for _ in $(seq 1 600); do
+  [ "$(wc -l <"$tmp/killed/frames.jsonl" 2>/dev/null || echo 0)" -ge 5 ] && break
+  sleep 0.1
+done
 kill -9 $pid
 wait $pid 2>/dev/null
 lines=$(wc -l <"$tmp/killed/frames.jsonl")

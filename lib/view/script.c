@@ -110,6 +110,9 @@ static void push(mr_viewer *v, mr_event_type t, double x, double y) {
     mr_viewer_push_event(v, &e);
 }
 
+/* How long a command naming a widget waits for it to be shown. */
+#define MR_VIEW_SCRIPT_WIDGET_WAIT_S 10.0
+
 void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out) {
     if (!v->script || v->script_next >= v->script->count) return;
     if (!v->script_started) {
@@ -125,14 +128,20 @@ void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out) {
     if (mr_viewer_pending(v) > 0 || busy || v->frames < v->script_frame + 2) return;
     const script_cmd *c = &v->script->cmds[v->script_next];
     if (c->t > v->now - v->script_t0) return;
-    v->script_next++;
-    v->script_frame = v->frames;
     double x = c->a, y = c->b;
     mr_ui_rect r = mr_ui_rect_make((float)x, (float)y, 0, 0);
+    int id = -1;
     if (c->target[0]) {
-        int id = -1;
         for (int i = 0; i < MR_VW_COUNT; i++)
             if (v->lay.shown[i] && strcmp(mr_view_widget_name((mr_view_widget_id)i), c->target) == 0) id = i;
+        /* A widget that an earlier command brings up (the note chooser
+         * after a tap in mark mode) may take a few frames on a slow
+         * machine: wait for it, for a while. */
+        if (id < 0 && v->now - v->script_t0 - c->t < MR_VIEW_SCRIPT_WIDGET_WAIT_S) return;
+    }
+    v->script_next++;
+    v->script_frame = v->frames;
+    if (c->target[0]) {
         if (id < 0) {
             mr_log(MR_LOG_WARN, "view: script: no widget named @%s on screen", c->target);
             return;
