@@ -14,7 +14,7 @@ demo_or_exit cli_ao "$mr" "$tmp/demo"
 d=$tmp/demo
 r() { "$mr" render --scene "$d/scene_planned.json" --view "$d/views/view_001.json" --size 96x72 "$@"; }
 
-for m in scheer crytek filion hbao alchemy; do
+for m in scheer crytek filion hbao alchemy gtao bitmask scheer-gt; do
   rm -rf "$tmp/aux_$m"
   if r --out "$tmp/$m.png" --ao "$m" --ao-samples 8 --aux "$tmp/aux_$m" --verbose 2>"$tmp/$m.err"; then
     [ -s "$tmp/aux_$m/ao.pfm" ] && ok || bad "--ao $m wrote no ao.pfm"

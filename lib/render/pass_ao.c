@@ -15,7 +15,9 @@
 
 _Static_assert(MR_AO_SCHEER == MR_AO_METHOD_ID_SCHEER && MR_AO_CRYTEK == MR_AO_METHOD_ID_CRYTEK &&
                    MR_AO_FILION == MR_AO_METHOD_ID_FILION && MR_AO_HBAO == MR_AO_METHOD_ID_HBAO &&
-                   MR_AO_ALCHEMY == MR_AO_METHOD_ID_ALCHEMY && MR_AO_MAX_SAMPLES == MR_AO_KERNEL_SIZE,
+                   MR_AO_ALCHEMY == MR_AO_METHOD_ID_ALCHEMY && MR_AO_MAX_SAMPLES == MR_AO_KERNEL_SIZE &&
+                   MR_AO_GTAO == MR_AO_METHOD_ID_GTAO && MR_AO_BITMASK == MR_AO_METHOD_ID_BITMASK &&
+                   MR_AO_SCHEER_GT == MR_AO_METHOD_ID_SCHEER_GT && MR_AO_MAX_SLICES == MR_AO_SLICES_SIZE,
                "shaders/mr_bindings.h and mr_render.h disagree on AO method ids or the kernel size");
 
 enum { AO_PLAN_OFF = 0, AO_PLAN_REUSE, AO_PLAN_RUN, AO_PLAN_EXTERNAL };
@@ -46,6 +48,8 @@ struct mr_ao_state {
     mr_ao_kernel k_kind;
     float k_rmin, k_rmax;
     float kernel3[MR_AO_MAX_SAMPLES * 4], kernel2[MR_AO_MAX_SAMPLES * 4];
+    float slices[MR_AO_MAX_SLICES * 4]; /* gtao / bitmask / scheer-gt: directions over half a turn */
+    GLuint linear_sampler;              /* their bilinear depth reads (texelFetch ignores it) */
     /* reuse */
     bool valid;
     ao_key last;
@@ -200,6 +204,7 @@ static void free_state(mr_ao_state *s) {
     glDeleteProgram(s->prog_blur);
     glDeleteProgram(s->prog_up);
     glDeleteProgram(s->prog_outline);
+    glDeleteSamplers(1, &s->linear_sampler);
     free(s);
 }
 
@@ -269,7 +274,9 @@ static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
      * well below the visibility they stand for), so each has its own
      * default strength: the value `bench ao` found best against the ray-
      * traced reference on a view it does not report. */
-    static const float k_strength[MR_AO_METHOD_COUNT] = {1.0f, 3.0f, 1.0f, 1.0f, 1.5f, 2.0f};
+    static const float k_strength[MR_AO_METHOD_COUNT] = {1.0f, 3.0f, 1.0f, 1.0f, 1.5f, 2.0f,
+                                                         /* gtao, bitmask, scheer-gt: visibility integrals, 1 */
+                                                         1.0f, 1.0f, 1.0f};
     if (!(p.strength > 0) || !isfinite(p.strength))
         p.strength = p.method > MR_AO_NONE && p.method < MR_AO_METHOD_COUNT ? k_strength[p.method] : 1.0f;
     if (!(p.c >= 0) || !isfinite(p.c)) p.c = MR_AO_DEFAULT_C;
@@ -285,6 +292,8 @@ static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
      * visibility in [0,1] whatever the method and its strength. */
     if (!(p.mask_strength > 0) || !isfinite(p.mask_strength)) p.mask_strength = MR_AO_DEFAULT_MASK_STRENGTH;
     if (p.mask_strength > 1) p.mask_strength = 1;
+    if (!(p.thickness > 0) || !isfinite(p.thickness)) p.thickness = MR_AO_DEFAULT_THICKNESS;
+    if (p.thickness > 100) p.thickness = 100;
     if ((int)p.radius_mode < 0 || p.radius_mode > MR_AO_RADIUS_VIEW) p.radius_mode = MR_AO_RADIUS_SCREEN;
     p.want_ao = false;
     p.want_mask = false;
@@ -322,6 +331,7 @@ static void copy_fields(mr_ao_params *d, const mr_ao_params *p) {
     d->positions = p->positions;
     d->mask = p->mask;
     d->mask_strength = p->mask_strength;
+    d->thickness = p->thickness;
     d->want_ao = p->want_ao;
     d->want_mask = p->want_mask;
     d->no_reuse = p->no_reuse;
@@ -541,6 +551,23 @@ static void mr_pass_ao_mask(frame *f) {
     glDepthMask(GL_TRUE);
 }
 
+/* The slice integrators' split of the sample budget: 4 steps per side,
+ * samples / 8 slices (8: 1 slice, 16: 2, 32: 4, 64: 8); fewer than 8
+ * samples: one slice with samples / 2 steps per side. */
+void mr_ao_slice_split(int samples, int *slices, int *steps) {
+    if (samples < 1) samples = 1;
+    int sl = samples / 8, st = 4;
+    if (sl < 1) {
+        sl = 1;
+        st = samples / 2 > 0 ? samples / 2 : 1;
+    }
+    if (sl > MR_AO_MAX_SLICES) sl = MR_AO_MAX_SLICES;
+    *slices = sl;
+    *steps = st;
+}
+
+static bool slice_method(mr_ao_method m) { return m == MR_AO_GTAO || m == MR_AO_BITMASK || m == MR_AO_SCHEER_GT; }
+
 static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
     const mr_ao_params *p = &s->p;
     glUseProgram(s->prog_main);
@@ -561,7 +588,34 @@ static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
     glUniform1f(MR_LOC_AO_MASK_STRENGTH, p->mask_strength);
     glUniform4fv(MR_LOC_AO_KERNEL, MR_AO_MAX_SAMPLES, s->kernel3);
     glUniform4fv(MR_LOC_AO_KERNEL2, MR_AO_MAX_SAMPLES, s->kernel2);
+    if (slice_method(p->method)) {
+        int sl, st;
+        mr_ao_slice_split(p->samples, &sl, &st);
+        /* Directions pi i / slices; the shader turns the set by a per-pixel
+         * angle in [0, pi / slices), so no pixel computes more than one
+         * sine and cosine for its directions. */
+        memset(s->slices, 0, sizeof s->slices);
+        for (int i = 0; i < sl; i++) {
+            double a = 3.14159265358979323846 * i / sl;
+            s->slices[4 * i] = (float)cos(a);
+            s->slices[4 * i + 1] = (float)sin(a);
+        }
+        glUniform4fv(MR_LOC_AO_SLICES, MR_AO_MAX_SLICES, s->slices);
+        glUniform1i(MR_LOC_AO_SLICE_COUNT, sl);
+        glUniform1i(MR_LOC_AO_STEPS, st);
+        glUniform1f(MR_LOC_AO_THICKNESS, p->thickness);
+        if (!s->linear_sampler) {
+            glCreateSamplers(1, &s->linear_sampler);
+            glSamplerParameteri(s->linear_sampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+            glSamplerParameteri(s->linear_sampler, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            glSamplerParameteri(s->linear_sampler, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            glSamplerParameteri(s->linear_sampler, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+            glSamplerParameteri(s->linear_sampler, GL_TEXTURE_COMPARE_MODE, GL_NONE);
+        }
+        glBindSampler(MR_TEX_AO_DEPTH, s->linear_sampler);
+    }
     fullscreen(f, s->fbo_ao[0], s->aw, s->ah);
+    glBindSampler(MR_TEX_AO_DEPTH, 0);
     s->cur = 0;
     s->result = s->tex_ao[0];
     s->valid = true;
