@@ -206,9 +206,10 @@ float occ_alchemy(vec3 P, vec3 n, float r, vec3 rnd, vec2 px) {
 // with nothing occluded (a ratio estimator): a plane is exactly 1.
 const float AO_PI = 3.14159265359;
 const float AO_HALF_PI = 1.57079632679;
-// gtao: the last fraction of the radius over which a sample's horizon
-// fades to the tangent (distance falloff); short, because the reference
-// counts an occluder fully up to R and not at all beyond.
+// gtao: the width (fraction of the radius) of the distance falloff over
+// which a sample's horizon fades to the tangent, centred on r: short,
+// because the reference counts an occluder fully up to r and not at all
+// beyond, and centred, so that what it drops inside r it adds outside.
 const float GTAO_FALLOFF = 0.1;
 
 float slice_arc(float t, float g) {
@@ -291,7 +292,7 @@ float occ_gtao(vec3 P, vec3 n, float r, vec3 rnd, vec2 px) {
                 float l = length(v);
                 if (!(l > 0.0) || isinf(l)) continue;
                 float c = dot(v, sl.V) / l;
-                float w = clamp((r - l) / (GTAO_FALLOFF * r), 0.0, 1.0);
+                float w = clamp(((1.0 + 0.5 * GTAO_FALLOFF) * r - l) / (GTAO_FALLOFF * r), 0.0, 1.0);
                 c = mix(lo[side], c, w);
                 if (c > hc[side]) hc[side] = c;
                 else if (w >= 1.0) hc[side] = mix(hc[side], c, beta);

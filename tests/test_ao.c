@@ -414,13 +414,16 @@ static double rmse(const mr_image *a, const mr_image *b) {
 static void test_scale_invariance(void) {
     const double scales[] = {1, 1e-3, 1e4, 1};
     const mr_dvec3 offs[] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {1e7, 0, -1e7}};
+    /* Every depth-scaled method: scheer, and (issue 18) the slice integrators. */
+    const mr_ao_method methods[] = {MR_AO_SCHEER, MR_AO_GTAO, MR_AO_BITMASK, MR_AO_SCHEER_GT};
+    for (size_t mi = 0; mi < sizeof methods / sizeof methods[0]; mi++)
     for (int half = 0; half < 2; half++) {
         mr_image ref = {0};
         for (int i = 0; i < 4; i++) {
             mr_scene *s = corner_scene(scales[i], offs[i], true);
             mr_view v = corner_view(scales[i], offs[i], 128, 96);
             mr_ao_params ao = MR_AO_DEFAULTS;
-            ao.method = MR_AO_SCHEER;
+            ao.method = methods[mi];
             ao.half_res = half;
             mr_frame_result res;
             if (render_ao(s, &v, &ao, &res)) {
@@ -431,9 +434,10 @@ static void test_scale_invariance(void) {
                 } else {
                     double e = rmse(&res.ao, &ref);
                     if (getenv("MR_TEST_VERBOSE"))
-                        printf("scheer%s scale %g offset %g: RMSE %.5f\n", half ? " half-res" : "", scales[i], offs[i].x, e);
-                    CHECK_MSG(e < 0.01, "scheer%s at scale %g offset %g: RMSE %.5f vs scale 1", half ? " half-res" : "",
-                              scales[i], offs[i].x, e);
+                        printf("%s%s scale %g offset %g: RMSE %.5f\n", mr_ao_method_name(methods[mi]), half ? " half-res" : "",
+                               scales[i], offs[i].x, e);
+                    CHECK_MSG(e < 0.01, "%s%s at scale %g offset %g: RMSE %.5f vs scale 1", mr_ao_method_name(methods[mi]),
+                              half ? " half-res" : "", scales[i], offs[i].x, e);
                 }
                 mr_frame_result_free(&res);
             }
@@ -811,6 +815,13 @@ static void test_golden(void) {
         {"scheer_radii5", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, 0, false, 5, MR_AO_MASK_OFF, false},
         {"mask_standalone", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, 4, false, 1, MR_AO_MASK_STANDALONE, false},
         {"scheer_paper", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, true},
+        /* issue 18 */
+        {"gtao_screen", MR_AO_GTAO, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"gtao_view", MR_AO_GTAO, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"bitmask_screen", MR_AO_BITMASK, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"bitmask_view", MR_AO_BITMASK, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"scheer_gt_screen", MR_AO_SCHEER_GT, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"scheer_gt_view", MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
     };
     mr_dvec3 o = mr_v3(0, 0, 0);
     mr_scene *s = corner_scene(1, o, true);
@@ -1163,6 +1174,68 @@ static void test_radii(void) {
     mr_renderer_set_scene(g_r, NULL, NULL);
 }
 
+/* ------------------------------------------------ issue 18: slice methods */
+
+/* RMSE of an AO image against the closed form beside the wall, over floor
+ * pixels in front of it (dist < 1, away from the cube and the image's
+ * ends), for the view radius R or the depth-scaled one (screen > 0). */
+static double wall_rmse(const mr_view *v, const mr_frame_result *g, const mr_image *ao, double R, double screen, int *count) {
+    mr_camera c = mr_camera_resized(&v->camera, g->depth.width, g->depth.height);
+    double se = 0;
+    int n = 0;
+    const float *a = ao->data, *d = g->depth.data;
+    for (int y = 0; y < g->depth.height; y++)
+        for (int x = 0; x < g->depth.width; x++) {
+            size_t i = (size_t)y * g->depth.width + x;
+            if (!(d[i] > 0)) continue;
+            mr_dvec3 p = pixel_world(v, &g->depth, x, y);
+            double dist = 2.9 - p.z, r = screen > 0 ? screen * d[i] * c.height / c.fy : R;
+            if (fabs(p.y) > 0.01 || dist < 0 || dist > 1.0 || p.x < -0.5 || p.x > 5) continue;
+            double e = a[i] - mr_eval_ao_wall_analytic(dist, r);
+            se += e * e;
+            n++;
+        }
+    if (count) *count = n;
+    return n ? sqrt(se / n) : 1e9;
+}
+
+/* GTAO, the bitmask and scheer-gt (c = 0, bias 0: its horizon is GTAO's
+ * without the falloff, so the same closed form) beside a wall: V = 1 -
+ * (acos a - a sqrt(1 - a^2)) / pi, a = d / R, within 0.025 RMSE with 64
+ * samples (4 slices x 8 steps per side), unblurred, for a fixed and for
+ * the depth-scaled radius. */
+static void test_slice_wall(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    mr_view v = corner_view(1, o, 160, 120);
+    const mr_ao_method ms[3] = {MR_AO_GTAO, MR_AO_BITMASK, MR_AO_SCHEER_GT};
+    for (int mi = 0; mi < 3; mi++)
+        for (int mode = 0; mode < 2; mode++) {
+            mr_ao_params ao = MR_AO_DEFAULTS;
+            ao.method = ms[mi];
+            ao.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
+            ao.radius = 0.6;
+            ao.screen_radius = 0.1;
+            ao.samples = 64;
+            ao.thickness = 2.0f; /* the wall is thick */
+            ao.blur_radius = 0;  /* the bilateral blur mixes the wall's AO into the floor's */
+            if (ms[mi] == MR_AO_SCHEER_GT) ao.c = 0, ao.bias = 0;
+            mr_frame_result res;
+            if (!render_ao(s, &v, &ao, &res)) continue;
+            int n = 0;
+            double e = wall_rmse(&v, &res, &res.ao, ao.radius, mode ? 0 : ao.screen_radius, &n);
+            if (getenv("MR_TEST_VERBOSE"))
+                printf("wall %s %s: RMSE %.4f over %d pixels\n", mr_ao_method_name(ao.method), mode ? "view" : "screen", e, n);
+            CHECK_MSG(n > 100, "only %d floor pixels in front of the wall", n);
+            CHECK_MSG(e < 0.025, "%s %s radius beside a wall: RMSE %.4f against the closed form", mr_ao_method_name(ao.method),
+                      mode ? "view" : "screen", e);
+            CHECK(count_bad(&res.ao) == 0);
+            mr_frame_result_free(&res);
+        }
+    mr_scene_destroy(&s);
+    mr_renderer_set_scene(g_r, NULL, NULL);
+}
+
 int main(void) {
     test_kernels();
     test_outline_dirs();
@@ -1193,6 +1266,7 @@ int main(void) {
         test_mask_count();
         test_mask_standalone();
         test_radii();
+        test_slice_wall();
     }
     mr_renderer_destroy(&g_r);
     mr_gpu_destroy(&g_gpu);

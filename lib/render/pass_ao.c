@@ -551,19 +551,19 @@ static void mr_pass_ao_mask(frame *f) {
     glDepthMask(GL_TRUE);
 }
 
-/* The slice integrators' split of the sample budget: 4 steps per side,
- * samples / 8 slices (8: 1 slice, 16: 2, 32: 4, 64: 8); fewer than 8
- * samples: one slice with samples / 2 steps per side. */
+/* The slice integrators' split of the sample budget: floor(sqrt(samples /
+ * 4)) slices (at least 1) and the rest as steps per side (8: 1 x 4,
+ * 16: 2 x 4, 32: 2 x 8, 64: 4 x 8). Too few steps under-reads every
+ * horizon (a bias the blur cannot remove), too few slices is noise across
+ * pixels (the per-pixel rotation), so steps grow first. */
 void mr_ao_slice_split(int samples, int *slices, int *steps) {
     if (samples < 1) samples = 1;
-    int sl = samples / 8, st = 4;
-    if (sl < 1) {
-        sl = 1;
-        st = samples / 2 > 0 ? samples / 2 : 1;
-    }
+    int sl = (int)floor(sqrt(samples / 4.0));
+    if (sl < 1) sl = 1;
     if (sl > MR_AO_MAX_SLICES) sl = MR_AO_MAX_SLICES;
+    int st = samples / (2 * sl);
     *slices = sl;
-    *steps = st;
+    *steps = st > 0 ? st : 1;
 }
 
 static bool slice_method(mr_ao_method m) { return m == MR_AO_GTAO || m == MR_AO_BITMASK || m == MR_AO_SCHEER_GT; }
