@@ -79,6 +79,11 @@
 #define MR_LOC_AO_STEPS                    (MR_LOC_AO_SLICE_COUNT + 1)
 #define MR_LOC_AO_THICKNESS                (MR_LOC_AO_SLICE_COUNT + 2)
 
+/* ao_probe (issue 18: the fetch floor) */
+#define MR_LOC_PROBE_FETCHES               0
+#define MR_LOC_PROBE_OFFSETS               1  /* vec4[MR_AO_KERNEL_SIZE] */
+#define MR_TEX_PROBE_SRC                   0
+
 /* ao_outline */
 #define MR_LOC_OUTLINE_RADIUS_MODE         3
 #define MR_LOC_OUTLINE_RADIUS              4

@@ -177,6 +177,13 @@ bool mr_ao_method_parse(const char *name, mr_ao_method *out);
 /* gtao / bitmask / scheer-gt: how `samples` splits into slices and steps
  * per slice side (slices * 2 * steps <= samples where samples >= 2). */
 void mr_ao_slice_split(int samples, int *slices, int *steps);
+/* issue 18: the fetch floor of an AO pass (lib/render/probe.c): a full-
+ * screen pass over a w x h R32F target doing `fetches` texel fetches per
+ * pixel spread over radius_px pixels (the AO disk kernel) and nothing
+ * else; each of `frames` draws (after one warm-up) is timed on the CPU
+ * between two glFinish, in ms[0 .. frames-1]. */
+bool mr_render_fetch_probe(mr_renderer *r, int w, int h, int fetches, double radius_px, int frames, double *ms,
+                           mr_error *err);
 const char *mr_ao_kernel_name(mr_ao_kernel k);
 bool mr_ao_kernel_parse(const char *name, mr_ao_kernel *out);
 /* The kernels the AO pass uses, deterministic for given arguments: out3
