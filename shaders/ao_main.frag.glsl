@@ -30,6 +30,7 @@ layout(location = MR_LOC_AO_SLICES) uniform vec4 u_slices[MR_AO_SLICES_SIZE]; //
 layout(location = MR_LOC_AO_SLICE_COUNT) uniform int u_slice_count;  // 1..16
 layout(location = MR_LOC_AO_STEPS) uniform int u_steps;              // samples per slice side
 layout(location = MR_LOC_AO_THICKNESS) uniform float u_thickness;    // fraction of the radius
+layout(location = MR_LOC_AO_FRAME) uniform int u_frame;              // temporal accumulation: frame index
 
 layout(binding = MR_TEX_AO_DEPTH) uniform sampler2D u_depth;
 layout(binding = MR_TEX_AO_NORMAL) uniform sampler2D u_normal;
@@ -409,6 +410,10 @@ void main() {
     }
     vec3 n = ao_normal(u_normal, fp, P);
     vec3 rnd = ao_rand3(ap);
+    // Temporal accumulation: the per-pixel numbers move on every frame (a
+    // Cranley-Patterson shift by the R3 sequence), so frames average to
+    // more samples; frame 0 keeps the fixed noise of a single frame.
+    if (u_frame != 0) rnd = fract(rnd + vec3(0.8191725134, 0.6710436067, 0.5497004779) * float(u_frame));
     vec3 plane = random_plane(rnd);
     float r0 = u_radius_mode == 0 ? u_screen_k * P.z : u_radius;
     float occ = 0.0;

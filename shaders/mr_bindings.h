@@ -78,6 +78,16 @@
 #define MR_LOC_AO_SLICE_COUNT              (MR_LOC_AO_SLICES + MR_AO_SLICES_SIZE)
 #define MR_LOC_AO_STEPS                    (MR_LOC_AO_SLICE_COUNT + 1)
 #define MR_LOC_AO_THICKNESS                (MR_LOC_AO_SLICE_COUNT + 2)
+#define MR_LOC_AO_FRAME                    (MR_LOC_AO_SLICE_COUNT + 3) /* temporal: frame index, 0 = the fixed noise */
+/* ao_temporal (issue 18), besides AO_INTR / AO_FULL / AO_NEAR and the AO textures */
+#define MR_LOC_TAA_PREV_FROM_CUR           8
+#define MR_LOC_TAA_PREV_INTR               9
+#define MR_LOC_TAA_HAVE_HISTORY            10
+#define MR_LOC_TAA_MAX_COUNT               11
+#define MR_LOC_TAA_DEPTH_TOL               12
+#define MR_LOC_TAA_NORMAL_COS              13
+#define MR_TEX_TAA_HISTORY                 5
+#define MR_TEX_TAA_HISTORY_N               6
 
 /* ao_probe (issue 18: the fetch floor) */
 #define MR_LOC_PROBE_FETCHES               0

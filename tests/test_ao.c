@@ -1236,6 +1236,132 @@ static void test_slice_wall(void) {
     mr_renderer_set_scene(g_r, NULL, NULL);
 }
 
+/* issue 18: temporal accumulation. A static camera converges towards the
+ * many-sample AO; a slowly moving one too (the reprojection carries the
+ * history: a wrong transform would smear it); after a jump with a
+ * tracking reset, or a jump to a view with nothing in common, the frame
+ * equals a fresh single frame (no ghost of the previous view). */
+/* Without mr_renderer_set_scene per frame: a new scene starts a new history. */
+static void render_ao_fp(const mr_scene *s, const mr_view *v, const mr_ao_params *ao, mr_image *out) {
+    (void)s;
+    mr_frame_params p = MR_FRAME_DEFAULTS;
+    p.ao = *ao;
+    p.ao.want_ao = true;
+    mr_frame_result res;
+    mr_error err = {0};
+    bool ok = mr_render_frame(g_r, v, &p, &res, &err);
+    CHECK_MSG(ok, "%s", err.msg);
+    if (!ok) return;
+    mr_image_free(out);
+    *out = res.ao;
+    res.ao.data = NULL;
+    mr_frame_result_free(&res);
+}
+
+static mr_view moved_view(double t, int w, int h) {
+    mr_view v = corner_view(1, mr_v3(0, 0, 0), w, h);
+    v.world_from_camera = mr_m4_look_at_cv(mr_v3(0.7 + 0.3 * t, 2.2, -2.5 + 0.2 * t), mr_v3(0.2 + 0.2 * t, 0.2, 2.5),
+                                           mr_v3(0, 1, 0));
+    return v;
+}
+
+static void test_temporal(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    const int w = 128, h = 96;
+    const mr_ao_method ms[2] = {MR_AO_SCHEER, MR_AO_GTAO};
+    mr_error serr = {0};
+    CHECK_MSG(mr_renderer_set_scene(g_r, s, &serr), "%s", serr.msg);
+    for (int mi = 0; mi < 2; mi++) {
+        mr_ao_params ao = MR_AO_DEFAULTS;
+        ao.method = ms[mi];
+        ao.radius_mode = MR_AO_RADIUS_VIEW;
+        ao.radius = 0.5;
+        ao.blur_radius = 0;
+        mr_image ref = {0}, single = {0}, acc = {0}, fresh = {0};
+        const char *name = mr_ao_method_name(ao.method);
+        for (int moving = 0; moving < 2; moving++) {
+            const int frames = 16;
+            mr_view last = moved_view(moving ? 1.0 : 0.0, w, h);
+            ao.samples = 64;
+            ao.temporal = false;
+            render_ao_fp(s, &last, &ao, &ref);
+            ao.samples = 4;
+            render_ao_fp(s, &last, &ao, &single);
+            ao.temporal = true;
+            for (int k = 0; k < frames; k++) {
+                mr_view v = moved_view(moving ? (double)k / (frames - 1) : 0.0, w, h);
+                ao.temporal_reset = k == 0;
+                render_ao_fp(s, &v, &ao, &acc);
+            }
+            ao.temporal_reset = false;
+            double e1 = rmse(&single, &ref), ea = rmse(&acc, &ref);
+            if (getenv("MR_TEST_VERBOSE"))
+                printf("temporal %s %s: 4 samples RMSE %.4f, accumulated %d frames %.4f (against 64 samples)\n", name,
+                       moving ? "moving" : "static", e1, frames, ea);
+            /* moving: history is lost at the image's edges and resampled at
+             * the nearest previous pixel every frame */
+            double bound = moving ? 0.75 : 0.6;
+            CHECK_MSG(ea < bound * e1, "temporal %s %s camera: accumulated RMSE %.4f not below %.2f x one frame's %.4f", name,
+                      moving ? "moving" : "static", ea, bound, e1);
+            CHECK(count_bad(&acc) == 0);
+        }
+        /* Jumps, after a history at the corner view: with a tracking reset
+         * the frame is the fresh one exactly (frame 0's noise); without a
+         * reset, to a view of the other side of the wall (nothing in
+         * common), every pixel's history is rejected: the frame is as far
+         * from the 64-sample AO as a fresh single frame (another frame's
+         * noise, so not equal to it), where a kept history would be the
+         * other view's AO. */
+        for (int reset = 1; reset >= 0; reset--) {
+            mr_view a = corner_view(1, o, w, h), b = a;
+            b.world_from_camera = reset ? mr_m4_look_at_cv(mr_v3(-3, 1.5, 0.5), mr_v3(2, 0.2, 2.8), mr_v3(0, 1, 0))
+                                        : mr_m4_look_at_cv(mr_v3(1, 2, 8), mr_v3(0.5, 0.5, 3.2), mr_v3(0, 1, 0));
+            ao.temporal = true;
+            for (int k = 0; k < 5; k++) {
+                ao.temporal_reset = k == 0;
+                render_ao_fp(s, &a, &ao, &acc);
+            }
+            ao.temporal_reset = reset;
+            render_ao_fp(s, &b, &ao, &acc);
+            ao.temporal = false;
+            ao.temporal_reset = false;
+            render_ao_fp(s, &b, &ao, &fresh);
+            double e = rmse(&acc, &fresh);
+            if (getenv("MR_TEST_VERBOSE")) printf("temporal %s jump %s: RMSE against a fresh frame %.6f\n", name, reset ? "with reset" : "no reset", e);
+            if (reset) {
+                CHECK_MSG(e < 1e-6, "temporal %s: after a tracking reset the frame differs from a fresh one: RMSE %.6f (a ghost)",
+                          name, e);
+            } else {
+                ao.samples = 64;
+                render_ao_fp(s, &b, &ao, &ref);
+                ao.samples = 4;
+                double ej = rmse(&acc, &ref), ef = rmse(&fresh, &ref);
+                if (getenv("MR_TEST_VERBOSE")) printf("temporal %s jump no reset: %.4f, fresh %.4f against 64 samples\n", name, ej, ef);
+                CHECK_MSG(ej < 1.15 * ef + 0.003, "temporal %s: after a jump to a view with nothing in common RMSE %.4f, a fresh "
+                          "frame %.4f (a ghost of the previous view)", name, ej, ef);
+            }
+        }
+        mr_image_free(&ref);
+        mr_image_free(&single);
+        mr_image_free(&acc);
+        mr_image_free(&fresh);
+    }
+    /* Off, single frames do not accumulate: the pass list has no ao_temporal. */
+    mr_ao_params off = MR_AO_DEFAULTS;
+    off.method = MR_AO_SCHEER;
+    mr_view v = corner_view(1, o, w, h);
+    mr_frame_result res;
+    if (render_ao(s, &v, &off, &res)) {
+        char buf[512];
+        mr_frame_result_passes(&res, buf, sizeof buf);
+        CHECK_MSG(strstr(buf, "ao_temporal") == NULL, "temporal accumulation ran while off: %s", buf);
+        mr_frame_result_free(&res);
+    }
+    mr_scene_destroy(&s);
+    mr_renderer_set_scene(g_r, NULL, NULL);
+}
+
 int main(void) {
     test_kernels();
     test_outline_dirs();
@@ -1267,6 +1393,7 @@ int main(void) {
         test_mask_standalone();
         test_radii();
         test_slice_wall();
+        test_temporal();
     }
     mr_renderer_destroy(&g_r);
     mr_gpu_destroy(&g_gpu);

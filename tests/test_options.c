@@ -269,6 +269,7 @@ static void test_tables(void) {
         E(mr_ao_params, "mask", mask, "off on standalone"),
         N(mr_ao_params, "mask-strength", mask_strength, 1e-3, 1),
         N(mr_ao_params, "thickness", thickness, 1e-3, 100), /* issue 18 */
+        N(mr_ao_params, "temporal", temporal, 0, 1),
     };
     const expect ex_gh[] = {
         E(mr_ghost_params, "", mode, "off alpha g0 adaptive"),

@@ -130,6 +130,14 @@ typedef struct mr_ao_params {
                                      (gtao, scheer-gt: the same fraction bounds how far
                                      in front of the pixel an occluder may be before the
                                      thickness heuristic fades it) */
+    bool temporal;                /* issue 18: accumulate the AO over frames (reprojected by
+                                     the poses, history rejected by depth and normal; a
+                                     running mean over up to MR_AO_TEMPORAL_FRAMES frames,
+                                     then weight 1/MR_AO_TEMPORAL_FRAMES for the new one);
+                                     off by default, and a single frame (render) has no
+                                     history to use */
+    bool temporal_reset;          /* this frame starts a new history (a tracking reset);
+                                     set by the caller per frame, like no_reuse */
     float mask_strength;          /* standalone mask: AO = 1 - mask_strength inside the
                                      mask before the blur, clamped to [0,1] (the method's
                                      strength plays no part); 0 = 0.5, the paper's grey
@@ -155,6 +163,9 @@ typedef struct mr_ao_params {
 #define MR_AO_DEFAULT_MASK_STRENGTH 0.5f
 #define MR_AO_DEFAULT_RADIUS_FRACTION 0.02 /* of the scene's bounding-box diagonal */
 #define MR_AO_DEFAULT_THICKNESS 0.5f
+#define MR_AO_TEMPORAL_FRAMES 16     /* temporal: frames in the running mean */
+#define MR_AO_TEMPORAL_DEPTH_TOL 0.02 /* temporal: relative depth difference that rejects history */
+#define MR_AO_TEMPORAL_NORMAL_COS 0.9 /* temporal: normals further apart reject history */
 #define MR_AO_MAX_SLICES 16 /* gtao / bitmask / scheer-gt: slice directions (a uniform array) */
 #define MR_AO_DEFAULTS {.method = MR_AO_NONE, .radius_mode = MR_AO_RADIUS_SCREEN, \
                         .screen_radius = MR_AO_DEFAULT_SCREEN_RADIUS, .samples = MR_AO_DEFAULT_SAMPLES, \

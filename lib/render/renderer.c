@@ -67,6 +67,7 @@ static const pass_desc *const k_passes[] = {
     &mr_pass_desc_ao,
     &mr_pass_desc_ao_blur,
     &mr_pass_desc_ao_upsample,
+    &mr_pass_desc_ao_temporal, /* issue 18 */
     &mr_pass_desc_ao_reuse,
     &mr_pass_desc_ao_external,
     &mr_pass_desc_ghost_hidden,
