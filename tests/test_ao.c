@@ -1306,6 +1306,29 @@ static void test_temporal(void) {
                       moving ? "moving" : "static", ea, bound, e1);
             CHECK(count_bad(&acc) == 0);
         }
+        /* A step of 0.4 units towards the wall after 16 still frames: every
+         * pixel's depth changes, so only a correct reprojection finds the
+         * history (at the same pixel the depth test rejects it: the frame
+         * would be a single frame's). */
+        {
+            mr_view a = corner_view(1, o, w, h), a2 = a;
+            a2.world_from_camera = mr_m4_look_at_cv(mr_v3(0.7, 2.1, -2.1), mr_v3(0.2, 0.2, 2.5), mr_v3(0, 1, 0));
+            ao.temporal = false;
+            ao.samples = 64;
+            render_ao_fp(s, &a2, &ao, &ref);
+            ao.samples = 4;
+            render_ao_fp(s, &a2, &ao, &single);
+            ao.temporal = true;
+            for (int k = 0; k < 16; k++) {
+                ao.temporal_reset = k == 0;
+                render_ao_fp(s, &a, &ao, &acc);
+            }
+            ao.temporal_reset = false;
+            render_ao_fp(s, &a2, &ao, &acc);
+            double e1 = rmse(&single, &ref), ea = rmse(&acc, &ref);
+            if (getenv("MR_TEST_VERBOSE")) printf("temporal %s step: one frame %.4f, with history %.4f\n", name, e1, ea);
+            CHECK_MSG(ea < 0.8 * e1, "temporal %s: after a step the history was lost (RMSE %.4f, one frame %.4f)", name, ea, e1);
+        }
         /* Jumps, after a history at the corner view: with a tracking reset
          * the frame is the fresh one exactly (frame 0's noise); without a
          * reset, to a view of the other side of the wall (nothing in
