@@ -114,6 +114,7 @@ int cmd_render(int argc, char **argv) {
     mr_gt_params gtp = MR_GT_DEFAULTS;
     if (!app_ao_check(cmd, &tables[0], opts, &groundtruth, &gtp)) return 2;
     fp.ao.want_ao = aux != NULL;
+    fp.ao.temporal = false; /* issue 18: a single frame has nothing to accumulate */
 
     /* Everything that can be checked without a GPU is checked first, so a
      * bad input never costs a context. */

@@ -71,6 +71,7 @@ int cmd_replay(int argc, char **argv) {
         if (n > 0) fps = 1.0 / mr_median(dt, n) / (double)every;
         free(dt);
     }
+    bool ao_restart = true; /* issue 18: --ao-temporal restarts after a frame without a pose (a tracking reset) */
     for (int i = 0; ok && i < rec->frame_count; i++) {
         const mr_rec_frame *f = &rec->frames[i];
         if (f->index < from || (to >= 0 && f->index > to) || (f->index - from) % every != 0) continue;
@@ -92,6 +93,8 @@ int cmd_replay(int argc, char **argv) {
             mr_frame_params fp = base;
             fp.video = &img;
             fp.alpha = (float)alpha;
+            fp.ao.temporal_reset = ao_restart;
+            ao_restart = false;
             mr_frame_result res;
             ok = mr_render_frame(gfx.renderer, &view, &fp, &res, &err) && mr_image_save_png(path, &res.color, &err);
             if (ok && app_get(opts, "video") && !vw) vw = mr_video_writer_open(app_get(opts, "video"), res.color.width, res.color.height, fps, &err);
@@ -100,6 +103,7 @@ int cmd_replay(int argc, char **argv) {
             rendered++;
         } else {
             /* No pose: the camera frame alone keeps the sequence complete. */
+            ao_restart = true;
             ok = mr_image_save_png(path, &img, &err);
             if (ok && app_get(opts, "video") && !vw) vw = mr_video_writer_open(app_get(opts, "video"), img.width, img.height, fps, &err);
             if (ok && app_get(opts, "video")) ok = vw && mr_video_writer_add(vw, &img, &err);
