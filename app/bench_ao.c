@@ -17,6 +17,7 @@ int bench_ao(int argc, char **argv) {
         {"rays", "N", "ground-truth rays per pixel (default 256)", NULL},
         {"radius", "R", "ground truth's fixed radius in scene units (default 2% of the scene diagonal)", NULL},
         {"screen-radius", "F", "depth-scaled reference: radius as a fraction of image height at each depth (default 0.05)", NULL},
+        {"sequence", "DIR", "recording whose poses are the moving sequence for temporal accumulation (default recordings/demo if there)", NULL},
         {"quick", NULL, "a reduced grid (samples 8 and 32, full resolution only, 2-point tuning)", NULL},
         {"out", "DIR", "output folder (default bench-out)", NULL},
         {"verbose", NULL, "more output", NULL},
@@ -43,6 +44,7 @@ int bench_ao(int argc, char **argv) {
     if (npos > 0 && !app_get(opts, "views")) return app_errorf(cmd, "view files given without --views"), 2;
     if (app_get(opts, "out")) p.out_dir = app_get(opts, "out");
     p.scene = app_get(opts, "scene");
+    p.sequence = app_get(opts, "sequence");
     p.frames = (int)frames;
     p.rays = (int)rays;
     p.quick = app_flag(opts, "quick");

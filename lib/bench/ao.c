@@ -23,6 +23,7 @@
  * only: nothing here passes or fails. */
 
 #include "bench_internal.h"
+#include "mr_session.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -114,6 +115,10 @@ typedef struct ao_bench {
     uint64_t tri_count[4];
     int ntri;
     mr_image ao; /* scratch: the last AO map */
+    /* issue 18: the moving sequence (step 6b) */
+    int seq_frames;
+    char seq_name[1100];
+    double seq_rmse[4][2], seq_ms[4]; /* config x {all frames, second half}, median ms */
 } ao_bench;
 
 /* Renders `frames` timed frames (plus one warm-up) and returns the median
@@ -702,6 +707,160 @@ static size_t equal_ms_table(const ao_bench *b, char *md, size_t cap, size_t len
     return len;
 }
 
+/* Step 6b (issue 18): temporal accumulation on a moving sequence, the
+ * poses of a recording (--sequence DIR; default the shipped
+ * recordings/demo when it is there, else the step is left out) at the
+ * bench's size: per frame the depth-scaled reference, and the tuned scheer
+ * (D2) and gtao at 16 samples per frame, at 4, and at 4 with accumulation
+ * (restarted at the first frame); RMSE per frame against that frame's
+ * reference, the AO passes timed between glFinish
+ * (bench_ao_sequence.csv). */
+enum { SEQ_MAX = 24 };
+static int contender_of(const char *label) {
+    for (int c = 0; c < NC; c++)
+        if (strcmp(k_contenders[c].label, label) == 0) return c;
+    return 0;
+}
+static const char *const k_seq_cfg[4] = {"scheer 16", "scheer 4 + temporal", "gtao 16", "gtao 4 + temporal"};
+static bool ao_sequence(ao_bench *b, mr_error *err) {
+    const char *dir = b->p.sequence ? b->p.sequence : "recordings/demo";
+    mr_error oe = {0};
+    mr_recording *rec = mr_recording_open(dir, &oe);
+    if (!rec) {
+        if (b->p.sequence) {
+            *err = oe;
+            return false;
+        }
+        BENCH_PRINT(b->p.out, "bench ao: no moving sequence (%s: %s); --sequence DIR gives one\n", dir, oe.msg);
+        return true;
+    }
+    snprintf(b->seq_name, sizeof b->seq_name, "%s", dir);
+    mr_view views[SEQ_MAX];
+    int nf = 0;
+    for (int i = 0; i < rec->frame_count && nf < SEQ_MAX; i++) {
+        const mr_rec_frame *f = &rec->frames[i];
+        if (!f->has_gt && !f->pose.valid) continue;
+        views[nf].camera = mr_camera_resized(&rec->camera, b->w, b->h);
+        views[nf].world_from_camera = f->has_gt ? f->gt : f->pose.world_from_camera;
+        nf++;
+    }
+    mr_recording_close(&rec);
+    mr_csv *csv = mr_csv_create(err);
+    if (!csv) return false;
+    mr_csv_comment(csv, "temporal accumulation on a moving sequence: RMSE per frame against the frame's depth-scaled "
+                        "reference; sync_ms: the AO passes between glFinish");
+    mr_csv_header(csv, "sequence,frame,config,samples,temporal,rmse_screen,sync_ms");
+    double rm[4][SEQ_MAX], ms[4][SEQ_MAX];
+    bool ok = mr_renderer_set_scene(b->gfx.renderer, b->scene, err);
+    mr_image depth = {0}, normal = {0}, ref = {0};
+    for (int k = 0; ok && k < nf; k++) {
+        mr_frame_params fp = MR_FRAME_DEFAULTS;
+        fp.width = b->w;
+        fp.height = b->h;
+        fp.want_depth = fp.want_normals = true;
+        mr_frame_result res;
+        ok = mr_render_frame(b->gfx.renderer, &views[k], &fp, &res, err);
+        if (!ok) break;
+        mr_image_free(&depth);
+        mr_image_free(&normal);
+        depth = res.depth;
+        normal = res.normal;
+        res.depth.data = res.normal.data = NULL;
+        mr_frame_result_free(&res);
+        mr_gt_params gp = MR_GT_DEFAULTS;
+        gp.rays = b->p.rays;
+        gp.radius_mode = MR_AO_RADIUS_SCREEN;
+        gp.screen_radius = b->screen_radius;
+        mr_image_free(&ref);
+        ok = mr_eval_ao_groundtruth(b->gt, &views[k], &depth, &normal, &gp, &ref, err);
+        /* the per-frame configurations; the accumulating ones need
+         * consecutive frames in the renderer's one history, so they run
+         * in passes of their own below */
+        for (int c = 0; ok && c < 4; c += 2) {
+            mr_ao_params p = b->cs[contender_of(c < 2 ? "scheer" : "gtao")].tuned;
+            p.samples = 16;
+            p.no_reuse = true;
+            double sync = 0, gms = 0;
+            ok = run_ao(b->gfx.renderer, &views[k], &p, b->w, b->h, 1, &gms, &sync, &b->ao, NULL, err);
+            mr_image_metrics m;
+            ok = ok && mr_image_compare(&b->ao, &ref, &depth, &m, err);
+            if (ok) {
+                rm[c][k] = m.rmse;
+                ms[c][k] = sync;
+            }
+        }
+        mr_image_free(&ref);
+    }
+    /* The accumulating runs: each a pass over the sequence of its own (the
+     * history must see consecutive frames); the references again per frame. */
+    for (int c = 1; ok && c < 4; c += 2) {
+        for (int k = 0; ok && k < nf; k++) {
+            mr_ao_params p = b->cs[contender_of(c < 2 ? "scheer" : "gtao")].tuned;
+            p.samples = 4;
+            p.temporal = true;
+            p.temporal_reset = k == 0;
+            mr_frame_params fp = MR_FRAME_DEFAULTS;
+            fp.width = b->w;
+            fp.height = b->h;
+            fp.timing = fp.timing_sync = true;
+            fp.want_depth = fp.want_normals = true;
+            fp.ao = p;
+            fp.ao.want_ao = true;
+            mr_frame_result res;
+            ok = mr_render_frame(b->gfx.renderer, &views[k], &fp, &res, err);
+            if (!ok) break;
+            double sync = 0;
+            for (int q = 0; q < res.pass_count; q++)
+                if (strncmp(res.passes[q], "ao", 2) == 0) sync += res.cpu_ms[q];
+            mr_gt_params gp = MR_GT_DEFAULTS;
+            gp.rays = b->p.rays;
+            gp.radius_mode = MR_AO_RADIUS_SCREEN;
+            gp.screen_radius = b->screen_radius;
+            mr_image_metrics m;
+            ok = mr_eval_ao_groundtruth(b->gt, &views[k], &res.depth, &res.normal, &gp, &ref, err) &&
+                 mr_image_compare(&res.ao, &ref, &res.depth, &m, err);
+            mr_image_free(&ref);
+            mr_frame_result_free(&res);
+            if (ok) {
+                rm[c][k] = m.rmse;
+                ms[c][k] = sync;
+            }
+        }
+    }
+    mr_image_free(&depth);
+    mr_image_free(&normal);
+    for (int c = 0; ok && c < 4; c++) {
+        double all = 0, late = 0;
+        int nl = 0;
+        for (int k = 0; k < nf; k++) {
+            mr_csv_quoted(csv, dir);
+            mr_csv_int(csv, k);
+            mr_csv_text(csv, k_seq_cfg[c]);
+            mr_csv_int(csv, c % 2 ? 4 : 16);
+            mr_csv_text(csv, c % 2 ? "on" : "off");
+            mr_csv_num(csv, "%.5f", rm[c][k]);
+            mr_csv_num(csv, "%.4f", ms[c][k]);
+            mr_csv_end_row(csv);
+            all += rm[c][k] / nf;
+            if (k >= nf / 2) {
+                late += rm[c][k];
+                nl++;
+            }
+        }
+        b->seq_rmse[c][0] = all;
+        b->seq_rmse[c][1] = nl ? late / nl : 0;
+        double t[SEQ_MAX];
+        memcpy(t, ms[c], sizeof t);
+        b->seq_ms[c] = nf > 0 ? mr_median(t, nf) : 0;
+    }
+    b->seq_frames = ok ? nf : 0;
+    if (!ok) {
+        mr_csv_destroy(&csv);
+        return false;
+    }
+    return save_csv(csv, b->p.out_dir, "bench_ao_sequence.csv", err);
+}
+
 /* Step 7: the summary table (bench_ao.md, also printed). */
 static bool ao_summary(ao_bench *b, mr_error *err) {
     char path[4096];
@@ -757,6 +916,16 @@ static bool ao_summary(ao_bench *b, mr_error *err) {
             len += (size_t)snprintf(md + len, sizeof md - len, " %.4f / %.4f |", b->pv_rf[v][c], b->pv_rs[v][c]);
     }
     len += (size_t)snprintf(md + len, sizeof md - len, "\n");
+    if (b->seq_frames > 0) {
+        len += (size_t)snprintf(md + len, sizeof md - len,
+                                "\nTemporal accumulation on the moving sequence %s (%d posed frames, %dx%d; RMSE against "
+                                "each frame's depth-scaled reference; ms: AO passes between glFinish, median):\n\n"
+                                "| configuration | RMSE all frames | RMSE second half | ms |\n|---|---|---|---|\n",
+                                b->seq_name, b->seq_frames, b->w, b->h);
+        for (int c = 0; c < 4; c++)
+            len += (size_t)snprintf(md + len, sizeof md - len, "| %s | %.4f | %.4f | %.2f |\n", k_seq_cfg[c], b->seq_rmse[c][0],
+                                    b->seq_rmse[c][1], b->seq_ms[c]);
+    }
     len += (size_t)snprintf(md + len, sizeof md - len, "\nAO passes against triangle count (scheer, 16 samples, %dx%d):\n\n"
                                                        "| triangles | AO GPU ms | G-buffer GPU ms |\n|---|---|---|\n", b->w, b->h);
     for (int i = 0; i < b->ntri; i++)
@@ -821,7 +990,7 @@ bool mr_bench_ao(const mr_bench_ao_params *params, mr_error *err) {
     memcpy(b->cs, k_contenders, sizeof b->cs);
     b->t0 = mr_time_now();
     bool ok = ao_setup(b, err) && ao_references(b, err) && ao_tune(b, err) && ao_grid(b, err) && ao_triangles(b, err) &&
-              ao_plots(b, err) && ao_shaded(b, err) && ao_summary(b, err);
+              ao_plots(b, err) && ao_shaded(b, err) && ao_sequence(b, err) && ao_summary(b, err);
     ao_free(b);
     return ok;
 }
