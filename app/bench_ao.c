@@ -13,6 +13,7 @@ int bench_ao(int argc, char **argv) {
                             "hall's near, mid-hall and far views)", NULL},
         {"tune-view", "V.json", "view the parameters are tuned on, not reported (default: a demo view not reported)", NULL},
         {"size", "WxH", "resolution (default 320x240)", NULL},
+        {"sequence", "DIR", "recording whose poses are the moving sequence for temporal accumulation (default recordings/demo if there)", NULL},
         {"out", "DIR", "output folder (default bench-out)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
@@ -35,6 +36,7 @@ int bench_ao(int argc, char **argv) {
     p.scene = mr_cli_get(opts, "scene");
     p.verbose = mr_cli_flag(opts, "verbose");
     p.progress = !mr_cli_flag(opts, "quiet");
+    p.sequence = mr_cli_get(opts, "sequence");
     p.out = stdout;
     mr_error err = {0};
     mr_view tune, views[MAX_VIEWS];

@@ -113,6 +113,7 @@ int cmd_render(int argc, char **argv) {
     bool groundtruth = false;
     if (!app_ao_check(cmd, &tables[0], &groundtruth, &gtp)) return 2;
     fp.ao.want_ao = aux != NULL;
+    fp.ao.temporal = false; /* issue 18: a single frame has nothing to accumulate */
 
     /* Everything that can be checked without a GPU is checked first, so a
      * bad input never costs a context. */

@@ -67,6 +67,8 @@ typedef struct view_app {
     mr_ui_rect image_rect;
     int rw, rh;
     bool dimmed;
+    /* issue 18: temporal AO (--ao-temporal); a frame after one without a valid pose restarts it */
+    bool ao_temporal, ao_had_pose;
     /* stats */
     bool stats;
     double t_start;
@@ -239,6 +241,9 @@ static void render_3d(view_app *a) {
     fp.video = s->show_video ? &a->frame.image : NULL;
     fp.hide_hidden_layer = s->hide_hidden;
     fp.ao.method = s->ao;
+    fp.ao.temporal = a->ao_temporal;
+    fp.ao.temporal_reset = !a->ao_had_pose; /* tracking (re)acquired: no history across the gap */
+    a->ao_had_pose = a->frame.have_pose && a->frame.pose_valid;
     fp.ghost.mode = s->ghost;
     mr_view_render_choice c =
         mr_view_render_policy(s, a->frame.have_pose, a->frame.pose_valid, mr_viewer_frozen(a->vc));
@@ -608,6 +613,7 @@ int cmd_view(int argc, char **argv) {
         {"stats", NULL, "print the frame-time split on exit", NULL},
         {"ao", "METHOD", ao_help, NULL},
         {"ghost", "MODE", ghost_help, NULL},
+        {"ao-temporal", NULL, "accumulate the AO over frames (reprojected; restarts when tracking is regained)", NULL},
         {"verbose", NULL, "more log output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -628,6 +634,7 @@ int cmd_view(int argc, char **argv) {
     if (!a) return mr_cli_errorf(k_cmd, "out of memory");
     a->t_start = a->fps_t0 = mr_time_now();
     a->stats = mr_cli_flag(opts, "stats");
+    a->ao_temporal = mr_cli_flag(opts, "ao-temporal");
     a->ui_scale = 1.0;
     mr_view_script *script = NULL;
     int rc = 0, ao = -1, ghost = -1;

@@ -25,6 +25,13 @@ layout(location = MR_LOC_AO_MASK_STRENGTH) uniform float u_mask_strength; // sta
 layout(location = MR_LOC_AO_KERNEL) uniform vec4 u_kernel[MR_AO_KERNEL_SIZE];  // xyz in the unit ball shell [r_min, r_max]
 layout(location = MR_LOC_AO_KERNEL2) uniform vec4 u_kernel2[MR_AO_KERNEL_SIZE]; // xy in the unit disk annulus [r_min, r_max]
 
+// issue 18: the slice integrators (gtao, bitmask, scheer-gt).
+layout(location = MR_LOC_AO_SLICES) uniform vec4 u_slices[MR_AO_SLICES_SIZE]; // xy: unit slice directions over half a turn
+layout(location = MR_LOC_AO_SLICE_COUNT) uniform int u_slice_count;  // 1..16
+layout(location = MR_LOC_AO_STEPS) uniform int u_steps;              // samples per slice side
+layout(location = MR_LOC_AO_THICKNESS) uniform float u_thickness;    // fraction of the radius
+layout(location = MR_LOC_AO_FRAME) uniform int u_frame;              // temporal accumulation: frame index
+
 layout(binding = MR_TEX_AO_DEPTH) uniform sampler2D u_depth;
 layout(binding = MR_TEX_AO_NORMAL) uniform sampler2D u_normal;
 layout(binding = MR_TEX_AO_POSITIONS) uniform sampler2D u_pos;
@@ -38,6 +45,9 @@ layout(location = 0) out float o_ao;
 #define M_HBAO MR_AO_METHOD_ID_HBAO
 #define M_ALCHEMY MR_AO_METHOD_ID_ALCHEMY
 #define M_MASK_STANDALONE MR_AO_METHOD_MASK_STANDALONE
+#define M_GTAO MR_AO_METHOD_ID_GTAO
+#define M_BITMASK MR_AO_METHOD_ID_BITMASK
+#define M_SCHEER_GT MR_AO_METHOD_ID_SCHEER_GT
 
 bool fetch_pos(ivec2 q, out vec3 p) {
     return ao_view_pos(u_depth, u_pos, u_use_pos != 0, u_near, u_intr, q, p);
@@ -180,6 +190,211 @@ float occ_alchemy(vec3 P, vec3 n, float r, vec3 rnd, vec2 px) {
     return sum / float(u_samples);                   // 2 sigma / s with sigma = 0.5
 }
 
+// ------------------------------------------------------------ issue 18
+// The slice integrators. A slice is the plane through the view vector V
+// (towards the camera) and a screen direction d; in it an angle t is
+// measured from V, positive towards +d. The normal projected into the
+// slice has length nl and angle g. The cosine-weighted solid angle of the
+// arc between 0 and t, signed (negative for t < 0), is
+//   A(t) = sign(t) (cos g + 2 t sin g - cos(2 t - g)) / 4
+// (Jimenez et al. 2016, eq. 10), so the visible part of a slice between
+// the horizons t0 <= 0 <= t1 weighs nl (A(t1) - A(t0)); averaged over
+// slice directions uniform in [0, pi) this is exactly the cosine-weighted
+// visibility the ray-traced reference measures (heightfield assumption).
+// With a few slices per pixel the sum scatters around 1 even on a plane,
+// and the clamp to [0,1] would cut the overshoot off (a plane came out
+// 0.03 dark), so all three divide by the same sum over the pixel's slices
+// with nothing occluded (a ratio estimator): a plane is exactly 1.
+const float AO_PI = 3.14159265359;
+const float AO_HALF_PI = 1.57079632679;
+// gtao: the width (fraction of the radius) of the distance falloff over
+// which a sample's horizon fades to the tangent, centred on r: short,
+// because the reference counts an occluder fully up to r and not at all
+// beyond, and centred, so that what it drops inside r it adds outside.
+const float GTAO_FALLOFF = 0.1;
+
+float slice_arc(float t, float g) {
+    return sign(t) * 0.25 * (cos(g) + 2.0 * t * sin(g) - cos(2.0 * t - g));
+}
+
+struct ao_slice {
+    vec2 d;      // screen direction (pixels), = view direction (OpenCV axes)
+    vec3 V;      // towards the camera
+    float g;     // signed angle of the projected normal from V
+    float nl;    // length of the projected normal
+};
+
+ao_slice make_slice(vec3 P, vec3 n, vec2 d) {
+    ao_slice s;
+    s.d = d;
+    s.V = normalize(-P);
+    vec3 D = vec3(d, 0.0);
+    vec3 ortho = D - dot(D, s.V) * s.V;              // +d side of the slice, orthogonal to V
+    vec3 axis = normalize(cross(ortho, s.V));
+    vec3 np = n - axis * dot(n, axis);
+    s.nl = length(np);
+    float cg = s.nl > 1e-6 ? clamp(dot(np, s.V) / s.nl, -1.0, 1.0) : 1.0;
+    s.g = (dot(np, ortho) < 0.0 ? -1.0 : 1.0) * acos(cg);
+    return s;
+}
+
+// The sample j of side `side` (0: +d, 1: -d) of a slice, at jittered
+// even steps over the projected radius; false outside the image or sky.
+// The point is taken on the ray through the sample's own (sub-pixel)
+// position, with the reversed-Z depth filtered bilinearly there (pass_ao.c
+// binds a linear sampler for these methods): 1/z is affine across a plane
+// in the image, so a plane's points come out exactly on it and in the
+// slice. The nearest pixel's point lies off the slice by up to half a
+// pixel, which reads as a horizon above the tangent (a plane came out
+// 0.02 dark). With a positions texture the nearest pixel is used.
+bool slice_sample(vec2 px, vec2 d, int side, int j, float jitter, float rpx, out vec3 S) {
+    S = vec3(0.0);
+    float off = max(1.0, (float(j) + jitter) / float(u_steps) * rpx);
+    vec2 uv = px + (side == 0 ? d : -d) * off;
+    if (!(uv.x > -0.5 && uv.y > -0.5 && uv.x < float(u_full.x) - 0.5 && uv.y < float(u_full.y) - 0.5)) return false;
+    if (u_use_pos != 0) return fetch_pos(ivec2(floor(uv + 0.5)), S);
+    float dz = textureLod(u_depth, (uv + 0.5) / vec2(u_full), 0.0).r;
+    if (!(dz > 0.0)) return false;
+    float z = u_near / dz;
+    if (isinf(z) || isnan(z)) return false;
+    S = vec3((uv - u_intr.zw) / u_intr.xy * z, z);
+    return true;
+}
+
+// The per-pixel rotation of the slice set (one cos/sin per pixel; the
+// directions themselves are the uniform array).
+vec2 slice_dir(int i, vec2 rot) {
+    vec2 d0 = u_slices[i].xy;
+    return vec2(rot.x * d0.x - rot.y * d0.y, rot.y * d0.x + rot.x * d0.y);
+}
+
+// Jimenez et al. 2016 (GTAO): per slice the highest horizon on each side
+// within r (cosines, with the distance falloff towards the tangent), the
+// thickness heuristic (a sample below the running horizon pulls it down by
+// beta = 0.05 / thickness: a thin occluder's horizon decays behind it),
+// the horizons clamped to the normal's hemisphere, then the arc integral.
+float occ_gtao(vec3 P, vec3 n, float r, vec3 rnd, vec2 px) {
+    float rpx = r * u_intr.x / P.z;
+    if (!(rpx >= 1.0)) return 0.0;
+    rpx = min(rpx, float(max(u_full.x, u_full.y)));
+    float a = rnd.x * AO_PI / float(u_slice_count);
+    vec2 rot = vec2(cos(a), sin(a));
+    float beta = clamp(0.05 / max(u_thickness, 1e-3), 0.0, 1.0);
+    float vis = 0.0, total = 0.0;
+    for (int i = 0; i < u_slice_count; i++) {
+        ao_slice sl = make_slice(P, n, slice_dir(i, rot));
+        float lo[2] = float[2](-sin(sl.g), sin(sl.g)); // cos(g + pi/2), cos(g - pi/2)
+        float hc[2] = float[2](lo[0], lo[1]);
+        for (int j = 0; j < u_steps; j++)
+            for (int side = 0; side < 2; side++) {
+                vec3 S;
+                if (!slice_sample(px, sl.d, side, j, rnd.y, rpx, S)) continue;
+                vec3 v = S - P;
+                float l = length(v);
+                if (!(l > 0.0) || isinf(l)) continue;
+                float c = dot(v, sl.V) / l;
+                float w = clamp(((1.0 + 0.5 * GTAO_FALLOFF) * r - l) / (GTAO_FALLOFF * r), 0.0, 1.0);
+                c = mix(lo[side], c, w);
+                if (c > hc[side]) hc[side] = c;
+                else if (w >= 1.0) hc[side] = mix(hc[side], c, beta);
+            }
+        float t1 = min(acos(clamp(hc[0], -1.0, 1.0)), sl.g + AO_HALF_PI);
+        float t0 = max(-acos(clamp(hc[1], -1.0, 1.0)), sl.g - AO_HALF_PI);
+        vis += sl.nl * (slice_arc(t1, sl.g) - slice_arc(t0, sl.g));
+        total += sl.nl * (slice_arc(sl.g + AO_HALF_PI, sl.g) - slice_arc(sl.g - AO_HALF_PI, sl.g));
+    }
+    return total > 0.0 ? 1.0 - vis / total : 0.0;
+}
+
+// Sectors [t0, t1] of a slice as bits: the arc between the normal's
+// hemisphere ends, cut into 32 sectors of equal cosine-weighted mass; a
+// sector is set when its centre lies in [t0, t1].
+uint sector_bits(float t0, float t1, float g, float a0, float inv_mass) {
+    float u0 = (slice_arc(clamp(t0, g - AO_HALF_PI, g + AO_HALF_PI), g) - a0) * inv_mass;
+    float u1 = (slice_arc(clamp(t1, g - AO_HALF_PI, g + AO_HALF_PI), g) - a0) * inv_mass;
+    uint b0 = uint(clamp(floor(u0 * 32.0 + 0.5), 0.0, 32.0));
+    uint b1 = uint(clamp(floor(u1 * 32.0 + 0.5), 0.0, 32.0));
+    if (b1 <= b0) return 0u;
+    uint cnt = b1 - b0;
+    return cnt >= 32u ? 0xffffffffu : ((1u << cnt) - 1u) << b0;
+}
+
+// Therrien, Levesque & Gilet 2023 (visibility bitmasks): every sample
+// within r occludes the angles between its front face and a point
+// `thickness * r` behind it along the view ray; the slice's visibility is
+// its share of unset sectors (sectors of equal cosine-weighted mass, so
+// the count is the cosine-weighted visibility).
+float occ_bitmask(vec3 P, vec3 n, float r, vec3 rnd, vec2 px) {
+    float rpx = r * u_intr.x / P.z;
+    if (!(rpx >= 1.0)) return 0.0;
+    rpx = min(rpx, float(max(u_full.x, u_full.y)));
+    float a = rnd.x * AO_PI / float(u_slice_count);
+    vec2 rot = vec2(cos(a), sin(a));
+    float th = u_thickness * r;
+    float vis = 0.0, total = 0.0;
+    for (int i = 0; i < u_slice_count; i++) {
+        ao_slice sl = make_slice(P, n, slice_dir(i, rot));
+        float a0 = slice_arc(sl.g - AO_HALF_PI, sl.g), mass = slice_arc(sl.g + AO_HALF_PI, sl.g) - a0;
+        if (!(mass > 1e-6)) continue;
+        float inv_mass = 1.0 / mass;
+        uint bits = 0u;
+        for (int j = 0; j < u_steps; j++)
+            for (int side = 0; side < 2; side++) {
+                vec3 S;
+                if (!slice_sample(px, sl.d, side, j, rnd.y, rpx, S)) continue;
+                vec3 v = S - P;
+                float l = length(v);
+                if (!(l > 0.0) || !(l <= r)) continue;
+                vec3 vb = S + normalize(S) * th - P;
+                float tf = acos(clamp(dot(v, sl.V) / l, -1.0, 1.0));
+                float tb = acos(clamp(dot(vb, sl.V) / max(length(vb), 1e-30), -1.0, 1.0));
+                float sg = side == 0 ? 1.0 : -1.0;
+                bits |= sector_bits(min(sg * tf, sg * tb), max(sg * tf, sg * tb), sl.g, a0, inv_mass);
+            }
+        vis += sl.nl * mass * (1.0 - float(bitCount(bits)) / 32.0);
+        total += sl.nl * mass;
+    }
+    return total > 0.0 ? 1.0 - vis / total : 0.0;
+}
+
+// scheer-gt: Scheer & Keutel's idea on GTAO's integrator. Each sample
+// within r occludes the cosine-weighted arc between the tangent and its
+// horizon, attenuated by Scheer's quasi-normalised 1/(1 + c l^2), l = |v|/r
+// (so a near occluder counts fully, one at the radius 1/(1+c)); per side
+// the largest attenuated arc wins (no double counting), and the occluded
+// mass is normalised by the slices' own unoccluded mass (a ratio
+// estimator: a plane is exactly 1 whatever the slice directions).
+float occ_scheer_gt(vec3 P, vec3 n, float r, vec3 rnd, vec2 px) {
+    float rpx = r * u_intr.x / P.z;
+    if (!(rpx >= 1.0)) return 0.0;
+    rpx = min(rpx, float(max(u_full.x, u_full.y)));
+    float a = rnd.x * AO_PI / float(u_slice_count);
+    vec2 rot = vec2(cos(a), sin(a));
+    float occ = 0.0, total = 0.0;
+    for (int i = 0; i < u_slice_count; i++) {
+        ao_slice sl = make_slice(P, n, slice_dir(i, rot));
+        float lo1 = sl.g + AO_HALF_PI, lo0 = sl.g - AO_HALF_PI;
+        float m1 = slice_arc(lo1, sl.g), m0 = slice_arc(lo0, sl.g);
+        float best[2] = float[2](0.0, 0.0);
+        for (int j = 0; j < u_steps; j++)
+            for (int side = 0; side < 2; side++) {
+                vec3 S;
+                if (!slice_sample(px, sl.d, side, j, rnd.y, rpx, S)) continue;
+                vec3 v = S - P;
+                float l = length(v);
+                if (!(l > 0.0) || !(l <= r)) continue;
+                float t = acos(clamp(dot(v, sl.V) / l, -1.0, 1.0));
+                float ln = l / r, att = 1.0 / (1.0 + u_c * ln * ln);
+                // occluded arc: from the horizon down to the hemisphere's end
+                float arc = side == 0 ? m1 - slice_arc(min(t, lo1), sl.g) : slice_arc(max(-t, lo0), sl.g) - m0;
+                best[side] = max(best[side], att * max(arc - u_bias * (side == 0 ? m1 : -m0), 0.0));
+            }
+        occ += sl.nl * (best[0] + best[1]);
+        total += sl.nl * (m1 - m0);
+    }
+    return total > 0.0 ? occ / total : 0.0;
+}
+
 void main() {
     ivec2 ap = ivec2(gl_FragCoord.xy);
     ivec2 fp = ap * u_step;
@@ -195,6 +410,10 @@ void main() {
     }
     vec3 n = ao_normal(u_normal, fp, P);
     vec3 rnd = ao_rand3(ap);
+    // Temporal accumulation: the per-pixel numbers move on every frame (a
+    // Cranley-Patterson shift by the R3 sequence), so frames average to
+    // more samples; frame 0 keeps the fixed noise of a single frame.
+    if (u_frame != 0) rnd = fract(rnd + vec3(0.8191725134, 0.6710436067, 0.5497004779) * float(u_frame));
     vec3 plane = random_plane(rnd);
     float r0 = u_radius_mode == 0 ? u_screen_k * P.z : u_radius;
     float occ = 0.0;
@@ -207,6 +426,9 @@ void main() {
         else if (u_method == M_FILION) o = occ_filion(P, n, r, plane);
         else if (u_method == M_HBAO) o = occ_hbao(P, n, r, rnd, vec2(fp));
         else if (u_method == M_ALCHEMY) o = occ_alchemy(P, n, r, rnd, vec2(fp));
+        else if (u_method == M_GTAO) o = occ_gtao(P, n, r, rnd, vec2(fp));
+        else if (u_method == M_BITMASK) o = occ_bitmask(P, n, r, rnd, vec2(fp));
+        else if (u_method == M_SCHEER_GT) o = occ_scheer_gt(P, n, r, rnd, vec2(fp));
         occ = max(occ, o);                           // multi-radius: the darkest radius wins
     }
     float ao = 1.0 - u_strength * occ;

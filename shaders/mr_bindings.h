@@ -72,6 +72,27 @@
 #define MR_AO_KERNEL_SIZE                  64 /* = MR_AO_MAX_SAMPLES (checked in pass_ao.c) */
 #define MR_LOC_AO_KERNEL2                  (MR_LOC_AO_KERNEL + MR_AO_KERNEL_SIZE)
 #define MR_TEX_AO_MASK                     3
+/* issue 18: gtao / bitmask / scheer-gt */
+#define MR_LOC_AO_SLICES                   (MR_LOC_AO_KERNEL2 + MR_AO_KERNEL_SIZE) /* vec4[MR_AO_SLICES_SIZE]: xy slice direction */
+#define MR_AO_SLICES_SIZE                  16 /* = MR_AO_MAX_SLICES */
+#define MR_LOC_AO_SLICE_COUNT              (MR_LOC_AO_SLICES + MR_AO_SLICES_SIZE)
+#define MR_LOC_AO_STEPS                    (MR_LOC_AO_SLICE_COUNT + 1)
+#define MR_LOC_AO_THICKNESS                (MR_LOC_AO_SLICE_COUNT + 2)
+#define MR_LOC_AO_FRAME                    (MR_LOC_AO_SLICE_COUNT + 3) /* temporal: frame index, 0 = the fixed noise */
+/* ao_temporal (issue 18), besides AO_INTR / AO_FULL / AO_NEAR and the AO textures */
+#define MR_LOC_TAA_PREV_FROM_CUR           8
+#define MR_LOC_TAA_PREV_INTR               9
+#define MR_LOC_TAA_HAVE_HISTORY            10
+#define MR_LOC_TAA_MAX_COUNT               11
+#define MR_LOC_TAA_DEPTH_TOL               12
+#define MR_LOC_TAA_NORMAL_COS              13
+#define MR_TEX_TAA_HISTORY                 5
+#define MR_TEX_TAA_HISTORY_N               6
+
+/* ao_probe (issue 18: the fetch floor) */
+#define MR_LOC_PROBE_FETCHES               0
+#define MR_LOC_PROBE_OFFSETS               1  /* vec4[MR_AO_KERNEL_SIZE] */
+#define MR_TEX_PROBE_SRC                   0
 
 /* ao_outline */
 #define MR_LOC_OUTLINE_RADIUS_MODE         3
@@ -210,6 +231,9 @@
 #define MR_AO_METHOD_ID_FILION             3
 #define MR_AO_METHOD_ID_HBAO               4
 #define MR_AO_METHOD_ID_ALCHEMY            5
+#define MR_AO_METHOD_ID_GTAO               6
+#define MR_AO_METHOD_ID_BITMASK            7
+#define MR_AO_METHOD_ID_SCHEER_GT          8
 #define MR_AO_METHOD_MASK_STANDALONE       100
 
 #endif

@@ -14,7 +14,7 @@ demo_or_exit cli_ao "$mr" "$tmp/demo"
 d=$tmp/demo
 r() { "$mr" render --scene "$d/scene_planned.json" --view "$d/views/view_001.json" --size 96x72 "$@"; }
 
-for m in scheer crytek filion hbao alchemy; do
+for m in scheer crytek filion hbao alchemy gtao bitmask scheer-gt; do
   rm -rf "$tmp/aux_$m"
   if r --out "$tmp/$m.png" --ao "$m" --ao-samples 8 --aux "$tmp/aux_$m" --verbose 2>"$tmp/$m.err"; then
     [ -s "$tmp/aux_$m/ao.pfm" ] && ok || bad "--ao $m wrote no ao.pfm"
@@ -66,4 +66,23 @@ for args in "--ao ssao" "--ao scheer --ao-samples 0" "--ao scheer --ao-samples 6
     [ ! -e "$tmp/bad.png" ] && ok || bad "$args: wrote an output"
   fi
 done
+# issue 18: temporal accumulation replays the shipped recording (4 frames),
+# gives the same first frame as without it, and --ao-thickness is range-checked.
+src=$(cd "$(dirname "$0")/.." && pwd)
+rp() { "$mr" replay "$src/recordings/demo" --scene "$src/configs/scenes/demo_planned.json" --from 20 --to 23 \
+  --ao gtao --ao-samples 8 "$@" >/dev/null; }
+if rp --out "$tmp/rp_taa" --ao-temporal 2>"$tmp/rp_taa.err" && rp --out "$tmp/rp_plain" 2>"$tmp/rp_plain.err"; then
+  [ "$(find "$tmp/rp_taa" -name 'overlay_*.png' | wc -l)" -eq 4 ] && ok || bad "replay --ao-temporal: $(ls "$tmp/rp_taa")"
+  first=$(find "$tmp/rp_taa" -name 'overlay_*.png' | sort | head -1)
+  cmp -s "$first" "$tmp/rp_plain/$(basename "$first")" && ok || bad "replay --ao-temporal: the first frame differs from plain AO"
+  last=$(find "$tmp/rp_taa" -name 'overlay_*.png' | sort | tail -1)
+  cmp -s "$last" "$tmp/rp_plain/$(basename "$last")" && bad "replay --ao-temporal: the last frame did not accumulate" || ok
+else
+  bad "replay --ao-temporal failed: $(cat "$tmp/rp_taa.err" "$tmp/rp_plain.err")"
+fi
+if r --out "$tmp/thick.png" --ao bitmask --ao-thickness 0 2>"$tmp/thick.err"; then
+  bad "accepted --ao-thickness 0"
+else
+  [ "$(wc -l <"$tmp/thick.err")" -eq 1 ] && ok || bad "--ao-thickness 0: not one line: $(cat "$tmp/thick.err")"
+fi
 cli_finish cli_ao

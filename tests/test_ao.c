@@ -414,13 +414,16 @@ static double rmse(const mr_image *a, const mr_image *b) {
 static void test_scale_invariance(void) {
     const double scales[] = {1, 1e-3, 1e4, 1};
     const mr_dvec3 offs[] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {1e7, 0, -1e7}};
+    /* Every depth-scaled method: scheer, and (issue 18) the slice integrators. */
+    const mr_ao_method methods[] = {MR_AO_SCHEER, MR_AO_GTAO, MR_AO_BITMASK, MR_AO_SCHEER_GT};
+    for (size_t mi = 0; mi < sizeof methods / sizeof methods[0]; mi++)
     for (int half = 0; half < 2; half++) {
         mr_image ref = {0};
         for (int i = 0; i < 4; i++) {
             mr_scene *s = corner_scene(scales[i], offs[i], true);
             mr_view v = corner_view(scales[i], offs[i], 128, 96);
             mr_ao_params ao = MR_AO_DEFAULTS;
-            ao.method = MR_AO_SCHEER;
+            ao.method = methods[mi];
             ao.half_res = half;
             mr_frame_result res;
             if (render_ao(s, &v, &ao, &res)) {
@@ -431,9 +434,10 @@ static void test_scale_invariance(void) {
                 } else {
                     double e = rmse(&res.ao, &ref);
                     if (getenv("MR_TEST_VERBOSE"))
-                        printf("scheer%s scale %g offset %g: RMSE %.5f\n", half ? " half-res" : "", scales[i], offs[i].x, e);
-                    CHECK_MSG(e < 0.01, "scheer%s at scale %g offset %g: RMSE %.5f vs scale 1", half ? " half-res" : "",
-                              scales[i], offs[i].x, e);
+                        printf("%s%s scale %g offset %g: RMSE %.5f\n", mr_ao_method_name(methods[mi]), half ? " half-res" : "",
+                               scales[i], offs[i].x, e);
+                    CHECK_MSG(e < 0.01, "%s%s at scale %g offset %g: RMSE %.5f vs scale 1", mr_ao_method_name(methods[mi]),
+                              half ? " half-res" : "", scales[i], offs[i].x, e);
                 }
                 mr_frame_result_free(&res);
             }
@@ -487,7 +491,7 @@ static void test_finite(void) {
                 frames++;
                 mr_frame_result_free(&res);
             }
-    CHECK(frames == 3 * 5 * 4 && bad_total == 0);
+    CHECK(frames == 3 * (MR_AO_METHOD_COUNT - 1) * 4 && bad_total == 0);
     mr_scene_destroy(&s);
 }
 
@@ -811,6 +815,13 @@ static void test_golden(void) {
         {"scheer_radii5", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, 0, false, 5, MR_AO_MASK_OFF, false},
         {"mask_standalone", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, 4, false, 1, MR_AO_MASK_STANDALONE, false},
         {"scheer_paper", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, true},
+        /* issue 18 */
+        {"gtao_screen", MR_AO_GTAO, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"gtao_view", MR_AO_GTAO, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"bitmask_screen", MR_AO_BITMASK, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"bitmask_view", MR_AO_BITMASK, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"scheer_gt_screen", MR_AO_SCHEER_GT, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
+        {"scheer_gt_view", MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
     };
     mr_dvec3 o = mr_v3(0, 0, 0);
     mr_scene *s = corner_scene(1, o, true);
@@ -1163,6 +1174,217 @@ static void test_radii(void) {
     mr_renderer_set_scene(g_r, NULL, NULL);
 }
 
+/* ------------------------------------------------ issue 18: slice methods */
+
+/* RMSE of an AO image against the closed form beside the wall, over floor
+ * pixels in front of it (dist < 1, away from the cube and the image's
+ * ends), for the view radius R or the depth-scaled one (screen > 0). */
+static double wall_rmse(const mr_view *v, const mr_frame_result *g, const mr_image *ao, double R, double screen, int *count) {
+    mr_camera c = mr_camera_resized(&v->camera, g->depth.width, g->depth.height);
+    double se = 0;
+    int n = 0;
+    const float *a = ao->data, *d = g->depth.data;
+    for (int y = 0; y < g->depth.height; y++)
+        for (int x = 0; x < g->depth.width; x++) {
+            size_t i = (size_t)y * g->depth.width + x;
+            if (!(d[i] > 0)) continue;
+            mr_dvec3 p = pixel_world(v, &g->depth, x, y);
+            double dist = 2.9 - p.z, r = screen > 0 ? screen * d[i] * c.height / c.fy : R;
+            if (fabs(p.y) > 0.01 || dist < 0 || dist > 1.0 || p.x < -0.5 || p.x > 5) continue;
+            double e = a[i] - mr_eval_ao_wall_analytic(dist, r);
+            se += e * e;
+            n++;
+        }
+    if (count) *count = n;
+    return n ? sqrt(se / n) : 1e9;
+}
+
+/* GTAO, the bitmask and scheer-gt (c = 0, bias 0: its horizon is GTAO's
+ * without the falloff, so the same closed form) beside a wall: V = 1 -
+ * (acos a - a sqrt(1 - a^2)) / pi, a = d / R, within 0.025 RMSE with 64
+ * samples (4 slices x 8 steps per side), unblurred, for a fixed and for
+ * the depth-scaled radius. */
+static void test_slice_wall(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    mr_view v = corner_view(1, o, 160, 120);
+    const mr_ao_method ms[3] = {MR_AO_GTAO, MR_AO_BITMASK, MR_AO_SCHEER_GT};
+    for (int mi = 0; mi < 3; mi++)
+        for (int mode = 0; mode < 2; mode++) {
+            mr_ao_params ao = MR_AO_DEFAULTS;
+            ao.method = ms[mi];
+            ao.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
+            ao.radius = 0.6;
+            ao.screen_radius = 0.1;
+            ao.samples = 64;
+            ao.thickness = 2.0f; /* the wall is thick */
+            ao.blur_radius = 0;  /* the bilateral blur mixes the wall's AO into the floor's */
+            if (ms[mi] == MR_AO_SCHEER_GT) ao.c = 0, ao.bias = 0;
+            mr_frame_result res;
+            if (!render_ao(s, &v, &ao, &res)) continue;
+            int n = 0;
+            double e = wall_rmse(&v, &res, &res.ao, ao.radius, mode ? 0 : ao.screen_radius, &n);
+            if (getenv("MR_TEST_VERBOSE"))
+                printf("wall %s %s: RMSE %.4f over %d pixels\n", mr_ao_method_name(ao.method), mode ? "view" : "screen", e, n);
+            CHECK_MSG(n > 100, "only %d floor pixels in front of the wall", n);
+            CHECK_MSG(e < 0.025, "%s %s radius beside a wall: RMSE %.4f against the closed form", mr_ao_method_name(ao.method),
+                      mode ? "view" : "screen", e);
+            CHECK(count_bad(&res.ao) == 0);
+            mr_frame_result_free(&res);
+        }
+    mr_scene_destroy(&s);
+    mr_renderer_set_scene(g_r, NULL, NULL);
+}
+
+/* issue 18: temporal accumulation. A static camera converges towards the
+ * many-sample AO; a slowly moving one too (the reprojection carries the
+ * history: a wrong transform would smear it); after a jump with a
+ * tracking reset, or a jump to a view with nothing in common, the frame
+ * equals a fresh single frame (no ghost of the previous view). */
+/* Without mr_renderer_set_scene per frame: a new scene starts a new history. */
+static void render_ao_fp(const mr_scene *s, const mr_view *v, const mr_ao_params *ao, mr_image *out) {
+    (void)s;
+    mr_frame_params p = MR_FRAME_DEFAULTS;
+    p.ao = *ao;
+    p.ao.want_ao = true;
+    mr_frame_result res;
+    mr_error err = {0};
+    bool ok = mr_render_frame(g_r, v, &p, &res, &err);
+    CHECK_MSG(ok, "%s", err.msg);
+    if (!ok) return;
+    mr_image_free(out);
+    *out = res.ao;
+    res.ao.data = NULL;
+    mr_frame_result_free(&res);
+}
+
+static mr_view moved_view(double t, int w, int h) {
+    mr_view v = corner_view(1, mr_v3(0, 0, 0), w, h);
+    v.world_from_camera = mr_m4_look_at_cv(mr_v3(0.7 + 0.3 * t, 2.2, -2.5 + 0.2 * t), mr_v3(0.2 + 0.2 * t, 0.2, 2.5),
+                                           mr_v3(0, 1, 0));
+    return v;
+}
+
+static void test_temporal(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    const int w = 128, h = 96;
+    const mr_ao_method ms[2] = {MR_AO_SCHEER, MR_AO_GTAO};
+    mr_error serr = {0};
+    CHECK_MSG(mr_renderer_set_scene(g_r, s, &serr), "%s", serr.msg);
+    for (int mi = 0; mi < 2; mi++) {
+        mr_ao_params ao = MR_AO_DEFAULTS;
+        ao.method = ms[mi];
+        ao.radius_mode = MR_AO_RADIUS_VIEW;
+        ao.radius = 0.5;
+        ao.blur_radius = 0;
+        mr_image ref = {0}, single = {0}, acc = {0}, fresh = {0};
+        const char *name = mr_ao_method_name(ao.method);
+        for (int moving = 0; moving < 2; moving++) {
+            const int frames = 16;
+            mr_view last = moved_view(moving ? 1.0 : 0.0, w, h);
+            ao.samples = 64;
+            ao.temporal = false;
+            render_ao_fp(s, &last, &ao, &ref);
+            ao.samples = 4;
+            render_ao_fp(s, &last, &ao, &single);
+            ao.temporal = true;
+            for (int k = 0; k < frames; k++) {
+                mr_view v = moved_view(moving ? (double)k / (frames - 1) : 0.0, w, h);
+                ao.temporal_reset = k == 0;
+                render_ao_fp(s, &v, &ao, &acc);
+            }
+            ao.temporal_reset = false;
+            double e1 = rmse(&single, &ref), ea = rmse(&acc, &ref);
+            if (getenv("MR_TEST_VERBOSE"))
+                printf("temporal %s %s: 4 samples RMSE %.4f, accumulated %d frames %.4f (against 64 samples)\n", name,
+                       moving ? "moving" : "static", e1, frames, ea);
+            /* moving: history is lost at the image's edges and resampled at
+             * the nearest previous pixel every frame */
+            double bound = moving ? 0.75 : 0.6;
+            CHECK_MSG(ea < bound * e1, "temporal %s %s camera: accumulated RMSE %.4f not below %.2f x one frame's %.4f", name,
+                      moving ? "moving" : "static", ea, bound, e1);
+            CHECK(count_bad(&acc) == 0);
+        }
+        /* A step of 0.4 units towards the wall after 16 still frames: every
+         * pixel's depth changes, so only a correct reprojection finds the
+         * history (at the same pixel the depth test rejects it: the frame
+         * would be a single frame's). */
+        {
+            mr_view a = corner_view(1, o, w, h), a2 = a;
+            a2.world_from_camera = mr_m4_look_at_cv(mr_v3(0.7, 2.1, -2.1), mr_v3(0.2, 0.2, 2.5), mr_v3(0, 1, 0));
+            ao.temporal = false;
+            ao.samples = 64;
+            render_ao_fp(s, &a2, &ao, &ref);
+            ao.samples = 4;
+            render_ao_fp(s, &a2, &ao, &single);
+            ao.temporal = true;
+            for (int k = 0; k < 16; k++) {
+                ao.temporal_reset = k == 0;
+                render_ao_fp(s, &a, &ao, &acc);
+            }
+            ao.temporal_reset = false;
+            render_ao_fp(s, &a2, &ao, &acc);
+            double e1 = rmse(&single, &ref), ea = rmse(&acc, &ref);
+            if (getenv("MR_TEST_VERBOSE")) printf("temporal %s step: one frame %.4f, with history %.4f\n", name, e1, ea);
+            CHECK_MSG(ea < 0.8 * e1, "temporal %s: after a step the history was lost (RMSE %.4f, one frame %.4f)", name, ea, e1);
+        }
+        /* Jumps, after a history at the corner view: with a tracking reset
+         * the frame is the fresh one exactly (frame 0's noise); without a
+         * reset, to a view of the other side of the wall (nothing in
+         * common), every pixel's history is rejected: the frame is as far
+         * from the 64-sample AO as a fresh single frame (another frame's
+         * noise, so not equal to it), where a kept history would be the
+         * other view's AO. */
+        for (int reset = 1; reset >= 0; reset--) {
+            mr_view a = corner_view(1, o, w, h), b = a;
+            b.world_from_camera = reset ? mr_m4_look_at_cv(mr_v3(-3, 1.5, 0.5), mr_v3(2, 0.2, 2.8), mr_v3(0, 1, 0))
+                                        : mr_m4_look_at_cv(mr_v3(1, 2, 8), mr_v3(0.5, 0.5, 3.2), mr_v3(0, 1, 0));
+            ao.temporal = true;
+            for (int k = 0; k < 5; k++) {
+                ao.temporal_reset = k == 0;
+                render_ao_fp(s, &a, &ao, &acc);
+            }
+            ao.temporal_reset = reset;
+            render_ao_fp(s, &b, &ao, &acc);
+            ao.temporal = false;
+            ao.temporal_reset = false;
+            render_ao_fp(s, &b, &ao, &fresh);
+            double e = rmse(&acc, &fresh);
+            if (getenv("MR_TEST_VERBOSE")) printf("temporal %s jump %s: RMSE against a fresh frame %.6f\n", name, reset ? "with reset" : "no reset", e);
+            if (reset) {
+                CHECK_MSG(e < 1e-6, "temporal %s: after a tracking reset the frame differs from a fresh one: RMSE %.6f (a ghost)",
+                          name, e);
+            } else {
+                ao.samples = 64;
+                render_ao_fp(s, &b, &ao, &ref);
+                ao.samples = 4;
+                double ej = rmse(&acc, &ref), ef = rmse(&fresh, &ref);
+                if (getenv("MR_TEST_VERBOSE")) printf("temporal %s jump no reset: %.4f, fresh %.4f against 64 samples\n", name, ej, ef);
+                CHECK_MSG(ej < 1.15 * ef + 0.003, "temporal %s: after a jump to a view with nothing in common RMSE %.4f, a fresh "
+                          "frame %.4f (a ghost of the previous view)", name, ej, ef);
+            }
+        }
+        mr_image_free(&ref);
+        mr_image_free(&single);
+        mr_image_free(&acc);
+        mr_image_free(&fresh);
+    }
+    /* Off, single frames do not accumulate: the pass list has no ao_temporal. */
+    mr_ao_params off = MR_AO_DEFAULTS;
+    off.method = MR_AO_SCHEER;
+    mr_view v = corner_view(1, o, w, h);
+    mr_frame_result res;
+    if (render_ao(s, &v, &off, &res)) {
+        char buf[512];
+        mr_frame_result_passes(&res, buf, sizeof buf);
+        CHECK_MSG(strstr(buf, "ao_temporal") == NULL, "temporal accumulation ran while off: %s", buf);
+        mr_frame_result_free(&res);
+    }
+    mr_scene_destroy(&s);
+    mr_renderer_set_scene(g_r, NULL, NULL);
+}
+
 int main(void) {
     test_kernels();
     test_outline_dirs();
@@ -1193,6 +1415,8 @@ int main(void) {
         test_mask_count();
         test_mask_standalone();
         test_radii();
+        test_slice_wall();
+        test_temporal();
     }
     mr_renderer_destroy(&g_r);
     mr_gpu_destroy(&g_gpu);

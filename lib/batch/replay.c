@@ -63,6 +63,7 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
     const double fps = recording_fps(rec, every);
     const bool tty = p->progress && isatty(2);
     int selected = 0;
+    bool ao_restart = true; /* --ao-temporal restarts after a frame without a pose (a tracking reset) */
     for (int i = 0; ok && i < rec->frame_count; i++) {
         const mr_rec_frame *f = &rec->frames[i];
         if (f->index < p->from || (p->to >= 0 && f->index > p->to) || (f->index - p->from) % every != 0) continue;
@@ -84,6 +85,8 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
             mr_frame_params fp = p->frame;
             fp.video = &img;
             fp.alpha = p->alpha;
+            fp.ao.temporal_reset = ao_restart;
+            ao_restart = false;
             mr_frame_result res;
             ok = mr_render_frame(r, &view, &fp, &res, err) && mr_image_save_png(path, &res.color, err) &&
                  video_add(p, &vw, &res.color, fps, err);
@@ -91,6 +94,7 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
             st.overlays++;
         } else {
             /* No pose: the camera frame alone keeps the sequence complete. */
+            ao_restart = true;
             ok = mr_image_save_png(path, &img, err) && video_add(p, &vw, &img, fps, err);
             st.plain++;
         }

@@ -23,13 +23,14 @@
  * only: nothing here passes or fails. */
 
 #include "bench_internal.h"
+#include "mr_session.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define MAX_VIEWS MR_BENCH_AO_MAX_VIEWS
-enum { MAXC = 16, MAXS = 4 };
+enum { MAXC = 32, MAXS = 4 };
 
 /* The methods raced. role: Scheer & Keutel's rendering it stands for, or
  * "-". radius: TUNE_RADIUS (tuned with the rest), REF_RADIUS (the
@@ -60,6 +61,19 @@ static const contender k_contenders[] = {
     {"hbao@R", "-", MR_AO_HBAO, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
     {"alchemy", "-", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
     {"alchemy@R", "-", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    /* issue 18: the modern integrators, with the depth-scaled and the fixed radius */
+    {"gtao", "-", MR_AO_GTAO, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
+    {"gtao@R", "-", MR_AO_GTAO, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
+    {"gtao-view", "-", MR_AO_GTAO, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"gtao-view@R", "-", MR_AO_GTAO, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"bitmask", "-", MR_AO_BITMASK, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
+    {"bitmask@R", "-", MR_AO_BITMASK, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
+    {"bitmask-view", "-", MR_AO_BITMASK, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"bitmask-view@R", "-", MR_AO_BITMASK, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"scheer-gt", "D2", MR_AO_SCHEER_GT, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
+    {"scheer-gt@R", "D2", MR_AO_SCHEER_GT, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
+    {"scheer-gt-view", "-", MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"scheer-gt-view@R", "-", MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
 };
 #define NC (int)(sizeof k_contenders / sizeof k_contenders[0])
 _Static_assert(NC <= MAXC, "MAXC bounds the contenders");
@@ -91,6 +105,7 @@ typedef struct ao_bench {
     view_data vd[MAX_VIEWS + 1];
     contender cs[NC];
     agg_table agg_ms, agg_rf, agg_rs, agg_sf, agg_ss, agg_bf, agg_bs, agg_mf;
+    agg_table agg_sync, agg_floor, agg_ratio; /* issue 18: glFinish-timed ms, the fetch floor, their ratio */
     double pv_rf[MAX_VIEWS + 1][MAXC + 1], pv_rs[MAX_VIEWS + 1][MAXC + 1]; /* per view, reported samples, full, mask off */
     double none_rf, none_rs, none_sf, none_ss, none_bf, none_bs;
     mr_image *montage[MAX_VIEWS * 10];
@@ -100,28 +115,37 @@ typedef struct ao_bench {
     uint64_t tri_count[4];
     int ntri;
     mr_image ao; /* scratch: the last AO map */
+    /* issue 18: the moving sequence (step 6b) */
+    int seq_frames;
+    char seq_name[1100];
+    double seq_rmse[4][2], seq_ms[4]; /* config x {all frames, second half}, median ms */
 } ao_bench;
 
 /* Renders `frames` timed frames (plus one warm-up) and returns the median
  * GPU ms of the AO passes (0 untimed); the last frame's AO goes to *ao. */
 static bool run_ao(mr_renderer *r, const mr_view *v, const mr_ao_params *ao, int w, int h, int frames, double *ms,
-                   mr_image *out_ao, double *masked, mr_error *err) {
+                   double *sync_ms, mr_image *out_ao, double *masked, mr_error *err) {
     mr_frame_params fp = MR_FRAME_DEFAULTS;
     fp.width = w;
     fp.height = h;
     fp.timing = frames > 0;
+    fp.timing_sync = true; /* issue 18: each pass's whole cost, glFinish before and after */
     fp.ao = *ao;
     fp.ao.no_reuse = true;
     fp.ao.want_ao = true;
-    double t[64];
+    double t[64], ts[64];
     int n = frames < 64 ? frames : 64;
     for (int f = -1; f < (n > 0 ? n : 0); f++) {
         mr_frame_result res;
         if (!mr_render_frame(r, v, &fp, &res, err)) return false;
-        double s = 0;
+        double s = 0, sc = 0;
         for (int k = 0; k < res.pass_count; k++)
-            if (strncmp(res.passes[k], "ao", 2) == 0) s += res.gpu_ms[k];
+            if (strncmp(res.passes[k], "ao", 2) == 0) {
+                s += res.gpu_ms[k];
+                sc += res.cpu_ms[k];
+            }
         if (f >= 0) t[f] = s;
+        if (f >= 0) ts[f] = sc;
         if (f == n - 1 || n <= 0) {
             mr_image_free(out_ao);
             *out_ao = res.ao;
@@ -131,6 +155,7 @@ static bool run_ao(mr_renderer *r, const mr_view *v, const mr_ao_params *ao, int
         mr_frame_result_free(&res);
     }
     *ms = n > 0 ? mr_median(t, n) : 0; /* untimed runs report 0 ms */
+    if (sync_ms) *sync_ms = n > 0 ? mr_median(ts, n) : 0;
     return true;
 }
 
@@ -310,7 +335,7 @@ static bool ao_tune(ao_bench *b, mr_error *err) {
         bool paper = cs->radius == PAPER;
         /* The radius grid's first entry is the reference's own radius. */
         int na = cs->radius == TUNE_RADIUS ? nr : 1, nbb = paper ? 1 : ns, nk = paper ? 1 : nb,
-            ncv = cs->method == MR_AO_SCHEER && !paper ? 3 : 1;
+            ncv = (cs->method == MR_AO_SCHEER || cs->method == MR_AO_SCHEER_GT) && !paper ? 3 : 1;
         for (int a = 0; ok && a < na; a++)
             for (int bi = 0; ok && bi < nbb; bi++)
                 for (int k = 0; ok && k < nk; k++)
@@ -336,7 +361,7 @@ static bool ao_tune(ao_bench *b, mr_error *err) {
                         }
                         double ms;
                         mr_image_metrics m;
-                        ok = run_ao(b->gfx.renderer, &vd->view, &p, b->w, b->h, 0, &ms, &b->ao, NULL, err) &&
+                        ok = run_ao(b->gfx.renderer, &vd->view, &p, b->w, b->h, 0, &ms, NULL, &b->ao, NULL, err) &&
                              mr_image_compare(&b->ao, cs->mode == MR_AO_RADIUS_SCREEN ? &vd->gt_screen : &vd->gt_fixed,
                                               &vd->depth, &m, err);
                         if (!ok) break;
@@ -360,6 +385,20 @@ static bool ao_tune(ao_bench *b, mr_error *err) {
     return save_csv(tune, b->p.out_dir, "bench_ao_tuning.csv", err);
 }
 
+/* issue 18: the fetch floor of one row, measured right after it (the
+ * machine is shared and noisy: side by side): as many R32F fetches per AO
+ * pixel as the row has samples (times its radii), over the AO target's
+ * size, spread over the depth-scaled radius in pixels. */
+static bool fetch_floor(ao_bench *b, const mr_ao_params *p, double *ms, mr_error *err) {
+    int step = p->half_res ? 2 : 1, aw = (b->w + step - 1) / step, ah = (b->h + step - 1) / step;
+    int n = b->p.frames < 64 ? b->p.frames : 64, fetches = p->samples * (p->radii > 0 ? p->radii : 1);
+    double t[64];
+    if (fetches > MR_AO_MAX_SAMPLES) fetches = MR_AO_MAX_SAMPLES;
+    if (!mr_render_fetch_probe(b->gfx.renderer, aw, ah, fetches, b->screen_radius * b->h / step, n, t, err)) return false;
+    *ms = mr_median(t, n);
+    return true;
+}
+
 /* One reported view of step 3: plain shading (D1: AO = 1 everywhere), then
  * every contender over samples x resolution x mask. */
 static bool ao_grid_view(ao_bench *b, int v, mr_csv *csv, mr_error *err) {
@@ -368,7 +407,7 @@ static bool ao_grid_view(ao_bench *b, int v, mr_csv *csv, mr_error *err) {
     mr_ao_params p0 = MR_AO_DEFAULTS;
     double ms = 0;
     mr_image_metrics mf, msr;
-    if (!run_ao(b->gfx.renderer, &vd->view, &p0, w, h, 0, &ms, &b->ao, NULL, err) || !metrics(&b->ao, vd, &mf, &msr, err))
+    if (!run_ao(b->gfx.renderer, &vd->view, &p0, w, h, 0, &ms, NULL, &b->ao, NULL, err) || !metrics(&b->ao, vd, &mf, &msr, err))
         return false;
     mr_csv_quoted(csv, vd->name);
     static const char *const d1[] = {"none", "D1", "-", "no", "", "", "", "", "", "", "", "", "", "0", "full", "off"};
@@ -380,6 +419,9 @@ static bool ao_grid_view(ao_bench *b, int v, mr_csv *csv, mr_error *err) {
     const double d1m[6] = {mf.rmse, mf.ssim, mf.bias, msr.rmse, msr.ssim, msr.bias};
     for (int k = 0; k < 6; k++) mr_csv_num(csv, "%.5f", d1m[k]);
     mr_csv_int(csv, -1);
+    mr_csv_int(csv, 0);
+    mr_csv_text(csv, "");
+    mr_csv_text(csv, "");
     mr_csv_end_row(csv);
     b->pv_rf[v][0] = mf.rmse;
     b->pv_rs[v][0] = msr.rmse;
@@ -399,9 +441,9 @@ static bool ao_grid_view(ao_bench *b, int v, mr_csv *csv, mr_error *err) {
                     p.samples = b->samples[si];
                     p.half_res = res == 1;
                     p.mask = mk ? MR_AO_MASK_ON : MR_AO_MASK_OFF;
-                    double masked = -1;
-                    if (!run_ao(b->gfx.renderer, &vd->view, &p, w, h, frames, &ms, &b->ao, &masked, err) ||
-                        !metrics(&b->ao, vd, &mf, &msr, err))
+                    double masked = -1, sync = 0, floor_ms = 0;
+                    if (!run_ao(b->gfx.renderer, &vd->view, &p, w, h, frames, &ms, &sync, &b->ao, &masked, err) ||
+                        !metrics(&b->ao, vd, &mf, &msr, err) || !fetch_floor(b, &p, &floor_ms, err))
                         return false;
                     mr_csv_quoted(csv, vd->name);
                     csv_contender(csv, &b->cs[c]);
@@ -416,7 +458,13 @@ static bool ao_grid_view(ao_bench *b, int v, mr_csv *csv, mr_error *err) {
                     const double m6[6] = {mf.rmse, mf.ssim, mf.bias, msr.rmse, msr.ssim, msr.bias};
                     for (int k = 0; k < 6; k++) mr_csv_num(csv, "%.5f", m6[k]);
                     mr_csv_num(csv, "%.4f", masked);
+                    mr_csv_num(csv, "%.4f", sync);
+                    mr_csv_num(csv, "%.4f", floor_ms);
+                    mr_csv_num(csv, "%.3f", floor_ms > 0 ? sync / floor_ms : 0.0);
                     mr_csv_end_row(csv);
+                    b->agg_sync[c][si][res][mk] += sync / nv;
+                    b->agg_floor[c][si][res][mk] += floor_ms / nv;
+                    b->agg_ratio[c][si][res][mk] += (floor_ms > 0 ? sync / floor_ms : 0.0) / nv;
                     b->agg_ms[c][si][res][mk] += ms / nv;
                     b->agg_rf[c][si][res][mk] += mf.rmse / nv;
                     b->agg_rs[c][si][res][mk] += msr.rmse / nv;
@@ -449,10 +497,13 @@ static bool ao_grid(ao_bench *b, mr_error *err) {
     mr_csv_comment(csv, "role: Scheer & Keutel's D1 (no AO), D2 (scheer, depth-scaled radius), D3 (standard SSAO = crytek, "
                         "constant radius) or -; radius_policy: tuned, or the reference's own radius; tuned: no = the paper's "
                         "parameters; strength <= 0: the method's default; *_fixed: against ray-traced AO with fixed R, *_screen: with "
-                        "the depth-scaled R");
+                        "the depth-scaled R; sync_ms: the AO passes timed between glFinish (llvmpipe defers rasterisation past "
+                        "a timer query); floor_ms: a full-screen pass of as many R32F fetches per AO pixel and nothing else, "
+                        "timed the same way right after the row; floor_ratio = sync_ms / floor_ms");
     mr_csv_header(csv, "view,contender,role,radius_policy,tuned,radius_mode,radius,screen_radius,strength,bias,c,kernel,r_min,"
                        "r_max,samples,resolution,mask,width,height,"
-                       "gpu_ms_median,frames,rmse_fixed,ssim_fixed,bias_fixed,rmse_screen,ssim_screen,bias_screen,masked_fraction");
+                       "gpu_ms_median,frames,rmse_fixed,ssim_fixed,bias_fixed,rmse_screen,ssim_screen,bias_screen,masked_fraction,"
+                       "sync_ms_median,floor_ms_median,floor_ratio");
     for (int v = 1; v <= b->nv; v++) {
         if (!ao_grid_view(b, v, csv, err)) {
             mr_csv_destroy(&csv);
@@ -539,7 +590,7 @@ static bool ao_plots(ao_bench *b, mr_error *err) {
         for (int c = 0; c < NC; c++)
             for (int res = 0; res < b->nres; res++) {
                 for (int si = 0; si < b->nsamp; si++) {
-                    xs[nser][si] = b->agg_ms[c][si][res][0];
+                    xs[nser][si] = b->agg_sync[c][si][res][0]; /* issue 18: glFinish-timed */
                     ys[nser][si] = ref ? b->agg_rs[c][si][res][0] : b->agg_rf[c][si][res][0];
                 }
                 snprintf(names[nser], sizeof names[nser], "%s%s", b->cs[c].label, res ? " half" : "");
@@ -553,7 +604,8 @@ static bool ao_plots(ao_bench *b, mr_error *err) {
         snprintf(title, sizeof title, "AO error vs GPU time, %dx%d, samples %d..%d, mean of %d views; reference: %s", b->w, b->h,
                  b->samples[0], b->samples[b->nsamp - 1], b->nv, ref ? "depth-scaled R" : "fixed R");
         mr_path_join(b->p.out_dir, ref ? "bench_ao_screen.svg" : "bench_ao.svg", path, sizeof path);
-        ok = mr_plot_svg(path, title, "AO passes, GPU ms (median)", "RMSE against ray-traced AO", ser, nser, true, err);
+        ok = mr_plot_svg(path, title, "AO passes, ms between glFinish (median)", "RMSE against ray-traced AO", ser, nser, true,
+                         err);
     }
     mr_path_join(b->p.out_dir, "bench_ao_montage.png", path, sizeof path);
     return ok && mr_montage_png(path, (const mr_image *const *)b->montage, b->nmont, 2 + NC, b->w, b->h, err);
@@ -596,6 +648,219 @@ static bool ao_shaded(ao_bench *b, mr_error *err) {
     return ok;
 }
 
+/* RMSE of contender c at `ms` (full resolution, mask off): linear in
+ * log ms between the two sample counts around it on its curve; outside
+ * the curve the nearest end, flagged. */
+static double rmse_at_ms(const ao_bench *b, int c, bool screen, double ms, bool *outside) {
+    int n = b->nsamp;
+    double x[MAXS], y[MAXS];
+    for (int si = 0; si < n; si++) {
+        x[si] = log(fmax(b->agg_sync[c][si][0][0], 1e-6));
+        y[si] = screen ? b->agg_rs[c][si][0][0] : b->agg_rf[c][si][0][0];
+    }
+    double lx = log(fmax(ms, 1e-6));
+    *outside = false;
+    int lo = 0, hi = 0;
+    for (int si = 1; si < n; si++) {
+        if (x[si] < x[lo]) lo = si;
+        if (x[si] > x[hi]) hi = si;
+    }
+    if (lx <= x[lo]) {
+        *outside = lx < x[lo];
+        return y[lo];
+    }
+    if (lx >= x[hi]) {
+        *outside = lx > x[hi];
+        return y[hi];
+    }
+    /* the nearest points below and above (the curve need not be sorted in ms) */
+    int a = lo, bb = hi;
+    for (int si = 0; si < n; si++) {
+        if (x[si] <= lx && x[si] > x[a]) a = si;
+        if (x[si] >= lx && x[si] < x[bb]) bb = si;
+    }
+    if (x[bb] - x[a] < 1e-12) return y[a];
+    double t = (lx - x[a]) / (x[bb] - x[a]);
+    return y[a] + t * (y[bb] - y[a]);
+}
+
+/* issue 18: the table at equal ms: every contender's RMSE interpolated on
+ * its error-against-ms curve at the ms of scheer (D2, tuned) at the
+ * reported sample count, and at that of the fetch floor's ratio. */
+static size_t equal_ms_table(const ao_bench *b, char *md, size_t cap, size_t len) {
+    const int s16 = b->s16;
+    double target = b->agg_sync[0][s16][0][0];
+    len += (size_t)snprintf(md + len, cap - len,
+                            "\nAt equal ms (%.2f ms: scheer at %d samples, full resolution, mask off; each method's RMSE "
+                            "interpolated in log ms between its sample counts %d..%d, `*` = outside its curve, its nearest "
+                            "end). x floor: its own ms over the fetch floor of as many fetches, at %d samples.\n\n"
+                            "| method | RMSE fixed R | RMSE depth-scaled R | ms at %d samples | x floor at %d samples |\n"
+                            "|---|---|---|---|---|\n",
+                            target, b->samples[s16], b->samples[0], b->samples[b->nsamp - 1], b->samples[s16], b->samples[s16],
+                            b->samples[s16]);
+    for (int c = 0; c < NC; c++) {
+        bool of, os;
+        double rf = rmse_at_ms(b, c, false, target, &of), rs = rmse_at_ms(b, c, true, target, &os);
+        len += (size_t)snprintf(md + len, cap - len, "| %s | %.4f%s | %.4f%s | %.2f | %.2f |\n", b->cs[c].label, rf,
+                                of ? "*" : "", rs, os ? "*" : "", b->agg_sync[c][s16][0][0], b->agg_ratio[c][s16][0][0]);
+    }
+    return len;
+}
+
+/* Step 6b (issue 18): temporal accumulation on a moving sequence, the
+ * poses of a recording (--sequence DIR; default the shipped
+ * recordings/demo when it is there, else the step is left out) at the
+ * bench's size: per frame the depth-scaled reference, and the tuned scheer
+ * (D2) and gtao at 16 samples per frame, at 4, and at 4 with accumulation
+ * (restarted at the first frame); RMSE per frame against that frame's
+ * reference, the AO passes timed between glFinish
+ * (bench_ao_sequence.csv). */
+enum { SEQ_MAX = 24 };
+static int contender_of(const char *label) {
+    for (int c = 0; c < NC; c++)
+        if (strcmp(k_contenders[c].label, label) == 0) return c;
+    return 0;
+}
+static const char *const k_seq_cfg[4] = {"scheer 16", "scheer 4 + temporal", "gtao 16", "gtao 4 + temporal"};
+static bool ao_sequence(ao_bench *b, mr_error *err) {
+    const char *dir = b->p.sequence ? b->p.sequence : "recordings/demo";
+    mr_error oe = {0};
+    mr_recording *rec = mr_recording_open(dir, &oe);
+    if (!rec) {
+        if (b->p.sequence) {
+            *err = oe;
+            return false;
+        }
+        BENCH_PRINT(b->p.out, "bench ao: no moving sequence (%s: %s); --sequence DIR gives one\n", dir, oe.msg);
+        return true;
+    }
+    snprintf(b->seq_name, sizeof b->seq_name, "%s", dir);
+    mr_view views[SEQ_MAX];
+    int nf = 0;
+    for (int i = 0; i < rec->frame_count && nf < SEQ_MAX; i++) {
+        const mr_rec_frame *f = &rec->frames[i];
+        if (!f->has_gt && !f->pose.valid) continue;
+        views[nf].camera = mr_camera_resized(&rec->camera, b->w, b->h);
+        views[nf].world_from_camera = f->has_gt ? f->gt : f->pose.world_from_camera;
+        nf++;
+    }
+    mr_recording_close(&rec);
+    mr_csv *csv = mr_csv_create(err);
+    if (!csv) return false;
+    mr_csv_comment(csv, "temporal accumulation on a moving sequence: RMSE per frame against the frame's depth-scaled "
+                        "reference; sync_ms: the AO passes between glFinish");
+    mr_csv_header(csv, "sequence,frame,config,samples,temporal,rmse_screen,sync_ms");
+    double rm[4][SEQ_MAX], ms[4][SEQ_MAX];
+    bool ok = mr_renderer_set_scene(b->gfx.renderer, b->scene, err);
+    mr_image depth = {0}, normal = {0}, ref = {0};
+    for (int k = 0; ok && k < nf; k++) {
+        mr_frame_params fp = MR_FRAME_DEFAULTS;
+        fp.width = b->w;
+        fp.height = b->h;
+        fp.want_depth = fp.want_normals = true;
+        mr_frame_result res;
+        ok = mr_render_frame(b->gfx.renderer, &views[k], &fp, &res, err);
+        if (!ok) break;
+        mr_image_free(&depth);
+        mr_image_free(&normal);
+        depth = res.depth;
+        normal = res.normal;
+        res.depth.data = res.normal.data = NULL;
+        mr_frame_result_free(&res);
+        mr_gt_params gp = MR_GT_DEFAULTS;
+        gp.rays = b->p.rays;
+        gp.radius_mode = MR_AO_RADIUS_SCREEN;
+        gp.screen_radius = b->screen_radius;
+        mr_image_free(&ref);
+        ok = mr_eval_ao_groundtruth(b->gt, &views[k], &depth, &normal, &gp, &ref, err);
+        /* the per-frame configurations; the accumulating ones need
+         * consecutive frames in the renderer's one history, so they run
+         * in passes of their own below */
+        for (int c = 0; ok && c < 4; c += 2) {
+            mr_ao_params p = b->cs[contender_of(c < 2 ? "scheer" : "gtao")].tuned;
+            p.samples = 16;
+            p.no_reuse = true;
+            double sync = 0, gms = 0;
+            ok = run_ao(b->gfx.renderer, &views[k], &p, b->w, b->h, 1, &gms, &sync, &b->ao, NULL, err);
+            mr_image_metrics m;
+            ok = ok && mr_image_compare(&b->ao, &ref, &depth, &m, err);
+            if (ok) {
+                rm[c][k] = m.rmse;
+                ms[c][k] = sync;
+            }
+        }
+        mr_image_free(&ref);
+    }
+    /* The accumulating runs: each a pass over the sequence of its own (the
+     * history must see consecutive frames); the references again per frame. */
+    for (int c = 1; ok && c < 4; c += 2) {
+        for (int k = 0; ok && k < nf; k++) {
+            mr_ao_params p = b->cs[contender_of(c < 2 ? "scheer" : "gtao")].tuned;
+            p.samples = 4;
+            p.temporal = true;
+            p.temporal_reset = k == 0;
+            mr_frame_params fp = MR_FRAME_DEFAULTS;
+            fp.width = b->w;
+            fp.height = b->h;
+            fp.timing = fp.timing_sync = true;
+            fp.want_depth = fp.want_normals = true;
+            fp.ao = p;
+            fp.ao.want_ao = true;
+            mr_frame_result res;
+            ok = mr_render_frame(b->gfx.renderer, &views[k], &fp, &res, err);
+            if (!ok) break;
+            double sync = 0;
+            for (int q = 0; q < res.pass_count; q++)
+                if (strncmp(res.passes[q], "ao", 2) == 0) sync += res.cpu_ms[q];
+            mr_gt_params gp = MR_GT_DEFAULTS;
+            gp.rays = b->p.rays;
+            gp.radius_mode = MR_AO_RADIUS_SCREEN;
+            gp.screen_radius = b->screen_radius;
+            mr_image_metrics m;
+            ok = mr_eval_ao_groundtruth(b->gt, &views[k], &res.depth, &res.normal, &gp, &ref, err) &&
+                 mr_image_compare(&res.ao, &ref, &res.depth, &m, err);
+            mr_image_free(&ref);
+            mr_frame_result_free(&res);
+            if (ok) {
+                rm[c][k] = m.rmse;
+                ms[c][k] = sync;
+            }
+        }
+    }
+    mr_image_free(&depth);
+    mr_image_free(&normal);
+    for (int c = 0; ok && c < 4; c++) {
+        double all = 0, late = 0;
+        int nl = 0;
+        for (int k = 0; k < nf; k++) {
+            mr_csv_quoted(csv, dir);
+            mr_csv_int(csv, k);
+            mr_csv_text(csv, k_seq_cfg[c]);
+            mr_csv_int(csv, c % 2 ? 4 : 16);
+            mr_csv_text(csv, c % 2 ? "on" : "off");
+            mr_csv_num(csv, "%.5f", rm[c][k]);
+            mr_csv_num(csv, "%.4f", ms[c][k]);
+            mr_csv_end_row(csv);
+            all += rm[c][k] / nf;
+            if (k >= nf / 2) {
+                late += rm[c][k];
+                nl++;
+            }
+        }
+        b->seq_rmse[c][0] = all;
+        b->seq_rmse[c][1] = nl ? late / nl : 0;
+        double t[SEQ_MAX];
+        memcpy(t, ms[c], sizeof t);
+        b->seq_ms[c] = nf > 0 ? mr_median(t, nf) : 0;
+    }
+    b->seq_frames = ok ? nf : 0;
+    if (!ok) {
+        mr_csv_destroy(&csv);
+        return false;
+    }
+    return save_csv(csv, b->p.out_dir, "bench_ao_sequence.csv", err);
+}
+
 /* Step 7: the summary table (bench_ao.md, also printed). */
 static bool ao_summary(ao_bench *b, mr_error *err) {
     char path[4096];
@@ -609,11 +874,11 @@ static bool ao_summary(ao_bench *b, mr_error *err) {
                             "units, or %g of the height), only strength / bias / c tuned; `scheer-paper`: the "
                             "paper's parameters (bias 0, whole-ball uniform kernel, c 1, default strength), nothing "
                             "tuned.\n\n"
-                            "| method | role | radius | strength | bias | c | kernel | res | mask | GPU ms | RMSE fixed R | SSIM fixed | bias fixed | RMSE depth-scaled R | SSIM d-s | bias d-s | masked |\n"
-                            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+                            "| method | role | radius | strength | bias | c | kernel | res | mask | GPU ms | RMSE fixed R | SSIM fixed | bias fixed | RMSE depth-scaled R | SSIM d-s | bias d-s | masked | sync ms | floor ms | x floor |\n"
+                            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
                             b->w, b->h, b->samples[b->p.quick ? 0 : 1], "GPU ms: median of timer queries", b->nv, b->vd[0].name, b->radius,
                             b->screen_radius);
-    len += (size_t)snprintf(md + len, sizeof md - len, "| none | D1 | - | - | - | - | - | full | off | 0 | %.4f | %.3f | %+.4f | %.4f | %.3f | %+.4f | - |\n",
+    len += (size_t)snprintf(md + len, sizeof md - len, "| none | D1 | - | - | - | - | - | full | off | 0 | %.4f | %.3f | %+.4f | %.4f | %.3f | %+.4f | - | 0 | - | - |\n",
                             b->none_rf, b->none_sf, b->none_bf, b->none_rs, b->none_ss, b->none_bs);
     const int s16 = b->s16;
     for (int c = 0; c < NC; c++)
@@ -630,13 +895,16 @@ static bool ao_summary(ao_bench *b, mr_error *err) {
                 char masked[32] = "-";
                 if (mk) snprintf(masked, sizeof masked, "%.3f", b->agg_mf[c][s16][res][mk]);
                 len += (size_t)snprintf(md + len, sizeof md - len,
-                                        "| %s | %s | %s | %s | %g | %g | %s | %s | %s | %.2f | %.4f | %.3f | %+.4f | %.4f | %.3f | %+.4f | %s |\n",
+                                        "| %s | %s | %s | %s | %g | %g | %s | %s | %s | %.2f | %.4f | %.3f | %+.4f | %.4f | %.3f | %+.4f | %s | %.2f | %.2f | %.2f |\n",
                                         b->cs[c].label, b->cs[c].role, rad, strength, b->cs[c].tuned.bias,
                                         b->cs[c].tuned.c, kern, res ? "half" : "full",
                                         mk ? "on" : "off", b->agg_ms[c][s16][res][mk], b->agg_rf[c][s16][res][mk],
                                         b->agg_sf[c][s16][res][mk], b->agg_bf[c][s16][res][mk], b->agg_rs[c][s16][res][mk],
-                                        b->agg_ss[c][s16][res][mk], b->agg_bs[c][s16][res][mk], masked);
+                                        b->agg_ss[c][s16][res][mk], b->agg_bs[c][s16][res][mk], masked,
+                                        b->agg_sync[c][s16][res][mk], b->agg_floor[c][s16][res][mk],
+                                        b->agg_ratio[c][s16][res][mk]);
             }
+    len = equal_ms_table(b, md, sizeof md, len);
     len += (size_t)snprintf(md + len, sizeof md - len, "\nRMSE per view (fixed R / depth-scaled R), %d samples, full resolution, mask off:\n\n| view | none |",
                             b->samples[s16]);
     for (int c = 0; c < NC; c++) len += (size_t)snprintf(md + len, sizeof md - len, " %s |", b->cs[c].label);
@@ -648,6 +916,16 @@ static bool ao_summary(ao_bench *b, mr_error *err) {
             len += (size_t)snprintf(md + len, sizeof md - len, " %.4f / %.4f |", b->pv_rf[v][c], b->pv_rs[v][c]);
     }
     len += (size_t)snprintf(md + len, sizeof md - len, "\n");
+    if (b->seq_frames > 0) {
+        len += (size_t)snprintf(md + len, sizeof md - len,
+                                "\nTemporal accumulation on the moving sequence %s (%d posed frames, %dx%d; RMSE against "
+                                "each frame's depth-scaled reference; ms: AO passes between glFinish, median):\n\n"
+                                "| configuration | RMSE all frames | RMSE second half | ms |\n|---|---|---|---|\n",
+                                b->seq_name, b->seq_frames, b->w, b->h);
+        for (int c = 0; c < 4; c++)
+            len += (size_t)snprintf(md + len, sizeof md - len, "| %s | %.4f | %.4f | %.2f |\n", k_seq_cfg[c], b->seq_rmse[c][0],
+                                    b->seq_rmse[c][1], b->seq_ms[c]);
+    }
     len += (size_t)snprintf(md + len, sizeof md - len, "\nAO passes against triangle count (scheer, 16 samples, %dx%d):\n\n"
                                                        "| triangles | AO GPU ms | G-buffer GPU ms |\n|---|---|---|\n", b->w, b->h);
     for (int i = 0; i < b->ntri; i++)
@@ -712,7 +990,7 @@ bool mr_bench_ao(const mr_bench_ao_params *params, mr_error *err) {
     memcpy(b->cs, k_contenders, sizeof b->cs);
     b->t0 = mr_time_now();
     bool ok = ao_setup(b, err) && ao_references(b, err) && ao_tune(b, err) && ao_grid(b, err) && ao_triangles(b, err) &&
-              ao_plots(b, err) && ao_shaded(b, err) && ao_summary(b, err);
+              ao_plots(b, err) && ao_shaded(b, err) && ao_sequence(b, err) && ao_summary(b, err);
     ao_free(b);
     return ok;
 }

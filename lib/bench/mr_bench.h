@@ -50,6 +50,8 @@ typedef struct mr_bench_ao_params {
     int rays;                    /* ground-truth rays per pixel, default 256 */
     double radius;               /* the fixed reference's R in scene units; 0: 2% of the scene diagonal */
     double screen_radius;        /* the depth-scaled reference: fraction of the image height, default 0.05 */
+    const char *sequence;        /* issue 18: recording whose poses are the moving sequence;
+                                    NULL: recordings/demo if it is there, else none */
     bool quick;                  /* samples 8 and 32, full resolution only, 2-point tuning */
     bool verbose;                /* print the tuned parameters */
     bool progress;               /* "view i/n done" on stderr */

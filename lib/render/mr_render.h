@@ -62,6 +62,14 @@ typedef enum mr_ao_method {
     MR_AO_FILION,      /* Filion & McNaughton 2008: hemisphere samples, depth-difference falloff */
     MR_AO_HBAO,        /* Bavoil et al. 2008: horizon search along image-space directions */
     MR_AO_ALCHEMY,     /* McGuire et al. 2011: obscurance estimator on a screen-space disk */
+    /* issue 18: the modern integrators (slices of the hemisphere around the
+     * view vector, per slice both horizons within the radius). */
+    MR_AO_GTAO,        /* Jimenez et al. 2016: cosine-weighted visibility between the two
+                          horizons against the normal projected into the slice */
+    MR_AO_BITMASK,     /* Therrien, Levesque & Gilet 2023: 32 sectors per slice marked
+                          occluded by samples assumed `thickness` deep */
+    MR_AO_SCHEER_GT,   /* scheer-gt: Scheer & Keutel's quasi-normalised attenuation
+                          1/(1 + c l^2) on GTAO's slices (see pass_ao.c) */
     MR_AO_METHOD_COUNT
 } mr_ao_method;
 
@@ -117,6 +125,19 @@ typedef struct mr_ao_params {
     bool positions;               /* read view-space positions from a positions texture
                                      instead of un-projecting depth */
     mr_ao_mask mask;              /* corner masking; default off */
+    float thickness;              /* bitmask: assumed depth of every occluder behind its
+                                     visible face, as a fraction of the radius; 0 = 0.5
+                                     (gtao, scheer-gt: the same fraction bounds how far
+                                     in front of the pixel an occluder may be before the
+                                     thickness heuristic fades it) */
+    bool temporal;                /* issue 18: accumulate the AO over frames (reprojected by
+                                     the poses, history rejected by depth and normal; a
+                                     running mean over up to MR_AO_TEMPORAL_FRAMES frames,
+                                     then weight 1/MR_AO_TEMPORAL_FRAMES for the new one);
+                                     off by default, and a single frame (render) has no
+                                     history to use */
+    bool temporal_reset;          /* this frame starts a new history (a tracking reset);
+                                     set by the caller per frame, like no_reuse */
     float mask_strength;          /* standalone mask: AO = 1 - mask_strength inside the
                                      mask before the blur, clamped to [0,1] (the method's
                                      strength plays no part); 0 = 0.5, the paper's grey
@@ -141,12 +162,17 @@ typedef struct mr_ao_params {
 #define MR_AO_DEFAULT_BLUR_RADIUS 4
 #define MR_AO_DEFAULT_MASK_STRENGTH 0.5f
 #define MR_AO_DEFAULT_RADIUS_FRACTION 0.02 /* of the scene's bounding-box diagonal */
+#define MR_AO_DEFAULT_THICKNESS 0.5f
+#define MR_AO_TEMPORAL_FRAMES 16     /* temporal: frames in the running mean */
+#define MR_AO_TEMPORAL_DEPTH_TOL 0.02 /* temporal: relative depth difference that rejects history */
+#define MR_AO_TEMPORAL_NORMAL_COS 0.9 /* temporal: normals further apart reject history */
+#define MR_AO_MAX_SLICES 16 /* gtao / bitmask / scheer-gt: slice directions (a uniform array) */
 #define MR_AO_DEFAULTS {.method = MR_AO_NONE, .radius_mode = MR_AO_RADIUS_SCREEN, \
                         .screen_radius = MR_AO_DEFAULT_SCREEN_RADIUS, .samples = MR_AO_DEFAULT_SAMPLES, \
                         .kernel = MR_AO_KERNEL_UNIFORM, .r_min = MR_AO_DEFAULT_R_MIN, .r_max = MR_AO_DEFAULT_R_MAX, \
                         .radii = MR_AO_DEFAULT_RADII, .c = MR_AO_DEFAULT_C, .bias = MR_AO_DEFAULT_BIAS, \
                         .blur_radius = MR_AO_DEFAULT_BLUR_RADIUS, .mask = MR_AO_MASK_OFF, \
-                        .mask_strength = MR_AO_DEFAULT_MASK_STRENGTH}
+                        .thickness = MR_AO_DEFAULT_THICKNESS, .mask_strength = MR_AO_DEFAULT_MASK_STRENGTH}
 
 /* The option table of mr_ao_params (lib/render/options.c): on the command
  * line "--ao" + "-" + key ("" is --ao itself, the method). Its rows cover the
@@ -159,6 +185,16 @@ extern const char *const mr_ao_method_names[MR_AO_METHOD_COUNT + 1];
 const char *mr_ao_method_name(mr_ao_method m);
 /* Parses a method name; false if unknown. */
 bool mr_ao_method_parse(const char *name, mr_ao_method *out);
+/* gtao / bitmask / scheer-gt: how `samples` splits into slices and steps
+ * per slice side (slices * 2 * steps <= samples where samples >= 2). */
+void mr_ao_slice_split(int samples, int *slices, int *steps);
+/* issue 18: the fetch floor of an AO pass (lib/render/probe.c): a full-
+ * screen pass over a w x h R32F target doing `fetches` texel fetches per
+ * pixel spread over radius_px pixels (the AO disk kernel) and nothing
+ * else; each of `frames` draws (after one warm-up) is timed on the CPU
+ * between two glFinish, in ms[0 .. frames-1]. */
+bool mr_render_fetch_probe(mr_renderer *r, int w, int h, int fetches, double radius_px, int frames, double *ms,
+                           mr_error *err);
 const char *mr_ao_kernel_name(mr_ao_kernel k);
 bool mr_ao_kernel_parse(const char *name, mr_ao_kernel *out);
 /* The kernels the AO pass uses, deterministic for given arguments: out3
@@ -277,6 +313,9 @@ typedef struct mr_frame_params {
     bool want_depth;           /* fill result.depth (linear view depth) */
     bool want_normals;         /* fill result.normal (view-space normals) */
     bool timing;               /* GPU timer queries per pass (adds a sync) */
+    bool timing_sync;          /* with timing: glFinish before and after every pass, so that
+                                  cpu_ms is the pass's whole synchronous cost (llvmpipe
+                                  defers rasterisation past a lone timer query) */
     mr_ao_params ao;           /* ambient occlusion; default none */
     mr_ghost_params ghost;     /* ghosted views of the hidden layer; default off */
     float specular;            /* Phong specular weight (white highlights); default 0 = Lambert only */

@@ -7,7 +7,9 @@
 #include <stddef.h>
 
 const char *const mr_ao_method_names[MR_AO_METHOD_COUNT + 1] = {"none", "scheer", "crytek", "filion",
-                                                                "hbao", "alchemy", NULL};
+                                                                "hbao", "alchemy",
+                                                                /* issue 18 */
+                                                                "gtao", "bitmask", "scheer-gt", NULL};
 static const char *const k_radius_mode_names[] = {"screen", "view", NULL};
 static const char *const k_kernel_names[] = {"uniform", "stratified", "latin", "poisson", NULL};
 static const char *const k_mask_names[] = {"off", "on", "standalone", NULL};
@@ -40,6 +42,10 @@ const mr_opt mr_ao_opts[] = {
     {"half", MR_OPT_BOOL, AO(half_res), 0, 1, 0, NULL, "AO at half resolution with a joint bilateral upsample", 0},
     {"positions", MR_OPT_BOOL, AO(positions), 0, 1, 0, NULL, "AO from a view-space positions texture", 0},
     {"mask", MR_OPT_ENUM, AO(mask), 0, 0, MR_AO_MASK_OFF, k_mask_names, "corner masking", 0},
+    {"thickness", MR_OPT_FLOAT, AO(thickness), 1e-3, 100, MR_AO_DEFAULT_THICKNESS, NULL,
+     "bitmask: assumed occluder depth; gtao, scheer-gt: thickness heuristic (fractions of the radius)", 0},
+    {"temporal", MR_OPT_BOOL, AO(temporal), 0, 1, 0, NULL,
+     "accumulate AO over frames (replay, view): reprojected history, rejected by depth and normal", 0},
     {"mask-strength", MR_OPT_FLOAT, AO(mask_strength), 1e-3, 1, MR_AO_DEFAULT_MASK_STRENGTH, NULL,
      "standalone mask: AO = 1 - S in the corners before the blur", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},

@@ -15,7 +15,9 @@
 
 _Static_assert(MR_AO_SCHEER == MR_AO_METHOD_ID_SCHEER && MR_AO_CRYTEK == MR_AO_METHOD_ID_CRYTEK &&
                    MR_AO_FILION == MR_AO_METHOD_ID_FILION && MR_AO_HBAO == MR_AO_METHOD_ID_HBAO &&
-                   MR_AO_ALCHEMY == MR_AO_METHOD_ID_ALCHEMY && MR_AO_MAX_SAMPLES == MR_AO_KERNEL_SIZE,
+                   MR_AO_ALCHEMY == MR_AO_METHOD_ID_ALCHEMY && MR_AO_MAX_SAMPLES == MR_AO_KERNEL_SIZE &&
+                   MR_AO_GTAO == MR_AO_METHOD_ID_GTAO && MR_AO_BITMASK == MR_AO_METHOD_ID_BITMASK &&
+                   MR_AO_SCHEER_GT == MR_AO_METHOD_ID_SCHEER_GT && MR_AO_MAX_SLICES == MR_AO_SLICES_SIZE,
                "shaders/mr_bindings.h and mr_render.h disagree on AO method ids or the kernel size");
 
 enum { AO_PLAN_OFF = 0, AO_PLAN_REUSE, AO_PLAN_RUN, AO_PLAN_EXTERNAL };
@@ -46,6 +48,17 @@ struct mr_ao_state {
     mr_ao_kernel k_kind;
     float k_rmin, k_rmax;
     float kernel3[MR_AO_MAX_SAMPLES * 4], kernel2[MR_AO_MAX_SAMPLES * 4];
+    float slices[MR_AO_MAX_SLICES * 4]; /* gtao / bitmask / scheer-gt: directions over half a turn */
+    GLuint linear_sampler;              /* their bilinear depth reads (texelFetch ignores it) */
+    /* issue 18: temporal accumulation, full resolution, ping-pong */
+    GLuint prog_temporal;
+    GLuint tex_hist[2], tex_hist_n[2], fbo_hist[2]; /* (AO, frames, view z), normal */
+    int t_cur;                 /* which holds the latest history */
+    bool t_valid;              /* a history to reproject */
+    int t_w, t_h;
+    int t_frame;               /* frames since the history started (the noise's frame index) */
+    mr_dmat4 t_pose;           /* world_from_camera of the history */
+    mr_camera t_cam;
     /* reuse */
     bool valid;
     ao_key last;
@@ -179,6 +192,18 @@ static void free_targets(mr_ao_state *s) {
     s->valid = false;
 }
 
+static void free_history(mr_ao_state *s) {
+    glDeleteFramebuffers(2, s->fbo_hist);
+    glDeleteTextures(2, s->tex_hist);
+    glDeleteTextures(2, s->tex_hist_n);
+    memset(s->fbo_hist, 0, sizeof s->fbo_hist);
+    memset(s->tex_hist, 0, sizeof s->tex_hist);
+    memset(s->tex_hist_n, 0, sizeof s->tex_hist_n);
+    s->t_w = s->t_h = 0;
+    s->t_valid = false;
+    s->t_frame = 0;
+}
+
 static void free_outlines(mr_ao_state *s) {
     mr_geometry_aux_free(&s->outline);
     s->outline_built = false;
@@ -196,10 +221,13 @@ static void free_state(mr_ao_state *s) {
     if (!s) return;
     free_targets(s);
     free_outlines(s);
+    free_history(s);
+    glDeleteProgram(s->prog_temporal);
     glDeleteProgram(s->prog_main);
     glDeleteProgram(s->prog_blur);
     glDeleteProgram(s->prog_up);
     glDeleteProgram(s->prog_outline);
+    glDeleteSamplers(1, &s->linear_sampler);
     free(s);
 }
 
@@ -209,6 +237,8 @@ static void mr_pass_ao_scene_changed(mr_renderer *r) {
         if (!states[i]) continue;
         states[i]->scene_gen++;
         states[i]->valid = false;
+        states[i]->t_valid = false; /* issue 18: another scene's history */
+        states[i]->t_frame = 0;
         free_outlines(states[i]);
     }
 }
@@ -269,7 +299,9 @@ static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
      * well below the visibility they stand for), so each has its own
      * default strength: the value `bench ao` found best against the ray-
      * traced reference on a view it does not report. */
-    static const float k_strength[MR_AO_METHOD_COUNT] = {1.0f, 3.0f, 1.0f, 1.0f, 1.5f, 2.0f};
+    static const float k_strength[MR_AO_METHOD_COUNT] = {1.0f, 3.0f, 1.0f, 1.0f, 1.5f, 2.0f,
+                                                         /* gtao, bitmask, scheer-gt: visibility integrals, 1 */
+                                                         1.0f, 1.0f, 1.0f};
     if (!(p.strength > 0) || !isfinite(p.strength))
         p.strength = p.method > MR_AO_NONE && p.method < MR_AO_METHOD_COUNT ? k_strength[p.method] : 1.0f;
     if (!(p.c >= 0) || !isfinite(p.c)) p.c = MR_AO_DEFAULT_C;
@@ -285,10 +317,13 @@ static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
      * visibility in [0,1] whatever the method and its strength. */
     if (!(p.mask_strength > 0) || !isfinite(p.mask_strength)) p.mask_strength = MR_AO_DEFAULT_MASK_STRENGTH;
     if (p.mask_strength > 1) p.mask_strength = 1;
+    if (!(p.thickness > 0) || !isfinite(p.thickness)) p.thickness = MR_AO_DEFAULT_THICKNESS;
+    if (p.thickness > 100) p.thickness = 100;
     if ((int)p.radius_mode < 0 || p.radius_mode > MR_AO_RADIUS_VIEW) p.radius_mode = MR_AO_RADIUS_SCREEN;
     p.want_ao = false;
     p.want_mask = false;
     p.no_reuse = false;
+    p.temporal_reset = false;
     p.external = NULL;
     return p;
 }
@@ -322,6 +357,9 @@ static void copy_fields(mr_ao_params *d, const mr_ao_params *p) {
     d->positions = p->positions;
     d->mask = p->mask;
     d->mask_strength = p->mask_strength;
+    d->thickness = p->thickness;
+    d->temporal = p->temporal;
+    d->temporal_reset = p->temporal_reset;
     d->want_ao = p->want_ao;
     d->want_mask = p->want_mask;
     d->no_reuse = p->no_reuse;
@@ -346,7 +384,8 @@ static int plan_of(const frame *f, const mr_ao_state *s) {
     if (external_ok(f)) return AO_PLAN_EXTERNAL; /* an AO image from outside: no AO pass runs */
     if (in->method <= MR_AO_NONE || in->method >= MR_AO_METHOD_COUNT) return AO_PLAN_OFF;
     if (s && s->broken) return AO_PLAN_OFF;
-    if (!s || !s->valid || in->no_reuse) return AO_PLAN_RUN;
+    /* Accumulation keeps refining a frozen camera's AO: computed every frame. */
+    if (!s || !s->valid || in->no_reuse || in->temporal) return AO_PLAN_RUN;
     mr_ao_params p = resolve(in, f->r->scene);
     ao_key key = key_of(f, &p, s->scene_gen);
     return memcmp(&key, &s->last, sizeof key) == 0 ? AO_PLAN_REUSE : AO_PLAN_RUN;
@@ -541,6 +580,23 @@ static void mr_pass_ao_mask(frame *f) {
     glDepthMask(GL_TRUE);
 }
 
+/* The slice integrators' split of the sample budget: floor(sqrt(samples /
+ * 4)) slices (at least 1) and the rest as steps per side (8: 1 x 4,
+ * 16: 2 x 4, 32: 2 x 8, 64: 4 x 8). Too few steps under-reads every
+ * horizon (a bias the blur cannot remove), too few slices is noise across
+ * pixels (the per-pixel rotation), so steps grow first. */
+void mr_ao_slice_split(int samples, int *slices, int *steps) {
+    if (samples < 1) samples = 1;
+    int sl = (int)floor(sqrt(samples / 4.0));
+    if (sl < 1) sl = 1;
+    if (sl > MR_AO_MAX_SLICES) sl = MR_AO_MAX_SLICES;
+    int st = samples / (2 * sl);
+    *slices = sl;
+    *steps = st > 0 ? st : 1;
+}
+
+static bool slice_method(mr_ao_method m) { return m == MR_AO_GTAO || m == MR_AO_BITMASK || m == MR_AO_SCHEER_GT; }
+
 static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
     const mr_ao_params *p = &s->p;
     glUseProgram(s->prog_main);
@@ -561,7 +617,35 @@ static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
     glUniform1f(MR_LOC_AO_MASK_STRENGTH, p->mask_strength);
     glUniform4fv(MR_LOC_AO_KERNEL, MR_AO_MAX_SAMPLES, s->kernel3);
     glUniform4fv(MR_LOC_AO_KERNEL2, MR_AO_MAX_SAMPLES, s->kernel2);
+    glUniform1i(MR_LOC_AO_FRAME, p->temporal ? s->t_frame : 0);
+    if (slice_method(p->method)) {
+        int sl, st;
+        mr_ao_slice_split(p->samples, &sl, &st);
+        /* Directions pi i / slices; the shader turns the set by a per-pixel
+         * angle in [0, pi / slices), so no pixel computes more than one
+         * sine and cosine for its directions. */
+        memset(s->slices, 0, sizeof s->slices);
+        for (int i = 0; i < sl; i++) {
+            double a = 3.14159265358979323846 * i / sl;
+            s->slices[4 * i] = (float)cos(a);
+            s->slices[4 * i + 1] = (float)sin(a);
+        }
+        glUniform4fv(MR_LOC_AO_SLICES, MR_AO_MAX_SLICES, s->slices);
+        glUniform1i(MR_LOC_AO_SLICE_COUNT, sl);
+        glUniform1i(MR_LOC_AO_STEPS, st);
+        glUniform1f(MR_LOC_AO_THICKNESS, p->thickness);
+        if (!s->linear_sampler) {
+            glCreateSamplers(1, &s->linear_sampler);
+            glSamplerParameteri(s->linear_sampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+            glSamplerParameteri(s->linear_sampler, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            glSamplerParameteri(s->linear_sampler, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            glSamplerParameteri(s->linear_sampler, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+            glSamplerParameteri(s->linear_sampler, GL_TEXTURE_COMPARE_MODE, GL_NONE);
+        }
+        glBindSampler(MR_TEX_AO_DEPTH, s->linear_sampler);
+    }
     fullscreen(f, s->fbo_ao[0], s->aw, s->ah);
+    glBindSampler(MR_TEX_AO_DEPTH, 0);
     s->cur = 0;
     s->result = s->tex_ao[0];
     s->valid = true;
@@ -609,6 +693,82 @@ static void mr_pass_ao_upsample(frame *f) {
     ao_inputs in = main_inputs(f);
     stage_upsample(f, f->r->ao, &in);
     frame_put(f, RES_AO, f->r->ao->result);
+}
+
+/* ------------------------------------------------ issue 18: temporal */
+
+static bool mr_pass_need_ao_temporal(const frame *f) { return runs(f) && f->p->ao.temporal; }
+
+/* Program and history targets; a new size, a reset or an explicit
+ * temporal_reset start the history again (and the noise at frame 0, so
+ * the first frame of a history is the single-frame AO). */
+static bool mr_pass_prepare_ao_temporal(frame *f, mr_error *err) {
+    mr_ao_state *s = f->r->ao;
+    if (!s->prog_temporal) {
+        static const char *const t[] = {"fullscreen.vert.glsl", "ao_temporal.frag.glsl", NULL};
+        if (!(s->prog_temporal = mr_gl_program(t, err))) {
+            mr_error_prefix(err, "ambient occlusion (temporal): ");
+            return false;
+        }
+    }
+    int w = f->r->w, h = f->r->h;
+    if (s->t_w != w || s->t_h != h) {
+        free_history(s);
+        for (int i = 0; i < 2; i++) {
+            s->tex_hist[i] = mr_gl_make_tex(GL_RGBA32F, w, h, GL_NEAREST);
+            s->tex_hist_n[i] = mr_gl_make_tex(GL_RGBA16F, w, h, GL_NEAREST);
+            glCreateFramebuffers(1, &s->fbo_hist[i]);
+            glNamedFramebufferTexture(s->fbo_hist[i], GL_COLOR_ATTACHMENT0, s->tex_hist[i], 0);
+            glNamedFramebufferTexture(s->fbo_hist[i], GL_COLOR_ATTACHMENT1, s->tex_hist_n[i], 0);
+            static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+            glNamedFramebufferDrawBuffers(s->fbo_hist[i], 2, bufs);
+        }
+        s->t_w = w;
+        s->t_h = h;
+    }
+    if (f->p->ao.temporal_reset) {
+        s->t_valid = false;
+        s->t_frame = 0;
+    }
+    return true;
+}
+
+static void mr_pass_ao_temporal(frame *f) {
+    mr_ao_state *s = f->r->ao;
+    mr_renderer *r = f->r;
+    /* current view -> previous view, in double, then float (camera-relative:
+     * the translation is the camera's motion, not a world position) */
+    mr_dmat4 prev_from_world = mr_m4_invert_rigid(&s->t_pose);
+    mr_dmat4 m = mr_m4_mul(&prev_from_world, &f->view->world_from_camera);
+    float mf[16];
+    for (int i = 0; i < 16; i++) mf[i] = (float)m.m[i];
+    int src = s->t_cur, dst = 1 - s->t_cur;
+    glUseProgram(s->prog_temporal);
+    glUniform4f(MR_LOC_AO_INTR, (float)f->cam.fx, (float)f->cam.fy, (float)f->cam.cx, (float)f->cam.cy);
+    glUniform2i(MR_LOC_AO_FULL, r->w, r->h);
+    glUniform1f(MR_LOC_AO_NEAR, (float)f->near_plane);
+    glUniformMatrix4fv(MR_LOC_TAA_PREV_FROM_CUR, 1, GL_TRUE, mf); /* mr_dmat4 is row-major */
+    glUniform4f(MR_LOC_TAA_PREV_INTR, (float)s->t_cam.fx, (float)s->t_cam.fy, (float)s->t_cam.cx, (float)s->t_cam.cy);
+    glUniform1i(MR_LOC_TAA_HAVE_HISTORY, s->t_valid ? 1 : 0);
+    glUniform1f(MR_LOC_TAA_MAX_COUNT, (float)MR_AO_TEMPORAL_FRAMES);
+    glUniform1f(MR_LOC_TAA_DEPTH_TOL, (float)MR_AO_TEMPORAL_DEPTH_TOL);
+    glUniform1f(MR_LOC_TAA_NORMAL_COS, (float)MR_AO_TEMPORAL_NORMAL_COS);
+    glBindTextureUnit(MR_TEX_AO_DEPTH, frame_get(f, RES_DEPTH));
+    glBindTextureUnit(MR_TEX_AO_NORMAL, frame_get(f, RES_NORMAL));
+    glBindTextureUnit(MR_TEX_AO_INPUT, frame_get(f, RES_AO));
+    glBindTextureUnit(MR_TEX_TAA_HISTORY, s->tex_hist[src]);
+    glBindTextureUnit(MR_TEX_TAA_HISTORY_N, s->tex_hist_n[src]);
+    fullscreen(f, s->fbo_hist[dst], r->w, r->h);
+    glBindTextureUnit(MR_TEX_AO_INPUT, 0);
+    glBindTextureUnit(MR_TEX_TAA_HISTORY, 0);
+    glBindTextureUnit(MR_TEX_TAA_HISTORY_N, 0);
+    s->t_cur = dst;
+    s->t_valid = true;
+    s->t_pose = f->view->world_from_camera;
+    s->t_cam = f->cam;
+    s->t_frame++;
+    s->result = s->tex_hist[dst]; /* its .r is the accumulated AO */
+    frame_put(f, RES_AO, s->result);
 }
 
 bool mr_pass_ao_read_back(frame *f, mr_error *err) {
@@ -709,6 +869,10 @@ const pass_desc mr_pass_desc_ao_upsample = {
 /* Not listed (no GPU work of their own): the AO of an earlier frame with the
  * same camera, size, scene and settings, or an AO image given from outside
  * (ground truth), stands in for the AO passes. */
+/* issue 18: after the AO (and its blur / upsample), before shading. */
+const pass_desc mr_pass_desc_ao_temporal = {
+    .name = "ao_temporal", .needed = mr_pass_need_ao_temporal, .prepare = mr_pass_prepare_ao_temporal,
+    .run = mr_pass_ao_temporal, AO_DESTROY, .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_AO), .writes = RES(RES_AO)};
 const pass_desc mr_pass_desc_ao_reuse = {
     .needed = mr_pass_need_ao_reuse, .run = mr_pass_ao_reuse, AO_DESTROY,
     .writes = RES(RES_AO) | RES(RES_AO_MASK)};

@@ -67,6 +67,7 @@ static const pass_desc *const k_passes[] = {
     &mr_pass_desc_ao,
     &mr_pass_desc_ao_blur,
     &mr_pass_desc_ao_upsample,
+    &mr_pass_desc_ao_temporal, /* issue 18 */
     &mr_pass_desc_ao_reuse,
     &mr_pass_desc_ao_external,
     &mr_pass_desc_ghost_hidden,
@@ -260,10 +261,14 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
             continue;
         }
         int k = out->pass_count;
+        /* issue 18: synchronous timing; the pass's wall time between two glFinish. */
+        bool sync = p->timing && p->timing_sync;
+        if (sync) glFinish();
         double t0 = mr_time_now();
         if (p->timing) glBeginQuery(GL_TIME_ELAPSED, r->queries[k]);
         d->run(&f);
         if (p->timing) glEndQuery(GL_TIME_ELAPSED);
+        if (sync) glFinish();
         out->cpu_ms[k] = (mr_time_now() - t0) * 1e3;
         out->passes[k] = d->name;
         out->pass_count++;
