@@ -106,9 +106,10 @@ static void draw(mr_draw2d *d, int mode, GLuint tex, int index_count) {
     glBindVertexArray(0);
 }
 
-bool mr_draw2d_frame(mr_draw2d *d, mr_renderer *r, float x, float y, float w, float h, mr_error *err) {
-    if (!r || !r->last.valid) return mr_fail(err, MR_ERR_INVALID, "no rendered frame to show");
-    /* Render targets hold the top image row first, so v runs with y. */
+/* One texture, top row first, over the rectangle (x, y, w, h), unblended. */
+static bool textured_quad(mr_draw2d *d, GLuint tex, float x, float y, float w, float h, const char *what,
+                          mr_error *err) {
+    /* Textures hold the top image row first, so v runs with y. */
     const mr_draw2d_vertex v[4] = {
         {x, y, 0, 0, 0xffffffffu}, {x + w, y, 1, 0, 0xffffffffu},
         {x + w, y + h, 1, 1, 0xffffffffu}, {x, y + h, 0, 1, 0xffffffffu},
@@ -118,11 +119,16 @@ bool mr_draw2d_frame(mr_draw2d *d, mr_renderer *r, float x, float y, float w, fl
     upload(&d->ibo, &d->ibo_bytes, ix, sizeof ix);
     glDisable(GL_BLEND);
     glBindSampler(MR_TEX_UI_TEX, d->sampler);
-    draw(d, 1, r->last.tex, 6);
+    draw(d, 1, tex, 6);
     glBindSampler(MR_TEX_UI_TEX, 0);
     GLenum e = glGetError();
-    if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x drawing the frame", e);
+    if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x drawing %s", e, what);
     return true;
+}
+
+bool mr_draw2d_frame(mr_draw2d *d, mr_renderer *r, float x, float y, float w, float h, mr_error *err) {
+    if (!r || !r->last.valid) return mr_fail(err, MR_ERR_INVALID, "no rendered frame to show");
+    return textured_quad(d, r->last.tex, x, y, w, h, "the frame", err);
 }
 
 struct mr_draw2d_image {
@@ -169,20 +175,7 @@ void mr_draw2d_image_destroy(mr_draw2d_image **im) {
 
 bool mr_draw2d_image_draw(mr_draw2d *d, const mr_draw2d_image *im, float x, float y, float w, float h, mr_error *err) {
     if (!im) return mr_fail(err, MR_ERR_INVALID, "no 2D image to draw");
-    const mr_draw2d_vertex v[4] = {
-        {x, y, 0, 0, 0xffffffffu}, {x + w, y, 1, 0, 0xffffffffu},
-        {x + w, y + h, 1, 1, 0xffffffffu}, {x, y + h, 0, 1, 0xffffffffu},
-    };
-    static const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
-    upload(&d->vbo, &d->vbo_bytes, v, sizeof v);
-    upload(&d->ibo, &d->ibo_bytes, ix, sizeof ix);
-    glDisable(GL_BLEND);
-    glBindSampler(MR_TEX_UI_TEX, d->sampler);
-    draw(d, 1, im->tex, 6);
-    glBindSampler(MR_TEX_UI_TEX, 0);
-    GLenum e = glGetError();
-    if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x drawing a 2D image", e);
-    return true;
+    return textured_quad(d, im->tex, x, y, w, h, "a 2D image", err);
 }
 
 bool mr_draw2d_list_draw(mr_draw2d *d, const mr_draw2d_list *l, mr_error *err) {
