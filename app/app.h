@@ -82,7 +82,14 @@ void app_gfx_close(app_gfx *g);
  * and returns false on a bad value. */
 bool app_ao_check(const char *cmd, const app_table *t, const app_opt *opts, bool *groundtruth, mr_gt_params *gt);
 
-/* Writes what --aux asks for: depth.pfm, normal.pfm, ao.pfm into dir. */
+/* Shadows (issue 12): --shadows METHOD, --shadows-KEY from mr_shadow_opts;
+ * without --shadows the scene config's "shadows" names the method (one line
+ * and false if it names none). In shadow_opts.c. */
+#define APP_SHADOW_TABLE(p) {.prefix = "shadows", .table = mr_shadow_opts, .params = (p)}
+bool app_shadow_scene_default(const char *cmd, const app_table *t, const mr_scene *s, mr_shadow_params *p);
+
+/* Writes what --aux asks for: depth.pfm, normal.pfm, ao.pfm (and
+ * shadow.pfm) into dir. */
 bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err);
 
 

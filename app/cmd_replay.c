@@ -27,11 +27,11 @@ int cmd_replay(int argc, char **argv) {
     int npos = 0;
     /* Depth cues as on render: the same option tables and checks. */
     mr_frame_params base = MR_FRAME_DEFAULTS;
-    app_table tables[] = {APP_AO_TABLE(&base.ao), APP_GHOST_TABLE(&base.ghost)};
+    app_table tables[] = {APP_AO_TABLE(&base.ao), APP_GHOST_TABLE(&base.ghost), APP_SHADOW_TABLE(&base.shadow)};
     bool help;
-    if (!app_parse_tables(argc, argv, 2, opts, tables, 2, pos, 1, &npos,
+    if (!app_parse_tables(argc, argv, 2, opts, tables, 3, pos, 1, &npos,
                    "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] [--raw] "
-                   "[--video F.avi] [--ao METHOD ...] [--ghost MODE ...]",
+                   "[--video F.avi] [--ao METHOD ...] [--ghost MODE ...] [--shadows METHOD ...]",
                    &help))
         return 2;
     if (help) return 0;
@@ -56,6 +56,11 @@ int cmd_replay(int argc, char **argv) {
     mr_recording *rec = mr_recording_open(pos[0], &err);
     if (!rec) return app_error(cmd, &err);
     mr_scene *scene = mr_scene_load(app_get(opts, "scene"), NULL, &err);
+    if (scene && !app_shadow_scene_default(cmd, &tables[2], scene, &base.shadow)) {
+        mr_scene_destroy(&scene);
+        mr_recording_close(&rec);
+        return 2;
+    }
     app_gfx gfx = {0};
     bool ok = scene && mr_mkdirs(out, &err) && app_gfx_open(&gfx, &err) && mr_renderer_set_scene(gfx.renderer, scene, &err);
     cJSON *log = cJSON_CreateArray();
