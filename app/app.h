@@ -101,6 +101,8 @@ bool app_demo_ghost_hall(bool conflict, mr_demo_hall *hall, mr_error *err);
 bool app_demo_ghost(const char *dir, mr_error *err);
 /* mrcheck bench ghost (bench_ghost.c). */
 int app_bench_ghost(int argc, char **argv);
+/* mrcheck bench shadows (bench_shadows.c). */
+int app_bench_shadows(int argc, char **argv);
 
 int cmd_demo(int argc, char **argv);
 int cmd_render(int argc, char **argv);

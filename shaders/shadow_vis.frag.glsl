@@ -40,8 +40,11 @@ layout(location = MR_LOC_SHADOW_KERNEL) uniform vec2 u_kernel[MR_SHADOW_KERNEL_S
 
 layout(binding = MR_TEX_SHADOW_DEPTH) uniform sampler2D u_depth;      // reversed-Z G-buffer depth
 layout(binding = MR_TEX_SHADOW_MAP) uniform sampler2D u_map;          // R32F linear light depth
+layout(binding = MR_TEX_SHADOW_NORMAL) uniform sampler2D u_normal;    // G-buffer view normal
 
 layout(location = 0) out float o_vis;
+
+bool nn_valid(vec3 n) { return dot(n, n) > 0.25; }
 
 vec3 cam_pos(ivec2 px) {
     float d = texelFetch(u_depth, px, 0).r;
@@ -72,6 +75,7 @@ float g_zR;      // receiver depth
 vec2 g_uvR;      // receiver uv
 vec2 g_grad;     // dz/duv of the receiver plane
 float g_bias;
+vec3 g_lR;       // receiver in light space (normal-offset)
 
 float tap_depth(ivec2 t) { return texelFetch(u_map, t, 0).r; }
 bool inside(ivec2 t) { return all(greaterThanEqual(t, ivec2(0))) && all(lessThan(t, ivec2(u_size))); }
@@ -158,8 +162,25 @@ void main() {
     if (pc.z <= 0.0) { o_vis = u_weight; return; }
     vec3 l = light_pos(pc);
     if (u_ortho == 0 && l.z <= 0.0) { o_vis = u_weight; return; } // behind the light's plane
-    g_zR = l.z;
-    g_uvR = light_uv(l);
+    // Normal offset: a receiver seen edge-on by the light (a wall under a
+    // light straight above) has no plane the map can resolve; lifting it a
+    // map texel off its surface, more the more it turns away, keeps it off
+    // its own texels. Scale-free: a texel's length at the receiver.
+    {
+        vec3 n = texelFetch(u_normal, px, 0).xyz;
+        float tl = u_ortho != 0 ? 1.0 / (float(u_size) * min(u_rect.z, u_rect.w)) : l.z / (float(u_size) * u_k);
+        vec3 ln = nn_valid(n) ? normalize(mat3(u_light_from_cam) * n) : vec3(0.0, 0.0, -1.0);
+        float edge = clamp(1.0 - abs(ln.z), 0.0, 1.0);
+        // A surface turned away from the light (from its sample, for the
+        // ground truth) gets none of it: its own far side blocks it, which
+        // the map of an edge-on surface cannot tell.
+        vec3 to_light = u_ortho != 0 ? normalize(vec3(-u_shear, -1.0)) : normalize(u_offset - (l + u_offset));
+        if (dot(ln, to_light) <= 0.0 && nn_valid(n)) { o_vis = 0.0; return; }
+        vec3 lo = light_pos(pc + n * (1.5 * tl * edge));
+        g_lR = lo;
+        g_zR = lo.z;
+        g_uvR = light_uv(lo);
+    }
     // Receiver plane from the screen neighbours.
     vec3 d[2];
     vec2 duv[2];
@@ -171,7 +192,7 @@ void main() {
         float sgn = use_p ? 1.0 : -1.0;
         if (q.z <= 0.0) { d[a] = vec3(0.0); duv[a] = vec2(0.0); continue; }
         vec3 lq = light_pos(q);
-        duv[a] = (light_uv(lq) - g_uvR) * sgn;
+        duv[a] = (light_uv(lq) - light_uv(l)) * sgn;
         d[a] = vec3(0.0, 0.0, (lq.z - l.z) * sgn);
     }
     mat2 J = mat2(duv[0], duv[1]);   // columns: d uv / d screen x, d uv / d screen y
@@ -199,7 +220,7 @@ void main() {
         vec2 sc = uv_scale();
         vec2 search = min(light_reach(u_zrange.x, g_zR) * sc, vec2(max_uv));
         if (u_method == MR_SHADOW_METHOD_ID_BP) {
-            v = backprojection(l, search);
+            v = backprojection(g_lR, search);
         } else {
             float zb = blocker_depth(search);
             if (zb < 0.0) {

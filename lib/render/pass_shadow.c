@@ -375,7 +375,7 @@ static bool need_map(const frame *f) { return casts(f) && map_method(f->p->shado
 static bool need_map_reuse(const frame *f) { return casts(f) && map_method(f->p->shadow.method) && reusable(f); }
 static bool need_vis(const frame *f) { return casts(f); }
 static uint32_t vis_reads_now(const frame *f) {
-    return RES(RES_DEPTH) | (map_method(f->p->shadow.method) ? RES(RES_SHADOW_MAP) : 0);
+    return RES(RES_DEPTH) | RES(RES_NORMAL) | (map_method(f->p->shadow.method) ? RES(RES_SHADOW_MAP) : 0);
 }
 
 /* Draws the map of one light position: the base eye moved by `offset`
@@ -463,6 +463,7 @@ static void draw_vis(frame *f, int method, const double offset[3], const double 
     glUniform1f(MR_LOC_SHADOW_MAX_SEARCH, (float)MAX_SEARCH_TEXELS);
     glUniform2fv(MR_LOC_SHADOW_KERNEL, s->kernel_taps, s->kernel);
     glBindTextureUnit(MR_TEX_SHADOW_DEPTH, frame_get(f, RES_DEPTH));
+    glBindTextureUnit(MR_TEX_SHADOW_NORMAL, frame_get(f, RES_NORMAL));
     glBindTextureUnit(MR_TEX_SHADOW_MAP, s->map.color[0]);
     glBindVertexArray(r->empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
@@ -532,4 +533,5 @@ const pass_desc mr_pass_desc_shadow_map_reuse = {
     .writes = RES(RES_SHADOW_MAP)};
 const pass_desc mr_pass_desc_shadow = {
     .name = "shadow", .needed = need_vis, .prepare = prepare_common, .run = run_vis,
-    .reads = RES(RES_DEPTH) | RES(RES_SHADOW_MAP), .reads_now = vis_reads_now, .writes = RES(RES_SHADOW)};
+    .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_SHADOW_MAP), .reads_now = vis_reads_now,
+    .writes = RES(RES_SHADOW)};

@@ -215,6 +215,24 @@ typedef struct mr_demo_hall {
 bool mr_mesh_outline_dirs(const mr_mesh *m, float *out, mr_error *err);
 
 bool mr_demo_build(const mr_demo_params *params, mr_demo_hall *out, mr_error *err);
+
+/* ------------------------------------------------- shadow suite (issue 12)
+ * Hecher's scene categories as generated scenes (shadow_suite.c): simple
+ * objects and furniture-like assemblies with constant or varying penumbra,
+ * without or with overlapping penumbrae; fences and plant-like leaves
+ * (always overlapping) with constant or varying penumbra; the demo hall.
+ * Each with its casting light and two views (320 x 240). */
+#define MR_SHADOW_SUITE_COUNT 13
+typedef struct mr_shadow_suite_case {
+    char name[48];        /* e.g. "simple_varying_overlap" */
+    bool varying;         /* the penumbra width varies (contact hardening) */
+    bool overlap;         /* penumbrae overlap */
+    mr_scene *scene;      /* owned */
+    mr_view views[2];
+} mr_shadow_suite_case;
+bool mr_shadow_suite_build(int index, mr_shadow_suite_case *out, mr_error *err);
+void mr_shadow_suite_free(mr_shadow_suite_case *c);
+const char *mr_shadow_suite_name(int index); /* NULL out of range */
 void mr_demo_free(mr_demo_hall *hall);
 
 /* The demo's camera side (demo_camera.c). */
