@@ -14,6 +14,7 @@
  *  - bad light sizes, a zero direction and a receiver glob that matches
  *    nothing fail the scene config with one line.
  * Skips (77) without an EGL device (after the CPU checks). */
+#include "mr_bench.h"
 #include "mr_eval.h"
 #include "mr_render.h"
 #include "mr_test.h"
@@ -483,6 +484,53 @@ static void bad_configs(void) {
     }
 }
 
+/* The bench at a tiny size: its files, its header, one row per setting;
+ * and the suite's cases all build with a casting light. */
+static void bench_and_suite(mr_gpu *gpu, mr_renderer *r) {
+    for (int i = 0; i < MR_SHADOW_SUITE_COUNT; i++) {
+        mr_shadow_suite_case c;
+        mr_error err = {0};
+        mr_light L;
+        CHECK_MSG(mr_shadow_suite_build(i, &c, &err), "suite case %d: %s", i, err.msg);
+        CHECK_MSG(c.scene && mr_shadow_light(c.scene, &L) && c.scene->node_count > 1, "suite case %d", i);
+        mr_shadow_suite_free(&c);
+    }
+    char dir[4096];
+    if (!mr_test_fresh_dir("test_shadow_bench", dir, sizeof dir)) return;
+    mr_bench_shadows_params p = {MR_BENCH_SHADOWS_DEFAULTS};
+    p.gfx.gpu = gpu;
+    p.gfx.renderer = r;
+    p.out_dir = dir;
+    p.width = 64;
+    p.height = 48;
+    p.frames = 1;
+    p.rays = 16;
+    p.first = 2;
+    p.count = 1;
+    p.views = 1;
+    mr_error err = {0};
+    CHECK_MSG(mr_bench_shadows(&p, &err), "bench shadows: %s", err.msg);
+    char path[4200];
+    snprintf(path, sizeof path, "%s/bench_shadows.csv", dir);
+    size_t n = 0;
+    char *csv = mr_file_read(path, &n, 1 << 20, &err);
+    const char *cols = "case,varying,overlap,view,tuning,method,setting,value,pcf_radius,gpu_ms,S_pixels,rmse_S,"
+                       "sqrtD_over_S,ssim_S\n";
+    const char *h = csv ? strstr(csv, "\ncase,") : NULL;
+    CHECK_MSG(h && strncmp(h + 1, cols, strlen(cols)) == 0, "bench_shadows.csv header");
+    int rows = 0;
+    for (const char *q = h ? h + 1 : NULL; q && (q = strstr(q, "\nsimple_varying,")); q++) rows++;
+    CHECK_MSG(rows == 17, "bench_shadows.csv: %d rows for one case and view, want 17 (one per setting)", rows);
+    free(csv);
+    static const char *const files[] = {"bench_shadows.svg", "bench_shadows.md", "bench_shadows_simple_varying.png"};
+    for (int i = 0; i < 3; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, files[i]);
+        FILE *f = fopen(path, "rb");
+        CHECK_MSG(f != NULL, "bench wrote no %s", files[i]);
+        if (f) fclose(f);
+    }
+}
+
 int main(void) {
     bad_configs();
     mr_error err = {0};
@@ -497,6 +545,7 @@ int main(void) {
         contact_hardening(r);
         acne_and_gaps(r);
         scales(r);
+        bench_and_suite(gpu, r);
     }
     mr_renderer_destroy(&r);
     mr_gpu_destroy(&gpu);
