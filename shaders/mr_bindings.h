@@ -235,6 +235,16 @@
 #define MR_SHADOW_METHOD_ID_PCSS           3
 #define MR_SHADOW_METHOD_ID_BP             4
 #define MR_SHADOW_METHOD_ID_GROUNDTRUTH    5
+/* overlay: the shadow catcher (pass_shadow.c's flags, passes.c's overlay) */
+#define MR_LOC_OVERLAY_CATCHER             9
+#define MR_LOC_OVERLAY_CATCHER_LIGHT       10
+#define MR_LOC_OVERLAY_CATCHER_LIGHT_LUM   11
+#define MR_LOC_OVERLAY_CATCHER_AMBIENT     12
+#define MR_TEX_OVERLAY_IDS                 2
+#define MR_TEX_OVERLAY_SHADOW              3
+#define MR_TEX_OVERLAY_CATCHER_FLAGS       4
+#define MR_TEX_OVERLAY_NORMAL              5
+#define MR_SHADOW_CATCHER_ROW              4096 /* flags texture: node i at (i % ROW, i / ROW) */
 /* shade: the casting light's visibility */
 #define MR_LOC_SHADE_SHADOW_LIGHT          22
 #define MR_TEX_SHADE_SHADOW                3

@@ -484,6 +484,52 @@ static void bad_configs(void) {
     }
 }
 
+/* The shadow catcher: over a uniform grey video, the floor (a receiver) is
+ * not drawn: lit, it is the video itself; in the box's shadow, darker; the
+ * box is blended as ever. */
+static void catcher(mr_renderer *r) {
+    world w = {1, {0, 0, 0}};
+    mr_scene *s = sun_scene(&w, 45, 2, 2);
+    s->nodes[0].shadow_catcher = true; /* the floor */
+    mr_view v = look(&w, mr_v3(-0.5, 3, 1.8), mr_v3(-0.6, 0, 0), mr_v3(0, 1, 0));
+    mr_image video = {0};
+    mr_error err = {0};
+    CHECK(mr_image_alloc(&video, W, H, 3, MR_PIX_U8, &err));
+    memset(video.data, 200, mr_image_bytes(&video));
+    for (int on = 0; on < 2; on++) {
+        mr_frame_params p = MR_FRAME_DEFAULTS;
+        p.video = &video;
+        p.alpha = 0.3f;
+        p.shadow.method = on ? MR_SHADOW_PCSS : MR_SHADOW_OFF;
+        p.want_depth = true;
+        mr_frame_result res;
+        if (!mr_renderer_set_scene(r, s, &err) || !mr_render_frame(r, &v, &p, &res, &err)) {
+            CHECK_MSG(false, "catcher: %s", err.msg);
+            continue;
+        }
+        /* Floor points: lit (in front of the box, towards the sun) and in
+         * its shadow (behind it); the box's top. */
+        mr_dmat4 cfw = mr_m4_invert_rigid(&v.world_from_camera);
+        const double pts[3][3] = {{0.8, 0, 0}, {-0.6, 0, 0}, {0, 0.6, 0}};
+        int val[3];
+        for (int k = 0; k < 3; k++) {
+            mr_dvec3 pc = mr_m4_point(&cfw, mr_v3(pts[k][0], pts[k][1], pts[k][2]));
+            int x = (int)lround(v.camera.fx * pc.x / pc.z + v.camera.cx), y = (int)lround(v.camera.fy * pc.y / pc.z + v.camera.cy);
+            val[k] = x >= 0 && y >= 0 && x < W && y < H ? ((const unsigned char *)res.color.data)[(y * W + x) * 3 + 1] : -1;
+        }
+        printf("  catcher, shadows %s: lit floor %d, shadowed floor %d, box top %d (video 200)\n", on ? "pcss" : "off",
+               val[0], val[1], val[2]);
+        CHECK_MSG(val[0] == 200, "the lit floor must be the video: %d", val[0]);
+        if (on) CHECK_MSG(val[1] >= 0 && val[1] < 170, "the box's shadow must darken the video: %d", val[1]);
+        else CHECK_MSG(val[1] == 200, "without shadows the floor is the video: %d", val[1]);
+        CHECK_MSG(val[2] != 200 && val[2] > 0, "the box must still be drawn over the video: %d", val[2]);
+        mr_frame_result_free(&res);
+    }
+    mr_image_free(&video);
+    mr_renderer_set_scene(r, NULL, NULL);
+    mr_scene_destroy(&s);
+}
+
 /* The bench at a tiny size: its files, its header, one row per setting;
  * and the suite's cases all build with a casting light. */
 static void bench_and_suite(mr_gpu *gpu, mr_renderer *r) {
@@ -545,6 +591,7 @@ int main(void) {
         contact_hardening(r);
         acne_and_gaps(r);
         scales(r);
+        catcher(r);
         bench_and_suite(gpu, r);
     }
     mr_renderer_destroy(&r);

@@ -71,6 +71,8 @@ struct mr_shadow_state {
     map_key key;
     float kernel[2 * MR_SHADOW_MAX_TAPS];
     int kernel_taps;
+    GLuint catcher_flags;  /* R8UI, node i at (i % ROW, i / ROW): 1 = shadow catcher */
+    const mr_scene *catcher_scene;
 };
 
 
@@ -311,6 +313,7 @@ void mr_pass_shadow_free(mr_renderer *r) {
     if (!s) return;
     mr_gl_target_free(&s->map);
     mr_gl_target_free(&s->vis);
+    glDeleteTextures(1, &s->catcher_flags);
     glDeleteProgram(s->prog_map);
     glDeleteProgram(s->prog_vis);
     free(s);
@@ -318,7 +321,62 @@ void mr_pass_shadow_free(mr_renderer *r) {
 }
 
 static void shadow_scene_changed(mr_renderer *r) {
-    if (r->shadow) r->shadow->key_valid = false;
+    if (!r->shadow) return;
+    r->shadow->key_valid = false;
+    glDeleteTextures(1, &r->shadow->catcher_flags);
+    r->shadow->catcher_flags = 0;
+    r->shadow->catcher_scene = NULL;
+}
+
+static bool has_catchers(const mr_scene *s) {
+    for (int32_t i = 0; s && i < s->node_count; i++)
+        if (s->nodes[i].shadow_catcher) return true;
+    return false;
+}
+
+bool mr_shadow_catcher_setup(frame *f, GLuint program_unused, mr_error *err) {
+    (void)program_unused;
+    mr_renderer *r = f->r;
+    const mr_scene *sc = r->scene;
+    if (!has_catchers(sc)) {
+        glUniform1i(MR_LOC_OVERLAY_CATCHER, 0);
+        return true;
+    }
+    if (!r->shadow && !(r->shadow = calloc(1, sizeof *r->shadow))) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    struct mr_shadow_state *s = r->shadow;
+    if (!s->catcher_flags || s->catcher_scene != sc) {
+        glDeleteTextures(1, &s->catcher_flags);
+        int row = MR_SHADOW_CATCHER_ROW, rows = (sc->node_count + row - 1) / row;
+        int w = sc->node_count < row ? sc->node_count : row;
+        uint8_t *flags = calloc((size_t)row * rows, 1);
+        if (!flags) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        for (int32_t i = 0; i < sc->node_count; i++) flags[i] = sc->nodes[i].shadow_catcher ? 1 : 0;
+        glCreateTextures(GL_TEXTURE_2D, 1, &s->catcher_flags);
+        glTextureStorage2D(s->catcher_flags, 1, GL_R8UI, w, rows);
+        /* An integer texture is complete only with nearest filtering. */
+        glTextureParameteri(s->catcher_flags, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(s->catcher_flags, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, row);
+        glTextureSubImage2D(s->catcher_flags, 0, 0, 0, w, rows, GL_RED_INTEGER, GL_UNSIGNED_BYTE, flags);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+        free(flags);
+        s->catcher_scene = sc;
+    }
+    GLuint vis = frame_get(f, RES_SHADOW);
+    glUniform1i(MR_LOC_OVERLAY_CATCHER, vis ? 2 : 1);
+    /* The casting light's share of the catcher's shading (overlay.frag). */
+    mr_light L;
+    if (!mr_shadow_light(sc, &L)) memset(&L, 0, sizeof L);
+    mr_dvec3 d = mr_v3_normalize(mr_m4_dir(&f->cam_from_world, mr_v3(L.direction[0], L.direction[1], L.direction[2])));
+    glUniform3f(MR_LOC_OVERLAY_CATCHER_LIGHT, (float)d.x, (float)d.y, (float)d.z);
+    glUniform1f(MR_LOC_OVERLAY_CATCHER_LIGHT_LUM, (L.color[0] + L.color[1] + L.color[2]) / 3.0f);
+    glUniform1f(MR_LOC_OVERLAY_CATCHER_AMBIENT, sc->ambient);
+    glBindTextureUnit(MR_TEX_OVERLAY_IDS, frame_get(f, RES_IDS));
+    glBindTextureUnit(MR_TEX_OVERLAY_SHADOW, vis);
+    glBindTextureUnit(MR_TEX_OVERLAY_CATCHER_FLAGS, s->catcher_flags);
+    glBindTextureUnit(MR_TEX_OVERLAY_NORMAL, frame_get(f, RES_NORMAL));
+    return true;
 }
 
 static struct mr_shadow_state *state(frame *f, mr_error *err) {

@@ -231,6 +231,9 @@ static void mr_pass_overlay(frame *f) {
     glUniform1fv(MR_LOC_OVERLAY_DIST, 5, dist);
     float a = f->p->alpha;
     glUniform1f(MR_LOC_OVERLAY_ALPHA, a < 0 ? 0.0f : a > 1 ? 1.0f : a);
+    /* Receivers of the scene config show the video, darkened by the plan's
+     * shadow (pass_shadow.c); off (and the image as before) without them. */
+    mr_shadow_catcher_setup(f, b->prog_overlay, NULL);
     glBindTextureUnit(MR_TEX_OVERLAY_VIRTUAL, frame_get(f, RES_IMAGE));
     glBindTextureUnit(MR_TEX_OVERLAY_VIDEO, b->video_tex);
     glBindVertexArray(r->empty_vao);
@@ -249,4 +252,5 @@ const pass_desc mr_pass_desc_shade = {
     .writes = RES(RES_SHADED) | RES(RES_IMAGE)};
 const pass_desc mr_pass_desc_overlay = {
     .name = "overlay", .needed = mr_pass_need_overlay, .prepare = mr_pass_prepare_overlay, .run = mr_pass_overlay,
-    .destroy = mr_base_free, .reads = RES(RES_IMAGE), .writes = RES(RES_IMAGE)};
+    .destroy = mr_base_free, .reads = RES(RES_IMAGE), .uses = RES(RES_IDS) | RES(RES_NORMAL) | RES(RES_SHADOW),
+    .writes = RES(RES_IMAGE)};

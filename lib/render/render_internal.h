@@ -193,5 +193,8 @@ void mr_pass_ao_free(mr_renderer *r);
 int mr_shadow_light_index(const mr_scene *s);
 bool mr_pass_shadow_read_back(frame *f, mr_error *err);
 void mr_pass_shadow_free(mr_renderer *r);
+/* The overlay's shadow catcher: sets its uniforms and textures on the bound
+ * overlay program (catcher off when the scene marks no receivers). */
+bool mr_shadow_catcher_setup(frame *f, GLuint program, mr_error *err);
 
 #endif
