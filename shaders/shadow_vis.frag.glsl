@@ -132,11 +132,21 @@ float backprojection(vec3 r, vec2 radius_uv) {
             ivec2 t = ivec2(x, y);
             if (!inside(t)) continue;
             float z = tap_depth(t);
-            if (!(z < ref_depth(t)) || z <= 0.0) continue;
+            // A patch must stand clear of the receiver's plane by two texels:
+            // closer, its projection through the receiver covers the whole
+            // light, so one texel of the receiver's own surface that the
+            // plane fit misses would black it out (PCSS only loses a tap).
+            float tlr = u_ortho != 0 ? 1.0 / (S * min(u_rect.z, u_rect.w)) : g_zR / (S * u_k);
+            if (!(z < ref_depth(t) - 2.0 * tlr) || z <= 0.0) continue;
             vec2 lo = vec2(t) / S, hi = (vec2(t) + 1.0) / S;
             ivec2 tx = t + ivec2(1, 0), ty = t + ivec2(0, 1);
             float zx = inside(tx) ? tap_depth(tx) : z, zy = inside(ty) ? tap_depth(ty) : z;
-            bool bx = inside(tx) && zx < ref_depth(tx), by = inside(ty) && zy < ref_depth(ty);
+            // Only neighbours of the same surface (a depth step under four
+            // texels' length, i.e. tilted less than ~76 degrees) are
+            // joined: across a depth edge the gap is real.
+            float tl = u_ortho != 0 ? 1.0 / (S * min(u_rect.z, u_rect.w)) : z / (S * u_k);
+            bool bx = inside(tx) && zx < ref_depth(tx) && abs(zx - z) < 4.0 * tl;
+            bool by = inside(ty) && zy < ref_depth(ty) && abs(zy - z) < 4.0 * tl;
             // Corners on the light of the patch (at its own depth).
             vec2 a = on_light(r, map_xy(lo, z), z), b = on_light(r, map_xy(hi, z), z);
             vec2 pmin = min(a, b), pmax = max(a, b);
