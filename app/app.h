@@ -26,7 +26,14 @@ void app_gfx_close(app_gfx *g);
  * and returns false on a bad value. */
 bool app_ao_check(const char *cmd, const mr_cli_table *t, bool *groundtruth, mr_gt_params *gt);
 
-/* Writes what --aux asks for: depth.pfm, normal.pfm, ao.pfm into dir. */
+/* Shadows (issue 12): --shadows METHOD, --shadows-KEY from mr_shadow_opts;
+ * without --shadows the scene config's "shadows" names the method (one line
+ * and false if it names none). In shadow_opts.c. */
+#define APP_SHADOW_TABLE(p) {.prefix = "shadows", .table = mr_shadow_opts, .params = (p)}
+bool app_shadow_scene_default(const char *cmd, const mr_cli_table *t, const mr_scene *s, mr_shadow_params *p);
+
+/* Writes what --aux asks for: depth.pfm, normal.pfm, ao.pfm (and
+ * shadow.pfm) into dir. */
 bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err);
 
 
@@ -38,6 +45,8 @@ bool app_demo_ghost_hall(bool conflict, mr_demo_hall *hall, mr_error *err);
 bool app_demo_ghost(const char *dir, mr_error *err);
 /* mrcheck bench ghost (bench_ghost.c). */
 int app_bench_ghost(int argc, char **argv);
+/* mrcheck bench shadows (bench_shadows.c). */
+int app_bench_shadows(int argc, char **argv);
 
 int cmd_demo(int argc, char **argv);
 int cmd_render(int argc, char **argv);

@@ -38,6 +38,10 @@ bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err) {
         mr_path_join(dir, "ao.pfm", path, sizeof path);
         if (!mr_image_save_pfm(path, &res->ao, err)) return false;
     }
+    if (res->shadow.data) {
+        mr_path_join(dir, "shadow.pfm", path, sizeof path);
+        if (!mr_image_save_pfm(path, &res->shadow, err)) return false;
+    }
     return true;
 }
 
@@ -75,7 +79,7 @@ int cmd_render(int argc, char **argv) {
         {"size", "WxH", "output size (default: the camera's)", NULL},
         {"video", "IMG", "camera frame to overlay (raw, distorted)", NULL},
         {"alpha", "A", "video transparency in [0,1]: 0 virtual only, 1 video only (default 0.5)", NULL},
-        {"aux", "DIR", "also write depth.pfm (linear view depth), normal.pfm and ao.pfm (1 = unoccluded)", NULL},
+        {"aux", "DIR", "also write depth.pfm (linear view depth), normal.pfm, ao.pfm (1 = unoccluded) and shadow.pfm", NULL},
         {"hidden", "GLOB", "extra node-name glob for the hidden layer", NULL},
         {"hide-hidden", NULL, "leave the hidden layer out", NULL},
         APP_DRAW_OPTS,
@@ -86,11 +90,13 @@ int cmd_render(int argc, char **argv) {
     };
     mr_frame_params fp = MR_FRAME_DEFAULTS;
     mr_gt_params gtp = MR_GT_DEFAULTS;
-    mr_cli_table tables[] = {APP_AO_TABLE(&fp.ao), APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&fp.ghost)};
+    mr_cli_table tables[] = {APP_AO_TABLE(&fp.ao), APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&fp.ghost),
+                             APP_SHADOW_TABLE(&fp.shadow)};
     bool help;
-    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 3, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 4, NULL, 0, NULL,
                    "usage: mrcheck render --scene FILE --view VIEW.json --out OUT.png [--size WxH] "
-                   "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive]",
+                   "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive] "
+                   "[--shadows off|hard|pcf|pcss|bp|groundtruth ...]",
                    &help))
         return 2;
     if (help) return 0;
@@ -114,6 +120,7 @@ int cmd_render(int argc, char **argv) {
     if (!app_ao_check(cmd, &tables[0], &groundtruth, &gtp)) return 2;
     fp.ao.want_ao = aux != NULL;
     fp.ao.temporal = false; /* issue 18: a single frame has nothing to accumulate */
+    fp.shadow.want_shadow = aux != NULL;
 
     /* Everything that can be checked without a GPU is checked first, so a
      * bad input never costs a context. */
@@ -133,6 +140,11 @@ int cmd_render(int argc, char **argv) {
     if (!scene) {
         mr_image_free(&video);
         return mr_cli_error(cmd, &err);
+    }
+    if (!app_shadow_scene_default(cmd, &tables[3], scene, &fp.shadow)) {
+        mr_scene_destroy(&scene);
+        mr_image_free(&video);
+        return 2;
     }
     mr_lod *lod = NULL;
     if (app_lod_auto(opts) && mr_scene_triangle_count(scene) < APP_LOD_AUTO_TRIANGLES) dp.no_lod = true;

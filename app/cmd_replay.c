@@ -19,11 +19,11 @@ int cmd_replay(int argc, char **argv) {
     /* Depth cues as on render: the same option tables and checks. */
     mr_gt_params gtp = MR_GT_DEFAULTS;
     mr_cli_table tables[] = {{"", mr_batch_replay_opts, &p, NULL, false, {0}}, APP_AO_TABLE(&p.frame.ao),
-                             APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&p.frame.ghost)};
+                             APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&p.frame.ghost), APP_SHADOW_TABLE(&p.frame.shadow)};
     bool help;
-    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 4, pos, 1, &npos,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 5, pos, 1, &npos,
                              "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] "
-                             "[--raw] [--video F.avi] [--ao METHOD ...] [--ghost MODE ...]",
+                             "[--raw] [--video F.avi] [--ao METHOD ...] [--ghost MODE ...] [--shadows METHOD ...]",
                              &help))
         return 2;
     if (help) return 0;
@@ -43,6 +43,11 @@ int cmd_replay(int argc, char **argv) {
     if (!rec) return mr_cli_error(cmd, &err);
     p.recording = rec;
     mr_scene *scene = mr_scene_load(mr_cli_get(opts, "scene"), NULL, &err);
+    if (scene && !app_shadow_scene_default(cmd, &tables[4], scene, &p.frame.shadow)) {
+        mr_scene_destroy(&scene);
+        mr_recording_close(&rec);
+        return 2;
+    }
     app_gfx gfx = {0};
     mr_batch_replay_stats st;
     bool ok = scene && app_gfx_open(&gfx, &err) && mr_batch_replay(&p, gfx.renderer, scene, &st, &err);

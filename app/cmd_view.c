@@ -57,6 +57,9 @@ typedef struct view_app {
     mr_image mark_screen;
     bool mark_grab_screen, snap_request;
     char session_dir[4096];
+    /* --shadows (else the scene config's "shadows", else off) */
+    mr_shadow_method shadows;
+    bool shadows_given;
     int snap_count, mark_count;
     char shot_path[1024], state_path[1024];
     /* the rendered frame */
@@ -224,6 +227,14 @@ static void carry_out(view_app *a, const mr_view_actions *acts) {
 }
 
 /* Renders the 3D frame when something it depends on changed. */
+/* The shadow method of a frame: --shadows, else the scene config's. */
+static mr_shadow_method view_shadows(const view_app *a) {
+    mr_shadow_method m = MR_SHADOW_OFF;
+    if (a->shadows_given) return a->shadows;
+    if (a->scene && a->scene->shadow_method[0] && !mr_shadow_method_parse(a->scene->shadow_method, &m)) m = MR_SHADOW_OFF;
+    return m;
+}
+
 static void render_3d(view_app *a) {
     if (!a->have_frame || !a->need_render) return;
     a->need_render = false;
@@ -245,6 +256,7 @@ static void render_3d(view_app *a) {
     fp.ao.temporal_reset = !a->ao_had_pose; /* tracking (re)acquired: no history across the gap */
     a->ao_had_pose = a->frame.have_pose && a->frame.pose_valid;
     fp.ghost.mode = s->ghost;
+    fp.shadow.method = view_shadows(a);
     mr_view_render_choice c =
         mr_view_render_policy(s, a->frame.have_pose, a->frame.pose_valid, mr_viewer_frozen(a->vc));
     fp.alpha = c.alpha;
@@ -310,6 +322,7 @@ static void write_state(view_app *a, const mr_image *screen) {
             fp.hide_hidden_layer = s->hide_hidden;
             fp.ao.method = s->ao;
             fp.ghost.mode = s->ghost;
+            fp.shadow.method = view_shadows(a);
             mr_frame_result r;
             mr_error err = {0};
             if (mr_render_frame(a->rend, &view, &fp, &r, &err)) {
@@ -614,6 +627,7 @@ int cmd_view(int argc, char **argv) {
         {"ao", "METHOD", ao_help, NULL},
         {"ghost", "MODE", ghost_help, NULL},
         {"ao-temporal", NULL, "accumulate the AO over frames (reprojected; restarts when tracking is regained)", NULL},
+        {"shadows", "METHOD", "soft shadows: off, hard, pcf, pcss, bp, groundtruth (default: the scene config's, else off)", NULL},
         {"verbose", NULL, "more log output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -655,6 +669,14 @@ int cmd_view(int argc, char **argv) {
     else if (replay) snprintf(a->session_dir, sizeof a->session_dir, "%s", replay);
     else snprintf(a->session_dir, sizeof a->session_dir, "mrcheck-session");
     if ((rc = parse_start_modes(opts, &ao, &ghost)) != 0) goto done;
+    if (mr_cli_get(opts, "shadows")) {
+        if (!mr_shadow_method_parse(mr_cli_get(opts, "shadows"), &a->shadows)) {
+            mr_cli_errorf(k_cmd, "--shadows must be off, hard, pcf, pcss, bp or groundtruth, not '%s'", mr_cli_get(opts, "shadows"));
+            rc = 2;
+            goto done;
+        }
+        a->shadows_given = true;
+    }
 
     /* A scene that fails to load is shown as a message; the window still
      * opens, so the video and the controls stay usable. */

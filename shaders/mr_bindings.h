@@ -219,6 +219,57 @@
 #define MR_TEX_SHADE_NORMAL                1
 #define MR_TEX_SHADE_AO                    2
 
+/* shadow_map (draws the scene through a view: 0..2 as above) */
+#define MR_LOC_SHADOW_MAP_ORTHO            3
+#define MR_LOC_SHADOW_MAP_RECT             4
+#define MR_LOC_SHADOW_MAP_DEPTH            5
+#define MR_LOC_SHADOW_MAP_OFFSET           6
+#define MR_LOC_SHADOW_MAP_SHEAR            7
+/* shadow_vis (full screen) */
+#define MR_LOC_SHADOW_INTR                 0
+#define MR_LOC_SHADOW_NEAR                 1
+#define MR_LOC_SHADOW_LIGHT_FROM_CAM       2
+#define MR_LOC_SHADOW_ORTHO                3
+#define MR_LOC_SHADOW_RECT                 4
+#define MR_LOC_SHADOW_K                    5
+#define MR_LOC_SHADOW_ZRANGE               6
+#define MR_LOC_SHADOW_LIGHT_HALF           7
+#define MR_LOC_SHADOW_METHOD               8
+#define MR_LOC_SHADOW_TAPS                 9
+#define MR_LOC_SHADOW_PCF_RADIUS           10
+#define MR_LOC_SHADOW_MAP_SIZE             11
+#define MR_LOC_SHADOW_OFFSET               12
+#define MR_LOC_SHADOW_SHEAR                13
+#define MR_LOC_SHADOW_WEIGHT               14
+#define MR_LOC_SHADOW_MAX_SEARCH           15
+#define MR_LOC_SHADOW_LIGHT_AREA           16
+#define MR_LOC_SHADOW_KERNEL               20
+#define MR_SHADOW_KERNEL_SIZE              64 /* = MR_SHADOW_MAX_TAPS (checked in pass_shadow.c) */
+#define MR_TEX_SHADOW_DEPTH                0
+#define MR_TEX_SHADOW_NORMAL               1
+#define MR_TEX_SHADOW_MAP                  2
+#define MR_TEX_SHADOW_MAP_MIN              3
+#define MR_TEX_SHADOW_MAP_MAX              4
+/* shadow_vis's methods: mr_shadow_method's values (checked in pass_shadow.c) */
+#define MR_SHADOW_METHOD_ID_HARD           1
+#define MR_SHADOW_METHOD_ID_PCF            2
+#define MR_SHADOW_METHOD_ID_PCSS           3
+#define MR_SHADOW_METHOD_ID_BP             4
+#define MR_SHADOW_METHOD_ID_GROUNDTRUTH    5
+/* overlay: the shadow catcher (pass_shadow.c's flags, passes.c's overlay) */
+#define MR_LOC_OVERLAY_CATCHER             9
+#define MR_LOC_OVERLAY_CATCHER_LIGHT       10
+#define MR_LOC_OVERLAY_CATCHER_LIGHT_LUM   11
+#define MR_LOC_OVERLAY_CATCHER_AMBIENT     12
+#define MR_TEX_OVERLAY_IDS                 2
+#define MR_TEX_OVERLAY_SHADOW              3
+#define MR_TEX_OVERLAY_CATCHER_FLAGS       4
+#define MR_TEX_OVERLAY_NORMAL              5
+#define MR_SHADOW_CATCHER_ROW              4096 /* flags texture: node i at (i % ROW, i / ROW) */
+/* shade: the casting light's visibility */
+#define MR_LOC_SHADE_SHADOW_LIGHT          22
+#define MR_TEX_SHADE_SHADOW                3
+
 /* ui */
 #define MR_LOC_UI_MODE                     1
 #define MR_TEX_UI_TEX                      0

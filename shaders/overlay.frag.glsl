@@ -14,6 +14,18 @@ layout(location = MR_LOC_OVERLAY_ALPHA) uniform float u_alpha;
 
 layout(binding = MR_TEX_OVERLAY_VIRTUAL) uniform sampler2D u_virtual;
 layout(binding = MR_TEX_OVERLAY_VIDEO) uniform sampler2D u_video;
+// Shadow catcher: receivers of the scene config (the real floor) are not
+// drawn; the video shows through them, darkened where the plan shadows them
+// by the share of the casting light in their shading:
+//   video * (1 - s (1 - V)),  s = c_L max(n.l, 0) / (ambient + c_L max(n.l, 0)).
+layout(location = MR_LOC_OVERLAY_CATCHER) uniform int u_catcher;            // 0: no catchers this frame
+layout(location = MR_LOC_OVERLAY_CATCHER_LIGHT) uniform vec3 u_catch_light;  // view space, towards the light
+layout(location = MR_LOC_OVERLAY_CATCHER_LIGHT_LUM) uniform float u_catch_lum;
+layout(location = MR_LOC_OVERLAY_CATCHER_AMBIENT) uniform float u_catch_ambient;
+layout(binding = MR_TEX_OVERLAY_IDS) uniform usampler2D u_ids;             // node index + 1, layer
+layout(binding = MR_TEX_OVERLAY_SHADOW) uniform sampler2D u_shadow;        // visibility (1 = lit)
+layout(binding = MR_TEX_OVERLAY_CATCHER_FLAGS) uniform usampler2D u_flags; // 1: node is a catcher
+layout(binding = MR_TEX_OVERLAY_NORMAL) uniform sampler2D u_normal;
 
 layout(location = 0) out vec4 o_color; // sRGB8 target
 
@@ -31,5 +43,19 @@ void main() {
     if (all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))))
         video = texture(u_video, uv).rgb;
     vec3 virt = texelFetch(u_virtual, ivec2(gl_FragCoord.xy), 0).rgb;
+    if (u_catcher != 0) {
+        ivec2 q = ivec2(gl_FragCoord.xy);
+        uint id = texelFetch(u_ids, q, 0).r;
+        if (id > 0u) {
+            int node = int(id) - 1;
+            if (texelFetch(u_flags, ivec2(node % MR_SHADOW_CATCHER_ROW, node / MR_SHADOW_CATCHER_ROW), 0).r != 0u) {
+                float v = u_catcher > 1 ? texelFetch(u_shadow, q, 0).r : 1.0;
+                float d = u_catch_lum * max(dot(texelFetch(u_normal, q, 0).xyz, u_catch_light), 0.0);
+                float sh = d / max(u_catch_ambient + d, 1e-6);
+                o_color = vec4(video * (1.0 - sh * (1.0 - v)), 1.0);
+                return;
+            }
+        }
+    }
     o_color = vec4(mix(virt, video, u_alpha), 1.0);
 }

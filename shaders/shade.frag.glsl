@@ -14,10 +14,12 @@ layout(location = MR_LOC_SHADE_BACKGROUND) uniform vec3 u_background;           
 layout(location = MR_LOC_SHADE_HAVE_AO) uniform int u_use_ao;                    // AO texture bound at 2
 layout(location = MR_LOC_SHADE_SPECULAR) uniform float u_specular;                // 0 = Lambert only
 layout(location = MR_LOC_SHADE_SHININESS) uniform float u_shininess;
+layout(location = MR_LOC_SHADE_SHADOW_LIGHT) uniform int u_shadow_light;            // -1: no shadows
 
 layout(binding = MR_TEX_SHADE_ALBEDO) uniform sampler2D u_albedo;
 layout(binding = MR_TEX_SHADE_NORMAL) uniform sampler2D u_normal;
 layout(binding = MR_TEX_SHADE_AO) uniform sampler2D u_ao;      // ambient visibility, 1 = unoccluded
+layout(binding = MR_TEX_SHADE_SHADOW) uniform sampler2D u_shadow; // visibility of light u_shadow_light
 
 layout(location = 0) out vec4 o_color; // sRGB8 target
 
@@ -33,11 +35,16 @@ void main() {
     vec3 light = vec3(u_ambient * ao);
     vec3 spec = vec3(0.0);
     const vec3 to_viewer = vec3(0.0, 0.0, -1.0);
+    float sv = u_shadow_light >= 0 ? texelFetch(u_shadow, px, 0).r : 1.0;
     for (int i = 0; i < u_light_count; i++) {
         float ndl = dot(n, u_light_dir[i]);
-        light += u_light_color[i] * max(ndl, 0.0);
+        // Only the casting light's direct terms are shadowed; without
+        // shadows this branch is never taken, so the image stays bit for bit.
+        vec3 c = u_light_color[i];
+        if (i == u_shadow_light) c *= sv;
+        light += c * max(ndl, 0.0);
         if (u_specular > 0.0 && ndl > 0.0)
-            spec += u_light_color[i] * pow(max(dot(reflect(-u_light_dir[i], n), to_viewer), 0.0), u_shininess);
+            spec += c * pow(max(dot(reflect(-u_light_dir[i], n), to_viewer), 0.0), u_shininess);
     }
     o_color = vec4(albedo * light + u_specular * spec, 1.0);
 }

@@ -253,6 +253,17 @@ if timeout 60 "$mr" view --scene "$tmp/missing.glb" --replay "$d" --out "$tmp/se
   [ "$(jget "$tmp/s_noscene.json" show_video)" = false ] && ok || bad "controls dead without a scene"
 else bad "missing-scene run failed: $(tail -3 "$tmp/noscene.err")"; fi
 
+# 6b. Shadows (issue 12): --shadows runs the shadow passes in the window.
+if view shadows "0.2 key .
+0.6 key .
+1.4 state $tmp/s_shadows.json
+1.5 quit" --shadows pcss; then
+  jget "$tmp/s_shadows.json" passes | grep -q "shadow_map shadow shade overlay" && ok \
+    || bad "passes with --shadows pcss: $(jget "$tmp/s_shadows.json" passes)"
+else bad "view --shadows pcss failed: $(tail -3 "$tmp/shadows.err")"; fi
+"$mr" view --scene "$d/scene_planned.json" --replay "$d" --shadows soft 2>"$tmp/bad3.err"; rc=$?
+[ $rc -eq 2 ] && [ "$(wc -l <"$tmp/bad3.err")" -eq 1 ] && ok || bad "--shadows soft: rc $rc, $(cat "$tmp/bad3.err")"
+
 # 7. Bad arguments: one line on stderr, exit 2, before any window.
 "$mr" view --scene "$d/scene_planned.json" 2>"$tmp/bad.err"; rc=$?
 [ $rc -eq 2 ] && [ "$(wc -l <"$tmp/bad.err")" -eq 1 ] && ok || bad "missing input: rc $rc, $(cat "$tmp/bad.err")"

@@ -283,6 +283,11 @@ static void test_runner(const char *tmp) {
     memset(&err, 0, sizeof err);
     CHECK_MSG(!mr_bench_ghost(&g, &err) && err.code == MR_ERR_INVALID && strstr(err.msg, "no GPU"),
               "a rendering bench without a GPU must fail naming it: '%s'", err.msg);
+    mr_bench_shadows_params sh = {MR_BENCH_SHADOWS_DEFAULTS};
+    sh.out_dir = out;
+    memset(&err, 0, sizeof err);
+    CHECK_MSG(!mr_bench_shadows(&sh, &err) && err.code == MR_ERR_INVALID && strstr(err.msg, "no GPU"),
+              "bench shadows without a GPU must fail naming it: '%s'", err.msg);
 }
 
 int main(void) {

@@ -114,6 +114,11 @@ static int render_frames(mr_renderer *r, mr_scene *s, mr_image *video) {
         p.ao.want_mask = true;
         p.ghost.mode = MR_GHOST_ADAPTIVE;
         p.ghost.stats = true;
+        /* shadows: every method now and then (the ground truth with few samples) */
+        p.shadow.method = (mr_shadow_method)(1 + i % (MR_SHADOW_METHOD_COUNT - 1));
+        p.shadow.gt_samples = 4;
+        p.shadow.map_size = 64 + 32 * (i % 3);
+        p.shadow.want_shadow = i % 2 == 0;
         p.video = i % 5 != 4 ? video : NULL;
         p.want_depth = p.want_normals = true;
         p.timing = i % 10 == 0;
@@ -125,7 +130,8 @@ static int render_frames(mr_renderer *r, mr_scene *s, mr_image *video) {
         char passes[512];
         mr_frame_result_passes(&res, passes, sizeof passes);
         bool all = strstr(passes, "ao_mask") && strstr(passes, "ghost_hidden") && strstr(passes, "ghost_emphasis") &&
-                   (!p.ao.half_res || strstr(passes, "ao_upsample")) && (!p.video || strstr(passes, "overlay"));
+                   (!p.ao.half_res || strstr(passes, "ao_upsample")) && (!p.video || strstr(passes, "overlay")) &&
+                   strstr(passes, "shadow");
         CHECK_MSG(all, "frame %d at %dx%d ran only \"%s\": the test does not reach every pass", i, w, h, passes);
         good += all;
         mr_frame_result_free(&res);

@@ -247,6 +247,8 @@ static void test_tables(void) {
     const mr_view_settings vs = MR_VIEW_SETTINGS_DEFAULTS;
     walk_table("mr_ao_opts", mr_ao_opts, sizeof ao, &ao);
     walk_table("mr_ghost_opts", mr_ghost_opts, sizeof gh, &gh);
+    const mr_shadow_params sh = MR_SHADOW_DEFAULTS;
+    walk_table("mr_shadow_opts", mr_shadow_opts, sizeof sh, &sh);
     walk_table("mr_view_settings_opts", mr_view_settings_opts, sizeof vs, &vs);
     const mr_detector_params dp = MR_DETECTOR_DEFAULTS;
     const mr_filter_params fp = MR_FILTER_DEFAULTS;
@@ -300,6 +302,14 @@ static void test_tables(void) {
         N(mr_ghost_params, "tc-min", tc_minimal, 0, 4),
         N(mr_ghost_params, "gamma", gamma, 0, 100),
         N(mr_ghost_params, "tc-sil", tc_silhouette, 0, 4),
+    };
+    const expect ex_sh[] = {
+        E(mr_shadow_params, "", method, "off hard pcf pcss bp groundtruth"),
+        N(mr_shadow_params, "map-size", map_size, 64, 8192),
+        N(mr_shadow_params, "taps", taps, 1, MR_SHADOW_MAX_TAPS),
+        N(mr_shadow_params, "pcf-radius", pcf_radius, 0.01f, 64),
+        N(mr_shadow_params, "samples", gt_samples, 1, 1024),
+        N(mr_shadow_params, "light-scale", light_scale, 1e-6f, 1e6f),
     };
     const expect ex_vs[] = {
         N(mr_view_settings, "alpha", alpha, 0, 1),
@@ -374,6 +384,9 @@ static void test_tables(void) {
                   mr_filter_opts[i].key, mr_filter_opts[i].def, want_fi[i]);
     check_rows("mr_ao_opts", mr_ao_opts, ex_ao, (int)(sizeof ex_ao / sizeof ex_ao[0]));
     check_rows("mr_ghost_opts", mr_ghost_opts, ex_gh, (int)(sizeof ex_gh / sizeof ex_gh[0]));
+    check_rows("mr_shadow_opts", mr_shadow_opts, ex_sh, (int)(sizeof ex_sh / sizeof ex_sh[0]));
+    CHECK_MSG(mr_opt_enum_count(mr_opt_find(mr_shadow_opts, "")) == MR_SHADOW_METHOD_COUNT,
+              "the shadow method row does not name every method");
     check_rows("mr_view_settings_opts", mr_view_settings_opts, ex_vs, (int)(sizeof ex_vs / sizeof ex_vs[0]));
     /* The enums' names in their value order, for every value. */
     const mr_opt *m = mr_opt_find(mr_ao_opts, "");

@@ -27,6 +27,26 @@ typedef struct mr_bench_gpu {
     mr_renderer *renderer;
 } mr_bench_gpu;
 
+/* -------------------------------------------------------------- shadows */
+
+/* Soft shadows, error against run time, on the shadow suite (issue 12):
+ * every method x setting x case x view, GPU ms against RMSE, sqrt(D)/|S|
+ * and SSIM over the shadow region against Embree (bench_shadows.csv,
+ * bench_shadows.svg, bench_shadows_<case>.png montages: reference, hard,
+ * pcf, pcss, bp, GPU ground truth; bench_shadows.md). */
+typedef struct mr_bench_shadows_params {
+    mr_bench_gpu gfx;
+    const char *out_dir;
+    int width, height;   /* default 320 x 240 */
+    int frames;          /* timed frames per row (median); default 3 */
+    int rays;            /* Embree reference rays per pixel; default 256 */
+    int first, count;    /* suite cases first .. first + count - 1; 0, 0 = all 13 */
+    int views;           /* 1 or 2 (default) views per case */
+    FILE *out;           /* progress and the table, or NULL */
+} mr_bench_shadows_params;
+#define MR_BENCH_SHADOWS_DEFAULTS .out_dir = "bench-out", .width = 320, .height = 240, .frames = 3, .rays = 256
+bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err);
+
 /* ------------------------------------------------------------------- ao */
 
 /* Ambient occlusion, error against run time: every method over a grid of

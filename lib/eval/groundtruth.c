@@ -237,3 +237,170 @@ bool mr_eval_ao_groundtruth(const mr_eval_gt *g, const mr_view *view, const mr_i
     pthread_mutex_destroy(&j.lock);
     return true;
 }
+
+/* ------------------------------------------------ area-light shadows
+ * Visibility of a light with size (issue 12): shadow rays from each visible
+ * surface point to stratified points on the light (a jittered g x g grid,
+ * n = g^2: the rectangle's area, the sphere's disk facing the point, the
+ * sun's disk of directions), unweighted: the fraction of the light's area
+ * seen, as the shadow-map methods estimate it. */
+
+typedef struct sgt_job {
+    const mr_eval_gt *g;
+    const mr_image *depth, *normal;
+    mr_image *out;
+    mr_camera cam;
+    mr_dmat4 rel_from_camera;
+    mr_light light;
+    double pos[3];          /* light centre in the Embree frame */
+    mr_dvec3 u, v, dir;     /* the light's axes (rect, sun) and its direction */
+    double hx, hy;          /* rect half sizes / sphere radius / sun tan(angle/2) */
+    int grid;
+    uint64_t seed;
+    int next_row;
+    pthread_mutex_t lock;
+} sgt_job;
+
+static bool occluded(const mr_eval_gt *g, const double o[3], mr_dvec3 d, double tfar) {
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRay ray;
+    ray.org_x = (float)o[0];
+    ray.org_y = (float)o[1];
+    ray.org_z = (float)o[2];
+    ray.dir_x = (float)d.x;
+    ray.dir_y = (float)d.y;
+    ray.dir_z = (float)d.z;
+    ray.tnear = 0.0f;
+    ray.tfar = (float)tfar;
+    ray.time = 0.0f;
+    ray.mask = 0xFFFFFFFFu;
+    ray.id = 0;
+    ray.flags = 0;
+    rtcOccluded1(g->scene, &ctx, &ray);
+    return ray.tfar < 0.0f;
+}
+
+static double light_visibility(const sgt_job *j, const double q[3], mr_dvec3 n, mr_rng *rng) {
+    int g = j->grid, seen = 0, total = g * g;
+    mr_dvec3 p = mr_v3(q[0], q[1], q[2]);
+    mr_dvec3 c = mr_v3(j->pos[0], j->pos[1], j->pos[2]);
+    /* The sphere's disk faces the point. */
+    mr_dvec3 su = j->u, sv = j->v;
+    if (j->light.kind == MR_LIGHT_SPHERE) {
+        mr_dvec3 a = mr_v3_normalize(mr_v3_sub(c, p));
+        mr_dvec3 t = fabs(a.x) < 0.9 ? mr_v3(1, 0, 0) : mr_v3(0, 0, 1);
+        su = mr_v3_normalize(mr_v3_sub(t, mr_v3_scale(a, mr_v3_dot(t, a))));
+        sv = mr_v3_cross(a, su);
+    }
+    for (int i = 0; i < total; i++) {
+        double u1 = ((i % g) + mr_rng_uniform(rng)) / g, u2 = ((i / g) + mr_rng_uniform(rng)) / g;
+        mr_dvec3 d;
+        double tfar;
+        if (j->light.kind == MR_LIGHT_RECT) {
+            mr_dvec3 s = mr_v3_add(c, mr_v3_add(mr_v3_scale(su, (2 * u1 - 1) * j->hx), mr_v3_scale(sv, (2 * u2 - 1) * j->hy)));
+            d = mr_v3_sub(s, p);
+            tfar = mr_v3_len(d);
+            d = mr_v3_scale(d, 1 / tfar);
+        } else {
+            double r = sqrt(u1) * j->hx, phi = 2 * 3.14159265358979323846 * u2;
+            mr_dvec3 off = mr_v3_add(mr_v3_scale(su, r * cos(phi)), mr_v3_scale(sv, r * sin(phi)));
+            if (j->light.kind == MR_LIGHT_SUN) {
+                d = mr_v3_normalize(mr_v3_add(j->dir, off));
+                tfar = INFINITY;
+            } else {
+                d = mr_v3_sub(mr_v3_add(c, off), p);
+                tfar = mr_v3_len(d);
+                d = mr_v3_scale(d, 1 / tfar);
+            }
+        }
+        /* Light below the surface's tangent plane is blocked by the surface. */
+        if (mr_v3_dot(d, n) <= 0) continue;
+        if (!occluded(j->g, q, d, tfar * (1 - 1e-6))) seen++;
+    }
+    return (double)seen / total;
+}
+
+static void *sgt_worker(void *arg) {
+    sgt_job *j = arg;
+    int w = j->depth->width, h = j->depth->height;
+    const float *dep = j->depth->data, *nor = j->normal->data;
+    float *out = j->out->data;
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        int y = j->next_row++;
+        pthread_mutex_unlock(&j->lock);
+        if (y >= h) break;
+        for (int x = 0; x < w; x++) {
+            size_t i = (size_t)y * w + x;
+            float z = dep[i];
+            out[i] = 1.0f;
+            if (!(z > 0) || !isfinite(z)) continue;
+            mr_dvec3 nc = mr_v3_normalize(mr_v3(nor[3 * i], nor[3 * i + 1], nor[3 * i + 2]));
+            mr_dvec3 pc = mr_v3((x - j->cam.cx) / j->cam.fx * z, (y - j->cam.cy) / j->cam.fy * z, z);
+            if (mr_v3_len(nc) == 0) nc = mr_v3_normalize(mr_v3_scale(pc, -1));
+            pc = mr_v3_add(pc, mr_v3_scale(nc, 2e-4 * z));
+            mr_dvec3 pw = mr_m4_point(&j->rel_from_camera, pc), nw = mr_m4_dir(&j->rel_from_camera, nc);
+            double q[3] = {pw.x, pw.y, pw.z};
+            mr_rng rng;
+            mr_rng_seed(&rng, j->seed * 0x9E3779B97F4A7C15ull + i);
+            out[i] = (float)light_visibility(j, q, nw, &rng);
+        }
+    }
+    return NULL;
+}
+
+bool mr_eval_shadow_groundtruth(const mr_eval_gt *g, const mr_view *view, const mr_image *depth, const mr_image *normal,
+                                const mr_light *light, const mr_shadow_gt_params *params, mr_image *out, mr_error *err) {
+    mr_shadow_gt_params p = MR_SHADOW_GT_DEFAULTS;
+    if (params) p = *params;
+    if (!depth || !normal || !depth->data || !normal->data || depth->type != MR_PIX_F32 || normal->type != MR_PIX_F32 ||
+        depth->channels != 1 || normal->channels != 3 || depth->width != normal->width || depth->height != normal->height)
+        return mr_fail(err, MR_ERR_INVALID, "ground truth needs an F32 depth image and an F32x3 normal image of one size");
+    double scale = p.light_scale > 0 ? p.light_scale : 1.0;
+    if (p.rays <= 0) p.rays = 256;
+    if (p.seed == 0) p.seed = 1;
+    sgt_job j;
+    memset(&j, 0, sizeof j);
+    j.light = *light;
+    j.dir = mr_v3_normalize(mr_v3(light->direction[0], light->direction[1], light->direction[2]));
+    if (mr_v3_len(j.dir) == 0) return mr_fail(err, MR_ERR_INVALID, "the light's direction is zero");
+    mr_dvec3 t = light->kind == MR_LIGHT_RECT ? mr_v3(light->axis_u[0], light->axis_u[1], light->axis_u[2])
+                                              : (fabs(j.dir.x) < 0.9 ? mr_v3(1, 0, 0) : mr_v3(0, 0, 1));
+    j.u = mr_v3_normalize(mr_v3_sub(t, mr_v3_scale(j.dir, mr_v3_dot(t, j.dir))));
+    j.v = mr_v3_cross(j.dir, j.u);
+    if (light->kind == MR_LIGHT_RECT) {
+        j.hx = 0.5 * light->size[0] * scale;
+        j.hy = 0.5 * light->size[1] * scale;
+    } else if (light->kind == MR_LIGHT_SPHERE) {
+        j.hx = light->size[0] * scale;
+    } else {
+        j.hx = tan(0.5 * light->angle * scale * 3.14159265358979323846 / 180.0);
+    }
+    if (!(j.hx >= 0) || !isfinite(j.hx) || !(j.hy >= 0) || !isfinite(j.hy))
+        return mr_fail(err, MR_ERR_INVALID, "the light's size is out of range");
+    for (int k = 0; k < 3; k++) j.pos[k] = light->position[k] - g->origin[k];
+    if (!mr_image_alloc(out, depth->width, depth->height, 1, MR_PIX_F32, err)) return false;
+    j.g = g;
+    j.depth = depth;
+    j.normal = normal;
+    j.out = out;
+    j.cam = mr_camera_resized(&view->camera, depth->width, depth->height);
+    j.grid = (int)floor(sqrt((double)p.rays) + 0.5);
+    if (j.grid < 1) j.grid = 1;
+    j.seed = p.seed;
+    mr_dmat4 shift = mr_m4_translate(-g->origin[0], -g->origin[1], -g->origin[2]);
+    j.rel_from_camera = mr_m4_mul(&shift, &view->world_from_camera);
+    pthread_mutex_init(&j.lock, NULL);
+    int nt = p.threads > 0 ? p.threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    if (nt < 1) nt = 1;
+    if (nt > 64) nt = 64;
+    pthread_t th[64];
+    int started = 0;
+    for (int i = 1; i < nt; i++)
+        if (pthread_create(&th[started], NULL, sgt_worker, &j) == 0) started++;
+    sgt_worker(&j);
+    for (int i = 0; i < started; i++) pthread_join(th[i], NULL);
+    pthread_mutex_destroy(&j.lock);
+    return true;
+}

@@ -63,6 +63,21 @@ double mr_eval_ao_point(const mr_eval_gt *gt, mr_dvec3 p, mr_dvec3 n, double rad
  * a = d / R, and V = 1 for d >= R. */
 double mr_eval_ao_wall_analytic(double d, double radius);
 
+/* Area-light shadows (issue 12): the fraction of the light's area (sun:
+ * its disk of directions) seen from each pixel's surface point, by shadow
+ * rays to a jittered g x g grid of points on the light (g = round(sqrt(rays))),
+ * the same light the renderer's shadows use (mr_shadow_light). 1 where depth
+ * is 0. out is allocated (F32x1). */
+typedef struct mr_shadow_gt_params {
+    int rays;            /* light samples per pixel; 0 = 256 */
+    float light_scale;   /* multiplies the light's size (as mr_shadow_params); 0 = 1 */
+    uint64_t seed;       /* 0 = 1 */
+    int threads;         /* 0 = one per online CPU */
+} mr_shadow_gt_params;
+#define MR_SHADOW_GT_DEFAULTS {.rays = 256, .light_scale = 1.0f, .seed = 1, .threads = 0}
+bool mr_eval_shadow_groundtruth(const mr_eval_gt *gt, const mr_view *view, const mr_image *depth, const mr_image *normal,
+                                const mr_light *light, const mr_shadow_gt_params *params, mr_image *out, mr_error *err);
+
 /* ------------------------------------------------------------ metrics */
 
 typedef struct mr_image_metrics {

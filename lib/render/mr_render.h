@@ -302,6 +302,50 @@ typedef struct mr_ghost_stats {
     double mean_contrast_missing; /* mean C over the region (adaptive mode only, else 0) */
 } mr_ghost_stats;
 
+/* ------------------------------------------------------------ shadows
+ * Soft shadows of the scene's casting light (the first light with `casts`;
+ * with no lights, the renderer's default sun of MR_LIGHT_DEFAULT_SUN_ANGLE)
+ * from a shadow map (pass_shadow.c, shaders/shadow_*.glsl), after Hecher's
+ * comparison of shadow-map soft-shadow methods. The result is a visibility
+ * buffer in [0,1] (1 = lit) that scales that light's direct term. */
+typedef enum mr_shadow_method {
+    MR_SHADOW_OFF = 0,     /* no shadow pass runs (default) */
+    MR_SHADOW_HARD,        /* one depth comparison at the light's centre */
+    MR_SHADOW_PCF,         /* fixed kernel of Poisson taps, rotated per pixel */
+    MR_SHADOW_PCSS,        /* Fernando 2005: blocker search, penumbra estimate, PCF */
+    MR_SHADOW_BP,          /* backprojection (Guennebaud et al. 2006) */
+    MR_SHADOW_GROUNDTRUTH, /* the average of `gt_samples` hard shadow maps from stratified
+                              points on the light (the frustum translated, not rotated) */
+    MR_SHADOW_METHOD_COUNT
+} mr_shadow_method;
+
+typedef struct mr_shadow_params {
+    mr_shadow_method method;   /* default off */
+    int map_size;              /* shadow-map side in texels, 64..8192; 0 = 1024 */
+    int taps;                  /* PCF / PCSS filter taps (and blocker-search taps), 1..64; 0 = 32 */
+    float pcf_radius;          /* PCF kernel radius in shadow-map texels; 0 = 3 */
+    int gt_samples;            /* groundtruth: light samples, 1..1024; 0 = 256 */
+    float light_scale;         /* multiplies the light's size (sun angle, rect, sphere); 0 = 1 */
+    bool want_shadow;          /* fill mr_frame_result.shadow */
+    bool no_reuse;             /* redraw the maps even when camera and light are unchanged */
+} mr_shadow_params;
+#define MR_SHADOW_DEFAULT_MAP_SIZE 1024
+#define MR_SHADOW_DEFAULT_TAPS 32
+#define MR_SHADOW_DEFAULT_PCF_RADIUS 3.0f
+#define MR_SHADOW_DEFAULT_GT_SAMPLES 256
+#define MR_SHADOW_MAX_TAPS 64
+#define MR_SHADOW_DEFAULTS {.method = MR_SHADOW_OFF, .map_size = MR_SHADOW_DEFAULT_MAP_SIZE, \
+                            .taps = MR_SHADOW_DEFAULT_TAPS, .pcf_radius = MR_SHADOW_DEFAULT_PCF_RADIUS, \
+                            .gt_samples = MR_SHADOW_DEFAULT_GT_SAMPLES, .light_scale = 1.0f}
+/* --shadows, --shadows-KEY (lib/render/options.c). */
+extern const mr_opt mr_shadow_opts[];
+/* "off", "hard", "pcf", "pcss", "bp", "groundtruth", NULL */
+extern const char *const mr_shadow_method_names[MR_SHADOW_METHOD_COUNT + 1];
+bool mr_shadow_method_parse(const char *name, mr_shadow_method *out);
+/* The light a frame's shadows come from: the scene's first casting light, or
+ * the default sun when the scene has no lights; false when none casts. */
+bool mr_shadow_light(const mr_scene *s, mr_light *out);
+
 typedef struct mr_frame_params {
     int width, height;         /* output size in pixels; 0 = the camera's */
     const mr_image *video;     /* camera frame (8-bit, 1/3/4 channels, raw
@@ -320,13 +364,14 @@ typedef struct mr_frame_params {
     mr_ghost_params ghost;     /* ghosted views of the hidden layer; default off */
     float specular;            /* Phong specular weight (white highlights); default 0 = Lambert only */
     float shininess;           /* Phong exponent, >= 1; 0 = 32 */
+    mr_shadow_params shadow;   /* soft shadows; default off */
 } mr_frame_params;
 #define MR_FRAME_DEFAULT_ALPHA 0.5f
 #define MR_FRAME_DEFAULT_BACKGROUND {0.62f, 0.66f, 0.70f}
 #define MR_FRAME_DEFAULT_SHININESS 32.0f /* used where shininess < 1 */
 /* Designated initialisers in declaration order (C; g++ accepts them too). */
 #define MR_FRAME_DEFAULTS {.alpha = MR_FRAME_DEFAULT_ALPHA, .background = MR_FRAME_DEFAULT_BACKGROUND, \
-                           .ao = MR_AO_DEFAULTS, .ghost = MR_GHOST_DEFAULTS}
+                           .ao = MR_AO_DEFAULTS, .ghost = MR_GHOST_DEFAULTS, .shadow = MR_SHADOW_DEFAULTS}
 
 #define MR_MAX_PASSES 32
 
@@ -352,6 +397,9 @@ typedef struct mr_frame_result {
                                   mask (-1 when masking is off) */
     bool ao_reused;            /* AO of the previous frame was reused (frozen camera) */
     mr_ghost_stats ghost;      /* when params.ghost.stats and ghosting ran */
+    mr_image shadow;           /* F32x1 visibility of the casting light in [0,1] (1 = lit,
+                                  1 where nothing) when shadow.want_shadow and shadows ran */
+    bool shadow_reused;        /* the shadow maps of the previous frame were reused */
 } mr_frame_result;
 
 /* Renders one frame of the current scene seen through `view`. */

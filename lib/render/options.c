@@ -91,3 +91,28 @@ bool mr_ao_kernel_parse(const char *name, mr_ao_kernel *out) {
     if (v >= 0) *out = (mr_ao_kernel)v;
     return v >= 0;
 }
+
+/* Shadows (pass_shadow.c): --shadows METHOD and --shadows-KEY. */
+const char *const mr_shadow_method_names[MR_SHADOW_METHOD_COUNT + 1] = {"off", "hard", "pcf", "pcss",
+                                                                        "bp", "groundtruth", NULL};
+#define SH(f) offsetof(mr_shadow_params, f)
+const mr_opt mr_shadow_opts[] = {
+    {"", MR_OPT_ENUM, SH(method), 0, 0, MR_SHADOW_OFF, mr_shadow_method_names,
+     "soft shadows of the casting light", 0},
+    {"map-size", MR_OPT_INT, SH(map_size), 64, 8192, MR_SHADOW_DEFAULT_MAP_SIZE, NULL, "shadow-map side in texels", 0},
+    {"taps", MR_OPT_INT, SH(taps), 1, MR_SHADOW_MAX_TAPS, MR_SHADOW_DEFAULT_TAPS, NULL,
+     "PCF / PCSS taps (and blocker-search taps)", 0},
+    {"pcf-radius", MR_OPT_FLOAT, SH(pcf_radius), 0.01f, 64, MR_SHADOW_DEFAULT_PCF_RADIUS, NULL,
+     "PCF kernel radius in shadow-map texels", 0},
+    {"samples", MR_OPT_INT, SH(gt_samples), 1, 1024, MR_SHADOW_DEFAULT_GT_SAMPLES, NULL,
+     "groundtruth: light samples (rounded to a square)", 0},
+    {"light-scale", MR_OPT_FLOAT, SH(light_scale), 1e-6f, 1e6f, 1, NULL, "multiplies the light's size", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef SH
+
+bool mr_shadow_method_parse(const char *name, mr_shadow_method *out) {
+    int v = mr_opt_enum_value(mr_opt_find(mr_shadow_opts, ""), name);
+    if (v >= 0) *out = (mr_shadow_method)v;
+    return v >= 0;
+}

@@ -151,6 +151,14 @@ static void mr_pass_shade(frame *f) {
     frame_put(f, RES_IMAGE, b->shaded.color[0]);
 }
 
+/* The lights of a scene without lights; the sun casts shadows (of the
+ * default angle) when a shadow method is on. */
+const mr_light mr_default_lights[2] = {
+    {.direction = {0.4, 1.0, 0.25}, .color = {0.55f, 0.55f, 0.52f}, .kind = MR_LIGHT_SUN, .casts = true,
+     .angle = MR_LIGHT_DEFAULT_SUN_ANGLE},                                        /* sun */
+    {.direction = {-0.5, 0.3, -0.7}, .color = {0.18f, 0.19f, 0.22f}, .kind = MR_LIGHT_SUN}, /* sky fill */
+};
+
 void mr_shade_draw(frame *f, GLuint albedo, GLuint normal, GLuint ao, const target *dst) {
     mr_renderer *r = f->r;
     glBindFramebuffer(GL_FRAMEBUFFER, dst->fbo);
@@ -160,11 +168,7 @@ void mr_shade_draw(frame *f, GLuint albedo, GLuint normal, GLuint ao, const targ
     const mr_scene *s = r->scene;
     float dirs[MR_SHADE_MAX_LIGHTS][3], cols[MR_SHADE_MAX_LIGHTS][3];
     int nl = 0;
-    static const mr_light default_lights[2] = {
-        {{0.4, 1.0, 0.25}, {0.55f, 0.55f, 0.52f}}, /* sun */
-        {{-0.5, 0.3, -0.7}, {0.18f, 0.19f, 0.22f}}, /* sky fill */
-    };
-    const mr_light *lights = s && s->light_count > 0 ? s->lights : default_lights;
+    const mr_light *lights = s && s->light_count > 0 ? s->lights : mr_default_lights;
     int count = s && s->light_count > 0 ? s->light_count : 2;
     for (int i = 0; i < count && i < MR_SHADE_MAX_LIGHTS; i++) {
         /* World direction to camera axes with the pose's rotation only. */
@@ -189,6 +193,12 @@ void mr_shade_draw(frame *f, GLuint albedo, GLuint normal, GLuint ao, const targ
     glUniform1f(MR_LOC_SHADE_SPECULAR, f->p->specular > 0 ? f->p->specular : 0.0f);
     glUniform1f(MR_LOC_SHADE_SHININESS, f->p->shininess >= 1 ? f->p->shininess : MR_FRAME_DEFAULT_SHININESS);
     glUniform1i(MR_LOC_SHADE_HAVE_AO, ao != 0);
+    /* The casting light's visibility shades the main image only (the
+     * hidden layer D, shaded here too, lies behind what the map saw). */
+    GLuint shadow = albedo == frame_get(f, RES_ALBEDO) ? frame_get(f, RES_SHADOW) : 0;
+    int si = shadow ? mr_shadow_light_index(s) : -1;
+    glUniform1i(MR_LOC_SHADE_SHADOW_LIGHT, si < nl ? si : -1);
+    glBindTextureUnit(MR_TEX_SHADE_SHADOW, shadow);
     glBindTextureUnit(MR_TEX_SHADE_ALBEDO, albedo);
     glBindTextureUnit(MR_TEX_SHADE_NORMAL, normal);
     glBindTextureUnit(MR_TEX_SHADE_AO, ao);
@@ -221,6 +231,9 @@ static void mr_pass_overlay(frame *f) {
     glUniform1fv(MR_LOC_OVERLAY_DIST, 5, dist);
     float a = f->p->alpha;
     glUniform1f(MR_LOC_OVERLAY_ALPHA, a < 0 ? 0.0f : a > 1 ? 1.0f : a);
+    /* Receivers of the scene config show the video, darkened by the plan's
+     * shadow (pass_shadow.c); off (and the image as before) without them. */
+    mr_shadow_catcher_setup(f, b->prog_overlay, NULL);
     glBindTextureUnit(MR_TEX_OVERLAY_VIRTUAL, frame_get(f, RES_IMAGE));
     glBindTextureUnit(MR_TEX_OVERLAY_VIDEO, b->video_tex);
     glBindVertexArray(r->empty_vao);
@@ -235,7 +248,9 @@ const pass_desc mr_pass_desc_gbuffer = {
     .writes = RES(RES_DEPTH) | RES(RES_ALBEDO) | RES(RES_NORMAL) | RES(RES_IDS) | RES(RES_POSITIONS)};
 const pass_desc mr_pass_desc_shade = {
     .name = "shade", .prepare = mr_pass_prepare_shade, .run = mr_pass_shade, .destroy = mr_base_free,
-    .reads = RES(RES_ALBEDO) | RES(RES_NORMAL), .uses = RES(RES_AO), .writes = RES(RES_SHADED) | RES(RES_IMAGE)};
+    .reads = RES(RES_ALBEDO) | RES(RES_NORMAL), .uses = RES(RES_AO) | RES(RES_SHADOW),
+    .writes = RES(RES_SHADED) | RES(RES_IMAGE)};
 const pass_desc mr_pass_desc_overlay = {
     .name = "overlay", .needed = mr_pass_need_overlay, .prepare = mr_pass_prepare_overlay, .run = mr_pass_overlay,
-    .destroy = mr_base_free, .reads = RES(RES_IMAGE), .writes = RES(RES_IMAGE)};
+    .destroy = mr_base_free, .reads = RES(RES_IMAGE), .uses = RES(RES_IDS) | RES(RES_NORMAL) | RES(RES_SHADOW),
+    .writes = RES(RES_IMAGE)};

@@ -36,6 +36,9 @@ typedef enum res_id {
     RES_IMAGE,          /* "image": the image so far; the frame's output is its last value */
     RES_CURVATURE,      /* "curvature": R32F per-pixel curvature of the occluder's mesh */
     RES_GHOST_MASK,     /* "ghost.mask": IM, region, silhouette (RGBA32F) */
+    /* shadows (pass_shadow.c) */
+    RES_SHADOW_MAP,     /* "shadow.map": R32F linear light depth of the casting light */
+    RES_SHADOW,         /* "shadow.visibility": R32F visibility of the casting light, 1 = lit */
     RES_COUNT
 } res_id;
 #define RES(x) (1u << (x))
@@ -67,6 +70,7 @@ struct mr_renderer {
     struct mr_ao_state *ao;        /* pass_ao.c: AO targets, programs, kernel, reuse cache */
     struct mr_ao_state *ao_hidden; /* the same for the ghosting's hidden layer D */
     struct mr_ghost_state *ghost;  /* pass_ghost.c: targets, programs, caches */
+    struct mr_shadow_state *shadow; /* pass_shadow.c: maps, visibility, the fitted light */
 };
 
 typedef struct frame {
@@ -153,6 +157,7 @@ extern const pass_desc mr_pass_desc_ao_mask, mr_pass_desc_ao, mr_pass_desc_ao_bl
 extern const pass_desc mr_pass_desc_ao_temporal; /* pass_ao.c, issue 18 */
 extern const pass_desc mr_pass_desc_ghost_hidden, mr_pass_desc_ghost_curvature, mr_pass_desc_ghost_importance,
     mr_pass_desc_ghost_g0, mr_pass_desc_ghost_analysis, mr_pass_desc_ghost_emphasis;            /* pass_ghost.c */
+extern const pass_desc mr_pass_desc_shadow_map, mr_pass_desc_shadow_map_reuse, mr_pass_desc_shadow; /* pass_shadow.c */
 
 /* Helpers the pass files share. */
 
@@ -166,6 +171,8 @@ GLuint mr_gbuffer_program(const frame *f);
 /* Shades albedo + normal (+ ao, 0 = none) into dst's first colour target
  * with the scene's lights: the main image and the hidden layer D. */
 void mr_shade_draw(frame *f, GLuint albedo, GLuint normal, GLuint ao, const target *dst);
+/* The lights of a scene without lights (the first, a sun, casts). */
+extern const mr_light mr_default_lights[2];
 
 /* pass_ghost.c: ghosted views. The G-buffer pass leaves the hidden layer
  * out when "hidden.*" is made this frame. */
@@ -181,5 +188,14 @@ GLuint mr_ao_hidden_run(frame *f, GLuint depth, GLuint normal);
 /* Fills out->ao (if asked) and the mask statistics. */
 bool mr_pass_ao_read_back(frame *f, mr_error *err);
 void mr_pass_ao_free(mr_renderer *r);
+
+/* pass_shadow.c: soft shadows. The index among the shaded lights of the
+ * casting one (-1: none); fills out->shadow (if asked). */
+int mr_shadow_light_index(const mr_scene *s);
+bool mr_pass_shadow_read_back(frame *f, mr_error *err);
+void mr_pass_shadow_free(mr_renderer *r);
+/* The overlay's shadow catcher: sets its uniforms and textures on the bound
+ * overlay program (catcher off when the scene marks no receivers). */
+bool mr_shadow_catcher_setup(frame *f, GLuint program, mr_error *err);
 
 #endif

@@ -57,6 +57,7 @@ const char *const mr_resource_names[RES_COUNT] = {
     [RES_HIDDEN_DEPTH] = "hidden.depth", [RES_HIDDEN_NORMAL] = "hidden.normal", [RES_HIDDEN_IDS] = "hidden.ids",
     [RES_HIDDEN_SHADED] = "hidden.shaded", [RES_SHADED] = "shaded", [RES_IMAGE] = "image",
     [RES_CURVATURE] = "curvature", [RES_GHOST_MASK] = "ghost.mask",
+    [RES_SHADOW_MAP] = "shadow.map", [RES_SHADOW] = "shadow.visibility",
 };
 
 /* The registry: one row per pass, in the order they run; each row's
@@ -71,6 +72,10 @@ static const pass_desc *const k_passes[] = {
     &mr_pass_desc_ao_reuse,
     &mr_pass_desc_ao_external,
     &mr_pass_desc_ghost_hidden,
+    /* Shadows before the shading, which scales the casting light by them. */
+    &mr_pass_desc_shadow_map,
+    &mr_pass_desc_shadow_map_reuse,
+    &mr_pass_desc_shadow,
     &mr_pass_desc_shade,
     &mr_pass_desc_overlay,
     /* Ghosting after the overlay: with video, the occluder O is what the
@@ -194,7 +199,7 @@ static bool read_back(frame *f, mr_error *err) {
         if (!mr_image_alloc(&o->normal, r->w, r->h, 3, MR_PIX_F32, err)) return false;
         glGetTextureImage(frame_get(f, RES_NORMAL), 0, GL_RGB, GL_FLOAT, (GLsizei)mr_image_bytes(&o->normal), o->normal.data);
     }
-    return mr_pass_ao_read_back(f, err);
+    return mr_pass_ao_read_back(f, err) && mr_pass_shadow_read_back(f, err);
 }
 
 
@@ -302,6 +307,7 @@ void mr_frame_result_free(mr_frame_result *res) {
     mr_image_free(&res->normal);
     mr_image_free(&res->ao);
     mr_image_free(&res->ao_mask);
+    mr_image_free(&res->shadow);
 }
 
 

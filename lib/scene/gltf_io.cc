@@ -706,6 +706,57 @@ void json_vec3(const cJSON *obj, const char *key, double out[3], const char *pat
 mr_scene *load_path(const char *path, const mr_scene_params *params, const std::vector<std::string> &extra_globs,
                     bool allow_config);
 
+// The size of a light for soft shadows (mr_light's comment): scene units or
+// degrees, never a fixed scale; anything negative, non-finite or degenerate
+// is an error, not a silent point light.
+void light_size(const cJSON *l, mr_light &L, const char *path) {
+    const cJSON *jk = cJSON_GetObjectItemCaseSensitive(l, "kind");
+    L.kind = MR_LIGHT_SUN;
+    if (jk) {
+        const char *k = cJSON_IsString(jk) ? jk->valuestring : "";
+        if (std::strcmp(k, "sun") == 0) L.kind = MR_LIGHT_SUN;
+        else if (std::strcmp(k, "rect") == 0) L.kind = MR_LIGHT_RECT;
+        else if (std::strcmp(k, "sphere") == 0) L.kind = MR_LIGHT_SPHERE;
+        else fail(MR_ERR_INVALID, "%s: a light 'kind' must be \"sun\", \"rect\" or \"sphere\"", path);
+    }
+    const cJSON *js = cJSON_GetObjectItemCaseSensitive(l, "shadows");
+    if (js && !cJSON_IsBool(js)) fail(MR_ERR_INVALID, "%s: a light's 'shadows' must be true or false", path);
+    L.casts = !js || cJSON_IsTrue(js);
+    if (L.kind == MR_LIGHT_SUN) {
+        L.angle = MR_LIGHT_DEFAULT_SUN_ANGLE;
+        const cJSON *ja = cJSON_GetObjectItemCaseSensitive(l, "angle");
+        if (ja) L.angle = json_finite(ja, "a light's 'angle'", path);
+        if (!(L.angle >= 0 && L.angle < 90)) fail(MR_ERR_INVALID, "%s: a sun's 'angle' must be in [0, 90) degrees", path);
+        return;
+    }
+    json_vec3(l, "position", L.position, path);
+    const cJSON *jz = cJSON_GetObjectItemCaseSensitive(l, "size");
+    if (L.kind == MR_LIGHT_SPHERE) {
+        L.size[0] = json_finite(jz, "a sphere light's 'size' (its radius)", path);
+        if (!(L.size[0] > 0)) fail(MR_ERR_INVALID, "%s: a light size must be positive", path);
+        return;
+    }
+    if (!cJSON_IsArray(jz) || cJSON_GetArraySize(jz) != 2)
+        fail(MR_ERR_INVALID, "%s: a rect light's 'size' must be [width, height]", path);
+    for (int k = 0; k < 2; k++) {
+        L.size[k] = json_finite(cJSON_GetArrayItem(jz, k), "a light size", path);
+        if (!(L.size[k] > 0)) fail(MR_ERR_INVALID, "%s: a light size must be positive", path);
+    }
+    // The width's axis: given, or any direction orthogonal to the light's.
+    double u[3] = {0, 0, 0};
+    const double *d = L.direction;
+    if (cJSON_GetObjectItemCaseSensitive(l, "axis")) {
+        json_vec3(l, "axis", u, path);
+    } else {
+        u[std::fabs(d[0]) < 0.9 ? 0 : 2] = 1;
+    }
+    double dot = u[0] * d[0] + u[1] * d[1] + u[2] * d[2];
+    for (int k = 0; k < 3; k++) u[k] -= dot * d[k];
+    double n = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    if (!(n > 1e-9)) fail(MR_ERR_INVALID, "%s: a rect light's 'axis' is parallel to its direction", path);
+    for (int k = 0; k < 3; k++) L.axis_u[k] = u[k] / n;
+}
+
 struct JsonGuard {
     cJSON *j;
     ~JsonGuard() { cJSON_Delete(j); }
@@ -767,7 +818,25 @@ mr_scene *load_config(const cJSON *cfg, const char *path, const mr_scene_params 
                 L.direction[k] = d[k] / len;
                 L.color[k] = (float)c[k];
             }
+            light_size(l, L, path);
         }
+    }
+    std::vector<std::string> receivers;
+    const cJSON *jr = cJSON_GetObjectItemCaseSensitive(cfg, "receivers");
+    if (jr) {
+        if (!cJSON_IsArray(jr)) fail(MR_ERR_INVALID, "%s: 'receivers' must be an array of name globs", path);
+        const cJSON *r;
+        cJSON_ArrayForEach(r, jr) {
+            if (!cJSON_IsString(r)) fail(MR_ERR_INVALID, "%s: 'receivers' must be an array of name globs", path);
+            receivers.push_back(r->valuestring);
+        }
+    }
+    std::string shadow_method;
+    const cJSON *jsm = cJSON_GetObjectItemCaseSensitive(cfg, "shadows");
+    if (jsm) {
+        if (!cJSON_IsString(jsm) || std::strlen(jsm->valuestring) >= sizeof(((mr_scene *)nullptr)->shadow_method))
+            fail(MR_ERR_INVALID, "%s: 'shadows' must be a method name", path);
+        shadow_method = jsm->valuestring;
     }
     double ambient = -1;
     const cJSON *ja = cJSON_GetObjectItemCaseSensitive(cfg, "ambient");
@@ -788,6 +857,21 @@ mr_scene *load_config(const cJSON *cfg, const char *path, const mr_scene_params 
     std::memcpy(s->lights, lights, sizeof lights);
     s->light_count = nlights;
     if (ambient >= 0) s->ambient = (float)ambient;
+    std::snprintf(s->shadow_method, sizeof s->shadow_method, "%s", shadow_method.c_str());
+    for (const std::string &gl : receivers) {
+        bool any = false;
+        for (int32_t i = 0; i < s->node_count; i++) {
+            mr_node &n = s->nodes[i];
+            bool hit = mr_glob_match(gl.c_str(), n.name) ||
+                       (n.parent >= 0 && n.parent < i && s->nodes[n.parent].shadow_catcher);
+            if (hit) n.shadow_catcher = true;
+            any = any || hit;
+        }
+        if (!any) {
+            mr_scene_destroy(&s);
+            fail(MR_ERR_INVALID, "%s: the receiver glob '%s' matches no node", path, gl.c_str());
+        }
+    }
     return s;
 }
 

@@ -54,14 +54,36 @@ typedef struct mr_node {
     int32_t mesh_first;   /* first of mesh_count consecutive meshes, or -1 */
     int32_t mesh_count;
     uint8_t layer;        /* mr_layer */
+    bool shadow_catcher;  /* a shadow receiver of the scene config: over video it is not
+                             drawn, it darkens the camera image by its shadow */
 } mr_node;
 
-/* A directional light: `direction` points from the scene towards the light,
- * in world space. */
+/* A light: `direction` points from the scene towards the light, in world
+ * space; the shading treats every light as directional along it. For
+ * shadows a light has a size, in scene units or as an angle, never a fixed
+ * scale: */
+typedef enum mr_light_kind {
+    MR_LIGHT_SUN = 0,     /* at infinity along direction, angular diameter `angle` */
+    MR_LIGHT_RECT,        /* a rectangle centred at position, facing -direction
+                             (it emits away from `direction`), size[0] along axis_u,
+                             size[1] along direction x axis_u */
+    MR_LIGHT_SPHERE,      /* a sphere of radius size[0] centred at position */
+} mr_light_kind;
+
 typedef struct mr_light {
     double direction[3];
     float color[3];       /* linear, multiplies the albedo */
+    /* Shadows (issue 12); all zero = a sun of angle 0 that casts nothing. */
+    uint8_t kind;         /* mr_light_kind */
+    bool casts;           /* casts shadows when a shadow method is on */
+    double angle;         /* sun: angular diameter in degrees, [0, 90) */
+    double position[3];   /* rect, sphere: centre (world, scene units) */
+    double size[2];       /* rect: width, height; sphere: radius in size[0] (scene units) */
+    double axis_u[3];     /* rect: unit direction of the width side, orthogonal to direction */
 } mr_light;
+/* The sun's angular diameter where a scene does not give one (degrees): a
+ * slightly overcast sun, so that contact hardening is visible. */
+#define MR_LIGHT_DEFAULT_SUN_ANGLE 2.0
 
 #define MR_SCENE_MAX_LIGHTS 8
 
@@ -75,6 +97,8 @@ typedef struct mr_scene {
     float ambient;           /* ambient term in [0,1], default 0.35 */
     double bounds_min[3], bounds_max[3]; /* world, over all drawn nodes */
     char source[512];        /* file it came from ("" if built in memory) */
+    char shadow_method[16];  /* the scene config's "shadows" (a method name the
+                                renderer parses), "" = not given: off */
 } mr_scene;
 
 /* ------------------------------------------------------------- building */
@@ -126,6 +150,12 @@ mr_scene *mr_scene_loader_finish(mr_scene_loader **loader, mr_error *err);
 /* Loads a scene from a .gltf/.glb (recognised by content, not extension)
  * or a scene config JSON: {"gltf": "rel/path.glb", "hidden": ["Pipe*"],
  * "lights": [{"direction": [x,y,z], "color": [r,g,b]}], "ambient": 0.35}.
+ * A light may have a size for shadows: "kind": "sun" (default; "angle":
+ * angular diameter in degrees, default MR_LIGHT_DEFAULT_SUN_ANGLE), "rect"
+ * ("position", "size": [w, h], "axis": the width's direction) or "sphere"
+ * ("position", "size": radius); "shadows": false keeps it from casting.
+ * "receivers": ["Floor*"] marks shadow catchers (each glob must match a
+ * node); "shadows": "pcss" turns a shadow method on by default.
  * A node is hidden if any glob matches its name (or an ancestor's) or its
  * glTF extras has "mrcheck_layer": "hidden" (inherited by children). */
 mr_scene *mr_scene_load(const char *path, const mr_scene_params *params, mr_error *err);
@@ -185,6 +215,24 @@ typedef struct mr_demo_hall {
 bool mr_mesh_outline_dirs(const mr_mesh *m, float *out, mr_error *err);
 
 bool mr_demo_build(const mr_demo_params *params, mr_demo_hall *out, mr_error *err);
+
+/* ------------------------------------------------- shadow suite (issue 12)
+ * Hecher's scene categories as generated scenes (shadow_suite.c): simple
+ * objects and furniture-like assemblies with constant or varying penumbra,
+ * without or with overlapping penumbrae; fences and plant-like leaves
+ * (always overlapping) with constant or varying penumbra; the demo hall.
+ * Each with its casting light and two views (320 x 240). */
+#define MR_SHADOW_SUITE_COUNT 13
+typedef struct mr_shadow_suite_case {
+    char name[48];        /* e.g. "simple_varying_overlap" */
+    bool varying;         /* the penumbra width varies (contact hardening) */
+    bool overlap;         /* penumbrae overlap */
+    mr_scene *scene;      /* owned */
+    mr_view views[2];
+} mr_shadow_suite_case;
+bool mr_shadow_suite_build(int index, mr_shadow_suite_case *out, mr_error *err);
+void mr_shadow_suite_free(mr_shadow_suite_case *c);
+const char *mr_shadow_suite_name(int index); /* NULL out of range */
 void mr_demo_free(mr_demo_hall *hall);
 
 /* The demo's camera side (demo_camera.c). */

@@ -1,0 +1,595 @@
+/* Soft shadows from a shadow map (issue 12; Hecher's comparison, ch. 3-5).
+ *
+ *   shadow_map   needed: a map method (hard, pcf, pcss, bp), a casting light,
+ *                and the maps of the last frame cannot stand in; draws the
+ *                scene from the light: linear light depth (R32F), writes
+ *                shadow.map
+ *   (unlisted)   the same camera, light, scene and map settings as the last
+ *                map: hands that map over (a frozen camera with a static
+ *                light draws no map)
+ *   shadow       needed: any method but off and a casting light; reads
+ *                depth (+ shadow.map), writes shadow.visibility; the ground
+ *                truth draws its own maps here, one per light sample, and
+ *                sums their hard visibilities
+ *
+ * The light frustum is fitted in double precision: the sun's orthographic
+ * rectangle to the part of the scene's bounds the camera can see (the
+ * casters towards the light all kept), a perspective light's field of view
+ * to the scene's bounds. Everything the GPU sees is relative to the light's
+ * eye, so a scene 1e7 units from the origin or at any scale shadows the
+ * same. */
+#include "render_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+_Static_assert(MR_SHADOW_KERNEL_SIZE == MR_SHADOW_MAX_TAPS, "shadow kernel size");
+_Static_assert(MR_SHADOW_METHOD_ID_HARD == MR_SHADOW_HARD && MR_SHADOW_METHOD_ID_PCF == MR_SHADOW_PCF &&
+                   MR_SHADOW_METHOD_ID_PCSS == MR_SHADOW_PCSS && MR_SHADOW_METHOD_ID_BP == MR_SHADOW_BP &&
+                   MR_SHADOW_METHOD_ID_GROUNDTRUTH == MR_SHADOW_GROUNDTRUTH,
+               "shadow method ids");
+
+/* The blocker search and the filters reach at most this far (texels): the
+ * cost per pixel stays bounded for huge lights; wider penumbrae saturate. */
+#define MAX_SEARCH_TEXELS 48.0
+
+/* The fitted light projection of one frame (all double, scene units). */
+typedef struct light_frame {
+    mr_light light;
+    bool ortho;
+    mr_dmat4 lcam_from_world, world_from_lcam; /* the light eye: OpenCV axes, z along the light */
+    mr_dmat4 cull_world_from_camera;           /* ortho: an eye behind the box that sees all of it */
+    double cull_back;                          /* ortho: its distance behind the light eye */
+    mr_camera cam;                             /* the map's intrinsics (perspective) / culling (ortho) */
+    double near_plane;
+    double x0, y0, wx, wy;                     /* ortho: the rectangle in light xy */
+    double k;                                  /* perspective: uv per unit of x/z */
+    double znear, zfar;                        /* nearest caster, farthest receiver (light z) */
+    double half;                               /* perspective: light half-width; sun: tan(angle/2) */
+    double half2[2];                           /* backprojection: half extents on the light */
+} light_frame;
+
+/* What a shadow map depends on: a frame with the same key reuses it. */
+typedef struct map_key {
+    const mr_scene *scene;
+    mr_dmat4 world_from_camera;
+    mr_camera cam;
+    mr_light light;
+    int map_size;
+    float light_scale;
+} map_key;
+
+struct mr_shadow_state {
+    GLuint prog_map, prog_vis;
+    int map_size;
+    target map;            /* R32F linear depth + depth attachment */
+    int w, h;
+    target vis;            /* R32F visibility at the output size */
+    light_frame lf;
+    bool key_valid;
+    map_key key;
+    float kernel[2 * MR_SHADOW_MAX_TAPS];
+    int kernel_taps;
+    GLuint catcher_flags;  /* R8UI, node i at (i % ROW, i / ROW): 1 = shadow catcher */
+    const mr_scene *catcher_scene;
+};
+
+
+/* The index among the shaded lights (passes.c's loop) of the casting light;
+ * -1: none casts. Without scene lights the shading's first default light is
+ * the sun, which casts. */
+int mr_shadow_light_index(const mr_scene *s) {
+    if (!s || s->light_count <= 0) return 0;
+    for (int i = 0; i < s->light_count && i < MR_SHADE_MAX_LIGHTS; i++)
+        if (s->lights[i].casts) return i;
+    return -1;
+}
+
+bool mr_shadow_light(const mr_scene *s, mr_light *out) {
+    int i = mr_shadow_light_index(s);
+    if (i < 0) return false;
+    *out = s && s->light_count > 0 ? s->lights[i] : mr_default_lights[0];
+    return true;
+}
+
+static int map_size(const mr_shadow_params *p) {
+    return p->map_size >= 64 && p->map_size <= 8192 ? p->map_size : MR_SHADOW_DEFAULT_MAP_SIZE;
+}
+static float light_scale(const mr_shadow_params *p) { return p->light_scale > 0 ? p->light_scale : 1.0f; }
+static bool map_method(mr_shadow_method m) { return m >= MR_SHADOW_HARD && m <= MR_SHADOW_BP; }
+
+static bool casts(const frame *f) {
+    mr_light l;
+    return f->r->scene && f->p->shadow.method != MR_SHADOW_OFF && mr_shadow_light(f->r->scene, &l);
+}
+
+static void make_key(const frame *f, map_key *k) {
+    memset(k, 0, sizeof *k);
+    k->scene = f->r->scene;
+    k->world_from_camera = f->view->world_from_camera;
+    k->cam = f->cam;
+    mr_shadow_light(f->r->scene, &k->light);
+    k->map_size = map_size(&f->p->shadow);
+    k->light_scale = light_scale(&f->p->shadow);
+}
+
+static bool reusable(const frame *f) {
+    const struct mr_shadow_state *s = f->r->shadow;
+    if (!s || !s->key_valid || f->p->shadow.no_reuse || !s->map.fbo) return false;
+    map_key k;
+    make_key(f, &k);
+    return memcmp(&k, &s->key, sizeof k) == 0;
+}
+
+/* ------------------------------------------------------ fitting the light */
+
+static mr_dvec3 any_orthogonal(mr_dvec3 d) {
+    mr_dvec3 a = fabs(d.x) < 0.9 ? mr_v3(1, 0, 0) : mr_v3(0, 0, 1);
+    return mr_v3_normalize(mr_v3_sub(a, mr_v3_scale(d, mr_v3_dot(a, d))));
+}
+
+/* world_from_lcam with axes x, y = z cross x, z at origin o. */
+static mr_dmat4 frame_from_axes(mr_dvec3 x, mr_dvec3 z, mr_dvec3 o) {
+    mr_dvec3 y = mr_v3_cross(z, x);
+    mr_dmat4 m = mr_m4_identity();
+    const mr_dvec3 c[4] = {x, y, z, o};
+    for (int j = 0; j < 4; j++) {
+        m.m[0 * 4 + j] = c[j].x;
+        m.m[1 * 4 + j] = c[j].y;
+        m.m[2 * 4 + j] = c[j].z;
+    }
+    return m;
+}
+
+static void scene_corners(const mr_scene *s, mr_dvec3 out[8]) {
+    for (int i = 0; i < 8; i++)
+        out[i] = mr_v3(i & 1 ? s->bounds_max[0] : s->bounds_min[0], i & 2 ? s->bounds_max[1] : s->bounds_min[1],
+                       i & 4 ? s->bounds_max[2] : s->bounds_min[2]);
+}
+
+static double scene_diag(const mr_scene *s) {
+    double d2 = 0;
+    for (int i = 0; i < 3; i++) d2 += (s->bounds_max[i] - s->bounds_min[i]) * (s->bounds_max[i] - s->bounds_min[i]);
+    double d = sqrt(d2);
+    return d > 0 && isfinite(d) ? d : 1.0;
+}
+
+static void fit_sun(const frame *f, const mr_light *L, double scale, int S, light_frame *lf) {
+    const mr_scene *s = f->r->scene;
+    mr_dvec3 dir = mr_v3_normalize(mr_v3(L->direction[0], L->direction[1], L->direction[2]));
+    mr_dvec3 z = mr_v3_scale(dir, -1), x = any_orthogonal(z);
+    mr_dvec3 c0 = mr_v3(0.5 * (s->bounds_min[0] + s->bounds_max[0]), 0.5 * (s->bounds_min[1] + s->bounds_max[1]),
+                        0.5 * (s->bounds_min[2] + s->bounds_max[2]));
+    mr_dmat4 w_from_l0 = frame_from_axes(x, z, c0), l0_from_w = mr_m4_invert_rigid(&w_from_l0);
+    mr_dvec3 corners[8];
+    scene_corners(s, corners);
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double eye_far = 0;
+    mr_dvec3 eye = mr_v3(f->view->world_from_camera.m[3], f->view->world_from_camera.m[7],
+                         f->view->world_from_camera.m[11]);
+    for (int i = 0; i < 8; i++) {
+        mr_dvec3 p = mr_m4_point(&l0_from_w, corners[i]);
+        const double *pp = &p.x;
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], pp[a]);
+            hi[a] = fmax(hi[a], pp[a]);
+        }
+        eye_far = fmax(eye_far, mr_v3_len(mr_v3_sub(corners[i], eye)));
+    }
+    /* The camera's frustum out to the farthest corner of the scene, in light
+     * xy: receivers outside it cannot be seen, so the map's texels go to
+     * the visible part (casters towards the light are kept through z). */
+    double flo[2] = {INFINITY, INFINITY}, fhi[2] = {-INFINITY, -INFINITY};
+    const mr_camera *c = &f->cam;
+    for (int i = 0; i < 8; i++) {
+        double u = i & 1 ? c->width - 0.5 : -0.5, v = i & 2 ? c->height - 0.5 : -0.5;
+        double d = i & 4 ? eye_far : f->near_plane;
+        mr_dvec3 pc = mr_v3((u - c->cx) / c->fx * d, (v - c->cy) / c->fy * d, d);
+        mr_dvec3 pw = mr_m4_point(&f->view->world_from_camera, pc);
+        mr_dvec3 pl = mr_m4_point(&l0_from_w, pw);
+        flo[0] = fmin(flo[0], pl.x); fhi[0] = fmax(fhi[0], pl.x);
+        flo[1] = fmin(flo[1], pl.y); fhi[1] = fmax(fhi[1], pl.y);
+    }
+    double xlo = fmax(lo[0], flo[0]), xhi = fmin(hi[0], fhi[0]);
+    double ylo = fmax(lo[1], flo[1]), yhi = fmin(hi[1], fhi[1]);
+    if (!(xhi > xlo)) xlo = lo[0], xhi = hi[0];
+    if (!(yhi > ylo)) ylo = lo[1], yhi = hi[1];
+    double diag = scene_diag(s);
+    double zspan = fmax(hi[2] - lo[2], 1e-9 * diag);
+    lf->half = tan(0.5 * L->angle * scale * 3.14159265358979323846 / 180.0);
+    /* Margins: the ground truth's sheared samples and the filters reach
+     * half * zspan sideways; 1% more against rounding at the border. */
+    double mx = lf->half * zspan + 0.01 * fmax(xhi - xlo, yhi - ylo) + 1e-9 * diag;
+    xlo -= mx, xhi += mx, ylo -= mx, yhi += mx;
+    double zmargin = 0.01 * zspan;
+    mr_dvec3 o = mr_v3_add(c0, mr_v3_add(mr_v3_scale(x, 0.5 * (xlo + xhi)),
+                                         mr_v3_add(mr_v3_scale(mr_v3_cross(z, x), 0.5 * (ylo + yhi)),
+                                                   mr_v3_scale(z, lo[2] - zmargin))));
+    lf->ortho = true;
+    lf->world_from_lcam = frame_from_axes(x, z, o);
+    lf->lcam_from_world = mr_m4_invert_rigid(&lf->world_from_lcam);
+    lf->wx = xhi - xlo;
+    lf->wy = yhi - ylo;
+    lf->x0 = -0.5 * lf->wx;
+    lf->y0 = -0.5 * lf->wy;
+    lf->znear = zmargin;
+    lf->zfar = zmargin + zspan + zmargin;
+    double eq = lf->half * 0.886226925452758; /* sqrt(pi)/2: the disk as a square of equal area */
+    lf->half2[0] = lf->half2[1] = eq;
+    /* Culling: an eye at distance D behind the light's plane whose pyramid
+     * holds the whole box (|x| <= D tan at depth >= D). */
+    double D = fmax(fmax(lf->wx, lf->wy), lf->zfar);
+    lf->cull_back = D;
+    lf->cull_world_from_camera = frame_from_axes(x, z, mr_v3_sub(o, mr_v3_scale(z, D)));
+    double tx = 0.5 * lf->wx / D * 1.05, ty = 0.5 * lf->wy / D * 1.05;
+    memset(&lf->cam, 0, sizeof lf->cam);
+    lf->cam.width = lf->cam.height = S;
+    lf->cam.fx = 0.5 * S / tx;
+    lf->cam.fy = 0.5 * S / ty;
+    lf->cam.cx = lf->cam.cy = 0.5 * S - 0.5;
+    lf->near_plane = 0.5 * D;
+}
+
+static void fit_perspective(const frame *f, const mr_light *L, double scale, int S, light_frame *lf) {
+    const mr_scene *s = f->r->scene;
+    mr_dvec3 pos = mr_v3(L->position[0], L->position[1], L->position[2]);
+    mr_dvec3 corners[8];
+    scene_corners(s, corners);
+    mr_dvec3 z, x;
+    if (L->kind == MR_LIGHT_RECT) {
+        z = mr_v3_scale(mr_v3_normalize(mr_v3(L->direction[0], L->direction[1], L->direction[2])), -1);
+        x = mr_v3_normalize(mr_v3(L->axis_u[0], L->axis_u[1], L->axis_u[2]));
+        x = mr_v3_normalize(mr_v3_sub(x, mr_v3_scale(z, mr_v3_dot(x, z))));
+        if (!(mr_v3_len(x) > 0.5)) x = any_orthogonal(z);
+    } else {
+        mr_dvec3 c = mr_v3(0.5 * (s->bounds_min[0] + s->bounds_max[0]), 0.5 * (s->bounds_min[1] + s->bounds_max[1]),
+                           0.5 * (s->bounds_min[2] + s->bounds_max[2]));
+        z = mr_v3_normalize(mr_v3_sub(c, pos));
+        if (!(mr_v3_len(z) > 0.5)) z = mr_v3(0, -1, 0);
+        x = any_orthogonal(z);
+    }
+    lf->ortho = false;
+    lf->world_from_lcam = frame_from_axes(x, z, pos);
+    lf->lcam_from_world = mr_m4_invert_rigid(&lf->world_from_lcam);
+    double hx, hy;
+    if (L->kind == MR_LIGHT_RECT) {
+        hx = 0.5 * L->size[0] * scale;
+        hy = 0.5 * L->size[1] * scale;
+        lf->half = sqrt(hx * hy);
+        lf->half2[0] = hx;
+        lf->half2[1] = hy;
+    } else {
+        hx = hy = L->size[0] * scale;
+        lf->half = hx;
+        lf->half2[0] = lf->half2[1] = hx * 0.886226925452758;
+    }
+    double diag = scene_diag(s);
+    double zn = INFINITY, zf = 0, tmax = 0;
+    for (int i = 0; i < 8; i++) {
+        mr_dvec3 p = mr_m4_point(&lf->lcam_from_world, corners[i]);
+        zf = fmax(zf, p.z);
+        zn = fmin(zn, p.z);
+        /* Seen from every corner of the light (the ground truth's samples
+         * translate the eye that far), the base eye's view is their mean. */
+        for (int e = 0; e < 4; e++) {
+            double ex = e & 1 ? hx : -hx, ey = e & 2 ? hy : -hy;
+            if (p.z <= 1e-6 * diag) {
+                tmax = INFINITY;
+                continue;
+            }
+            tmax = fmax(tmax, fmax(fabs(p.x - ex), fabs(p.y - ey)) / p.z);
+        }
+    }
+    /* A scene around the light: at most 160 degrees (the map's texels
+     * would thin out beyond); the rest is lit. */
+    tmax = fmin(tmax * 1.02, 5.67);
+    if (!(tmax > 0)) tmax = 1;
+    lf->k = 0.5 / tmax;
+    lf->zfar = fmax(zf, 1e-6 * diag);
+    lf->znear = fmax(zn, 1e-4 * lf->zfar);
+    memset(&lf->cam, 0, sizeof lf->cam);
+    lf->cam.width = lf->cam.height = S;
+    lf->cam.fx = lf->cam.fy = lf->k * S;
+    lf->cam.cx = lf->cam.cy = 0.5 * S - 0.5;
+    lf->near_plane = 0.5 * lf->znear;
+    lf->cull_world_from_camera = lf->world_from_lcam;
+    lf->cull_back = 0;
+}
+
+static void fit_light(const frame *f, light_frame *lf) {
+    memset(lf, 0, sizeof *lf);
+    mr_shadow_light(f->r->scene, &lf->light);
+    double scale = light_scale(&f->p->shadow);
+    int S = map_size(&f->p->shadow);
+    if (lf->light.kind == MR_LIGHT_SUN) fit_sun(f, &lf->light, scale, S, lf);
+    else fit_perspective(f, &lf->light, scale, S, lf);
+}
+
+/* ------------------------------------------------------------ the passes */
+
+void mr_pass_shadow_free(mr_renderer *r) {
+    struct mr_shadow_state *s = r->shadow;
+    if (!s) return;
+    mr_gl_target_free(&s->map);
+    mr_gl_target_free(&s->vis);
+    glDeleteTextures(1, &s->catcher_flags);
+    glDeleteProgram(s->prog_map);
+    glDeleteProgram(s->prog_vis);
+    free(s);
+    r->shadow = NULL;
+}
+
+static void shadow_scene_changed(mr_renderer *r) {
+    if (!r->shadow) return;
+    r->shadow->key_valid = false;
+    glDeleteTextures(1, &r->shadow->catcher_flags);
+    r->shadow->catcher_flags = 0;
+    r->shadow->catcher_scene = NULL;
+}
+
+static bool has_catchers(const mr_scene *s) {
+    for (int32_t i = 0; s && i < s->node_count; i++)
+        if (s->nodes[i].shadow_catcher) return true;
+    return false;
+}
+
+bool mr_shadow_catcher_setup(frame *f, GLuint program_unused, mr_error *err) {
+    (void)program_unused;
+    mr_renderer *r = f->r;
+    const mr_scene *sc = r->scene;
+    if (!has_catchers(sc)) {
+        glUniform1i(MR_LOC_OVERLAY_CATCHER, 0);
+        return true;
+    }
+    if (!r->shadow && !(r->shadow = calloc(1, sizeof *r->shadow))) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    struct mr_shadow_state *s = r->shadow;
+    if (!s->catcher_flags || s->catcher_scene != sc) {
+        glDeleteTextures(1, &s->catcher_flags);
+        int row = MR_SHADOW_CATCHER_ROW, rows = (sc->node_count + row - 1) / row;
+        int w = sc->node_count < row ? sc->node_count : row;
+        uint8_t *flags = calloc((size_t)row * rows, 1);
+        if (!flags) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        for (int32_t i = 0; i < sc->node_count; i++) flags[i] = sc->nodes[i].shadow_catcher ? 1 : 0;
+        glCreateTextures(GL_TEXTURE_2D, 1, &s->catcher_flags);
+        glTextureStorage2D(s->catcher_flags, 1, GL_R8UI, w, rows);
+        /* An integer texture is complete only with nearest filtering. */
+        glTextureParameteri(s->catcher_flags, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(s->catcher_flags, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, row);
+        glTextureSubImage2D(s->catcher_flags, 0, 0, 0, w, rows, GL_RED_INTEGER, GL_UNSIGNED_BYTE, flags);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+        free(flags);
+        s->catcher_scene = sc;
+    }
+    GLuint vis = frame_get(f, RES_SHADOW);
+    glUniform1i(MR_LOC_OVERLAY_CATCHER, vis ? 2 : 1);
+    /* The casting light's share of the catcher's shading (overlay.frag). */
+    mr_light L;
+    if (!mr_shadow_light(sc, &L)) memset(&L, 0, sizeof L);
+    mr_dvec3 d = mr_v3_normalize(mr_m4_dir(&f->cam_from_world, mr_v3(L.direction[0], L.direction[1], L.direction[2])));
+    glUniform3f(MR_LOC_OVERLAY_CATCHER_LIGHT, (float)d.x, (float)d.y, (float)d.z);
+    glUniform1f(MR_LOC_OVERLAY_CATCHER_LIGHT_LUM, (L.color[0] + L.color[1] + L.color[2]) / 3.0f);
+    glUniform1f(MR_LOC_OVERLAY_CATCHER_AMBIENT, sc->ambient);
+    glBindTextureUnit(MR_TEX_OVERLAY_IDS, frame_get(f, RES_IDS));
+    glBindTextureUnit(MR_TEX_OVERLAY_SHADOW, vis);
+    glBindTextureUnit(MR_TEX_OVERLAY_CATCHER_FLAGS, s->catcher_flags);
+    glBindTextureUnit(MR_TEX_OVERLAY_NORMAL, frame_get(f, RES_NORMAL));
+    return true;
+}
+
+static struct mr_shadow_state *state(frame *f, mr_error *err) {
+    mr_renderer *r = f->r;
+    if (!r->shadow && !(r->shadow = calloc(1, sizeof *r->shadow))) {
+        mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    return r->shadow;
+}
+
+static bool prepare_common(frame *f, mr_error *err) {
+    struct mr_shadow_state *s = state(f, err);
+    if (!s) return false;
+    const mr_shadow_params *p = &f->p->shadow;
+    if (!(p->taps >= 0 && p->taps <= MR_SHADOW_MAX_TAPS) || !(p->pcf_radius >= 0) || !(p->light_scale >= 0) ||
+        !(p->gt_samples >= 0 && p->gt_samples <= 1024) || !(p->map_size == 0 || (p->map_size >= 64 && p->map_size <= 8192)))
+        return mr_fail(err, MR_ERR_INVALID, "shadow settings out of range");
+    if (!s->prog_map) {
+        const char *const files[] = {"shadow_map.vert.glsl", "shadow_map.frag.glsl", NULL};
+        if (!(s->prog_map = mr_gl_program(files, err))) return false;
+    }
+    if (!s->prog_vis) {
+        const char *const files[] = {"fullscreen.vert.glsl", "shadow_vis.frag.glsl", NULL};
+        if (!(s->prog_vis = mr_gl_program(files, err))) return false;
+    }
+    int S = map_size(p);
+    if (s->map_size != S) {
+        mr_gl_target_free(&s->map);
+        s->key_valid = false;
+        static const GLenum fmt[1] = {GL_R32F};
+        if (!mr_gl_target_make(&s->map, S, S, fmt, 1, true, err)) return false;
+        s->map_size = S;
+    }
+    if (s->w != f->r->w || s->h != f->r->h) {
+        mr_gl_target_free(&s->vis);
+        static const GLenum fmt[1] = {GL_R32F};
+        if (!mr_gl_target_make(&s->vis, f->r->w, f->r->h, fmt, 1, false, err)) return false;
+        s->w = f->r->w;
+        s->h = f->r->h;
+    }
+    int taps = p->taps > 0 ? p->taps : MR_SHADOW_DEFAULT_TAPS;
+    if (s->kernel_taps != taps) {
+        /* Poisson-disk taps in the unit disk, fixed seed: the same pattern
+         * every frame, rotated per pixel by the shader. */
+        mr_ao_kernel_generate(MR_AO_KERNEL_POISSON, taps, 0.0f, 1.0f, 0x5ad0u, NULL, s->kernel);
+        s->kernel_taps = taps;
+    }
+    fit_light(f, &s->lf);
+    return true;
+}
+
+static bool need_map(const frame *f) { return casts(f) && map_method(f->p->shadow.method) && !reusable(f); }
+static bool need_map_reuse(const frame *f) { return casts(f) && map_method(f->p->shadow.method) && reusable(f); }
+static bool need_vis(const frame *f) { return casts(f); }
+static uint32_t vis_reads_now(const frame *f) {
+    return RES(RES_DEPTH) | RES(RES_NORMAL) | (map_method(f->p->shadow.method) ? RES(RES_SHADOW_MAP) : 0);
+}
+
+/* Draws the map of one light position: the base eye moved by `offset`
+ * (perspective, light axes) or the projection sheared by `shear` (sun). */
+static void draw_map(frame *f, const double offset[3], const double shear[2]) {
+    struct mr_shadow_state *s = f->r->shadow;
+    const light_frame *lf = &s->lf;
+    int S = s->map_size;
+    glBindFramebuffer(GL_FRAMEBUFFER, s->map.fbo);
+    glViewport(0, 0, S, S);
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_DEPTH_TEST);
+    glEnable(GL_DEPTH_CLAMP);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    const float far_z[4] = {1e30f, 0, 0, 0};
+    static const float depth0 = 0.0f;
+    glClearNamedFramebufferfv(s->map.fbo, GL_COLOR, 0, far_z);
+    glClearNamedFramebufferfv(s->map.fbo, GL_DEPTH, 0, &depth0);
+    glUseProgram(s->prog_map);
+    glUniform1i(MR_LOC_SHADOW_MAP_ORTHO, lf->ortho);
+    glUniform4f(MR_LOC_SHADOW_MAP_RECT, (float)lf->x0, (float)lf->y0, (float)(1 / lf->wx), (float)(1 / lf->wy));
+    glUniform2f(MR_LOC_SHADOW_MAP_DEPTH, 0.0f, (float)(1.0 / (lf->zfar * 1.5)));
+    /* The culling eye of the sun sits cull_back behind the light's plane:
+     * the vertices arrive relative to it. */
+    glUniform3f(MR_LOC_SHADOW_MAP_OFFSET, (float)offset[0], (float)offset[1], (float)(offset[2] + lf->cull_back));
+    glUniform2f(MR_LOC_SHADOW_MAP_SHEAR, (float)shear[0], (float)shear[1]);
+    mr_geo_view v;
+    memset(&v, 0, sizeof v);
+    v.cam = lf->cam;
+    v.world_from_camera = lf->cull_world_from_camera;
+    v.cam_from_world = mr_m4_invert_rigid(&lf->cull_world_from_camera);
+    v.near_plane = lf->near_plane;
+    v.program = s->prog_map;
+    v.layers = (1u << MR_LAYER_VISIBLE) | (f->p->hide_hidden_layer ? 0u : 1u << MR_LAYER_HIDDEN);
+    mr_geometry_draw(f->r, &v, f->out);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_DEPTH_CLAMP);
+}
+
+static void run_map(frame *f) {
+    struct mr_shadow_state *s = f->r->shadow;
+    const double zero3[3] = {0, 0, 0}, zero2[2] = {0, 0};
+    draw_map(f, zero3, zero2);
+    make_key(f, &s->key);
+    s->key_valid = true;
+    frame_put(f, RES_SHADOW_MAP, s->map.color[0]);
+}
+
+static void run_map_reuse(frame *f) {
+    f->out->shadow_reused = true;
+    frame_put(f, RES_SHADOW_MAP, f->r->shadow->map.color[0]);
+}
+
+static void draw_vis(frame *f, int method, const double offset[3], const double shear[2], float weight) {
+    mr_renderer *r = f->r;
+    struct mr_shadow_state *s = r->shadow;
+    const light_frame *lf = &s->lf;
+    const mr_shadow_params *p = &f->p->shadow;
+    glBindFramebuffer(GL_FRAMEBUFFER, s->vis.fbo);
+    glViewport(0, 0, r->w, r->h);
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glUseProgram(s->prog_vis);
+    glUniform4f(MR_LOC_SHADOW_INTR, (float)f->cam.fx, (float)f->cam.fy, (float)f->cam.cx, (float)f->cam.cy);
+    glUniform1f(MR_LOC_SHADOW_NEAR, (float)f->near_plane);
+    mr_dmat4 lfc = mr_m4_mul(&lf->lcam_from_world, &f->view->world_from_camera);
+    float m[16];
+    mr_m4_to_gl(&lfc, m);
+    glUniformMatrix4fv(MR_LOC_SHADOW_LIGHT_FROM_CAM, 1, GL_FALSE, m);
+    glUniform1i(MR_LOC_SHADOW_ORTHO, lf->ortho);
+    glUniform4f(MR_LOC_SHADOW_RECT, (float)lf->x0, (float)lf->y0, (float)(1 / lf->wx), (float)(1 / lf->wy));
+    glUniform1f(MR_LOC_SHADOW_K, (float)lf->k);
+    glUniform2f(MR_LOC_SHADOW_ZRANGE, (float)lf->znear, (float)lf->zfar);
+    glUniform1f(MR_LOC_SHADOW_LIGHT_HALF, (float)lf->half);
+    glUniform2f(MR_LOC_SHADOW_LIGHT_AREA, (float)lf->half2[0], (float)lf->half2[1]);
+    glUniform1i(MR_LOC_SHADOW_METHOD, method);
+    glUniform1i(MR_LOC_SHADOW_TAPS, s->kernel_taps);
+    glUniform1f(MR_LOC_SHADOW_PCF_RADIUS, p->pcf_radius > 0 ? p->pcf_radius : MR_SHADOW_DEFAULT_PCF_RADIUS);
+    glUniform1i(MR_LOC_SHADOW_MAP_SIZE, s->map_size);
+    glUniform3f(MR_LOC_SHADOW_OFFSET, (float)offset[0], (float)offset[1], (float)offset[2]);
+    glUniform2f(MR_LOC_SHADOW_SHEAR, (float)shear[0], (float)shear[1]);
+    glUniform1f(MR_LOC_SHADOW_WEIGHT, weight);
+    glUniform1f(MR_LOC_SHADOW_MAX_SEARCH, (float)MAX_SEARCH_TEXELS);
+    glUniform2fv(MR_LOC_SHADOW_KERNEL, s->kernel_taps, s->kernel);
+    glBindTextureUnit(MR_TEX_SHADOW_DEPTH, frame_get(f, RES_DEPTH));
+    glBindTextureUnit(MR_TEX_SHADOW_NORMAL, frame_get(f, RES_NORMAL));
+    glBindTextureUnit(MR_TEX_SHADOW_MAP, s->map.color[0]);
+    glBindVertexArray(r->empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+/* The ground truth: the mean of n hard shadows from stratified points on
+ * the light (a jittered g x g grid, n = g^2, fixed seed): for a rectangle
+ * its area, for a sphere and the sun's disk the disk (concentric radii). */
+static void run_groundtruth(frame *f) {
+    struct mr_shadow_state *s = f->r->shadow;
+    const light_frame *lf = &s->lf;
+    int n = f->p->shadow.gt_samples > 0 ? f->p->shadow.gt_samples : MR_SHADOW_DEFAULT_GT_SAMPLES;
+    int g = (int)floor(sqrt((double)n) + 0.5);
+    if (g < 1) g = 1;
+    n = g * g;
+    static const float zero4[4] = {0, 0, 0, 0};
+    glClearNamedFramebufferfv(s->vis.fbo, GL_COLOR, 0, zero4);
+    mr_rng rng;
+    mr_rng_seed(&rng, 0x6d72u);
+    for (int i = 0; i < n; i++) {
+        double u = ((i % g) + mr_rng_uniform(&rng)) / g, v = ((i / g) + mr_rng_uniform(&rng)) / g;
+        double off[3] = {0, 0, 0}, sh[2] = {0, 0};
+        if (lf->light.kind == MR_LIGHT_RECT) {
+            off[0] = (2 * u - 1) * lf->half2[0];
+            off[1] = (2 * v - 1) * lf->half2[1];
+        } else {
+            double rad = sqrt(u) * lf->half, phi = 2 * 3.14159265358979323846 * v;
+            double *t = lf->light.kind == MR_LIGHT_SUN ? sh : off;
+            t[0] = rad * cos(phi);
+            t[1] = rad * sin(phi);
+        }
+        draw_map(f, off, sh);
+        glEnable(GL_BLEND);
+        glBlendFunc(GL_ONE, GL_ONE);
+        glBlendEquation(GL_FUNC_ADD);
+        draw_vis(f, MR_SHADOW_METHOD_ID_GROUNDTRUTH, off, sh, 1.0f / (float)n);
+        glDisable(GL_BLEND);
+    }
+    s->key_valid = false; /* the map holds the last sample's */
+}
+
+static void run_vis(frame *f) {
+    struct mr_shadow_state *s = f->r->shadow;
+    if (f->p->shadow.method == MR_SHADOW_GROUNDTRUTH) {
+        run_groundtruth(f);
+    } else {
+        const double zero3[3] = {0, 0, 0}, zero2[2] = {0, 0};
+        draw_vis(f, (int)f->p->shadow.method, zero3, zero2, 1.0f);
+    }
+    frame_put(f, RES_SHADOW, s->vis.color[0]);
+}
+
+bool mr_pass_shadow_read_back(frame *f, mr_error *err) {
+    if (!f->p->shadow.want_shadow || !frame_get(f, RES_SHADOW)) return true;
+    mr_renderer *r = f->r;
+    if (!mr_image_alloc(&f->out->shadow, r->w, r->h, 1, MR_PIX_F32, err)) return false;
+    glGetTextureImage(frame_get(f, RES_SHADOW), 0, GL_RED, GL_FLOAT, (GLsizei)mr_image_bytes(&f->out->shadow),
+                      f->out->shadow.data);
+    return true;
+}
+
+const pass_desc mr_pass_desc_shadow_map = {
+    .name = "shadow_map", .needed = need_map, .prepare = prepare_common, .run = run_map,
+    .scene_changed = shadow_scene_changed, .destroy = mr_pass_shadow_free, .writes = RES(RES_SHADOW_MAP)};
+const pass_desc mr_pass_desc_shadow_map_reuse = {
+    .name = NULL, .needed = need_map_reuse, .prepare = prepare_common, .run = run_map_reuse,
+    .writes = RES(RES_SHADOW_MAP)};
+const pass_desc mr_pass_desc_shadow = {
+    .name = "shadow", .needed = need_vis, .prepare = prepare_common, .run = run_vis,
+    .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_SHADOW_MAP), .reads_now = vis_reads_now,
+    .writes = RES(RES_SHADOW)};

@@ -1,0 +1,245 @@
+// Visibility of the casting light at each G-buffer pixel, from the shadow
+// map (Hecher's comparison, ch. 3): hard, PCF, PCSS (Fernando 2005),
+// backprojection (Guennebaud et al. 2006), or one hard sample of the
+// ground truth's average (weighted, blended additively by the caller).
+//
+// Light space: the light eye's OpenCV axes (z along the light's axis).
+// Perspective lights (rect, sphere) sit at z = 0 with uv = 0.5 + k xy/z;
+// the sun projects orthographically, uv = (xy - x0y0) / wxy. Sizes: u_half
+// is the light's half-width (scene units) for a perspective light and
+// tan(angle / 2) for the sun, so the formulas below stay scale-free.
+//
+// Receiver-plane depth bias: the receiver's light-space depth is treated as
+// a plane over the kernel, dz/duv = J^-T (dz/dx, dz/dy), with J the Jacobian
+// of uv with respect to the screen. The screen differences are taken from
+// the neighbour pixel on the side with the smaller depth step (dFdx's
+// one-sided choice at depth edges, where a 2x2 quad would straddle two
+// surfaces). Each tap compares at its texel centre, where the map's depth
+// was rasterised, so planar receivers compare exactly.
+#include "mr_bindings.h"
+#include "common.glsl"
+
+layout(location = MR_LOC_SHADOW_INTR) uniform vec4 u_intr;            // fx fy cx cy of the output
+layout(location = MR_LOC_SHADOW_NEAR) uniform float u_near;
+layout(location = MR_LOC_SHADOW_LIGHT_FROM_CAM) uniform mat4 u_light_from_cam;
+layout(location = MR_LOC_SHADOW_ORTHO) uniform int u_ortho;
+layout(location = MR_LOC_SHADOW_RECT) uniform vec4 u_rect;            // ortho: x0, y0, 1/wx, 1/wy
+layout(location = MR_LOC_SHADOW_K) uniform float u_k;                 // perspective: uv per unit of x/z
+layout(location = MR_LOC_SHADOW_ZRANGE) uniform vec2 u_zrange;        // nearest caster, farthest receiver
+layout(location = MR_LOC_SHADOW_LIGHT_HALF) uniform float u_half;
+layout(location = MR_LOC_SHADOW_METHOD) uniform int u_method;
+layout(location = MR_LOC_SHADOW_TAPS) uniform int u_taps;
+layout(location = MR_LOC_SHADOW_PCF_RADIUS) uniform float u_pcf_radius; // texels
+layout(location = MR_LOC_SHADOW_MAP_SIZE) uniform int u_size;
+layout(location = MR_LOC_SHADOW_OFFSET) uniform vec3 u_offset;        // ground-truth sample (as the map)
+layout(location = MR_LOC_SHADOW_SHEAR) uniform vec2 u_shear;
+layout(location = MR_LOC_SHADOW_WEIGHT) uniform float u_weight;       // ground truth: 1 / samples
+layout(location = MR_LOC_SHADOW_MAX_SEARCH) uniform float u_max_search; // texels
+layout(location = MR_LOC_SHADOW_LIGHT_AREA) uniform vec2 u_light_half2; // BP: half extents on the light plane
+layout(location = MR_LOC_SHADOW_KERNEL) uniform vec2 u_kernel[MR_SHADOW_KERNEL_SIZE]; // unit-disk taps
+
+layout(binding = MR_TEX_SHADOW_DEPTH) uniform sampler2D u_depth;      // reversed-Z G-buffer depth
+layout(binding = MR_TEX_SHADOW_MAP) uniform sampler2D u_map;          // R32F linear light depth
+layout(binding = MR_TEX_SHADOW_NORMAL) uniform sampler2D u_normal;    // G-buffer view normal
+
+layout(location = 0) out float o_vis;
+
+bool nn_valid(vec3 n) { return dot(n, n) > 0.25; }
+
+vec3 cam_pos(ivec2 px) {
+    float d = texelFetch(u_depth, px, 0).r;
+    if (d <= 0.0) return vec3(0.0);
+    float z = u_near / d;
+    vec2 p = vec2(px);
+    return vec3((p - u_intr.zw) / u_intr.xy * z, z);
+}
+
+vec3 light_pos(vec3 pc) {
+    vec3 l = (u_light_from_cam * vec4(pc, 1.0)).xyz - u_offset;
+    l.xy -= u_shear * l.z;
+    return l;
+}
+
+vec2 light_uv(vec3 l) { return u_ortho != 0 ? (l.xy - u_rect.xy) * u_rect.zw : 0.5 + u_k * l.xy / l.z; }
+
+// uv per unit of the kernel's radius (world units for the sun, x/z for perspective)
+vec2 uv_scale() { return u_ortho != 0 ? u_rect.zw : vec2(u_k); }
+
+// The blocker-search / penumbra radius for depth z: how far (kernel units)
+// the light, seen from the receiver at zR, reaches in the map at depth z.
+float light_reach(float z, float zR) {
+    return u_ortho != 0 ? u_half * max(zR - z, 0.0) : u_half * max(1.0 / z - 1.0 / zR, 0.0);
+}
+
+float g_zR;      // receiver depth
+vec2 g_uvR;      // receiver uv
+vec2 g_grad;     // dz/duv of the receiver plane
+float g_bias;
+vec3 g_lR;       // receiver in light space (normal-offset)
+
+float tap_depth(ivec2 t) { return texelFetch(u_map, t, 0).r; }
+bool inside(ivec2 t) { return all(greaterThanEqual(t, ivec2(0))) && all(lessThan(t, ivec2(u_size))); }
+vec2 texel_centre(ivec2 t) { return (vec2(t) + 0.5) / float(u_size); }
+float ref_depth(ivec2 t) { return g_zR + dot(g_grad, texel_centre(t) - g_uvR) - g_bias; }
+float lit(ivec2 t) { return !inside(t) || tap_depth(t) >= ref_depth(t) ? 1.0 : 0.0; }
+ivec2 texel_of(vec2 uv) { return ivec2(floor(uv * float(u_size))); }
+
+mat2 g_rot;
+vec2 tap(int i, vec2 radius_uv) { return g_uvR + (g_rot * u_kernel[i]) * radius_uv; }
+
+float pcf(vec2 radius_uv) {
+    float s = 0.0;
+    for (int i = 0; i < u_taps; i++) s += lit(texel_of(tap(i, radius_uv)));
+    return s / float(u_taps);
+}
+
+// Mean depth of the blockers in the search disk; < 0: none.
+float blocker_depth(vec2 radius_uv) {
+    float sum = 0.0, n = 0.0;
+    for (int i = 0; i < u_taps; i++) {
+        ivec2 t = texel_of(tap(i, radius_uv));
+        if (!inside(t)) continue;
+        float z = tap_depth(t);
+        if (z < ref_depth(t)) { sum += z; n += 1.0; }
+    }
+    return n > 0.0 ? sum / n : -1.0;
+}
+
+// A point of the map (uv, depth z) in light-space xy (scene units).
+vec2 map_xy(vec2 uv, float z) { return u_ortho != 0 ? u_rect.xy + uv / u_rect.zw : (uv - 0.5) / u_k * z; }
+// Where the line from the receiver through a point at (xy, z) meets the
+// light: the light plane z = 0 for perspective lights (scene units), the
+// direction's tangent for the sun.
+vec2 on_light(vec3 r, vec2 xy, float z) {
+    float t = r.z - z;
+    return u_ortho != 0 ? (xy - r.xy) / t : r.xy + (xy - r.xy) * r.z / t;
+}
+
+// Backprojection: every blocking texel of the search square is a
+// light-parallel micro-patch at its depth; its projection through the
+// receiver onto the light, clipped to the light, occludes that area. Gap
+// filling: a patch reaches to its right and lower neighbour's edge when the
+// neighbour blocks too (projected at the farther of the two depths), so a
+// tilted blocker leaves no cracks between the patches of its texels.
+float backprojection(vec3 r, vec2 radius_uv) {
+    vec2 lh = u_light_half2;
+    float area_l = 4.0 * lh.x * lh.y;
+    ivec2 t0 = texel_of(g_uvR - radius_uv), t1 = texel_of(g_uvR + radius_uv);
+    float occ = 0.0;
+    float S = float(u_size);
+    for (int y = t0.y; y <= t1.y; y++)
+        for (int x = t0.x; x <= t1.x; x++) {
+            ivec2 t = ivec2(x, y);
+            if (!inside(t)) continue;
+            float z = tap_depth(t);
+            // A patch must stand clear of the receiver's plane by two texels:
+            // closer, its projection through the receiver covers the whole
+            // light, so one texel of the receiver's own surface that the
+            // plane fit misses would black it out (PCSS only loses a tap).
+            float tlr = u_ortho != 0 ? 1.0 / (S * min(u_rect.z, u_rect.w)) : g_zR / (S * u_k);
+            if (!(z < ref_depth(t) - 2.0 * tlr) || z <= 0.0) continue;
+            vec2 lo = vec2(t) / S, hi = (vec2(t) + 1.0) / S;
+            ivec2 tx = t + ivec2(1, 0), ty = t + ivec2(0, 1);
+            float zx = inside(tx) ? tap_depth(tx) : z, zy = inside(ty) ? tap_depth(ty) : z;
+            // Only neighbours of the same surface (a depth step under four
+            // texels' length, i.e. tilted less than ~76 degrees) are
+            // joined: across a depth edge the gap is real.
+            float tl = u_ortho != 0 ? 1.0 / (S * min(u_rect.z, u_rect.w)) : z / (S * u_k);
+            bool bx = inside(tx) && zx < ref_depth(tx) && abs(zx - z) < 4.0 * tl;
+            bool by = inside(ty) && zy < ref_depth(ty) && abs(zy - z) < 4.0 * tl;
+            // Corners on the light of the patch (at its own depth).
+            vec2 a = on_light(r, map_xy(lo, z), z), b = on_light(r, map_xy(hi, z), z);
+            vec2 pmin = min(a, b), pmax = max(a, b);
+            // Gap filling: stretch to the neighbour's shared edge.
+            if (bx) {
+                float ex = on_light(r, map_xy(vec2(hi.x, lo.y), zx), zx).x;
+                pmin.x = min(pmin.x, ex); pmax.x = max(pmax.x, ex);
+            }
+            if (by) {
+                float ey = on_light(r, map_xy(vec2(lo.x, hi.y), zy), zy).y;
+                pmin.y = min(pmin.y, ey); pmax.y = max(pmax.y, ey);
+            }
+            vec2 c0 = max(pmin, -lh), c1 = min(pmax, lh);
+            vec2 e = max(c1 - c0, vec2(0.0));
+            occ += e.x * e.y;
+        }
+    return 1.0 - min(1.0, occ / area_l);
+}
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec3 pc = cam_pos(px);
+    if (pc.z <= 0.0) { o_vis = u_weight; return; }
+    vec3 l = light_pos(pc);
+    if (u_ortho == 0 && l.z <= 0.0) { o_vis = u_weight; return; } // behind the light's plane
+    // Normal offset: a receiver seen edge-on by the light (a wall under a
+    // light straight above) has no plane the map can resolve; lifting it a
+    // map texel off its surface, more the more it turns away, keeps it off
+    // its own texels. Scale-free: a texel's length at the receiver.
+    {
+        vec3 n = texelFetch(u_normal, px, 0).xyz;
+        float tl = u_ortho != 0 ? 1.0 / (float(u_size) * min(u_rect.z, u_rect.w)) : l.z / (float(u_size) * u_k);
+        vec3 ln = nn_valid(n) ? normalize(mat3(u_light_from_cam) * n) : vec3(0.0, 0.0, -1.0);
+        float edge = clamp(1.0 - abs(ln.z), 0.0, 1.0);
+        // A surface turned away from the light (from its sample, for the
+        // ground truth) gets none of it: its own far side blocks it, which
+        // the map of an edge-on surface cannot tell.
+        vec3 to_light = u_ortho != 0 ? normalize(vec3(-u_shear, -1.0)) : normalize(u_offset - (l + u_offset));
+        if (dot(ln, to_light) <= 0.0 && nn_valid(n)) { o_vis = 0.0; return; }
+        vec3 lo = light_pos(pc + n * (1.5 * tl * edge));
+        g_lR = lo;
+        g_zR = lo.z;
+        g_uvR = light_uv(lo);
+    }
+    // Receiver plane from the screen neighbours.
+    vec3 d[2];
+    vec2 duv[2];
+    for (int a = 0; a < 2; a++) {
+        ivec2 e = a == 0 ? ivec2(1, 0) : ivec2(0, 1);
+        vec3 pp = cam_pos(px + e), pm = cam_pos(px - e);
+        bool use_p = pp.z > 0.0 && (pm.z <= 0.0 || abs(pp.z - pc.z) <= abs(pm.z - pc.z));
+        vec3 q = use_p ? pp : pm;
+        float sgn = use_p ? 1.0 : -1.0;
+        if (q.z <= 0.0) { d[a] = vec3(0.0); duv[a] = vec2(0.0); continue; }
+        vec3 lq = light_pos(q);
+        duv[a] = (light_uv(lq) - light_uv(l)) * sgn;
+        d[a] = vec3(0.0, 0.0, (lq.z - l.z) * sgn);
+    }
+    mat2 J = mat2(duv[0], duv[1]);   // columns: d uv / d screen x, d uv / d screen y
+    float det = determinant(J);
+    g_grad = vec2(0.0);
+    if (abs(det) > 1e-20) g_grad = transpose(inverse(J)) * vec2(d[0].z, d[1].z);
+    // A slope steeper than 89 degrees is an edge, not a plane.
+    float texel_len = u_ortho != 0 ? 1.0 / (float(u_size) * max(u_rect.z, u_rect.w))
+                                   : l.z / (float(u_size) * u_k);
+    float max_slope = 57.0 * texel_len * float(u_size);
+    float gl = length(g_grad);
+    if (!(gl <= max_slope)) g_grad = gl > 0.0 && !isinf(gl) && !isnan(gl) ? g_grad * (max_slope / gl) : vec2(0.0);
+    // Float rounding of the two depth paths, relative to the depth range.
+    g_bias = 2e-5 * max(u_zrange.y, abs(l.z)) + 0.02 * texel_len;
+    float ang = 6.2831853 * fract(sin(dot(vec2(px), vec2(12.9898, 78.233))) * 43758.5453);
+    g_rot = mat2(cos(ang), sin(ang), -sin(ang), cos(ang));
+    float texel_uv = 1.0 / float(u_size);
+    float max_uv = u_max_search * texel_uv;
+    float v;
+    if (u_method == MR_SHADOW_METHOD_ID_HARD || u_method == MR_SHADOW_METHOD_ID_GROUNDTRUTH) {
+        v = lit(texel_of(g_uvR));
+    } else if (u_method == MR_SHADOW_METHOD_ID_PCF) {
+        v = pcf(vec2(u_pcf_radius * texel_uv));
+    } else {
+        vec2 sc = uv_scale();
+        vec2 search = min(light_reach(u_zrange.x, g_zR) * sc, vec2(max_uv));
+        if (u_method == MR_SHADOW_METHOD_ID_BP) {
+            v = backprojection(g_lR, search);
+        } else {
+            float zb = blocker_depth(search);
+            if (zb < 0.0) {
+                v = 1.0;
+            } else {
+                vec2 pen = clamp(light_reach(zb, g_zR) * sc, vec2(0.5 * texel_uv), vec2(max_uv));
+                v = pcf(pen);
+            }
+        }
+    }
+    o_vis = v * u_weight;
+}
