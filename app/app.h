@@ -134,6 +134,20 @@ bool app_lod_auto(const app_opt *opts);
     {"lod-pixels", "PX", "largest projected error of a level in pixels (default 1)", NULL},                    \
     {"occlusion", "on|off", "occlusion culling (default off)", NULL}
 
+/* Multi-view output (rig_opts.c): the rig table (no prefix: --views,
+ * --view-cone, --view-fov, --focal-distance) and --quilt, shared by render
+ * and replay. */
+#define APP_RIG_OPTS {"quilt", "SPEC", "multi-view quilt: portrait, go, 4k, 8k, CxR or CxR@WxH (default: about square)", NULL}
+#define APP_RIG_TABLE(p) {.prefix = "", .table = mr_rig_opts, .params = (p)}
+/* --quilt into quilt (zeroed when not given); rig options without --views
+ * or --quilt are a mistake. Prints one line and returns false on bad input. */
+bool app_rig_check(const char *cmd, const app_table *t, const app_opt *opts, mr_quilt *quilt, bool *have_quilt);
+/* Renders the rig around `centre` into dir: view_NNN.png (when per_view)
+ * and NAME_qs{C}x{R}a{A}.png; the layout it used into *layout. */
+bool app_rig_render(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, const mr_quilt *quilt,
+                    const mr_view *centre, const mr_frame_params *fp, const char *dir, const char *quilt_name,
+                    bool per_view, mr_quilt_layout *layout, mr_rig_result *res, mr_error *err);
+
 int cmd_synth(int argc, char **argv);
 int cmd_factory(int argc, char **argv);
 int bench_scene(int argc, char **argv);

@@ -80,17 +80,20 @@ int cmd_render(int argc, char **argv) {
         {"hide-hidden", NULL, "leave the hidden layer out", NULL},
         APP_AO_OPTS,
         APP_DRAW_OPTS,
+        APP_RIG_OPTS,
         {"lod-cache", "on|off", "read/write LOD levels in <scene>.mrlod (default on)", NULL},
         {"verbose", NULL, "print the passes that ran and more", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
     mr_frame_params fp = MR_FRAME_DEFAULTS;
-    app_table tables[] = {APP_AO_TABLE(&fp.ao), APP_GHOST_TABLE(&fp.ghost)};
+    mr_rig_params rp = MR_RIG_DEFAULTS;
+    app_table tables[] = {APP_AO_TABLE(&fp.ao), APP_GHOST_TABLE(&fp.ghost), APP_RIG_TABLE(&rp)};
     bool help;
-    if (!app_parse_tables(argc, argv, 2, opts, tables, 2, NULL, 0, NULL,
+    if (!app_parse_tables(argc, argv, 2, opts, tables, 3, NULL, 0, NULL,
                    "usage: mrcheck render --scene FILE --view VIEW.json --out OUT.png [--size WxH] "
-                   "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive]",
+                   "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive] "
+                   "[--views N --view-cone DEG [--focal-distance D] [--quilt SPEC]: --out is then a folder]",
                    &help))
         return 2;
     if (help) return 0;
@@ -114,6 +117,12 @@ int cmd_render(int argc, char **argv) {
     mr_gt_params gtp = MR_GT_DEFAULTS;
     if (!app_ao_check(cmd, &tables[0], opts, &groundtruth, &gtp)) return 2;
     fp.ao.want_ao = aux != NULL;
+    mr_quilt quilt = {0};
+    bool have_quilt;
+    if (!app_rig_check(cmd, &tables[2], opts, &quilt, &have_quilt)) return 2;
+    bool multiview = rp.views > 0 || have_quilt;
+    if (multiview && (aux || groundtruth || app_get(opts, "video")))
+        return app_errorf(cmd, "--aux, --video and --ao groundtruth are for single views, not --views"), 2;
 
     /* Everything that can be checked without a GPU is checked first, so a
      * bad input never costs a context. */
@@ -149,12 +158,22 @@ int cmd_render(int argc, char **argv) {
         rc = app_error(cmd, &err);
     } else {
         if (!mr_renderer_set_draw_params(gfx.renderer, &dp, &err) || !mr_renderer_set_scene(gfx.renderer, scene, &err) ||
-            !mr_renderer_set_lod(gfx.renderer, lod, &err) || !mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||
-            (groundtruth && !render_groundtruth(gfx.renderer, scene, &view, &fp, &gtp, &res, &err)))
+            !mr_renderer_set_lod(gfx.renderer, lod, &err)) {
+            rc = app_error(cmd, &err);
+        } else if (multiview) {
+            mr_quilt_layout ql;
+            mr_rig_result rr;
+            if (!app_rig_render(gfx.renderer, scene, &rp, &quilt, &view, &fp, out, "quilt", true, &ql, &rr, &err))
+                rc = app_error(cmd, &err);
+            else if (!app_flag(opts, "quiet"))
+                printf("rendered %d views of %dx%d into %s/ (quilt %dx%d) in %.0f ms\n", rr.views, ql.tile_w, ql.tile_h,
+                       out, ql.cols, ql.rows, rr.ms_total);
+        } else if (!mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||
+                   (groundtruth && !render_groundtruth(gfx.renderer, scene, &view, &fp, &gtp, &res, &err)))
             rc = app_error(cmd, &err);
         else if (!mr_image_save_png(out, &res.color, &err) || (aux && !app_write_aux(aux, &res, &err)))
             rc = app_error(cmd, &err);
-        if (rc == 0 && app_flag(opts, "verbose")) {
+        if (rc == 0 && !multiview && app_flag(opts, "verbose")) {
             char passes[256];
             mr_frame_result_passes(&res, passes, sizeof passes);
             fprintf(stderr, "mrcheck: render: passes: %s; %u draw calls, %llu triangles, near plane %g\n", passes,

@@ -25,6 +25,10 @@ layout(location = MR_LOC_AO_MASK_STRENGTH) uniform float u_mask_strength; // sta
 layout(location = MR_LOC_AO_KERNEL) uniform vec4 u_kernel[MR_AO_KERNEL_SIZE];  // xyz in the unit ball shell [r_min, r_max]
 layout(location = MR_LOC_AO_KERNEL2) uniform vec4 u_kernel2[MR_AO_KERNEL_SIZE]; // xy in the unit disk annulus [r_min, r_max]
 
+layout(location = MR_LOC_AO_NOISE) uniform int u_noise;         // 0 pixel hash, 1 world-position hash
+layout(location = MR_LOC_AO_NOISE_CELL) uniform float u_noise_cell; // grid cell of the hash (scene units)
+layout(location = MR_LOC_AO_NOISE_FRAME) uniform mat4 u_noise_frame; // anchor_from_camera
+
 layout(binding = MR_TEX_AO_DEPTH) uniform sampler2D u_depth;
 layout(binding = MR_TEX_AO_NORMAL) uniform sampler2D u_normal;
 layout(binding = MR_TEX_AO_POSITIONS) uniform sampler2D u_pos;
@@ -195,6 +199,13 @@ void main() {
     }
     vec3 n = ao_normal(u_normal, fp, P);
     vec3 rnd = ao_rand3(ap);
+    if (u_noise == 1) {
+        // The surface point's grid cell in the anchor's frame: the same in
+        // every view that shares the anchor.
+        vec3 w = (u_noise_frame * vec4(P, 1.0)).xyz / u_noise_cell;
+        ivec3 c = ivec3(clamp(floor(w), vec3(-2.0e9), vec3(2.0e9)));
+        rnd = vec3(ao_pcg3(uvec3(c) ^ uvec3(0x9e3779b9u, 0x85ebca6bu, 0xc2b2ae35u)) >> 8u) * (1.0 / 16777216.0);
+    }
     vec3 plane = random_plane(rnd);
     float r0 = u_radius_mode == 0 ? u_screen_k * P.z : u_radius;
     float occ = 0.0;

@@ -72,6 +72,10 @@
 #define MR_AO_KERNEL_SIZE                  64 /* = MR_AO_MAX_SAMPLES (checked in pass_ao.c) */
 #define MR_LOC_AO_KERNEL2                  (MR_LOC_AO_KERNEL + MR_AO_KERNEL_SIZE)
 #define MR_TEX_AO_MASK                     3
+/* multi-view: AO noise from the world position (after the kernels) */
+#define MR_LOC_AO_NOISE                    (MR_LOC_AO_KERNEL2 + MR_AO_KERNEL_SIZE)
+#define MR_LOC_AO_NOISE_CELL               (MR_LOC_AO_NOISE + 1)
+#define MR_LOC_AO_NOISE_FRAME              (MR_LOC_AO_NOISE + 2) /* mat4: 4 locations */
 
 /* ao_outline */
 #define MR_LOC_OUTLINE_RADIUS_MODE         3

@@ -326,6 +326,10 @@ static void copy_fields(mr_ao_params *d, const mr_ao_params *p) {
     d->want_mask = p->want_mask;
     d->no_reuse = p->no_reuse;
     d->external = p->external;
+    d->noise = p->noise;
+    d->noise_cell = p->noise_cell;
+    d->noise_anchor = p->noise_anchor;
+    d->noise_anchor_set = p->noise_anchor_set;
 }
 
 static ao_key key_of(const frame *f, const mr_ao_params *resolved, uint64_t scene_gen) {
@@ -541,6 +545,35 @@ static void mr_pass_ao_mask(frame *f) {
     glDepthMask(GL_TRUE);
 }
 
+/* World noise: the camera-space position goes to the anchor's frame
+ * (composed in double, so only the small anchor-relative part is float)
+ * and is hashed on a grid of noise_cell. Views that share the anchor give
+ * the same surface point the same rotation. */
+static void noise_uniforms(const frame *f, const mr_ao_params *p) {
+    glUniform1i(MR_LOC_AO_NOISE, p->noise == MR_AO_NOISE_WORLD ? 1 : 0);
+    if (p->noise != MR_AO_NOISE_WORLD) return;
+    mr_dmat4 world_from_anchor = p->noise_anchor_set ? p->noise_anchor : mr_m4_identity();
+    mr_dmat4 anchor_from_world;
+    if (!mr_m4_invert(&world_from_anchor, &anchor_from_world)) anchor_from_world = mr_m4_identity();
+    mr_dmat4 a = mr_m4_mul(&anchor_from_world, &f->view->world_from_camera);
+    float m[16];
+    mr_m4_to_gl(&a, m);
+    glUniformMatrix4fv(MR_LOC_AO_NOISE_FRAME, 1, GL_FALSE, m);
+    double cell = p->noise_cell;
+    if (!(cell > 0) || !isfinite(cell)) {
+        /* one pixel at the depth of the scene's centre, seen from the anchor */
+        const mr_scene *sc = f->r->scene;
+        double z = 0;
+        if (sc) {
+            mr_dvec3 c = mr_v3(0.5 * (sc->bounds_min[0] + sc->bounds_max[0]), 0.5 * (sc->bounds_min[1] + sc->bounds_max[1]),
+                               0.5 * (sc->bounds_min[2] + sc->bounds_max[2]));
+            z = fabs(mr_m4_point(&anchor_from_world, c).z);
+        }
+        cell = z > 0 && isfinite(z) ? z / f->cam.fy : 1.0;
+    }
+    glUniform1f(MR_LOC_AO_NOISE_CELL, (float)cell);
+}
+
 static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
     const mr_ao_params *p = &s->p;
     glUseProgram(s->prog_main);
@@ -561,6 +594,7 @@ static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
     glUniform1f(MR_LOC_AO_MASK_STRENGTH, p->mask_strength);
     glUniform4fv(MR_LOC_AO_KERNEL, MR_AO_MAX_SAMPLES, s->kernel3);
     glUniform4fv(MR_LOC_AO_KERNEL2, MR_AO_MAX_SAMPLES, s->kernel2);
+    noise_uniforms(f, p);
     fullscreen(f, s->fbo_ao[0], s->aw, s->ah);
     s->cur = 0;
     s->result = s->tex_ao[0];

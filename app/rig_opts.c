@@ -1,0 +1,58 @@
+/* The multi-view options shared by render and replay: mr_rig_opts does
+ * --views, --view-cone, --view-fov and --focal-distance; --quilt is parsed
+ * by mr_quilt_parse. What is left here is wiring: the rig and the quilt
+ * layout for a view, and writing one rig frame into a folder. */
+#include "app.h"
+
+#include <stdio.h>
+
+bool app_rig_check(const char *cmd, const app_table *t, const app_opt *opts, mr_quilt *quilt, bool *have_quilt) {
+    const mr_rig_params *rp = t->params;
+    *have_quilt = false;
+    const char *q = app_get(opts, "quilt");
+    if (q) {
+        mr_error err = {0};
+        if (!mr_quilt_parse(q, quilt, &err)) return app_errorf(cmd, "--quilt: %s", err.msg), false;
+        *have_quilt = true;
+    }
+    bool rig_opt = app_table_given(t, "view-cone") || app_table_given(t, "view-fov") || app_table_given(t, "focal-distance");
+    if (rp->views == 0 && !*have_quilt && rig_opt)
+        return app_errorf(cmd, "--view-cone, --view-fov and --focal-distance need --views or --quilt"), false;
+    return true;
+}
+
+bool app_rig_render(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, const mr_quilt *quilt,
+                    const mr_view *centre, const mr_frame_params *fp, const char *dir, const char *quilt_name,
+                    bool per_view, mr_quilt_layout *layout, mr_rig_result *res, mr_error *err) {
+    mr_rig_params p = *rp;
+    int w = fp->width > 0 ? fp->width : centre->camera.width, h = fp->height > 0 ? fp->height : centre->camera.height;
+    if (p.views == 0) p.views = quilt->cols * quilt->rows; /* --quilt alone: a view per tile */
+    if (!mr_quilt_layout_make(quilt->cols ? quilt : NULL, p.views, w, h, layout, err)) return false;
+    double d = p.focal_distance;
+    if (!(d > 0)) {
+        /* Where the centre view looks: one frame of depth at the tile size. */
+        mr_frame_params dp = *fp;
+        dp.video = NULL;
+        dp.want_depth = true;
+        dp.ao.method = MR_AO_NONE;
+        dp.width = layout->tile_w;
+        dp.height = layout->tile_h;
+        mr_frame_result fr;
+        if (!mr_render_frame(r, centre, &dp, &fr, err)) return false;
+        d = mr_rig_focal_from_depth(&fr.depth);
+        mr_frame_result_free(&fr);
+        if (!(d > 0)) d = mr_rig_auto_focal_distance(scene, centre);
+    }
+    if (!(d > 0))
+        return mr_fail(err, MR_ERR_INVALID, "nothing in front of the camera to focus on: give --focal-distance");
+    mr_rig rig;
+    if (!mr_rig_make(&p, layout->aspect, d, &rig, err)) return false;
+    mr_image img = {0};
+    if (!mr_render_rig(r, &rig, centre, fp, layout, per_view ? dir : NULL, &img, res, err)) return false;
+    char name[256], path[4096];
+    mr_quilt_file_name(quilt_name, layout, name, sizeof name);
+    mr_path_join(dir, name, path, sizeof path);
+    bool ok = mr_image_save_png(path, &img, err);
+    mr_image_free(&img);
+    return ok;
+}
