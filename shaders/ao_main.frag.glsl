@@ -199,10 +199,14 @@ void main() {
     }
     vec3 n = ao_normal(u_normal, fp, P);
     vec3 rnd = ao_rand3(ap);
-    if (u_noise == 1) {
-        // The surface point's grid cell in the anchor's frame: the same in
-        // every view that shares the anchor.
-        vec3 w = (u_noise_frame * vec4(P, 1.0)).xyz / u_noise_cell;
+    if (u_noise != 0) {
+        // The surface point's cell in the anchor's frame, the same in every
+        // view that shares the anchor: a grid of u_noise_cell scene units
+        // (1), or the anchor camera's pixels grouped u_noise_cell x
+        // u_noise_cell (2: cells as fine as the image wherever the point is).
+        vec3 a = (u_noise_frame * vec4(P, 1.0)).xyz;
+        vec3 w = a / u_noise_cell;
+        if (u_noise == 2) w = a.z > 0.0 ? vec3(a.xy / a.z * u_intr.xy / u_noise_cell, 0.0) : vec3(vec2(ap), 1.0);
         ivec3 c = ivec3(clamp(floor(w), vec3(-2.0e9), vec3(2.0e9)));
         rnd = vec3(ao_pcg3(uvec3(c) ^ uvec3(0x9e3779b9u, 0x85ebca6bu, 0xc2b2ae35u)) >> 8u) * (1.0 / 16777216.0);
     }

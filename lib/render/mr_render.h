@@ -95,6 +95,11 @@ typedef enum mr_ao_noise {
     MR_AO_NOISE_WORLD,
 } mr_ao_noise;
 
+/* World noise: the anchor camera's pixels per cell side. A surface point
+ * seen at a pixel centre in one view is seen up to half a pixel away in
+ * another, so cells of one pixel would split it half the time. */
+#define MR_AO_NOISE_CELL_PX 4
+
 #define MR_AO_MAX_SAMPLES 64
 #define MR_AO_MAX_RADII 5 /* Doronin et al. merge 5 radii */
 
@@ -137,8 +142,11 @@ typedef struct mr_ao_params {
                                      computing one (e.g. ray-traced ground truth); NULL */
     /* multi-view: where the kernel's per-pixel rotation comes from */
     mr_ao_noise noise;            /* default pixel (a hash of the pixel) */
-    double noise_cell;            /* world noise: grid cell of the position hash in scene
-                                     units; 0 = one pixel at the depth of the scene's centre */
+    double noise_cell;            /* world noise: > 0, a grid of cells this size in scene
+                                     units, in the anchor's frame; 0 = the anchor camera's
+                                     pixels (the frame's intrinsics) grouped
+                                     MR_AO_NOISE_CELL_PX x MR_AO_NOISE_CELL_PX, so the noise
+                                     is as fine as the image at any depth */
     mr_dmat4 noise_anchor;        /* world noise: world_from_anchor, the frame positions are
                                      hashed in (a multi-view rig sets its centre camera, so
                                      all views share it); used when noise_anchor_set */

@@ -550,28 +550,22 @@ static void mr_pass_ao_mask(frame *f) {
  * and is hashed on a grid of noise_cell. Views that share the anchor give
  * the same surface point the same rotation. */
 static void noise_uniforms(const frame *f, const mr_ao_params *p) {
-    glUniform1i(MR_LOC_AO_NOISE, p->noise == MR_AO_NOISE_WORLD ? 1 : 0);
-    if (p->noise != MR_AO_NOISE_WORLD) return;
-    mr_dmat4 world_from_anchor = p->noise_anchor_set ? p->noise_anchor : mr_m4_identity();
-    mr_dmat4 anchor_from_world;
-    if (!mr_m4_invert(&world_from_anchor, &anchor_from_world)) anchor_from_world = mr_m4_identity();
-    mr_dmat4 a = mr_m4_mul(&anchor_from_world, &f->view->world_from_camera);
+    if (p->noise != MR_AO_NOISE_WORLD) {
+        glUniform1i(MR_LOC_AO_NOISE, 0);
+        return;
+    }
+    bool grid = p->noise_cell > 0 && isfinite(p->noise_cell);
+    glUniform1i(MR_LOC_AO_NOISE, grid ? 1 : 2);
+    /* Without an anchor the frame's own camera is it. */
+    mr_dmat4 a = mr_m4_identity();
+    if (p->noise_anchor_set) {
+        mr_dmat4 anchor_from_world;
+        if (mr_m4_invert(&p->noise_anchor, &anchor_from_world)) a = mr_m4_mul(&anchor_from_world, &f->view->world_from_camera);
+    }
     float m[16];
     mr_m4_to_gl(&a, m);
     glUniformMatrix4fv(MR_LOC_AO_NOISE_FRAME, 1, GL_FALSE, m);
-    double cell = p->noise_cell;
-    if (!(cell > 0) || !isfinite(cell)) {
-        /* one pixel at the depth of the scene's centre, seen from the anchor */
-        const mr_scene *sc = f->r->scene;
-        double z = 0;
-        if (sc) {
-            mr_dvec3 c = mr_v3(0.5 * (sc->bounds_min[0] + sc->bounds_max[0]), 0.5 * (sc->bounds_min[1] + sc->bounds_max[1]),
-                               0.5 * (sc->bounds_min[2] + sc->bounds_max[2]));
-            z = fabs(mr_m4_point(&anchor_from_world, c).z);
-        }
-        cell = z > 0 && isfinite(z) ? z / f->cam.fy : 1.0;
-    }
-    glUniform1f(MR_LOC_AO_NOISE_CELL, (float)cell);
+    glUniform1f(MR_LOC_AO_NOISE_CELL, grid ? (float)p->noise_cell : (float)MR_AO_NOISE_CELL_PX);
 }
 
 static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
