@@ -142,11 +142,14 @@ bool app_lod_auto(const app_opt *opts);
 /* --quilt into quilt (zeroed when not given); rig options without --views
  * or --quilt are a mistake. Prints one line and returns false on bad input. */
 bool app_rig_check(const char *cmd, const app_table *t, const app_opt *opts, mr_quilt *quilt, bool *have_quilt);
-/* Renders the rig around `centre` into dir: view_NNN.png (when per_view)
- * and NAME_qs{C}x{R}a{A}.png; the layout it used into *layout. */
+/* Renders the rig around `centre`: view_NNN.png into views_dir (NULL:
+ * none) and NAME_qs{C}x{R}a{A}.png into quilt_dir; the layout it used into
+ * *layout. The focal distance is --focal-distance, else *focal when > 0,
+ * else where the centre view looks (then stored in *focal, so a replay
+ * keeps the first frame's). */
 bool app_rig_render(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, const mr_quilt *quilt,
-                    const mr_view *centre, const mr_frame_params *fp, const char *dir, const char *quilt_name,
-                    bool per_view, mr_quilt_layout *layout, mr_rig_result *res, mr_error *err);
+                    const mr_view *centre, const mr_frame_params *fp, const char *views_dir, const char *quilt_dir,
+                    const char *quilt_name, double *focal, mr_quilt_layout *layout, mr_rig_result *res, mr_error *err);
 
 int cmd_synth(int argc, char **argv);
 int cmd_factory(int argc, char **argv);

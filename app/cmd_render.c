@@ -163,11 +163,12 @@ int cmd_render(int argc, char **argv) {
         } else if (multiview) {
             mr_quilt_layout ql;
             mr_rig_result rr;
-            if (!app_rig_render(gfx.renderer, scene, &rp, &quilt, &view, &fp, out, "quilt", true, &ql, &rr, &err))
+            double focal = 0;
+            if (!app_rig_render(gfx.renderer, scene, &rp, &quilt, &view, &fp, out, out, "quilt", &focal, &ql, &rr, &err))
                 rc = app_error(cmd, &err);
             else if (!app_flag(opts, "quiet"))
-                printf("rendered %d views of %dx%d into %s/ (quilt %dx%d) in %.0f ms\n", rr.views, ql.tile_w, ql.tile_h,
-                       out, ql.cols, ql.rows, rr.ms_total);
+                printf("rendered %d views of %dx%d into %s/ (quilt %dx%d, focal distance %g) in %.0f ms\n", rr.views,
+                       ql.tile_w, ql.tile_h, out, ql.cols, ql.rows, focal, rr.ms_total);
         } else if (!mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||
                    (groundtruth && !render_groundtruth(gfx.renderer, scene, &view, &fp, &gtp, &res, &err)))
             rc = app_error(cmd, &err);

@@ -19,6 +19,7 @@ int cmd_replay(int argc, char **argv) {
         {"raw", NULL, "use the raw pose instead of the filtered one", NULL},
         {"video", "FILE.avi", "also write the overlays as a Motion-JPEG AVI at the recording's rate", NULL},
         APP_AO_OPTS,
+        APP_RIG_OPTS,
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -27,11 +28,13 @@ int cmd_replay(int argc, char **argv) {
     int npos = 0;
     /* Depth cues as on render: the same option tables and checks. */
     mr_frame_params base = MR_FRAME_DEFAULTS;
-    app_table tables[] = {APP_AO_TABLE(&base.ao), APP_GHOST_TABLE(&base.ghost)};
+    mr_rig_params rp = MR_RIG_DEFAULTS;
+    app_table tables[] = {APP_AO_TABLE(&base.ao), APP_GHOST_TABLE(&base.ghost), APP_RIG_TABLE(&rp)};
     bool help;
-    if (!app_parse_tables(argc, argv, 2, opts, tables, 2, pos, 1, &npos,
+    if (!app_parse_tables(argc, argv, 2, opts, tables, 3, pos, 1, &npos,
                    "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] [--raw] "
-                   "[--video F.avi] [--ao METHOD ...] [--ghost MODE ...]",
+                   "[--video F.avi] [--ao METHOD ...] [--ghost MODE ...] "
+                   "[--views N --view-cone DEG [--focal-distance D] [--quilt SPEC]]",
                    &help))
         return 2;
     if (help) return 0;
@@ -51,10 +54,30 @@ int cmd_replay(int argc, char **argv) {
     mr_gt_params gtp = MR_GT_DEFAULTS;
     if (!app_ao_check(cmd, &tables[0], opts, &groundtruth, &gtp)) return 2;
     if (groundtruth) return app_errorf(cmd, "--ao groundtruth is for single frames (mrcheck render), not replays"), 2;
+    mr_quilt quilt = {0};
+    bool have_quilt;
+    if (!app_rig_check(cmd, &tables[2], opts, &quilt, &have_quilt)) return 2;
+    /* Multi-view: per frame a quilt overlay_NNNNNN_qs..png and its views in
+     * overlay_NNNNNN/; the camera frame is seen from one eye only, so the
+     * views show the plan alone. */
+    bool multiview = rp.views > 0 || have_quilt;
+    if (multiview && app_get(opts, "video")) return app_errorf(cmd, "--video is for single views, not --views"), 2;
+    double focal = 0;
 
     mr_error err = {0};
     mr_recording *rec = mr_recording_open(pos[0], &err);
     if (!rec) return app_error(cmd, &err);
+    if (multiview) {
+        /* A quilt too small for the views is bad input: found before any
+         * output folder or GPU context is made. */
+        mr_quilt_layout ql;
+        mr_rig_params chk = rp;
+        if (chk.views == 0) chk.views = quilt.cols * quilt.rows;
+        if (!mr_quilt_layout_make(quilt.cols ? &quilt : NULL, chk.views, rec->camera.width, rec->camera.height, &ql, &err)) {
+            mr_recording_close(&rec);
+            return app_error(cmd, &err);
+        }
+    }
     mr_scene *scene = mr_scene_load(app_get(opts, "scene"), NULL, &err);
     app_gfx gfx = {0};
     bool ok = scene && mr_mkdirs(out, &err) && app_gfx_open(&gfx, &err) && mr_renderer_set_scene(gfx.renderer, scene, &err);
@@ -87,7 +110,20 @@ int cmd_replay(int argc, char **argv) {
         char name[64], path[4096];
         snprintf(name, sizeof name, "overlay_%06lld.png", (long long)f->index);
         mr_path_join(out, name, path, sizeof path);
-        if (has_pose) {
+        if (has_pose && multiview) {
+            mr_view view = {mr_camera_resized(&rec->camera, img.width, img.height), pose};
+            char stem[64], vdir[4096];
+            snprintf(stem, sizeof stem, "overlay_%06lld", (long long)f->index);
+            mr_path_join(out, stem, vdir, sizeof vdir);
+            mr_quilt_layout ql;
+            ok = app_rig_render(gfx.renderer, scene, &rp, &quilt, &view, &base, vdir, out, stem, &focal, &ql, NULL, &err);
+            if (ok) mr_quilt_file_name(stem, &ql, name, sizeof name);
+            rendered++;
+        } else if (multiview) {
+            /* No pose: nothing to show on a 3D display; the log says so. */
+            snprintf(name, sizeof name, "-");
+            plain++;
+        } else if (has_pose) {
             mr_view view = {mr_camera_resized(&rec->camera, img.width, img.height), pose};
             mr_frame_params fp = base;
             fp.video = &img;

@@ -22,13 +22,13 @@ bool app_rig_check(const char *cmd, const app_table *t, const app_opt *opts, mr_
 }
 
 bool app_rig_render(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, const mr_quilt *quilt,
-                    const mr_view *centre, const mr_frame_params *fp, const char *dir, const char *quilt_name,
-                    bool per_view, mr_quilt_layout *layout, mr_rig_result *res, mr_error *err) {
+                    const mr_view *centre, const mr_frame_params *fp, const char *views_dir, const char *quilt_dir,
+                    const char *quilt_name, double *focal, mr_quilt_layout *layout, mr_rig_result *res, mr_error *err) {
     mr_rig_params p = *rp;
     int w = fp->width > 0 ? fp->width : centre->camera.width, h = fp->height > 0 ? fp->height : centre->camera.height;
     if (p.views == 0) p.views = quilt->cols * quilt->rows; /* --quilt alone: a view per tile */
     if (!mr_quilt_layout_make(quilt->cols ? quilt : NULL, p.views, w, h, layout, err)) return false;
-    double d = p.focal_distance;
+    double d = p.focal_distance > 0 ? p.focal_distance : *focal;
     if (!(d > 0)) {
         /* Where the centre view looks: one frame of depth at the tile size. */
         mr_frame_params dp = *fp;
@@ -43,15 +43,16 @@ bool app_rig_render(mr_renderer *r, const mr_scene *scene, const mr_rig_params *
         mr_frame_result_free(&fr);
         if (!(d > 0)) d = mr_rig_auto_focal_distance(scene, centre);
     }
+    if (d > 0) *focal = d;
     if (!(d > 0))
         return mr_fail(err, MR_ERR_INVALID, "nothing in front of the camera to focus on: give --focal-distance");
     mr_rig rig;
     if (!mr_rig_make(&p, layout->aspect, d, &rig, err)) return false;
     mr_image img = {0};
-    if (!mr_render_rig(r, &rig, centre, fp, layout, per_view ? dir : NULL, &img, res, err)) return false;
+    if (!mr_render_rig(r, &rig, centre, fp, layout, views_dir, &img, res, err)) return false;
     char name[256], path[4096];
     mr_quilt_file_name(quilt_name, layout, name, sizeof name);
-    mr_path_join(dir, name, path, sizeof path);
+    mr_path_join(quilt_dir, name, path, sizeof path);
     bool ok = mr_image_save_png(path, &img, err);
     mr_image_free(&img);
     return ok;
