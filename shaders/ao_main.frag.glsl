@@ -29,6 +29,8 @@ layout(location = MR_LOC_AO_NOISE) uniform int u_noise;         // 0 pixel hash,
 layout(location = MR_LOC_AO_NOISE_CELL) uniform float u_noise_cell; // grid cell of the hash (scene units)
 layout(location = MR_LOC_AO_NOISE_FRAME) uniform mat4 u_noise_frame; // anchor_from_camera
 
+layout(location = MR_LOC_AO_DISPLAY) uniform vec3 u_display;       // D, E, width; D = 0: pinhole
+
 layout(binding = MR_TEX_AO_DEPTH) uniform sampler2D u_depth;
 layout(binding = MR_TEX_AO_NORMAL) uniform sampler2D u_normal;
 layout(binding = MR_TEX_AO_POSITIONS) uniform sampler2D u_pos;
@@ -53,6 +55,14 @@ bool project(vec3 s, out ivec2 q) {
     q = ivec2(0);
     if (!(s.z > 0.0)) return false;
     vec2 uv = s.xy / s.z * u_intr.xy + u_intr.zw;
+    if (u_display.x > 0.0) {
+        // Light-field display: the column whose own eye e(u) = a (u + 0.5) - E
+        // sees s; solved from u = fx x/z + cx + fx e(u) (1/D - 1/z).
+        float a = 2.0 * u_display.y / u_display.z, g = u_intr.x * (1.0 / u_display.x - 1.0 / s.z);
+        float den = 1.0 - g * a;
+        if (!(abs(den) > 1e-6)) return false;
+        uv.x = (uv.x + g * (0.5 * a - u_display.y)) / den;
+    }
     if (!(uv.x > -0.5 && uv.y > -0.5 && uv.x < float(u_full.x) - 0.5 && uv.y < float(u_full.y) - 0.5)) return false;
     q = ivec2(floor(uv + 0.5));
     return true;

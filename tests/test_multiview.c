@@ -159,6 +159,58 @@ static void test_focal_from_depth(void) {
     mr_image_free(&d);
 }
 
+
+/* The display mapping on the CPU: exact round trip, the band error formula,
+ * and that it is no pinhole (a straight line does not stay straight). */
+static void test_display_cpu(void) {
+    mr_camera c = {96, 72, 80, 80, 47.5, 35.5, {0, 0, 0, 0, 0}};
+    mr_display_map m = {4.0, 4.0 * tan(17.5 * 3.14159265358979 / 180), 1};
+    int bad = 0;
+    for (int u = 0; u < 96; u += 5)
+        for (double z = 0.5; z < 6; z += 0.37) {
+            mr_dvec3 p = mr_display_point(&m, &c, u, 20, z);
+            double uu, vv;
+            if (!mr_display_project(&m, &c, p, &uu, &vv) || fabs(uu - u) > 1e-9 || fabs(vv - 20) > 1e-9) bad++;
+        }
+    CHECK_MSG(bad == 0, "%d display round trips off", bad);
+    /* Band 1: exact at every pixel centre; band 8: |j| (E/A) |1 - D/z|. */
+    double A = (c.width / 2.0) * m.distance / c.fx; /* half-width of the focal plane seen */
+    double worst1 = 0, worst8 = 0, worst8_formula = 0;
+    for (int u = 0; u < 96; u++)
+        for (double z = 1; z < 8; z += 0.5) {
+            worst1 = fmax(worst1, fabs(mr_display_column_error(&m, &c, u, z)));
+            mr_display_map m8 = m;
+            m8.band = 8;
+            double e = fabs(mr_display_column_error(&m8, &c, u, z));
+            double j = fabs(u % 8 - 3.5);
+            double q = (m.eye_half / A) * (1 - m.distance / z);
+            double want = j * fabs(q / (1 - q));
+            if (fabs(e - want) > 1e-9 * (1 + want)) bad++;
+            worst8 = fmax(worst8, e);
+            worst8_formula = fmax(worst8_formula, want);
+        }
+    CHECK_MSG(worst1 < 1e-9, "band 1 off by %g px", worst1);
+    CHECK_MSG(bad == 0, "%d band-8 errors off the formula", bad);
+    CHECK(worst8 > 1.0);
+    printf("display mapping: band 1 column error %.2g px, band 8 up to %.2f px (formula %.2f) for z in [1, 8), D = 4\n",
+           worst1, worst8, worst8_formula);
+    /* A straight 3D line (not through the eye line) is not straight in the
+     * image: the middle point leaves the chord by more than a pixel. */
+    mr_dvec3 a = mr_v3(-2, -1, 2), b = mr_v3(2, 1, 7), mid = mr_v3(0, 0, 4.5);
+    double ua, va, ub, vb, um, vm;
+    CHECK(mr_display_project(&m, &c, a, &ua, &va) && mr_display_project(&m, &c, b, &ub, &vb) &&
+          mr_display_project(&m, &c, mid, &um, &vm));
+    double cross = ((ub - ua) * (vm - va) - (vb - va) * (um - ua)) / hypot(ub - ua, vb - va);
+    CHECK_MSG(fabs(cross) > 1.0, "the line stayed straight (%.3f px off the chord)", cross);
+    /* The pinhole keeps it straight. */
+    mr_display_map pin = m;
+    pin.eye_half = 0;
+    CHECK(mr_display_project(&pin, &c, a, &ua, &va) && mr_display_project(&pin, &c, b, &ub, &vb) &&
+          mr_display_project(&pin, &c, mid, &um, &vm));
+    cross = ((ub - ua) * (vm - va) - (vb - va) * (um - ua)) / hypot(ub - ua, vb - va);
+    CHECK_NEAR(cross, 0, 1e-9);
+}
+
 /* ------------------------------------------------------------ GPU part */
 
 static void add_node(mr_scene *s, mr_dmat4 m, int32_t mesh) { mr_test_add_node(s, "n", m, mesh, MR_LAYER_VISIBLE); }
@@ -295,6 +347,7 @@ int main(void) {
     test_known_answers();
     test_quilt();
     test_focal_from_depth();
+    test_display_cpu();
     int rc = test_gpu();
     if (rc) return rc;
     return mr_test_finish("test_multiview");

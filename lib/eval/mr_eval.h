@@ -37,8 +37,11 @@ typedef struct mr_gt_params {
     int rays;                      /* cosine-weighted rays per pixel; 0 = 256 */
     uint64_t seed;                 /* 0 = 1 */
     int threads;                   /* 0 = one per online CPU */
+    const mr_display_map *display; /* the frame's light-field display mapping: the
+                                      surface point of pixel (u, v) lies on column u's
+                                      own ray (mr_display_point); NULL = pinhole */
 } mr_gt_params;
-#define MR_GT_DEFAULTS {MR_AO_RADIUS_VIEW, 0.0, 0.05, 256, 1, 0}
+#define MR_GT_DEFAULTS {MR_AO_RADIUS_VIEW, 0.0, 0.05, 256, 1, 0, NULL}
 
 /* Ambient visibility (fraction of cosine-weighted rays of length R that
  * escape; 1 = unoccluded, 1 where depth is 0) for each pixel of a rendered

@@ -305,6 +305,8 @@ typedef struct mr_frame_params {
     mr_ghost_params ghost;     /* ghosted views of the hidden layer; default off */
     float specular;            /* Phong specular weight (white highlights); default 0 = Lambert only */
     float shininess;           /* Phong exponent, >= 1; 0 = 32 */
+    const struct mr_display_map *display; /* light-field display mapping instead of the
+                                  pinhole (then the AO reads positions); NULL = pinhole */
 } mr_frame_params;
 #define MR_FRAME_DEFAULT_ALPHA 0.5f
 #define MR_FRAME_DEFAULT_BACKGROUND {0.62f, 0.66f, 0.70f}
@@ -437,6 +439,46 @@ void mr_quilt_tile_origin(const mr_quilt_layout *q, int i, int *x, int *y);
 bool mr_quilt_put(const mr_quilt_layout *q, mr_image *quilt, int i, const mr_image *view, mr_error *err);
 /* "NAME_qs8x6a0.75.png". */
 void mr_quilt_file_name(const char *name, const mr_quilt_layout *q, char *out, size_t n);
+
+/* A horizontal-parallax-only light-field display (HoloVizio-like): each
+ * pixel column u is seen from its own eye on the observer line (the centre
+ * camera's x axis), e(u) = (2 (u + 0.5) / W - 1) E with E = D tan(cone/2),
+ * through its own point of the focal plane; vertically every column is the
+ * centre camera. The world-to-image mapping is not affine and not a 4x4
+ * projection (x and y have different denominators; all columns' rays cross
+ * at one depth when E exceeds the focal plane's half-width), so AO reads
+ * positions, never un-projected depth. It is rendered in narrow perspective
+ * slices: each band of `band` columns is a pinhole view from the eye of its
+ * middle column, scissored to the band, into the one G-buffer. At band 1
+ * every pixel centre's ray is the column's exact ray; a column j away from
+ * its band's middle is off by |j q / (1 - q)| pixels, q = (E / A)(1 - D/z),
+ * for a surface at depth z (A the focal plane's half-width seen by the
+ * camera): mr_display_column_error. */
+typedef struct mr_display_map {
+    double distance;        /* D: the focal plane, scene units */
+    double eye_half;        /* E: the observer line spans [-E, E] on the x axis */
+    int band;               /* columns per perspective slice, >= 1 */
+} mr_display_map;
+#define MR_DISPLAY_DEFAULT_BAND 1
+/* From a rig: its D and E = D tan(cone/2). */
+mr_display_map mr_display_from_rig(const mr_rig *rig, int band);
+/* The eye (x on the observer line) of column u of a W-pixel image. */
+double mr_display_eye(const mr_display_map *m, int width, double u);
+/* The centre-camera point seen at pixel (u, v) at depth z through the exact
+ * ray of column u; `cam` is the frame's (centre) camera. */
+mr_dvec3 mr_display_point(const mr_display_map *m, const mr_camera *cam, double u, double v, double z);
+/* The exact pixel of a centre-camera point (the inverse of the above for
+ * its own depth); false behind the observer line or where the columns'
+ * rays cross (no single column sees the point's depth). */
+bool mr_display_project(const mr_display_map *m, const mr_camera *cam, mr_dvec3 p, double *u, double *v);
+/* Band b's columns [*x0, *x1) and its pinhole camera (the frame camera
+ * with the principal point shifted by fx e_b / D) and eye offset e_b. */
+int mr_display_band_count(const mr_display_map *m, int width);
+mr_camera mr_display_band_camera(const mr_display_map *m, const mr_camera *cam, int b, int *x0, int *x1, double *eye);
+/* Column error (pixels) of the banded rendering for a surface at depth z
+ * seen in column u: where the exact mapping puts the point the band's
+ * camera drew there, minus u. 0 for band 1 at pixel centres. */
+double mr_display_column_error(const mr_display_map *m, const mr_camera *cam, int u, double z);
 
 /* Renders the rig's views with one renderer (scene upload and programs are
  * shared; each view is a mr_render_frame of its own camera). Writes

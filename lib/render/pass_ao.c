@@ -29,6 +29,7 @@ typedef struct ao_key {
     bool hide_hidden;
     uint64_t scene_gen;
     mr_ao_params p; /* resolved, with want_ao / want_mask / no_reuse cleared */
+    mr_display_map display; /* zeros for the pinhole */
 } ao_key;
 
 struct mr_ao_state {
@@ -342,6 +343,11 @@ static ao_key key_of(const frame *f, const mr_ao_params *resolved, uint64_t scen
     key.hide_hidden = f->p->hide_hidden_layer;
     key.scene_gen = scene_gen;
     copy_fields(&key.p, resolved);
+    if (f->p->display) {
+        key.display.distance = f->p->display->distance;
+        key.display.eye_half = f->p->display->eye_half;
+        key.display.band = f->p->display->band;
+    }
     return key;
 }
 
@@ -589,6 +595,10 @@ static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
     glUniform4fv(MR_LOC_AO_KERNEL, MR_AO_MAX_SAMPLES, s->kernel3);
     glUniform4fv(MR_LOC_AO_KERNEL2, MR_AO_MAX_SAMPLES, s->kernel2);
     noise_uniforms(f, p);
+    /* The display mapping: D, E and the width for project()'s exact
+     * per-column formula; D = 0 is the pinhole. */
+    const mr_display_map *dm = f->p->display;
+    glUniform3f(MR_LOC_AO_DISPLAY, dm ? (float)dm->distance : 0.0f, dm ? (float)dm->eye_half : 0.0f, (float)f->r->w);
     fullscreen(f, s->fbo_ao[0], s->aw, s->ah);
     s->cur = 0;
     s->result = s->tex_ao[0];
