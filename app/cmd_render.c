@@ -123,6 +123,15 @@ int cmd_render(int argc, char **argv) {
     bool multiview = rp.views > 0 || have_quilt;
     if (multiview && (aux || groundtruth || app_get(opts, "video")))
         return app_errorf(cmd, "--aux, --video and --ao groundtruth are for single views, not --views"), 2;
+    long lf_band = 0;
+    if (app_get(opts, "lightfield")) {
+        if (!app_int("lightfield", app_get(opts, "lightfield"), 1, 16384, &lf_band)) return 2;
+        if (app_get(opts, "video") || fp.ghost.mode != MR_GHOST_OFF)
+            return app_errorf(cmd, "--lightfield draws no --video and no --ghost"), 2;
+    }
+    /* filled by app_lightfield_view once the GPU is there */
+    mr_display_map lf_map = {0};
+    if (lf_band > 0) fp.display = gtp.display = &lf_map;
 
     /* Everything that can be checked without a GPU is checked first, so a
      * bad input never costs a context. */
@@ -169,6 +178,9 @@ int cmd_render(int argc, char **argv) {
             else if (!app_flag(opts, "quiet"))
                 printf("rendered %d views of %dx%d into %s/ (quilt %dx%d, focal distance %g) in %.0f ms\n", rr.views,
                        ql.tile_w, ql.tile_h, out, ql.cols, ql.rows, focal, rr.ms_total);
+        } else if (lf_band > 0 && !app_lightfield_view(gfx.renderer, scene, &rp, (int)lf_band, &view, &fp, &view, &lf_map,
+                                                       &err)) {
+            rc = app_error(cmd, &err);
         } else if (!mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||
                    (groundtruth && !render_groundtruth(gfx.renderer, scene, &view, &fp, &gtp, &res, &err)))
             rc = app_error(cmd, &err);

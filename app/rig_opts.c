@@ -16,8 +16,50 @@ bool app_rig_check(const char *cmd, const app_table *t, const app_opt *opts, mr_
         *have_quilt = true;
     }
     bool rig_opt = app_table_given(t, "view-cone") || app_table_given(t, "view-fov") || app_table_given(t, "focal-distance");
-    if (rp->views == 0 && !*have_quilt && rig_opt)
-        return app_errorf(cmd, "--view-cone, --view-fov and --focal-distance need --views or --quilt"), false;
+    bool lf = app_get(opts, "lightfield") != NULL;
+    if (rp->views == 0 && !*have_quilt && !lf && rig_opt)
+        return app_errorf(cmd, "--view-cone, --view-fov and --focal-distance need --views, --quilt or --lightfield"), false;
+    if (lf && (rp->views > 0 || *have_quilt))
+        return app_errorf(cmd, "--lightfield is one display image: not with --views or --quilt"), false;
+    return true;
+}
+
+bool app_rig_focal(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, const mr_view *centre,
+                   const mr_frame_params *fp, int w, int h, double *focal, mr_error *err) {
+    double d = rp->focal_distance > 0 ? rp->focal_distance : *focal;
+    if (!(d > 0)) {
+        /* Where the centre view looks: one frame of depth at the view size. */
+        mr_frame_params dp = *fp;
+        dp.video = NULL;
+        dp.display = NULL;
+        dp.want_depth = true;
+        dp.ao.method = MR_AO_NONE;
+        dp.ao.external = NULL;
+        dp.width = w;
+        dp.height = h;
+        mr_frame_result fr;
+        if (!mr_render_frame(r, centre, &dp, &fr, err)) return false;
+        d = mr_rig_focal_from_depth(&fr.depth);
+        mr_frame_result_free(&fr);
+        if (!(d > 0)) d = mr_rig_auto_focal_distance(scene, centre);
+    }
+    if (!(d > 0)) return mr_fail(err, MR_ERR_INVALID, "nothing in front of the camera to focus on: give --focal-distance");
+    *focal = d;
+    return true;
+}
+
+bool app_lightfield_view(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, int band, const mr_view *view,
+                         const mr_frame_params *fp, mr_view *centre, mr_display_map *map, mr_error *err) {
+    int w = fp->width > 0 ? fp->width : view->camera.width, h = fp->height > 0 ? fp->height : view->camera.height;
+    double d = 0;
+    if (!app_rig_focal(r, scene, rp, view, fp, w, h, &d, err)) return false;
+    mr_rig_params one = *rp;
+    one.views = 1;
+    mr_rig rig;
+    if (!mr_rig_make(&one, (double)w / h, d, &rig, err)) return false;
+    rig.cone = rp->cone_deg * 3.14159265358979323846 / 180; /* the observer line's, not a single view's */
+    *centre = mr_rig_view(&rig, view, 0, w, h);
+    *map = mr_display_from_rig(&rig, band);
     return true;
 }
 
@@ -28,24 +70,8 @@ bool app_rig_render(mr_renderer *r, const mr_scene *scene, const mr_rig_params *
     int w = fp->width > 0 ? fp->width : centre->camera.width, h = fp->height > 0 ? fp->height : centre->camera.height;
     if (p.views == 0) p.views = quilt->cols * quilt->rows; /* --quilt alone: a view per tile */
     if (!mr_quilt_layout_make(quilt->cols ? quilt : NULL, p.views, w, h, layout, err)) return false;
-    double d = p.focal_distance > 0 ? p.focal_distance : *focal;
-    if (!(d > 0)) {
-        /* Where the centre view looks: one frame of depth at the tile size. */
-        mr_frame_params dp = *fp;
-        dp.video = NULL;
-        dp.want_depth = true;
-        dp.ao.method = MR_AO_NONE;
-        dp.width = layout->tile_w;
-        dp.height = layout->tile_h;
-        mr_frame_result fr;
-        if (!mr_render_frame(r, centre, &dp, &fr, err)) return false;
-        d = mr_rig_focal_from_depth(&fr.depth);
-        mr_frame_result_free(&fr);
-        if (!(d > 0)) d = mr_rig_auto_focal_distance(scene, centre);
-    }
-    if (d > 0) *focal = d;
-    if (!(d > 0))
-        return mr_fail(err, MR_ERR_INVALID, "nothing in front of the camera to focus on: give --focal-distance");
+    if (!app_rig_focal(r, scene, &p, centre, fp, layout->tile_w, layout->tile_h, focal, err)) return false;
+    double d = *focal;
     mr_rig rig;
     if (!mr_rig_make(&p, layout->aspect, d, &rig, err)) return false;
     mr_image img = {0};

@@ -54,7 +54,16 @@ else
   need_device $rc "$tmp/rp.log" "replay --views"
 fi
 
+# One image under the light-field display mapping, exact (band 1) and in
+# slices of 8 columns: both a picture, not the same one.
+"$mr" render --scene "$s" --view "$v" --out "$tmp/lf1.png" --lightfield 1 --size 64x48 --ao filion >"$tmp/lf.log" 2>&1 \
+  && "$mr" render --scene "$s" --view "$v" --out "$tmp/lf8.png" --lightfield 8 --size 64x48 --ao filion >>"$tmp/lf.log" 2>&1 \
+  && [ "$(png_size "$tmp/lf1.png")" = "64x48" ] && ! cmp -s "$tmp/lf1.png" "$tmp/lf8.png" && ok \
+  || bad "--lightfield: $(cat "$tmp/lf.log")"
+
 # --- bad input -----------------------------------------------------------
+expect_fail lf0 "$tmp/b12.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b12.png" --lightfield 0
+expect_fail lf_views "$tmp/b13" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b13" --lightfield 1 --views 4
 expect_fail views0 "$tmp/b1" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b1" --views 0
 expect_fail views_neg "$tmp/b2" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b2" --views -3
 expect_fail cone180 "$tmp/b3" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b3" --views 8 --view-cone 180
