@@ -161,6 +161,9 @@ bool app_rig_render(mr_renderer *r, const mr_scene *scene, const mr_rig_params *
                     const mr_view *centre, const mr_frame_params *fp, const char *views_dir, const char *quilt_dir,
                     const char *quilt_name, double *focal, mr_quilt_layout *layout, mr_rig_result *res, mr_error *err);
 
+/* mrcheck bench multiview (bench_multiview.c). */
+int bench_multiview(int argc, char **argv);
+
 int cmd_synth(int argc, char **argv);
 int cmd_factory(int argc, char **argv);
 int bench_scene(int argc, char **argv);

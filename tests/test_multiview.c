@@ -6,6 +6,7 @@
 #include "mr_test.h"
 #include "mr_test_scene.h"
 
+#include "mr_bench.h"
 #include "mr_eval.h"
 #include "mr_render.h"
 
@@ -437,6 +438,67 @@ static void test_display_gpu(mr_renderer *r) {
     mr_scene_destroy(&s);
 }
 
+/* Lines of a file (0 if unreadable) and whether its first non-comment
+ * line is `header`. */
+static int csv_lines(const char *path, const char *header) {
+    size_t n = 0;
+    mr_error err = {0};
+    char *t = mr_file_read(path, &n, 0, &err);
+    if (!t) return 0;
+    int lines = 0;
+    bool head_ok = false, seen_head = false;
+    for (char *l = t; l && *l; ) {
+        char *e = strchr(l, '\n');
+        if (e) *e = 0;
+        if (l[0] != '#') {
+            if (!seen_head) head_ok = strcmp(l, header) == 0, seen_head = true;
+            else lines++;
+        }
+        l = e ? e + 1 : NULL;
+    }
+    free(t);
+    return head_ok ? lines : -1;
+}
+
+/* The bench at a tiny size: its files, columns and rows. */
+static void test_bench_tiny(mr_gpu *gpu, mr_renderer *r) {
+    char dir[4096], path[4200];
+    if (!mr_test_fresh_dir("multiview_bench", dir, sizeof dir)) return;
+    mr_bench_multiview_params p = {MR_BENCH_MULTIVIEW_DEFAULTS};
+    p.gfx.gpu = gpu;
+    p.gfx.renderer = r;
+    p.out_dir = dir;
+    p.quick = true;
+    p.budget_w = 64;
+    p.budget_h = 48;
+    p.view_w = 32;
+    p.view_h = 24;
+    p.table_w = 32;
+    p.table_h = 24;
+    p.frames = 1;
+    p.rays = 4;
+    mr_error err = {0};
+    CHECK_MSG(mr_bench_multiview(&p, &err), "bench multiview: %s", err.msg);
+    snprintf(path, sizeof path, "%s/bench_multiview.csv", dir);
+    CHECK_MSG(csv_lines(path, "mode,views,width,height,ms_frame,ms_per_view,ao_rmse_pinhole,ao_rmse_display,"
+                              "consistency_rmse_world,consistency_rmse_pixel,consistency_rmse_world_noblur,"
+                              "consistency_rmse_pixel_noblur,shared_fraction") == 4,
+              "bench_multiview.csv: header or 4 rows (quick: 2 modes x views 1, 8)");
+    snprintf(path, sizeof path, "%s/bench_multiview_display.csv", dir);
+    CHECK(csv_lines(path, "band,width,height,ms_frame,column_error_mean_px,column_error_max_px,ao_rmse_display") == 3);
+    snprintf(path, sizeof path, "%s/bench_multiview_table1.csv", dir);
+    CHECK(csv_lines(path, "scene,triangles,width,height,ms_no_ssao,ms_ssao,ms_difference") == 3);
+    snprintf(path, sizeof path, "%s/bench_multiview.svg", dir);
+    size_t n = 0;
+    char *svg = mr_file_read(path, &n, 0, &err);
+    CHECK(svg && strstr(svg, "<svg"));
+    free(svg);
+    snprintf(path, sizeof path, "%s/bench_multiview.md", dir);
+    char *md = mr_file_read(path, &n, 0, &err);
+    CHECK(md && strstr(md, "| per_view | 8 | 32x24 |") && strstr(md, "Table 1"));
+    free(md);
+}
+
 static int test_gpu(void) {
     mr_error err = {0};
     mr_gpu_params gp = MR_GPU_DEFAULTS;
@@ -510,6 +572,7 @@ static int test_gpu(void) {
     CHECK(mr_renderer_set_scene(r, NULL, &err));
     mr_scene_destroy(&s);
     test_display_gpu(r);
+    test_bench_tiny(gpu, r);
     mr_renderer_destroy(&r);
     mr_gpu_destroy(&gpu);
     return 0;

@@ -38,8 +38,9 @@ typedef struct mr_gt_params {
     uint64_t seed;                 /* 0 = 1 */
     int threads;                   /* 0 = one per online CPU */
     const mr_display_map *display; /* the frame's light-field display mapping: the
-                                      surface point of pixel (u, v) lies on column u's
-                                      own ray (mr_display_point); NULL = pinhole */
+                                      surface point of pixel (u, v) lies on the ray the
+                                      slices drew it with (mr_display_point; column u's
+                                      own ray at band 1); NULL = pinhole */
 } mr_gt_params;
 #define MR_GT_DEFAULTS {MR_AO_RADIUS_VIEW, 0.0, 0.05, 256, 1, 0, NULL}
 

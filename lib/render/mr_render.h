@@ -464,12 +464,14 @@ typedef struct mr_display_map {
 mr_display_map mr_display_from_rig(const mr_rig *rig, int band);
 /* The eye (x on the observer line) of column u of a W-pixel image. */
 double mr_display_eye(const mr_display_map *m, int width, double u);
-/* The centre-camera point seen at pixel (u, v) at depth z through the exact
- * ray of column u; `cam` is the frame's (centre) camera. */
+/* The centre-camera point the banded rendering puts at pixel (u, v) at
+ * depth z: on the ray of u in its band's camera (at band 1 the exact ray of
+ * column u), as the positions texture holds it; `cam` is the frame's
+ * (centre) camera. */
 mr_dvec3 mr_display_point(const mr_display_map *m, const mr_camera *cam, double u, double v, double z);
-/* The exact pixel of a centre-camera point (the inverse of the above for
- * its own depth); false behind the observer line or where the columns'
- * rays cross (no single column sees the point's depth). */
+/* The exact pixel of a centre-camera point under the per-column mapping
+ * (the inverse of the above at band 1); false behind the observer line or
+ * where the columns' rays cross (no single column sees the point's depth). */
 bool mr_display_project(const mr_display_map *m, const mr_camera *cam, mr_dvec3 p, double *u, double *v);
 /* Band b's columns [*x0, *x1) and its pinhole camera (the frame camera
  * with the principal point shifted by fx e_b / D) and eye offset e_b. */

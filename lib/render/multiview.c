@@ -278,9 +278,14 @@ mr_display_map mr_display_from_rig(const mr_rig *rig, int band) {
 double mr_display_eye(const mr_display_map *m, int width, double u) { return (2 * (u + 0.5) / width - 1) * m->eye_half; }
 
 mr_dvec3 mr_display_point(const mr_display_map *m, const mr_camera *cam, double u, double v, double z) {
-    /* Column u's ray is the pinhole ray of u in a camera at eye e whose
-     * principal point is moved by fx e / D (the rig's shear). */
-    double e = mr_display_eye(m, cam->width, u);
+    /* The ray of u in its band's camera: a pinhole at the band's eye e whose
+     * principal point is moved by fx e / D (the rig's shear); at band 1,
+     * column u's own ray. */
+    int k = m->band > 0 ? m->band : 1, b = (int)floor((u + 0.5) / k), x0, x1;
+    if (b < 0) b = 0;
+    double e;
+    mr_display_band_camera(m, cam, b, &x0, &x1, &e);
+    if (k == 1) e = mr_display_eye(m, cam->width, u); /* exact between pixel centres too */
     return mr_v3((u - cam->cx - cam->fx * e / m->distance) / cam->fx * z + e, (v - cam->cy) / cam->fy * z, z);
 }
 
@@ -311,11 +316,8 @@ mr_camera mr_display_band_camera(const mr_display_map *m, const mr_camera *cam, 
 }
 
 double mr_display_column_error(const mr_display_map *m, const mr_camera *cam, int u, double z) {
-    int k = m->band > 0 ? m->band : 1, x0, x1;
-    double e;
-    mr_camera bc = mr_display_band_camera(m, cam, u / k, &x0, &x1, &e);
     /* The band camera's ray through column u's centre, at depth z. */
-    mr_dvec3 p = mr_v3((u - bc.cx) / bc.fx * z + e, 0, z);
+    mr_dvec3 p = mr_display_point(m, cam, u, cam->cy, z);
     double uu, vv;
     if (!mr_display_project(m, cam, p, &uu, &vv)) return NAN;
     return uu - u;
