@@ -57,6 +57,7 @@ int cmd_replay(int argc, char **argv) {
     mr_quilt quilt = {0};
     bool have_quilt;
     if (!app_rig_check(cmd, &tables[2], opts, &quilt, &have_quilt)) return 2;
+    if (app_get(opts, "lightfield")) return app_errorf(cmd, "--lightfield is for single frames (mrcheck render)"), 2;
     /* Multi-view: per frame a quilt overlay_NNNNNN_qs..png and its views in
      * overlay_NNNNNN/; the camera frame is seen from one eye only, so the
      * views show the plan alone. */

@@ -73,6 +73,7 @@ expect_fail quilt_tiny "$tmp/b6" -- "$mr" render --scene "$s" --view "$v" --out 
 expect_fail cone_alone "$tmp/b7" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b7.png" --view-cone 20
 expect_fail focal_neg "$tmp/b8" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b8" --views 4 --focal-distance -1
 expect_fail views_aux "$tmp/b9" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b9" --views 4 --aux "$tmp/b9aux"
+expect_fail replay_lf "$tmp/b14" -- "$mr" replay "$src/recordings/demo" --scene "$s" --out "$tmp/b14" --lightfield 1
 expect_fail replay_views0 "$tmp/b10" -- "$mr" replay "$src/recordings/demo" --scene "$s" --out "$tmp/b10" --views 0
 expect_fail replay_quilt_small "$tmp/b11" -- "$mr" replay "$src/recordings/demo" --scene "$s" --out "$tmp/b11/x" --from 20 --to 20 --views 5 --quilt 2x2
 
