@@ -403,32 +403,42 @@ static void test_display_gpu(mr_renderer *r) {
          * positions there and is less sensitive. */
         const mr_ao_method methods[2] = {MR_AO_FILION, MR_AO_SCHEER};
         for (int mi = 0; mi < 2; mi++) {
-        mr_frame_params sp = MR_FRAME_DEFAULTS;
-        sp.want_depth = true;
-        sp.ao.method = methods[mi];
-        sp.ao.radius_mode = MR_AO_RADIUS_VIEW;
-        sp.ao.radius = 0.6;
-        sp.ao.want_ao = true;
-        sp.ao.positions = true;
-        mr_frame_result sa_pin, sa_disp;
-        CHECK(mr_render_frame(r, &v, &sp, &sa_pin, &err));
-        sp.display = &m;
-        CHECK(mr_render_frame(r, &v, &sp, &sa_disp, &err));
-        if (sa_pin.ao.data && sa_disp.ao.data) {
-            double e_pin = image_rmse(&sa_pin.ao, &gt_pin, &pinr.depth), e_disp = image_rmse(&sa_disp.ao, &gt_disp, &disp.depth);
-            /* The AO computed as if the frame were a pinhole (positions
-             * right, projection of the samples wrong). */
-            printf("SSAO (%s) RMSE vs ground truth: pinhole %.4f, display %.4f\n", mr_ao_method_name(methods[mi]), e_pin,
-                   e_disp);
-            CHECK_MSG(e_disp < e_pin + 0.03, "%s: display SSAO error %.4f far above the pinhole's %.4f",
-                      mr_ao_method_name(methods[mi]), e_disp, e_pin);
-        }
-        mr_frame_result_free(&sa_pin);
-        mr_frame_result_free(&sa_disp);
+            mr_frame_params sp = MR_FRAME_DEFAULTS;
+            sp.want_depth = true;
+            sp.ao.method = methods[mi];
+            sp.ao.radius_mode = MR_AO_RADIUS_VIEW;
+            sp.ao.radius = 0.6;
+            sp.ao.want_ao = true;
+            sp.ao.positions = true;
+            mr_frame_result sa_pin, sa_disp;
+            CHECK(mr_render_frame(r, &v, &sp, &sa_pin, &err));
+            sp.display = &m;
+            CHECK(mr_render_frame(r, &v, &sp, &sa_disp, &err));
+            if (sa_pin.ao.data && sa_disp.ao.data) {
+                double e_pin = image_rmse(&sa_pin.ao, &gt_pin, &pinr.depth), e_disp = image_rmse(&sa_disp.ao, &gt_disp, &disp.depth);
+                printf("SSAO (%s) RMSE vs ground truth: pinhole %.4f, display %.4f\n", mr_ao_method_name(methods[mi]), e_pin,
+                       e_disp);
+                CHECK_MSG(e_disp < e_pin + 0.03, "%s: display SSAO error %.4f far above the pinhole's %.4f",
+                          mr_ao_method_name(methods[mi]), e_disp, e_pin);
+            }
+            mr_frame_result_free(&sa_pin);
+            mr_frame_result_free(&sa_disp);
         }
     } else {
         CHECK_MSG(false, "ground truth: %s", err.msg);
     }
+    /* What the mapping cannot draw is refused with one line. */
+    mr_frame_params refused = MR_FRAME_DEFAULTS;
+    refused.display = &m;
+    refused.ao.method = MR_AO_CRYTEK;
+    refused.ao.mask = MR_AO_MASK_ON;
+    mr_frame_result br;
+    CHECK(!mr_render_frame(r, &v, &refused, &br, &err) && strstr(err.msg, "display mapping"));
+    mr_display_map zero = m;
+    zero.band = 0;
+    refused.display = &zero;
+    refused.ao.mask = MR_AO_MASK_OFF;
+    CHECK(!mr_render_frame(r, &v, &refused, &br, &err) && strstr(err.msg, "band"));
     mr_image_free(&gt_disp);
     mr_image_free(&gt_pin);
     mr_eval_gt_destroy(&gt);

@@ -220,8 +220,10 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
         const mr_display_map *m = p->display;
         if (!(m->distance > 0 && isfinite(m->distance)) || !(m->eye_half >= 0 && isfinite(m->eye_half)) || m->band < 1)
             return mr_fail(err, MR_ERR_INVALID, "display mapping needs D > 0, E >= 0 and a band of >= 1 columns");
-        if (p->ghost.mode != MR_GHOST_OFF || p->video)
-            return mr_fail(err, MR_ERR_INVALID, "the display mapping draws no ghosting and no video overlay");
+        /* The outline volumes and the hidden layer are drawn through the
+         * frame's pinhole camera, so they would not line up. */
+        if (p->ghost.mode != MR_GHOST_OFF || p->video || p->ao.mask != MR_AO_MASK_OFF)
+            return mr_fail(err, MR_ERR_INVALID, "the display mapping draws no ghosting, corner mask or video overlay");
         with_pos = *p;
         with_pos.ao.positions = true;
         p = &with_pos;
