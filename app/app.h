@@ -89,6 +89,35 @@ bool app_lod_auto(const mr_cli_opt *opts);
 
 /* mrcheck study {stimuli,plan,run,analyze} (cmd_study.c). */
 int cmd_study(int argc, char **argv);
+/* Multi-view output (rig_opts.c): the rig table (no prefix: --views,
+ * --view-cone, --view-fov, --focal-distance) and --quilt, shared by render
+ * and replay. */
+#define APP_RIG_OPTS {"quilt", "SPEC", "multi-view quilt: portrait, go, 4k, 8k, CxR or CxR@WxH (default: about square)", NULL}, \
+    {"lightfield", "BAND", "one image under a light-field display's mapping (each column its own eye on the observer line of --view-cone), drawn in slices of BAND columns (1 = exact)", NULL}
+#define APP_RIG_TABLE(p) {.prefix = "", .table = mr_rig_opts, .params = (p)}
+/* --quilt into quilt (zeroed when not given); rig options without --views
+ * or --quilt are a mistake. Prints one line and returns false on bad input. */
+bool app_rig_check(const char *cmd, const mr_cli_table *t, const mr_cli_opt *opts, mr_quilt *quilt, bool *have_quilt);
+/* The focal distance: --focal-distance, else *focal when > 0, else the
+ * median depth the view sees in its middle third at w x h (one extra
+ * frame), else the scene's centre; false + err if none lies ahead. */
+bool app_rig_focal(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, const mr_view *centre,
+                   const mr_frame_params *fp, int w, int h, double *focal, mr_error *err);
+/* --lightfield BAND: the centre camera of the rig's focal-plane rectangle
+ * and the light-field display mapping for one frame around `view`. */
+bool app_lightfield_view(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, int band, const mr_view *view,
+                         const mr_frame_params *fp, mr_view *centre, mr_display_map *map, mr_error *err);
+/* Renders the rig around `centre`: view_NNN.png into views_dir (NULL:
+ * none) and NAME_qs{C}x{R}a{A}.png into quilt_dir; the layout it used into
+ * *layout. The focal distance is --focal-distance, else *focal when > 0,
+ * else where the centre view looks (then stored in *focal, so a replay
+ * keeps the first frame's). */
+bool app_rig_render(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, const mr_quilt *quilt,
+                    const mr_view *centre, const mr_frame_params *fp, const char *views_dir, const char *quilt_dir,
+                    const char *quilt_name, double *focal, mr_quilt_layout *layout, mr_rig_result *res, mr_error *err);
+
+/* mrcheck bench multiview (bench_multiview.c). */
+int bench_multiview(int argc, char **argv);
 
 int cmd_synth(int argc, char **argv);
 int cmd_factory(int argc, char **argv);

@@ -83,6 +83,7 @@ int cmd_render(int argc, char **argv) {
         {"hidden", "GLOB", "extra node-name glob for the hidden layer", NULL},
         {"hide-hidden", NULL, "leave the hidden layer out", NULL},
         APP_DRAW_OPTS,
+        APP_RIG_OPTS,
         {"lod-cache", "on|off", "read/write LOD levels in <scene>.mrlod (default on)", NULL},
         {"verbose", NULL, "print the passes that ran and more", NULL},
         {"quiet", NULL, "errors only", NULL},
@@ -90,13 +91,15 @@ int cmd_render(int argc, char **argv) {
     };
     mr_frame_params fp = MR_FRAME_DEFAULTS;
     mr_gt_params gtp = MR_GT_DEFAULTS;
+    mr_rig_params rp = MR_RIG_DEFAULTS;
     mr_cli_table tables[] = {APP_AO_TABLE(&fp.ao), APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&fp.ghost),
-                             APP_SHADOW_TABLE(&fp.shadow)};
+                             APP_SHADOW_TABLE(&fp.shadow), APP_RIG_TABLE(&rp)};
     bool help;
-    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 4, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 5, NULL, 0, NULL,
                    "usage: mrcheck render --scene FILE --view VIEW.json --out OUT.png [--size WxH] "
                    "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive] "
-                   "[--shadows off|hard|pcf|pcss|bp|groundtruth ...]",
+                   "[--shadows off|hard|pcf|pcss|bp|groundtruth ...] "
+                   "[--views N --view-cone DEG [--focal-distance D] [--quilt SPEC]: --out is then a folder]",
                    &help))
         return 2;
     if (help) return 0;
@@ -121,6 +124,21 @@ int cmd_render(int argc, char **argv) {
     fp.ao.want_ao = aux != NULL;
     fp.ao.temporal = false; /* issue 18: a single frame has nothing to accumulate */
     fp.shadow.want_shadow = aux != NULL;
+    mr_quilt quilt = {0};
+    bool have_quilt;
+    if (!app_rig_check(cmd, &tables[4], opts, &quilt, &have_quilt)) return 2;
+    bool multiview = rp.views > 0 || have_quilt;
+    if (multiview && (aux || groundtruth || mr_cli_get(opts, "video")))
+        return mr_cli_errorf(cmd, "--aux, --video and --ao groundtruth are for single views, not --views"), 2;
+    long lf_band = 0;
+    if (mr_cli_get(opts, "lightfield")) {
+        if (!mr_cli_int("lightfield", mr_cli_get(opts, "lightfield"), 1, 16384, &lf_band)) return 2;
+        if (mr_cli_get(opts, "video") || fp.ghost.mode != MR_GHOST_OFF)
+            return mr_cli_errorf(cmd, "--lightfield draws no --video and no --ghost"), 2;
+    }
+    /* filled by app_lightfield_view once the GPU is there */
+    mr_display_map lf_map = {0};
+    if (lf_band > 0) fp.display = gtp.display = &lf_map;
 
     /* Everything that can be checked without a GPU is checked first, so a
      * bad input never costs a context. */
@@ -161,12 +179,26 @@ int cmd_render(int argc, char **argv) {
         rc = mr_cli_error(cmd, &err);
     } else {
         if (!mr_renderer_set_draw_params(gfx.renderer, &dp, &err) || !mr_renderer_set_scene(gfx.renderer, scene, &err) ||
-            !mr_renderer_set_lod(gfx.renderer, lod, &err) || !mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||
-            (groundtruth && !render_groundtruth(gfx.renderer, scene, &view, &fp, &gtp, &res, &err)))
+            !mr_renderer_set_lod(gfx.renderer, lod, &err)) {
+            rc = mr_cli_error(cmd, &err);
+        } else if (multiview) {
+            mr_quilt_layout ql;
+            mr_rig_result rr;
+            double focal = 0;
+            if (!app_rig_render(gfx.renderer, scene, &rp, &quilt, &view, &fp, out, out, "quilt", &focal, &ql, &rr, &err))
+                rc = mr_cli_error(cmd, &err);
+            else if (!mr_cli_flag(opts, "quiet"))
+                printf("rendered %d views of %dx%d into %s/ (quilt %dx%d, focal distance %g) in %.0f ms\n", rr.views,
+                       ql.tile_w, ql.tile_h, out, ql.cols, ql.rows, focal, rr.ms_total);
+        } else if (lf_band > 0 && !app_lightfield_view(gfx.renderer, scene, &rp, (int)lf_band, &view, &fp, &view, &lf_map,
+                                                       &err)) {
+            rc = mr_cli_error(cmd, &err);
+        } else if (!mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||
+                   (groundtruth && !render_groundtruth(gfx.renderer, scene, &view, &fp, &gtp, &res, &err)))
             rc = mr_cli_error(cmd, &err);
         else if (!mr_image_save_png(out, &res.color, &err) || (aux && !app_write_aux(aux, &res, &err)))
             rc = mr_cli_error(cmd, &err);
-        if (rc == 0 && mr_cli_flag(opts, "verbose")) {
+        if (rc == 0 && !multiview && mr_cli_flag(opts, "verbose")) {
             char passes[256];
             mr_frame_result_passes(&res, passes, sizeof passes);
             fprintf(stderr, "mrcheck: render: passes: %s; %u draw calls, %llu triangles, near plane %g\n", passes,

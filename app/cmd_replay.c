@@ -3,12 +3,39 @@
 #include "app_track.h"
 #include "mr_batch.h"
 
+#include <string.h>
+
+/* --views / --quilt: per frame a quilt overlay_NNNNNN_qs..png and its views
+ * in overlay_NNNNNN/ (app_rig_render); the camera frame is seen from one
+ * eye only, so the views show the plan alone. */
+typedef struct rig_replay {
+    const mr_scene *scene;
+    const mr_rig_params *rp;
+    const mr_quilt *quilt;
+    const char *out;
+    double focal; /* the first frame's, kept for the whole replay */
+} rig_replay;
+
+static bool render_rig(void *user, mr_renderer *r, const mr_view *view, const mr_frame_params *fp, int64_t index,
+                       char *name, size_t name_n, mr_error *err) {
+    rig_replay *rr = user;
+    char stem[64], vdir[4096];
+    snprintf(stem, sizeof stem, "overlay_%06lld", (long long)index);
+    mr_path_join(rr->out, stem, vdir, sizeof vdir);
+    mr_quilt_layout ql;
+    if (!app_rig_render(r, rr->scene, rr->rp, rr->quilt, view, fp, vdir, rr->out, stem, &rr->focal, &ql, NULL, err))
+        return false;
+    mr_quilt_file_name(stem, &ql, name, name_n);
+    return true;
+}
+
 int cmd_replay(int argc, char **argv) {
     static const char *cmd = "replay";
     mr_cli_opt opts[] = {
         {"scene", "S", "glTF/GLB or scene config of the plan (required)", NULL},
         {"out", "OUTDIR", "where overlay_NNNNNN.png and replay.jsonl go (required)", NULL},
         {"video", "FILE.avi", "also write the overlays as a Motion-JPEG AVI at the recording's rate", NULL},
+        APP_RIG_OPTS,
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -18,12 +45,15 @@ int cmd_replay(int argc, char **argv) {
     mr_batch_replay_params p = MR_BATCH_REPLAY_DEFAULTS;
     /* Depth cues as on render: the same option tables and checks. */
     mr_gt_params gtp = MR_GT_DEFAULTS;
+    mr_rig_params rp = MR_RIG_DEFAULTS;
     mr_cli_table tables[] = {{"", mr_batch_replay_opts, &p, NULL, false, {0}}, APP_AO_TABLE(&p.frame.ao),
-                             APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&p.frame.ghost), APP_SHADOW_TABLE(&p.frame.shadow)};
+                             APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&p.frame.ghost), APP_SHADOW_TABLE(&p.frame.shadow),
+                             APP_RIG_TABLE(&rp)};
     bool help;
-    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 5, pos, 1, &npos,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 6, pos, 1, &npos,
                              "usage: mrcheck replay DIR --scene S --out OUTDIR [--alpha A] [--every N] [--from F --to T] "
-                             "[--raw] [--video F.avi] [--ao METHOD ...] [--ghost MODE ...] [--shadows METHOD ...]",
+                             "[--raw] [--video F.avi] [--ao METHOD ...] [--ghost MODE ...] [--shadows METHOD ...] "
+                             "[--views N --view-cone DEG [--focal-distance D] [--quilt SPEC]]",
                              &help))
         return 2;
     if (help) return 0;
@@ -36,18 +66,40 @@ int cmd_replay(int argc, char **argv) {
     p.out_dir = mr_cli_get(opts, "out");
     p.video_path = mr_cli_get(opts, "video");
     p.progress = true;
+    mr_quilt quilt = {0};
+    bool have_quilt;
+    if (!app_rig_check(cmd, &tables[5], opts, &quilt, &have_quilt)) return 2;
+    if (mr_cli_get(opts, "lightfield")) return mr_cli_errorf(cmd, "--lightfield is for single frames (mrcheck render)"), 2;
+    bool multiview = rp.views > 0 || have_quilt;
+    rig_replay rig = {NULL, &rp, &quilt, p.out_dir, 0};
+    if (multiview) {
+        p.render = render_rig;
+        p.render_user = &rig;
+    }
     mr_error err = {0};
     /* Everything that can be checked without a GPU is checked first. */
     if (!mr_batch_replay_check(&p, &err)) return mr_cli_error(cmd, &err), 2;
     mr_recording *rec = mr_recording_open(pos[0], &err);
     if (!rec) return mr_cli_error(cmd, &err);
     p.recording = rec;
+    if (multiview) {
+        /* A quilt too small for the views is bad input: found before any
+         * output folder or GPU context is made. */
+        mr_quilt_layout ql;
+        mr_rig_params chk = rp;
+        if (chk.views == 0) chk.views = quilt.cols * quilt.rows;
+        if (!mr_quilt_layout_make(quilt.cols ? &quilt : NULL, chk.views, rec->camera.width, rec->camera.height, &ql, &err)) {
+            mr_recording_close(&rec);
+            return mr_cli_error(cmd, &err);
+        }
+    }
     mr_scene *scene = mr_scene_load(mr_cli_get(opts, "scene"), NULL, &err);
     if (scene && !app_shadow_scene_default(cmd, &tables[4], scene, &p.frame.shadow)) {
         mr_scene_destroy(&scene);
         mr_recording_close(&rec);
         return 2;
     }
+    rig.scene = scene;
     app_gfx gfx = {0};
     mr_batch_replay_stats st;
     bool ok = scene && app_gfx_open(&gfx, &err) && mr_batch_replay(&p, gfx.renderer, scene, &st, &err);

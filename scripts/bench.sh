@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Rebuilds mrcheck and regenerates every bench table committed under
-# docs/bench/ (ao, ghost, tracking, scene), each stamped with the commit it
-# was made at and the exact command.
+# docs/bench/ (ao, ghost, tracking, scene, multiview), each stamped with the
+# commit it was made at and the exact command.
 #
-#   scripts/bench.sh [ao|ghost|tracking|scene|shadows ...]   (default: the first four)
+#   scripts/bench.sh [ao|ghost|tracking|scene|multiview|shadows ...]   (default: all but shadows)
 #
 # Commit first, then run: the stamp names HEAD and says "dirty" when the
 # working tree differs from it (tables of uncommitted code). Sizes are
@@ -15,7 +15,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 benches=("$@")
-[ ${#benches[@]} -gt 0 ] || benches=(ao ghost tracking scene)
+[ ${#benches[@]} -gt 0 ] || benches=(ao ghost tracking scene multiview)
 full=${MR_BENCH_FULL:-0}
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
@@ -103,7 +103,9 @@ for b in "${benches[@]}"; do
     shadows)
         # Not in the default list: about 30 minutes here (13 cases x 2 views).
         run bench_shadows docs/bench/shadows $mr bench shadows --out docs/bench/shadows --quiet ;;
-    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, shadows)" >&2; exit 2 ;;
+    multiview)
+        run bench_multiview docs/bench/multiview $mr bench multiview --out docs/bench/multiview --quiet ;;
+    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, multiview, shadows)" >&2; exit 2 ;;
     esac
 done
 echo "bench.sh: wrote docs/bench/ at commit $commit ($dirty)" >&2

@@ -31,6 +31,11 @@ layout(location = MR_LOC_AO_SLICE_COUNT) uniform int u_slice_count;  // 1..16
 layout(location = MR_LOC_AO_STEPS) uniform int u_steps;              // samples per slice side
 layout(location = MR_LOC_AO_THICKNESS) uniform float u_thickness;    // fraction of the radius
 layout(location = MR_LOC_AO_FRAME) uniform int u_frame;              // temporal accumulation: frame index
+layout(location = MR_LOC_AO_NOISE) uniform int u_noise;         // 0 pixel hash, 1 world-position hash
+layout(location = MR_LOC_AO_NOISE_CELL) uniform float u_noise_cell; // grid cell of the hash (scene units)
+layout(location = MR_LOC_AO_NOISE_FRAME) uniform mat4 u_noise_frame; // anchor_from_camera
+
+layout(location = MR_LOC_AO_DISPLAY) uniform vec3 u_display;       // D, E, width; D = 0: pinhole
 
 layout(binding = MR_TEX_AO_DEPTH) uniform sampler2D u_depth;
 layout(binding = MR_TEX_AO_NORMAL) uniform sampler2D u_normal;
@@ -59,6 +64,14 @@ bool project(vec3 s, out ivec2 q) {
     q = ivec2(0);
     if (!(s.z > 0.0)) return false;
     vec2 uv = s.xy / s.z * u_intr.xy + u_intr.zw;
+    if (u_display.x > 0.0) {
+        // Light-field display: the column whose own eye e(u) = a (u + 0.5) - E
+        // sees s; solved from u = fx x/z + cx + fx e(u) (1/D - 1/z).
+        float a = 2.0 * u_display.y / u_display.z, g = u_intr.x * (1.0 / u_display.x - 1.0 / s.z);
+        float den = 1.0 - g * a;
+        if (!(abs(den) > 1e-6)) return false;
+        uv.x = (uv.x + g * (0.5 * a - u_display.y)) / den;
+    }
     if (!(uv.x > -0.5 && uv.y > -0.5 && uv.x < float(u_full.x) - 0.5 && uv.y < float(u_full.y) - 0.5)) return false;
     q = ivec2(floor(uv + 0.5));
     return true;
@@ -410,6 +423,17 @@ void main() {
     }
     vec3 n = ao_normal(u_normal, fp, P);
     vec3 rnd = ao_rand3(ap);
+    if (u_noise != 0) {
+        // The surface point's cell in the anchor's frame, the same in every
+        // view that shares the anchor: a grid of u_noise_cell scene units
+        // (1), or the anchor camera's pixels grouped u_noise_cell x
+        // u_noise_cell (2: cells as fine as the image wherever the point is).
+        vec3 a = (u_noise_frame * vec4(P, 1.0)).xyz;
+        vec3 w = a / u_noise_cell;
+        if (u_noise == 2) w = a.z > 0.0 ? vec3(a.xy / a.z * u_intr.xy / u_noise_cell, 0.0) : vec3(vec2(ap), 1.0);
+        ivec3 c = ivec3(clamp(floor(w), vec3(-2.0e9), vec3(2.0e9)));
+        rnd = vec3(ao_pcg3(uvec3(c) ^ uvec3(0x9e3779b9u, 0x85ebca6bu, 0xc2b2ae35u)) >> 8u) * (1.0 / 16777216.0);
+    }
     // Temporal accumulation: the per-pixel numbers move on every frame (a
     // Cranley-Patterson shift by the R3 sequence), so frames average to
     // more samples; frame 0 keeps the fixed noise of a single frame.

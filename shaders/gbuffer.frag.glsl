@@ -6,6 +6,7 @@ flat in uvec3 v_ids;    // node index + 1, layer, has texture
 
 #include "mr_bindings.h"
 layout(binding = MR_TEX_GBUFFER_BASE_COLOR) uniform sampler2D u_base_tex; // sRGB texture: sampled linear
+layout(location = MR_LOC_GBUFFER_POS_OFFSET) uniform vec3 u_pos_offset;   // this band's eye in the frame camera (display mapping)
 
 layout(location = MR_OUT_GBUFFER_ALBEDO) out vec4 o_albedo;  // sRGB8 target: linear in, encoded on write
 layout(location = MR_OUT_GBUFFER_NORMAL) out vec4 o_normal;  // xyz view normal, w = 1 where geometry
@@ -23,5 +24,5 @@ void main() {
     o_albedo = vec4(c.rgb, 1.0);
     o_normal = vec4(n, 1.0);
     o_ids = v_ids.xy;
-    o_pos = vec4(v_pos, 1.0);
+    o_pos = vec4(v_pos + u_pos_offset, 1.0);
 }

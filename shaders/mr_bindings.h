@@ -43,6 +43,7 @@
 #define MR_LOC_MODELVIEW                   0
 #define MR_LOC_NORMAL_MATRIX               1
 #define MR_LOC_PROJECTION                  2
+#define MR_LOC_GBUFFER_POS_OFFSET          3  /* gbuffer: band eye -> frame camera, added to positions */
 /* ao_main, ao_blur, ao_upsample (full screen) */
 #define MR_LOC_AO_INTR                     0
 #define MR_LOC_AO_FULL                     1
@@ -93,6 +94,11 @@
 #define MR_LOC_PROBE_FETCHES               0
 #define MR_LOC_PROBE_OFFSETS               1  /* vec4[MR_AO_KERNEL_SIZE] */
 #define MR_TEX_PROBE_SRC                   0
+/* multi-view: AO noise from the world position (after the kernels) */
+#define MR_LOC_AO_NOISE                    (MR_LOC_AO_FRAME + 1)
+#define MR_LOC_AO_NOISE_CELL               (MR_LOC_AO_NOISE + 1)
+#define MR_LOC_AO_NOISE_FRAME              (MR_LOC_AO_NOISE + 2) /* mat4: 4 locations */
+#define MR_LOC_AO_DISPLAY                  (MR_LOC_AO_NOISE + 6) /* vec3 D, E, width: light-field mapping */
 
 /* ao_outline */
 #define MR_LOC_OUTLINE_RADIUS_MODE         3

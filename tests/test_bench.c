@@ -288,6 +288,12 @@ static void test_runner(const char *tmp) {
     memset(&err, 0, sizeof err);
     CHECK_MSG(!mr_bench_shadows(&sh, &err) && err.code == MR_ERR_INVALID && strstr(err.msg, "no GPU"),
               "bench shadows without a GPU must fail naming it: '%s'", err.msg);
+    /* multiview (its run at a tiny size is in test_multiview) */
+    mr_bench_multiview_params mv = {MR_BENCH_MULTIVIEW_DEFAULTS};
+    mv.out_dir = out;
+    memset(&err, 0, sizeof err);
+    CHECK_MSG(!mr_bench_multiview(&mv, &err) && err.code == MR_ERR_INVALID && strstr(err.msg, "no GPU"),
+              "bench multiview without a GPU must fail naming it: '%s'", err.msg);
 }
 
 int main(void) {

@@ -291,7 +291,18 @@ static void test_tables(void) {
         N(mr_ao_params, "mask-strength", mask_strength, 1e-3, 1),
         N(mr_ao_params, "thickness", thickness, 1e-3, 100), /* issue 18 */
         N(mr_ao_params, "temporal", temporal, 0, 1),
+        E(mr_ao_params, "noise", noise, "pixel world"),
     };
+    /* multi-view rig (no prefix) */
+    const mr_rig_params rg = MR_RIG_DEFAULTS;
+    walk_table("mr_rig_opts", mr_rig_opts, sizeof rg, &rg);
+    const expect ex_rg[] = {
+        N(mr_rig_params, "views", views, 1, MR_RIG_MAX_VIEWS),
+        N(mr_rig_params, "view-cone", cone_deg, 0, 179),
+        N(mr_rig_params, "view-fov", fov_deg, 0.01, 179),
+        N(mr_rig_params, "focal-distance", focal_distance, 1e-30, 1e30),
+    };
+    check_rows("mr_rig_opts", mr_rig_opts, ex_rg, (int)(sizeof ex_rg / sizeof ex_rg[0]));
     const expect ex_gh[] = {
         E(mr_ghost_params, "", mode, "off alpha g0 adaptive"),
         E(mr_ghost_params, "importance", importance, "auto curvature saliency"),

@@ -26,6 +26,15 @@ extern "C" {
  * and optionally a Motion-JPEG AVI at the recording's median frame rate
  * divided by `every` (no half-written video after a failure).
  * Deterministic: the same recording gives the same images. */
+
+/* A caller's own output per frame in place of the overlay (the multi-view
+ * rig: a quilt and its views): called for each selected frame with a pose,
+ * with the frame's view and depth cues; writes its files under out_dir and
+ * puts the name replay.jsonl lists into name. Frames without a pose are
+ * then listed as "-" and nothing is written for them. */
+typedef bool (*mr_batch_replay_render_fn)(void *user, mr_renderer *r, const mr_view *view, const mr_frame_params *fp,
+                                          int64_t index, char *name, size_t name_n, mr_error *err);
+
 typedef struct mr_batch_replay_params {
     const mr_recording *recording; /* required (mr_recording_open) */
     const char *out_dir;        /* required; created */
@@ -37,6 +46,8 @@ typedef struct mr_batch_replay_params {
     int to;                     /* last frame number; < 0 (the default): the last */
     bool raw;                   /* the raw pose, not the filtered one */
     bool progress;              /* "replay: frame N" on a terminal */
+    mr_batch_replay_render_fn render; /* NULL: the overlay PNG (and the AVI) */
+    void *render_user;
 } mr_batch_replay_params;
 #define MR_BATCH_REPLAY_DEFAULT_ALPHA 0.5f
 #define MR_BATCH_REPLAY_DEFAULTS                                                                   \

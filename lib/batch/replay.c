@@ -23,6 +23,7 @@ const mr_opt mr_batch_replay_opts[] = {
 
 bool mr_batch_replay_check(const mr_batch_replay_params *p, mr_error *err) {
     if (!p->out_dir) return mr_fail(err, MR_ERR_INVALID, "replay needs an output folder");
+    if (p->render && p->video_path) return mr_fail(err, MR_ERR_INVALID, "--video is for single views, not --views");
     if (p->to >= 0 && p->to < p->from)
         return mr_fail(err, MR_ERR_INVALID, "--to %d is before --from %d", p->to, p->from);
     return true;
@@ -80,7 +81,20 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
         char name[64], path[4096];
         snprintf(name, sizeof name, "overlay_%06lld.png", (long long)f->index);
         mr_path_join(p->out_dir, name, path, sizeof path);
-        if (has_pose) {
+        if (p->render) {
+            if (has_pose) {
+                mr_view view = {mr_camera_resized(&rec->camera, img.width, img.height), pose};
+                mr_frame_params fp = p->frame;
+                fp.ao.temporal_reset = ao_restart;
+                ao_restart = false;
+                ok = p->render(p->render_user, r, &view, &fp, f->index, name, sizeof name, err);
+                st.overlays++;
+            } else {
+                ao_restart = true;
+                snprintf(name, sizeof name, "-");
+                st.plain++;
+            }
+        } else if (has_pose) {
             mr_view view = {mr_camera_resized(&rec->camera, img.width, img.height), pose};
             mr_frame_params fp = p->frame;
             fp.video = &img;

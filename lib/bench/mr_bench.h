@@ -188,6 +188,32 @@ bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params
  * around, rendered on the CPU through the demo camera. */
 bool mr_synth_calibration(const char *dir, int images, mr_error *err);
 
+/* ------------------------------------------------------------ multiview */
+
+/* Multi-view output on the demo hall (lib/bench/multiview.c): views 1, 8,
+ * 24, 48 at a fixed total pixel budget and at a fixed per-view size (ms per
+ * frame and per view, AO error against the ray-traced reference under the
+ * pinhole and the light-field display mapping, cross-view AO consistency
+ * with world and pixel noise); the display mapping's slice width against
+ * time and error; Doronin et al.'s Table 1 shape (one view, no SSAO / SSAO,
+ * three scenes). bench_multiview.csv, _display.csv, _table1.csv, .svg, .md. */
+typedef struct mr_bench_multiview_params {
+    mr_bench_gpu gfx;           /* required */
+    const char *out_dir;        /* default "bench-out" */
+    const mr_view *view;        /* the rig's centre; NULL: the demo's first viewpoint */
+    int budget_w, budget_h;     /* total pixels of all views, default 1024x768 */
+    int view_w, view_h;         /* the fixed per-view size, default 160x120 */
+    int table_w, table_h;       /* Table 1's size, default 1024x768 */
+    int frames;                 /* timed runs, median, default 3 */
+    int rays;                   /* reference rays per pixel, default 64 */
+    bool quick;                 /* views 1 and 8 only */
+    bool progress;              /* a line per row on stderr */
+    FILE *out;                  /* the tables; NULL: silent */
+} mr_bench_multiview_params;
+#define MR_BENCH_MULTIVIEW_DEFAULTS .out_dir = "bench-out", .budget_w = 1024, .budget_h = 768, .view_w = 160, \
+                                    .view_h = 120, .table_w = 1024, .table_h = 768, .frames = 3, .rays = 64
+bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -184,7 +184,8 @@ static void *gt_worker(void *arg) {
             out[i] = 1.0f;
             if (!(z > 0) || !isfinite(z)) continue;
             mr_dvec3 nc = mr_v3(nor[3 * i], nor[3 * i + 1], nor[3 * i + 2]);
-            mr_dvec3 pc = mr_v3((x - j->cam.cx) / j->cam.fx * z, (y - j->cam.cy) / j->cam.fy * z, z);
+            mr_dvec3 pc = j->p.display ? mr_display_point(j->p.display, &j->cam, x, y, z)
+                                       : mr_v3((x - j->cam.cx) / j->cam.fx * z, (y - j->cam.cy) / j->cam.fy * z, z);
             nc = mr_v3_normalize(nc);
             if (mr_v3_len(nc) == 0) nc = mr_v3_normalize(mr_v3_scale(pc, -1));
             double R = j->p.radius_mode == MR_AO_RADIUS_SCREEN ? j->p.screen_radius * z * j->cam.height / j->cam.fy

@@ -37,6 +37,10 @@ typedef struct mr_gt_params {
     int rays;                      /* cosine-weighted rays per pixel; 0 = 256 */
     uint64_t seed;                 /* 0 = 1 */
     int threads;                   /* 0 = one per online CPU */
+    const mr_display_map *display; /* the frame's light-field display mapping: the
+                                      surface point of pixel (u, v) lies on the ray the
+                                      slices drew it with (mr_display_point; column u's
+                                      own ray at band 1); NULL = pinhole */
 } mr_gt_params;
 #define MR_GT_DEFAULT_RAYS 256
 #define MR_GT_DEFAULTS {.radius_mode = MR_AO_RADIUS_VIEW, .radius = 0.0, .screen_radius = 0.05, \
@@ -141,6 +145,20 @@ bool mr_eval_saliency_ratio(const mr_image *final, const mr_image *region, doubl
  * NaN, linearly interpolated between order statistics: q = 0.5 is the median
  * (the mean of the two middle values for an even count). Reorders v. NaN
  * when no value is left. The one median of every bench (report.c). */
+/* Multi-view agreement (lib/eval/multiview.c): each pixel of view b with a
+ * surface (depth_b > 0) is moved through its depth into view a and read
+ * there (nearest pixel); it counts when a sees the same point (a's depth
+ * within rel_tol of the point's, 0 = 1%). Depth and values are F32x1 at
+ * their views' sizes (cameras scaled to them). */
+typedef struct mr_view_consistency {
+    double rmse;        /* root mean square of val_a - val_b over the pixels seen by both; NaN if none */
+    long pixels;        /* pixels seen by both */
+    double fraction;    /* of b's surface pixels */
+} mr_view_consistency;
+bool mr_eval_view_consistency(const mr_view *va, const mr_image *depth_a, const mr_image *val_a, const mr_view *vb,
+                              const mr_image *depth_b, const mr_image *val_b, double rel_tol,
+                              mr_view_consistency *out, mr_error *err);
+
 double mr_quantile(double *v, int n, double q);
 double mr_median(double *v, int n);
 

@@ -95,6 +95,19 @@ typedef enum mr_ao_mask {
                               inside, 1 outside, then blurred (Park & Baek sec. 5) */
 } mr_ao_mask;
 
+/* The kernel's per-pixel rotation: a hash of the pixel, or of the surface's
+ * position (quantised to a grid), so that the noise stays on the surface
+ * when the eye moves (multi-view displays). */
+typedef enum mr_ao_noise {
+    MR_AO_NOISE_PIXEL = 0,
+    MR_AO_NOISE_WORLD,
+} mr_ao_noise;
+
+/* World noise: the anchor camera's pixels per cell side. A surface point
+ * seen at a pixel centre in one view is seen up to half a pixel away in
+ * another, so cells of one pixel would split it half the time. */
+#define MR_AO_NOISE_CELL_PX 4
+
 #define MR_AO_MAX_SAMPLES 64
 #define MR_AO_MAX_RADII 5 /* Doronin et al. merge 5 radii */
 
@@ -148,6 +161,17 @@ typedef struct mr_ao_params {
                                      (benchmarks) */
     const mr_image *external;     /* F32x1 AO at the output size to shade with instead of
                                      computing one (e.g. ray-traced ground truth); NULL */
+    /* multi-view: where the kernel's per-pixel rotation comes from */
+    mr_ao_noise noise;            /* default pixel (a hash of the pixel) */
+    double noise_cell;            /* world noise: > 0, a grid of cells this size in scene
+                                     units, in the anchor's frame; 0 = the anchor camera's
+                                     pixels (the frame's intrinsics) grouped
+                                     MR_AO_NOISE_CELL_PX x MR_AO_NOISE_CELL_PX, so the noise
+                                     is as fine as the image at any depth */
+    mr_dmat4 noise_anchor;        /* world noise: world_from_anchor, the frame positions are
+                                     hashed in (a multi-view rig sets its centre camera, so
+                                     all views share it); used when noise_anchor_set */
+    bool noise_anchor_set;        /* false: the world frame itself */
 } mr_ao_params;
 /* Each default is written once, here: the initialiser below, the AO pass
  * (which puts them in where a field is zero or out of range) and option
@@ -365,6 +389,8 @@ typedef struct mr_frame_params {
     float specular;            /* Phong specular weight (white highlights); default 0 = Lambert only */
     float shininess;           /* Phong exponent, >= 1; 0 = 32 */
     mr_shadow_params shadow;   /* soft shadows; default off */
+    const struct mr_display_map *display; /* light-field display mapping instead of the
+                                  pinhole (then the AO reads positions); NULL = pinhole */
 } mr_frame_params;
 #define MR_FRAME_DEFAULT_ALPHA 0.5f
 #define MR_FRAME_DEFAULT_BACKGROUND {0.62f, 0.66f, 0.70f}
@@ -408,6 +434,154 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
 void mr_frame_result_free(mr_frame_result *res);
 /* "gbuffer shade overlay" — the pass list as one line. */
 void mr_frame_result_passes(const mr_frame_result *res, char *buf, size_t n);
+
+/* ------------------------------------------------------- multi-view rigs
+ * Views for 3D displays (lib/render/multiview.c; pure functions, no GL).
+ * N parallel cameras along the centre camera's x axis, each with an
+ * off-axis (sheared) frustum converging on a focal plane at distance D, no
+ * toe-in: view i has theta_i = (i/(N-1) - 1/2) cone, its eye at
+ * s_i = D tan(theta_i) on the x axis, and at the near plane n the frustum
+ * left/right = (-/+ aspect size - s_i) n / D, bottom/top = -/+ size n / D,
+ * where size = D tan(fov/2) is the focal plane's half-height. Every view
+ * sees the same rectangle of the focal plane. */
+typedef struct mr_rig_params {
+    int views;              /* N; 0 = off (one ordinary view); 1..1024 */
+    double cone_deg;        /* total view cone, degrees; default 35 */
+    double fov_deg;         /* vertical field of view at the focal plane, degrees;
+                               default 14 (0 in a struct = the default) */
+    double focal_distance;  /* D in scene units; 0 = the median depth the centre
+                               view sees in its middle third (mr_rig_focal_from_depth),
+                               else the scene's centre (mr_rig_auto_focal_distance) */
+} mr_rig_params;
+#define MR_RIG_DEFAULT_CONE 35.0
+#define MR_RIG_DEFAULT_FOV 14.0
+#define MR_RIG_MAX_VIEWS 1024
+#define MR_RIG_DEFAULTS {.views = 0, .cone_deg = MR_RIG_DEFAULT_CONE, .fov_deg = MR_RIG_DEFAULT_FOV, \
+                         .focal_distance = 0.0}
+/* The option table of mr_rig_params (no prefix: --views, --view-cone,
+ * --view-fov, --focal-distance). */
+extern const mr_opt mr_rig_opts[];
+
+typedef struct mr_rig {
+    int views;
+    double cone, fov;       /* radians */
+    double distance;        /* D, scene units */
+    double size;            /* half-height of the focal plane's rectangle, scene units */
+    double aspect;          /* view aspect: half-width / half-height of that rectangle */
+} mr_rig;
+
+/* D = size / tan(fov/2): the focal distance at which a focal plane of
+ * half-height `size` fills a vertical field of view of fov_deg. */
+double mr_rig_distance_for_size(double fov_deg, double size);
+/* Fills rig from params, the view aspect (> 0) and D (> 0, finite); false +
+ * one line on a value out of range (N < 1, cone outside [0, 180), ...). */
+bool mr_rig_make(const mr_rig_params *p, double aspect, double distance, mr_rig *rig, mr_error *err);
+/* theta_i (radians) and s_i = D tan(theta_i); a single view sits at 0. */
+double mr_rig_angle(const mr_rig *rig, int i);
+double mr_rig_shift(const mr_rig *rig, int i);
+/* The frustum of view i at near distance n (GL glFrustum's l r b t). */
+void mr_rig_frustum(const mr_rig *rig, int i, double n, double *l, double *r, double *b, double *t);
+/* A point p in the centre camera's axes (OpenCV: x right, y down, z forward)
+ * to view i's NDC (x right, y down), through the frustum above. */
+void mr_rig_project(const mr_rig *rig, int i, mr_dvec3 p, double ndc[2]);
+/* View i as a pinhole view of width x height pixels: eye moved by s_i along
+ * the centre camera's x axis, principal point shifted to shear the frustum
+ * (fx = W D / (2 aspect size), fy = H D / (2 size); no lens distortion).
+ * Rendering it with mr_render_frame gives exactly the frustum above. */
+mr_view mr_rig_view(const mr_rig *rig, const mr_view *centre, int i, int width, int height);
+/* The depth of the scene's bounding-box centre along the view's axis; <= 0
+ * when the centre is behind the camera (then D must be given). */
+double mr_rig_auto_focal_distance(const mr_scene *scene, const mr_view *view);
+/* The median depth (F32x1 linear depth, 0 = nothing) over the middle third
+ * of the image: the default focal plane, where the centre view looks; 0 if
+ * nothing is seen there. */
+double mr_rig_focal_from_depth(const mr_image *depth);
+
+/* A quilt in the Looking Glass convention: cols x rows tiles, view 0 at the
+ * bottom-left, views going right then up; file name NAME_qs{C}x{R}a{A}.png
+ * with A the view aspect (not the tile's pixel aspect). */
+typedef struct mr_quilt {
+    int cols, rows;
+    int width, height;      /* quilt pixels; 0 = cols x tile width, rows x tile height */
+    double aspect;          /* the device's view aspect; 0 = the views' */
+    const char *preset;     /* the preset's name, or NULL */
+} mr_quilt;
+/* "portrait" (8x6, 3360x3360, a 0.75), "go" (11x6, 4092x4092, a 0.5625),
+ * "4k" (5x9, 4096x4096, a 1.7778), "8k" (5x9, 8192x8192, a 1.7778), or
+ * "CxR" (tiles of the view size) or "CxR@WxH" (tiles cut from W x H). */
+bool mr_quilt_parse(const char *spec, mr_quilt *q, mr_error *err);
+/* The layout for n views: a tiles grid of the spec (or, with spec NULL,
+ * ceil(sqrt(n)) columns and as many rows as needed) and the tile size: the
+ * quilt's size / grid, else view_w x view_h. false + one line if the quilt
+ * has fewer tiles than views or tiles under 1 pixel. */
+typedef struct mr_quilt_layout {
+    int cols, rows, tile_w, tile_h, width, height;
+    double aspect;          /* view aspect written into the name */
+} mr_quilt_layout;
+bool mr_quilt_layout_make(const mr_quilt *spec, int views, int view_w, int view_h, mr_quilt_layout *out,
+                          mr_error *err);
+/* Top-left pixel of view i's tile, image rows top-down (PNG order). */
+void mr_quilt_tile_origin(const mr_quilt_layout *q, int i, int *x, int *y);
+/* Copies view i (tile_w x tile_h, same channels and type as quilt) into its tile. */
+bool mr_quilt_put(const mr_quilt_layout *q, mr_image *quilt, int i, const mr_image *view, mr_error *err);
+/* "NAME_qs8x6a0.75.png". */
+void mr_quilt_file_name(const char *name, const mr_quilt_layout *q, char *out, size_t n);
+
+/* A horizontal-parallax-only light-field display (HoloVizio-like): each
+ * pixel column u is seen from its own eye on the observer line (the centre
+ * camera's x axis), e(u) = (2 (u + 0.5) / W - 1) E with E = D tan(cone/2),
+ * through its own point of the focal plane; vertically every column is the
+ * centre camera. The world-to-image mapping is not affine and not a 4x4
+ * projection (x and y have different denominators; all columns' rays cross
+ * at one depth when E exceeds the focal plane's half-width), so AO reads
+ * positions, never un-projected depth. It is rendered in narrow perspective
+ * slices: each band of `band` columns is a pinhole view from the eye of its
+ * middle column, scissored to the band, into the one G-buffer. At band 1
+ * every pixel centre's ray is the column's exact ray; a column j away from
+ * its band's middle is off by |j q / (1 - q)| pixels, q = (E / A)(1 - D/z),
+ * for a surface at depth z (A the focal plane's half-width seen by the
+ * camera): mr_display_column_error. */
+typedef struct mr_display_map {
+    double distance;        /* D: the focal plane, scene units */
+    double eye_half;        /* E: the observer line spans [-E, E] on the x axis */
+    int band;               /* columns per perspective slice, >= 1 */
+} mr_display_map;
+#define MR_DISPLAY_DEFAULT_BAND 1
+/* From a rig: its D and E = D tan(cone/2). */
+mr_display_map mr_display_from_rig(const mr_rig *rig, int band);
+/* The eye (x on the observer line) of column u of a W-pixel image. */
+double mr_display_eye(const mr_display_map *m, int width, double u);
+/* The centre-camera point the banded rendering puts at pixel (u, v) at
+ * depth z: on the ray of u in its band's camera (at band 1 the exact ray of
+ * column u), as the positions texture holds it; `cam` is the frame's
+ * (centre) camera. */
+mr_dvec3 mr_display_point(const mr_display_map *m, const mr_camera *cam, double u, double v, double z);
+/* The exact pixel of a centre-camera point under the per-column mapping
+ * (the inverse of the above at band 1); false behind the observer line or
+ * where the columns' rays cross (no single column sees the point's depth). */
+bool mr_display_project(const mr_display_map *m, const mr_camera *cam, mr_dvec3 p, double *u, double *v);
+/* Band b's columns [*x0, *x1) and its pinhole camera (the frame camera
+ * with the principal point shifted by fx e_b / D) and eye offset e_b. */
+int mr_display_band_count(const mr_display_map *m, int width);
+mr_camera mr_display_band_camera(const mr_display_map *m, const mr_camera *cam, int b, int *x0, int *x1, double *eye);
+/* Column error (pixels) of the banded rendering for a surface at depth z
+ * seen in column u: where the exact mapping puts the point the band's
+ * camera drew there, minus u. 0 for band 1 at pixel centres. */
+double mr_display_column_error(const mr_display_map *m, const mr_camera *cam, int u, double z);
+
+/* Renders the rig's views with one renderer (scene upload and programs are
+ * shared; each view is a mr_render_frame of its own camera). Writes
+ * view_NNN.png into views_dir (NULL: none) and fills quilt (RGB8, when not
+ * NULL). The video overlay is left out (the camera frame is seen from one
+ * eye only). AO noise is anchored to the centre camera when the AO's noise
+ * is "world", so it stays on the surface from view to view. */
+typedef struct mr_rig_result {
+    double ms_total;        /* wall-clock, all views, glFinish'ed */
+    int views;
+} mr_rig_result;
+bool mr_render_rig(mr_renderer *r, const mr_rig *rig, const mr_view *centre, const mr_frame_params *params,
+                   const mr_quilt_layout *layout, const char *views_dir, mr_image *quilt, mr_rig_result *res,
+                   mr_error *err);
 
 /* -------------------------------------------------------------- picking */
 

@@ -13,6 +13,7 @@ const char *const mr_ao_method_names[MR_AO_METHOD_COUNT + 1] = {"none", "scheer"
 static const char *const k_radius_mode_names[] = {"screen", "view", NULL};
 static const char *const k_kernel_names[] = {"uniform", "stratified", "latin", "poisson", NULL};
 static const char *const k_mask_names[] = {"off", "on", "standalone", NULL};
+static const char *const k_noise_names[] = {"pixel", "world", NULL};
 
 #define AO(f) offsetof(mr_ao_params, f)
 const mr_opt mr_ao_opts[] = {
@@ -48,6 +49,8 @@ const mr_opt mr_ao_opts[] = {
      "accumulate AO over frames (replay, view): reprojected history, rejected by depth and normal", 0},
     {"mask-strength", MR_OPT_FLOAT, AO(mask_strength), 1e-3, 1, MR_AO_DEFAULT_MASK_STRENGTH, NULL,
      "standalone mask: AO = 1 - S in the corners before the blur", 0},
+    {"noise", MR_OPT_ENUM, AO(noise), 0, 0, MR_AO_NOISE_PIXEL, k_noise_names,
+     "kernel rotation from a hash of the pixel or of the world position (stays on the surface across views)", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef AO

@@ -31,6 +31,7 @@ typedef struct ao_key {
     bool hide_hidden;
     uint64_t scene_gen;
     mr_ao_params p; /* resolved, with want_ao / want_mask / no_reuse cleared */
+    mr_display_map display; /* zeros for the pinhole */
 } ao_key;
 
 struct mr_ao_state {
@@ -364,6 +365,10 @@ static void copy_fields(mr_ao_params *d, const mr_ao_params *p) {
     d->want_mask = p->want_mask;
     d->no_reuse = p->no_reuse;
     d->external = p->external;
+    d->noise = p->noise;
+    d->noise_cell = p->noise_cell;
+    d->noise_anchor = p->noise_anchor;
+    d->noise_anchor_set = p->noise_anchor_set;
 }
 
 static ao_key key_of(const frame *f, const mr_ao_params *resolved, uint64_t scene_gen) {
@@ -376,6 +381,11 @@ static ao_key key_of(const frame *f, const mr_ao_params *resolved, uint64_t scen
     key.hide_hidden = f->p->hide_hidden_layer;
     key.scene_gen = scene_gen;
     copy_fields(&key.p, resolved);
+    if (f->p->display) {
+        key.display.distance = f->p->display->distance;
+        key.display.eye_half = f->p->display->eye_half;
+        key.display.band = f->p->display->band;
+    }
     return key;
 }
 
@@ -597,6 +607,29 @@ void mr_ao_slice_split(int samples, int *slices, int *steps) {
 
 static bool slice_method(mr_ao_method m) { return m == MR_AO_GTAO || m == MR_AO_BITMASK || m == MR_AO_SCHEER_GT; }
 
+/* World noise: the camera-space position goes to the anchor's frame
+ * (composed in double, so only the small anchor-relative part is float)
+ * and is hashed on a grid of noise_cell. Views that share the anchor give
+ * the same surface point the same rotation. */
+static void noise_uniforms(const frame *f, const mr_ao_params *p) {
+    if (p->noise != MR_AO_NOISE_WORLD) {
+        glUniform1i(MR_LOC_AO_NOISE, 0);
+        return;
+    }
+    bool grid = p->noise_cell > 0 && isfinite(p->noise_cell);
+    glUniform1i(MR_LOC_AO_NOISE, grid ? 1 : 2);
+    /* Without an anchor the frame's own camera is it. */
+    mr_dmat4 a = mr_m4_identity();
+    if (p->noise_anchor_set) {
+        mr_dmat4 anchor_from_world;
+        if (mr_m4_invert(&p->noise_anchor, &anchor_from_world)) a = mr_m4_mul(&anchor_from_world, &f->view->world_from_camera);
+    }
+    float m[16];
+    mr_m4_to_gl(&a, m);
+    glUniformMatrix4fv(MR_LOC_AO_NOISE_FRAME, 1, GL_FALSE, m);
+    glUniform1f(MR_LOC_AO_NOISE_CELL, grid ? (float)p->noise_cell : (float)MR_AO_NOISE_CELL_PX);
+}
+
 static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
     const mr_ao_params *p = &s->p;
     glUseProgram(s->prog_main);
@@ -644,6 +677,11 @@ static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
         }
         glBindSampler(MR_TEX_AO_DEPTH, s->linear_sampler);
     }
+    noise_uniforms(f, p);
+    /* The display mapping: D, E and the width for project()'s exact
+     * per-column formula; D = 0 is the pinhole. */
+    const mr_display_map *dm = f->p->display;
+    glUniform3f(MR_LOC_AO_DISPLAY, dm ? (float)dm->distance : 0.0f, dm ? (float)dm->eye_half : 0.0f, (float)f->r->w);
     fullscreen(f, s->fbo_ao[0], s->aw, s->ah);
     glBindSampler(MR_TEX_AO_DEPTH, 0);
     s->cur = 0;

@@ -117,6 +117,31 @@ void mr_gbuffer_begin(frame *f, const target *t) {
     glClearNamedFramebufferfv(t->fbo, GL_DEPTH, 0, &depth0);
 }
 
+/* The light-field display mapping: narrow perspective slices, each band of
+ * columns a pinhole view from its own eye on the observer line, scissored
+ * into the one G-buffer. Positions are written in the frame camera's axes
+ * (the band's eye offset added), so AO reads them across band borders. */
+static void gbuffer_display(frame *f, const mr_geo_view *centre) {
+    const mr_display_map *m = f->p->display;
+    GLuint prog = centre->program;
+    int n = mr_display_band_count(m, f->r->w);
+    glEnable(GL_SCISSOR_TEST);
+    for (int b = 0; b < n; b++) {
+        int x0, x1;
+        double e;
+        mr_geo_view v = *centre;
+        v.cam = mr_display_band_camera(m, &centre->cam, b, &x0, &x1, &e);
+        mr_dmat4 shift = mr_m4_translate(e, 0, 0);
+        v.world_from_camera = mr_m4_mul(&centre->world_from_camera, &shift);
+        v.cam_from_world = mr_m4_invert_rigid(&v.world_from_camera);
+        glScissor(x0, 0, x1 - x0, f->r->h);
+        glProgramUniform3f(prog, MR_LOC_GBUFFER_POS_OFFSET, (float)e, 0, 0);
+        mr_geometry_draw(f->r, &v, f->out);
+    }
+    glDisable(GL_SCISSOR_TEST);
+    glProgramUniform3f(prog, MR_LOC_GBUFFER_POS_OFFSET, 0, 0, 0);
+}
+
 static void mr_pass_gbuffer(frame *f) {
     struct mr_base_state *b = f->r->base;
     static const float zero4[4] = {0, 0, 0, 0};
@@ -135,7 +160,12 @@ static void mr_pass_gbuffer(frame *f) {
     /* With ghosting, the hidden layer goes to its own target D (pass_ghost.c). */
     if (!f->p->hide_hidden_layer && !(f->writing & RES(RES_HIDDEN_DEPTH))) mask |= 1u << MR_LAYER_HIDDEN;
     mr_geo_view v = mr_frame_view(f, b->prog_gbuffer, mask);
-    mr_geometry_draw(f->r, &v, f->out);
+    glProgramUniform3f(b->prog_gbuffer, MR_LOC_GBUFFER_POS_OFFSET, 0, 0, 0);
+    if (f->p->display) {
+        gbuffer_display(f, &v);
+    } else {
+        mr_geometry_draw(f->r, &v, f->out);
+    }
     glDisable(GL_DEPTH_TEST);
     frame_put(f, RES_DEPTH, b->gbuf.depth);
     frame_put(f, RES_ALBEDO, b->gbuf.color[MR_OUT_GBUFFER_ALBEDO]);

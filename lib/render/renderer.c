@@ -220,6 +220,20 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
     int h = p->height > 0 ? p->height : view->camera.height;
     if (w > 16384 || h > 16384) return mr_fail(err, MR_ERR_INVALID, "output size %dx%d too large", w, h);
     if (!mr_ghost_check_params(&p->ghost, err)) return false;
+    /* The display mapping cannot be un-projected: AO reads positions. */
+    mr_frame_params with_pos;
+    if (p->display) {
+        const mr_display_map *m = p->display;
+        if (!(m->distance > 0 && isfinite(m->distance)) || !(m->eye_half >= 0 && isfinite(m->eye_half)) || m->band < 1)
+            return mr_fail(err, MR_ERR_INVALID, "display mapping needs D > 0, E >= 0 and a band of >= 1 columns");
+        /* The outline volumes and the hidden layer are drawn through the
+         * frame's pinhole camera, so they would not line up. */
+        if (p->ghost.mode != MR_GHOST_OFF || p->video || p->ao.mask != MR_AO_MASK_OFF)
+            return mr_fail(err, MR_ERR_INVALID, "the display mapping draws no ghosting, corner mask or video overlay");
+        with_pos = *p;
+        with_pos.ao.positions = true;
+        p = &with_pos;
+    }
     r->w = w;
     r->h = h;
 

@@ -1,0 +1,448 @@
+/* mrcheck bench multiview: N views at a fixed total pixel budget and at a
+ * fixed per-view size (ms per frame and per view, AO error against the ray-
+ * traced reference under the pinhole and the light-field display mapping,
+ * cross-view AO consistency with the pixel and the world-position noise),
+ * the display mapping's slices (band width against time, mapping and AO
+ * error), and Doronin et al.'s Table 1 shape (per-view ms without and with
+ * SSAO for three scenes). */
+#include "bench_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define DEG (3.14159265358979323846 / 180.0)
+
+static double now_ms(void) { return mr_time_now() * 1e3; }
+
+/* The AO both the frames and the reference use: a fixed radius, so the
+ * reference is the same surface integral in every view. */
+static mr_frame_params ao_frame(int w, int h, double radius, mr_ao_noise noise, const mr_view *anchor, bool no_blur) {
+    mr_frame_params fp = MR_FRAME_DEFAULTS;
+    fp.width = w;
+    fp.height = h;
+    fp.ao.method = MR_AO_CRYTEK;
+    fp.ao.radius_mode = MR_AO_RADIUS_VIEW;
+    fp.ao.radius = radius;
+    fp.ao.positions = true;
+    fp.ao.no_reuse = true;
+    fp.ao.noise = noise;
+    if (no_blur) fp.ao.blur_radius = 0; /* the noise itself */
+    if (anchor) {
+        fp.ao.noise_anchor = anchor->world_from_camera;
+        fp.ao.noise_anchor_set = true;
+    }
+    return fp;
+}
+
+static double rmse_over_surface(const mr_image *a, const mr_image *b, const mr_image *depth) {
+    const float *x = a->data, *y = b->data, *d = depth->data;
+    double se = 0;
+    long n = 0;
+    for (size_t i = 0; i < (size_t)a->width * a->height; i++)
+        if (d[i] > 0) {
+            se += (x[i] - y[i]) * (double)(x[i] - y[i]);
+            n++;
+        }
+    return n ? sqrt(se / n) : NAN;
+}
+
+/* AO of one frame against its ray-traced reference (the frame's own
+ * surface points; the display mapping's exact rays when m is given). */
+static bool ao_error(mr_renderer *r, const mr_eval_gt *gt, const mr_view *v, const mr_frame_params *base,
+                     const mr_display_map *m, double radius, int rays, double *rmse, mr_error *err) {
+    mr_frame_params fp = *base;
+    fp.want_depth = fp.want_normals = true;
+    fp.ao.want_ao = true;
+    fp.display = m;
+    mr_frame_result res;
+    if (!mr_render_frame(r, v, &fp, &res, err)) return false;
+    mr_gt_params gp = MR_GT_DEFAULTS;
+    gp.radius = radius;
+    gp.rays = rays;
+    gp.display = m;
+    mr_image ref = {0};
+    bool ok = mr_eval_ao_groundtruth(gt, v, &res.depth, &res.normal, &gp, &ref, err);
+    if (ok) *rmse = rmse_over_surface(&res.ao, &ref, &res.depth);
+    mr_image_free(&ref);
+    mr_frame_result_free(&res);
+    return ok;
+}
+
+/* Mean over neighbouring views of the AO's RMSE, reprojected through depth. */
+static bool consistency(mr_renderer *r, const mr_rig *rig, const mr_view *centre, const mr_frame_params *base,
+                        double *rmse, double *fraction, mr_error *err) {
+    mr_frame_params fp = *base;
+    fp.want_depth = true;
+    fp.ao.want_ao = true;
+    mr_frame_result prev = {0}, cur;
+    mr_view vprev;
+    memset(&vprev, 0, sizeof vprev);
+    double sum = 0, fsum = 0;
+    int pairs = 0;
+    for (int i = 0; i < rig->views; i++) {
+        mr_view v = mr_rig_view(rig, centre, i, fp.width, fp.height);
+        if (!mr_render_frame(r, &v, &fp, &cur, err)) {
+            mr_frame_result_free(&prev);
+            return false;
+        }
+        if (i > 0) {
+            mr_view_consistency c;
+            if (!mr_eval_view_consistency(&vprev, &prev.depth, &prev.ao, &v, &cur.depth, &cur.ao, 0.01, &c, err)) {
+                mr_frame_result_free(&prev);
+                mr_frame_result_free(&cur);
+                return false;
+            }
+            if (c.pixels > 0) {
+                sum += c.rmse;
+                fsum += c.fraction;
+                pairs++;
+            }
+        }
+        mr_frame_result_free(&prev);
+        prev = cur;
+        vprev = v;
+    }
+    mr_frame_result_free(&prev);
+    *rmse = pairs ? sum / pairs : NAN;
+    *fraction = pairs ? fsum / pairs : NAN;
+    return true;
+}
+
+/* Median wall-clock ms of rendering all the rig's views (glFinish'ed: each
+ * frame reads its image back). */
+static bool time_rig(mr_renderer *r, const mr_rig *rig, const mr_view *centre, const mr_frame_params *fp, int frames,
+                     double *ms, mr_error *err) {
+    double t[64];
+    if (frames > 64) frames = 64;
+    mr_quilt_layout l;
+    if (!mr_quilt_layout_make(NULL, rig->views, fp->width, fp->height, &l, err)) return false;
+    for (int f = -1; f < frames; f++) {
+        double t0 = now_ms();
+        mr_image q = {0};
+        if (!mr_render_rig(r, rig, centre, fp, &l, NULL, &q, NULL, err)) return false;
+        mr_image_free(&q);
+        if (f >= 0) t[f] = now_ms() - t0; /* the first one compiles and allocates */
+    }
+    *ms = mr_median(t, frames);
+    return true;
+}
+
+static bool time_frame(mr_renderer *r, const mr_view *v, const mr_frame_params *fp, int frames, double *ms, mr_error *err) {
+    double t[64];
+    if (frames > 64) frames = 64;
+    for (int f = -1; f < frames; f++) {
+        mr_frame_result res;
+        double t0 = now_ms();
+        if (!mr_render_frame(r, v, fp, &res, err)) return false;
+        mr_frame_result_free(&res);
+        if (f >= 0) t[f] = now_ms() - t0;
+    }
+    *ms = mr_median(t, frames);
+    return true;
+}
+
+static double diag_of(const mr_scene *s) {
+    double d2 = 0;
+    for (int i = 0; i < 3; i++) d2 += (s->bounds_max[i] - s->bounds_min[i]) * (s->bounds_max[i] - s->bounds_min[i]);
+    return sqrt(d2);
+}
+
+typedef struct row {
+    const char *mode;
+    int views, w, h;
+    double ms_frame, ms_view, err_pin, err_disp, cons_world, cons_pixel, cons_world0, cons_pixel0, shared;
+} row;
+
+bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err) {
+    mr_bench_multiview_params p = {MR_BENCH_MULTIVIEW_DEFAULTS};
+    if (params) p = *params;
+    const mr_bench_multiview_params dflt = {MR_BENCH_MULTIVIEW_DEFAULTS};
+    if (!p.out_dir) p.out_dir = dflt.out_dir;
+    if (p.budget_w <= 0 || p.budget_h <= 0) p.budget_w = dflt.budget_w, p.budget_h = dflt.budget_h;
+    if (p.view_w <= 0 || p.view_h <= 0) p.view_w = dflt.view_w, p.view_h = dflt.view_h;
+    if (p.table_w <= 0 || p.table_h <= 0) p.table_w = dflt.table_w, p.table_h = dflt.table_h;
+    if (p.frames <= 0) p.frames = dflt.frames;
+    if (p.rays <= 0) p.rays = dflt.rays;
+    FILE *out = p.out;
+    if (!bench_gpu_check(&p.gfx, "bench multiview", err)) return false;
+    mr_renderer *r = p.gfx.renderer;
+    if (!mr_mkdirs(p.out_dir, err)) return false;
+
+    static const int k_views[] = {1, 8, 24, 48};
+    int nviews = p.quick ? 2 : 4;
+    mr_demo_hall hall;
+    memset(&hall, 0, sizeof hall);
+    if (!mr_demo_build_tagged(NULL, 0, &hall, err)) return false;
+    mr_scene *scene = hall.planned;
+    mr_view centre = p.view ? *p.view : mr_demo_view(0);
+    memset(centre.camera.dist, 0, sizeof centre.camera.dist);
+    double radius = 0.02 * diag_of(scene);
+    mr_eval_gt *gt = NULL;
+    bool ok = mr_renderer_set_scene(r, scene, err) && (gt = mr_eval_gt_create(scene, false, err)) != NULL;
+    /* The rig: the display defaults (35 degree cone) around the camera's own
+     * vertical field of view, focused where the centre view looks. */
+    double fov = 2 * atan(0.5 * centre.camera.height / centre.camera.fy) / DEG, focal = 0;
+    if (ok) {
+        mr_frame_params dp = MR_FRAME_DEFAULTS;
+        dp.want_depth = true;
+        dp.width = p.view_w;
+        dp.height = p.view_h;
+        mr_frame_result fr;
+        ok = mr_render_frame(r, &centre, &dp, &fr, err);
+        if (ok) focal = mr_rig_focal_from_depth(&fr.depth);
+        mr_frame_result_free(&fr);
+        if (ok && !(focal > 0)) ok = mr_fail(err, MR_ERR_INVALID, "bench multiview: the view sees nothing to focus on");
+    }
+    row rows[8];
+    int nrows = 0;
+    for (int mode = 0; ok && mode < 2; mode++)
+        for (int k = 0; ok && k < nviews; k++) {
+            int n = k_views[k];
+            row *rw = &rows[nrows];
+            memset(rw, 0, sizeof *rw);
+            rw->mode = mode == 0 ? "budget" : "per_view";
+            rw->views = n;
+            if (mode == 0) {
+                rw->w = (int)lround(p.budget_w / sqrt((double)n));
+                rw->h = (int)lround(p.budget_h / sqrt((double)n));
+            } else {
+                rw->w = p.view_w;
+                rw->h = p.view_h;
+            }
+            mr_rig_params rp = MR_RIG_DEFAULTS;
+            rp.views = n;
+            rp.fov_deg = fov;
+            mr_rig rig;
+            ok = mr_rig_make(&rp, (double)rw->w / rw->h, focal, &rig, err);
+            mr_frame_params fw = ao_frame(rw->w, rw->h, radius, MR_AO_NOISE_WORLD, &centre, false);
+            mr_frame_params fpx = ao_frame(rw->w, rw->h, radius, MR_AO_NOISE_PIXEL, NULL, false);
+            mr_frame_params fw0 = ao_frame(rw->w, rw->h, radius, MR_AO_NOISE_WORLD, &centre, true);
+            mr_frame_params fpx0 = ao_frame(rw->w, rw->h, radius, MR_AO_NOISE_PIXEL, NULL, true);
+            ok = ok && time_rig(r, &rig, &centre, &fw, p.frames, &rw->ms_frame, err);
+            rw->ms_view = rw->ms_frame / n;
+            /* AO error against the reference on the outer and middle views. */
+            int probe[3] = {0, n / 2, n - 1}, np = n >= 3 ? 3 : 1;
+            double se = 0;
+            for (int j = 0; ok && j < np; j++) {
+                mr_view v = mr_rig_view(&rig, &centre, probe[j], rw->w, rw->h);
+                double e = 0;
+                ok = ao_error(r, gt, &v, &fw, NULL, radius, p.rays, &e, err);
+                se += e;
+            }
+            rw->err_pin = se / np;
+            /* The display mapping at the same size and cone (exact slices). */
+            mr_rig_params one = rp;
+            one.views = 1;
+            mr_rig crig;
+            ok = ok && mr_rig_make(&one, (double)rw->w / rw->h, focal, &crig, err);
+            crig.cone = rp.cone_deg * DEG;
+            mr_display_map m = mr_display_from_rig(&crig, 1);
+            mr_view cv = mr_rig_view(&crig, &centre, 0, rw->w, rw->h);
+            ok = ok && ao_error(r, gt, &cv, &fw, &m, radius, p.rays, &rw->err_disp, err);
+            rw->cons_world = rw->cons_pixel = rw->cons_world0 = rw->cons_pixel0 = rw->shared = NAN;
+            if (ok && n > 1) {
+                double f1, f2;
+                ok = consistency(r, &rig, &centre, &fw, &rw->cons_world, &f1, err) &&
+                     consistency(r, &rig, &centre, &fpx, &rw->cons_pixel, &f2, err) &&
+                     consistency(r, &rig, &centre, &fw0, &rw->cons_world0, &f2, err) &&
+                     consistency(r, &rig, &centre, &fpx0, &rw->cons_pixel0, &f2, err);
+                rw->shared = f1;
+            }
+            if (ok && p.progress) fprintf(stderr, "bench multiview: %s %d views done\n", rw->mode, n);
+            nrows++;
+        }
+
+    /* The display mapping's slices at the per-view size. */
+    static const int k_bands[] = {1, 4, 16};
+    double band_ms[3] = {0}, band_err_mean[3] = {0}, band_err_max[3] = {0}, band_ao[3] = {0};
+    for (int b = 0; ok && b < 3; b++) {
+        mr_rig_params one = MR_RIG_DEFAULTS;
+        one.views = 1;
+        one.fov_deg = fov;
+        mr_rig crig;
+        ok = mr_rig_make(&one, (double)p.view_w / p.view_h, focal, &crig, err);
+        mr_display_map m = mr_display_from_rig(&crig, k_bands[b]);
+        mr_view cv = mr_rig_view(&crig, &centre, 0, p.view_w, p.view_h);
+        mr_frame_params fw = ao_frame(p.view_w, p.view_h, radius, MR_AO_NOISE_WORLD, &centre, false);
+        fw.display = &m;
+        ok = ok && time_frame(r, &cv, &fw, p.frames, &band_ms[b], err);
+        mr_frame_params fd = fw;
+        fd.want_depth = true;
+        mr_frame_result res;
+        if (ok && (ok = mr_render_frame(r, &cv, &fd, &res, err))) {
+            /* Where the exact mapping puts each pixel's surface point, from
+             * the depth the slices rendered. */
+            double sum = 0, mx = 0;
+            long cnt = 0;
+            const float *d = res.depth.data;
+            for (int y = 0; y < p.view_h; y++)
+                for (int x = 0; x < p.view_w; x++) {
+                    double z = d[(size_t)y * p.view_w + x];
+                    if (!(z > 0)) continue;
+                    double e = fabs(mr_display_column_error(&m, &cv.camera, x, z));
+                    if (!isfinite(e)) continue;
+                    sum += e;
+                    mx = fmax(mx, e);
+                    cnt++;
+                }
+            band_err_mean[b] = cnt ? sum / cnt : NAN;
+            band_err_max[b] = mx;
+            mr_frame_result_free(&res);
+        }
+        fw.display = NULL;
+        ok = ok && ao_error(r, gt, &cv, &fw, &m, radius, p.rays, &band_ao[b], err);
+    }
+    mr_eval_gt_destroy(&gt);
+    mr_renderer_set_scene(r, NULL, NULL);
+
+    /* Table 1's shape: three scenes, per-view ms without and with SSAO. */
+    const char *tnames[3] = {"demo hall (planned)", "demo hall (built)", "synthetic factory"};
+    double t_no[3] = {0}, t_ao[3] = {0};
+    uint64_t t_tris[3] = {0};
+    mr_synth_params sp = MR_SYNTH_DEFAULTS;
+    mr_scene *synth = ok ? mr_synth_build(&sp, err) : NULL;
+    if (ok && !synth) ok = false;
+    for (int s = 0; ok && s < 3; s++) {
+        mr_scene *sc = s == 0 ? hall.planned : s == 1 ? hall.built : synth;
+        mr_view v = centre;
+        if (s == 2) v.world_from_camera = mr_synth_viewpoint(&sp, MR_SYNTH_VIEW_AISLE);
+        ok = mr_renderer_set_scene(r, sc, err);
+        mr_frame_params f0 = MR_FRAME_DEFAULTS;
+        f0.width = p.table_w;
+        f0.height = p.table_h;
+        mr_frame_params f1 = f0;
+        f1.ao.method = MR_AO_CRYTEK; /* Mittring's, as the paper */
+        f1.ao.no_reuse = true;
+        ok = ok && time_frame(r, &v, &f0, p.frames, &t_no[s], err) && time_frame(r, &v, &f1, p.frames, &t_ao[s], err);
+        if (ok) {
+            mr_frame_result res;
+            if ((ok = mr_render_frame(r, &v, &f0, &res, err))) t_tris[s] = res.triangles;
+            mr_frame_result_free(&res);
+        }
+        mr_renderer_set_scene(r, NULL, NULL);
+    }
+    mr_scene_destroy(&synth);
+    mr_demo_free(&hall);
+    if (!ok) return false;
+
+    /* CSV, plot, markdown. */
+    char path[4096];
+    mr_csv *csv = mr_csv_create(err);
+    if (!csv) return false;
+    mr_csv_comment(csv, "mrcheck bench multiview: demo hall, crytek AO (view radius, positions), 35 degree cone");
+    mr_csv_header(csv, "mode,views,width,height,ms_frame,ms_per_view,ao_rmse_pinhole,ao_rmse_display,"
+                       "consistency_rmse_world,consistency_rmse_pixel,consistency_rmse_world_noblur,"
+                       "consistency_rmse_pixel_noblur,shared_fraction");
+    for (int i = 0; i < nrows; i++) {
+        const row *rw = &rows[i];
+        mr_csv_text(csv, rw->mode);
+        mr_csv_int(csv, rw->views);
+        mr_csv_int(csv, rw->w);
+        mr_csv_int(csv, rw->h);
+        mr_csv_num(csv, "%.2f", rw->ms_frame);
+        mr_csv_num(csv, "%.3f", rw->ms_view);
+        mr_csv_num(csv, "%.4f", rw->err_pin);
+        mr_csv_num(csv, "%.4f", rw->err_disp);
+        mr_csv_num(csv, "%.4f", rw->cons_world);
+        mr_csv_num(csv, "%.4f", rw->cons_pixel);
+        mr_csv_num(csv, "%.4f", rw->cons_world0);
+        mr_csv_num(csv, "%.4f", rw->cons_pixel0);
+        mr_csv_num(csv, "%.3f", rw->shared);
+        mr_csv_end_row(csv);
+    }
+    mr_path_join(p.out_dir, "bench_multiview.csv", path, sizeof path);
+    ok = mr_csv_save(csv, path, err);
+    mr_csv_destroy(&csv);
+    if (ok && (csv = mr_csv_create(err))) {
+        mr_csv_header(csv, "band,width,height,ms_frame,column_error_mean_px,column_error_max_px,ao_rmse_display");
+        for (int b = 0; b < 3; b++) {
+            mr_csv_int(csv, k_bands[b]);
+            mr_csv_int(csv, p.view_w);
+            mr_csv_int(csv, p.view_h);
+            mr_csv_num(csv, "%.2f", band_ms[b]);
+            mr_csv_num(csv, "%.4f", band_err_mean[b]);
+            mr_csv_num(csv, "%.4f", band_err_max[b]);
+            mr_csv_num(csv, "%.4f", band_ao[b]);
+            mr_csv_end_row(csv);
+        }
+        mr_path_join(p.out_dir, "bench_multiview_display.csv", path, sizeof path);
+        ok = mr_csv_save(csv, path, err);
+        mr_csv_destroy(&csv);
+    } else {
+        ok = false;
+    }
+    if (ok && (csv = mr_csv_create(err))) {
+        mr_csv_header(csv, "scene,triangles,width,height,ms_no_ssao,ms_ssao,ms_difference");
+        for (int s = 0; s < 3; s++) {
+            mr_csv_quoted(csv, tnames[s]);
+            mr_csv_int(csv, (long long)t_tris[s]);
+            mr_csv_int(csv, p.table_w);
+            mr_csv_int(csv, p.table_h);
+            mr_csv_num(csv, "%.2f", t_no[s]);
+            mr_csv_num(csv, "%.2f", t_ao[s]);
+            mr_csv_num(csv, "%.2f", t_ao[s] - t_no[s]);
+            mr_csv_end_row(csv);
+        }
+        mr_path_join(p.out_dir, "bench_multiview_table1.csv", path, sizeof path);
+        ok = mr_csv_save(csv, path, err);
+        mr_csv_destroy(&csv);
+    } else {
+        ok = false;
+    }
+    /* ms per view against the number of views, both ways. */
+    double xs[2][4], ys[2][4];
+    int cnt[2] = {0, 0};
+    for (int i = 0; i < nrows; i++) {
+        int m = strcmp(rows[i].mode, "budget") == 0 ? 0 : 1;
+        xs[m][cnt[m]] = rows[i].views;
+        ys[m][cnt[m]] = rows[i].ms_view;
+        cnt[m]++;
+    }
+    char s0[96], s1[96];
+    snprintf(s0, sizeof s0, "total %dx%d px", p.budget_w, p.budget_h);
+    snprintf(s1, sizeof s1, "%dx%d px per view", p.view_w, p.view_h);
+    mr_plot_series ser[2] = {{.name = s0, .x = xs[0], .y = ys[0], .count = cnt[0]},
+                             {.name = s1, .x = xs[1], .y = ys[1], .count = cnt[1], .mark = MR_PLOT_MARK_SQUARE}};
+    mr_plot_params pp = {.title = "mrcheck bench multiview: ms per view (median, crytek AO, llvmpipe)",
+                         .xlabel = "views", .ylabel = "ms per view", .log_x = true, .log_y = true};
+    mr_path_join(p.out_dir, "bench_multiview.svg", path, sizeof path);
+    ok = ok && mr_plot_write(path, &pp, ser, 2, err);
+
+    /* The tables, as markdown and on `out`. */
+    size_t cap = 16384, len = 0;
+    char *md = malloc(cap);
+    if (!md) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+#define MD(...) do { if (len < cap) len += (size_t)snprintf(md + len, cap - len, __VA_ARGS__); } while (0)
+    MD("# mrcheck bench multiview\n\nGPU: %s. Demo hall, crytek AO with a fixed view radius (%.3g units) read from the "
+       "positions texture, 35 degree cone, focal plane at %.3g units (where the centre view looks), median of %d runs. "
+       "AO error: RMSE against the Embree reference (%d rays) over surface pixels, mean of views 0, N/2 and N-1; "
+       "the display column renders the light-field mapping at the same size in 1-column slices. Consistency: RMSE "
+       "of view i's AO reprojected into view i+1 through the depth, mean over neighbouring pairs, with the "
+       "default blur (what is shown) and without (the noise itself); world = the kernel rotation hashed from the "
+       "position in the centre camera's pixel grid (4 px cells), pixel = hashed from the pixel.\n\n",
+       mr_gpu_description(p.gfx.gpu), radius, focal, p.frames, p.rays);
+    MD("| mode | views | size | ms/frame | ms/view | AO RMSE pinhole | AO RMSE display | consistency world | "
+       "consistency pixel | no blur: world | no blur: pixel |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (int i = 0; i < nrows; i++)
+        MD("| %s | %d | %dx%d | %.1f | %.2f | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f |\n", rows[i].mode, rows[i].views,
+           rows[i].w, rows[i].h, rows[i].ms_frame, rows[i].ms_view, rows[i].err_pin, rows[i].err_disp, rows[i].cons_world,
+           rows[i].cons_pixel, rows[i].cons_world0, rows[i].cons_pixel0);
+    MD("\n## The display mapping's slices (%dx%d)\n\n| band (columns) | ms/frame | column error mean px | max px | AO "
+       "RMSE |\n|---|---|---|---|---|\n",
+       p.view_w, p.view_h);
+    for (int b = 0; b < 3; b++)
+        MD("| %d | %.1f | %.4f | %.3f | %.4f |\n", k_bands[b], band_ms[b], band_err_mean[b], band_err_max[b], band_ao[b]);
+    MD("\n## Doronin et al.'s Table 1 on this machine (%dx%d, one view)\n\n| scene | triangles | no SSAO ms | SSAO ms | "
+       "difference |\n|---|---|---|---|---|\n",
+       p.table_w, p.table_h);
+    for (int s = 0; s < 3; s++)
+        MD("| %s | %llu | %.1f | %.1f | %.1f |\n", tnames[s], (unsigned long long)t_tris[s], t_no[s], t_ao[s],
+           t_ao[s] - t_no[s]);
+#undef MD
+    mr_path_join(p.out_dir, "bench_multiview.md", path, sizeof path);
+    ok = ok && mr_file_write_atomic(path, md, len < cap ? len : cap - 1, err);
+    if (ok) BENCH_PRINT(out, "%.*s\nwrote %s/bench_multiview{.csv,.svg,.md,_display.csv,_table1.csv}\n", (int)len, md, p.out_dir);
+    free(md);
+    return ok;
+}

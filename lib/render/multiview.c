@@ -1,0 +1,324 @@
+/* Multi-view rigs and quilts for 3D displays: the frusta, the views as
+ * pinhole cameras, the quilt layout and its file name (pure functions), and
+ * the loop that renders a rig's views with one renderer. */
+#include "mr_render.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define DEG (3.14159265358979323846 / 180.0)
+
+#define RIG(f) offsetof(mr_rig_params, f)
+const mr_opt mr_rig_opts[] = {
+    {"views", MR_OPT_INT, RIG(views), 1, MR_RIG_MAX_VIEWS, 0, NULL,
+     "render N views for a 3D display (per-view PNGs and a quilt; --out is then a folder)", MR_OPT_ZERO_AUTO},
+    /* 180 degrees would put the outer eyes at infinity. */
+    {"view-cone", MR_OPT_DOUBLE, RIG(cone_deg), 0, 179, MR_RIG_DEFAULT_CONE, NULL,
+     "multi-view: total view cone in degrees", 0},
+    {"view-fov", MR_OPT_DOUBLE, RIG(fov_deg), 0.01, 179, MR_RIG_DEFAULT_FOV, NULL,
+     "multi-view: vertical field of view at the focal plane in degrees", 0},
+    {"focal-distance", MR_OPT_DOUBLE, RIG(focal_distance), 1e-30, 1e30, 0, NULL,
+     "multi-view: distance of the focal (zero-parallax) plane in scene units (auto: the scene's centre)",
+     MR_OPT_ZERO_AUTO},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef RIG
+
+double mr_rig_distance_for_size(double fov_deg, double size) { return size / tan(0.5 * fov_deg * DEG); }
+
+bool mr_rig_make(const mr_rig_params *p, double aspect, double distance, mr_rig *rig, mr_error *err) {
+    memset(rig, 0, sizeof *rig);
+    double fov = p->fov_deg > 0 ? p->fov_deg : MR_RIG_DEFAULT_FOV;
+    if (p->views < 1 || p->views > MR_RIG_MAX_VIEWS)
+        return mr_fail(err, MR_ERR_INVALID, "views must be in [1, %d], got %d", MR_RIG_MAX_VIEWS, p->views);
+    if (!(p->cone_deg >= 0 && p->cone_deg < 180))
+        return mr_fail(err, MR_ERR_INVALID, "view cone must be in [0, 180) degrees, got %g", p->cone_deg);
+    if (!(fov > 0 && fov < 180))
+        return mr_fail(err, MR_ERR_INVALID, "view field of view must be in (0, 180) degrees, got %g", fov);
+    if (!(aspect > 0 && isfinite(aspect))) return mr_fail(err, MR_ERR_INVALID, "view aspect must be positive, got %g", aspect);
+    if (!(distance > 0 && isfinite(distance)))
+        return mr_fail(err, MR_ERR_INVALID, "focal distance must be positive and finite, got %g", distance);
+    rig->views = p->views;
+    rig->cone = p->cone_deg * DEG;
+    rig->fov = fov * DEG;
+    rig->distance = distance;
+    rig->size = distance * tan(0.5 * rig->fov);
+    rig->aspect = aspect;
+    return true;
+}
+
+double mr_rig_angle(const mr_rig *rig, int i) {
+    if (rig->views < 2) return 0;
+    return ((double)i / (rig->views - 1) - 0.5) * rig->cone;
+}
+
+double mr_rig_shift(const mr_rig *rig, int i) { return rig->distance * tan(mr_rig_angle(rig, i)); }
+
+void mr_rig_frustum(const mr_rig *rig, int i, double n, double *l, double *r, double *b, double *t) {
+    double s = mr_rig_shift(rig, i), k = n / rig->distance, hw = rig->aspect * rig->size;
+    *l = (-hw - s) * k;
+    *r = (hw - s) * k;
+    *b = -rig->size * k;
+    *t = rig->size * k;
+}
+
+void mr_rig_project(const mr_rig *rig, int i, mr_dvec3 p, double ndc[2]) {
+    /* The point in view i's axes, on its near plane (n = 1), mapped
+     * linearly from [l, r] x [b, t] to [-1, 1]^2. */
+    double l, r, b, t;
+    mr_rig_frustum(rig, i, 1.0, &l, &r, &b, &t);
+    double x = (p.x - mr_rig_shift(rig, i)) / p.z, y = p.y / p.z;
+    ndc[0] = (2 * x - (r + l)) / (r - l);
+    ndc[1] = (2 * y - (t + b)) / (t - b);
+}
+
+mr_view mr_rig_view(const mr_rig *rig, const mr_view *centre, int i, int width, int height) {
+    mr_view v;
+    memset(&v, 0, sizeof v);
+    double s = mr_rig_shift(rig, i), hw = rig->aspect * rig->size;
+    mr_camera *c = &v.camera;
+    c->width = width;
+    c->height = height;
+    c->fx = width * rig->distance / (2 * hw);
+    c->fy = height * rig->distance / (2 * rig->size);
+    /* mr_gl_projection puts NDC 0 at cx + 0.5 = W/2; the shear moves it by
+     * s_i / half-width of NDC. */
+    c->cx = 0.5 * width * (1 + s / hw) - 0.5;
+    c->cy = 0.5 * height - 0.5;
+    mr_dmat4 shift = mr_m4_translate(s, 0, 0);
+    v.world_from_camera = mr_m4_mul(&centre->world_from_camera, &shift);
+    return v;
+}
+
+double mr_rig_auto_focal_distance(const mr_scene *scene, const mr_view *view) {
+    mr_dvec3 c = mr_v3(0.5 * (scene->bounds_min[0] + scene->bounds_max[0]), 0.5 * (scene->bounds_min[1] + scene->bounds_max[1]),
+                       0.5 * (scene->bounds_min[2] + scene->bounds_max[2]));
+    mr_dmat4 cw = mr_m4_invert_rigid(&view->world_from_camera);
+    mr_dvec3 pc = mr_m4_point(&cw, c);
+    return isfinite(pc.z) ? pc.z : 0;
+}
+
+static int cmp_float(const void *a, const void *b) {
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+double mr_rig_focal_from_depth(const mr_image *depth) {
+    if (!depth->data || depth->type != MR_PIX_F32 || depth->channels != 1) return 0;
+    int x0 = depth->width / 3, x1 = depth->width - x0, y0 = depth->height / 3, y1 = depth->height - y0;
+    float *v = malloc((size_t)(x1 - x0) * (size_t)(y1 - y0) * sizeof *v + 1);
+    if (!v) return 0;
+    size_t n = 0;
+    const float *d = depth->data;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            float z = d[(size_t)y * depth->width + x];
+            if (z > 0 && isfinite(z)) v[n++] = z;
+        }
+    double m = 0;
+    if (n) {
+        qsort(v, n, sizeof *v, cmp_float);
+        m = v[n / 2];
+    }
+    free(v);
+    return m;
+}
+
+/* Looking Glass's published quilt defaults for its displays. */
+static const struct {
+    const char *name;
+    int cols, rows, w, h;
+    double aspect;
+} k_presets[] = {
+    {"portrait", 8, 6, 3360, 3360, 0.75},
+    {"go", 11, 6, 4092, 4092, 0.5625},
+    {"4k", 5, 9, 4096, 4096, 16.0 / 9.0},
+    {"8k", 5, 9, 8192, 8192, 16.0 / 9.0},
+};
+
+bool mr_quilt_parse(const char *spec, mr_quilt *q, mr_error *err) {
+    memset(q, 0, sizeof *q);
+    for (size_t k = 0; k < sizeof k_presets / sizeof k_presets[0]; k++)
+        if (strcmp(spec, k_presets[k].name) == 0) {
+            q->cols = k_presets[k].cols;
+            q->rows = k_presets[k].rows;
+            q->width = k_presets[k].w;
+            q->height = k_presets[k].h;
+            q->aspect = k_presets[k].aspect;
+            q->preset = k_presets[k].name;
+            return true;
+        }
+    int c = 0, r = 0, w = 0, h = 0, used = 0;
+    size_t len = strlen(spec);
+    bool ok = (sscanf(spec, "%dx%d%n", &c, &r, &used) == 2 && (size_t)used == len) ||
+              (sscanf(spec, "%dx%d@%dx%d%n", &c, &r, &w, &h, &used) == 4 && (size_t)used == len);
+    if (!ok || c < 1 || r < 1 || c > 1024 || r > 1024 || w < 0 || h < 0 || w > 16384 || h > 16384 ||
+        (used && strchr(spec, '@') && (w < 1 || h < 1)))
+        return mr_fail(err, MR_ERR_INVALID,
+                       "quilt must be portrait, go, 4k, 8k, CxR or CxR@WxH (1..1024 tiles, up to 16384 pixels), got '%s'",
+                       spec);
+    q->cols = c;
+    q->rows = r;
+    q->width = w;
+    q->height = h;
+    return true;
+}
+
+bool mr_quilt_layout_make(const mr_quilt *spec, int views, int view_w, int view_h, mr_quilt_layout *out,
+                          mr_error *err) {
+    memset(out, 0, sizeof *out);
+    if (views < 1) return mr_fail(err, MR_ERR_INVALID, "a quilt needs at least one view, got %d", views);
+    int cols, rows;
+    if (spec) {
+        cols = spec->cols;
+        rows = spec->rows;
+    } else {
+        cols = (int)ceil(sqrt((double)views));
+        rows = (views + cols - 1) / cols;
+    }
+    if ((long)cols * rows < views)
+        return mr_fail(err, MR_ERR_INVALID, "quilt %dx%d has %ld tiles, too few for %d views", cols, rows,
+                       (long)cols * rows, views);
+    int tw = view_w, th = view_h, w = 0, h = 0;
+    if (spec && spec->width > 0) {
+        tw = spec->width / cols;
+        th = spec->height / rows;
+        w = spec->width;
+        h = spec->height;
+    }
+    if (tw < 1 || th < 1)
+        return mr_fail(err, MR_ERR_INVALID, "quilt %dx%d of %dx%d pixels leaves tiles under one pixel", cols, rows, w, h);
+    if (!w) {
+        w = cols * tw;
+        h = rows * th;
+    }
+    if (w > 16384 || h > 16384) return mr_fail(err, MR_ERR_INVALID, "quilt of %dx%d pixels is too large", w, h);
+    out->cols = cols;
+    out->rows = rows;
+    out->tile_w = tw;
+    out->tile_h = th;
+    out->width = w;
+    out->height = h;
+    out->aspect = spec && spec->aspect > 0 ? spec->aspect : (double)tw / th;
+    return true;
+}
+
+void mr_quilt_tile_origin(const mr_quilt_layout *q, int i, int *x, int *y) {
+    /* Tile rows count up from the bottom; image rows go down from the top. */
+    *x = (i % q->cols) * q->tile_w;
+    *y = q->height - (i / q->cols + 1) * q->tile_h;
+}
+
+bool mr_quilt_put(const mr_quilt_layout *q, mr_image *quilt, int i, const mr_image *view, mr_error *err) {
+    if (i < 0 || i >= q->cols * q->rows) return mr_fail(err, MR_ERR_INVALID, "view %d is outside the quilt", i);
+    if (view->width != q->tile_w || view->height != q->tile_h || view->channels != quilt->channels ||
+        view->type != quilt->type || quilt->width != q->width || quilt->height != q->height)
+        return mr_fail(err, MR_ERR_INVALID, "view %d (%dx%d) does not fit the quilt's %dx%d tiles", i, view->width,
+                       view->height, q->tile_w, q->tile_h);
+    int x0, y0;
+    mr_quilt_tile_origin(q, i, &x0, &y0);
+    size_t px = (size_t)quilt->channels * (quilt->type == MR_PIX_F32 ? 4 : 1);
+    for (int y = 0; y < q->tile_h; y++)
+        memcpy((unsigned char *)quilt->data + ((size_t)(y0 + y) * quilt->width + x0) * px,
+               (const unsigned char *)view->data + (size_t)y * view->width * px, (size_t)view->width * px);
+    return true;
+}
+
+void mr_quilt_file_name(const char *name, const mr_quilt_layout *q, char *out, size_t n) {
+    snprintf(out, n, "%s_qs%dx%da%.4g.png", name, q->cols, q->rows, q->aspect);
+}
+
+bool mr_render_rig(mr_renderer *r, const mr_rig *rig, const mr_view *centre, const mr_frame_params *params,
+                   const mr_quilt_layout *layout, const char *views_dir, mr_image *quilt, mr_rig_result *res,
+                   mr_error *err) {
+    mr_rig_result dummy;
+    if (!res) res = &dummy;
+    memset(res, 0, sizeof *res);
+    if (quilt && !mr_image_alloc(quilt, layout->width, layout->height, 3, MR_PIX_U8, err)) return false;
+    if (quilt) memset(quilt->data, 0, mr_image_bytes(quilt));
+    if (views_dir && !mr_mkdirs(views_dir, err)) goto fail;
+    mr_frame_params fp = *params;
+    fp.video = NULL;
+    fp.width = layout->tile_w;
+    fp.height = layout->tile_h;
+    /* The noise's frame: the centre camera, shared by all views. */
+    fp.ao.noise_anchor = centre->world_from_camera;
+    fp.ao.noise_anchor_set = true;
+    double t0 = mr_time_now();
+    for (int i = 0; i < rig->views; i++) {
+        mr_view v = mr_rig_view(rig, centre, i, layout->tile_w, layout->tile_h);
+        mr_frame_result fr;
+        if (!mr_render_frame(r, &v, &fp, &fr, err)) goto fail;
+        bool ok = !quilt || mr_quilt_put(layout, quilt, i, &fr.color, err);
+        if (ok && views_dir) {
+            char name[32], path[4096];
+            snprintf(name, sizeof name, "view_%03d.png", i);
+            mr_path_join(views_dir, name, path, sizeof path);
+            ok = mr_image_save_png(path, &fr.color, err);
+        }
+        mr_frame_result_free(&fr);
+        if (!ok) goto fail;
+    }
+    res->ms_total = (mr_time_now() - t0) * 1e3;
+    res->views = rig->views;
+    return true;
+fail:
+    if (quilt) mr_image_free(quilt);
+    return false;
+}
+
+mr_display_map mr_display_from_rig(const mr_rig *rig, int band) {
+    mr_display_map m = {rig->distance, rig->distance * tan(0.5 * rig->cone), band > 0 ? band : MR_DISPLAY_DEFAULT_BAND};
+    return m;
+}
+
+double mr_display_eye(const mr_display_map *m, int width, double u) { return (2 * (u + 0.5) / width - 1) * m->eye_half; }
+
+mr_dvec3 mr_display_point(const mr_display_map *m, const mr_camera *cam, double u, double v, double z) {
+    /* The ray of u in its band's camera: a pinhole at the band's eye e whose
+     * principal point is moved by fx e / D (the rig's shear); at band 1,
+     * column u's own ray. */
+    int k = m->band > 0 ? m->band : 1, b = (int)floor((u + 0.5) / k), x0, x1;
+    if (b < 0) b = 0;
+    double e;
+    mr_display_band_camera(m, cam, b, &x0, &x1, &e);
+    if (k == 1) e = mr_display_eye(m, cam->width, u); /* exact between pixel centres too */
+    return mr_v3((u - cam->cx - cam->fx * e / m->distance) / cam->fx * z + e, (v - cam->cy) / cam->fy * z, z);
+}
+
+bool mr_display_project(const mr_display_map *m, const mr_camera *cam, mr_dvec3 p, double *u, double *v) {
+    /* u = fx X/z + cx + g e(u) with g = fx (1/D - 1/z) and e linear in u:
+     * e(u) = a (u + 0.5) - E, a = 2E/W; solved for u. */
+    if (!(p.z > 0)) return false;
+    double a = 2 * m->eye_half / cam->width, g = cam->fx * (1 / m->distance - 1 / p.z), den = 1 - g * a;
+    if (!(fabs(den) > 1e-12)) return false;
+    *u = (cam->fx * p.x / p.z + cam->cx + g * (0.5 * a - m->eye_half)) / den;
+    *v = cam->fy * p.y / p.z + cam->cy;
+    return isfinite(*u) && isfinite(*v);
+}
+
+int mr_display_band_count(const mr_display_map *m, int width) {
+    int k = m->band > 0 ? m->band : 1;
+    return (width + k - 1) / k;
+}
+
+mr_camera mr_display_band_camera(const mr_display_map *m, const mr_camera *cam, int b, int *x0, int *x1, double *eye) {
+    int k = m->band > 0 ? m->band : 1;
+    *x0 = b * k;
+    *x1 = *x0 + k < cam->width ? *x0 + k : cam->width;
+    *eye = mr_display_eye(m, cam->width, 0.5 * (*x0 + *x1 - 1));
+    mr_camera c = *cam;
+    c.cx += cam->fx * *eye / m->distance;
+    return c;
+}
+
+double mr_display_column_error(const mr_display_map *m, const mr_camera *cam, int u, double z) {
+    /* The band camera's ray through column u's centre, at depth z. */
+    mr_dvec3 p = mr_display_point(m, cam, u, cam->cy, z);
+    double uu, vv;
+    if (!mr_display_project(m, cam, p, &uu, &vv)) return NAN;
+    return uu - u;
+}
