@@ -14,6 +14,7 @@
 #include "mr_eval.h"
 #include "mr_render.h"
 #include "mr_scene.h"
+#include "mr_track.h" /* the marker map and detections of mr_synth_map */
 
 #ifdef __cplusplus
 extern "C" {
@@ -158,6 +159,45 @@ bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params
  * marker map) and dir/images/board_NN.png, `images` (>= 1) views of it from
  * around, rendered on the CPU through the demo camera. */
 bool mr_synth_calibration(const char *dir, int images, mr_error *err);
+
+/* A synthetic photo set for the marker map (synth_map.c): `tags` tags on a
+ * ring of walls (radius, facing its centre, a little tilted; with
+ * mixed_sizes every third is 1.5x tag_size), `photos` photos from inside
+ * it, each seeing a few neighbouring tags; `isolated` more tags in a room
+ * of their own far off, seen by two extra photos only (a disconnected
+ * part). Either projected corners with Gaussian noise (dets, counts; a
+ * fraction `misdetect` of the photos has one sighting with a wrong id) or,
+ * with render, CPU ray-cast grey images (images) for the real detector.
+ * The demo camera scaled to width x height. */
+typedef struct mr_synth_map_params {
+    uint64_t seed;          /* default 1 */
+    int tags;               /* 3..200, default 16 */
+    int photos;             /* 1..10000, default 24 */
+    int isolated;           /* 0..50, default 0 */
+    double tag_size;        /* m, default 0.2 */
+    bool mixed_sizes;
+    double radius;          /* m, default 3 */
+    double offset;          /* added to every x (far-from-origin sites), m */
+    double corner_noise_px; /* projected corners: sigma, default 0.3 */
+    double misdetect;       /* 0..1, default 0 */
+    bool render;            /* images instead of projected corners */
+    double image_noise;     /* grey levels, default 2 */
+    int width, height;      /* px, default 320x240 */
+} mr_synth_map_params;
+#define MR_SYNTH_MAP_DEFAULTS \
+    .seed = 1, .tags = 16, .photos = 24, .tag_size = 0.2, .radius = 3.0, .corner_noise_px = 0.3, .image_noise = 2.0, \
+    .width = 320, .height = 240
+typedef struct mr_synth_map {
+    mr_camera camera;
+    mr_marker_map truth;          /* the tags' true poses (and sizes) */
+    int photo_count;
+    mr_dmat4 *world_from_camera;  /* photo_count true poses */
+    mr_detection **dets;          /* projected: per photo counts[j] sightings */
+    int *counts;
+    mr_image *images;             /* render: photo_count grey images */
+} mr_synth_map;
+bool mr_synth_map_make(const mr_synth_map_params *params, mr_synth_map *out, mr_error *err);
+void mr_synth_map_free(mr_synth_map *s);
 
 #ifdef __cplusplus
 }

@@ -210,20 +210,21 @@ bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_dete
     /* Candidates: both IPPE solutions of every tag, in world terms. */
     cand cands[MAX_CAND];
     int nc = 0;
-    mr_dvec3 tc[4];
-    mr_marker_corners_tag(map->tag_size, tc);
-    double objt[12];
-    for (int k = 0; k < 4; k++) {
-        objt[3 * k] = tc[k].x;
-        objt[3 * k + 1] = tc[k].y;
-        objt[3 * k + 2] = tc[k].z;
-    }
     for (int i = 0; i < n; i++) {
         double R[2][9], t[2][3];
         double img8[8];
         memcpy(img8, obs[i].norm, sizeof img8);
-        int ns = mr_cv_ippe_square(objt, img8, R, t);
         const mr_marker *m = mr_marker_map_find(map, obs[i].id);
+        /* Each tag's own size (maps of mixed sizes). */
+        mr_dvec3 tc[4];
+        mr_marker_corners_tag(mr_marker_size(map, m), tc);
+        double objt[12];
+        for (int k = 0; k < 4; k++) {
+            objt[3 * k] = tc[k].x;
+            objt[3 * k + 1] = tc[k].y;
+            objt[3 * k + 2] = tc[k].z;
+        }
+        int ns = mr_cv_ippe_square(objt, img8, R, t);
         mr_dmat4 tfw = mr_m4_invert_rigid(&m->world_from_tag);
         for (int s = 0; s < ns; s++) {
             rt ct;
