@@ -584,6 +584,7 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
                         w[m++] = edges[e].count;
                     }
                     double Rm[9], t[3] = {rft[i].m[3], rft[i].m[7], rft[i].m[11]};
+                    if (m == 0) continue;
                     mr_ba_rotation_mean(R, w, m, Rm);
                     rft[i] = m4_rt(Rm, t);
                 }
@@ -601,6 +602,7 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
                         t[2] += edges[e].count * q.z;
                         sw += edges[e].count;
                     }
+                    if (!(sw > 0)) continue;
                     rft[i].m[3] = t[0] / sw;
                     rft[i].m[7] = t[1] / sw;
                     rft[i].m[11] = t[2] / sw;
