@@ -19,6 +19,7 @@ static const struct {
     {"calibrate", cmd_calibrate, "camera intrinsics from images of an AprilTag grid board (OpenCV)"},
     {"replay", cmd_replay, "render the overlay of a recording's frames headless (deterministic)"},
     {"factory", cmd_factory, "write a big synthetic factory (1M..20M triangles) as .glb"},
+    {"map", cmd_map, "the marker map from photos: bundle adjustment, per-tag sigma, control points"},
 };
 
 static void usage(FILE *f) {

@@ -221,3 +221,57 @@ bool mr_synth_map_make(const mr_synth_map_params *params, mr_synth_map *out, mr_
     if (!ok) mr_synth_map_free(out);
     return ok;
 }
+
+bool mr_synth_map_write(const char *dir, const mr_synth_map_params *params, mr_error *err) {
+    mr_synth_map_params p = params ? *params : (mr_synth_map_params){MR_SYNTH_MAP_SET_DEFAULTS};
+    p.render = true;
+    char path[4096];
+    mr_path_join(dir, "images", path, sizeof path);
+    if (mr_file_exists(path)) return mr_fail(err, MR_ERR_INVALID, "%s already exists (never overwritten)", path);
+    if (!mr_mkdirs(path, err)) return false;
+    mr_synth_map s;
+    if (!mr_synth_map_make(&p, &s, err)) return false;
+    bool ok = true;
+    for (int j = 0; ok && j < s.photo_count; j++) {
+        char name[64];
+        snprintf(name, sizeof name, "images/photo_%03d.png", j);
+        mr_path_join(dir, name, path, sizeof path);
+        ok = mr_image_save_png(path, &s.images[j], err);
+    }
+    if (ok) {
+        cJSON *c = mr_camera_to_json(&s.camera);
+        mr_path_join(dir, "camera.json", path, sizeof path);
+        ok = mr_json_save(path, c, err);
+        cJSON_Delete(c);
+    }
+    if (ok) {
+        cJSON *t = mr_marker_map_to_json(&s.truth);
+        mr_path_join(dir, "truth.json", path, sizeof path);
+        ok = mr_json_save(path, t, err);
+        cJSON_Delete(t);
+    }
+    if (ok) {
+        /* Four tag centres as a total station would give them (exact here;
+         * sigma 1 mm). */
+        cJSON *j = cJSON_CreateObject(), *pts = cJSON_AddArrayToObject(j, "points");
+        cJSON_AddNumberToObject(j, "sigma", 0.001);
+        int n = s.truth.count < 4 ? s.truth.count : 4;
+        for (int q = 0; q < n; q++) {
+            const mr_marker *m = &s.truth.tags[q * (s.truth.count / n)];
+            cJSON *o = cJSON_CreateObject();
+            char nm[32];
+            snprintf(nm, sizeof nm, "P%d", q + 1);
+            cJSON_AddStringToObject(o, "name", nm);
+            cJSON_AddNumberToObject(o, "tag", m->id);
+            cJSON_AddStringToObject(o, "corner", "centre");
+            double xyz[3] = {m->world_from_tag.m[3], m->world_from_tag.m[7], m->world_from_tag.m[11]};
+            cJSON_AddItemToObject(o, "xyz", mr_json_from_doubles(xyz, 3));
+            cJSON_AddItemToArray(pts, o);
+        }
+        mr_path_join(dir, "control.json", path, sizeof path);
+        ok = mr_json_save(path, j, err);
+        cJSON_Delete(j);
+    }
+    mr_synth_map_free(&s);
+    return ok;
+}
