@@ -7,6 +7,7 @@
 #include <ceres/rotation.h>
 
 #include <Eigen/Dense>
+#include <glog/logging.h>
 
 #include <cmath>
 #include <cstdio>
@@ -99,6 +100,9 @@ void tag_point(double size, int corner, double *X, double *Y) {
 } // namespace
 
 extern "C" bool mr_ba_solve(mr_ba_problem *p, char *msg, size_t msg_size) {
+    /* Ceres logs through glog on stderr (rank-deficient covariances, the
+     * minimiser's stops); mrcheck reports on its own, in one line. */
+    FLAGS_minloglevel = google::GLOG_FATAL;
     try {
         std::vector<double> tq(4 * (size_t)p->ntags), tt(3 * (size_t)p->ntags);
         std::vector<double> cq(4 * (size_t)p->nphotos), ct(3 * (size_t)p->nphotos);
