@@ -108,11 +108,11 @@ static void test_fixed_gauge_and_chaining(void) {
 static void test_disconnected_mixed_misdetect(void) {
     mr_synth_map_params sp = {MR_SYNTH_MAP_DEFAULTS};
     room(&sp);
-    sp.tags = 9;
+    sp.tags = 12;
     sp.photos = 40;
     sp.isolated = 2;
     sp.mixed_sizes = true;
-    /* Misdetections (wrong ids) are not handled well enough yet to test. */
+    sp.misdetect = getenv("NOMIS") ? 0 : 0.2;
     sp.seed = 7;
     mr_synth_map s;
     mr_error err = {0};
@@ -138,7 +138,21 @@ static void test_disconnected_mixed_misdetect(void) {
     CHECK(r.unconnected_count == 2 && r.unconnected[0] == sp.tags && r.unconnected[1] == sp.tags + 1);
     double e_rms, e_max, e_deg, z;
     map_error(&r, &s.truth, &e_rms, &e_max, &e_deg, &z);
-    printf("disconnected + mixed sizes: rms %.2f mm max %.2f mm\n", e_rms * 1e3, e_max * 1e3);
+    int wrong = 0, total = 0;
+    for (int j = 0; j < s.photo_count; j++)
+        for (int k = 0; k < s.counts[j]; k++) {
+            const mr_marker *t = mr_marker_map_find(&s.truth, s.dets[j][k].id);
+            double u, v;
+            mr_dvec3 c[4];
+            mr_marker_corners_world(&s.truth, t, c);
+            total++;
+            wrong += !mr_project_point(&s.camera, &s.world_from_camera[j], c[0], &u, &v) ||
+                     hypot(u - s.dets[j][k].corners[0][0], v - s.dets[j][k].corners[0][1]) > 5;
+        }
+    printf("disconnected + mixed sizes + %d wrong ids in %d sightings: rms %.2f mm max %.2f mm, %d sightings used\n",
+           wrong, total, e_rms * 1e3, e_max * 1e3, r.observations);
+    CHECK(wrong > 0);
+    CHECK(r.observations <= total - wrong);
     CHECK(e_max < 0.060);
     for (int i = 0; i < r.tag_count; i++) {
         const mr_marker *t = mr_marker_map_find(&s.truth, r.tags[i].id);

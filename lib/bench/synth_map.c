@@ -104,8 +104,9 @@ bool mr_synth_map_make(const mr_synth_map_params *params, mr_synth_map *out, mr_
         !(p.tag_size > 0) || !(p.corner_noise_px >= 0) || !(p.radius > 0) || p.width < 64 || p.height < 48 ||
         !(p.misdetect >= 0 && p.misdetect <= 1))
         return mr_fail(err, MR_ERR_INVALID, "synth map: parameters out of range");
-    mr_rng rng;
+    mr_rng rng, mis; /* misdetections draw apart: the same set with and without them */
     mr_rng_seed(&rng, p.seed);
+    mr_rng_seed(&mis, p.seed ^ 0x9e3779b97f4a7c15ull);
     mr_camera base = mr_demo_camera();
     mr_camera cam = mr_camera_resized(&base, p.width, p.height);
     out->camera = cam;
@@ -160,8 +161,8 @@ bool mr_synth_map_make(const mr_synth_map_params *params, mr_synth_map *out, mr_
         if (j < p.photos) {
             /* Around the ring, looking at a spot of the wall from inside. */
             double th = 2 * M_PI * (j + 0.5 * mr_rng_uniform(&rng)) / p.photos;
-            double r = p.radius * 0.7 * mr_rng_uniform(&rng);
-            double side = 2 * M_PI * mr_rng_uniform(&rng);
+            double r = p.radius * (0.3 + 0.5 * mr_rng_uniform(&rng));
+            double side = th + M_PI + 0.8 * (mr_rng_uniform(&rng) - 0.5); /* across the room */
             mr_dvec3 eye = mr_v3(r * cos(side), 1.5 + 0.4 * (mr_rng_uniform(&rng) - 0.5), r * sin(side));
             mr_dvec3 at = mr_v3(p.radius * cos(th), 1.5, p.radius * sin(th));
             wfc = mr_m4_look_at_cv(eye, at, mr_v3(0, 1, 0));
@@ -205,10 +206,10 @@ bool mr_synth_map_make(const mr_synth_map_params *params, mr_synth_map *out, mr_
             out->dets[j][out->counts[j]++] = d;
         }
         /* A misdetection: one sighting gets another tag's id. */
-        if (out->counts[j] > 1 && mr_rng_uniform(&rng) < p.misdetect) {
-            int k = (int)(mr_rng_uniform(&rng) * out->counts[j]);
+        if (j < p.photos && out->counts[j] > 0 && mr_rng_uniform(&mis) < p.misdetect) {
+            int k = (int)(mr_rng_uniform(&mis) * out->counts[j]);
             for (int tries = 0; tries < 20; tries++) {
-                int id = (int)(mr_rng_uniform(&rng) * p.tags), dup = 0;
+                int id = (int)(mr_rng_uniform(&mis) * p.tags), dup = 0;
                 for (int q = 0; q < out->counts[j]; q++) dup += out->dets[j][q].id == id;
                 if (!dup) {
                     out->dets[j][k].id = id;

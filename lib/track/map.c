@@ -193,6 +193,133 @@ typedef struct ctx_t {
     int nobs;
 } ctx_t;
 
+/* Pairwise relative poses from every photo that sees both tags (used
+ * sightings only, if asked), sorted by pair, and one robust mean per pair
+ * into edges. pairs and edges hold the count of all pairs. Returns the
+ * number of edges. */
+static int build_edges(const ctx_t *c, bool used_only, pair_t *pairs, edge_t *edges) {
+    size_t npair = 0;
+    for (int a = 0; a < c->nobs;) {
+        int b = a;
+        while (b < c->nobs && c->obs[b].photo == c->obs[a].photo) b++;
+        for (int x = a; x < b; x++)
+            for (int y = x + 1; y < b; y++) {
+                const obs_t *ox = &c->obs[x], *oy = &c->obs[y];
+                if (used_only && (!ox->use || !oy->use)) continue;
+                const obs_t *lo = ox->tag < oy->tag ? ox : oy, *hi = ox->tag < oy->tag ? oy : ox;
+                pairs[npair].a = lo->tag;
+                pairs[npair].b = hi->tag;
+                pairs[npair].n = 0;
+                for (int sl = 0; sl < lo->ns; sl++) {
+                    mr_dmat4 tfc = mr_m4_invert_rigid(&lo->cft[sl]);
+                    for (int sh = 0; sh < hi->ns; sh++)
+                        pairs[npair].rel[pairs[npair].n++] = mr_m4_mul(&tfc, &hi->cft[sh]);
+                }
+                npair++;
+            }
+        a = b;
+    }
+    qsort(pairs, npair, sizeof *pairs, cmp_pair);
+    int ne = 0;
+    for (size_t i = 0; i < npair;) {
+        size_t e = i;
+        while (e < npair && pairs[e].a == pairs[i].a && pairs[e].b == pairs[i].b) e++;
+        edges[ne].a = pairs[i].a;
+        edges[ne].b = pairs[i].b;
+        edges[ne].count = robust_mean(&pairs[i], (int)(e - i), &edges[ne].rel);
+        ne++;
+        i = e;
+    }
+    return ne;
+}
+
+/* The initial map again, one tag at a time by view count (Prim's order:
+ * next the unplaced tag sharing the most photos with placed ones), each
+ * from the robust mean of its poses through every such photo. A photo
+ * whose pose for the tag disagrees with the others (a wrong id, a wrong
+ * IPPE branch of both tags) loses that sighting: it does not reach the
+ * rotation averaging or the adjustment. in_part: the tags to place;
+ * rft[root] is the identity. Returns the number of sightings dropped. */
+static int place_tags(ctx_t *c, const bool *in_part, int root, mr_dmat4 *rft, bool *placed, pair_t *buf) {
+    int dropped = 0;
+    memset(placed, 0, (size_t)c->ntags * sizeof *placed);
+    placed[root] = true;
+    rft[root] = mr_m4_identity();
+    for (;;) {
+        int best = -1, best_n = 0;
+        for (int t = 0; t < c->ntags; t++) {
+            if (!in_part[t] || placed[t]) continue;
+            int n = 0;
+            for (int a = 0; a < c->nobs;) {
+                int b = a;
+                while (b < c->nobs && c->obs[b].photo == c->obs[a].photo) b++;
+                bool has_t = false, has_p = false;
+                for (int x = a; x < b; x++) {
+                    if (!c->obs[x].use) continue;
+                    has_t |= c->obs[x].tag == t;
+                    has_p |= placed[c->obs[x].tag];
+                }
+                n += has_t && has_p;
+                a = b;
+            }
+            if (n > best_n) best = t, best_n = n;
+        }
+        if (best < 0) break;
+        /* Candidates: through each placed tag of each photo of best. */
+        int n = 0;
+        for (int a = 0; a < c->nobs;) {
+            int b = a;
+            while (b < c->nobs && c->obs[b].photo == c->obs[a].photo) b++;
+            const obs_t *ot = NULL;
+            for (int x = a; x < b; x++)
+                if (c->obs[x].use && c->obs[x].tag == best) ot = &c->obs[x];
+            for (int x = a; ot && x < b; x++) {
+                const obs_t *op = &c->obs[x];
+                if (!op->use || !placed[op->tag]) continue;
+                pair_t *e = &buf[n++];
+                e->a = (int)(ot - c->obs); /* the sighting, to drop it */
+                e->b = x;
+                e->n = 0;
+                for (int sp = 0; sp < op->ns; sp++) {
+                    mr_dmat4 pfc = mr_m4_invert_rigid(&op->cft[sp]), rfc = mr_m4_mul(&rft[op->tag], &pfc);
+                    for (int st = 0; st < ot->ns; st++) e->rel[e->n++] = mr_m4_mul(&rfc, &ot->cft[st]);
+                }
+            }
+            a = b;
+        }
+        mr_dmat4 m;
+        robust_mean(buf, n, &m);
+        double lim_t = 2 * c->size[best];
+        for (int i = 0; i < n; i++) {
+            bool in = false;
+            for (int k = 0; k < buf[i].n && !in; k++) {
+                mr_dvec3 d = mr_v3(buf[i].rel[k].m[3] - m.m[3], buf[i].rel[k].m[7] - m.m[7], buf[i].rel[k].m[11] - m.m[11]);
+                in = mr_pose_angle_deg(&buf[i].rel[k], &m) <= 2 * PAIR_INLIER_DEG && mr_v3_len(d) <= lim_t;
+            }
+            /* Out: either sighting may be the wrong one; the new tag's is
+             * dropped unless it agrees through another placed tag. */
+            if (!in) {
+                bool other = false;
+                for (int q = 0; q < n && !other; q++)
+                    if (q != i && buf[q].a == buf[i].a)
+                        for (int k = 0; k < buf[q].n && !other; k++) {
+                            mr_dvec3 d = mr_v3(buf[q].rel[k].m[3] - m.m[3], buf[q].rel[k].m[7] - m.m[7],
+                                               buf[q].rel[k].m[11] - m.m[11]);
+                            other = mr_pose_angle_deg(&buf[q].rel[k], &m) <= 2 * PAIR_INLIER_DEG && mr_v3_len(d) <= lim_t;
+                        }
+                obs_t *drop = &c->obs[other ? buf[i].b : buf[i].a];
+                if (drop->use && drop->tag != root) {
+                    drop->use = false;
+                    dropped++;
+                }
+            }
+        }
+        rft[best] = m;
+        placed[best] = true;
+    }
+    return dropped;
+}
+
 /* One bundle adjustment of the component's tags (wft, nt of them) and the
  * used photos' poses (cfw, np), controls as given by use. */
 static bool run_ba(const ctx_t *c, int nt, const int *tag_of, mr_dmat4 *wft, int np, const int *photo_slot,
@@ -424,37 +551,7 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
         pairs = malloc((np + 1) * sizeof *pairs);
         edges = malloc((np + 1) * sizeof *edges);
         if (!pairs || !edges) goto nomem;
-        size_t npair = 0;
-        for (int a = 0; a < c.nobs;) {
-            int b = a;
-            while (b < c.nobs && c.obs[b].photo == c.obs[a].photo) b++;
-            for (int x = a; x < b; x++)
-                for (int y = x + 1; y < b; y++) {
-                    const obs_t *ox = &c.obs[x], *oy = &c.obs[y];
-                    const obs_t *lo = ox->tag < oy->tag ? ox : oy, *hi = ox->tag < oy->tag ? oy : ox;
-                    pairs[npair].a = lo->tag;
-                    pairs[npair].b = hi->tag;
-                    pairs[npair].n = 0;
-                    for (int sl = 0; sl < lo->ns; sl++) {
-                        mr_dmat4 tfc = mr_m4_invert_rigid(&lo->cft[sl]);
-                        for (int sh = 0; sh < hi->ns; sh++)
-                            pairs[npair].rel[pairs[npair].n++] = mr_m4_mul(&tfc, &hi->cft[sh]);
-                    }
-                    npair++;
-                }
-            a = b;
-        }
-        qsort(pairs, npair, sizeof *pairs, cmp_pair);
-        int ne = 0;
-        for (size_t i = 0; i < npair;) {
-            size_t e = i;
-            while (e < npair && pairs[e].a == pairs[i].a && pairs[e].b == pairs[i].b) e++;
-            edges[ne].a = pairs[i].a;
-            edges[ne].b = pairs[i].b;
-            edges[ne].count = robust_mean(&pairs[i], (int)(e - i), &edges[ne].rel);
-            ne++;
-            i = e;
-        }
+        int ne = build_edges(&c, false, pairs, edges);
         /* 4. Connected parts. */
         parent = malloc((size_t)c.ntags * sizeof *parent);
         tag_obs_count = calloc((size_t)c.ntags, sizeof *tag_obs_count);
@@ -564,8 +661,25 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
         free(tree_edge);
 
         /* 6. Rotation averaging over every pair of the part (the tree is
-         * only the start), then the positions with the rotations held. */
+         * only the start), then the positions with the rotations held;
+         * before that, the tags placed again one by one with the sightings
+         * that disagree left out, and the pairs made again without them. */
         if (!p->no_adjust) {
+            bool *part = calloc((size_t)c.ntags, sizeof *part), *placed = calloc((size_t)c.ntags, sizeof *placed);
+            pair_t *buf = malloc(((size_t)c.nobs * 8 + 1) * sizeof *buf);
+            if (!part || !placed || !buf) {
+                free(part);
+                free(placed);
+                free(buf);
+                goto nomem;
+            }
+            for (int i = 0; i < c.ntags; i++) part[i] = tag_of[i] >= 0;
+            int dropped = place_tags(&c, part, root, rft, placed, buf);
+            if (dropped) mr_log(MR_LOG_INFO, "map: %d sightings disagree with the others: left out", dropped);
+            free(part);
+            free(placed);
+            free(buf);
+            ne = build_edges(&c, true, pairs, edges);
             double *R = malloc((size_t)(ne + 1) * 9 * sizeof *R), *w = malloc((size_t)(ne + 1) * sizeof *w);
             if (!R || !w) {
                 free(R);

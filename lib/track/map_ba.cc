@@ -9,10 +9,15 @@
 #include <Eigen/Dense>
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <vector>
+
+/* Corner sigmas below this are taken as this (px): exact synthetic
+ * corners would otherwise weigh the control points down to nothing. */
+#define MR_BA_SIGMA_FLOOR_PX 0.02
 
 namespace {
 
@@ -46,6 +51,7 @@ void join_pose(const double q[4], const double t[3], double *m) {
 struct CornerCost {
     double X, Y; /* tag frame, z = 0 */
     double u, v; /* observed pixel */
+    double w;    /* 1 / corner sigma (px) */
     template <typename T>
     bool operator()(const T *tq, const T *tt, const T *cq, const T *ct, const T *k, T *r) const {
         T pt[3] = {T(X), T(Y), T(0)}, pw[3], pc[3];
@@ -65,8 +71,8 @@ struct CornerCost {
         T radial = T(1) + k[4] * r2 + k[5] * r2 * r2 + k[8] * r2 * r2 * r2;
         T xd = x * radial + T(2) * k[6] * x * y + k[7] * (r2 + T(2) * x * x);
         T yd = y * radial + k[6] * (r2 + T(2) * y * y) + T(2) * k[7] * x * y;
-        r[0] = k[0] * xd + k[2] - T(u);
-        r[1] = k[1] * yd + k[3] - T(v);
+        r[0] = (k[0] * xd + k[2] - T(u)) * T(w);
+        r[1] = (k[1] * yd + k[3] - T(v)) * T(w);
         return true;
     }
 };
@@ -114,53 +120,54 @@ extern "C" bool mr_ba_solve(mr_ba_problem *p, char *msg, size_t msg_size) {
         ceres::Problem::Options po;
         po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
         po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-        ceres::Problem problem(po);
         ceres::QuaternionManifold qman;
-        ceres::HuberLoss loss(p->loss_px > 0 ? p->loss_px : 1.0);
         std::unique_ptr<ceres::SubsetManifold> kman(new ceres::SubsetManifold(9, {6, 7, 8}));
         std::vector<bool> tag_used(p->ntags, false), cam_used(p->nphotos, false);
         int nres = 0;
-        for (int o = 0; o < p->nobs; o++) {
-            int ti = p->obs_tag[o], pj = p->obs_photo[o];
-            for (int c = 0; c < 4; c++) {
-                CornerCost *cc = new CornerCost;
-                tag_point(p->tag_size[ti], c, &cc->X, &cc->Y);
-                cc->u = p->obs_px[8 * o + 2 * c];
-                cc->v = p->obs_px[8 * o + 2 * c + 1];
-                problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CornerCost, 2, 4, 3, 4, 3, 9>(cc), &loss,
-                                         &tq[4 * ti], &tt[3 * ti], &cq[4 * pj], &ct[3 * pj], k);
-                nres += 2;
+        const double loss_px = p->loss_px > 0 ? p->loss_px : 1.0;
+        /* The whole problem, corners weighted by w = 1 / their sigma (px)
+         * and the control points by theirs, so that both speak in sigmas. */
+        auto build = [&](ceres::Problem &problem, double w, ceres::LossFunction *loss) {
+            nres = 0;
+            for (int o = 0; o < p->nobs; o++) {
+                int ti = p->obs_tag[o], pj = p->obs_photo[o];
+                for (int c = 0; c < 4; c++) {
+                    CornerCost *cc = new CornerCost;
+                    tag_point(p->tag_size[ti], c, &cc->X, &cc->Y);
+                    cc->u = p->obs_px[8 * o + 2 * c];
+                    cc->v = p->obs_px[8 * o + 2 * c + 1];
+                    cc->w = w;
+                    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CornerCost, 2, 4, 3, 4, 3, 9>(cc), loss,
+                                             &tq[4 * ti], &tt[3 * ti], &cq[4 * pj], &ct[3 * pj], k);
+                    nres += 2;
+                }
+                tag_used[ti] = cam_used[pj] = true;
             }
-            tag_used[ti] = cam_used[pj] = true;
-        }
-        if (nres == 0) {
-            snprintf(msg, msg_size, "no observations to adjust");
-            return false;
-        }
-        for (int i = 0; i < p->ntags; i++)
-            if (tag_used[i]) problem.SetManifold(&tq[4 * i], &qman);
-        for (int j = 0; j < p->nphotos; j++)
-            if (cam_used[j]) problem.SetManifold(&cq[4 * j], &qman);
-        if (p->refine_intrinsics)
-            problem.SetManifold(k, kman.get());
-        else
-            problem.SetParameterBlockConstant(k);
-        if (p->fixed_tag >= 0) {
-            problem.SetParameterBlockConstant(&tq[4 * p->fixed_tag]);
-            problem.SetParameterBlockConstant(&tt[3 * p->fixed_tag]);
-        }
-        for (int c = 0; c < p->ncontrol; c++) {
-            if (p->ctl_use && !p->ctl_use[c]) continue;
-            int ti = p->ctl_tag[c];
-            if (!tag_used[ti]) continue;
-            ControlCost *cc = new ControlCost;
-            tag_point(p->tag_size[ti], p->ctl_corner[c], &cc->X, &cc->Y);
-            for (int a = 0; a < 3; a++) cc->w[a] = p->ctl_world[3 * c + a];
-            cc->inv_sigma = 1.0 / p->ctl_sigma[c];
-            problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ControlCost, 3, 4, 3>(cc), nullptr, &tq[4 * ti],
-                                     &tt[3 * ti]);
-        }
-
+            if (nres == 0) return;
+            for (int i = 0; i < p->ntags; i++)
+                if (tag_used[i]) problem.SetManifold(&tq[4 * i], &qman);
+            for (int j = 0; j < p->nphotos; j++)
+                if (cam_used[j]) problem.SetManifold(&cq[4 * j], &qman);
+            if (p->refine_intrinsics)
+                problem.SetManifold(k, kman.get());
+            else
+                problem.SetParameterBlockConstant(k);
+            if (p->fixed_tag >= 0) {
+                problem.SetParameterBlockConstant(&tq[4 * p->fixed_tag]);
+                problem.SetParameterBlockConstant(&tt[3 * p->fixed_tag]);
+            }
+            for (int c = 0; c < p->ncontrol; c++) {
+                if (p->ctl_use && !p->ctl_use[c]) continue;
+                int ti = p->ctl_tag[c];
+                if (!tag_used[ti]) continue;
+                ControlCost *cc = new ControlCost;
+                tag_point(p->tag_size[ti], p->ctl_corner[c], &cc->X, &cc->Y);
+                for (int a = 0; a < 3; a++) cc->w[a] = p->ctl_world[3 * c + a];
+                cc->inv_sigma = 1.0 / p->ctl_sigma[c];
+                problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ControlCost, 3, 4, 3>(cc), nullptr,
+                                         &tq[4 * ti], &tt[3 * ti]);
+            }
+        };
         ceres::Solver::Options so;
         so.max_num_iterations = p->max_iterations > 0 ? p->max_iterations : 100;
         so.num_threads = p->threads > 0 ? p->threads : 1;
@@ -171,38 +178,65 @@ extern "C" bool mr_ba_solve(mr_ba_problem *p, char *msg, size_t msg_size) {
         so.parameter_tolerance = 1e-10;
         so.logging_type = ceres::SILENT;
         ceres::Solver::Summary sum;
-        ceres::Solve(so, &problem, &sum);
+        /* Pass 1: corners at 1 px. Their sigma is then estimated from the
+         * residuals (floored: synthetic corners can be near exact) and pass
+         * 2 weights them by it, which is what the control points' sigmas
+         * are weighed against and what the covariance needs. */
+        ceres::HuberLoss loss1(loss_px);
+        std::unique_ptr<ceres::Problem> problem(new ceres::Problem(po));
+        build(*problem, 1.0, &loss1);
+        if (nres == 0) {
+            snprintf(msg, msg_size, "no observations to adjust");
+            return false;
+        }
+        ceres::Solve(so, problem.get(), &sum);
         if (!sum.IsSolutionUsable()) {
             snprintf(msg, msg_size, "bundle adjustment failed: %s", sum.message.c_str());
             return false;
         }
-        p->iterations = (int)sum.iterations.size();
-
-        /* Plain (not robustified) corner residuals for the RMS. */
-        double ss = 0;
-        int nc = 0;
-        for (int o = 0; o < p->nobs; o++) {
-            int ti = p->obs_tag[o], pj = p->obs_photo[o];
-            for (int c = 0; c < 4; c++) {
-                CornerCost cc;
-                tag_point(p->tag_size[ti], c, &cc.X, &cc.Y);
-                cc.u = p->obs_px[8 * o + 2 * c];
-                cc.v = p->obs_px[8 * o + 2 * c + 1];
-                double r[2];
-                cc(&tq[4 * ti], &tt[3 * ti], &cq[4 * pj], &ct[3 * pj], k, r);
-                ss += r[0] * r[0] + r[1] * r[1];
-                nc++;
+        int iters = (int)sum.iterations.size();
+        auto corner_ss = [&](int *count) {
+            double ss = 0;
+            int nc = 0;
+            for (int o = 0; o < p->nobs; o++) {
+                int ti = p->obs_tag[o], pj = p->obs_photo[o];
+                for (int c = 0; c < 4; c++) {
+                    CornerCost cc;
+                    tag_point(p->tag_size[ti], c, &cc.X, &cc.Y);
+                    cc.u = p->obs_px[8 * o + 2 * c];
+                    cc.v = p->obs_px[8 * o + 2 * c + 1];
+                    cc.w = 1;
+                    double r[2];
+                    cc(&tq[4 * ti], &tt[3 * ti], &cq[4 * pj], &ct[3 * pj], k, r);
+                    ss += r[0] * r[0] + r[1] * r[1];
+                    nc++;
+                }
             }
-        }
-        p->rms_px = std::sqrt(ss / (2.0 * nc));
-        int nparams = problem.NumParameters(); /* ambient; the tangent has one less per quaternion */
-        int tangent = nparams;
-        for (int i = 0; i < p->ntags; i++) tangent -= tag_used[i] ? 1 : 0;
-        for (int j = 0; j < p->nphotos; j++) tangent -= cam_used[j] ? 1 : 0;
+            *count = nc;
+            return ss;
+        };
+        int tangent = 0;
+        for (int i = 0; i < p->ntags; i++) tangent += tag_used[i] ? 6 : 0;
+        for (int j = 0; j < p->nphotos; j++) tangent += cam_used[j] ? 6 : 0;
         if (p->fixed_tag >= 0) tangent -= 6;
-        tangent -= p->refine_intrinsics ? 3 : 9;
+        tangent += p->refine_intrinsics ? 6 : 0;
+        int nc = 0;
+        double ss = corner_ss(&nc);
         int dof = nres - tangent;
-        p->sigma_px = dof > 0 ? std::sqrt(ss / dof) : p->rms_px;
+        double sigma1 = std::sqrt(ss / (dof > 0 ? dof : nres));
+        double w = 1.0 / std::max(sigma1, MR_BA_SIGMA_FLOOR_PX);
+        ceres::HuberLoss loss2(loss_px * w);
+        problem.reset(new ceres::Problem(po));
+        build(*problem, w, &loss2);
+        ceres::Solve(so, problem.get(), &sum);
+        if (!sum.IsSolutionUsable()) {
+            snprintf(msg, msg_size, "bundle adjustment failed: %s", sum.message.c_str());
+            return false;
+        }
+        p->iterations = iters + (int)sum.iterations.size();
+        ss = corner_ss(&nc);
+        p->rms_px = std::sqrt(ss / (2.0 * nc));
+        p->sigma_px = std::sqrt(ss / (dof > 0 ? dof : nres));
 
         for (int i = 0; i < p->ntags; i++) join_pose(&tq[4 * i], &tt[3 * i], p->tag + 16 * i);
         for (int j = 0; j < p->nphotos; j++) join_pose(&cq[4 * j], &ct[3 * j], p->cam + 16 * j);
@@ -223,12 +257,12 @@ extern "C" bool mr_ba_solve(mr_ba_problem *p, char *msg, size_t msg_size) {
                 blocks.push_back({&tq[4 * i], &tt[3 * i]});
                 blocks.push_back({&tt[3 * i], &tt[3 * i]});
             }
-            if (cov.Compute(blocks, &problem)) {
-                /* Unit-variance corners were assumed: scale by the estimated
-                 * corner variance. QuaternionManifold's tangent is half
+            if (cov.Compute(blocks, problem.get())) {
+                /* QuaternionManifold's tangent is half
                  * the rotation angle (q = [cos|d|, sin|d| d/|d|]), and it
                  * perturbs on the left, i.e. about world axes. */
-                double s2 = p->sigma_px * p->sigma_px;
+                /* The residuals are in sigmas already (pass 2's weights). */
+                double s2 = 1.0;
                 for (int i = 0; i < p->ntags; i++) {
                     double *C = p->tag_cov + 36 * i;
                     if (i == p->fixed_tag) {
