@@ -137,5 +137,7 @@ bool app_lod_auto(const app_opt *opts);
 int cmd_synth(int argc, char **argv);
 int cmd_factory(int argc, char **argv);
 int bench_scene(int argc, char **argv);
+/* mrcheck bench map (bench_map.c). */
+int bench_map(int argc, char **argv);
 
 #endif

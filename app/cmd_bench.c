@@ -65,11 +65,12 @@ int cmd_bench(int argc, char **argv) {
     if (argc >= 3 && strcmp(argv[2], "ao") == 0) return bench_ao(argc, argv);
     if (argc >= 3 && strcmp(argv[2], "ghost") == 0) return app_bench_ghost(argc, argv);
     if (argc >= 3 && strcmp(argv[2], "tracking") == 0) return bench_tracking(argc, argv);
+    if (argc >= 3 && strcmp(argv[2], "map") == 0) return bench_map(argc, argv);
     if (argc >= 3 && (strcmp(argv[2], "--help") == 0 || strcmp(argv[2], "-h") == 0)) {
-        printf("usage: mrcheck bench {frame,ao,ghost,tracking,scene} [options]   (mrcheck bench NAME --help)\n");
+        printf("usage: mrcheck bench {frame,ao,ghost,tracking,map,scene} [options]   (mrcheck bench NAME --help)\n");
         return 0;
     }
-    fprintf(stderr, "mrcheck: bench: unknown or missing benchmark%s%s (available: frame, ao, ghost, tracking, scene)\n", argc >= 3 ? " " : "",
+    fprintf(stderr, "mrcheck: bench: unknown or missing benchmark%s%s (available: frame, ao, ghost, tracking, map, scene)\n", argc >= 3 ? " " : "",
             argc >= 3 ? argv[2] : "");
     return 2;
 }

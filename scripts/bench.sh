@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Rebuilds mrcheck and regenerates every bench table committed under
-# docs/bench/ (ao, ghost, tracking, scene), each stamped with the commit it
+# docs/bench/ (ao, ghost, tracking, scene, map), each stamped with the commit it
 # was made at and the exact command.
 #
-#   scripts/bench.sh [ao|ghost|tracking|scene ...]   (default: all four)
+#   scripts/bench.sh [ao|ghost|tracking|scene|map ...]   (default: all five)
 #
 # Commit first, then run: the stamp names HEAD and says "dirty" when the
 # working tree differs from it (tables of uncommitted code). Sizes are
@@ -15,7 +15,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 benches=("$@")
-[ ${#benches[@]} -gt 0 ] || benches=(ao ghost tracking scene)
+[ ${#benches[@]} -gt 0 ] || benches=(ao ghost tracking scene map)
 full=${MR_BENCH_FULL:-0}
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
@@ -100,7 +100,10 @@ for b in "${benches[@]}"; do
         else run bench_scene docs/bench/scene $mr bench scene --sizes 1M,5M --frames 3 --out docs/bench/scene --quiet; fi
         find docs/bench/scene -type f ! -name '*.csv' ! -name '*.md' ! -name '*.svg' ! -name '*.log' -delete
         find docs/bench/scene -mindepth 1 -type d -empty -delete ;;
-    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene)" >&2; exit 2 ;;
+    map)
+        # CPU only, about 10 s: the full photo counts 10..200, 5 seeds.
+        run bench_map docs/bench/map $mr bench map --out docs/bench/map ;;
+    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, map)" >&2; exit 2 ;;
     esac
 done
 echo "bench.sh: wrote docs/bench/ at commit $commit ($dirty)" >&2

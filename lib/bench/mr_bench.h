@@ -129,6 +129,27 @@ typedef struct mr_bench_tracking_params {
 #define MR_BENCH_TRACKING_DEFAULTS .out_dir = "bench-out", .recording = "recordings/demo"
 bool mr_bench_tracking(const mr_bench_tracking_params *params, mr_error *err);
 
+/* bench map (map.c): synthetic photo sets (mr_synth_map, projected corners
+ * with noise and wrong ids, 1280x960, 0.3 m tags on a ring) of 10, 20, 50,
+ * 100, 200 photos, mapped with the fixed-tag gauge by the bundle adjustment
+ * ("ours") and by chaining along the spanning tree; per photo count and
+ * method the median over seeds of the tag position error (RMS, max, mm),
+ * the largest rotation error, the run time, the reprojection RMS and the
+ * largest predicted sigma: bench_map.csv and bench_map.svg in out_dir. */
+typedef struct mr_bench_map_params {
+    const char *out_dir;    /* default "bench-out" */
+    int seeds;              /* sets per photo count, default 5 */
+    int max_photos;         /* only counts up to this; 0 = all (200) */
+    int tags;               /* default 16 */
+    double radius;          /* m, default 3 */
+    double noise_px;        /* corner noise, default 0.3 px */
+    double misdetect;       /* fraction of photos with one wrong id, default 0.05 */
+    FILE *out;              /* the table; NULL: silent */
+} mr_bench_map_params;
+#define MR_BENCH_MAP_DEFAULTS \
+    .out_dir = "bench-out", .seeds = 5, .tags = 16, .radius = 3.0, .noise_px = 0.3, .misdetect = 0.05
+bool mr_bench_map(const mr_bench_map_params *params, mr_error *err);
+
 /* ------------------------------------------------------ synthetic data */
 
 /* A synthetic recording of the demo hall (as built) along a walking path
