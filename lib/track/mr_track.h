@@ -265,7 +265,25 @@ typedef struct mr_pose {
     double rms_px;           /* reprojection RMS over used corners, pixels */
     bool ambiguous;          /* single tag with two plausible IPPE solutions;
                                 the one nearest the previous pose was kept */
+    /* The pose's uncertainty (valid poses): the 6x6 row-major covariance
+     * of camera_from_world's error as a small left perturbation in camera
+     * axes, X_cam -> exp([w]x) X_cam + tau: w (rotation vector, radians)
+     * then tau (scene units). From the used corners' Jacobian, with the
+     * corner noise estimated from the residuals (dof-corrected) and never
+     * below MR_POSE_MIN_CORNER_SIGMA_PX. mr_pose_point_sigma turns it into
+     * "± N here". */
+    double cov[36];
+    double corner_sigma_px;  /* the corner noise used, px */
 } mr_pose;
+/* Corner noise floor of the covariance (px): a lucky frame with near-exact
+ * corners must not claim sub-micron registration. */
+#define MR_POSE_MIN_CORNER_SIGMA_PX 0.1
+/* The uncertainty of a world point's place relative to the camera under
+ * pose's covariance: *sigma_3d = sqrt(trace) of its 3x3 covariance (scene
+ * units), *sigma_lateral the part across the line of sight (what moves the
+ * overlay on screen), either may be NULL. false if the pose is invalid,
+ * has no covariance, or the point is behind the camera. */
+bool mr_pose_point_sigma(const mr_pose *pose, mr_dvec3 world_point, double *sigma_3d, double *sigma_lateral);
 
 /* Camera pose from the detections: corners undistorted, candidate poses from
  * each tag's two IPPE solutions, the candidate that most tags agree with
