@@ -120,5 +120,10 @@ cJSON *app_pose_line(int64_t frame, double t, const mr_tracker_result *r) {
     cJSON_AddNumberToObject(o, "tags_used", r->pose.tags_used);
     cJSON_AddNumberToObject(o, "rms_px", r->pose.rms_px);
     cJSON_AddBoolToObject(o, "ambiguous", r->pose.ambiguous);
+    if (r->pose.valid && r->pose.corner_sigma_px > 0) {
+        /* The pose's uncertainty (mr_pose.cov, camera axes: rad, scene units). */
+        cJSON_AddNumberToObject(o, "corner_sigma_px", r->pose.corner_sigma_px);
+        cJSON_AddItemToObject(o, "covariance", mr_json_from_doubles(r->pose.cov, 36));
+    }
     return o;
 }

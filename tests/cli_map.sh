@@ -18,7 +18,7 @@ sed -n 's/.*"id":[ ]*0,[ ]*"world_from_tag":[ ]*\(\[[^]]*\]\).*/{"world_from_tag
   <(tr -d '\n\t ' <"$set_dir/truth.json" | sed 's/},{/}\n{/g') | head -1 >"$tmp/fix.json"
 grep -q world_from_tag "$tmp/fix.json" && ok || bad "could not take tag 0's pose from truth.json"
 
-common=(--images "$set_dir/images" --camera "$set_dir/camera.json" --tag-size 0.15)
+common=(--images "$set_dir/images" --camera "$set_dir/camera.json" --tag-size 0.25)
 "$mr" map "${common[@]}" --fix 0 --fix-pose "$tmp/fix.json" --out "$tmp/ours.json" >"$tmp/ours.out" 2>"$tmp/ours.err" \
   && ok || bad "map --fix: $(cat "$tmp/ours.err")"
 grep -q "mapped 10 tags" "$tmp/ours.out" && ok || bad "map --fix: $(cat "$tmp/ours.out")"
@@ -54,7 +54,7 @@ expect_fail unseen_fix "$tmp/x.json" -- "$mr" map "${common[@]}" --fix 77 --out 
 mkdir -p "$tmp/empty"
 expect_fail no_gauge "$tmp/x.json" -- "$mr" map "${common[@]}" --out "$tmp/x.json"
 expect_fail both_gauges "$tmp/x.json" -- "$mr" map "${common[@]}" --fix 0 --control "$set_dir/control.json" --out "$tmp/x.json"
-expect_fail no_images "$tmp/x.json" -- "$mr" map --images "$tmp/empty" --camera "$set_dir/camera.json" --tag-size 0.15 --fix 0 --out "$tmp/x.json"
+expect_fail no_images "$tmp/x.json" -- "$mr" map --images "$tmp/empty" --camera "$set_dir/camera.json" --tag-size 0.25 --fix 0 --out "$tmp/x.json"
 expect_fail bad_sizes "$tmp/x.json" -- "$mr" map "${common[@]}" --tag-sizes 3=-1 --fix 0 --out "$tmp/x.json"
 printf '{"points": [{"name": "A", "tag": 0, "xyz": [0, 0, 0]}, {"name": "B", "tag": 1, "xyz": [1, 0, 0]}]}' >"$tmp/two.json"
 expect_fail two_controls "$tmp/x.json" -- "$mr" map "${common[@]}" --control "$tmp/two.json" --out "$tmp/x.json"

@@ -224,7 +224,7 @@ void mr_synth_map_free(mr_synth_map *s);
  * control.json (four tag centres, sigma 1 mm). params NULL: a small room
  * (MR_SYNTH_MAP_SET_DEFAULTS); images/ is never overwritten. */
 #define MR_SYNTH_MAP_SET_DEFAULTS \
-    .seed = 1, .tags = 10, .photos = 24, .tag_size = 0.15, .radius = 1.2, .image_noise = 2.0, .render = true, \
+    .seed = 1, .tags = 10, .photos = 24, .tag_size = 0.25, .radius = 1.2, .image_noise = 2.0, .render = true, \
     .width = 320, .height = 240
 bool mr_synth_map_write(const char *dir, const mr_synth_map_params *params, mr_error *err);
 

@@ -440,7 +440,7 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
     pair_t *pairs = NULL;
     edge_t *edges = NULL;
     mr_dmat4 *rft = NULL, *wft = NULL, *cfw = NULL, *wft_loo = NULL, *cfw_loo = NULL;
-    double *cov = NULL;
+    double *cov = NULL, *cov_loo = NULL;
 
     /* 1. The tags seen and their sizes. */
     int nall = 0;
@@ -847,8 +847,9 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
         if (!p->no_adjust) {
             mr_dmat4 *wft0 = malloc((size_t)nt * sizeof *wft0), *cfw0 = malloc((size_t)(nphot + 1) * sizeof *cfw0);
             wft_loo = malloc((size_t)nt * sizeof *wft_loo);
+            cov_loo = malloc((size_t)nt * 36 * sizeof *cov_loo);
             cfw_loo = malloc((size_t)(nphot + 1) * sizeof *cfw_loo);
-            if (!wft0 || !cfw0 || !wft_loo || !cfw_loo) {
+            if (!wft0 || !cfw0 || !wft_loo || !cfw_loo || !cov_loo) {
                 free(wft0);
                 free(cfw0);
                 goto nomem;
@@ -902,7 +903,7 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
                     int it1;
                     ctl_use[q] = false;
                     bool lok = run_ba(&c, nt, tag_of, wft_loo, nphot, photo_slot, cfw_loo, &cl, -1, ctl_tag, ctl_use,
-                                      false, NULL, &r1, &s1, &it1, err);
+                                      true, cov_loo, &r1, &s1, &it1, err);
                     ctl_use[q] = true;
                     if (!lok) continue;
                     int ti = tag_of[ctl_tag[q]];
@@ -911,8 +912,16 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
                     cr->loo[0] = pr.x - p->controls[q].world.x;
                     cr->loo[1] = pr.y - p->controls[q].world.y;
                     cr->loo[2] = pr.z - p->controls[q].world.z;
+                    /* Expected spread: the survey's sigma and the point's
+                     * own uncertainty in the solve without it (the left
+                     * perturbation: d = w x (p - t) + dt, world axes). */
+                    const double *C = &cov_loo[36 * ti];
+                    mr_dvec3 a = mr_v3_sub(pr, mr_v3(wft_loo[ti].m[3], wft_loo[ti].m[7], wft_loo[ti].m[11]));
+                    double A[3][6] = {{0, a.z, -a.y, 1, 0, 0}, {-a.z, 0, a.x, 0, 1, 0}, {a.y, -a.x, 0, 0, 0, 1}};
                     double tr = 0;
-                    for (int a = 3; a < 6; a++) tr += cov[36 * ti + 7 * a];
+                    for (int r = 0; r < 3; r++)
+                        for (int x = 0; x < 6; x++)
+                            for (int y = 0; y < 6; y++) tr += A[r][x] * C[6 * x + y] * A[r][y];
                     double sig = sqrt(3 * p->controls[q].sigma * p->controls[q].sigma + (isfinite(tr) ? tr : 0));
                     cr->loo_sigma =
                         sqrt(cr->loo[0] * cr->loo[0] + cr->loo[1] * cr->loo[1] + cr->loo[2] * cr->loo[2]) / sig;
@@ -1026,6 +1035,7 @@ done:
     free(wft_loo);
     free(cfw_loo);
     free(cov);
+    free(cov_loo);
     free(c.ids);
     free(c.size);
     free(c.obs);
