@@ -306,6 +306,41 @@ double mr_pose_angle_deg(const mr_dmat4 *a, const mr_dmat4 *b);
 void mr_rotvec_to_mat(const double rv[3], double R[9]);
 void mr_mat_to_rotvec(const double R[9], double rv[3]);
 
+/* ------------------------------------------------------ triangulation */
+
+/* A real feature tapped in several frames (`mrcheck measure`): each tap is
+ * a pixel (distorted, OpenCV convention) in a frame with its tracked pose
+ * and that pose's covariance (mr_pose.cov; none: only the tap's noise). */
+typedef struct mr_tap {
+    mr_dmat4 world_from_camera;
+    const double *pose_cov;  /* 36, mr_pose.cov's convention; NULL: none */
+    double px[2];
+} mr_tap;
+typedef struct mr_triangulate_params {
+    double tap_sigma_px;     /* a tap's 1-σ per axis, px; 0 = 1.0 */
+    double min_angle_deg;    /* refused below this largest angle between rays; 0 = 2 */
+} mr_triangulate_params;
+#define MR_TRIANGULATE_DEFAULTS {0.0, 0.0}
+typedef struct mr_triangulation {
+    mr_dvec3 point;          /* world, scene units */
+    double cov[9];           /* 3x3 covariance of point (taps and poses) */
+    double sigma;            /* sqrt(trace(cov)) */
+    double angle_deg;        /* the largest angle between two rays */
+    double rms_px;           /* reprojection RMS of the taps */
+} mr_triangulation;
+/* Linear (closest point to all rays), then Gauss-Newton on the taps'
+ * reprojection error, each weighted by its tap noise plus its pose's
+ * covariance carried into the image. false + err: fewer than 2 taps, a tap
+ * that cannot be undistorted, rays nearly parallel ("baseline angle 0.4
+ * deg < 2 deg": taken from nearly the same place), the point behind a
+ * camera. */
+bool mr_triangulate(const mr_camera *cam, const mr_tap *taps, int n, const mr_triangulate_params *params,
+                    mr_triangulation *out, mr_error *err);
+/* Distance from planned to measured and its
+ * 1-σ (the covariance projected on that direction; with a zero difference,
+ * sqrt(trace / 3)). */
+void mr_triangulation_distance(const mr_triangulation *t, mr_dvec3 planned, double *dist, double *sigma);
+
 /* ---------------------------------------------------------------- filter */
 
 typedef struct mr_filter_params {
