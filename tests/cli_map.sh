@@ -64,4 +64,42 @@ printf '{"world_from_tag": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,2]}' >"$tmp/badfix.
 expect_fail bad_fix_pose "$tmp/x.json" -- "$mr" map "${common[@]}" --fix 0 --fix-pose "$tmp/badfix.json" --out "$tmp/x.json"
 expect_fail unknown_size "$tmp/x.json" -- "$mr" map --images "$set_dir/images" --camera "$set_dir/camera.json" --tag-sizes 99=0.2 --fix 0 --out "$tmp/x.json"
 
+# measure: a tag corner of the shipped recording tapped where the detector
+# found it, in frames far apart, against the corner's mapped position.
+src=$(cd "$(dirname "$0")/.." && pwd)
+rec=$src/recordings/demo
+if command -v python3 >/dev/null 2>&1; then
+  python3 - "$rec" "$tmp" <<'PY'
+import json, sys
+rec, tmp = sys.argv[1], sys.argv[2]
+meta = json.load(open(rec + "/meta.json"))
+frames = [json.loads(l) for l in open(rec + "/frames.jsonl") if l.strip()]
+best = None
+for tag in meta["markers"]["tags"]:
+    seen = [f for f in frames if f["pose"]["valid"] and any(d["id"] == tag["id"] for d in f["detections"])]
+    if len(seen) >= 3 and (best is None or len(seen) > len(best[1])):
+        best = (tag, seen)
+tag, seen = best
+pick = [seen[0], seen[len(seen) // 2], seen[-1]]
+taps = [{"frame": f["frame"], "px": [d["corners"][0] for d in f["detections"] if d["id"] == tag["id"]][0]} for f in pick]
+s = meta["markers"]["tag_size"] / 2
+m = tag["world_from_tag"]
+corner = [m[4 * r] * -s + m[4 * r + 1] * s + m[4 * r + 3] for r in range(3)]  # corner 0: (-s/2, +s/2)
+json.dump({"taps": taps, "planned": corner}, open(tmp + "/obs.json", "w"))
+json.dump({"taps": [taps[0], taps[0]], "planned": corner}, open(tmp + "/same.json", "w"))
+json.dump({"taps": [taps[0], {"frame": 99999, "px": [1, 2]}]}, open(tmp + "/noframe.json", "w"))
+PY
+  "$mr" measure --recording "$rec" --observations "$tmp/obs.json" --out "$tmp/measured.json" >"$tmp/measure.out" 2>&1 \
+    && ok || bad "measure: $(cat "$tmp/measure.out")"
+  cat "$tmp/measure.out"
+  grep -q "distance to the planned point: .* mm +- .* mm" "$tmp/measure.out" && ok || bad "measure printed no distance"
+  grep -q '"distance_sigma_mm"' "$tmp/measured.json" && ok || bad "measure wrote no result"
+  expect_fail measure_same_pose "$tmp/m2.json" -- "$mr" measure --recording "$rec" --observations "$tmp/same.json" --out "$tmp/m2.json"
+  grep -q "baseline angle" "$tmp/measure_same_pose.err" && ok || bad "same pose: $(cat "$tmp/measure_same_pose.err")"
+  expect_fail measure_no_frame "$tmp/m2.json" -- "$mr" measure --recording "$rec" --observations "$tmp/noframe.json" --out "$tmp/m2.json"
+fi
+printf '{"taps": [{"frame": 0, "px": [NaN, 1]}]}' >"$tmp/nan_obs.json"
+expect_fail measure_nan "$tmp/m2.json" -- "$mr" measure --recording "$rec" --observations "$tmp/nan_obs.json" --out "$tmp/m2.json"
+expect_fail measure_no_args "" -- "$mr" measure --recording "$rec"
+
 cli_finish cli_map
