@@ -162,19 +162,16 @@ int cmd_map(int argc, char **argv) {
                 goto fail;
             }
         }
-        /* Intrinsics are for the camera's size: photos of another size get
-         * them rescaled (the same lens at another resolution). */
-        mr_camera fc = cam;
+        /* Intrinsics are for the camera's size: the first photo of another
+         * size gets them rescaled (the same lens at another resolution);
+         * later photos must match it. */
+        if (n == 0 && (f.image.width != cam.width || f.image.height != cam.height))
+            cam = mr_camera_resized(&cam, f.image.width, f.image.height);
         if (f.image.width != cam.width || f.image.height != cam.height) {
-            if (n == 0) cam = mr_camera_resized(&cam, f.image.width, f.image.height);
-            fc = cam;
-            if (f.image.width != cam.width || f.image.height != cam.height) {
-                fprintf(stderr, "mrcheck: map: warning: %s is %dx%d, not %dx%d; skipped\n", f.name, f.image.width,
-                        f.image.height, cam.width, cam.height);
-                continue;
-            }
+            fprintf(stderr, "mrcheck: map: warning: %s is %dx%d, not %dx%d; skipped\n", f.name, f.image.width,
+                    f.image.height, cam.width, cam.height);
+            continue;
         }
-        (void)fc;
         int k = 0;
         mr_error fe = {0};
         const mr_detection *d = mr_detector_detect(det, &f.image, &k, &fe);
