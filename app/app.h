@@ -122,5 +122,7 @@ int bench_multiview(int argc, char **argv);
 int cmd_synth(int argc, char **argv);
 int cmd_factory(int argc, char **argv);
 int bench_scene(int argc, char **argv);
+/* mrcheck bench map (bench_map.c). */
+int bench_map(int argc, char **argv);
 
 #endif

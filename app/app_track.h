@@ -58,6 +58,8 @@ int cmd_record(int argc, char **argv);
 int cmd_replay(int argc, char **argv);
 int cmd_synth(int argc, char **argv);
 int cmd_calibrate(int argc, char **argv);
+int cmd_map(int argc, char **argv);
+int cmd_measure(int argc, char **argv);
 int bench_tracking(int argc, char **argv);
 
 /* Set by SIGINT/SIGTERM while a long command runs (app/track_util.c). */

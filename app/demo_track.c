@@ -51,6 +51,7 @@ int cmd_synth(int argc, char **argv) {
         {"seed", "N", "noise seed (default 1)", NULL},
         {"fps", "F", "frame rate of the timestamps (default 10)", NULL},
         {"calibration", "DIR", "instead: write a calibration board and 12 images there", NULL},
+        {"map-photos", "DIR", "instead: write a synthetic photo set for `mrcheck map` there (images/, camera.json, truth.json, control.json)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -65,6 +66,11 @@ int cmd_synth(int argc, char **argv) {
     if (help) return 0;
     mr_cli_log_level(opts);
     mr_error err = {0};
+    if (mr_cli_get(opts, "map-photos")) {
+        if (!mr_synth_map_write(mr_cli_get(opts, "map-photos"), NULL, &err)) return mr_cli_error(cmd, &err);
+        printf("wrote %s/images/, camera.json, truth.json, control.json\n", mr_cli_get(opts, "map-photos"));
+        return 0;
+    }
     if (mr_cli_get(opts, "calibration")) {
         if (!mr_synth_calibration(mr_cli_get(opts, "calibration"), 12, &err)) return mr_cli_error(cmd, &err);
         printf("wrote %s/board.json and %s/images/\n", mr_cli_get(opts, "calibration"), mr_cli_get(opts, "calibration"));

@@ -20,6 +20,8 @@ static const struct {
     {"replay", cmd_replay, "render the overlay of a recording's frames headless (deterministic)"},
     {"factory", cmd_factory, "write a big synthetic factory (1M..20M triangles) as .glb"},
     {"study", cmd_study, "pairwise comparison studies: stimuli, plan, run (window), analyze"},
+    {"map", cmd_map, "the marker map from photos: bundle adjustment, per-tag sigma, control points"},
+    {"measure", cmd_measure, "triangulate a feature tapped in several recorded frames; distance to the plan with sigma"},
 };
 
 static void usage(FILE *f) {

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Rebuilds mrcheck and regenerates every bench table committed under
-# docs/bench/ (ao, ghost, tracking, scene, multiview), each stamped with the
-# commit it was made at and the exact command.
+# docs/bench/ (ao, ghost, tracking, scene, multiview, map), each stamped with
+# the commit it was made at and the exact command.
 #
-#   scripts/bench.sh [ao|ghost|tracking|scene|multiview|shadows ...]   (default: all but shadows)
+#   scripts/bench.sh [ao|ghost|tracking|scene|multiview|map|shadows ...]   (default: all but shadows)
 #
 # Commit first, then run: the stamp names HEAD and says "dirty" when the
 # working tree differs from it (tables of uncommitted code). Sizes are
@@ -15,7 +15,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 benches=("$@")
-[ ${#benches[@]} -gt 0 ] || benches=(ao ghost tracking scene multiview)
+[ ${#benches[@]} -gt 0 ] || benches=(ao ghost tracking scene multiview map)
 full=${MR_BENCH_FULL:-0}
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
@@ -105,7 +105,10 @@ for b in "${benches[@]}"; do
         run bench_shadows docs/bench/shadows $mr bench shadows --out docs/bench/shadows --quiet ;;
     multiview)
         run bench_multiview docs/bench/multiview $mr bench multiview --out docs/bench/multiview --quiet ;;
-    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, multiview, shadows)" >&2; exit 2 ;;
+    map)
+        # CPU only, about 10 s: the full photo counts 10..200, 5 seeds.
+        run bench_map docs/bench/map $mr bench map --out docs/bench/map ;;
+    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, multiview, map, shadows)" >&2; exit 2 ;;
     esac
 done
 echo "bench.sh: wrote docs/bench/ at commit $commit ($dirty)" >&2

@@ -296,6 +296,33 @@ static void test_runner(const char *tmp) {
               "bench multiview without a GPU must fail naming it: '%s'", err.msg);
 }
 
+/* bench map at its smallest: 10 photos, 2 seeds; the documented columns,
+ * one row per method, the adjustment no worse than chaining. */
+static void test_map_runner(const char *tmp) {
+    char out[4096], path[4096];
+    mr_path_join(tmp, "map", out, sizeof out);
+    mr_bench_map_params p = {MR_BENCH_MAP_DEFAULTS};
+    p.out_dir = out;
+    p.max_photos = 10;
+    p.seeds = 2;
+    mr_error err = {0};
+    CHECK_MSG(mr_bench_map(&p, &err), "mr_bench_map: %s", err.msg);
+    mr_path_join(out, "bench_map.csv", path, sizeof path);
+    size_t n = 0;
+    const char *csv = slurp(path, &n);
+    const char *cols = "photos,method,err_rms_mm,err_max_mm,err_max_deg,time_s,tags_mapped,sightings_used,rms_px,sigma_max_mm\n";
+    CHECK_MSG(csv && strncmp(csv, cols, strlen(cols)) == 0, "bench_map.csv must start with the documented header");
+    CHECK(csv && count(csv, "\n10,ours,") == 1 && count(csv, "\n10,chaining,") == 1);
+    CHECK(csv && count(csv, "\n") == 3 && count(csv, ",") == 9 * 3);
+    double ours = NAN, chain = NAN;
+    const char *o = csv ? strstr(csv, "\n10,ours,") : NULL, *c = csv ? strstr(csv, "\n10,chaining,") : NULL;
+    if (o) ours = atof(o + strlen("\n10,ours,"));
+    if (c) chain = atof(c + strlen("\n10,chaining,"));
+    CHECK_MSG(ours < chain, "ours %.2f mm, chaining %.2f mm", ours, chain);
+    mr_path_join(out, "bench_map.svg", path, sizeof path);
+    read_svg(path, "bench_map.svg");
+}
+
 int main(void) {
     const char *tmp = getenv("MR_TEST_TMP");
     char dir[4096];
@@ -309,5 +336,6 @@ int main(void) {
     test_csv(dir);
     test_plot(dir);
     test_runner(dir);
+    test_map_runner(dir);
     return mr_test_finish("test_bench");
 }

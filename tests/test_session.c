@@ -66,7 +66,7 @@ static void test_round_trip(void) {
     char dir[1100], path[1200];
     tmp_path("rec_rt", dir, sizeof dir);
     mr_camera cam = {64, 48, 50, 50, 31.5, 23.5, {0.01, 0, 0, 0, 0}};
-    mr_marker tags[2] = {{3, mr_m4_translate(0, 1, 0)}, {8, mr_m4_translate(1, 1, 0)}};
+    mr_marker tags[2] = {{3, mr_m4_translate(0, 1, 0), 0}, {8, mr_m4_translate(1, 1, 0), 0}};
     mr_marker_map map = {"tag36h11", 0.2, tags, 2};
     mr_recorder_params rp = MR_RECORDER_DEFAULTS;
     rp.camera = &cam;

@@ -51,7 +51,10 @@ static void test_board(void) {
     if (!all) return;
     mr_marker tags[n_tags];
     mr_marker_map map = {.family = "tag36h11", .tag_size = MR_DEMO_BOARD_TAG, .tags = tags, .count = n_tags};
-    for (int i = 0; i < n_tags; i++) tags[i].id = mr_demo_board_tag(i, &tags[i].world_from_tag);
+    for (int i = 0; i < n_tags; i++) {
+        tags[i].id = mr_demo_board_tag(i, &tags[i].world_from_tag);
+        tags[i].size = 0; /* the map's tag_size */
+    }
     CHECK_MSG(tags[0].id == MR_DEMO_BOARD_FIRST_ID && tags[n_tags - 1].id == MR_DEMO_BOARD_FIRST_ID + n_tags - 1,
               "board ids run %d..%d, want %d..%d", tags[0].id, tags[n_tags - 1].id, MR_DEMO_BOARD_FIRST_ID,
               MR_DEMO_BOARD_FIRST_ID + n_tags - 1);

@@ -14,6 +14,7 @@
 #include "mr_eval.h"
 #include "mr_render.h"
 #include "mr_scene.h"
+#include "mr_track.h" /* the marker map and detections of mr_synth_map */
 
 #ifdef __cplusplus
 extern "C" {
@@ -157,6 +158,27 @@ typedef struct mr_bench_tracking_params {
 bool mr_bench_tracking(const mr_bench_tracking_params *params, mr_error *err);
 extern const mr_opt mr_bench_tracking_opts[]; /* frames, quick, min-cutoff, beta */
 
+/* bench map (map.c): synthetic photo sets (mr_synth_map, projected corners
+ * with noise and wrong ids, 1280x960, 0.3 m tags on a ring) of 10, 20, 50,
+ * 100, 200 photos, mapped with the fixed-tag gauge by the bundle adjustment
+ * ("ours") and by chaining along the spanning tree; per photo count and
+ * method the median over seeds of the tag position error (RMS, max, mm),
+ * the largest rotation error, the run time, the reprojection RMS and the
+ * largest predicted sigma: bench_map.csv and bench_map.svg in out_dir. */
+typedef struct mr_bench_map_params {
+    const char *out_dir;    /* default "bench-out" */
+    int seeds;              /* sets per photo count, default 5 */
+    int max_photos;         /* only counts up to this; 0 = all (200) */
+    int tags;               /* default 16 */
+    double radius;          /* m, default 3 */
+    double noise_px;        /* corner noise, default 0.3 px */
+    double misdetect;       /* fraction of photos with one wrong id, default 0.05 */
+    FILE *out;              /* the table; NULL: silent */
+} mr_bench_map_params;
+#define MR_BENCH_MAP_DEFAULTS \
+    .out_dir = "bench-out", .seeds = 5, .tags = 16, .radius = 3.0, .noise_px = 0.3, .misdetect = 0.05
+bool mr_bench_map(const mr_bench_map_params *params, mr_error *err);
+
 /* ------------------------------------------------------ synthetic data */
 
 /* A synthetic recording of the demo hall (as built) along a walking path
@@ -213,6 +235,53 @@ typedef struct mr_bench_multiview_params {
 #define MR_BENCH_MULTIVIEW_DEFAULTS .out_dir = "bench-out", .budget_w = 1024, .budget_h = 768, .view_w = 160, \
                                     .view_h = 120, .table_w = 1024, .table_h = 768, .frames = 3, .rays = 64
 bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err);
+
+/* A synthetic photo set for the marker map (synth_map.c): `tags` tags on a
+ * ring of walls (radius, facing its centre, a little tilted; with
+ * mixed_sizes every third is 1.5x tag_size), `photos` photos from inside
+ * it, each seeing a few neighbouring tags; `isolated` more tags in a room
+ * of their own far off, seen by two extra photos only (a disconnected
+ * part). Either projected corners with Gaussian noise (dets, counts; a
+ * fraction `misdetect` of the photos has one sighting with a wrong id) or,
+ * with render, CPU ray-cast grey images (images) for the real detector.
+ * The demo camera scaled to width x height. */
+typedef struct mr_synth_map_params {
+    uint64_t seed;          /* default 1 */
+    int tags;               /* 3..200, default 16 */
+    int photos;             /* 1..10000, default 24 */
+    int isolated;           /* 0..50, default 0 */
+    double tag_size;        /* m, default 0.2 */
+    bool mixed_sizes;
+    double radius;          /* m, default 3 */
+    double offset;          /* added to every x (far-from-origin sites), m */
+    double corner_noise_px; /* projected corners: sigma, default 0.3 */
+    double misdetect;       /* 0..1, default 0 */
+    bool render;            /* images instead of projected corners */
+    double image_noise;     /* grey levels, default 2 */
+    int width, height;      /* px, default 320x240 */
+} mr_synth_map_params;
+#define MR_SYNTH_MAP_DEFAULTS \
+    .seed = 1, .tags = 16, .photos = 24, .tag_size = 0.2, .radius = 3.0, .corner_noise_px = 0.3, .image_noise = 2.0, \
+    .width = 320, .height = 240
+typedef struct mr_synth_map {
+    mr_camera camera;
+    mr_marker_map truth;          /* the tags' true poses (and sizes) */
+    int photo_count;
+    mr_dmat4 *world_from_camera;  /* photo_count true poses */
+    mr_detection **dets;          /* projected: per photo counts[j] sightings */
+    int *counts;
+    mr_image *images;             /* render: photo_count grey images */
+} mr_synth_map;
+bool mr_synth_map_make(const mr_synth_map_params *params, mr_synth_map *out, mr_error *err);
+void mr_synth_map_free(mr_synth_map *s);
+/* A rendered set on disk (`mrcheck synth --map-photos DIR`): DIR/images/
+ * photo_NNN.png, camera.json, truth.json (the true marker map) and
+ * control.json (four tag centres, sigma 1 mm). params NULL: a small room
+ * (MR_SYNTH_MAP_SET_DEFAULTS); images/ is never overwritten. */
+#define MR_SYNTH_MAP_SET_DEFAULTS \
+    .seed = 1, .tags = 10, .photos = 24, .tag_size = 0.25, .radius = 1.2, .image_noise = 2.0, .render = true, \
+    .width = 320, .height = 240
+bool mr_synth_map_write(const char *dir, const mr_synth_map_params *params, mr_error *err);
 
 #ifdef __cplusplus
 }

@@ -121,6 +121,11 @@ cJSON *mr_pose_line_json(int64_t frame, double t, const mr_tracker_result *r) {
     cJSON_AddNumberToObject(o, "tags_used", r->pose.tags_used);
     cJSON_AddNumberToObject(o, "rms_px", r->pose.rms_px);
     cJSON_AddBoolToObject(o, "ambiguous", r->pose.ambiguous);
+    if (r->pose.valid && r->pose.corner_sigma_px > 0) {
+        /* The pose's uncertainty (mr_pose.cov, camera axes: rad, scene units). */
+        cJSON_AddNumberToObject(o, "corner_sigma_px", r->pose.corner_sigma_px);
+        cJSON_AddItemToObject(o, "covariance", mr_json_from_doubles(r->pose.cov, 36));
+    }
     return o;
 }
 
@@ -150,6 +155,11 @@ bool mr_recorder_append(mr_recorder *r, mr_frame_record *rec, const mr_image *im
     cJSON_AddNumberToObject(p, "tags_used", rec->pose.tags_used);
     cJSON_AddNumberToObject(p, "rms_px", rec->pose.rms_px);
     cJSON_AddBoolToObject(p, "ambiguous", rec->pose.ambiguous);
+    if (rec->pose.valid && rec->pose.corner_sigma_px > 0) {
+        /* The pose's uncertainty (mr_pose.cov: camera axes, rad, scene units). */
+        cJSON_AddNumberToObject(p, "corner_sigma_px", rec->pose.corner_sigma_px);
+        cJSON_AddItemToObject(p, "covariance", mr_json_from_doubles(rec->pose.cov, 36));
+    }
     cJSON *ids = cJSON_AddArrayToObject(p, "ids");
     for (int i = 0; i < rec->pose.tags_used && i < MR_POSE_MAX_IDS; i++)
         cJSON_AddItemToArray(ids, cJSON_CreateNumber(rec->pose.ids_used[i]));
@@ -258,6 +268,16 @@ static bool parse_frame_line(const cJSON *o, mr_rec_frame *f) {
         x = 0;
         if (mr_json_number(p, "rms_px", &x, false, NULL) && isfinite(x)) f->pose.rms_px = x;
         f->pose.ambiguous = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(p, "ambiguous"));
+        /* The covariance, when written (recordings before it have none);
+         * a broken one is dropped, not fatal: the pose stands without it. */
+        x = 0;
+        if (f->pose.valid && mr_json_number(p, "corner_sigma_px", &x, false, NULL) && isfinite(x) && x > 0 &&
+            mr_json_numbers(p, "covariance", f->pose.cov, 36, NULL)) {
+            bool fin = true;
+            for (int i = 0; i < 36; i++) fin = fin && isfinite(f->pose.cov[i]);
+            f->pose.corner_sigma_px = fin ? x : 0;
+            if (!fin) memset(f->pose.cov, 0, sizeof f->pose.cov);
+        }
         const cJSON *ids = cJSON_GetObjectItemCaseSensitive(p, "ids"), *id;
         int k = 0;
         if (cJSON_IsArray(ids))

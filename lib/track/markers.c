@@ -63,6 +63,14 @@ bool mr_marker_map_from_json(const cJSON *obj, mr_marker_map *map, mr_error *err
             return mr_fail(err, MR_ERR_INVALID, "marker map: tag %d: id must be a whole number >= 0 (got %g)", i, id);
         }
         m->id = (int)id;
+        if (cJSON_GetObjectItemCaseSensitive(t, "tag_size")) {
+            double ts = 0;
+            if (!mr_json_number(t, "tag_size", &ts, true, err) || !isfinite(ts) || !(ts > 0)) {
+                mr_marker_map_free(map);
+                return mr_fail(err, MR_ERR_INVALID, "marker map: tag id %d: tag_size must be a number > 0", (int)id);
+            }
+            m->size = ts;
+        }
         if (!mr_m4_is_rigid(&m->world_from_tag, 1e-4)) {
             mr_marker_map_free(map);
             return mr_fail(err, MR_ERR_INVALID, "marker map: tag id %d: world_from_tag is not a rigid transform", (int)id);
@@ -106,6 +114,8 @@ cJSON *mr_marker_map_to_json(const mr_marker_map *map) {
         cJSON *t = cJSON_CreateObject();
         cJSON_AddNumberToObject(t, "id", map->tags[i].id);
         cJSON_AddItemToObject(t, "world_from_tag", mr_json_from_dmat4(&map->tags[i].world_from_tag));
+        if (map->tags[i].size > 0 && map->tags[i].size != map->tag_size)
+            cJSON_AddNumberToObject(t, "tag_size", map->tags[i].size);
         cJSON_AddItemToArray(tags, t);
     }
     return j;
@@ -131,9 +141,13 @@ void mr_marker_corners_tag(double s, mr_dvec3 out[4]) {
     out[3] = mr_v3(-h, -h, 0);
 }
 
+double mr_marker_size(const mr_marker_map *map, const mr_marker *m) {
+    return m && m->size > 0 ? m->size : map->tag_size;
+}
+
 void mr_marker_corners_world(const mr_marker_map *map, const mr_marker *m, mr_dvec3 out[4]) {
     mr_dvec3 c[4];
-    mr_marker_corners_tag(map->tag_size, c);
+    mr_marker_corners_tag(mr_marker_size(map, m), c);
     for (int i = 0; i < 4; i++) out[i] = mr_m4_point(&m->world_from_tag, c[i]);
 }
 

@@ -29,6 +29,8 @@ extern "C" {
 typedef struct mr_marker {
     int id;                  /* tag id in the family */
     mr_dmat4 world_from_tag; /* rigid */
+    double size;             /* this tag's black-square edge (scene units) in a
+                                map of mixed sizes; 0 = the map's tag_size */
 } mr_marker;
 
 typedef struct mr_marker_map {
@@ -39,14 +41,18 @@ typedef struct mr_marker_map {
 } mr_marker_map;
 
 /* {"family": "tag36h11", "tag_size": 0.4, "tags": [{"id": 0,
- *   "world_from_tag": [16]}, ...]}. Refuses duplicate ids, a tag size <= 0,
- * non-rigid transforms and unknown families. */
+ *   "world_from_tag": [16]}, ...]}; a tag may carry its own "tag_size"
+ * (maps of mixed sizes). Other keys (e.g. the σ fields `mrcheck map`
+ * writes) are ignored. Refuses duplicate ids, a tag size <= 0, non-rigid
+ * transforms and unknown families. */
 bool mr_marker_map_from_json(const cJSON *obj, mr_marker_map *map, mr_error *err);
 bool mr_marker_map_parse(const char *text, size_t size, mr_marker_map *map, mr_error *err);
 bool mr_marker_map_load(const char *path, mr_marker_map *map, mr_error *err);
 cJSON *mr_marker_map_to_json(const mr_marker_map *map);
 void mr_marker_map_free(mr_marker_map *map); /* zeroes the struct */
 const mr_marker *mr_marker_map_find(const mr_marker_map *map, int id);
+/* The black-square edge of tag m: its own size, else the map's. */
+double mr_marker_size(const mr_marker_map *map, const mr_marker *m);
 /* World positions of the four corners of tag m, apriltag order. */
 void mr_marker_corners_world(const mr_marker_map *map, const mr_marker *m, mr_dvec3 out[4]);
 /* Corners in the tag frame (z = 0), apriltag order. */
@@ -100,6 +106,139 @@ void mr_detector_destroy(mr_detector **det);
  * that is too small, a bad image). Zero detections is success. */
 const mr_detection *mr_detector_detect(mr_detector *det, const mr_image *img, int *count, mr_error *err);
 
+/* ------------------------------------------------- marker-map building */
+
+/* `mrcheck map` (map.c, the adjustment in map_ba.cc through Ceres):
+ *
+ *   per photo and tag: undistorted corners -> IPPE camera_from_tag
+ *   -> pairwise relative poses tag_a_from_tag_b from photos that see both
+ *   -> per pair a robust mean (medoid, then the mean of those within
+ *      5 degrees of it: IPPE's mirror branch drops out)
+ *   -> connected parts; the part holding the gauge is mapped, the other
+ *      tags are reported
+ *   -> initial map: maximum spanning tree by shared photos from the root
+ *      (the fixed tag, else the most seen), then rotation averaging over
+ *      every pair (chordal means, a few sweeps) and the positions by
+ *      averaging over every pair
+ *   -> each photo's pose from all its tags (best single-tag start, LM)
+ *   -> gauge: the fixed tag's given pose, or a weighted rigid fit to the
+ *      control points
+ *   -> global bundle adjustment of all tag and camera poses (and, asked,
+ *      fx fy cx cy k1 k2) on corner reprojection error under a Huber loss,
+ *      the control points as weighted residuals in the same problem
+ *   -> per tag covariance (Ceres), scaled by the corner variance estimated
+ *      from the residuals; control points' residuals and leave-one-out.
+ *
+ * "Chaining" (params.no_adjust) stops after the spanning tree: each tag's
+ * pose is the product of the averaged relative poses along its tree path,
+ * what a bundle calibration without global adjustment gives. */
+
+typedef struct mr_map_photo {
+    const mr_detection *dets; /* count detections, corners in pixels (distorted) */
+    int count;
+    const char *name;         /* for messages; may be NULL */
+} mr_map_photo;
+
+typedef struct mr_map_control {
+    char name[64];
+    int tag_id;
+    int corner;               /* -1: the tag's centre; 0..3: that corner, apriltag order */
+    mr_dvec3 world;           /* measured, scene units */
+    double sigma;             /* 1-σ per axis, scene units, > 0 */
+} mr_map_control;
+
+typedef struct mr_map_params {
+    double tag_size;          /* edge of every tag not in sizes, scene units;
+                                 0 = none (such tags are skipped, with a warning) */
+    const int *size_ids;      /* size_count tags of their own size */
+    const double *sizes;
+    int size_count;
+    int fix_id;               /* gauge when control_count == 0: this tag */
+    const mr_dmat4 *fix_pose; /* its world_from_tag; NULL = identity */
+    const mr_map_control *controls; /* >= 3 control points: they are the gauge */
+    int control_count;
+    bool refine_intrinsics;   /* also adjust fx fy cx cy k1 k2 */
+    bool no_adjust;           /* chaining only (the bench's baseline) */
+    double loss_px;           /* Huber scale of the corner residuals, px; 0 = 1.0 */
+    int max_iterations;       /* 0 = 100 */
+    double min_tag_px;        /* shorter tag edges are ignored, px; 0 = 8 */
+    double outlier_sigma;     /* a control point whose leave-one-out residual
+                                 exceeds this many σ is an outlier; 0 = 5 */
+    int threads;              /* Ceres threads; 0 = 1 */
+    void (*progress)(void *user, const char *stage, double fraction); /* may be NULL */
+    void *progress_user;
+} mr_map_params;
+#define MR_MAP_DEFAULTS {.tag_size = 0.0, .fix_id = 0, .fix_pose = NULL, .controls = NULL, .control_count = 0}
+
+typedef struct mr_map_tag {
+    int id;
+    double size;              /* black-square edge, scene units */
+    mr_dmat4 world_from_tag;
+    int photos;               /* photos that saw it (and were used) */
+    double cov[36];           /* 6x6 covariance of (rotation about world x y z,
+                                 radians; centre x y z, scene units); the
+                                 fixed tag's is 0; NaN = not computable */
+    double sigma_xyz[3];      /* sqrt of the position diagonal, scene units */
+    double sigma_pos;         /* sqrt(trace) of the position block: 3D 1-σ */
+    double sigma_deg;         /* sqrt(trace) of the rotation block, degrees */
+    double rms_px;            /* its corners' reprojection RMS */
+} mr_map_tag;
+
+typedef struct mr_map_control_result {
+    double residual[3];       /* adjusted minus measured, scene units */
+    double loo[3];            /* the same with this point left out of the
+                                 solve (needs >= 4 points), else NaN */
+    double loo_sigma;         /* |loo| over its expected σ; NaN if none */
+    bool used;                /* in the gauge (false: an outlier, or its tag
+                                 was not mapped) */
+    bool outlier;             /* disagrees by more than outlier_sigma σ */
+} mr_map_control_result;
+
+typedef struct mr_map_result {
+    mr_map_tag *tags;         /* tag_count mapped tags, sorted by id */
+    int tag_count;
+    int *unconnected;         /* ids seen but not connected to the gauge's part */
+    int unconnected_count;
+    int *unsized;             /* ids seen without a known size (skipped) */
+    int unsized_count;
+    mr_camera camera;         /* the intrinsics used (refined if asked) */
+    int photos_used;          /* photos with a pose in the map */
+    int photos_total;
+    int observations;         /* tag sightings in the adjustment */
+    double rms_px;            /* corner reprojection RMS after the adjustment
+                                 (chaining: of the initial map) */
+    double sigma_px;          /* corner noise estimated from the residuals */
+    int iterations;
+    bool adjusted;            /* the bundle adjustment ran */
+    bool refined_intrinsics;  /* camera holds refined intrinsics */
+    mr_map_control_result *controls; /* control_count, in the given order */
+    int control_count;
+} mr_map_result;
+
+/* Builds the map. false + err on bad input (no photo, no tag seen, the
+ * fixed tag never seen, < 3 usable control points or collinear ones, more
+ * than one outlier too many); unconnected tags are no error. */
+bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_count, const mr_map_params *params,
+                  mr_map_result *out, mr_error *err);
+void mr_map_result_free(mr_map_result *r); /* zeroes it */
+/* The mapped tags as a marker map (family copied; tag_size: params' or
+ * the first tag's; each tag of another size carries its own). */
+bool mr_map_result_markers(const mr_map_result *r, const char *family, double tag_size, mr_marker_map *out,
+                           mr_error *err);
+/* The marker-map JSON (mr_marker_map_to_json) plus the map's evidence:
+ * per tag "photos", "sigma_mm" [x y z] and "sigma_pos_mm" (1-σ position,
+ * scene units taken as metres), "sigma_deg", "rms_px", "covariance" [36]
+ * (rad, scene units), and a top-level "map" object: "rms_px", "sigma_px",
+ * "photos_used", "photos_total", "observations", "gauge", "unconnected"
+ * [ids], "unsized" [ids], "control_points" [{name, tag, corner,
+ * residual_mm [3], loo_mm [3] or null, loo_sigma, used, outlier}]. */
+cJSON *mr_map_result_to_json(const mr_map_result *r, const mr_marker_map *markers, const mr_map_params *params);
+/* Control points file: {"points": [{"name": "P1", "tag": 3, "corner":
+ * "centre"|0..3, "xyz": [x, y, z], "sigma": s}, ...]} (sigma in scene
+ * units; defaults to "sigma" at the top level, else 0.002). */
+bool mr_map_controls_parse(const char *text, size_t size, mr_map_control **out, int *count, mr_error *err);
+bool mr_map_controls_load(const char *path, mr_map_control **out, int *count, mr_error *err);
+
 /* ------------------------------------------------------------------ pose */
 
 typedef struct mr_pose_params {
@@ -126,7 +265,25 @@ typedef struct mr_pose {
     double rms_px;           /* reprojection RMS over used corners, pixels */
     bool ambiguous;          /* single tag with two plausible IPPE solutions;
                                 the one nearest the previous pose was kept */
+    /* The pose's uncertainty (valid poses): the 6x6 row-major covariance
+     * of camera_from_world's error as a small left perturbation in camera
+     * axes, X_cam -> exp([w]x) X_cam + tau: w (rotation vector, radians)
+     * then tau (scene units). From the used corners' Jacobian, with the
+     * corner noise estimated from the residuals (dof-corrected) and never
+     * below MR_POSE_MIN_CORNER_SIGMA_PX. mr_pose_point_sigma turns it into
+     * "± N here". */
+    double cov[36];
+    double corner_sigma_px;  /* the corner noise used, px */
 } mr_pose;
+/* Corner noise floor of the covariance (px): a lucky frame with near-exact
+ * corners must not claim sub-micron registration. */
+#define MR_POSE_MIN_CORNER_SIGMA_PX 0.1
+/* The uncertainty of a world point's place relative to the camera under
+ * pose's covariance: *sigma_3d = sqrt(trace) of its 3x3 covariance (scene
+ * units), *sigma_lateral the part across the line of sight (what moves the
+ * overlay on screen), either may be NULL. false if the pose is invalid,
+ * has no covariance, or the point is behind the camera. */
+bool mr_pose_point_sigma(const mr_pose *pose, mr_dvec3 world_point, double *sigma_3d, double *sigma_lateral);
 
 /* Camera pose from the detections: corners undistorted, candidate poses from
  * each tag's two IPPE solutions, the candidate that most tags agree with
@@ -148,6 +305,41 @@ double mr_pose_angle_deg(const mr_dmat4 *a, const mr_dmat4 *b);
 /* Rotation vector (axis * angle, radians) <-> rotation matrix (3x3 row-major). */
 void mr_rotvec_to_mat(const double rv[3], double R[9]);
 void mr_mat_to_rotvec(const double R[9], double rv[3]);
+
+/* ------------------------------------------------------ triangulation */
+
+/* A real feature tapped in several frames (`mrcheck measure`): each tap is
+ * a pixel (distorted, OpenCV convention) in a frame with its tracked pose
+ * and that pose's covariance (mr_pose.cov; none: only the tap's noise). */
+typedef struct mr_tap {
+    mr_dmat4 world_from_camera;
+    const double *pose_cov;  /* 36, mr_pose.cov's convention; NULL: none */
+    double px[2];
+} mr_tap;
+typedef struct mr_triangulate_params {
+    double tap_sigma_px;     /* a tap's 1-σ per axis, px; 0 = 1.0 */
+    double min_angle_deg;    /* refused below this largest angle between rays; 0 = 2 */
+} mr_triangulate_params;
+#define MR_TRIANGULATE_DEFAULTS {0.0, 0.0}
+typedef struct mr_triangulation {
+    mr_dvec3 point;          /* world, scene units */
+    double cov[9];           /* 3x3 covariance of point (taps and poses) */
+    double sigma;            /* sqrt(trace(cov)) */
+    double angle_deg;        /* the largest angle between two rays */
+    double rms_px;           /* reprojection RMS of the taps */
+} mr_triangulation;
+/* Linear (closest point to all rays), then Gauss-Newton on the taps'
+ * reprojection error, each weighted by its tap noise plus its pose's
+ * covariance carried into the image. false + err: fewer than 2 taps, a tap
+ * that cannot be undistorted, rays nearly parallel ("baseline angle 0.4
+ * deg < 2 deg": taken from nearly the same place), the point behind a
+ * camera. */
+bool mr_triangulate(const mr_camera *cam, const mr_tap *taps, int n, const mr_triangulate_params *params,
+                    mr_triangulation *out, mr_error *err);
+/* Distance from planned to measured and its
+ * 1-σ (the covariance projected on that direction; with a zero difference,
+ * sqrt(trace / 3)). */
+void mr_triangulation_distance(const mr_triangulation *t, mr_dvec3 planned, double *dist, double *sigma);
 
 /* ---------------------------------------------------------------- filter */
 

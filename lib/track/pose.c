@@ -163,6 +163,8 @@ static bool refine(const tag_obs *obs, const bool *use, int n, rt *x) {
     return m >= 4 && mr_cv_refine_lm(o, p, m, x->R, x->t);
 }
 
+static void covariance(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, double outlier_px, mr_pose *out);
+
 bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_detection *dets, int count,
                    const mr_pose *prev, const mr_pose_params *params, mr_pose *out, mr_error *err) {
     memset(out, 0, sizeof *out);
@@ -210,20 +212,21 @@ bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_dete
     /* Candidates: both IPPE solutions of every tag, in world terms. */
     cand cands[MAX_CAND];
     int nc = 0;
-    mr_dvec3 tc[4];
-    mr_marker_corners_tag(map->tag_size, tc);
-    double objt[12];
-    for (int k = 0; k < 4; k++) {
-        objt[3 * k] = tc[k].x;
-        objt[3 * k + 1] = tc[k].y;
-        objt[3 * k + 2] = tc[k].z;
-    }
     for (int i = 0; i < n; i++) {
         double R[2][9], t[2][3];
         double img8[8];
         memcpy(img8, obs[i].norm, sizeof img8);
-        int ns = mr_cv_ippe_square(objt, img8, R, t);
         const mr_marker *m = mr_marker_map_find(map, obs[i].id);
+        /* Each tag's own size (maps of mixed sizes). */
+        mr_dvec3 tc[4];
+        mr_marker_corners_tag(mr_marker_size(map, m), tc);
+        double objt[12];
+        for (int k = 0; k < 4; k++) {
+            objt[3 * k] = tc[k].x;
+            objt[3 * k + 1] = tc[k].y;
+            objt[3 * k + 2] = tc[k].z;
+        }
+        int ns = mr_cv_ippe_square(objt, img8, R, t);
         mr_dmat4 tfw = mr_m4_invert_rigid(&m->world_from_tag);
         for (int s = 0; s < ns; s++) {
             rt ct;
@@ -312,5 +315,112 @@ bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_dete
     mr_dmat4 cfw = rt_to_m4(&x);
     out->world_from_camera = mr_m4_invert_rigid(&cfw);
     out->valid = out->rms_px <= max_rms && mr_m4_is_finite(&out->world_from_camera);
+    if (out->valid) covariance(cam, &x, obs, n, outlier_px, out);
     return true;
+}
+
+/* In-place inverse of a symmetric positive definite n x n matrix
+ * (Gauss-Jordan with partial pivoting); false if singular. */
+static bool invert_n(double *a, int n) {
+    double inv[36];
+    for (int i = 0; i < n * n; i++) inv[i] = (i / n == i % n) ? 1 : 0;
+    double scale = 0;
+    for (int i = 0; i < n; i++) scale = fmax(scale, fabs(a[i * n + i]));
+    for (int c = 0; c < n; c++) {
+        int piv = c;
+        for (int r = c + 1; r < n; r++)
+            if (fabs(a[r * n + c]) > fabs(a[piv * n + c])) piv = r;
+        if (!(fabs(a[piv * n + c]) > 1e-14 * scale)) return false;
+        for (int k = 0; k < n; k++) {
+            double t = a[c * n + k];
+            a[c * n + k] = a[piv * n + k];
+            a[piv * n + k] = t;
+            t = inv[c * n + k];
+            inv[c * n + k] = inv[piv * n + k];
+            inv[piv * n + k] = t;
+        }
+        double d = a[c * n + c];
+        for (int k = 0; k < n; k++) {
+            a[c * n + k] /= d;
+            inv[c * n + k] /= d;
+        }
+        for (int r = 0; r < n; r++) {
+            if (r == c) continue;
+            double f = a[r * n + c];
+            if (f == 0) continue;
+            for (int k = 0; k < n; k++) {
+                a[r * n + k] -= f * a[c * n + k];
+                inv[r * n + k] -= f * inv[c * n + k];
+            }
+        }
+    }
+    memcpy(a, inv, (size_t)n * n * sizeof *a);
+    return true;
+}
+
+/* Covariance of the solved pose: J^T J over the inlier corners (pixel
+ * residuals of the pinhole projection; the lens only rescales them
+ * locally), scaled by the residual variance with its floor. */
+static void covariance(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, double outlier_px, mr_pose *out) {
+    double JtJ[36] = {0};
+    double sse = 0;
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        if (tag_rms(cam, x, &obs[i]) > outlier_px) continue;
+        for (int k = 0; k < 4; k++) {
+            const double *p = obs[i].world[k];
+            double q[3];
+            for (int r = 0; r < 3; r++)
+                q[r] = x->R[3 * r] * p[0] + x->R[3 * r + 1] * p[1] + x->R[3 * r + 2] * p[2] + x->t[r];
+            double iz = 1 / q[2], u = q[0] * iz, v = q[1] * iz;
+            double du = cam->fx * (u - obs[i].norm[k][0]), dv = cam->fy * (v - obs[i].norm[k][1]);
+            sse += du * du + dv * dv;
+            /* d(pixel)/dq, then dq/d(w, tau) = [-[q]x | I]. */
+            double Pu[3] = {cam->fx * iz, 0, -cam->fx * u * iz}, Pv[3] = {0, cam->fy * iz, -cam->fy * v * iz};
+            double J[2][6];
+            for (int row = 0; row < 2; row++) {
+                const double *P = row ? Pv : Pu;
+                /* P . (-[q]x w) = P . (w x q) = w . (q x P) */
+                J[row][0] = q[1] * P[2] - q[2] * P[1];
+                J[row][1] = q[2] * P[0] - q[0] * P[2];
+                J[row][2] = q[0] * P[1] - q[1] * P[0];
+                J[row][3] = P[0];
+                J[row][4] = P[1];
+                J[row][5] = P[2];
+            }
+            for (int a = 0; a < 6; a++)
+                for (int b = 0; b < 6; b++) JtJ[6 * a + b] += J[0][a] * J[0][b] + J[1][a] * J[1][b];
+            m++;
+        }
+    }
+    if (2 * m <= 6 || !invert_n(JtJ, 6)) return;
+    double s = sqrt(sse / (2 * m - 6));
+    if (!(s >= MR_POSE_MIN_CORNER_SIGMA_PX)) s = MR_POSE_MIN_CORNER_SIGMA_PX;
+    out->corner_sigma_px = s;
+    for (int i = 0; i < 36; i++) out->cov[i] = s * s * JtJ[i];
+}
+
+bool mr_pose_point_sigma(const mr_pose *pose, mr_dvec3 world_point, double *sigma_3d, double *sigma_lateral) {
+    if (!pose || !pose->valid || !(pose->corner_sigma_px > 0)) return false;
+    mr_dmat4 cfw = mr_m4_invert_rigid(&pose->world_from_camera);
+    mr_dvec3 q = mr_m4_point(&cfw, world_point);
+    if (!(q.z > 0)) return false;
+    /* dq = -[q]x w + tau: A = [-[q]x | I], C = A cov A^T. */
+    double A[3][6] = {{0, q.z, -q.y, 1, 0, 0}, {-q.z, 0, q.x, 0, 1, 0}, {q.y, -q.x, 0, 0, 0, 1}};
+    double C[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) {
+            double v = 0;
+            for (int a = 0; a < 6; a++)
+                for (int b = 0; b < 6; b++) v += A[r][a] * pose->cov[6 * a + b] * A[c][b];
+            C[r][c] = v;
+        }
+    double tr = C[0][0] + C[1][1] + C[2][2];
+    double len = sqrt(q.x * q.x + q.y * q.y + q.z * q.z), d[3] = {q.x / len, q.y / len, q.z / len};
+    double along = 0;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) along += d[r] * C[r][c] * d[c];
+    if (sigma_3d) *sigma_3d = sqrt(fmax(tr, 0));
+    if (sigma_lateral) *sigma_lateral = sqrt(fmax(tr - along, 0));
+    return isfinite(tr);
 }

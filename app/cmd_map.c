@@ -1,0 +1,253 @@
+/* mrcheck map: the marker map from photos (lib/track's mr_map_build). */
+#include "app_track.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static void progress(void *user, const char *stage, double f) {
+    (void)user;
+    fprintf(stderr, "\rmap: %s %3.0f%%   ", stage, 100 * f);
+}
+
+/* "id=size,id=size" into arrays (malloc'd). */
+static bool parse_sizes(const char *s, int **ids, double **sizes, int *n) {
+    int cap = 1;
+    for (const char *c = s; *c; c++) cap += *c == ',';
+    *ids = calloc((size_t)cap, sizeof **ids);
+    *sizes = calloc((size_t)cap, sizeof **sizes);
+    *n = 0;
+    if (!*ids || !*sizes) return false;
+    const char *c = s;
+    while (*c) {
+        char *e;
+        long id = strtol(c, &e, 10);
+        if (e == c || *e != '=' || id < 0) return false;
+        c = e + 1;
+        double v = strtod(c, &e);
+        if (e == c || !isfinite(v) || !(v > 0)) return false;
+        (*ids)[*n] = (int)id;
+        (*sizes)[(*n)++] = v;
+        c = e;
+        if (*c == ',') c++;
+        else if (*c) return false;
+    }
+    return *n > 0;
+}
+
+int cmd_map(int argc, char **argv) {
+    static const char *cmd = "map";
+    mr_cli_opt opts[] = {
+        {"images", "DIR", "folder of photos of the tags (png, jpg, ...)", NULL},
+        {"video", "FILE", "instead: a video walked past the tags (every frame is a photo)", NULL},
+        {"camera", "C.json", "camera intrinsics (mrcheck calibrate)", NULL},
+        {"family", "F", "tag family (default tag36h11)", NULL},
+        {"tag-size", "S", "black-square edge of the tags, scene units", NULL},
+        {"tag-sizes", "ID=S,...", "tags of other sizes", NULL},
+        {"fix", "ID", "gauge: this tag's pose is given (--fix-pose, default identity)", NULL},
+        {"fix-pose", "P.json", "{\"world_from_tag\": [16]} for the --fix tag", NULL},
+        {"control", "P.json", "gauge: >= 3 control points with plan coordinates and sigma", NULL},
+        {"refine-intrinsics", NULL, "also adjust fx fy cx cy k1 k2", NULL},
+        {"chain", NULL, "no global adjustment: chain relative poses along the spanning tree (baseline)", NULL},
+        {"loss", "PX", "Huber scale of the corner residuals (default 1 px)", NULL},
+        {"out", "MARKERS.json", "marker map to write (with sigma, RMS, control residuals)", NULL},
+        {"verbose", NULL, "more output", NULL},
+        {"quiet", NULL, "errors only", NULL},
+        {NULL, NULL, NULL, NULL},
+    };
+    bool help;
+    if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
+                   "usage: mrcheck map (--images DIR | --video FILE) --camera C.json --tag-size S\n"
+                   "                   [--tag-sizes ID=S,...] (--fix ID [--fix-pose P.json] | --control P.json)\n"
+                   "                   --out MARKERS.json\n"
+                   "Detects the tags in every photo, chains their relative poses into an initial map and\n"
+                   "adjusts all tag and photo poses together (bundle adjustment, Ceres). Writes the marker\n"
+                   "map with each tag's sigma, the reprojection RMS, control-point residuals with a\n"
+                   "leave-one-out check, and the tags that could not be connected (the largest part is mapped).",
+                   &help))
+        return 2;
+    if (help) return 0;
+    mr_cli_log_level(opts);
+    const char *in = mr_cli_get(opts, "images") ? mr_cli_get(opts, "images") : mr_cli_get(opts, "video");
+    const char *camf = mr_cli_get(opts, "camera"), *out = mr_cli_get(opts, "out");
+    if (!in || !camf || !out) return mr_cli_errorf(cmd, "--images (or --video), --camera and --out are required (see --help)"), 2;
+    if (mr_cli_get(opts, "images") && mr_cli_get(opts, "video")) return mr_cli_errorf(cmd, "give --images or --video, not both"), 2;
+    if (!mr_cli_get(opts, "fix") == !mr_cli_get(opts, "control"))
+        return mr_cli_errorf(cmd, "give the gauge: --fix ID or --control P.json (one of them)"), 2;
+    if (!mr_cli_get(opts, "tag-size") && !mr_cli_get(opts, "tag-sizes"))
+        return mr_cli_errorf(cmd, "--tag-size (or --tag-sizes) is required"), 2;
+    const char *family = mr_cli_get(opts, "family") ? mr_cli_get(opts, "family") : "tag36h11";
+    if (!mr_tag_family_known(family)) return mr_cli_errorf(cmd, "unknown tag family '%s'", family), 2;
+
+    mr_map_params mp = MR_MAP_DEFAULTS;
+    if (mr_cli_get(opts, "tag-size") && !mr_cli_double("tag-size", mr_cli_get(opts, "tag-size"), 1e-9, 1e9, &mp.tag_size))
+        return 2;
+    if (mr_cli_get(opts, "loss") && !mr_cli_double("loss", mr_cli_get(opts, "loss"), 1e-3, 1e3, &mp.loss_px)) return 2;
+    mp.refine_intrinsics = mr_cli_flag(opts, "refine-intrinsics");
+    mp.no_adjust = mr_cli_flag(opts, "chain");
+    int *size_ids = NULL;
+    double *sizes = NULL;
+    if (mr_cli_get(opts, "tag-sizes") && !parse_sizes(mr_cli_get(opts, "tag-sizes"), &size_ids, &sizes, &mp.size_count)) {
+        free(size_ids);
+        free(sizes);
+        return mr_cli_errorf(cmd, "--tag-sizes: expected ID=SIZE,... with sizes > 0, got '%s'", mr_cli_get(opts, "tag-sizes")), 2;
+    }
+    mp.size_ids = size_ids;
+    mp.sizes = sizes;
+
+    mr_error err = {0};
+    mr_camera cam;
+    mr_dmat4 fix_pose;
+    mr_map_control *ctl = NULL;
+    mr_source *src = NULL;
+    mr_detector *det = NULL;
+    mr_detection **dets = NULL;
+    mr_map_photo *photos = NULL;
+    char (*names)[256] = NULL;
+    int n = 0, cap = 0;
+    int rc = 1;
+    mr_map_result res = {0};
+    mr_marker_map mm = {0};
+    if (!mr_camera_load(camf, &cam, &err)) goto fail;
+    if (mr_cli_get(opts, "fix")) {
+        long id;
+        if (!mr_cli_int("fix", mr_cli_get(opts, "fix"), 0, 1000000, &id)) {
+            rc = 2;
+            goto out;
+        }
+        mp.fix_id = (int)id;
+        if (mr_cli_get(opts, "fix-pose")) {
+            cJSON *j = mr_json_load(mr_cli_get(opts, "fix-pose"), &err);
+            bool ok = j && mr_json_dmat4(j, "world_from_tag", &fix_pose, &err);
+            cJSON_Delete(j);
+            if (ok && !mr_m4_is_rigid(&fix_pose, 1e-4))
+                ok = mr_fail(&err, MR_ERR_INVALID, "world_from_tag is not a rigid transform");
+            if (!ok) {
+                mr_error_prefix(&err, "%s", mr_cli_get(opts, "fix-pose"));
+                goto fail;
+            }
+            mp.fix_pose = &fix_pose;
+        }
+    } else {
+        if (!mr_map_controls_load(mr_cli_get(opts, "control"), &ctl, &mp.control_count, &err)) goto fail;
+        mp.controls = ctl;
+    }
+
+    mr_source_params sp = MR_SOURCE_DEFAULTS;
+    sp.gray = true;
+    src = mr_source_open(in, &sp, &err);
+    if (!src) goto fail;
+    mr_detector_params dp = MR_DETECTOR_DEFAULTS;
+    dp.family = family;
+    dp.decimate = 1; /* full resolution: corner accuracy is the map's accuracy */
+    det = mr_detector_create(&dp, &err);
+    if (!det) goto fail;
+    bool tty = isatty(2) && mr_log_get_level() >= MR_LOG_WARN;
+    for (;;) {
+        mr_frame f;
+        mr_read_status st = mr_source_read(src, &f, &err);
+        if (st == MR_READ_END) break;
+        if (st == MR_READ_ERROR) goto fail;
+        if (n == cap) {
+            cap = cap ? 2 * cap : 64;
+            mr_detection **nd = realloc(dets, (size_t)cap * sizeof *nd);
+            if (nd) dets = nd;
+            mr_map_photo *np = realloc(photos, (size_t)cap * sizeof *np);
+            if (np) photos = np;
+            char (*nn)[256] = realloc(names, (size_t)cap * sizeof *nn);
+            if (nn) names = nn;
+            if (!nd || !np || !nn) {
+                mr_fail(&err, MR_ERR_NOMEM, "out of memory");
+                goto fail;
+            }
+        }
+        /* Intrinsics are for the camera's size: the first photo of another
+         * size gets them rescaled (the same lens at another resolution);
+         * later photos must match it. */
+        if (n == 0 && (f.image.width != cam.width || f.image.height != cam.height))
+            cam = mr_camera_resized(&cam, f.image.width, f.image.height);
+        if (f.image.width != cam.width || f.image.height != cam.height) {
+            fprintf(stderr, "mrcheck: map: warning: %s is %dx%d, not %dx%d; skipped\n", f.name, f.image.width,
+                    f.image.height, cam.width, cam.height);
+            continue;
+        }
+        int k = 0;
+        mr_error fe = {0};
+        const mr_detection *d = mr_detector_detect(det, &f.image, &k, &fe);
+        if (!d) {
+            fprintf(stderr, "mrcheck: map: warning: %s: %s\n", f.name, fe.msg);
+            continue;
+        }
+        dets[n] = k ? malloc((size_t)k * sizeof **dets) : NULL;
+        if (k && !dets[n]) {
+            mr_fail(&err, MR_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        if (k) memcpy(dets[n], d, (size_t)k * sizeof *d);
+        snprintf(names[n], sizeof names[n], "%s", f.name[0] ? f.name : "frame");
+        photos[n] = (mr_map_photo){dets[n], k, names[n]};
+        n++;
+        if (tty) fprintf(stderr, "\rmap: detecting, photo %d   ", n);
+        mr_log(MR_LOG_INFO, "%s: %d tags", names[n - 1], k);
+    }
+    if (tty) {
+        fprintf(stderr, "\n");
+        mp.progress = progress;
+    }
+    if (!mr_map_build(&cam, photos, n, &mp, &res, &err)) {
+        if (tty) fprintf(stderr, "\n");
+        goto fail;
+    }
+    if (tty) fprintf(stderr, "\n");
+    if (!mr_map_result_markers(&res, family, mp.tag_size, &mm, &err)) goto fail;
+    cJSON *j = mr_map_result_to_json(&res, &mm, &mp);
+    bool saved = j && mr_json_save(out, j, &err);
+    cJSON_Delete(j);
+    if (!saved) goto fail;
+    for (int i = 0; i < res.unsized_count; i++)
+        fprintf(stderr, "mrcheck: map: warning: tag %d has no size (--tag-sizes): not mapped\n", res.unsized[i]);
+    for (int i = 0; i < res.unconnected_count; i++)
+        fprintf(stderr, "mrcheck: map: warning: tag %d is not connected to the mapped part: no shared photo\n",
+                res.unconnected[i]);
+    printf("mapped %d tags from %d of %d photos (%d sightings)%s; reprojection RMS %.3f px", res.tag_count,
+           res.photos_used, res.photos_total, res.observations, res.adjusted ? "" : " by chaining (no adjustment)",
+           res.rms_px);
+    if (res.adjusted) printf(", corner sigma %.3f px", res.sigma_px);
+    printf("; wrote %s\n", out);
+    double worst = 0;
+    int worst_id = -1;
+    for (int i = 0; i < res.tag_count; i++)
+        if (isfinite(res.tags[i].sigma_pos) && res.tags[i].sigma_pos > worst)
+            worst = res.tags[i].sigma_pos, worst_id = res.tags[i].id;
+    if (worst_id >= 0) printf("largest tag sigma: tag %d, %.1f mm\n", worst_id, worst * 1e3);
+    for (int i = 0; i < res.tag_count && mr_log_get_level() >= MR_LOG_INFO; i++)
+        printf("  tag %d: %d photos, sigma %.1f mm %.2f deg, rms %.3f px\n", res.tags[i].id, res.tags[i].photos,
+               res.tags[i].sigma_pos * 1e3, res.tags[i].sigma_deg, res.tags[i].rms_px);
+    for (int q = 0; q < res.control_count; q++) {
+        const mr_map_control_result *c = &res.controls[q];
+        printf("control %s: residual %.1f mm", ctl[q].name,
+               1e3 * sqrt(c->residual[0] * c->residual[0] + c->residual[1] * c->residual[1] + c->residual[2] * c->residual[2]));
+        if (isfinite(c->loo_sigma))
+            printf(", left out %.1f mm (%.1f sigma)",
+                   1e3 * sqrt(c->loo[0] * c->loo[0] + c->loo[1] * c->loo[1] + c->loo[2] * c->loo[2]), c->loo_sigma);
+        printf("%s\n", c->outlier ? " OUTLIER: left out of the gauge" : c->used ? "" : " (tag not mapped)");
+    }
+    rc = 0;
+    goto out;
+fail:
+    rc = mr_cli_error(cmd, &err);
+out:
+    for (int i = 0; i < n; i++) free(dets[i]);
+    free(dets);
+    free(photos);
+    free(names);
+    free(size_ids);
+    free(sizes);
+    free(ctl);
+    mr_detector_destroy(&det);
+    mr_source_close(&src);
+    mr_map_result_free(&res);
+    mr_marker_map_free(&mm);
+    return rc;
+}

@@ -1,0 +1,121 @@
+/* mrcheck measure: a real feature tapped in several frames of a recording,
+ * triangulated (lib/track's mr_triangulate) and compared with the plan. */
+#include "app_track.h"
+#include "mr_session.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int cmd_measure(int argc, char **argv) {
+    static const char *cmd = "measure";
+    mr_cli_opt opts[] = {
+        {"recording", "DIR", "recording whose frames were tapped (poses and their covariance)", NULL},
+        {"observations", "OBS.json", "{\"taps\": [{\"frame\": N, \"px\": [u, v]}, ...], \"planned\": [x, y, z]}", NULL},
+        {"out", "RESULT.json", "also write the result there", NULL},
+        {"tap-sigma", "PX", "1-sigma of a tap (default 1 px)", NULL},
+        {"min-angle", "DEG", "refuse rays closer than this (default 2 degrees)", NULL},
+        {NULL, NULL, NULL, NULL},
+    };
+    bool help;
+    if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
+                   "usage: mrcheck measure --recording DIR --observations OBS.json [--out RESULT.json]\n"
+                   "Triangulates the feature tapped in two or more frames (linear, then refined, with the taps'\n"
+                   "noise and each frame's pose covariance) and reports its distance to the planned point in mm\n"
+                   "with its 1-sigma uncertainty.",
+                   &help))
+        return 2;
+    if (help) return 0;
+    const char *dir = mr_cli_get(opts, "recording"), *obsf = mr_cli_get(opts, "observations"), *out = mr_cli_get(opts, "out");
+    if (!dir || !obsf) return mr_cli_errorf(cmd, "--recording and --observations are required (see --help)"), 2;
+    mr_triangulate_params tp = MR_TRIANGULATE_DEFAULTS;
+    if (mr_cli_get(opts, "tap-sigma") && !mr_cli_double("tap-sigma", mr_cli_get(opts, "tap-sigma"), 1e-3, 100, &tp.tap_sigma_px))
+        return 2;
+    if (mr_cli_get(opts, "min-angle") && !mr_cli_double("min-angle", mr_cli_get(opts, "min-angle"), 1e-3, 90, &tp.min_angle_deg))
+        return 2;
+    mr_error err = {0};
+    cJSON *obs = mr_json_load(obsf, &err);
+    if (!obs) return mr_cli_error(cmd, &err);
+    mr_recording *rec = NULL;
+    mr_tap taps[64];
+    int n = 0, rc = 1;
+    double planned[3];
+    bool has_planned = cJSON_GetObjectItemCaseSensitive(obs, "planned") != NULL;
+    const cJSON *arr = cJSON_GetObjectItemCaseSensitive(obs, "taps"), *t;
+    if (has_planned && !mr_json_numbers(obs, "planned", planned, 3, &err)) {
+        mr_error_prefix(&err, "%s", obsf);
+        goto fail;
+    }
+    if (!cJSON_IsArray(arr)) {
+        mr_fail(&err, MR_ERR_PARSE, "%s: \"taps\" must be an array of {\"frame\", \"px\"}", obsf);
+        goto fail;
+    }
+    rec = mr_recording_open(dir, &err);
+    if (!rec) goto fail;
+    int no_cov = 0;
+    cJSON_ArrayForEach(t, arr) {
+        double fr = -1, px[2];
+        if (n == 64) {
+            mr_fail(&err, MR_ERR_INVALID, "%s: more than 64 taps", obsf);
+            goto fail;
+        }
+        if (!cJSON_IsObject(t) || !mr_json_number(t, "frame", &fr, true, &err) || !mr_json_numbers(t, "px", px, 2, &err)) {
+            if (!cJSON_IsObject(t)) mr_fail(&err, MR_ERR_PARSE, "not an object");
+            mr_error_prefix(&err, "%s: tap %d", obsf, n + 1);
+            goto fail;
+        }
+        const mr_rec_frame *f = NULL;
+        for (int i = 0; i < rec->frame_count; i++)
+            if ((double)rec->frames[i].index == fr) f = &rec->frames[i];
+        if (!f) {
+            mr_fail(&err, MR_ERR_INVALID, "%s: tap %d: frame %g is not in the recording", obsf, n + 1, fr);
+            goto fail;
+        }
+        if (!f->pose.valid) {
+            mr_fail(&err, MR_ERR_INVALID, "%s: tap %d: frame %g has no tracked pose", obsf, n + 1, fr);
+            goto fail;
+        }
+        bool cov = f->pose.corner_sigma_px > 0;
+        no_cov += !cov;
+        taps[n++] = (mr_tap){f->pose.world_from_camera, cov ? f->pose.cov : NULL, {px[0], px[1]}};
+    }
+    mr_triangulation tr;
+    if (!mr_triangulate(&rec->camera, taps, n, &tp, &tr, &err)) goto fail;
+    /* After the solve, so that a refusal stays one line. */
+    if (no_cov)
+        fprintf(stderr, "mrcheck: measure: warning: %d frame(s) carry no pose covariance (an older recording): "
+                        "only the taps' noise is counted there\n", no_cov);
+    printf("point %.4f %.4f %.4f  sigma %.1f mm  from %d taps, baseline angle %.1f deg, tap RMS %.2f px\n", tr.point.x,
+           tr.point.y, tr.point.z, tr.sigma * 1e3, n, tr.angle_deg, tr.rms_px);
+    double dist = NAN, dsig = NAN;
+    if (has_planned) {
+        mr_triangulation_distance(&tr, mr_v3(planned[0], planned[1], planned[2]), &dist, &dsig);
+        printf("distance to the planned point: %.1f mm +- %.1f mm (1 sigma)\n", dist * 1e3, dsig * 1e3);
+    }
+    if (out) {
+        cJSON *r = cJSON_CreateObject();
+        double pt[3] = {tr.point.x, tr.point.y, tr.point.z};
+        cJSON_AddItemToObject(r, "point", mr_json_from_doubles(pt, 3));
+        cJSON_AddItemToObject(r, "covariance", mr_json_from_doubles(tr.cov, 9));
+        cJSON_AddNumberToObject(r, "sigma_mm", tr.sigma * 1e3);
+        cJSON_AddNumberToObject(r, "angle_deg", tr.angle_deg);
+        cJSON_AddNumberToObject(r, "rms_px", tr.rms_px);
+        cJSON_AddNumberToObject(r, "taps", n);
+        if (has_planned) {
+            cJSON_AddItemToObject(r, "planned", mr_json_from_doubles(planned, 3));
+            cJSON_AddNumberToObject(r, "distance_mm", dist * 1e3);
+            cJSON_AddNumberToObject(r, "distance_sigma_mm", dsig * 1e3);
+        }
+        bool ok = mr_json_save(out, r, &err);
+        cJSON_Delete(r);
+        if (!ok) goto fail;
+    }
+    rc = 0;
+    goto done;
+fail:
+    rc = mr_cli_error(cmd, &err);
+done:
+    mr_recording_close(&rec);
+    cJSON_Delete(obs);
+    return rc;
+}

@@ -1,0 +1,105 @@
+#!/usr/bin/env bash
+# End-to-end checks of `mrcheck map` on a rendered synthetic photo set
+# (`mrcheck synth --map-photos`): the map against the true tag poses, the
+# global adjustment against chaining, control points, a disconnected part,
+# and bad input (one line on stderr, non-zero exit, no output file).
+# Usage: cli_map.sh MRCHECK TMPDIR.
+set -u
+mr=$1
+tmp=$2
+rm -rf "$tmp" && mkdir -p "$tmp"
+. "$(dirname "$0")/common_cli.sh"
+
+set_dir=$tmp/set
+"$mr" synth --map-photos "$set_dir" >/dev/null 2>"$tmp/synth.err" && ok || bad "synth --map-photos: $(cat "$tmp/synth.err")"
+[ "$(ls "$set_dir/images" | wc -l)" -eq 24 ] && ok || bad "expected 24 photos"
+# The true pose of tag 0 as the fixed tag's pose.
+sed -n 's/.*"id":[ ]*0,[ ]*"world_from_tag":[ ]*\(\[[^]]*\]\).*/{"world_from_tag": \1}/p' \
+  <(tr -d '\n\t ' <"$set_dir/truth.json" | sed 's/},{/}\n{/g') | head -1 >"$tmp/fix.json"
+grep -q world_from_tag "$tmp/fix.json" && ok || bad "could not take tag 0's pose from truth.json"
+
+common=(--images "$set_dir/images" --camera "$set_dir/camera.json" --tag-size 0.25)
+"$mr" map "${common[@]}" --fix 0 --fix-pose "$tmp/fix.json" --out "$tmp/ours.json" >"$tmp/ours.out" 2>"$tmp/ours.err" \
+  && ok || bad "map --fix: $(cat "$tmp/ours.err")"
+grep -q "mapped 10 tags" "$tmp/ours.out" && ok || bad "map --fix: $(cat "$tmp/ours.out")"
+"$mr" map "${common[@]}" --fix 0 --fix-pose "$tmp/fix.json" --chain --out "$tmp/chain.json" >/dev/null 2>&1 \
+  && ok || bad "map --chain failed"
+"$mr" map "${common[@]}" --control "$set_dir/control.json" --out "$tmp/ctl.json" >"$tmp/ctl.out" 2>&1 \
+  && ok || bad "map --control: $(cat "$tmp/ctl.out")"
+grep -q "control P4: residual" "$tmp/ctl.out" && grep -q "left out" "$tmp/ctl.out" && ok || bad "control residuals missing"
+# The written map is a marker map the tracker reads, with the evidence.
+"$mr" track --input "$set_dir/images/photo_000.png" --camera "$set_dir/camera.json" --markers "$tmp/ours.json" \
+  >/dev/null 2>&1 && ok || bad "track cannot read the written map"
+for k in sigma_pos_mm sigma_deg covariance rms_px unconnected control_points; do
+  grep -q "\"$k\"" "$tmp/ctl.json" && ok || bad "no $k in the written map"
+done
+if command -v python3 >/dev/null 2>&1; then
+  python3 - "$set_dir/truth.json" "$tmp/ours.json" "$tmp/chain.json" "$tmp/ctl.json" >"$tmp/err.txt" <<'PY'
+import json, math, sys
+t = {x["id"]: x["world_from_tag"] for x in json.load(open(sys.argv[1]))["tags"]}
+for f in sys.argv[2:]:
+    e = [math.dist([a[3], a[7], a[11]], [t[x["id"]][3], t[x["id"]][7], t[x["id"]][11]])
+         for x in json.load(open(f))["tags"] for a in [x["world_from_tag"]]]
+    print(1e3 * math.sqrt(sum(d * d for d in e) / len(e)))
+PY
+  read -r e_ours e_chain e_ctl < <(tr '\n' ' ' <"$tmp/err.txt")
+  echo "map error RMS: ours ${e_ours} mm, chaining ${e_chain} mm, control points ${e_ctl} mm"
+  awk -v a="$e_ours" -v b="$e_chain" 'BEGIN { exit !(a < 60 && b > 3 * a) }' && ok || bad "ours $e_ours mm vs chaining $e_chain mm"
+  awk -v a="$e_ctl" 'BEGIN { exit !(a < 20) }' && ok || bad "control-point map $e_ctl mm off"
+fi
+
+# A disconnected part: photos of tags 0..2 and, apart, of the others would
+# need another set; a fixed tag that is never seen is the bad-input case.
+expect_fail unseen_fix "$tmp/x.json" -- "$mr" map "${common[@]}" --fix 77 --out "$tmp/x.json"
+mkdir -p "$tmp/empty"
+expect_fail no_gauge "$tmp/x.json" -- "$mr" map "${common[@]}" --out "$tmp/x.json"
+expect_fail both_gauges "$tmp/x.json" -- "$mr" map "${common[@]}" --fix 0 --control "$set_dir/control.json" --out "$tmp/x.json"
+expect_fail no_images "$tmp/x.json" -- "$mr" map --images "$tmp/empty" --camera "$set_dir/camera.json" --tag-size 0.25 --fix 0 --out "$tmp/x.json"
+expect_fail bad_sizes "$tmp/x.json" -- "$mr" map "${common[@]}" --tag-sizes 3=-1 --fix 0 --out "$tmp/x.json"
+printf '{"points": [{"name": "A", "tag": 0, "xyz": [0, 0, 0]}, {"name": "B", "tag": 1, "xyz": [1, 0, 0]}]}' >"$tmp/two.json"
+expect_fail two_controls "$tmp/x.json" -- "$mr" map "${common[@]}" --control "$tmp/two.json" --out "$tmp/x.json"
+printf '{"points": [{"name": "A", "tag": 0, "xyz": [0, NaN, 0]}]}' >"$tmp/nan.json"
+expect_fail nan_control "$tmp/x.json" -- "$mr" map "${common[@]}" --control "$tmp/nan.json" --out "$tmp/x.json"
+printf '{"world_from_tag": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,2]}' >"$tmp/badfix.json"
+expect_fail bad_fix_pose "$tmp/x.json" -- "$mr" map "${common[@]}" --fix 0 --fix-pose "$tmp/badfix.json" --out "$tmp/x.json"
+expect_fail unknown_size "$tmp/x.json" -- "$mr" map --images "$set_dir/images" --camera "$set_dir/camera.json" --tag-sizes 99=0.2 --fix 0 --out "$tmp/x.json"
+
+# measure: a tag corner of the shipped recording tapped where the detector
+# found it, in frames far apart, against the corner's mapped position.
+src=$(cd "$(dirname "$0")/.." && pwd)
+rec=$src/recordings/demo
+if command -v python3 >/dev/null 2>&1; then
+  python3 - "$rec" "$tmp" <<'PY'
+import json, sys
+rec, tmp = sys.argv[1], sys.argv[2]
+meta = json.load(open(rec + "/meta.json"))
+frames = [json.loads(l) for l in open(rec + "/frames.jsonl") if l.strip()]
+best = None
+for tag in meta["markers"]["tags"]:
+    seen = [f for f in frames if f["pose"]["valid"] and any(d["id"] == tag["id"] for d in f["detections"])]
+    if len(seen) >= 3 and (best is None or len(seen) > len(best[1])):
+        best = (tag, seen)
+tag, seen = best
+pick = [seen[0], seen[len(seen) // 2], seen[-1]]
+taps = [{"frame": f["frame"], "px": [d["corners"][0] for d in f["detections"] if d["id"] == tag["id"]][0]} for f in pick]
+s = meta["markers"]["tag_size"] / 2
+m = tag["world_from_tag"]
+corner = [m[4 * r] * -s + m[4 * r + 1] * s + m[4 * r + 3] for r in range(3)]  # corner 0: (-s/2, +s/2)
+json.dump({"taps": taps, "planned": corner}, open(tmp + "/obs.json", "w"))
+json.dump({"taps": [taps[0], taps[0]], "planned": corner}, open(tmp + "/same.json", "w"))
+json.dump({"taps": [taps[0], {"frame": 99999, "px": [1, 2]}]}, open(tmp + "/noframe.json", "w"))
+PY
+  "$mr" measure --recording "$rec" --observations "$tmp/obs.json" --out "$tmp/measured.json" >"$tmp/measure.out" 2>&1 \
+    && ok || bad "measure: $(cat "$tmp/measure.out")"
+  cat "$tmp/measure.out"
+  grep -q "distance to the planned point: .* mm +- .* mm" "$tmp/measure.out" && ok || bad "measure printed no distance"
+  grep -q '"distance_sigma_mm"' "$tmp/measured.json" && ok || bad "measure wrote no result"
+  expect_fail measure_same_pose "$tmp/m2.json" -- "$mr" measure --recording "$rec" --observations "$tmp/same.json" --out "$tmp/m2.json"
+  grep -q "baseline angle" "$tmp/measure_same_pose.err" && ok || bad "same pose: $(cat "$tmp/measure_same_pose.err")"
+  expect_fail measure_no_frame "$tmp/m2.json" -- "$mr" measure --recording "$rec" --observations "$tmp/noframe.json" --out "$tmp/m2.json"
+fi
+printf '{"taps": [{"frame": 0, "px": [NaN, 1]}]}' >"$tmp/nan_obs.json"
+expect_fail measure_nan "$tmp/m2.json" -- "$mr" measure --recording "$rec" --observations "$tmp/nan_obs.json" --out "$tmp/m2.json"
+expect_fail measure_no_args "" -- "$mr" measure --recording "$rec"
+
+cli_finish cli_map
