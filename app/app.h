@@ -136,6 +136,8 @@ bool app_lod_auto(const app_opt *opts);
 
 int cmd_synth(int argc, char **argv);
 int cmd_factory(int argc, char **argv);
+/* issue 16: mrcheck export (cmd_export.c) */
+int cmd_export(int argc, char **argv);
 int bench_scene(int argc, char **argv);
 
 #endif

@@ -19,6 +19,8 @@ static const struct {
     {"calibrate", cmd_calibrate, "camera intrinsics from images of an AprilTag grid board (OpenCV)"},
     {"replay", cmd_replay, "render the overlay of a recording's frames headless (deterministic)"},
     {"factory", cmd_factory, "write a big synthetic factory (1M..20M triangles) as .glb"},
+    /* issue 16: findings as BCF and a report */
+    {"export", cmd_export, "a session's marks as BCF 2.1/3.0 topics or a self-contained HTML report"},
 };
 
 static void usage(FILE *f) {
