@@ -475,11 +475,82 @@ static void test_bad_input(void) {
     check_archive(out, MR_BCF_2_1, &pose, titles, 1, false);
 }
 
+
+/* Every src="..." of the page names a file beside it: no server, no web. */
+static void check_links(const char *dir, const char *html) {
+    int n = 0;
+    for (const char *p = html; (p = strstr(p, "src=\"")); n++) {
+        p += 5;
+        const char *q = strchr(p, '"');
+        if (!q) break;
+        char rel[256], path[1600];
+        snprintf(rel, sizeof rel, "%.*s", (int)(q - p), p);
+        CHECK_MSG(!strstr(rel, "://"), "external link %s", rel);
+        snprintf(path, sizeof path, "%s/%s", dir, rel);
+        CHECK_MSG(mr_file_exists(path), "missing %s", path);
+        p = q;
+    }
+    CHECK(n >= 3);
+    CHECK(!strstr(html, "http://") || strstr(html, "http://www.w3.org/2000/svg"));
+    CHECK(!strstr(html, "https://"));
+}
+
+static void test_report(void) {
+    char dir[1200], out[1300], path[1500];
+    snprintf(dir, sizeof dir, "%s/session", g_tmp);
+    snprintf(out, sizeof out, "%s/report", g_tmp);
+    mr_export_params p = MR_EXPORT_DEFAULTS;
+    mr_error err = {0};
+    CHECK_MSG(mr_export_report(dir, out, &p, &err), "report: %s", err.msg);
+    snprintf(path, sizeof path, "%s/index.html", out);
+    size_t n = 0;
+    char *html = mr_file_read(path, &n, 0, &err);
+    CHECK(html != NULL);
+    if (html) {
+        CHECK(strstr(html, "pipe &lt;DN50&gt; &amp; valve &quot;moved&quot;") != NULL);
+        CHECK(!strstr(html, "<DN50>"));
+        CHECK(strstr(html, "conveyor missing") != NULL);
+        CHECK(strstr(html, "42 mm") && strstr(html, "5 mm") && strstr(html, "<svg"));
+        CHECK(strstr(html, "img/mark_1_overlay.png") && strstr(html, "img/mark_2_photo.png"));
+        check_links(out, html);
+    }
+    free(html);
+    snprintf(path, sizeof path, "%s/report.md", out);
+    char *md = mr_file_read(path, &n, 0, &err);
+    CHECK(md && strstr(md, "| 1 | pipe <DN50> & valve \"moved\" |") && strstr(md, "img/mark_2_photo.png"));
+    free(md);
+    mr_image img;
+    snprintf(path, sizeof path, "%s/img/mark_1_photo.png", out);
+    CHECK(mr_image_load(path, 0, &img, &err) && img.width == 160 && img.height == 120);
+    mr_image_free(&img);
+    /* Again: the earlier report is replaced. */
+    CHECK_MSG(mr_export_report(dir, out, &p, &err), "again: %s", err.msg);
+    /* A folder of something else is refused, untouched. */
+    char other[1300];
+    snprintf(other, sizeof other, "%s/other", g_tmp);
+    snprintf(path, sizeof path, "%s/keep.txt", other);
+    mr_mkdirs(other, NULL);
+    CHECK(mr_file_write_atomic(path, "x", 1, &err));
+    CHECK(!mr_export_report(dir, other, &p, &err) && strstr(err.msg, "not an earlier"));
+    CHECK(mr_file_exists(path));
+    snprintf(path, sizeof path, "%s/index.html", other);
+    CHECK(!mr_file_exists(path));
+    /* A missing snapshot: nothing at OUT, no temporary folder left. */
+    snprintf(dir, sizeof dir, "%s/missing", g_tmp);
+    snprintf(out, sizeof out, "%s/report_missing", g_tmp);
+    CHECK(!mr_export_report(dir, out, &p, &err) && strstr(err.msg, "mark 2"));
+    CHECK(!mr_file_exists(out));
+    char cmd[1500];
+    snprintf(cmd, sizeof cmd, "ls -d '%s'.tmp.* >/dev/null 2>&1", out);
+    CHECK(system(cmd) != 0);
+}
+
 int main(void) {
     if (!mr_test_fresh_dir("export", g_tmp, sizeof g_tmp)) return 1;
     test_camera_conversion();
     test_undistort();
     test_round_trip();
     test_bad_input();
+    test_report();
     return mr_test_finish("test_export");
 }
