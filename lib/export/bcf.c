@@ -6,6 +6,7 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <zip.h>
 
 static const char *k_status = "Open";
@@ -122,22 +123,33 @@ static char *viewpoint_xml(const mr_finding *f, const mr_bcf_camera *c, const mr
     return mr_xml_take(&x, n);
 }
 
+/* Every entry's time: the newest mark's, so the same marks give the same
+ * bytes (set by build_zip). */
+typedef struct zipw { zip_t *z; time_t mtime; } zipw;
+
+static void stamp(zipw *w, zip_int64_t idx) {
+    if (idx >= 0) zip_file_set_mtime(w->z, (zip_uint64_t)idx, w->mtime, 0);
+}
+
 /* Adds data (taken over, freed by libzip) as name. */
-static bool add_file(zip_t *z, const char *name, void *data, size_t n, mr_error *err) {
+static bool add_file(zipw *w, const char *name, void *data, size_t n, mr_error *err) {
+    zip_t *z = w->z;
     if (!data) return mr_fail(err, MR_ERR_NOMEM, "out of memory writing %s", name);
     zip_source_t *s = zip_source_buffer(z, data, n, 1);
     if (!s) {
         free(data);
         return mr_fail(err, MR_ERR_NOMEM, "zip: %s", zip_strerror(z));
     }
-    if (zip_file_add(z, name, s, ZIP_FL_ENC_UTF_8) < 0) {
+    zip_int64_t idx = zip_file_add(z, name, s, ZIP_FL_ENC_UTF_8);
+    if (idx < 0) {
         zip_source_free(s);
         return mr_fail(err, MR_ERR_IO, "zip: %s: %s", name, zip_strerror(z));
     }
+    stamp(w, idx);
     return true;
 }
 
-static bool add_topic(zip_t *z, const mr_finding *f, const mr_export_params *p, mr_error *err) {
+static bool add_topic(zipw *w, const mr_finding *f, const mr_export_params *p, mr_error *err) {
     mr_bcf_frame fr;
     if (!mr_bcf_frame_of(&f->camera, p->max_side, &fr, err)) {
         mr_error_prefix(err, "mark %d", f->number);
@@ -150,26 +162,28 @@ static bool add_topic(zip_t *z, const mr_finding *f, const mr_export_params *p, 
     void *png = mr_image_encode_png(&snap, &pn, err);
     mr_image_free(&snap);
     if (!png) return false;
-    if (zip_dir_add(z, f->topic_guid, ZIP_FL_ENC_UTF_8) < 0) {
+    zip_int64_t di = zip_dir_add(w->z, f->topic_guid, ZIP_FL_ENC_UTF_8);
+    if (di < 0) {
         free(png);
-        return mr_fail(err, MR_ERR_IO, "zip: %s", zip_strerror(z));
+        return mr_fail(err, MR_ERR_IO, "zip: %s", zip_strerror(w->z));
     }
+    stamp(w, di);
     char name[128];
     size_t n = 0;
     snprintf(name, sizeof name, "%s/markup.bcf", f->topic_guid);
     char *m = markup_xml(f, p, &n);
-    if (!add_file(z, name, m, n, err)) {
+    if (!add_file(w, name, m, n, err)) {
         free(png);
         return false;
     }
     snprintf(name, sizeof name, "%s/viewpoint.bcfv", f->topic_guid);
     char *v = viewpoint_xml(f, &cam, p, &n);
-    if (!add_file(z, name, v, n, err)) {
+    if (!add_file(w, name, v, n, err)) {
         free(png);
         return false;
     }
     snprintf(name, sizeof name, "%s/snapshot.png", f->topic_guid);
-    return add_file(z, name, png, pn, err);
+    return add_file(w, name, png, pn, err);
 }
 
 /* The archive's bytes: libzip writes into a buffer source we keep. */
@@ -187,14 +201,18 @@ static bool build_zip(const mr_findings *fs, const mr_export_params *p, void **o
         return r;
     }
     /* (The length is set by the call, so it is made before add_file reads it.) */
+    zipw w = {z, 315532800}; /* 1980-01-01, the zip format's first day */
+    for (int i = 0; i < fs->count; i++)
+        if (fs->items[i].mark->time_unix > (double)w.mtime && fs->items[i].mark->time_unix < 4e9)
+            w.mtime = (time_t)fs->items[i].mark->time_unix;
     size_t n = 0;
     char *doc = version_xml(p->bcf_version, &n);
-    bool ok = add_file(z, "bcf.version", doc, n, err);
+    bool ok = add_file(&w, "bcf.version", doc, n, err);
     if (ok && p->bcf_version == MR_BCF_3_0) {
         doc = extensions_xml(p, &n);
-        ok = add_file(z, "extensions.xml", doc, n, err);
+        ok = add_file(&w, "extensions.xml", doc, n, err);
     }
-    for (int i = 0; ok && i < fs->count; i++) ok = add_topic(z, &fs->items[i], p, err);
+    for (int i = 0; ok && i < fs->count; i++) ok = add_topic(&w, &fs->items[i], p, err);
     if (!ok) {
         zip_discard(z);
         zip_source_free(src);
