@@ -239,6 +239,12 @@ static void check_today(const err_stats *raw, const err_stats *filt, int frames,
         {"filtered jitter at rest, position (mm)", filt->jit_still_pos, 44.16, true},
         {"filtered jitter at rest, rotation (deg)", filt->jit_still_rot, 0.4748, true},
     };
+    /* MR_PRINT_TODAY=1 prints every measured value (to re-pin on purpose). */
+    if (getenv("MR_PRINT_TODAY")) {
+        printf("today: tracked %d of %d, multi %d, flips %d / %d, >5 deg %d / %d, >10 deg %d / %d\n", raw->n, frames,
+               multi, raw->flips, filt->flips, raw->over5, filt->over5, raw->over10, filt->over10);
+        for (size_t i = 0; i < sizeof pins / sizeof pins[0]; i++) printf("today: %s = %.4g\n", pins[i].what, pins[i].value);
+    }
     for (size_t i = 0; i < sizeof pins / sizeof pins[0]; i++) {
         const pin *p = &pins[i];
         bool high = !(p->value <= 1.03 * p->today), low = p->both_ways && !(p->value >= 0.97 * p->today);

@@ -24,7 +24,7 @@
  * away), which stay in view while walking on. */
 typedef struct keyframe { double eye[3], at[3]; int pause, walk; } keyframe;
 static const keyframe k_path[] = {
-    {{13.5, 1.60, 3.5}, {9.0, 1.3, -0.5}, 10, 36},    /* lathe, roller conveyor, post 0 */
+    {{11.5, 1.60, 4.0}, {9.0, 1.3, -0.5}, 10, 36},    /* lathe, roller conveyor, post 0 */
     {{6.0, 1.60, 5.0}, {0.8, 1.2, 0.3}, 14, 36},      /* the moved robot cell, post 1 */
     {{-2.5, 1.60, 2.5}, {-8.0, 1.1, 0.5}, 10, 20},    /* west conveyor, post 2 */
     {{-6.5, 1.60, 3.0}, {-12.0, 1.8, 6.0}, 24, 0},    /* missing column, partition, post 3 */

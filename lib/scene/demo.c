@@ -304,8 +304,8 @@ static void make_plan(uint64_t seed, demo_plan *plan) {
  * part of the marker map. Tags 16.. sit on them, four per post. */
 typedef struct tag_post { double x, z, toward_x, toward_z; } tag_post;
 static const tag_post k_tag_posts[(MAX_TAGS - WALL_TAGS) / 4] = {
-    {10.5, -1.2, 13.5, 3.5},   /* by the yellow lathe and the roller conveyor */
-    {3.4, 2.2, 6.0, 5.0},      /* by the robot cell (Machine_2, moved) */
+    {10.5, -1.2, 11.5, 4.0},   /* by the yellow lathe and the roller conveyor */
+    {3.4, 2.2, 7.5, 4.8},      /* by the robot cell (Machine_2, moved); both faces seen on the way */
     {-6.2, 2.4, -2.5, 2.5},    /* by the west roller conveyor */
     {-9.6, 6.6, -6.5, 3.0},    /* by the missing column and the partition */
 };
