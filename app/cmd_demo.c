@@ -132,6 +132,8 @@ static bool run_demo(const char *dir, mr_error *err) {
         mr_frame_result_free(&res);
         mr_image_free(&frame);
     }
+    /* issue 16: marks at the known discrepancies, as BCF and a report */
+    ok = ok && app_demo_marks(dir, &gfx, built, planned, err);
     if (gfx.gpu) app_gfx_close(&gfx);
     uint64_t tri = planned ? mr_scene_triangle_count(planned) : 0;
     mr_scene_destroy(&built);

@@ -10,6 +10,7 @@ pkgs=(
   libembree-dev
   libopencv-dev libopencv-contrib-dev
   libceres-dev libzip-dev
+  unzip
 )
 missing=()
 for p in "${pkgs[@]}"; do

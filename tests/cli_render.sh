@@ -101,4 +101,14 @@ echo '{"gltf": "missing.glb"}' >"$tmp/cfg_missing.json"
 expect_fail config_missing_gltf "$tmp/o15.png" -- "$mr" render --scene "$tmp/cfg_missing.json" --view "$v" --out "$tmp/o15.png"
 ls "$tmp"/*.tmp.* >/dev/null 2>&1 && bad "temporary files left behind" || ok
 
+# issue 16: the demo ends with three marks at the known discrepancies, as
+# BCF 2.1 and 3.0 (a topic folder each) and the report.
+for b in findings.bcf findings-3.0.bcf; do
+  n=$(unzip -l "$tmp/demo/$b" 2>/dev/null | grep -cE ' [0-9a-f-]{36}/$')
+  [ "$n" = 3 ] && ok || bad "demo: $b has ${n:-no} topic folders, want 3"
+done
+[ -s "$tmp/demo/report/index.html" ] && [ -s "$tmp/demo/report/img/mark_3_overlay.png" ] && ok || bad "demo: no report"
+grep -q "Machine_2" "$tmp/demo/report/index.html" && grep -q "Column_1_0" "$tmp/demo/report/index.html" && ok ||
+  bad "demo: the report does not name the discrepancies"
+
 cli_finish cli_render

@@ -17,7 +17,7 @@ nframes=$(wc -l <"$rec/frames.jsonl")
 # --- track ---------------------------------------------------------------
 "$mr" track --input "$rec" --print-detections >"$tmp/det.jsonl" 2>"$tmp/det.err" && ok || bad "track --print-detections failed: $(cat "$tmp/det.err")"
 [ "$(wc -l <"$tmp/det.jsonl")" -eq "$nframes" ] && ok || bad "track printed $(wc -l <"$tmp/det.jsonl") lines for $nframes frames"
-grep -q '^{"frame":0,"detections":\[{"id":2,"hamming":0,"corners":\[\[' "$tmp/det.jsonl" && ok || bad "detection line format: $(head -c 200 "$tmp/det.jsonl")"
+grep -q '^{"frame":0,"detections":\[{"id":16,"hamming":0,"corners":\[\[' "$tmp/det.jsonl" && ok || bad "detection line format: $(head -c 200 "$tmp/det.jsonl")"
 "$mr" track --input "$rec" --out "$tmp/poses.jsonl" 2>"$tmp/poses.err" && ok || bad "track --out failed: $(cat "$tmp/poses.err")"
 [ "$(grep -c '"valid":true' "$tmp/poses.jsonl")" -ge $((nframes / 2)) ] && ok || bad "fewer than half the frames have a pose"
 grep -q '"world_from_camera":\[' "$tmp/poses.jsonl" && grep -q '"filtered":\[' "$tmp/poses.jsonl" && ok || bad "pose lines lack matrices"

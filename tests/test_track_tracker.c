@@ -5,7 +5,7 @@
  * -> filter and nothing else (bit-equal to the parts run by hand), freeze
  * and hold, no filter, detection only, bad frames and bad parameters.
  *
- * Frame 52 of recordings/demo shows one tag whose two IPPE solutions are
+ * Frame 52 of the old recordings/demo (tests/data/tracker) shows one tag whose two IPPE solutions are
  * ambiguous: with frame 0's pose as the previous one it gives another pose
  * than without (checked below), so the policy is visible in the poses. */
 #include "mr_session.h"
@@ -227,13 +227,16 @@ static void test_detect_only_and_errors(void) {
 int main(void) {
     const char *src = getenv("MR_SOURCE_DIR");
     char dir[2048];
-    snprintf(dir, sizeof dir, "%s/recordings/demo", src ? src : ".");
+    /* Frames 0 and 52 of the recording shipped before issue 16 (its walk saw
+     * lone wall tags; the new one sees tag posts), kept as a two-frame
+     * recording: the cases below need a lone ambiguous tag. */
+    snprintf(dir, sizeof dir, "%s/tests/data/tracker", src ? src : ".");
     mr_error err = {0};
     g_rec = mr_recording_open(dir, &err);
     CHECK_MSG(g_rec != NULL, "%s", err.msg);
     if (!g_rec) return mr_test_finish("test_track_tracker");
     CHECK(mr_recording_load_image(g_rec, 0, true, &g_f0, &err));
-    CHECK(mr_recording_load_image(g_rec, 52, true, &g_f52, &err));
+    CHECK(g_rec->frame_count == 2 && mr_recording_load_image(g_rec, 1, true, &g_f52, &err));
     test_policy();
     test_composition();
     test_freeze_hold();

@@ -14,18 +14,20 @@
 
 /* ------------------------------------------------------------ the path */
 
-/* Keyframes of a walk along the east side of the hall: eye, look-at target
- * and how many frames to pause there (the camera is still: jitter is
- * measured there) before walking `walk` frames to the next keyframe. Chosen
- * so that most frames see one tag at 3-5 m and some see two. */
+/* Keyframes of the check walk (issue 16): eye, look-at target and how many
+ * frames to pause there (the camera is still: jitter is measured there)
+ * before walking `walk` frames to the next keyframe. From the yellow lathe
+ * and the roller conveyor in the east, past the robot cell that was
+ * installed 0.30 m off its plan, along the west roller conveyor, to the
+ * missing column and the partition with the raised pipe behind it. Each
+ * pause faces one of the hall's tag posts (four tags on two faces, 3.5-5 m
+ * away), which stay in view while walking on. */
 typedef struct keyframe { double eye[3], at[3]; int pause, walk; } keyframe;
 static const keyframe k_path[] = {
-    {{12.5, 1.60, -5.5}, {12.5, 2.0, -12.0}, 8, 16},  /* tags 2 and 12, far */
-    {{15.0, 1.60, -8.0}, {16.0, 1.9, -12.0}, 8, 16},  /* tag 12 close */
-    {{16.0, 1.55, -6.5}, {20.0, 2.0, -6.0}, 8, 14},   /* tag 3 */
-    {{16.0, 1.60, -2.0}, {20.0, 2.2, -1.0}, 8, 14},   /* tag 13 */
-    {{15.5, 1.65, 2.5}, {20.0, 2.0, 2.5}, 8, 12},     /* tags 13 and 4 */
-    {{16.5, 1.60, 5.3}, {20.0, 1.7, 5.0}, 8, 0},      /* tag 4 close */
+    {{11.5, 1.60, 4.0}, {9.0, 1.3, -0.5}, 10, 36},    /* lathe, roller conveyor, post 0 */
+    {{6.0, 1.60, 5.0}, {0.8, 1.2, 0.3}, 14, 36},      /* the moved robot cell, post 1 */
+    {{-2.5, 1.60, 2.5}, {-8.0, 1.1, 0.5}, 10, 20},    /* west conveyor, post 2 */
+    {{-6.5, 1.60, 3.0}, {-12.0, 1.8, 6.0}, 24, 0},    /* missing column, partition, post 3 */
 };
 #define PATH_KEYS (int)(sizeof k_path / sizeof k_path[0])
 

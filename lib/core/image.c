@@ -76,17 +76,33 @@ static void membuf_write(void *ctx, void *data, int size) {
     m->n += (size_t)size;
 }
 
-bool mr_image_save_png(const char *path, const mr_image *img, mr_error *err) {
-    if (img->type != MR_PIX_U8 || !img->data) return mr_fail(err, MR_ERR_INVALID, "PNG needs an 8-bit image (%s)", path);
+void *mr_image_encode_png(const mr_image *img, size_t *size, mr_error *err) {
+    if (img->type != MR_PIX_U8 || !img->data) {
+        mr_fail(err, MR_ERR_INVALID, "PNG needs an 8-bit image");
+        return NULL;
+    }
     membuf m = {0};
     int ok = stbi_write_png_to_func(membuf_write, &m, img->width, img->height, img->channels, img->data,
                                     img->width * img->channels);
     if (!ok || m.failed) {
         free(m.p);
-        return mr_fail(err, MR_ERR_NOMEM, "cannot encode PNG %s", path);
+        mr_fail(err, MR_ERR_NOMEM, "cannot encode a %dx%d PNG", img->width, img->height);
+        return NULL;
     }
-    bool r = mr_file_write_atomic(path, m.p, m.n, err);
-    free(m.p);
+    *size = m.n;
+    return m.p;
+}
+
+bool mr_image_save_png(const char *path, const mr_image *img, mr_error *err) {
+    if (img->type != MR_PIX_U8 || !img->data) return mr_fail(err, MR_ERR_INVALID, "PNG needs an 8-bit image (%s)", path);
+    size_t n = 0;
+    void *p = mr_image_encode_png(img, &n, err);
+    if (!p) {
+        mr_error_prefix(err, "%s", path);
+        return false;
+    }
+    bool r = mr_file_write_atomic(path, p, n, err);
+    free(p);
     return r;
 }
 

@@ -226,6 +226,8 @@ bool mr_image_load(const char *path, int channels, mr_image *img, mr_error *err)
 /* PNG (8-bit only) and PFM (float, 1 or 3 channels), written atomically. */
 bool mr_image_save_png(const char *path, const mr_image *img, mr_error *err);
 bool mr_image_save_pfm(const char *path, const mr_image *img, mr_error *err);
+/* The PNG file's bytes in memory (free with free()); NULL + err on failure. */
+void *mr_image_encode_png(const mr_image *img, size_t *size, mr_error *err);
 bool mr_image_load_pfm(const char *path, mr_image *img, mr_error *err);
 /* Bilinear sample of an 8-bit image at OpenCV pixel coordinates; out gets
  * img->channels values in [0,255]; false if outside. */

@@ -38,7 +38,8 @@ static const double k_col_z[2] = {-4.0, 4.0};
 #define N_PIPES 4
 #define N_TRAYS 3
 #define N_CONVEYORS 3
-#define MAX_TAGS 16
+#define MAX_TAGS 32 /* 16 on walls and columns, 16 on the four tag posts */
+#define WALL_TAGS 16
 
 /* Partition wall and the pipes behind it (on its +z side). */
 #define PART_X 12.0  /* length */
@@ -266,7 +267,7 @@ static const double k_tray_w[N_TRAYS] = {0.6, 0.6, 0.4};
  * (nx, 0, nz). Walls first, then columns; extra slots only used when more
  * than 12 tag images are given. None sits on the missing column. */
 typedef struct tag_slot { double x, y, z, nx, nz; } tag_slot;
-static const tag_slot k_tag_slots[MAX_TAGS] = {
+static const tag_slot k_tag_slots[WALL_TAGS] = {
     {-11.0, 2.2, -HALL_Z, 0, 1},  {-1.0, 1.8, -HALL_Z, 0, 1}, {9.0, 2.3, -HALL_Z, 0, 1},
     {HALL_X, 2.0, -6.0, -1, 0},   {HALL_X, 1.7, 5.0, -1, 0},
     {12.0, 2.1, HALL_Z, 0, -1},   {1.0, 1.9, HALL_Z, 0, -1},
@@ -294,6 +295,46 @@ static void make_plan(uint64_t seed, demo_plan *plan) {
         m->sz += jitter(&rng, 0.1);
         for (int c = 0; c < 3; c++) m->rgb[c] *= (float)(1.0 + jitter(&rng, 0.05));
     }
+}
+
+/* Tag posts (issue 16): square pillars carrying a cluster of four tags, two
+ * on each of the two faces turned towards a check point of the walk, so
+ * that a camera there sees 2-4 tags within a metre, not coplanar (a pose
+ * from them has no mirror ambiguity). In both halls: they are surveyed,
+ * part of the marker map. Tags 16.. sit on them, four per post. */
+typedef struct tag_post { double x, z, toward_x, toward_z; } tag_post;
+static const tag_post k_tag_posts[(MAX_TAGS - WALL_TAGS) / 4] = {
+    {10.5, -1.2, 11.5, 4.0},   /* by the yellow lathe and the roller conveyor */
+    {3.4, 2.2, 7.5, 4.8},      /* by the robot cell (Machine_2, moved); both faces seen on the way */
+    {-6.2, 2.4, -2.5, 2.5},    /* by the west roller conveyor */
+    {-9.6, 6.6, -6.5, 3.0},    /* by the missing column and the partition */
+};
+#define POST_HALF 0.3
+#define POST_H 2.3
+static const double k_post_tag_y[2] = {1.05, 1.75};
+
+/* The two face normals of post k: towards its check point, turned by
+ * -45 and +45 degrees (rotation about +y: (x, z) -> (x c + z s, -x s + z c)). */
+static void post_normals(int k, double n[2][2]) {
+    const tag_post *p = &k_tag_posts[k];
+    double dx = p->toward_x - p->x, dz = p->toward_z - p->z, l = sqrt(dx * dx + dz * dz);
+    dx /= l, dz /= l;
+    const double c = sqrt(0.5);
+    for (int f = 0; f < 2; f++) {
+        double s = f == 0 ? c : -c;
+        n[f][0] = dx * c + dz * s;
+        n[f][1] = -dx * s + dz * c;
+    }
+}
+
+static tag_slot slot_of(int i) {
+    if (i < WALL_TAGS) return k_tag_slots[i];
+    int j = i - WALL_TAGS, k = j / 4, f = (j / 2) % 2, level = j % 2;
+    double n[2][2];
+    post_normals(k, n);
+    tag_slot t = {k_tag_posts[k].x + POST_HALF * n[f][0], k_post_tag_y[level], k_tag_posts[k].z + POST_HALF * n[f][1],
+                  n[f][0], n[f][1]};
+    return t;
 }
 
 static mr_dmat4 tag_pose(const tag_slot *t) {
@@ -640,7 +681,25 @@ static int32_t tag_texture(hall_ctx *h, const mr_image *img) {
     return idx;
 }
 
+/* The posts whose tags are placed: local +x onto the first face normal. */
+static void build_tag_posts(hall_ctx *h) {
+    int32_t post = -1;
+    for (int k = 0; k < (MAX_TAGS - WALL_TAGS) / 4 && WALL_TAGS + 4 * k < h->tag_count && h->ok; k++) {
+        if (post < 0)
+            post = box_mesh(h, "TagPost", h->mat[MAT_COLUMN], mr_v3(-POST_HALF, 0, -POST_HALF),
+                            mr_v3(POST_HALF, POST_H, POST_HALF));
+        double n[2][2];
+        post_normals(k, n);
+        double yaw = atan2(-n[0][1], n[0][0]);
+        mr_dmat4 r = mr_m4_rotate_axis(mr_v3(0, 1, 0), yaw), t = mr_m4_translate(k_tag_posts[k].x, 0, k_tag_posts[k].z);
+        char name[32];
+        snprintf(name, sizeof name, "TagPost_%d", k);
+        add_node(h, name, -1, mr_m4_mul(&t, &r), post, MR_LAYER_VISIBLE);
+    }
+}
+
 static void build_tags(hall_ctx *h) {
+    build_tag_posts(h);
     const mr_demo_params *p = h->params;
     int32_t shared_quad = -1, backing = -1;
     double backing_plate = -1.0;
@@ -670,7 +729,8 @@ static void build_tags(hall_ctx *h) {
             backing = box_mesh(h, "TagBacking", h->mat[MAT_TAG_BACKING], mr_v3(-e, -e, 0.001), mr_v3(e, e, TAG_GAP));
             backing_plate = plate;
         }
-        mr_dmat4 w = tag_pose(&k_tag_slots[i]);
+        tag_slot slot = slot_of(i);
+        mr_dmat4 w = tag_pose(&slot);
         snprintf(name, sizeof name, "Tag_%d", i);
         int32_t node = add_node(h, name, -1, w, quad, MR_LAYER_VISIBLE);
         snprintf(name, sizeof name, "TagBacking_%d", i);
@@ -818,7 +878,8 @@ bool mr_demo_build(const mr_demo_params *params, mr_demo_hall *out, mr_error *er
     out->tag_count = tag_count;
     for (int i = 0; i < tag_count; i++) {
         out->tags[i].id = i;
-        out->tags[i].world_from_tag = tag_pose(&k_tag_slots[i]);
+        tag_slot slot = slot_of(i);
+        out->tags[i].world_from_tag = tag_pose(&slot);
     }
     out->discrepancies = make_discrepancies(&plan);
     if (!out->discrepancies) {

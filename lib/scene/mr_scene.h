@@ -242,9 +242,9 @@ void mr_demo_free(mr_demo_hall *hall);
 bool mr_demo_tag_images(int count, mr_image **out, int *border, mr_error *err);
 void mr_demo_tag_images_free(mr_image *imgs, int count);
 /* mr_demo_build with tag plates for ids 0..tag_count-1 (0: MR_DEMO_TAGS, the
- * demo hall's 16; params may be NULL: MR_DEMO_DEFAULTS; its tag image
- * fields are replaced). */
-#define MR_DEMO_TAGS 16
+ * demo hall's 32; params may be NULL: MR_DEMO_DEFAULTS; its tag image
+ * fields are replaced; 16 tags on walls and columns, 16 on four tag posts). */
+#define MR_DEMO_TAGS 32
 bool mr_demo_build_tagged(const mr_demo_params *params, int tag_count, mr_demo_hall *hall, mr_error *err);
 /* The demo tablet camera (640x480, mild barrel distortion) and its standing
  * viewpoints (i is clamped to 0..mr_demo_view_count()-1). */

@@ -1,0 +1,173 @@
+/* The last part of `mrcheck demo`: three marks at the hall's known
+ * discrepancies, as a planner would place them in `mrcheck view` (camera
+ * frame of the as-built hall, the plan overlaid, a pick on the plan), then
+ * the findings as BCF 2.1 and 3.0 and as the HTML report (lib/export). */
+#include "app.h"
+#include "mr_export.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* The standing viewpoint that looks most directly at target, moved to look
+ * straight at it: the fallback when no close view below is clear. */
+static mr_dmat4 pose_towards(mr_dvec3 target) {
+    double best = -2;
+    mr_dvec3 eye = mr_v3(0, 1.6, 0);
+    for (int i = 0; i < mr_demo_view_count(); i++) {
+        mr_view v = mr_demo_view(i);
+        const double *m = v.world_from_camera.m;
+        mr_dvec3 e = mr_v3(m[3], m[7], m[11]), ax = mr_v3(m[2], m[6], m[10]);
+        mr_dvec3 to = mr_v3_sub(target, e);
+        double d = mr_v3_len(to);
+        if (d < 2) continue;
+        double c = mr_v3_dot(ax, to) / d;
+        if (c > best) best = c, eye = e;
+    }
+    return mr_m4_look_at_cv(eye, target, mr_v3(0, 1, 0));
+}
+
+/* Where a planner would stand: a few metres from the part at eye height,
+ * inside the hall, with a clear line of sight on the plan (the pick at the
+ * part's pixel lands on the part, or, for a hidden part, on what hides it
+ * just in front). Tried on small renders, nearest first. */
+static mr_dmat4 pose_for(app_gfx *g, const mr_scene *planned, const char *node, mr_dvec3 target, bool hidden) {
+    mr_camera small = mr_demo_camera();
+    small = mr_camera_resized(&small, 160, 120);
+    memset(small.dist, 0, sizeof small.dist);
+    const double *lo = planned->bounds_min, *hi = planned->bounds_max;
+    static const double dist[] = {5, 7, 9};
+    for (int di = 0; di < 3; di++)
+        for (int k = 0; k < 12; k++) {
+            double a = k * (2 * M_PI / 12) + 0.3;
+            mr_dvec3 eye = mr_v3(target.x + dist[di] * cos(a), 1.6, target.z + dist[di] * sin(a));
+            if (eye.x < lo[0] + 1 || eye.x > hi[0] - 1 || eye.z < lo[2] + 1 || eye.z > hi[2] - 1) continue;
+            mr_view v = {small, mr_m4_look_at_cv(eye, target, mr_v3(0, 1, 0))};
+            mr_frame_params fp = MR_FRAME_DEFAULTS;
+            mr_frame_result res = {0};
+            mr_pick pick = {0};
+            mr_error e = {0};
+            bool ok = mr_render_frame(g->renderer, &v, &fp, &res, &e) &&
+                      mr_renderer_pick(g->renderer, small.cx, small.cy, &pick, &e);
+            mr_frame_result_free(&res);
+            if (!ok || !pick.hit || pick.node < 0 || pick.node >= planned->node_count) continue;
+            double d = mr_v3_len(mr_v3_sub(target, eye));
+            bool on_part = strcmp(planned->nodes[pick.node].name, node) == 0;
+            if (hidden ? pick.depth < d && pick.depth > d - 1.0 : on_part) return v.world_from_camera;
+        }
+    return pose_towards(target);
+}
+
+static bool one_mark(const char *session, int i, const cJSON *d, app_gfx *g, const mr_scene *built,
+                     const mr_scene *planned, mr_error *err) {
+    const cJSON *desc = cJSON_GetObjectItemCaseSensitive(d, "description");
+    const cJSON *node = cJSON_GetObjectItemCaseSensitive(d, "node");
+    double at[3], delta[3] = {0, 0, 0};
+    bool has_delta = mr_json_numbers(d, "delta", delta, 3, NULL);
+    if (!mr_json_numbers(d, "built_position", at, 3, NULL) && !mr_json_numbers(d, "planned_position", at, 3, err))
+        return false;
+    /* Floor-standing parts are listed at their foot: aim at their middle. */
+    if (fabs(at[1]) < 1e-9) at[1] = 1.0;
+    mr_dvec3 target = mr_v3(at[0], at[1], at[2]);
+    mr_camera cam = mr_demo_camera();
+    const char *node_name = cJSON_IsString(node) ? node->valuestring : "";
+    int32_t ni = -1;
+    for (int32_t n = 0; n < planned->node_count && ni < 0; n++)
+        if (strcmp(planned->nodes[n].name, node_name) == 0) ni = n;
+    bool hidden = ni >= 0 && planned->nodes[ni].layer == MR_LAYER_HIDDEN;
+    if (!mr_renderer_set_scene(g->renderer, planned, err)) return false;
+    mr_view view = {cam, pose_for(g, planned, node_name, target, hidden)};
+
+    /* The camera frame of the as-built hall (lens, blur, noise), as in the
+     * demo's frames. */
+    const int margin = 48, scale = 2;
+    mr_view wide = view;
+    wide.camera = mr_demo_wide_camera(&cam, margin);
+    mr_frame_params fp = MR_FRAME_DEFAULTS;
+    fp.width = wide.camera.width * scale;
+    fp.height = wide.camera.height * scale;
+    mr_frame_result res = {0};
+    mr_image frame = {0};
+    mr_rng rng;
+    mr_rng_seed(&rng, 2000u + (uint64_t)i);
+    bool ok = mr_renderer_set_scene(g->renderer, built, err) && mr_render_frame(g->renderer, &wide, &fp, &res, err) &&
+              mr_demo_camera_frame(&cam, &res.color, 1, margin, scale, 1.0, 2.5, &rng, &frame, err);
+    mr_frame_result_free(&res);
+    /* The check: the plan over the frame, and the pick on the plan. */
+    mr_frame_params op = MR_FRAME_DEFAULTS;
+    op.video = &frame;
+    op.alpha = 0.5f;
+    op.ghost.mode = MR_GHOST_ADAPTIVE;
+    ok = ok && mr_renderer_set_scene(g->renderer, planned, err) && mr_render_frame(g->renderer, &view, &op, &res, err);
+    mr_dmat4 cw = mr_m4_invert_rigid(&view.world_from_camera);
+    mr_dvec3 pc = mr_m4_point(&cw, target);
+    double px = cam.fx * pc.x / pc.z + cam.cx, py = cam.fy * pc.y / pc.z + cam.cy;
+    mr_pick pick = {0};
+    ok = ok && mr_renderer_pick(g->renderer, px, py, &pick, err);
+    mr_annotation m;
+    memset(&m, 0, sizeof m);
+    snprintf(m.type, sizeof m.type, "discrepancy");
+    m.time_unix = 1764619200.0 + 60.0 * i; /* fixed: the demo's output is the same every run */
+    m.frame_index = i;
+    m.timestamp = 0;
+    snprintf(m.note, sizeof m.note, "%s", cJSON_IsString(desc) ? desc->valuestring : "discrepancy");
+    m.has_pixel = true;
+    m.pixel[0] = px, m.pixel[1] = py;
+    m.hit = pick.hit;
+    m.world[0] = pick.world.x, m.world[1] = pick.world.y, m.world[2] = pick.world.z;
+    m.depth = pick.depth;
+    m.node_index = -1;
+    if (pick.node >= 0 && pick.node < planned->node_count) {
+        m.node_index = pick.node;
+        snprintf(m.node, sizeof m.node, "%s", planned->nodes[pick.node].name);
+        snprintf(m.layer, sizeof m.layer, "%s", pick.layer == MR_LAYER_HIDDEN ? "hidden" : "visible");
+    }
+    m.has_pose = m.pose_valid = true;
+    m.world_from_camera = view.world_from_camera;
+    m.pose_tags_seen = -1;
+    m.pose_rms_px = -1;
+    char stem[32];
+    snprintf(stem, sizeof stem, "mark_%04d", i + 1);
+    mr_mark_files fl = {.stem = stem, .frame = &frame, .screen = &res.color, .camera = &cam,
+                        .distance_m = has_delta ? mr_v3_len(mr_v3(delta[0], delta[1], delta[2])) : -1,
+                        .uncertainty_m = -1};
+    ok = ok && mr_export_mark_write(session, &m, &fl, err);
+    if (ok)
+        printf("  mark %d at (%.2f, %.2f, %.2f) on %s: %s\n", i + 1, target.x, target.y, target.z,
+               cJSON_IsString(node) ? node->valuestring : "?", m.note);
+    mr_frame_result_free(&res);
+    mr_image_free(&frame);
+    return ok;
+}
+
+bool app_demo_marks(const char *dir, app_gfx *g, const mr_scene *built, const mr_scene *planned, mr_error *err) {
+    char path[4096], session[4096];
+    mr_path_join(dir, "discrepancies.json", path, sizeof path);
+    cJSON *list = mr_json_load(path, err);
+    if (!list) return false;
+    mr_path_join(dir, "session", session, sizeof session);
+    /* The demo rebuilds its session: an earlier run's marks would add up. */
+    mr_path_join(session, "annotations.jsonl", path, sizeof path);
+    remove(path);
+    bool ok = mr_mkdirs(session, err);
+    printf("marks at the known discrepancies (%s/session/):\n", dir);
+    for (int i = 0; ok && i < cJSON_GetArraySize(list); i++)
+        ok = one_mark(session, i, cJSON_GetArrayItem(list, i), g, built, planned, err);
+    cJSON_Delete(list);
+    mr_export_params p = MR_EXPORT_DEFAULTS;
+    p.scene = planned;
+    p.title = "mrcheck demo: the hall as built against the plan";
+    mr_path_join(dir, "findings.bcf", path, sizeof path);
+    ok = ok && mr_export_bcf(session, path, &p, err);
+    p.bcf_version = MR_BCF_3_0;
+    mr_path_join(dir, "findings-3.0.bcf", path, sizeof path);
+    ok = ok && mr_export_bcf(session, path, &p, err);
+    mr_path_join(dir, "report", path, sizeof path);
+    ok = ok && mr_export_report(session, path, &p, err);
+    if (ok) {
+        printf("  BCF (open in BIMcollab, Solibri, xeokit, ...): %s/findings.bcf (2.1), %s/findings-3.0.bcf\n", dir,
+               dir);
+        printf("  report:                        %s/report/index.html\n", dir);
+    }
+    return ok;
+}
