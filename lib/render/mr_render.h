@@ -487,8 +487,9 @@ typedef struct mr_draw_params {
                               mesh (and LOD level); default off */
     bool no_lod;           /* always full detail; default off */
     double lod_tolerance;  /* largest geometric error (scene units) a LOD level
-                              may have, whatever its projected size; 0 = 0.005
-                              (5 mm in a metre scene); < 0: no LOD at all */
+                              may have, whatever its projected size; 0 = no
+                              such cap (the default: only lod_pixels decides,
+                              so no unit is assumed); < 0: no LOD at all */
     double lod_pixels;     /* largest projected error of a chosen level, pixels;
                               0 = 1.0 */
     bool occlusion;        /* occlusion culling within the frame: big
@@ -496,7 +497,6 @@ typedef struct mr_draw_params {
                               of the rest on the CPU; exact (same image),
                               costs a depth read-back; default off */
 } mr_draw_params;
-#define MR_DRAW_DEFAULT_LOD_TOLERANCE 0.005
 #define MR_DRAW_DEFAULT_LOD_PIXELS 1.0
 #define MR_DRAW_DEFAULTS {.no_cull = false, .lod_tolerance = 0.0, .lod_pixels = 0.0} /* 0 = the defaults above */
 
