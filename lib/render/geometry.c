@@ -489,6 +489,7 @@ static void submit_nodes(mr_renderer *r, const mr_geo_view *vw, mr_frame_result 
             if (gm->count[0] == 0) continue;
             int level = use_lod && gm->level_count > 1 && isfinite(ppu) ? choose_level(gm, g->node_scale[ni], ppu, tol, pix) : 0;
             lod_inst += level > 0;
+            r->stats.level_instances[level]++;
             if (level > 0 && gm->error[level] * g->node_scale[ni] > r->stats.lod_max_error)
                 r->stats.lod_max_error = gm->error[level] * g->node_scale[ni];
             tri_full += gm->count[0] / 3;

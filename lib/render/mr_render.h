@@ -515,6 +515,9 @@ typedef struct mr_draw_stats {
     uint32_t lod_instances;    /* instances drawn with a simplified level */
     double lod_max_error;      /* largest error bound (scene units, node
                                   stretch included) of a level drawn */
+    uint32_t level_instances[MR_LOD_MAX_LEVELS + 1]; /* instances drawn at
+                                  each level: 0 full detail, 1 the finest
+                                  simplified level, ... */
 } mr_draw_stats;
 
 /* Sets how geometry is submitted from the next frame on (NULL: defaults). */

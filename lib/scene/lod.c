@@ -615,10 +615,19 @@ typedef struct weld {
     size_t count;
     double slack;             /* largest distance of a vertex from its canonical one */
     uint32_t *gstart, *gitem; /* vertices per canonical vertex (CSR) */
+    /* The welded mesh as meshoptimizer gets it: only the canonical
+     * vertices, renumbered (a vertex buffer that still held the unused
+     * duplicates would make meshoptimizer see every seam vertex as a seam of
+     * wedges with no triangles, and lock it). idx is in these numbers. */
+    float *cpos;              /* 3 * ccount */
+    uint32_t *corig;          /* compact -> canonical vertex of the mesh */
+    uint32_t ccount;
 } weld;
 
 static void weld_free(weld *w) {
     free(w->idx);
+    free(w->cpos);
+    free(w->corig);
     free(w->gstart);
     free(w->gitem);
     memset(w, 0, sizeof *w);
@@ -674,16 +683,38 @@ static bool weld_build(const mr_mesh *m, weld *w) {
         w->idx[kept++] = c;
     }
     w->count = kept;
+    /* Compact numbering of the canonical vertices used. */
+    uint32_t *cid = malloc((nv + 1) * sizeof *cid);
+    w->corig = malloc((nv + 1) * sizeof *w->corig);
+    if (!cid || !w->corig) {
+        free(cid);
+        return false;
+    }
+    for (size_t v = 0; v < nv; v++) cid[v] = UINT32_MAX;
+    uint32_t nc = 0;
+    for (size_t i = 0; i < kept; i++) {
+        uint32_t v = w->idx[i];
+        if (cid[v] == UINT32_MAX) {
+            cid[v] = nc;
+            w->corig[nc++] = v;
+        }
+        w->idx[i] = cid[v];
+    }
+    free(cid);
+    w->ccount = nc;
+    w->cpos = malloc(((size_t)nc * 3 + 1) * sizeof *w->cpos);
+    if (!w->cpos) return false;
+    for (uint32_t c = 0; c < nc; c++) memcpy(w->cpos + 3 * (size_t)c, m->positions + 3 * (size_t)w->corig[c], 12);
     return true;
 }
 
 static void unweld(const mr_mesh *m, const weld *w, const uint32_t *src, uint32_t *dst, size_t n) {
     for (size_t t = 0; t + 2 < n; t += 3) {
-        dv a = vtx(m->positions, src[t]), b = vtx(m->positions, src[t + 1]), c = vtx(m->positions, src[t + 2]);
+        dv a = vtx(w->cpos, src[t]), b = vtx(w->cpos, src[t + 1]), c = vtx(w->cpos, src[t + 2]);
         dv ab = dv_sub(b, a), ac = dv_sub(c, a);
         dv fn = {ab.y * ac.z - ab.z * ac.y, ab.z * ac.x - ab.x * ac.z, ab.x * ac.y - ab.y * ac.x};
         for (int k = 0; k < 3; k++) {
-            uint32_t cv = src[t + (size_t)k], best = cv;
+            uint32_t cv = w->corig[src[t + (size_t)k]], best = cv;
             uint32_t g0 = w->gstart[cv], g1 = w->gstart[cv + 1];
             if (m->normals && g1 - g0 > 1) {
                 double bd = -INFINITY;
@@ -715,7 +746,10 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
     if (!(scale > 0) || !isfinite(scale)) return true;
     double cap = p->max_error > 0 ? p->max_error : p->rel_error * scale;
     weld w;
-    if (!weld_build(m, &w)) return false;
+    if (!weld_build(m, &w)) {
+        weld_free(&w);
+        return false;
+    }
     uint32_t *buf[3] = {malloc(((size_t)m->index_count + 1) * sizeof *buf[0]),
                         malloc(((size_t)m->index_count + 1) * sizeof *buf[1]),
                         malloc(((size_t)m->index_count + 1) * sizeof *buf[2])};
@@ -747,13 +781,13 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
         int di = si < 0 ? 0 : (si + 1) % 3, d2 = si < 0 ? 1 : (si + 2) % 3;
         uint32_t *dst = buf[di], *dst2 = buf[d2];
         float est = 0;
-        size_t n = meshopt_simplify(dst, src, src_n, m->positions, m->vertex_count, 12, 0, (float)(step / scale), 0, &est);
+        size_t n = meshopt_simplify(dst, src, src_n, w.cpos, w.ccount, 12, 0, (float)(step / scale), 0, &est);
         if (n > src_n / 2) {
             /* Edge collapses stall on some shapes (thin tori, long lathed
              * strips); vertex clustering does not, and its result indexes
              * the same vertices. Its error is certified like any other. */
             float est2 = 0;
-            size_t n2 = meshopt_simplifySloppy(dst2, src, src_n, m->positions, m->vertex_count, 12, 0, (float)(step / scale), &est2);
+            size_t n2 = meshopt_simplifySloppy(dst2, src, src_n, w.cpos, w.ccount, 12, 0, (float)(step / scale), &est2);
             if (n2 >= 3 && n2 < n) {
                 dst = dst2;
                 di = d2;
@@ -768,7 +802,7 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
          * small part of the level's error budget; it only ever adds to the
          * bound. */
         double res = fmax(0.05 * target, 1e-6 * scale);
-        double e = mr_lod_hausdorff_bound(m->positions, m->vertex_count, w.idx, (uint32_t)w.count, dst, (uint32_t)n, res,
+        double e = mr_lod_hausdorff_bound(w.cpos, w.ccount, w.idx, (uint32_t)w.count, dst, (uint32_t)n, res,
                                           2 * cap);
         if (!(e + 2 * w.slack <= cap)) break; /* coarser levels only get worse */
         mr_lod_level *l = &out->levels[out->level_count];

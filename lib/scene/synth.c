@@ -431,7 +431,7 @@ static void cad_part(sbuf *b, uint32_t budget, mr_rng *rng) {
     prof[np - 1][1] = prof[np - 2][1];
     /* Triangle shares: body 60 %, rim 25 %, bolts 15 %. */
     double body = 0.6 * budget, rim = 0.25 * budget, bolts = 0.15 * budget;
-    int rings = 2 + (int)(mr_rng_uniform(rng) * 3);
+    int rings = 1 + (int)(mr_rng_uniform(rng) * 2); /* CAD tessellates a surface of revolution in one strip or two */
     int seg = (int)(body / (2.0 * (np - 1) * rings));
     if (seg < 8) seg = 8;
     sb_lathe(b, (const double(*)[2])prof, np, seg, rings, 0, 0);
