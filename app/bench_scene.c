@@ -31,13 +31,15 @@ int bench_scene(int argc, char **argv) {
         {"sizes", "LIST", "drawn-triangle targets (default 1M,5M,20M)", NULL},
         {"size", "WxH", "frame size (default 1024x768)", NULL},
         {"frames", "N", "timed frames per case after one warm-up (default 3)", NULL},
+        {"unique", NULL, "unique CAD-like geometry (every part its own mesh) instead of instanced parts", NULL},
+        {"unit", "U", "scene units per metre of the unique factory (default 1; 1000: millimetres)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
     bool help;
     if (!app_parse(argc, argv, 3, opts, NULL, 0, NULL,
-                   "usage: mrcheck bench scene [--out DIR] [--sizes 1M,5M,20M] [--size WxH] [--frames N]", &help))
+                   "usage: mrcheck bench scene [--out DIR] [--sizes 1M,5M,20M] [--size WxH] [--frames N] [--unique [--unit U]]", &help))
         return 2;
     if (help) return 0;
     app_log_level(opts);
@@ -55,6 +57,8 @@ int bench_scene(int argc, char **argv) {
     p.height = h;
     p.frames = (int)frames;
     p.out = stdout;
+    p.unique = app_get(opts, "unique") != NULL;
+    if (app_get(opts, "unit") && !app_double("unit", app_get(opts, "unit"), 1e-6, 1e9, &p.unit)) return 2;
     mr_error err = {0};
     app_gfx g;
     bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_scene(&p, &err);
