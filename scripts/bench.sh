@@ -100,7 +100,14 @@ for b in "${benches[@]}"; do
         else run bench_scene docs/bench/scene $mr bench scene --sizes 1M,5M --frames 3 --out docs/bench/scene --quiet; fi
         find docs/bench/scene -type f ! -name '*.csv' ! -name '*.md' ! -name '*.svg' ! -name '*.log' -delete
         find docs/bench/scene -mindepth 1 -type d -empty -delete ;;
-    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene)" >&2; exit 2 ;;
+    scene-unique)
+        # Unique CAD-like geometry (issue 17); its LOD build (certified
+        # bounds) dominates: small sizes unless full.
+        if [ "$full" = 1 ]; then run bench_scene_unique docs/bench/scene_unique $mr bench scene --unique --sizes 2M,10M,20M --out docs/bench/scene_unique --quiet
+        else run bench_scene_unique docs/bench/scene_unique $mr bench scene --unique --sizes 100k,200k --frames 3 --out docs/bench/scene_unique --quiet; fi
+        find docs/bench/scene_unique -type f ! -name '*.csv' ! -name '*.md' ! -name '*.svg' ! -name '*.log' -delete
+        find docs/bench/scene_unique -mindepth 1 -type d -empty -delete ;;
+    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, scene-unique)" >&2; exit 2 ;;
     esac
 done
 echo "bench.sh: wrote docs/bench/ at commit $commit ($dirty)" >&2
