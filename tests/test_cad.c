@@ -190,9 +190,10 @@ static void test_cad_levels(void) {
             CHECK_MSG(ml->level_count >= 1, "unit %g, part %d: %d levels", units[u], (int)i, ml->level_count);
             if (ml->level_count < 1) continue;
             const mr_lod_level *last = &ml->levels[ml->level_count - 1];
-            /* Engages: the coarsest level saves at least 30 % of these
-             * coarsely tessellated parts' triangles. */
-            CHECK_MSG(last->index_count * 10 <= m->index_count * 7, "unit %g, part %d: coarsest %u of %u triangles", units[u],
+            /* Engages: the coarsest level keeps at most 45 % of these
+             * coarsely tessellated parts' triangles (41 % here; without the
+             * weld, meshoptimizer's own seam handling keeps 47 %). */
+            CHECK_MSG(last->index_count * 100 <= m->index_count * 45, "unit %g, part %d: coarsest %u of %u triangles", units[u],
                       (int)i, last->index_count / 3, m->index_count / 3);
             printf("  unit %g part %d: %u triangles, size %g:", units[u], (int)i, m->index_count / 3, size);
             for (int k = 0; k < ml->level_count; k++) printf(" %u@%.3g", ml->levels[k].index_count / 3, ml->levels[k].error / size);

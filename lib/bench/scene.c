@@ -306,8 +306,8 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                li.load_s, upload_s, mb / (li.load_s + upload_s), parse_s, mb / parse_s, lod_s,
                linfo.from_cache ? "from the cache" : "built");
         if (p.unique)
-            BENCH_PRINT(out, "  LOD first build %.2f s = %.3f M input triangles/s; from the cache %.3f s\n", lod_s,
-                        li.unique_triangles / 1e6 / lod_s, lod_cached_s);
+            BENCH_PRINT(out, "  LOD first build %.2f s = %.0f input triangles/s; from the cache %.3f s\n", lod_s,
+                        li.unique_triangles / lod_s, lod_cached_s);
         mr_renderer_set_scene(gfx.renderer, NULL, err);
         mr_lod_destroy(&lod);
         mr_scene_destroy(&s);

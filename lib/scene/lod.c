@@ -859,8 +859,8 @@ static void *build_worker(void *arg) {
         j->tri_done += j->s->meshes[i].index_count / 3;
         double dt = mr_time_now() - j->t0;
         if (j->p->progress && dt > 1.0) {
-            fprintf(stderr, "\rLOD: mesh %d of %d, %.1f of %.1f M triangles (%.2f M/s)   ", (int)j->done,
-                    (int)j->s->mesh_count, j->tri_done / 1e6, j->tri_total / 1e6, j->tri_done / 1e6 / dt);
+            fprintf(stderr, "\rLOD: mesh %d of %d, %.2f of %.2f M triangles (%.0f triangles/s)   ", (int)j->done,
+                    (int)j->s->mesh_count, j->tri_done / 1e6, j->tri_total / 1e6, j->tri_done / dt);
             fflush(stderr);
             j->shown = true;
         }

@@ -295,8 +295,11 @@ const double *mr_bvh_bounds(const mr_bvh *bvh, int32_t node);
 
 /* ------------------------------------------ level of detail (lod.c) */
 
-/* Simplified index lists of a mesh (meshoptimizer, edge collapses onto
- * existing vertices, so a level indexes the mesh's own vertex arrays).
+/* Simplified index lists of a mesh (meshoptimizer on the mesh welded by
+ * position across its normal seams: edge collapses, or vertex clustering
+ * where they stall; both keep existing vertices, and each corner is mapped
+ * back to the vertex of its position whose normal fits its face, so a level
+ * indexes the mesh's own vertex arrays and keeps its creases).
  * `error` is a certified upper bound, in the mesh's units (before the node
  * transform), of the two-sided Hausdorff distance between the level and the
  * full mesh: measured, not the simplifier's estimate (see lod.c). */
