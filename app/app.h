@@ -83,7 +83,7 @@ bool app_lod_auto(const mr_cli_opt *opts);
     {"batch", "on|off", "multi-draw-indirect batching (default on)", NULL},                                   \
     {"instancing", "on|off", "one command per mesh instead of per node (default on)", NULL},                   \
     {"lod", "auto|on|off", "simplified levels within the tolerance, cached next to the scene (default auto: on for scenes over 500k triangles)", NULL}, \
-    {"lod-tolerance", "UNITS", "largest geometric error of a level in scene units (default 0.005)", NULL},     \
+    {"lod-tolerance", "UNITS", "largest geometric error of a level in scene units (default: none, pixels decide)", NULL},     \
     {"lod-pixels", "PX", "largest projected error of a level in pixels (default 1)", NULL},                    \
     {"occlusion", "on|off", "occlusion culling (default off)", NULL}
 

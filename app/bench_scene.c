@@ -30,6 +30,8 @@ int bench_scene(int argc, char **argv) {
         {"out", "DIR", "write bench_scene.csv, bench_scene.svg and the scenes there (default bench-out)", NULL},
         {"sizes", "LIST", "drawn-triangle targets (default 1M,5M,20M)", NULL},
         {"size", "WxH", "frame size (default 1024x768)", NULL},
+        {"unique", NULL, "unique CAD-like geometry (every part its own mesh) instead of instanced parts", NULL},
+        {"unit", "U", "scene units per metre of the unique factory (default 1; 1000: millimetres)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -38,7 +40,7 @@ int bench_scene(int argc, char **argv) {
     mr_cli_table table = {"", mr_bench_scene_opts, &p, NULL, false, {0}};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
-                   "usage: mrcheck bench scene [--out DIR] [--sizes 1M,5M,20M] [--size WxH] [--frames N]", &help))
+                   "usage: mrcheck bench scene [--out DIR] [--sizes 1M,5M,20M] [--size WxH] [--frames N] [--unique [--unit U]]", &help))
         return 2;
     if (help) return 0;
     mr_cli_log_level(opts);
@@ -48,6 +50,8 @@ int bench_scene(int argc, char **argv) {
     if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &p.width, &p.height)) return 2;
     p.size_count = nsizes;
     p.out = stdout;
+    p.unique = mr_cli_get(opts, "unique") != NULL;
+    if (mr_cli_get(opts, "unit") && !mr_cli_double("unit", mr_cli_get(opts, "unit"), 1e-6, 1e9, &p.unit)) return 2;
     mr_error err = {0};
     app_gfx g;
     bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_scene(&p, &err);

@@ -26,19 +26,26 @@ int cmd_factory(int argc, char **argv) {
         {"seed", "S", "random seed (default 1)", NULL},
         {"offset", "X,Z", "move the whole plant (tests far from the origin)", NULL},
         {"views", "DIR", "also write view_floor.json, view_aisle.json, view_overview.json there", NULL},
+        {"unique", NULL, "unique CAD-like geometry: every part its own mesh (20k triangles), split at normal seams", NULL},
+        {"unit", "U", "with --unique: scene units per metre (default 1; 1000: millimetres)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
     bool help;
     if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
-                   "usage: mrcheck factory --out FILE.glb [--triangles N | --halls N] [--seed S] [--views DIR]", &help))
+                   "usage: mrcheck factory --out FILE.glb [--triangles N | --halls N] [--seed S] [--views DIR] [--unique [--unit U]]", &help))
         return 2;
     if (help) return 0;
     mr_cli_log_level(opts);
     const char *out = mr_cli_get(opts, "out");
     if (!out) return mr_cli_errorf(cmd, "--out is required"), 2;
     mr_synth_params sp = MR_SYNTH_DEFAULTS;
+    const bool unique = mr_cli_get(opts, "unique") != NULL;
+    mr_synth_cad_params cp = MR_SYNTH_CAD_DEFAULTS;
+    if (unique && mr_cli_get(opts, "halls")) return mr_cli_errorf(cmd, "--halls is for the instanced factory, not --unique"), 2;
+    if (!unique && mr_cli_get(opts, "unit")) return mr_cli_errorf(cmd, "--unit needs --unique"), 2;
+    if (mr_cli_get(opts, "unit") && !mr_cli_double("unit", mr_cli_get(opts, "unit"), 1e-6, 1e9, &cp.unit)) return 2;
     if (mr_cli_get(opts, "halls") && mr_cli_get(opts, "triangles")) return mr_cli_errorf(cmd, "give --halls or --triangles, not both"), 2;
     if (mr_cli_get(opts, "halls")) {
         long h;
@@ -49,11 +56,13 @@ int cmd_factory(int argc, char **argv) {
         if (mr_cli_get(opts, "triangles") && !parse_count(mr_cli_get(opts, "triangles"), &tri))
             return mr_cli_errorf(cmd, "--triangles: '%s' is not a count like 5M", mr_cli_get(opts, "triangles")), 2;
         sp.halls = mr_synth_halls_for(tri);
+        cp.parts = (int)fmin(1e6, fmax(1, floor((double)tri / cp.part_triangles + 0.5)));
     }
     if (mr_cli_get(opts, "seed")) {
         long seed;
         if (!mr_cli_int("seed", mr_cli_get(opts, "seed"), 0, 2147483647L, &seed)) return 2;
         sp.seed = (uint64_t)seed;
+        cp.seed = (uint64_t)seed;
     }
     if (mr_cli_get(opts, "offset")) {
         char *e1 = NULL, *e2 = NULL;
@@ -62,16 +71,23 @@ int cmd_factory(int argc, char **argv) {
         if (e1 == v || *e1 != ',' || (sp.origin[2] = strtod(e1 + 1, &e2), e2 == e1 + 1 || *e2) || !isfinite(sp.origin[0]) ||
             !isfinite(sp.origin[2]) || fabs(sp.origin[0]) > 1e9 || fabs(sp.origin[2]) > 1e9)
             return mr_cli_errorf(cmd, "--offset must be X,Z (finite, |v| <= 1e9)"), 2;
+        cp.origin[0] = sp.origin[0]; /* metres */
+        cp.origin[2] = sp.origin[2];
     }
     mr_error err = {0};
     double t0 = mr_time_now();
-    mr_scene *s = mr_synth_build(&sp, &err);
+    mr_scene *s = unique ? mr_synth_cad_build(&cp, &err) : mr_synth_build(&sp, &err);
     if (!s) return mr_cli_error(cmd, &err);
     uint64_t uniq = 0;
     for (int32_t i = 0; i < s->mesh_count; i++) uniq += s->meshes[i].index_count / 3;
-    printf("factory: %d halls, %d nodes, %d meshes, %llu triangles drawn (%llu stored), built in %.2f s\n", sp.halls,
-           (int)s->node_count, (int)s->mesh_count, (unsigned long long)mr_scene_triangle_count(s),
-           (unsigned long long)uniq, mr_time_now() - t0);
+    if (unique)
+        printf("factory: %d unique parts in unit %g per metre, %d nodes, %d meshes, %llu triangles drawn (%llu stored), built in %.2f s\n",
+               cp.parts, cp.unit, (int)s->node_count, (int)s->mesh_count, (unsigned long long)mr_scene_triangle_count(s),
+               (unsigned long long)uniq, mr_time_now() - t0);
+    else
+        printf("factory: %d halls, %d nodes, %d meshes, %llu triangles drawn (%llu stored), built in %.2f s\n", sp.halls,
+               (int)s->node_count, (int)s->mesh_count, (unsigned long long)mr_scene_triangle_count(s),
+               (unsigned long long)uniq, mr_time_now() - t0);
     char dir[4096];
     mr_path_dir(out, dir, sizeof dir);
     bool ok = mr_mkdirs(dir, &err) && mr_scene_save_glb(s, out, &err);
@@ -86,7 +102,7 @@ int cmd_factory(int argc, char **argv) {
         mr_view view;
         view.camera = mr_demo_camera();
         memset(view.camera.dist, 0, sizeof view.camera.dist); /* an ideal camera for renders */
-        view.world_from_camera = mr_synth_viewpoint(&sp, v);
+        view.world_from_camera = unique ? mr_synth_cad_viewpoint(&cp, v) : mr_synth_viewpoint(&sp, v);
         cJSON *j = mr_view_to_json(&view);
         ok = ok && j && mr_json_save(path, j, &err);
         cJSON_Delete(j);

@@ -65,9 +65,11 @@ mr_lod *app_load_lod(const mr_scene *s, const char *scene_path, bool use_cache, 
     lp.progress = isatty(2);
     mr_lod_info info;
     mr_lod *lod = mr_lod_load_or_build(s, use_cache ? cache : NULL, &lp, &info, err);
-    if (lod)
-        mr_log(MR_LOG_INFO, "LOD: %llu levels %s in %.2f s%s", (unsigned long long)info.levels,
-               info.from_cache ? "read from the cache" : "built", info.build_s,
+    if (lod && info.from_cache)
+        mr_log(MR_LOG_INFO, "LOD: %llu levels read from the cache", (unsigned long long)info.levels);
+    else if (lod)
+        mr_log(MR_LOG_INFO, "LOD: %llu levels built in %.2f s (%.0f input triangles/s)%s", (unsigned long long)info.levels,
+               info.build_s, info.build_s > 0 ? info.triangles / info.build_s : 0.0,
                info.cache_written ? " (cache written)" : "");
     return lod;
 }

@@ -108,7 +108,14 @@ for b in "${benches[@]}"; do
     map)
         # CPU only, about 10 s: the full photo counts 10..200, 5 seeds.
         run bench_map docs/bench/map $mr bench map --out docs/bench/map ;;
-    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, multiview, map, shadows)" >&2; exit 2 ;;
+    scene-unique)
+        # Unique CAD-like geometry (issue 17); its LOD build (certified
+        # bounds) dominates: small sizes unless full.
+        if [ "$full" = 1 ]; then run bench_scene_unique docs/bench/scene_unique $mr bench scene --unique --sizes 2M,10M,20M --out docs/bench/scene_unique --quiet
+        else run bench_scene_unique docs/bench/scene_unique $mr bench scene --unique --sizes 100k,200k --frames 3 --out docs/bench/scene_unique --quiet; fi
+        find docs/bench/scene_unique -type f ! -name '*.csv' ! -name '*.md' ! -name '*.svg' ! -name '*.log' -delete
+        find docs/bench/scene_unique -mindepth 1 -type d -empty -delete ;;
+    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, scene-unique, multiview, map, shadows)" >&2; exit 2 ;;
     esac
 done
 echo "bench.sh: wrote docs/bench/ at commit $commit ($dirty)" >&2

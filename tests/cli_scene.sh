@@ -60,6 +60,17 @@ expect_fail synth_no_out -- "$mr" factory --halls 2
 expect_fail synth_bad_count -- "$mr" factory --out "$tmp/y.glb" --triangles lots
 expect_fail synth_both -- "$mr" factory --out "$tmp/y.glb" --triangles 1M --halls 3
 expect_fail bench_bad_sizes -- "$mr" bench scene --sizes 5Q --out "$tmp/b"
+# Unique CAD-like geometry (issue 17): every part its own mesh, in millimetres.
+if "$mr" factory --unique --unit 1000 --triangles 40k --out "$tmp/cad/c.glb" --views "$tmp/cadviews" >"$tmp/cad.log" 2>&1; then
+  [ -s "$tmp/cad/c.glb" ] && [ -s "$tmp/cadviews/view_overview.json" ] && ok || bad "factory --unique did not write its files"
+  grep -q "2 unique parts in unit 1000 per metre, 3 nodes, 3 meshes" "$tmp/cad.log" && ok || bad "factory --unique summary: $(cat "$tmp/cad.log")"
+else
+  bad "factory --unique failed: $(cat "$tmp/cad.log")"
+fi
+expect_fail factory_bad_unit "$tmp/cad/bad.glb" -- "$mr" factory --unique --unit 0 --out "$tmp/cad/bad.glb"
+expect_fail factory_unit_alone "$tmp/cad/bad.glb" -- "$mr" factory --unit 1000 --out "$tmp/cad/bad.glb"
+expect_fail factory_unique_halls "$tmp/cad/bad.glb" -- "$mr" factory --unique --halls 2 --out "$tmp/cad/bad.glb"
+expect_fail bench_bad_unit -- "$mr" bench scene --unique --unit -1 --out "$tmp/b"
 [ ! -e "$tmp/x.png" ] && [ ! -e "$tmp/y.glb" ] && ok || bad "output left behind"
 
 cli_finish cli_scene

@@ -135,6 +135,12 @@ typedef struct mr_bench_scene_params {
     int width, height;      /* px, default 1024x768 */
     int frames;             /* timed frames per case after one warm-up, default 3 */
     FILE *out;              /* the table; NULL: silent */
+    /* Unique geometry (issue 17): the CAD-like factory (mr_synth_cad_build,
+     * every part its own mesh of 20k triangles, split at normal seams)
+     * instead of the instanced one; bench_scene_unique.csv/.svg, with the
+     * LOD's first build and its cached load timed apart. */
+    bool unique;
+    double unit;            /* scene units per metre of the unique factory; 0 = 1 */
 } mr_bench_scene_params;
 #define MR_BENCH_SCENE_DEFAULTS .out_dir = "bench-out", .width = 1024, .height = 768, .frames = 3
 bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err);

@@ -128,6 +128,8 @@ typedef struct size_info {
     int nodes;
     double mb, parse_s, upload_s, lod_s;
     bool from_cache;
+    bool unique;
+    double lod_cached_s, unit;
 } size_info;
 
 /* One case: its line of the table and its CSV row. */
@@ -158,6 +160,10 @@ static void report_row(FILE *out, mr_csv *csv, const size_info *z, int v, int c,
     const uint64_t counts[] = {st->triangles,     st->gl_draw_calls,  st->commands,      st->nodes_visible,
                                st->nodes_drawable, st->nodes_occluded, st->lod_instances};
     for (int k = 0; k < 7; k++) mr_csv_int(csv, (long long)counts[k]);
+    if (z->unique) {
+        mr_csv_num(csv, "%.3f", z->lod_cached_s);
+        mr_csv_num(csv, "%g", z->unit);
+    }
     mr_csv_end_row(csv);
 }
 
@@ -187,9 +193,12 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
         failed = !mr_fail(err, MR_ERR_NOMEM, "out of memory");
         goto done;
     }
-    mr_csv_header(csv, "scene_triangles,stored_triangles,nodes,file_mb,raw_parse_s,load_s,upload_s,load_upload_mb_s,"
+    char header[512];
+    snprintf(header, sizeof header, "scene_triangles,stored_triangles,nodes,file_mb,raw_parse_s,load_s,upload_s,load_upload_mb_s,"
                        "raw_parse_mb_s,lod_s,lod_from_cache,peak_rss_mb,view,config,frame_ms,cull_ms,gpu_geometry_ms,"
-                       "triangles_submitted,draw_calls,commands,nodes_visible,nodes_drawable,nodes_occluded,lod_instances");
+                       "triangles_submitted,draw_calls,commands,nodes_visible,nodes_drawable,nodes_occluded,lod_instances%s",
+             p.unique ? ",lod_cached_s,unit" : "");
+    mr_csv_header(csv, header);
     BENCH_PRINT(out, "bench scene: %s, %dx%d, median of %ld frames\n", mr_gpu_description(gfx.gpu), w, h, frames);
     BENCH_PRINT(out, "%10s %8s %9s %6s %6s %7s %8s %-9s %-9s %9s %8s %8s %11s %6s %7s %7s\n", "triangles", "nodes", "file MB", "parse",
            "load", "upload", "RSS MB", "view", "config", "frame ms", "cull ms", "GPU ms", "submitted", "calls", "visible",
@@ -198,11 +207,24 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
     mr_path_join(out_dir, "synth.glb.mrlod", lod_cache, sizeof lod_cache); /* same parts at every size */
     for (int si = 0; si < nsizes; si++) {
         mr_synth_params sp = MR_SYNTH_DEFAULTS;
-        sp.halls = mr_synth_halls_for((uint64_t)sizes[si]);
+        mr_synth_cad_params cp = MR_SYNTH_CAD_DEFAULTS;
         char glb[4096], name[64];
-        snprintf(name, sizeof name, "synth_%dhalls.glb", sp.halls);
-        mr_path_join(out_dir, name, glb, sizeof glb);
-        mr_scene *s = mr_synth_build(&sp, err);
+        mr_scene *s;
+        if (p.unique) {
+            /* Parts of 20k triangles each, all distinct: the size is what is stored. */
+            cp.parts = (int)fmax(1, floor(sizes[si] / cp.part_triangles + 0.5));
+            cp.unit = p.unit > 0 ? p.unit : 1;
+            snprintf(name, sizeof name, "cad_%dparts.glb", cp.parts);
+            mr_path_join(out_dir, name, glb, sizeof glb);
+            mr_lod_cache_path(glb, lod_cache, sizeof lod_cache); /* its own geometry at every size */
+            remove(lod_cache); /* the first build is timed, then the cached load */
+            s = mr_synth_cad_build(&cp, err);
+        } else {
+            sp.halls = mr_synth_halls_for((uint64_t)sizes[si]);
+            snprintf(name, sizeof name, "synth_%dhalls.glb", sp.halls);
+            mr_path_join(out_dir, name, glb, sizeof glb);
+            s = mr_synth_build(&sp, err);
+        }
         bool ok = s && mr_scene_save_glb(s, glb, err);
         mr_scene_destroy(&s);
         if (!ok) {
@@ -234,7 +256,20 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
         mr_lod_info linfo;
         t0 = mr_time_now();
         mr_lod *lod = ok ? mr_lod_load_or_build(s, lod_cache, &lp, &linfo, err) : NULL;
-        double lod_s = mr_time_now() - t0;
+        double lod_s = mr_time_now() - t0, lod_cached_s = 0;
+        if (lod && p.unique) {
+            /* The second load of the same file: levels from the cache. */
+            mr_lod_info li2;
+            t0 = mr_time_now();
+            mr_lod *again = mr_lod_load_or_build(s, lod_cache, &lp, &li2, err);
+            lod_cached_s = mr_time_now() - t0;
+            if (again && li2.from_cache) {
+                mr_lod_destroy(&lod);
+                lod = again;
+            } else {
+                mr_lod_destroy(&again);
+            }
+        }
         ok = lod && mr_renderer_set_lod(gfx.renderer, lod, err);
         if (!ok) {
             failed = true;
@@ -247,7 +282,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
             mr_view view;
             view.camera = mr_demo_camera();
             memset(view.camera.dist, 0, sizeof view.camera.dist);
-            view.world_from_camera = mr_synth_viewpoint(&sp, v);
+            view.world_from_camera = p.unique ? mr_synth_cad_viewpoint(&cp, v) : mr_synth_viewpoint(&sp, v);
             for (int c = 0; c < N_CONFIGS && ok; c++) {
                 mr_draw_params dp = MR_DRAW_DEFAULTS;
                 dp.no_cull = k_configs[c].no_cull;
@@ -262,13 +297,17 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                 mr_draw_stats st;
                 if (!(ok = time_case(&gfx, &view, &dp, w, h, frames, ft, ct, gt, r, &st, err))) break;
                 nrows++;
-                const size_info z = {li, (int)s->node_count, mb, parse_s, upload_s, lod_s, linfo.from_cache};
+                const size_info z = {li, (int)s->node_count, mb, parse_s, upload_s, lod_s, linfo.from_cache,
+                                     p.unique, lod_cached_s, cp.unit};
                 report_row(out, csv, &z, v, c, r, &st);
             }
         }
         BENCH_PRINT(out, "  load %.2f s + upload %.2f s = %.0f MB/s; tinygltf raw parse %.2f s = %.0f MB/s; LOD %.2f s (%s)\n",
                li.load_s, upload_s, mb / (li.load_s + upload_s), parse_s, mb / parse_s, lod_s,
                linfo.from_cache ? "from the cache" : "built");
+        if (p.unique)
+            BENCH_PRINT(out, "  LOD first build %.2f s = %.0f input triangles/s; from the cache %.3f s\n", lod_s,
+                        li.unique_triangles / lod_s, lod_cached_s);
         mr_renderer_set_scene(gfx.renderer, NULL, err);
         mr_lod_destroy(&lod);
         mr_scene_destroy(&s);
@@ -279,12 +318,16 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
     }
     {
         char path[4096];
-        mr_path_join(out_dir, "bench_scene.csv", path, sizeof path);
+        const char *stem = p.unique ? "bench_scene_unique" : "bench_scene";
+        char file[64];
+        snprintf(file, sizeof file, "%s.csv", stem);
+        mr_path_join(out_dir, file, path, sizeof path);
         bool ok = mr_csv_save(csv, path, err);
-        mr_path_join(out_dir, "bench_scene.svg", path, sizeof path);
+        snprintf(file, sizeof file, "%s.svg", stem);
+        mr_path_join(out_dir, file, path, sizeof path);
         ok = ok && write_plot(path, rows, nrows, err);
         if (!ok) failed = true;
-        else BENCH_PRINT(out, "wrote %s/bench_scene.csv and bench_scene.svg\n", out_dir);
+        else BENCH_PRINT(out, "wrote %s/%s.csv and %s.svg\n", out_dir, stem, stem);
     }
 done:
     mr_csv_destroy(&csv);

@@ -460,7 +460,10 @@ static void submit_nodes(mr_renderer *r, const mr_geo_view *vw, mr_frame_result 
     double t0 = mr_time_now();
 
     /* 2. LOD choice and bucketing of (node, mesh) pairs. */
-    double tol = dp->lod_tolerance == 0 ? MR_DRAW_DEFAULT_LOD_TOLERANCE : dp->lod_tolerance;
+    /* No absolute cap by default: the projected error alone decides, which
+     * knows no unit (a hall in millimetres picks the levels it picks in
+     * metres); an explicit tolerance, in the scene's own units, caps it. */
+    double tol = dp->lod_tolerance == 0 ? INFINITY : dp->lod_tolerance;
     double pix = dp->lod_pixels == 0 ? MR_DRAW_DEFAULT_LOD_PIXELS : dp->lod_pixels;
     bool use_lod = g->lod && !dp->no_lod && tol > 0;
     double fmax_t = 0;
@@ -486,6 +489,7 @@ static void submit_nodes(mr_renderer *r, const mr_geo_view *vw, mr_frame_result 
             if (gm->count[0] == 0) continue;
             int level = use_lod && gm->level_count > 1 && isfinite(ppu) ? choose_level(gm, g->node_scale[ni], ppu, tol, pix) : 0;
             lod_inst += level > 0;
+            r->stats.level_instances[level]++;
             if (level > 0 && gm->error[level] * g->node_scale[ni] > r->stats.lod_max_error)
                 r->stats.lod_max_error = gm->error[level] * g->node_scale[ni];
             tri_full += gm->count[0] / 3;

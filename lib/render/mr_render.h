@@ -754,8 +754,9 @@ typedef struct mr_draw_params {
                               mesh (and LOD level); default off */
     bool no_lod;           /* always full detail; default off */
     double lod_tolerance;  /* largest geometric error (scene units) a LOD level
-                              may have, whatever its projected size; 0 = 0.005
-                              (5 mm in a metre scene); < 0: no LOD at all */
+                              may have, whatever its projected size; 0 = no
+                              such cap (the default: only lod_pixels decides,
+                              so no unit is assumed); < 0: no LOD at all */
     double lod_pixels;     /* largest projected error of a chosen level, pixels;
                               0 = 1.0 */
     bool occlusion;        /* occlusion culling within the frame: big
@@ -763,7 +764,6 @@ typedef struct mr_draw_params {
                               of the rest on the CPU; exact (same image),
                               costs a depth read-back; default off */
 } mr_draw_params;
-#define MR_DRAW_DEFAULT_LOD_TOLERANCE 0.005
 #define MR_DRAW_DEFAULT_LOD_PIXELS 1.0
 #define MR_DRAW_DEFAULTS {.no_cull = false, .lod_tolerance = 0.0, .lod_pixels = 0.0} /* 0 = the defaults above */
 
@@ -782,6 +782,9 @@ typedef struct mr_draw_stats {
     uint32_t lod_instances;    /* instances drawn with a simplified level */
     double lod_max_error;      /* largest error bound (scene units, node
                                   stretch included) of a level drawn */
+    uint32_t level_instances[MR_LOD_MAX_LEVELS + 1]; /* instances drawn at
+                                  each level: 0 full detail, 1 the finest
+                                  simplified level, ... */
 } mr_draw_stats;
 
 /* Sets how geometry is submitted from the next frame on (NULL: defaults). */

@@ -595,54 +595,238 @@ uint64_t mr_lod_scene_hash(const mr_scene *s) {
 static void resolve(const mr_lod_params *in, mr_lod_params *p) {
     mr_lod_params d = MR_LOD_DEFAULTS;
     *p = in ? *in : d;
-    if (!(p->max_error > 0)) p->max_error = 0.02;
+    if (!(p->max_error > 0)) p->max_error = 0; /* none: relative to each mesh's size */
+    if (!(p->rel_error > 0)) p->rel_error = MR_LOD_DEFAULT_REL_ERROR;
     if (p->min_triangles == 0) p->min_triangles = 64;
 }
 
-/* Levels of one mesh: halving triangle targets from the full mesh, each
- * certified; a level is kept if it saves triangles and its bound stays
- * within max_error. */
+/* Position welding. A CAD mesh repeats a position along every normal seam
+ * (each face of a box, each segment of a lathed profile has its own
+ * vertices), and an edge collapse never crosses such a seam: the simplifier
+ * sees a mesh of many small open patches and stops almost at once. So it
+ * runs on the index list welded by position (meshopt's shadow index
+ * buffer), and each level is mapped back onto the mesh's own vertices
+ * afterwards: every corner takes, among the vertices at its position, the
+ * one whose normal is closest to the level triangle's face normal, so both
+ * sides of a crease keep their own (sharp) normals. Positions are
+ * unchanged, hence the error bound holds for the mapped level too. */
+typedef struct weld {
+    uint32_t *idx;            /* welded index list, degenerate triangles left out */
+    size_t count;
+    double slack;             /* largest distance of a vertex from its canonical one */
+    uint32_t *gstart, *gitem; /* vertices per canonical vertex (CSR) */
+    /* The welded mesh as meshoptimizer gets it: only the canonical
+     * vertices, renumbered (a vertex buffer that still held the unused
+     * duplicates would make meshoptimizer see every seam vertex as a seam of
+     * wedges with no triangles, and lock it). idx is in these numbers. */
+    float *cpos;              /* 3 * ccount */
+    uint32_t *corig;          /* compact -> canonical vertex of the mesh */
+    uint32_t ccount;
+} weld;
+
+static void weld_free(weld *w) {
+    free(w->idx);
+    free(w->cpos);
+    free(w->corig);
+    free(w->gstart);
+    free(w->gitem);
+    memset(w, 0, sizeof *w);
+}
+
+static bool weld_build(const mr_mesh *m, weld *w) {
+    memset(w, 0, sizeof *w);
+    size_t nv = m->vertex_count;
+    w->idx = malloc(((size_t)m->index_count + 1) * sizeof *w->idx);
+    uint32_t *canon = malloc((nv + 1) * sizeof *canon);
+    w->gstart = calloc(nv + 2, sizeof *w->gstart);
+    w->gitem = malloc((nv + 1) * sizeof *w->gitem);
+    if (!w->idx || !canon || !w->gstart || !w->gitem) {
+        free(canon);
+        weld_free(w);
+        return false;
+    }
+    /* Exporters round the same point differently on the two sides of a
+     * seam (sin(2 pi) is not 0): positions are welded on a grid of about
+     * 1e-6 of the mesh's size, and what that moves is measured exactly and
+     * added to every bound (slack). */
+    float *q = malloc((nv * 3 + 1) * sizeof *q);
+    if (!q) {
+        free(canon);
+        weld_free(w);
+        return false;
+    }
+    float ext = meshopt_simplifyScale(m->positions, nv, 12);
+    double step = ldexp(1.0, (int)floor(log2(ext > 0 ? ext : 1.0)) - 20);
+    for (size_t i = 0; i < nv * 3; i++) q[i] = (float)(nearbyint(m->positions[i] / step) * step);
+    meshopt_generateShadowIndexBuffer(w->idx, m->indices, m->index_count, q, nv, 12, 12);
+    free(q);
+    for (size_t v = 0; v < nv; v++) canon[v] = (uint32_t)v;
+    for (size_t i = 0; i < m->index_count; i++) canon[m->indices[i]] = w->idx[i];
+    w->slack = 0;
+    for (size_t v = 0; v < nv; v++) {
+        dv d = dv_sub(vtx(m->positions, (uint32_t)v), vtx(m->positions, canon[v]));
+        w->slack = fmax(w->slack, sqrt(dv_dot(d, d)));
+    }
+    for (size_t v = 0; v < nv; v++) w->gstart[canon[v] + 2]++;
+    for (size_t v = 0; v < nv; v++) w->gstart[v + 2] += w->gstart[v + 1];
+    for (size_t v = 0; v < nv; v++) w->gitem[w->gstart[canon[v] + 1]++] = (uint32_t)v;
+    free(canon);
+    /* Triangles that welding makes degenerate (the fan of a lathed cap at
+     * its axis, where a ring of vertices shares one position) are segments
+     * on the surface: left out, the simplifier sees a clean manifold. */
+    size_t kept = 0;
+    for (size_t t = 0; t + 2 < m->index_count; t += 3) {
+        uint32_t a = w->idx[t], b = w->idx[t + 1], c = w->idx[t + 2];
+        if (a == b || b == c || a == c) continue;
+        w->idx[kept++] = a;
+        w->idx[kept++] = b;
+        w->idx[kept++] = c;
+    }
+    w->count = kept;
+    /* Compact numbering of the canonical vertices used. */
+    uint32_t *cid = malloc((nv + 1) * sizeof *cid);
+    w->corig = malloc((nv + 1) * sizeof *w->corig);
+    if (!cid || !w->corig) {
+        free(cid);
+        return false;
+    }
+    for (size_t v = 0; v < nv; v++) cid[v] = UINT32_MAX;
+    uint32_t nc = 0;
+    for (size_t i = 0; i < kept; i++) {
+        uint32_t v = w->idx[i];
+        if (cid[v] == UINT32_MAX) {
+            cid[v] = nc;
+            w->corig[nc++] = v;
+        }
+        w->idx[i] = cid[v];
+    }
+    free(cid);
+    w->ccount = nc;
+    w->cpos = malloc(((size_t)nc * 3 + 1) * sizeof *w->cpos);
+    if (!w->cpos) return false;
+    for (uint32_t c = 0; c < nc; c++) memcpy(w->cpos + 3 * (size_t)c, m->positions + 3 * (size_t)w->corig[c], 12);
+    return true;
+}
+
+static void unweld(const mr_mesh *m, const weld *w, const uint32_t *src, uint32_t *dst, size_t n) {
+    for (size_t t = 0; t + 2 < n; t += 3) {
+        dv a = vtx(w->cpos, src[t]), b = vtx(w->cpos, src[t + 1]), c = vtx(w->cpos, src[t + 2]);
+        dv ab = dv_sub(b, a), ac = dv_sub(c, a);
+        dv fn = {ab.y * ac.z - ab.z * ac.y, ab.z * ac.x - ab.x * ac.z, ab.x * ac.y - ab.y * ac.x};
+        for (int k = 0; k < 3; k++) {
+            uint32_t cv = w->corig[src[t + (size_t)k]], best = cv;
+            uint32_t g0 = w->gstart[cv], g1 = w->gstart[cv + 1];
+            if (m->normals && g1 - g0 > 1) {
+                double bd = -INFINITY;
+                for (uint32_t j = g0; j < g1; j++) {
+                    uint32_t v = w->gitem[j];
+                    dv nn = vtx(m->normals, v);
+                    double d = dv_dot(nn, fn);
+                    if (d > bd) {
+                        bd = d;
+                        best = v;
+                    }
+                }
+            }
+            dst[t + (size_t)k] = best;
+        }
+    }
+}
+
+/* Levels of one mesh, for the errors cap / 32, cap / 16, ..., cap with
+ * cap = rel_error * the mesh's size (or max_error): each level simplifies
+ * the previous one (welded by position) by what is left of its error budget
+ * (the error so far being certified, the budget is what the simplifier may
+ * add), and is then certified against the full mesh. A level is kept if it
+ * saves at least 15 % of the triangles of the one before. */
 static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *out) {
     memset(out, 0, sizeof *out);
     if (m->index_count / 3 < p->min_triangles || m->vertex_count == 0) return true;
     float scale = meshopt_simplifyScale(m->positions, m->vertex_count, 12);
-    if (!(scale > 0)) return true;
-    uint32_t *dst = malloc((size_t)m->index_count * sizeof *dst);
-    if (!dst) return false;
-    uint32_t prev = m->index_count;
-    double prev_err = 0;
-    for (int k = 1; k <= 12 && out->level_count < MR_LOD_MAX_LEVELS; k++) {
-        size_t target = (size_t)((double)m->index_count / (double)(1u << k)) / 3 * 3;
-        if (target < 12) break;
+    if (!(scale > 0) || !isfinite(scale)) return true;
+    double cap = p->max_error > 0 ? p->max_error : p->rel_error * scale;
+    weld w;
+    if (!weld_build(m, &w)) {
+        weld_free(&w);
+        return false;
+    }
+    uint32_t *buf[3] = {malloc(((size_t)m->index_count + 1) * sizeof *buf[0]),
+                        malloc(((size_t)m->index_count + 1) * sizeof *buf[1]),
+                        malloc(((size_t)m->index_count + 1) * sizeof *buf[2])};
+    if (!buf[0] || !buf[1] || !buf[2]) {
+        free(buf[0]);
+        free(buf[1]);
+        free(buf[2]);
+        weld_free(&w);
+        return false;
+    }
+    /* Three buffers rotate: the source (the welded mesh at first), the
+     * result and a second result to compare. */
+    int si = -1;
+    size_t src_n = w.count;
+    double src_err = 0;
+    if (src_n < 3) {
+        free(buf[0]);
+        free(buf[1]);
+        free(buf[2]);
+        weld_free(&w);
+        return true;
+    }
+    bool ok = true;
+    for (int k = MR_LOD_MAX_LEVELS - 1; k >= 0 && out->level_count < MR_LOD_MAX_LEVELS; k--) {
+        double target = cap / (double)(1u << k);
+        double step = target - src_err;
+        if (!(step > 0.05 * target)) continue;
+        const uint32_t *src = si < 0 ? w.idx : buf[si];
+        int di = si < 0 ? 0 : (si + 1) % 3, d2 = si < 0 ? 1 : (si + 2) % 3;
+        uint32_t *dst = buf[di], *dst2 = buf[d2];
         float est = 0;
-        size_t n = meshopt_simplify(dst, m->indices, m->index_count, m->positions, m->vertex_count, 12, target,
-                                    (float)(p->max_error / scale), 0, &est);
-        if (n < 3 || n > (size_t)(prev * 0.85)) {
-            if (n >= prev) break; /* the error cap stops it: coarser targets cannot do better */
-            continue;
+        size_t n = meshopt_simplify(dst, src, src_n, w.cpos, w.ccount, 12, 0, (float)(step / scale), 0, &est);
+        if (n > src_n / 2) {
+            /* Edge collapses stall on some shapes (thin tori, long lathed
+             * strips); vertex clustering does not, and its result indexes
+             * the same vertices. Its error is certified like any other. */
+            float est2 = 0;
+            size_t n2 = meshopt_simplifySloppy(dst2, src, src_n, w.cpos, w.ccount, 12, 0, (float)(step / scale), &est2);
+            if (n2 >= 3 && n2 < n) {
+                dst = dst2;
+                di = d2;
+                n = n2;
+            }
         }
-        /* Resolution: far below the errors that matter, coarse enough to
-         * keep the bisection cheap; it only ever adds to the bound. */
-        double res = fmax(0.1 * est * scale, fmax(0.01 * p->max_error, 1e-6 * scale));
-        double e = mr_lod_hausdorff_bound(m->positions, m->vertex_count, m->indices, m->index_count, dst, (uint32_t)n,
-                                          res, 2 * p->max_error);
-        if (!(e <= p->max_error)) break; /* coarser levels only get worse */
+        if (n < 3) break;
+        if (n > (size_t)(src_n * 0.85)) continue; /* too little saved: try the next, larger error */
+        /* Certified against the full mesh (welded: the same surface), not
+         * chained through the previous level: the triangle inequality would
+         * be cheaper but adds up the slack of every step. Resolution: a
+         * small part of the level's error budget; it only ever adds to the
+         * bound. */
+        double res = fmax(0.05 * target, 1e-6 * scale);
+        double e = mr_lod_hausdorff_bound(w.cpos, w.ccount, w.idx, (uint32_t)w.count, dst, (uint32_t)n, res,
+                                          2 * cap);
+        if (!(e + 2 * w.slack <= cap)) break; /* coarser levels only get worse */
         mr_lod_level *l = &out->levels[out->level_count];
         l->indices = malloc(n * sizeof *l->indices);
         if (!l->indices) {
-            free(dst);
-            return false;
+            ok = false;
+            break;
         }
-        memcpy(l->indices, dst, n * sizeof *dst);
+        unweld(m, &w, dst, l->indices, n);
         l->index_count = (uint32_t)n;
-        /* Bounds only ever overstate: keep them increasing for the renderer. */
-        l->error = e > prev_err ? e : prev_err;
-        prev_err = l->error;
-        prev = (uint32_t)n;
+        /* The welded surfaces differ from the mesh's own (full, and the
+         * level mapped back) by at most the weld's slack each. */
+        l->error = fmax(e + 2 * w.slack, src_err + 2 * w.slack); /* kept increasing for the renderer */
         out->level_count++;
+        /* This level (welded) is the next one's source. */
+        si = di;
+        src_n = n;
+        src_err = e;
     }
-    free(dst);
-    return true;
+    free(buf[0]);
+    free(buf[1]);
+    free(buf[2]);
+    weld_free(&w);
+    return ok;
 }
 
 /* Meshes are independent: workers take the next mesh from a shared
@@ -654,6 +838,7 @@ typedef struct build_job {
     const int32_t *order;
     pthread_mutex_t lock;
     int32_t next, done;
+    uint64_t tri_total, tri_done; /* input triangles, for the progress line */
     int32_t failed;          /* mesh that ran out of memory, or -1 */
     double t0;
     bool shown;
@@ -671,8 +856,11 @@ static void *build_worker(void *arg) {
         pthread_mutex_lock(&j->lock);
         if (!ok && j->failed < 0) j->failed = i;
         j->done++;
-        if (j->p->progress && mr_time_now() - j->t0 > 1.0) {
-            fprintf(stderr, "\rLOD: mesh %d of %d   ", (int)j->done, (int)j->s->mesh_count);
+        j->tri_done += j->s->meshes[i].index_count / 3;
+        double dt = mr_time_now() - j->t0;
+        if (j->p->progress && dt > 1.0) {
+            fprintf(stderr, "\rLOD: mesh %d of %d, %.2f of %.2f M triangles (%.0f triangles/s)   ", (int)j->done,
+                    (int)j->s->mesh_count, j->tri_done / 1e6, j->tri_total / 1e6, j->tri_done / dt);
             fflush(stderr);
             j->shown = true;
         }
@@ -717,6 +905,7 @@ mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *e
     j.order = order;
     j.failed = -1;
     j.t0 = mr_time_now();
+    for (int32_t i = 0; i < s->mesh_count; i++) j.tri_total += s->meshes[i].index_count / 3;
     pthread_mutex_init(&j.lock, NULL);
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
     int nthreads = ncpu < 1 ? 1 : ncpu > 16 ? 16 : (int)ncpu;
@@ -729,7 +918,7 @@ mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *e
     for (int t = 0; t < started; t++) pthread_join(threads[t], NULL);
     pthread_mutex_destroy(&j.lock);
     free(order);
-    if (j.shown) fprintf(stderr, "\r%40s\r", "");
+    if (j.shown) fprintf(stderr, "\r%80s\r", "");
     if (j.failed >= 0) {
         mr_fail(err, MR_ERR_NOMEM, "out of memory simplifying mesh '%s'", s->meshes[j.failed].name);
         mr_lod_destroy(&l);
@@ -741,7 +930,7 @@ mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *e
 /* -------------------------------------------------------------- cache */
 
 #define CACHE_MAGIC "MRLOD\r\n\x1a"
-#define CACHE_VERSION 1u /* bump whenever simplification or certification changes */
+#define CACHE_VERSION 2u /* bump whenever simplification or certification changes */
 
 void mr_lod_cache_path(const char *scene_path, char *out, size_t n) {
     snprintf(out, n, "%s.mrlod", scene_path ? scene_path : "scene");
@@ -776,6 +965,7 @@ static bool cache_write(const mr_lod *l, const mr_lod_params *p, const char *pat
     put(&b, &l->scene_hash, 8);
     put(&b, &p->max_error, 8);
     put(&b, &mt, 4);
+    put(&b, &p->rel_error, 8);
     for (int32_t i = 0; i < l->mesh_count; i++) {
         uint32_t lc = (uint32_t)l->meshes[i].level_count;
         put(&b, &lc, 4);
@@ -820,7 +1010,7 @@ static mr_lod *cache_read(const mr_scene *s, const mr_lod_params *p, const char 
     char magic[8];
     uint32_t ver, mc, mt;
     uint64_t hash, sum;
-    double maxe;
+    double maxe, rele;
     mr_lod *l = NULL;
     *why = "not a LOD cache";
     if (size < 8 + 8 || !get(&r, magic, 8) || memcmp(magic, CACHE_MAGIC, 8) != 0) goto out;
@@ -831,7 +1021,7 @@ static mr_lod *cache_read(const mr_scene *s, const mr_lod_params *p, const char 
     *why = "written for another scene or other settings";
     if (!get(&r, &ver, 4) || ver != CACHE_VERSION || !get(&r, &mc, 4) || mc != (uint32_t)s->mesh_count ||
         !get(&r, &hash, 8) || hash != mr_lod_scene_hash(s) || !get(&r, &maxe, 8) || maxe != p->max_error ||
-        !get(&r, &mt, 4) || mt != p->min_triangles)
+        !get(&r, &mt, 4) || mt != p->min_triangles || !get(&r, &rele, 8) || rele != p->rel_error)
         goto out;
     l = calloc(1, sizeof *l);
     if (!l || !(l->meshes = calloc((size_t)mc + 1, sizeof *l->meshes))) {
@@ -894,6 +1084,7 @@ mr_lod *mr_lod_load_or_build(const mr_scene *s, const char *cache_path, const mr
         l = mr_lod_build(s, &p, err);
         if (!l) return NULL;
         li.build_s = mr_time_now() - t0;
+        for (int32_t i = 0; i < s->mesh_count; i++) li.triangles += s->meshes[i].index_count / 3;
         if (cache_path) {
             mr_error we = {0};
             li.cache_written = cache_write(l, &p, cache_path, &we);

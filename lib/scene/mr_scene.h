@@ -343,8 +343,11 @@ const double *mr_bvh_bounds(const mr_bvh *bvh, int32_t node);
 
 /* ------------------------------------------ level of detail (lod.c) */
 
-/* Simplified index lists of a mesh (meshoptimizer, edge collapses onto
- * existing vertices, so a level indexes the mesh's own vertex arrays).
+/* Simplified index lists of a mesh (meshoptimizer on the mesh welded by
+ * position across its normal seams: edge collapses, or vertex clustering
+ * where they stall; both keep existing vertices, and each corner is mapped
+ * back to the vertex of its position whose normal fits its face, so a level
+ * indexes the mesh's own vertex arrays and keeps its creases).
  * `error` is a certified upper bound, in the mesh's units (before the node
  * transform), of the two-sided Hausdorff distance between the level and the
  * full mesh: measured, not the simplifier's estimate (see lod.c). */
@@ -368,21 +371,27 @@ typedef struct mr_lod {
 } mr_lod;
 
 typedef struct mr_lod_params {
-    double max_error;         /* largest certified error worth keeping, in
-                                 mesh units (scene units for unscaled nodes);
-                                 0 = 0.02: coarser levels are never usable
-                                 under the default 5 mm tolerance, with
-                                 headroom for a larger --lod-tolerance */
+    double max_error;         /* absolute cap of a kept level's certified
+                                 error, in mesh units; 0 = none: the cap is
+                                 rel_error times the mesh's size, so the
+                                 same part gets the same levels in metres
+                                 or in millimetres */
     uint32_t min_triangles;   /* meshes with fewer triangles get no levels; 0 = 64 */
     bool progress;            /* progress line on stderr (caller decides on a tty) */
+    double rel_error;         /* coarsest level's error as a fraction of the
+                                 mesh's size (largest bounding-box extent);
+                                 0 = 0.01 (1 %). Levels are built for the
+                                 errors rel_error / 32, / 16, ... / 1 */
 } mr_lod_params;
-#define MR_LOD_DEFAULTS {0.0, 0, false}
+#define MR_LOD_DEFAULTS {0.0, 0, false, 0.0}
+#define MR_LOD_DEFAULT_REL_ERROR 0.01
 
 typedef struct mr_lod_info {
     bool from_cache;          /* the cache was valid and used */
     bool cache_written;
     double build_s;           /* seconds spent simplifying and certifying */
     uint64_t levels;          /* levels kept over all meshes */
+    uint64_t triangles;       /* input triangles simplified (when built) */
 } mr_lod_info;
 
 /* Builds the levels of every mesh. */
@@ -430,6 +439,25 @@ enum { MR_SYNTH_VIEW_FLOOR = 0, MR_SYNTH_VIEW_AISLE = 1, MR_SYNTH_VIEW_OVERVIEW 
  * first hall, looking down an aisle through the row of halls, or an
  * overview from above. */
 mr_dmat4 mr_synth_viewpoint(const mr_synth_params *params, int which);
+
+/* Unique CAD-like geometry (issue 17): `parts` distinct parts, each its own
+ * mesh drawn by one node (nothing instanced), with finely tessellated
+ * curved surfaces and split at every normal seam as CAD exporters write
+ * them, on a floor; in metres (unit 1), millimetres (unit 1000) or any unit:
+ * positions and placements are multiplied by `unit`, so two factories that
+ * differ only in unit are the same hall scaled. Deterministic for a seed. */
+typedef struct mr_synth_cad_params {
+    uint64_t seed;            /* default 1 */
+    int parts;                /* 0 = 64 */
+    uint32_t part_triangles;  /* about this many triangles per part; 0 = 20000 */
+    double unit;              /* scene units per metre; 0 = 1 */
+    double origin[3];         /* offset of the whole hall, metres */
+} mr_synth_cad_params;
+#define MR_SYNTH_CAD_DEFAULTS {1, 64, 20000u, 1.0, {0.0, 0.0, 0.0}}
+mr_scene *mr_synth_cad_build(const mr_synth_cad_params *params, mr_error *err);
+/* The same three kinds of viewpoint as mr_synth_viewpoint (floor, aisle,
+ * overview), in the factory's unit. */
+mr_dmat4 mr_synth_cad_viewpoint(const mr_synth_cad_params *params, int which);
 
 #ifdef __cplusplus
 }

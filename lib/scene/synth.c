@@ -400,3 +400,152 @@ mr_dmat4 mr_synth_viewpoint(const mr_synth_params *params, int which) {
     }
     }
 }
+
+/* ------------------------------------------------ unique CAD-like parts
+ *
+ * What a CAD export of a plant looks like, as opposed to the instanced
+ * factory above: every part is its own mesh (no sharing), curved surfaces
+ * tessellated finely, and the mesh split at every normal seam (each profile
+ * segment of a lathed body, each face of a box has its own vertices), so
+ * positions repeat along creases and an edge collapse never crosses one
+ * unless the simplifier welds by position first. In metres or in any other
+ * unit (positions and placements multiplied by `unit`). */
+
+/* One part of about `budget` triangles, in metres, around the origin, its
+ * shape drawn from rng: a base plate, a lathed body with a random profile
+ * (creases between its segments), a torus rim and a bolt circle. */
+static void cad_part(sbuf *b, uint32_t budget, mr_rng *rng) {
+    double size = 0.3 + 2.2 * mr_rng_uniform(rng); /* 0.3 .. 2.5 m */
+    double R = 0.35 * size, H = size * (0.6 + 0.6 * mr_rng_uniform(rng));
+    sb_box(b, -0.6 * size, 0, -0.6 * size, 0.6 * size, 0.04 * size, 0.6 * size);
+    /* Body: 5..9 profile points from the axis out and back (a closed solid). */
+    double prof[10][2];
+    int np = 5 + (int)(mr_rng_uniform(rng) * 4.999);
+    prof[0][0] = 0;
+    prof[0][1] = 0.04 * size;
+    for (int k = 1; k < np - 1; k++) {
+        prof[k][0] = R * (0.5 + 0.5 * mr_rng_uniform(rng));
+        prof[k][1] = 0.04 * size + H * (k - 1) / (np - 3 > 0 ? np - 3 : 1);
+    }
+    prof[np - 1][0] = 0;
+    prof[np - 1][1] = prof[np - 2][1];
+    /* Triangle shares: body 60 %, rim 25 %, bolts 15 %. */
+    double body = 0.6 * budget, rim = 0.25 * budget, bolts = 0.15 * budget;
+    int rings = 1 + (int)(mr_rng_uniform(rng) * 2); /* CAD tessellates a surface of revolution in one strip or two */
+    int seg = (int)(body / (2.0 * (np - 1) * rings));
+    if (seg < 8) seg = 8;
+    sb_lathe(b, (const double(*)[2])prof, np, seg, rings, 0, 0);
+    int nu = (int)sqrt(rim / 2 * 4), nv = nu / 4;
+    if (nu < 8) nu = 8;
+    if (nv < 4) nv = 4;
+    uint32_t base = b->nv;
+    sb_torus(b, R * 1.05, 0.05 * size, nu, nv);
+    for (uint32_t v = base; !b->oom && v < b->nv; v++) b->p[3 * (size_t)v + 1] += (float)(0.04 * size + 0.05 * size);
+    int nb = 4 + (int)(mr_rng_uniform(rng) * 5);
+    int bseg = (int)(bolts / nb / 6);
+    if (bseg < 6) bseg = 6;
+    for (int k = 0; k < nb; k++) {
+        double a = 2 * PI * k / nb, br = 0.02 * size;
+        const double bp[][2] = {{0, 0.04 * size}, {br, 0.04 * size}, {br, 0.1 * size}, {0.6 * br, 0.12 * size}, {0, 0.12 * size}};
+        sb_lathe(b, bp, 5, bseg, 1, 0.5 * size * cos(a), 0.5 * size * sin(a));
+    }
+}
+
+static void cad_resolve(const mr_synth_cad_params *in, mr_synth_cad_params *p) {
+    mr_synth_cad_params d = MR_SYNTH_CAD_DEFAULTS;
+    *p = in ? *in : d;
+    if (p->parts <= 0) p->parts = 64;
+    if (p->part_triangles == 0) p->part_triangles = 20000;
+    if (!(p->unit > 0)) p->unit = 1;
+}
+
+/* Parts stand in a grid 3.5 m apart; the floor reaches 3 m beyond. */
+static void cad_grid(const mr_synth_cad_params *p, int *cols, int *rows) {
+    *cols = (int)ceil(sqrt(2.0 * p->parts));
+    *rows = (p->parts + *cols - 1) / *cols;
+}
+
+mr_scene *mr_synth_cad_build(const mr_synth_cad_params *params, mr_error *err) {
+    mr_synth_cad_params p;
+    cad_resolve(params, &p);
+    if (p.parts > 1000000 || p.part_triangles > 4000000u || !(p.unit >= 1e-6 && p.unit <= 1e9)) {
+        mr_fail(err, MR_ERR_INVALID, "CAD factory: %d parts of %u triangles in unit %g out of range", p.parts,
+                (unsigned)p.part_triangles, p.unit);
+        return NULL;
+    }
+    synth_ctx c;
+    memset(&c, 0, sizeof c);
+    c.s = mr_scene_create();
+    c.err = err;
+    c.ok = c.s != NULL;
+    if (!c.s) {
+        mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    static const float cols_rgb[4][3] = {{0.85f, 0.55f, 0.15f}, {0.35f, 0.45f, 0.62f}, {0.15f, 0.35f, 0.25f}, {0.55f, 0.56f, 0.55f}};
+    for (int i = 0; i < 4; i++) {
+        mr_material m;
+        memset(&m, 0, sizeof m);
+        snprintf(m.name, sizeof m.name, "cad%d", i);
+        memcpy(m.base_color, cols_rgb[i], sizeof cols_rgb[i]);
+        m.base_color[3] = 1;
+        m.base_color_texture = -1;
+        c.mat[i] = mr_scene_add_material(c.s, &m);
+    }
+    mr_rng rng;
+    mr_rng_seed(&rng, p.seed ? p.seed : 1);
+    int cols, rows;
+    cad_grid(&p, &cols, &rows);
+    const double u = p.unit, pitch = 3.5;
+    sbuf b;
+    memset(&b, 0, sizeof b);
+    sb_box(&b, -3, -0.3, -3, cols * pitch + 3, 0, rows * pitch + 3);
+    for (uint32_t i = 0; !b.oom && i < 3 * b.nv; i++) b.p[i] = (float)(b.p[i] * u);
+    int32_t floor_mesh = commit(&c, &b, "Floor", c.mat[3]);
+    node(&c, "Floor", floor_mesh, mr_m4_translate(p.origin[0] * u, p.origin[1] * u, p.origin[2] * u), MR_LAYER_VISIBLE);
+    for (int i = 0; c.ok && i < p.parts; i++) {
+        memset(&b, 0, sizeof b);
+        cad_part(&b, p.part_triangles, &rng);
+        for (uint32_t k = 0; !b.oom && k < 3 * b.nv; k++) b.p[k] = (float)(b.p[k] * u);
+        char name[64];
+        snprintf(name, sizeof name, "Part_%d", i);
+        int32_t mesh = commit(&c, &b, name, c.mat[i % 3]);
+        double x = (i % cols + 0.5) * pitch, z = (i / cols + 0.5) * pitch, yaw = 2 * PI * mr_rng_uniform(&rng);
+        mr_dmat4 t = mr_m4_translate((p.origin[0] + x) * u, p.origin[1] * u, (p.origin[2] + z) * u);
+        mr_dmat4 r = mr_m4_rotate_axis(mr_v3(0, 1, 0), yaw);
+        node(&c, name, mesh, mr_m4_mul(&t, &r), MR_LAYER_VISIBLE);
+    }
+    if (!c.ok) {
+        mr_scene_destroy(&c.s);
+        return NULL;
+    }
+    mr_scene_update_bounds(c.s);
+    return c.s;
+}
+
+mr_dmat4 mr_synth_cad_viewpoint(const mr_synth_cad_params *params, int which) {
+    mr_synth_cad_params p;
+    cad_resolve(params, &p);
+    int cols, rows;
+    cad_grid(&p, &cols, &rows);
+    const double u = p.unit, W = cols * 3.5, D = rows * 3.5, ox = p.origin[0], oy = p.origin[1], oz = p.origin[2];
+    mr_dvec3 up = mr_v3(0, 1, 0);
+    mr_dvec3 eye, target;
+    switch (which) {
+    case MR_SYNTH_VIEW_FLOOR: /* standing among the first parts */
+        eye = mr_v3(ox + 1.75, oy + 1.7, oz + 1.2);
+        target = mr_v3(ox + 8, oy + 0.8, oz + 6);
+        break;
+    case MR_SYNTH_VIEW_AISLE: /* down the gap between the first two rows */
+        eye = mr_v3(ox - 1.5, oy + 1.7, oz + 3.5);
+        target = mr_v3(ox + W, oy + 0.6, oz + 3.5);
+        break;
+    default: { /* from above a corner */
+        double span = fmax(W, D);
+        eye = mr_v3(ox - 0.1 * span, oy + 0.45 * span + 3, oz - 0.1 * span);
+        target = mr_v3(ox + 0.5 * W, oy, oz + 0.5 * D);
+        break;
+    }
+    }
+    return mr_m4_look_at_cv(mr_v3(eye.x * u, eye.y * u, eye.z * u), mr_v3(target.x * u, target.y * u, target.z * u), up);
+}
