@@ -70,22 +70,19 @@ typedef struct app_load_info {
 } app_load_info;
 mr_scene *app_load_scene(const char *path, const mr_scene_params *params, app_load_info *info, mr_error *err);
 mr_lod *app_load_lod(const mr_scene *s, const char *scene_path, bool use_cache, mr_error *err);
-/* Reads --cull --batch --instancing --lod --occlusion (on|off),
- * --lod-tolerance and --lod-pixels; prints one line and returns false on a
- * bad value. */
-bool app_draw_params(const mr_cli_opt *opts, mr_draw_params *dp);
+/* --lod: "auto" (or not given), "on" or "off" into dp->no_lod (auto: on,
+ * decided by app_lod_auto once the scene is loaded); prints one line and
+ * returns false on a bad value. */
+bool app_draw_lod(const mr_cli_opt *opts, mr_draw_params *dp);
 /* --lod auto (the default): levels only for scenes that draw at least
  * APP_LOD_AUTO_TRIANGLES, where simplifying pays for its one-off cost. */
 bool app_lod_auto(const mr_cli_opt *opts);
 #define APP_LOD_AUTO_TRIANGLES 500000u
+/* The draw table (no prefix) and --lod auto|on|off, which decides whether
+ * levels are built or read at all. */
+#define APP_DRAW_TABLE(p) {.prefix = "", .table = mr_draw_opts, .params = (p)}
 #define APP_DRAW_OPTS                                                                                          \
-    {"cull", "on|off", "BVH frustum culling (default on)", NULL},                                              \
-    {"batch", "on|off", "multi-draw-indirect batching (default on)", NULL},                                   \
-    {"instancing", "on|off", "one command per mesh instead of per node (default on)", NULL},                   \
-    {"lod", "auto|on|off", "simplified levels within the tolerance, cached next to the scene (default auto: on for scenes over 500k triangles)", NULL}, \
-    {"lod-tolerance", "UNITS", "largest geometric error of a level in scene units (default: none, pixels decide)", NULL},     \
-    {"lod-pixels", "PX", "largest projected error of a level in pixels (default 1)", NULL},                    \
-    {"occlusion", "on|off", "occlusion culling (default off)", NULL}
+    {"lod", "auto|on|off", "simplified levels within the tolerance, cached next to the scene (default auto: on for scenes over 500k triangles)", NULL}
 
 /* mrcheck study {stimuli,plan,run,analyze} (cmd_study.c). */
 int cmd_study(int argc, char **argv);

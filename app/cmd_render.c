@@ -92,10 +92,11 @@ int cmd_render(int argc, char **argv) {
     mr_frame_params fp = MR_FRAME_DEFAULTS;
     mr_gt_params gtp = MR_GT_DEFAULTS;
     mr_rig_params rp = MR_RIG_DEFAULTS;
+    mr_draw_params dp = MR_DRAW_DEFAULTS;
     mr_cli_table tables[] = {APP_AO_TABLE(&fp.ao), APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&fp.ghost),
-                             APP_SHADOW_TABLE(&fp.shadow), APP_RIG_TABLE(&rp)};
+                             APP_SHADOW_TABLE(&fp.shadow), APP_RIG_TABLE(&rp), APP_DRAW_TABLE(&dp)};
     bool help;
-    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 5, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 6, NULL, 0, NULL,
                    "usage: mrcheck render --scene FILE --view VIEW.json --out OUT.png [--size WxH] "
                    "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive] "
                    "[--shadows off|hard|pcf|pcss|bp|groundtruth ...] "
@@ -112,8 +113,7 @@ int cmd_render(int argc, char **argv) {
     if (mr_cli_get(opts, "alpha") && !mr_cli_double("alpha", mr_cli_get(opts, "alpha"), 0, 1, &alpha)) return 2;
     fp.alpha = (float)alpha;
     fp.hide_hidden_layer = mr_cli_flag(opts, "hide-hidden");
-    mr_draw_params dp;
-    if (!app_draw_params(opts, &dp)) return 2;
+    if (!app_draw_lod(opts, &dp)) return 2;
     const char *lod_cache = mr_cli_get(opts, "lod-cache");
     if (lod_cache && strcmp(lod_cache, "on") != 0 && strcmp(lod_cache, "off") != 0)
         return mr_cli_errorf(cmd, "--lod-cache must be 'on' or 'off'"), 2;

@@ -74,31 +74,15 @@ mr_lod *app_load_lod(const mr_scene *s, const char *scene_path, bool use_cache, 
     return lod;
 }
 
-static bool on_off(const char *opt, const char *v, bool *off) {
-    if (!v) return true;
-    if (strcmp(v, "on") == 0) *off = false;
-    else if (strcmp(v, "off") == 0) *off = true;
-    else return mr_cli_errorf("render", "--%s must be 'on' or 'off'%s, not '%s'", opt, strcmp(opt, "lod") ? "" : " or 'auto'", v), false;
-    return true;
-}
-
 bool app_lod_auto(const mr_cli_opt *opts) {
     const char *v = mr_cli_get(opts, "lod");
     return !v || strcmp(v, "auto") == 0;
 }
 
-bool app_draw_params(const mr_cli_opt *opts, mr_draw_params *dp) {
-    mr_draw_params d = MR_DRAW_DEFAULTS;
-    bool occl_off = true;
-    if (!on_off("cull", mr_cli_get(opts, "cull"), &d.no_cull) || !on_off("batch", mr_cli_get(opts, "batch"), &d.no_batch) ||
-        !on_off("instancing", mr_cli_get(opts, "instancing"), &d.no_instancing) ||
-        !on_off("lod", app_lod_auto(opts) ? NULL : mr_cli_get(opts, "lod"), &d.no_lod) || !on_off("occlusion", mr_cli_get(opts, "occlusion"), &occl_off))
-        return false;
-    d.occlusion = !occl_off;
-    if (mr_cli_get(opts, "lod-tolerance") && !mr_cli_double("lod-tolerance", mr_cli_get(opts, "lod-tolerance"), 1e-12, 1e12, &d.lod_tolerance))
-        return false;
-    if (mr_cli_get(opts, "lod-pixels") && !mr_cli_double("lod-pixels", mr_cli_get(opts, "lod-pixels"), 1e-3, 1e4, &d.lod_pixels))
-        return false;
-    *dp = d;
+bool app_draw_lod(const mr_cli_opt *opts, mr_draw_params *dp) {
+    const char *v = mr_cli_get(opts, "lod");
+    if (!v || strcmp(v, "auto") == 0 || strcmp(v, "on") == 0) dp->no_lod = false;
+    else if (strcmp(v, "off") == 0) dp->no_lod = true;
+    else return mr_cli_errorf("render", "--lod must be 'on' or 'off' or 'auto', not '%s'", v), false;
     return true;
 }

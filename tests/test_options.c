@@ -254,6 +254,8 @@ static void test_tables(void) {
     const mr_filter_params fp = MR_FILTER_DEFAULTS;
     walk_table("mr_detector_opts", mr_detector_opts, sizeof dp, &dp);
     walk_table("mr_filter_opts", mr_filter_opts, sizeof fp, &fp);
+    const mr_draw_params dr = MR_DRAW_DEFAULTS;
+    walk_table("mr_draw_opts", mr_draw_opts, sizeof dr, &dr);
     const mr_gt_params gt = MR_GT_DEFAULTS;
     walk_table("mr_gt_opts", mr_gt_opts, sizeof gt, &gt);
     const mr_bench_ao_params bao = {MR_BENCH_AO_DEFAULTS};
@@ -345,6 +347,14 @@ static void test_tables(void) {
         N(mr_filter_params, "jump-deg", jump_deg, 1e-3, 180),
         N(mr_filter_params, "max-gap", max_gap_s, 1e-3, 3600),
     };
+    const expect ex_dr[] = {
+        N(mr_draw_params, "cull", no_cull, 0, 1),
+        N(mr_draw_params, "batch", no_batch, 0, 1),
+        N(mr_draw_params, "instancing", no_instancing, 0, 1),
+        N(mr_draw_params, "lod-tolerance", lod_tolerance, 1e-12, 1e12),
+        N(mr_draw_params, "lod-pixels", lod_pixels, 1e-3, 1e4),
+        N(mr_draw_params, "occlusion", occlusion, 0, 1),
+    };
     const expect ex_gt[] = {N(mr_gt_params, "rays", rays, 1, 1 << 20)};
     const expect ex_bao[] = {
         N(mr_bench_ao_params, "frames", frames, 1, 64),
@@ -375,6 +385,16 @@ static void test_tables(void) {
 #undef N
 #define ROWS(t, ex) check_rows(#t, t, ex, (int)(sizeof ex / sizeof ex[0]))
     ROWS(mr_gt_opts, ex_gt);
+    ROWS(mr_draw_opts, ex_dr);
+    /* The negated switches: the option on is the field off, both ways. */
+    {
+        mr_draw_params d = MR_DRAW_DEFAULTS;
+        mr_error e = {0};
+        CHECK(mr_opt_set(mr_draw_opts, &d, "cull", "off", &e) && d.no_cull && mr_opt_get(mr_opt_find(mr_draw_opts, "cull"), &d) == 0);
+        CHECK(mr_opt_set(mr_draw_opts, &d, "cull", "on", &e) && !d.no_cull && mr_opt_get(mr_opt_find(mr_draw_opts, "cull"), &d) == 1);
+        CHECK(mr_opt_set(mr_draw_opts, &d, "occlusion", "on", &e) && d.occlusion);
+        CHECK(!mr_opt_set(mr_draw_opts, &d, "batch", "maybe", &e) && strstr(e.msg, "on or off"));
+    }
     ROWS(mr_batch_replay_opts, ex_rp);
     ROWS(mr_bench_ao_opts, ex_bao);
     ROWS(mr_bench_frame_opts, ex_bfr);

@@ -21,7 +21,7 @@ static void row_name(const mr_cli_table *t, const mr_opt *o, char *out, size_t n
 
 static const char *row_arg(const mr_opt *o) {
     switch (o->type) {
-    case MR_OPT_BOOL: return NULL;
+    case MR_OPT_BOOL: return (o->flags & MR_OPT_ONOFF) ? "on|off" : NULL;
     case MR_OPT_ENUM: return "NAME";
     case MR_OPT_INT: return "N";
     default: return "X";

@@ -263,6 +263,12 @@ typedef enum mr_opt_type {
 /* The default is negative and means "chosen at run time" (--to: the last
  * frame); a user sets values in [lo, hi] only. */
 #define MR_OPT_NEG_AUTO 4u
+/* Bool rows: the field holds the negation of the option (no_cull for
+ * --cull), so a zero-initialised struct keeps the option on. */
+#define MR_OPT_NEGATE 8u
+/* Bool rows: on the command line the option takes a value, on or off
+ * (--cull off), instead of being a flag. */
+#define MR_OPT_ONOFF 16u
 
 typedef struct mr_opt {
     const char *key;          /* file / UI name; on the command line prefix + key,
@@ -273,7 +279,7 @@ typedef struct mr_opt {
     double def;               /* default (enums: the index) */
     const char *const *names; /* enums: names by value, NULL-terminated */
     const char *help;         /* one line, no default or range (added from the row) */
-    unsigned flags;           /* MR_OPT_ZERO_AUTO, MR_OPT_ZERO_DEFAULT, MR_OPT_NEG_AUTO */
+    unsigned flags;           /* MR_OPT_ZERO_AUTO, _ZERO_DEFAULT, _NEG_AUTO, _NEGATE, _ONOFF */
 } mr_opt;
 
 /* The row named key; NULL if none. */

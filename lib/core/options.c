@@ -60,7 +60,7 @@ static void store(const mr_opt *o, void *params, double v) {
     case MR_OPT_ENUM: *(int *)f = (int)v; break;
     case MR_OPT_DOUBLE: *(double *)f = v; break;
     case MR_OPT_FLOAT: *(float *)f = (float)v; break;
-    case MR_OPT_BOOL: *(bool *)f = v != 0; break;
+    case MR_OPT_BOOL: *(bool *)f = (v != 0) != ((o->flags & MR_OPT_NEGATE) != 0); break;
     }
 }
 
@@ -72,7 +72,7 @@ static double load(const mr_opt *o, const void *params) {
     case MR_OPT_ENUM: return *(const int *)f;
     case MR_OPT_DOUBLE: return *(const double *)f;
     case MR_OPT_FLOAT: return *(const float *)f;
-    case MR_OPT_BOOL: return *(const bool *)f;
+    case MR_OPT_BOOL: return *(const bool *)f != ((o->flags & MR_OPT_NEGATE) != 0);
     }
     return 0;
 }
@@ -114,6 +114,7 @@ bool mr_opt_set_row(const mr_opt *o, void *params, const char *text, mr_error *e
     case MR_OPT_BOOL:
         if (!strcmp(text, "1") || !strcmp(text, "true") || !strcmp(text, "on")) store(o, params, 1);
         else if (!strcmp(text, "0") || !strcmp(text, "false") || !strcmp(text, "off")) store(o, params, 0);
+        else if (o->flags & MR_OPT_ONOFF) return mr_fail(err, MR_ERR_INVALID, "%s must be on or off, got '%s'", o->key, text);
         else return mr_fail(err, MR_ERR_INVALID, "%s must be true or false, got '%s'", o->key, text);
         return true;
     case MR_OPT_ENUM: {

@@ -766,6 +766,11 @@ typedef struct mr_draw_params {
 } mr_draw_params;
 #define MR_DRAW_DEFAULT_LOD_PIXELS 1.0
 #define MR_DRAW_DEFAULTS {.no_cull = false, .lod_tolerance = 0.0, .lod_pixels = 0.0} /* 0 = the defaults above */
+/* Option table (lib/render/options.c): --cull --batch --instancing
+ * --occlusion (on|off), --lod-tolerance, --lod-pixels. Whether levels are
+ * built at all (--lod auto|on|off) is the loading's choice, not a draw
+ * parameter: no_lod is set by the caller. */
+extern const mr_opt mr_draw_opts[];
 
 /* What the last frame's geometry submission did (summed over the passes
  * that drew geometry). */

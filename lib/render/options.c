@@ -119,3 +119,20 @@ bool mr_shadow_method_parse(const char *name, mr_shadow_method *out) {
     if (v >= 0) *out = (mr_shadow_method)v;
     return v >= 0;
 }
+
+#define DR(f) offsetof(mr_draw_params, f)
+const mr_opt mr_draw_opts[] = {
+    {"cull", MR_OPT_BOOL, DR(no_cull), 0, 1, 1, NULL, "BVH frustum culling", MR_OPT_NEGATE | MR_OPT_ONOFF},
+    {"batch", MR_OPT_BOOL, DR(no_batch), 0, 1, 1, NULL, "multi-draw-indirect batching", MR_OPT_NEGATE | MR_OPT_ONOFF},
+    {"instancing", MR_OPT_BOOL, DR(no_instancing), 0, 1, 1, NULL, "one command per mesh instead of per node",
+     MR_OPT_NEGATE | MR_OPT_ONOFF},
+    /* No unit is assumed: by default only the projected error decides. */
+    {"lod-tolerance", MR_OPT_DOUBLE, DR(lod_tolerance), 1e-12, 1e12, 0, NULL,
+     "largest geometric error of a level in scene units (auto: none, pixels decide)", MR_OPT_ZERO_AUTO},
+    {"lod-pixels", MR_OPT_DOUBLE, DR(lod_pixels), 1e-3, 1e4, MR_DRAW_DEFAULT_LOD_PIXELS, NULL,
+     "largest projected error of a level in pixels", MR_OPT_ZERO_DEFAULT},
+    {"occlusion", MR_OPT_BOOL, DR(occlusion), 0, 1, 0, NULL, "occlusion culling (exact; costs a depth read-back)",
+     MR_OPT_ONOFF},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef DR
