@@ -43,12 +43,12 @@ fi
   || bad "plain render"
 
 # Replay: per frame a quilt and a folder of views; the log names the quilt.
-if "$mr" replay "$src/recordings/demo" --scene "$s" --out "$tmp/rp" --from 20 --to 21 --views 4 --quilt 2x2 \
+if "$mr" replay "$src/recordings/demo" --scene "$s" --out "$tmp/rp" --from 40 --to 41 --views 4 --quilt 2x2 \
      --focal-distance 3 >"$tmp/rp.log" 2>&1; then
-  [ -s "$tmp/rp/overlay_000020_qs2x2a1.333.png" ] && [ -s "$tmp/rp/overlay_000021_qs2x2a1.333.png" ] && ok \
+  [ -s "$tmp/rp/overlay_000040_qs2x2a1.333.png" ] && [ -s "$tmp/rp/overlay_000041_qs2x2a1.333.png" ] && ok \
     || bad "replay quilts missing: $(ls "$tmp/rp")"
-  [ "$(ls "$tmp/rp/overlay_000020"/view_*.png | wc -l)" -eq 4 ] && ok || bad "replay views missing"
-  grep -q '"image":"overlay_000020_qs2x2a1.333.png"' "$tmp/rp/replay.jsonl" && ok || bad "replay.jsonl: $(head -c 300 "$tmp/rp/replay.jsonl")"
+  [ "$(ls "$tmp/rp/overlay_000040"/view_*.png | wc -l)" -eq 4 ] && ok || bad "replay views missing"
+  grep -q '"image":"overlay_000040_qs2x2a1.333.png"' "$tmp/rp/replay.jsonl" && ok || bad "replay.jsonl: $(head -c 300 "$tmp/rp/replay.jsonl")"
 else
   rc=$?
   need_device $rc "$tmp/rp.log" "replay --views"
