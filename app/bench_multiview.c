@@ -12,33 +12,25 @@ int bench_multiview(int argc, char **argv) {
         {"budget", "WxH", "total pixels of all views in the budget rows (default 1024x768)", NULL},
         {"view-size", "WxH", "per-view size of the fixed-size rows and the display slices (default 160x120)", NULL},
         {"table-size", "WxH", "size of the no-SSAO / SSAO table (default 1024x768, as the paper)", NULL},
-        {"frames", "N", "timed runs, median reported (default 3)", NULL},
-        {"rays", "N", "reference rays per pixel (default 64)", NULL},
-        {"quick", NULL, "views 1 and 8 only", NULL},
         {"out", "DIR", "output folder (default bench-out)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
+    mr_bench_multiview_params p = {MR_BENCH_MULTIVIEW_DEFAULTS};
+    mr_cli_table table = {"", mr_bench_multiview_opts, &p, NULL, false, {0}};
     bool help;
-    if (!mr_cli_parse(argc, argv, 3, opts, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck bench multiview [--budget WxH] [--view-size WxH] [--table-size WxH] [--frames N] "
                    "[--rays N] [--quick] [--out DIR]",
                    &help))
         return 2;
     if (help) return 0;
     mr_cli_log_level(opts);
-    mr_bench_multiview_params p = {MR_BENCH_MULTIVIEW_DEFAULTS};
-    long frames = p.frames, rays = p.rays;
     if (mr_cli_get(opts, "budget") && !mr_cli_size("budget", mr_cli_get(opts, "budget"), &p.budget_w, &p.budget_h)) return 2;
     if (mr_cli_get(opts, "view-size") && !mr_cli_size("view-size", mr_cli_get(opts, "view-size"), &p.view_w, &p.view_h)) return 2;
     if (mr_cli_get(opts, "table-size") && !mr_cli_size("table-size", mr_cli_get(opts, "table-size"), &p.table_w, &p.table_h))
         return 2;
-    if (mr_cli_get(opts, "frames") && !mr_cli_int("frames", mr_cli_get(opts, "frames"), 1, 64, &frames)) return 2;
-    if (mr_cli_get(opts, "rays") && !mr_cli_int("rays", mr_cli_get(opts, "rays"), 1, 1 << 16, &rays)) return 2;
-    p.frames = (int)frames;
-    p.rays = (int)rays;
-    p.quick = mr_cli_flag(opts, "quick");
     if (mr_cli_get(opts, "out")) p.out_dir = mr_cli_get(opts, "out");
     p.out = mr_cli_flag(opts, "quiet") ? NULL : stdout;
     p.progress = isatty(2);

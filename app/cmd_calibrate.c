@@ -10,13 +10,14 @@ int cmd_calibrate(int argc, char **argv) {
         {"images", "DIR", "folder of board images (png, jpg, ...)", NULL},
         {"board", "BOARD.json", "the board as a marker map: tag poses in the board frame (z = 0 plane)", NULL},
         {"out", "CAMERA.json", "camera file to write", NULL},
-        {"min-tags", "N", "images with fewer board tags are skipped (default 4)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
+    mr_board_calib_params bp = {.min_tags = 0};
+    mr_cli_table table = {"", mr_board_calib_opts, &bp, NULL, false, {0}};
     bool help;
-    if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck calibrate --images DIR --board BOARD.json --out CAMERA.json\n"
                    "Detects the board's AprilTags in every image and calibrates fx fy cx cy and k1 k2 p1 p2\n"
                    "(k3 = 0) with OpenCV; prints the RMS reprojection error.",
@@ -26,13 +27,13 @@ int cmd_calibrate(int argc, char **argv) {
     mr_cli_log_level(opts);
     const char *dir = mr_cli_get(opts, "images"), *board = mr_cli_get(opts, "board"), *out = mr_cli_get(opts, "out");
     if (!dir || !board || !out) return mr_cli_errorf(cmd, "--images, --board and --out are required (see --help)"), 2;
-    long min_tags = 4;
-    if (mr_cli_get(opts, "min-tags") && !mr_cli_int("min-tags", mr_cli_get(opts, "min-tags"), 1, 10000, &min_tags)) return 2;
 
     mr_error err = {0};
     mr_marker_map map;
     if (!mr_marker_map_load(board, &map, &err)) return mr_cli_error(cmd, &err);
-    mr_board_calib_params bp = {dir, &map, board, (int)min_tags};
+    bp.images = dir;
+    bp.board = &map;
+    bp.board_name = board;
     mr_board_calib c;
     bool ok = mr_calibrate_board(&bp, &c, &err);
     mr_marker_map_free(&map);

@@ -36,6 +36,46 @@ static bool parse_sizes(const char *s, int **ids, double **sizes, int *n) {
     return *n > 0;
 }
 
+/* The photos' detections as mr_map_build takes them, gathered by
+ * mr_detect_each (lib/track). */
+typedef struct photo_set {
+    mr_camera *cam;
+    mr_detection **dets;
+    mr_map_photo *photos;
+    char (*names)[256];
+    int n, cap;
+    bool tty;
+} photo_set;
+
+static bool take_photo(void *user, const mr_frame *f, const mr_detection *d, int k, mr_error *err) {
+    photo_set *ps = user;
+    if (ps->n == ps->cap) {
+        ps->cap = ps->cap ? 2 * ps->cap : 64;
+        mr_detection **nd = realloc(ps->dets, (size_t)ps->cap * sizeof *nd);
+        if (nd) ps->dets = nd;
+        mr_map_photo *np = realloc(ps->photos, (size_t)ps->cap * sizeof *np);
+        if (np) ps->photos = np;
+        char(*nn)[256] = realloc(ps->names, (size_t)ps->cap * sizeof *nn);
+        if (nn) ps->names = nn;
+        if (!nd || !np || !nn) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    }
+    /* Intrinsics are for the camera's size: photos of another size get them
+     * rescaled (the same lens at another resolution; mr_detect_each keeps
+     * the first photo's size for all). */
+    if (ps->n == 0 && (f->image.width != ps->cam->width || f->image.height != ps->cam->height))
+        *ps->cam = mr_camera_resized(ps->cam, f->image.width, f->image.height);
+    int i = ps->n;
+    ps->dets[i] = k ? malloc((size_t)k * sizeof **ps->dets) : NULL;
+    if (k && !ps->dets[i]) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    if (k) memcpy(ps->dets[i], d, (size_t)k * sizeof *d);
+    snprintf(ps->names[i], sizeof ps->names[i], "%s", f->name[0] ? f->name : "frame");
+    ps->photos[i] = (mr_map_photo){ps->dets[i], k, ps->names[i]};
+    ps->n++;
+    if (ps->tty) fprintf(stderr, "\rmap: detecting, photo %d   ", ps->n);
+    mr_log(MR_LOG_INFO, "%s: %d tags", ps->names[i], k);
+    return true;
+}
+
 int cmd_map(int argc, char **argv) {
     static const char *cmd = "map";
     mr_cli_opt opts[] = {
@@ -43,21 +83,19 @@ int cmd_map(int argc, char **argv) {
         {"video", "FILE", "instead: a video walked past the tags (every frame is a photo)", NULL},
         {"camera", "C.json", "camera intrinsics (mrcheck calibrate)", NULL},
         {"family", "F", "tag family (default tag36h11)", NULL},
-        {"tag-size", "S", "black-square edge of the tags, scene units", NULL},
         {"tag-sizes", "ID=S,...", "tags of other sizes", NULL},
         {"fix", "ID", "gauge: this tag's pose is given (--fix-pose, default identity)", NULL},
         {"fix-pose", "P.json", "{\"world_from_tag\": [16]} for the --fix tag", NULL},
         {"control", "P.json", "gauge: >= 3 control points with plan coordinates and sigma", NULL},
-        {"refine-intrinsics", NULL, "also adjust fx fy cx cy k1 k2", NULL},
-        {"chain", NULL, "no global adjustment: chain relative poses along the spanning tree (baseline)", NULL},
-        {"loss", "PX", "Huber scale of the corner residuals (default 1 px)", NULL},
         {"out", "MARKERS.json", "marker map to write (with sigma, RMS, control residuals)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
+    mr_map_params mp = MR_MAP_DEFAULTS;
+    mr_cli_table table = {"", mr_map_opts, &mp, NULL, false, {0}};
     bool help;
-    if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck map (--images DIR | --video FILE) --camera C.json --tag-size S\n"
                    "                   [--tag-sizes ID=S,...] (--fix ID [--fix-pose P.json] | --control P.json)\n"
                    "                   --out MARKERS.json\n"
@@ -75,17 +113,11 @@ int cmd_map(int argc, char **argv) {
     if (mr_cli_get(opts, "images") && mr_cli_get(opts, "video")) return mr_cli_errorf(cmd, "give --images or --video, not both"), 2;
     if (!mr_cli_get(opts, "fix") == !mr_cli_get(opts, "control"))
         return mr_cli_errorf(cmd, "give the gauge: --fix ID or --control P.json (one of them)"), 2;
-    if (!mr_cli_get(opts, "tag-size") && !mr_cli_get(opts, "tag-sizes"))
+    if (!(mp.tag_size > 0) && !mr_cli_get(opts, "tag-sizes"))
         return mr_cli_errorf(cmd, "--tag-size (or --tag-sizes) is required"), 2;
     const char *family = mr_cli_get(opts, "family") ? mr_cli_get(opts, "family") : "tag36h11";
     if (!mr_tag_family_known(family)) return mr_cli_errorf(cmd, "unknown tag family '%s'", family), 2;
 
-    mr_map_params mp = MR_MAP_DEFAULTS;
-    if (mr_cli_get(opts, "tag-size") && !mr_cli_double("tag-size", mr_cli_get(opts, "tag-size"), 1e-9, 1e9, &mp.tag_size))
-        return 2;
-    if (mr_cli_get(opts, "loss") && !mr_cli_double("loss", mr_cli_get(opts, "loss"), 1e-3, 1e3, &mp.loss_px)) return 2;
-    mp.refine_intrinsics = mr_cli_flag(opts, "refine-intrinsics");
-    mp.no_adjust = mr_cli_flag(opts, "chain");
     int *size_ids = NULL;
     double *sizes = NULL;
     if (mr_cli_get(opts, "tag-sizes") && !parse_sizes(mr_cli_get(opts, "tag-sizes"), &size_ids, &sizes, &mp.size_count)) {
@@ -100,12 +132,10 @@ int cmd_map(int argc, char **argv) {
     mr_camera cam;
     mr_dmat4 fix_pose;
     mr_map_control *ctl = NULL;
-    mr_source *src = NULL;
-    mr_detector *det = NULL;
     mr_detection **dets = NULL;
     mr_map_photo *photos = NULL;
     char (*names)[256] = NULL;
-    int n = 0, cap = 0;
+    int n = 0;
     int rc = 1;
     mr_map_result res = {0};
     mr_marker_map mm = {0};
@@ -134,63 +164,14 @@ int cmd_map(int argc, char **argv) {
         mp.controls = ctl;
     }
 
-    mr_source_params sp = MR_SOURCE_DEFAULTS;
-    sp.gray = true;
-    src = mr_source_open(in, &sp, &err);
-    if (!src) goto fail;
-    mr_detector_params dp = MR_DETECTOR_DEFAULTS;
-    dp.family = family;
-    dp.decimate = 1; /* full resolution: corner accuracy is the map's accuracy */
-    det = mr_detector_create(&dp, &err);
-    if (!det) goto fail;
-    bool tty = isatty(2) && mr_log_get_level() >= MR_LOG_WARN;
-    for (;;) {
-        mr_frame f;
-        mr_read_status st = mr_source_read(src, &f, &err);
-        if (st == MR_READ_END) break;
-        if (st == MR_READ_ERROR) goto fail;
-        if (n == cap) {
-            cap = cap ? 2 * cap : 64;
-            mr_detection **nd = realloc(dets, (size_t)cap * sizeof *nd);
-            if (nd) dets = nd;
-            mr_map_photo *np = realloc(photos, (size_t)cap * sizeof *np);
-            if (np) photos = np;
-            char (*nn)[256] = realloc(names, (size_t)cap * sizeof *nn);
-            if (nn) names = nn;
-            if (!nd || !np || !nn) {
-                mr_fail(&err, MR_ERR_NOMEM, "out of memory");
-                goto fail;
-            }
-        }
-        /* Intrinsics are for the camera's size: the first photo of another
-         * size gets them rescaled (the same lens at another resolution);
-         * later photos must match it. */
-        if (n == 0 && (f.image.width != cam.width || f.image.height != cam.height))
-            cam = mr_camera_resized(&cam, f.image.width, f.image.height);
-        if (f.image.width != cam.width || f.image.height != cam.height) {
-            fprintf(stderr, "mrcheck: map: warning: %s is %dx%d, not %dx%d; skipped\n", f.name, f.image.width,
-                    f.image.height, cam.width, cam.height);
-            continue;
-        }
-        int k = 0;
-        mr_error fe = {0};
-        const mr_detection *d = mr_detector_detect(det, &f.image, &k, &fe);
-        if (!d) {
-            fprintf(stderr, "mrcheck: map: warning: %s: %s\n", f.name, fe.msg);
-            continue;
-        }
-        dets[n] = k ? malloc((size_t)k * sizeof **dets) : NULL;
-        if (k && !dets[n]) {
-            mr_fail(&err, MR_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        if (k) memcpy(dets[n], d, (size_t)k * sizeof *d);
-        snprintf(names[n], sizeof names[n], "%s", f.name[0] ? f.name : "frame");
-        photos[n] = (mr_map_photo){dets[n], k, names[n]};
-        n++;
-        if (tty) fprintf(stderr, "\rmap: detecting, photo %d   ", n);
-        mr_log(MR_LOG_INFO, "%s: %d tags", names[n - 1], k);
-    }
+    photo_set ps = {&cam, NULL, NULL, NULL, 0, 0, isatty(2) && mr_log_get_level() >= MR_LOG_WARN};
+    bool tty = ps.tty;
+    bool detected = mr_detect_each(in, family, cmd, take_photo, &ps, NULL, &err);
+    dets = ps.dets;
+    photos = ps.photos;
+    names = ps.names;
+    n = ps.n;
+    if (!detected) goto fail;
     if (tty) {
         fprintf(stderr, "\n");
         mp.progress = progress;
@@ -245,8 +226,6 @@ out:
     free(size_ids);
     free(sizes);
     free(ctl);
-    mr_detector_destroy(&det);
-    mr_source_close(&src);
     mr_map_result_free(&res);
     mr_marker_map_free(&mm);
     return rc;

@@ -13,12 +13,12 @@ int cmd_measure(int argc, char **argv) {
         {"recording", "DIR", "recording whose frames were tapped (poses and their covariance)", NULL},
         {"observations", "OBS.json", "{\"taps\": [{\"frame\": N, \"px\": [u, v]}, ...], \"planned\": [x, y, z]}", NULL},
         {"out", "RESULT.json", "also write the result there", NULL},
-        {"tap-sigma", "PX", "1-sigma of a tap (default 1 px)", NULL},
-        {"min-angle", "DEG", "refuse rays closer than this (default 2 degrees)", NULL},
         {NULL, NULL, NULL, NULL},
     };
+    mr_triangulate_params tp = MR_TRIANGULATE_DEFAULTS;
+    mr_cli_table table = {"", mr_triangulate_opts, &tp, NULL, false, {0}};
     bool help;
-    if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck measure --recording DIR --observations OBS.json [--out RESULT.json]\n"
                    "Triangulates the feature tapped in two or more frames (linear, then refined, with the taps'\n"
                    "noise and each frame's pose covariance) and reports its distance to the planned point in mm\n"
@@ -28,11 +28,6 @@ int cmd_measure(int argc, char **argv) {
     if (help) return 0;
     const char *dir = mr_cli_get(opts, "recording"), *obsf = mr_cli_get(opts, "observations"), *out = mr_cli_get(opts, "out");
     if (!dir || !obsf) return mr_cli_errorf(cmd, "--recording and --observations are required (see --help)"), 2;
-    mr_triangulate_params tp = MR_TRIANGULATE_DEFAULTS;
-    if (mr_cli_get(opts, "tap-sigma") && !mr_cli_double("tap-sigma", mr_cli_get(opts, "tap-sigma"), 1e-3, 100, &tp.tap_sigma_px))
-        return 2;
-    if (mr_cli_get(opts, "min-angle") && !mr_cli_double("min-angle", mr_cli_get(opts, "min-angle"), 1e-3, 90, &tp.min_angle_deg))
-        return 2;
     mr_error err = {0};
     cJSON *obs = mr_json_load(obsf, &err);
     if (!obs) return mr_cli_error(cmd, &err);

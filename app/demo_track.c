@@ -42,22 +42,18 @@ int cmd_synth(int argc, char **argv) {
     static const char *cmd = "synth";
     mr_cli_opt opts[] = {
         {"out", "DIR", "recording folder to create (required; never overwritten)", NULL},
-        {"frames", "N", "frames spread over the walking path (default 120: one per path step)", NULL},
         {"size", "WxH", "frame size (default 640x480, the demo camera scaled)", NULL},
-        {"noise", "SIGMA", "sensor noise in grey levels (default 2)", NULL},
-        {"motion-blur", "N", "sub-frames averaged per frame, 1 = none (default 3)", NULL},
-        {"exposure", "A", "relative exposure swing along the path, 0..0.9 (default 0.25)", NULL},
-        {"jpeg", "Q", "JPEG quality of the stored frames (default 90)", NULL},
         {"seed", "N", "noise seed (default 1)", NULL},
-        {"fps", "F", "frame rate of the timestamps (default 10)", NULL},
         {"calibration", "DIR", "instead: write a calibration board and 12 images there", NULL},
         {"map-photos", "DIR", "instead: write a synthetic photo set for `mrcheck map` there (images/, camera.json, truth.json, control.json)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
+    mr_synth_recording_params p = {MR_SYNTH_RECORDING_DEFAULTS};
+    mr_cli_table table = {"", mr_synth_recording_opts, &p, NULL, false, {0}};
     bool help;
-    if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck synth --out DIR [--frames N] [--size WxH] [--noise S] [--motion-blur N] [--exposure A] [--jpeg Q]\n"
                    "Renders the as-built demo hall along a walking path with pauses and writes a tracked recording\n"
                    "with groundtruth.jsonl (needs EGL).",
@@ -77,38 +73,12 @@ int cmd_synth(int argc, char **argv) {
         return 0;
     }
     if (!mr_cli_get(opts, "out")) return mr_cli_errorf(cmd, "--out is required (see --help)"), 2;
-    mr_synth_recording_params p = {MR_SYNTH_RECORDING_DEFAULTS};
-    long l;
-    double v;
-    if (mr_cli_get(opts, "frames")) {
-        if (!mr_cli_int("frames", mr_cli_get(opts, "frames"), 1, 100000, &l)) return 2;
-        p.frames = (int)l;
-    }
     if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &p.width, &p.height)) return 2;
     if (p.width < 64 || p.height < 48) return mr_cli_errorf(cmd, "--size must be at least 64x48"), 2;
-    if (mr_cli_get(opts, "noise")) {
-        if (!mr_cli_double("noise", mr_cli_get(opts, "noise"), 0, 100, &v)) return 2;
-        p.noise = v;
-    }
-    if (mr_cli_get(opts, "motion-blur")) {
-        if (!mr_cli_int("motion-blur", mr_cli_get(opts, "motion-blur"), 1, 16, &l)) return 2;
-        p.motion_blur = (int)l;
-    }
-    if (mr_cli_get(opts, "exposure")) {
-        if (!mr_cli_double("exposure", mr_cli_get(opts, "exposure"), 0, 0.9, &v)) return 2;
-        p.exposure = v;
-    }
-    if (mr_cli_get(opts, "jpeg")) {
-        if (!mr_cli_int("jpeg", mr_cli_get(opts, "jpeg"), 1, 100, &l)) return 2;
-        p.jpeg_quality = (int)l;
-    }
+    long l;
     if (mr_cli_get(opts, "seed")) {
         if (!mr_cli_int("seed", mr_cli_get(opts, "seed"), 0, 1L << 40, &l)) return 2;
         p.seed = (uint64_t)l;
-    }
-    if (mr_cli_get(opts, "fps")) {
-        if (!mr_cli_double("fps", mr_cli_get(opts, "fps"), 0.1, 1000, &v)) return 2;
-        p.fps = v;
     }
     double t0 = mr_time_now();
     if (!synth_recording(mr_cli_get(opts, "out"), &p, &err)) return mr_cli_error(cmd, &err);

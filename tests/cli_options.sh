@@ -120,7 +120,7 @@ accepted refine-edges 0
 # outside its printed range with one line before it opens a GPU or writes
 # anything. (An accepted value would run the bench, so only refusals here;
 # test_options walks the same tables in-process, both ways.)
-for b in ao frame ghost scene tracking; do
+for b in ao frame ghost scene tracking shadows multiview map; do
   "$mr" bench $b --help >"$tmp/bench_$b.txt" 2>&1 || bad "bench $b --help failed"
   grep -E "$table_rows" "$tmp/bench_$b.txt" >"$tmp/bench_${b}_rows.txt"
   refuse_cmd=("$mr" bench "$b" --out "$tmp/bench_$b")

@@ -254,6 +254,8 @@ static void test_tables(void) {
     const mr_filter_params fp = MR_FILTER_DEFAULTS;
     walk_table("mr_detector_opts", mr_detector_opts, sizeof dp, &dp);
     walk_table("mr_filter_opts", mr_filter_opts, sizeof fp, &fp);
+    const mr_map_params mpp = MR_MAP_DEFAULTS;
+    walk_table("mr_map_opts", mr_map_opts, sizeof mpp, &mpp);
     const mr_draw_params dr = MR_DRAW_DEFAULTS;
     walk_table("mr_draw_opts", mr_draw_opts, sizeof dr, &dr);
     const mr_gt_params gt = MR_GT_DEFAULTS;
@@ -268,6 +270,18 @@ static void test_tables(void) {
     walk_table("mr_bench_ghost_opts", mr_bench_ghost_opts, sizeof bgh, &bgh);
     walk_table("mr_bench_scene_opts", mr_bench_scene_opts, sizeof bsc, &bsc);
     walk_table("mr_bench_tracking_opts", mr_bench_tracking_opts, sizeof btr, &btr);
+    const mr_bench_shadows_params bsh = {MR_BENCH_SHADOWS_DEFAULTS};
+    const mr_bench_multiview_params bmv = {MR_BENCH_MULTIVIEW_DEFAULTS};
+    const mr_bench_map_params bmp = {MR_BENCH_MAP_DEFAULTS};
+    walk_table("mr_bench_shadows_opts", mr_bench_shadows_opts, sizeof bsh, &bsh);
+    walk_table("mr_bench_multiview_opts", mr_bench_multiview_opts, sizeof bmv, &bmv);
+    walk_table("mr_bench_map_opts", mr_bench_map_opts, sizeof bmp, &bmp);
+    const mr_board_calib_params bcp = {.min_tags = 0};
+    const mr_triangulate_params trp = MR_TRIANGULATE_DEFAULTS;
+    const mr_synth_recording_params srp = {MR_SYNTH_RECORDING_DEFAULTS};
+    walk_table("mr_board_calib_opts", mr_board_calib_opts, sizeof bcp, &bcp);
+    walk_table("mr_triangulate_opts", mr_triangulate_opts, sizeof trp, &trp);
+    walk_table("mr_synth_recording_opts", mr_synth_recording_opts, sizeof srp, &srp);
     const mr_batch_replay_params rp = MR_BATCH_REPLAY_DEFAULTS;
     walk_table("mr_batch_replay_opts", mr_batch_replay_opts, sizeof rp, &rp);
 
@@ -355,6 +369,41 @@ static void test_tables(void) {
         N(mr_draw_params, "lod-pixels", lod_pixels, 1e-3, 1e4),
         N(mr_draw_params, "occlusion", occlusion, 0, 1),
     };
+    const expect ex_mp[] = {
+        N(mr_map_params, "tag-size", tag_size, 1e-9, 1e9),
+        N(mr_map_params, "loss", loss_px, 1e-3, 1e3),
+        N(mr_map_params, "refine-intrinsics", refine_intrinsics, 0, 1),
+        N(mr_map_params, "chain", no_adjust, 0, 1),
+    };
+    const expect ex_bsh[] = {
+        N(mr_bench_shadows_params, "frames", frames, 1, 64),
+        N(mr_bench_shadows_params, "rays", rays, 1, 1 << 16),
+        N(mr_bench_shadows_params, "first", first, 0, MR_SHADOW_SUITE_COUNT - 1),
+        N(mr_bench_shadows_params, "count", count, 1, MR_SHADOW_SUITE_COUNT),
+        N(mr_bench_shadows_params, "views", views, 1, 2),
+    };
+    const expect ex_bmv[] = {
+        N(mr_bench_multiview_params, "frames", frames, 1, 64),
+        N(mr_bench_multiview_params, "rays", rays, 1, 1 << 16),
+        N(mr_bench_multiview_params, "quick", quick, 0, 1),
+    };
+    const expect ex_bmp[] = {
+        N(mr_bench_map_params, "seeds", seeds, 1, 1000),
+        N(mr_bench_map_params, "max-photos", max_photos, 10, 200),
+        N(mr_bench_map_params, "noise", noise_px, 0, 10),
+        N(mr_bench_map_params, "misdetect", misdetect, 0, 1),
+    };
+    const expect ex_bcp[] = {N(mr_board_calib_params, "min-tags", min_tags, 1, 10000)};
+    const expect ex_trp[] = {N(mr_triangulate_params, "tap-sigma", tap_sigma_px, 1e-3, 100),
+                             N(mr_triangulate_params, "min-angle", min_angle_deg, 1e-3, 90)};
+    const expect ex_srp[] = {
+        N(mr_synth_recording_params, "frames", frames, 1, 100000),
+        N(mr_synth_recording_params, "noise", noise, 0, 100),
+        N(mr_synth_recording_params, "motion-blur", motion_blur, 1, 16),
+        N(mr_synth_recording_params, "exposure", exposure, 0, 0.9),
+        N(mr_synth_recording_params, "jpeg", jpeg_quality, 1, 100),
+        N(mr_synth_recording_params, "fps", fps, 0.1, 1000),
+    };
     const expect ex_gt[] = {N(mr_gt_params, "rays", rays, 1, 1 << 20)};
     const expect ex_bao[] = {
         N(mr_bench_ao_params, "frames", frames, 1, 64),
@@ -386,6 +435,13 @@ static void test_tables(void) {
 #define ROWS(t, ex) check_rows(#t, t, ex, (int)(sizeof ex / sizeof ex[0]))
     ROWS(mr_gt_opts, ex_gt);
     ROWS(mr_draw_opts, ex_dr);
+    ROWS(mr_map_opts, ex_mp);
+    ROWS(mr_bench_shadows_opts, ex_bsh);
+    ROWS(mr_bench_multiview_opts, ex_bmv);
+    ROWS(mr_bench_map_opts, ex_bmp);
+    ROWS(mr_board_calib_opts, ex_bcp);
+    ROWS(mr_triangulate_opts, ex_trp);
+    ROWS(mr_synth_recording_opts, ex_srp);
     /* The negated switches: the option on is the field off, both ways. */
     {
         mr_draw_params d = MR_DRAW_DEFAULTS;

@@ -47,6 +47,7 @@ typedef struct mr_bench_shadows_params {
 } mr_bench_shadows_params;
 #define MR_BENCH_SHADOWS_DEFAULTS .out_dir = "bench-out", .width = 320, .height = 240, .frames = 3, .rays = 256
 bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err);
+extern const mr_opt mr_bench_shadows_opts[]; /* frames, rays, first, count, views */
 
 /* ------------------------------------------------------------------- ao */
 
@@ -184,6 +185,7 @@ typedef struct mr_bench_map_params {
 #define MR_BENCH_MAP_DEFAULTS \
     .out_dir = "bench-out", .seeds = 5, .tags = 16, .radius = 3.0, .noise_px = 0.3, .misdetect = 0.05
 bool mr_bench_map(const mr_bench_map_params *params, mr_error *err);
+extern const mr_opt mr_bench_map_opts[]; /* seeds, max-photos, noise, misdetect */
 
 /* ------------------------------------------------------ synthetic data */
 
@@ -211,6 +213,9 @@ typedef struct mr_synth_recording_params {
     .frames = 120, .width = 640, .height = 480, .noise = 2.0, .motion_blur = 3, .exposure = 0.25, .jpeg_quality = 90, \
     .seed = 1, .fps = 10.0
 bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params, const mr_bench_gpu *gfx, mr_error *err);
+/* frames, noise, motion-blur, exposure, jpeg, fps (the seed, 64 bits, and
+ * the size stay the command's own options). */
+extern const mr_opt mr_synth_recording_opts[];
 /* The calibration set: dir/board.json (the board of mr_demo_board_tag as a
  * marker map) and dir/images/board_NN.png, `images` (>= 1) views of it from
  * around, rendered on the CPU through the demo camera. */
@@ -241,6 +246,7 @@ typedef struct mr_bench_multiview_params {
 #define MR_BENCH_MULTIVIEW_DEFAULTS .out_dir = "bench-out", .budget_w = 1024, .budget_h = 768, .view_w = 160, \
                                     .view_h = 120, .table_w = 1024, .table_h = 768, .frames = 3, .rays = 64
 bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err);
+extern const mr_opt mr_bench_multiview_opts[]; /* frames, rays, quick */
 
 /* A synthetic photo set for the marker map (synth_map.c): `tags` tags on a
  * ring of walls (radius, facing its centre, a little tilted; with

@@ -52,3 +52,48 @@ const mr_opt mr_bench_tracking_opts[] = {
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef TR
+
+#define SH(f) offsetof(mr_bench_shadows_params, f)
+const mr_opt mr_bench_shadows_opts[] = {
+    {"frames", MR_OPT_INT, SH(frames), 1, 64, 3, NULL, "timed frames per row, median reported", 0},
+    {"rays", MR_OPT_INT, SH(rays), 1, 1 << 16, 256, NULL, "Embree reference rays per pixel", 0},
+    {"first", MR_OPT_INT, SH(first), 0, MR_SHADOW_SUITE_COUNT - 1, 0, NULL, "first suite case", 0},
+    {"count", MR_OPT_INT, SH(count), 1, MR_SHADOW_SUITE_COUNT, 0, NULL, "suite cases from --first (auto: to the last)",
+     MR_OPT_ZERO_AUTO},
+    /* 0 in the field is both views, as mr_bench_shadows reads it. */
+    {"views", MR_OPT_INT, SH(views), 1, 2, 2, NULL, "views per case", MR_OPT_ZERO_DEFAULT},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef SH
+
+#define MV(f) offsetof(mr_bench_multiview_params, f)
+const mr_opt mr_bench_multiview_opts[] = {
+    {"frames", MR_OPT_INT, MV(frames), 1, 64, 3, NULL, "timed runs, median reported", 0},
+    {"rays", MR_OPT_INT, MV(rays), 1, 1 << 16, 64, NULL, "reference rays per pixel", 0},
+    {"quick", MR_OPT_BOOL, MV(quick), 0, 1, 0, NULL, "views 1 and 8 only", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef MV
+
+#define MP(f) offsetof(mr_bench_map_params, f)
+const mr_opt mr_bench_map_opts[] = {
+    {"seeds", MR_OPT_INT, MP(seeds), 1, 1000, 5, NULL, "photo sets per photo count, median reported", 0},
+    {"max-photos", MR_OPT_INT, MP(max_photos), 10, 200, 0, NULL, "photo counts up to this (auto: all, 200)",
+     MR_OPT_ZERO_AUTO},
+    {"noise", MR_OPT_DOUBLE, MP(noise_px), 0, 10, 0.3, NULL, "corner noise sigma, px", 0},
+    {"misdetect", MR_OPT_DOUBLE, MP(misdetect), 0, 1, 0.05, NULL, "fraction of photos with one wrong id", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef MP
+
+#define SR(f) offsetof(mr_synth_recording_params, f)
+const mr_opt mr_synth_recording_opts[] = {
+    {"frames", MR_OPT_INT, SR(frames), 1, 100000, 120, NULL, "frames spread over the walking path (120: one per path step)", 0},
+    {"noise", MR_OPT_DOUBLE, SR(noise), 0, 100, 2.0, NULL, "sensor noise in grey levels", 0},
+    {"motion-blur", MR_OPT_INT, SR(motion_blur), 1, 16, 3, NULL, "sub-frames averaged per frame, 1 = none", 0},
+    {"exposure", MR_OPT_DOUBLE, SR(exposure), 0, 0.9, 0.25, NULL, "relative exposure swing along the path", 0},
+    {"jpeg", MR_OPT_INT, SR(jpeg_quality), 1, 100, 90, NULL, "JPEG quality of the stored frames", 0},
+    {"fps", MR_OPT_DOUBLE, SR(fps), 0.1, 1000, 10.0, NULL, "frame rate of the timestamps", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef SR

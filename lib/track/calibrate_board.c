@@ -43,6 +43,41 @@ static bool view_from_detections(const mr_marker_map *map, const mr_detection *d
     return true;
 }
 
+/* The views gathered so far, as mr_detect_each hands the photos over. */
+typedef struct gather {
+    const mr_marker_map *map;
+    int min_tags;
+    mr_board_calib *out;
+    mr_calib_view *views;
+    int cap, width, height;
+} gather;
+
+static bool take_photo(void *user, const mr_frame *f, const mr_detection *d, int n, mr_error *err) {
+    gather *g = user;
+    mr_board_calib *out = g->out;
+    int used = 0;
+    for (int i = 0; i < n; i++) used += mr_marker_map_find(g->map, d[i].id) != NULL;
+    if (used < g->min_tags) {
+        mr_log(MR_LOG_INFO, "%s: %d board tags, skipped", f->name, used);
+        out->skipped++;
+        return true;
+    }
+    if (out->views == g->cap) {
+        g->cap = g->cap ? 2 * g->cap : 16;
+        mr_calib_view *nvw = realloc(g->views, (size_t)g->cap * sizeof *nvw);
+        char(*nn)[256] = realloc(out->names, (size_t)g->cap * sizeof *nn);
+        if (nvw) g->views = nvw;
+        if (nn) out->names = nn;
+        if (!nvw || !nn) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    }
+    if (!view_from_detections(g->map, d, n, used, &g->views[out->views])) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    snprintf(out->names[out->views], 256, "%s", f->name);
+    out->views++;
+    g->width = f->image.width;
+    g->height = f->image.height;
+    return true;
+}
+
 bool mr_calibrate_board(const mr_board_calib_params *p, mr_board_calib *out, mr_error *err) {
     memset(out, 0, sizeof *out);
     const mr_marker_map *map = p->board;
@@ -50,81 +85,18 @@ bool mr_calibrate_board(const mr_board_calib_params *p, mr_board_calib *out, mr_
     if (!board_is_planar(map))
         return mr_fail(err, MR_ERR_INVALID, "%s: the board must be planar (all tags in the z = 0 plane)",
                        p->board_name ? p->board_name : "board");
-    const int min_tags = p->min_tags > 0 ? p->min_tags : MR_BOARD_CALIB_DEFAULT_MIN_TAGS;
-    mr_source_params sp = MR_SOURCE_DEFAULTS;
-    sp.gray = true;
-    mr_source *src = mr_source_open(p->images, &sp, err);
-    mr_detector_params dp = MR_DETECTOR_DEFAULTS;
-    dp.family = map->family;
-    dp.decimate = 1; /* full resolution: corner accuracy matters here */
-    mr_detector *det = src ? mr_detector_create(&dp, err) : NULL;
-    if (!det) {
-        mr_source_close(&src);
-        return false;
-    }
-    int cap = 0, nv = 0, width = 0, height = 0;
-    mr_calib_view *views = NULL;
-    bool ok = true;
-    for (;;) {
-        mr_frame f;
-        mr_read_status st = mr_source_read(src, &f, err);
-        if (st == MR_READ_END) break;
-        if (st == MR_READ_ERROR) {
-            ok = false;
-            break;
-        }
-        if (width == 0) {
-            width = f.image.width;
-            height = f.image.height;
-        } else if (f.image.width != width || f.image.height != height) {
-            fprintf(stderr, "mrcheck: calibrate: warning: %s is %dx%d, not %dx%d; skipped\n", f.name, f.image.width,
-                    f.image.height, width, height);
-            out->skipped++;
-            continue;
-        }
-        int n = 0;
-        mr_error fe = {0};
-        const mr_detection *d = mr_detector_detect(det, &f.image, &n, &fe);
-        if (!d) {
-            fprintf(stderr, "mrcheck: calibrate: warning: %s: %s\n", f.name, fe.msg);
-            out->skipped++;
-            continue;
-        }
-        int used = 0;
-        for (int i = 0; i < n; i++) used += mr_marker_map_find(map, d[i].id) != NULL;
-        if (used < min_tags) {
-            mr_log(MR_LOG_INFO, "%s: %d board tags, skipped", f.name, used);
-            out->skipped++;
-            continue;
-        }
-        if (nv == cap) {
-            cap = cap ? 2 * cap : 16;
-            mr_calib_view *nvw = realloc(views, (size_t)cap * sizeof *nvw);
-            char(*nn)[256] = realloc(out->names, (size_t)cap * sizeof *nn);
-            if (nvw) views = nvw;
-            if (nn) out->names = nn;
-            if (!nvw || !nn) {
-                ok = mr_fail(err, MR_ERR_NOMEM, "out of memory");
-                break;
-            }
-        }
-        if (!view_from_detections(map, d, n, used, &views[nv])) {
-            ok = mr_fail(err, MR_ERR_NOMEM, "out of memory");
-            break;
-        }
-        snprintf(out->names[nv], 256, "%s", f.name);
-        nv++;
-    }
-    out->views = nv;
+    gather g = {map, p->min_tags > 0 ? p->min_tags : MR_BOARD_CALIB_DEFAULT_MIN_TAGS, out, NULL, 0, 0, 0};
+    int skipped = 0;
+    bool ok = mr_detect_each(p->images, map->family, "calibrate", take_photo, &g, &skipped, err);
+    out->skipped += skipped;
+    const int nv = out->views;
     out->view_rms_px = nv ? calloc((size_t)nv, sizeof *out->view_rms_px) : NULL;
-    ok = ok && mr_calibrate(views, nv, width, height, &out->camera, &out->rms_px, out->view_rms_px, err);
+    ok = ok && mr_calibrate(g.views, nv, g.width, g.height, &out->camera, &out->rms_px, out->view_rms_px, err);
     for (int v = 0; v < nv; v++) {
-        free((void *)views[v].object);
-        free((void *)views[v].image);
+        free((void *)g.views[v].object);
+        free((void *)g.views[v].image);
     }
-    free(views);
-    mr_detector_destroy(&det);
-    mr_source_close(&src);
+    free(g.views);
     if (!ok) mr_board_calib_free(out);
     return ok;
 }

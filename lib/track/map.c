@@ -378,7 +378,7 @@ static bool run_ba(const ctx_t *c, int nt, const int *tag_of, mr_dmat4 *wft, int
             .ctl_world = cw,
             .ctl_sigma = cs,
             .ctl_use = cu,
-            .loss_px = p->loss_px > 0 ? p->loss_px : 1.0,
+            .loss_px = p->loss_px > 0 ? p->loss_px : MR_MAP_DEFAULT_LOSS_PX,
             .max_iterations = p->max_iterations > 0 ? p->max_iterations : 100,
             .threads = p->threads > 0 ? p->threads : 1,
             .want_cov = want_cov,

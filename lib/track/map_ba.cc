@@ -124,7 +124,7 @@ extern "C" bool mr_ba_solve(mr_ba_problem *p, char *msg, size_t msg_size) {
         std::unique_ptr<ceres::SubsetManifold> kman(new ceres::SubsetManifold(9, {6, 7, 8}));
         std::vector<bool> tag_used(p->ntags, false), cam_used(p->nphotos, false);
         int nres = 0;
-        const double loss_px = p->loss_px > 0 ? p->loss_px : 1.0;
+        const double loss_px = p->loss_px > 0 ? p->loss_px : MR_MAP_DEFAULT_LOSS_PX;
         /* The whole problem, corners weighted by w = 1 / their sigma (px)
          * and the control points by theirs, so that both speak in sigmas. */
         auto build = [&](ceres::Problem &problem, double w, ceres::LossFunction *loss) {

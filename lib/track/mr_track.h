@@ -169,6 +169,10 @@ typedef struct mr_map_params {
     void *progress_user;
 } mr_map_params;
 #define MR_MAP_DEFAULTS {.tag_size = 0.0, .fix_id = 0, .fix_pose = NULL, .controls = NULL, .control_count = 0}
+#define MR_MAP_DEFAULT_LOSS_PX 1.0
+/* Option table (lib/track/options.c) of the numbers and switches above:
+ * tag-size, loss, refine-intrinsics, chain. */
+extern const mr_opt mr_map_opts[];
 
 typedef struct mr_map_tag {
     int id;
@@ -320,7 +324,10 @@ typedef struct mr_triangulate_params {
     double tap_sigma_px;     /* a tap's 1-σ per axis, px; 0 = 1.0 */
     double min_angle_deg;    /* refused below this largest angle between rays; 0 = 2 */
 } mr_triangulate_params;
-#define MR_TRIANGULATE_DEFAULTS {0.0, 0.0}
+#define MR_TRIANGULATE_DEFAULT_TAP_SIGMA_PX 1.0
+#define MR_TRIANGULATE_DEFAULT_MIN_ANGLE_DEG 2.0
+#define MR_TRIANGULATE_DEFAULTS {.tap_sigma_px = 0.0, .min_angle_deg = 0.0} /* 0 = the defaults above */
+extern const mr_opt mr_triangulate_opts[]; /* tap-sigma, min-angle */
 typedef struct mr_triangulation {
     mr_dvec3 point;          /* world, scene units */
     double cov[9];           /* 3x3 covariance of point (taps and poses) */
@@ -544,6 +551,18 @@ void mr_aruco_destroy(mr_aruco **a);
 const mr_detection *mr_aruco_detect(mr_aruco *a, const mr_image *img, int *count, mr_error *err);
 const char *mr_aruco_refine_name(mr_aruco_refine refine);
 
+/* ------------------------------------------------ photo sets
+ * What calibration and mapping share: every image of a folder, a video or
+ * one image (grey, mr_source_open) through one detector at full
+ * resolution, since corner accuracy is what they measure. Frames of
+ * another size than the first, and frames the detector refuses, are skipped
+ * with a warning "mrcheck: WHO: warning: ..." on stderr. fn gets each
+ * other frame and its detections (valid during the call); false from fn
+ * stops the run and fails it. */
+typedef bool (*mr_detect_each_fn)(void *user, const mr_frame *f, const mr_detection *d, int count, mr_error *err);
+bool mr_detect_each(const char *input, const char *family, const char *who, mr_detect_each_fn fn, void *user,
+                    int *skipped, mr_error *err);
+
 /* ------------------------------------------------------- calibration */
 
 /* One image's correspondences: n board points (board frame, z = 0) and
@@ -572,6 +591,7 @@ typedef struct mr_board_calib_params {
     int min_tags;                 /* 0 = 4 */
 } mr_board_calib_params;
 #define MR_BOARD_CALIB_DEFAULT_MIN_TAGS 4
+extern const mr_opt mr_board_calib_opts[]; /* min-tags */
 typedef struct mr_board_calib {
     mr_camera camera;
     double rms_px;                /* RMS reprojection error over all views */

@@ -70,7 +70,8 @@ bool mr_triangulate(const mr_camera *cam, const mr_tap *taps, int n, const mr_tr
                     mr_triangulation *out, mr_error *err) {
     memset(out, 0, sizeof *out);
     mr_triangulate_params p = params ? *params : (mr_triangulate_params)MR_TRIANGULATE_DEFAULTS;
-    double sig = p.tap_sigma_px > 0 ? p.tap_sigma_px : 1.0, min_angle = p.min_angle_deg > 0 ? p.min_angle_deg : 2.0;
+    double sig = p.tap_sigma_px > 0 ? p.tap_sigma_px : MR_TRIANGULATE_DEFAULT_TAP_SIGMA_PX,
+           min_angle = p.min_angle_deg > 0 ? p.min_angle_deg : MR_TRIANGULATE_DEFAULT_MIN_ANGLE_DEG;
     if (!cam || (n > 0 && !taps)) return mr_fail(err, MR_ERR_INVALID, "triangulate: bad arguments");
     if (n < 2) return mr_fail(err, MR_ERR_INVALID, "triangulate: %d tap(s); a point needs taps in 2 or more frames", n);
     if (!mr_camera_validate(cam, err)) return false;
