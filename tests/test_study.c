@@ -40,7 +40,8 @@ static void test_families(void) {
     CHECK(n == 4 && seen[MR_SHADOW_HARD] && seen[MR_SHADOW_PCF] && seen[MR_SHADOW_PCSS] && seen[MR_SHADOW_BP]);
     for (int c = 0; c < MR_STUDY_SHADOW_CASES; c++) {
         bool found = false;
-        for (int i = 0; i < MR_SHADOW_SUITE_COUNT; i++) found |= strcmp(mr_shadow_suite_name(i), mr_study_shadow_cases[c]) == 0;
+        for (int i = 0; i < MR_SHADOW_SUITE_COUNT; i++)
+            found |= strcmp(mr_shadow_suite_name(i), mr_study_shadow_cases[c]) == 0;
         CHECK_MSG(found && strcmp(mr_study_shadow_cases[c], "factory") != 0, "case %s", mr_study_shadow_cases[c]);
     }
     /* Out-of-range arguments fail before anything is rendered or written. */

@@ -118,7 +118,8 @@ static bool render_stimulus(mr_renderer *r, const mr_study_family *fam, const mr
     }
     if (ok && fam->has_reference && fam->reference) {
         mr_frame_result res = {0};
-        ok = fam->reference(r, scene, view, &base, p, &res, err) && save(dir, MR_STUDY_REFERENCE, stim, &res.color, err);
+        ok = fam->reference(r, scene, view, &base, p, &res, err) &&
+             save(dir, MR_STUDY_REFERENCE, stim, &res.color, err);
         mr_frame_result_free(&res);
         if (ok && count) (*count)++;
     }
