@@ -25,7 +25,7 @@ static int study_stimuli(int argc, char **argv) {
     mr_cli_table tables[] = {{.prefix = "", .table = mr_study_stimuli_opts, .params = &sp}};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, tables, 1, NULL, 0, NULL,
-                          "usage: mrcheck study stimuli --family ao|ghost --out DIR [--views N] [--width W --height H]",
+                          "usage: mrcheck study stimuli --family ao|ghost|shadows --out DIR [--views N] [--width W --height H]",
                           &help))
         return 2;
     if (help) return 0;

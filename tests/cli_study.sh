@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `mrcheck study` end to end: stimuli of the demo hall (ao with its
-# ray-traced reference, ghost without one), plans reproducible from the
-# seed, the run window under Xvfb driven by --script (three buttons and the
+# ray-traced reference, ghost without one, shadows of the hall and a
+# suite case with the ground truth as the reference), plans reproducible
+# from the seed, the run window under Xvfb driven by --script (three buttons and the
 # slider), a run killed with kill -9 that resumes at the next unanswered
 # trial (also after a torn last line), answers twice, votes for another
 # plan, and analyze's files. Bad input gives one line and no output.
@@ -30,6 +31,23 @@ n=$(ls "$tmp"/ao/*/hall_v*.png | wc -l)
 "$mr" study stimuli --family ghost --out "$tmp/ghost" --views 1 --width 96 --height 72 >"$tmp/sg.log" 2>&1 && ok || bad "ghost stimuli: $(cat "$tmp/sg.log")"
 [ "$(ls "$tmp"/ghost | tr '\n' ' ')" = "adaptive alpha g0 " ] && ok || bad "ghost methods: $(ls "$tmp/ghost")"
 cmp -s "$tmp/ghost/alpha/hall_v0.png" "$tmp/ghost/adaptive/hall_v0.png" && bad "ghost: alpha and adaptive give the same image" || ok
+# shadows: the hall (default sun) and both views of one suite case, four
+# methods and the ground truth as the reference; block II needs it.
+"$mr" study stimuli --family shadows --out "$tmp/sh" --views 1 --cases 1 --width 96 --height 72 --gt-samples 16 >"$tmp/ss.log" 2>&1 && ok || bad "shadows stimuli: $(cat "$tmp/ss.log")"
+[ "$(ls "$tmp"/sh | tr '\n' ' ')" = "bp hard pcf pcss reference " ] && ok || bad "shadows methods: $(ls "$tmp/sh")"
+for m in bp hard pcf pcss reference; do
+  [ "$(ls "$tmp/sh/$m" 2>/dev/null | tr '\n' ' ')" = "hall_v0.png simple_varying_overlap_v0.png simple_varying_overlap_v1.png " ] && ok ||
+    bad "shadows $m: $(ls "$tmp/sh/$m" 2>&1)"
+done
+grep -q "15 images of family shadows" "$tmp/ss.log" && ok || bad "shadows: expected 3 stimuli x 5 images: $(cat "$tmp/ss.log")"
+cmp -s "$tmp/sh/hard/hall_v0.png" "$tmp/sh/pcss/hall_v0.png" && bad "shadows: hard and pcss give the same hall image" || ok
+cmp -s "$tmp/sh/hard/simple_varying_overlap_v0.png" "$tmp/sh/reference/simple_varying_overlap_v0.png" && bad "shadows: the reference is the hard shadow" || ok
+# The default blocks I,II,III: block II shows the reference, so it needs one.
+"$mr" study plan "$tmp/sh" --out "$tmp/plan_sh.json" --seed 2 --fixation-ms 50 >"$tmp/psh.log" 2>&1 && ok || bad "plan of shadows: $(cat "$tmp/psh.log")"
+# 5 methods: C(5,2) = 10 pairs + 1 identical per stimulus, 3 stimuli, 3 blocks.
+grep -q "99 trials (5 methods with the reference, 3 stimuli, blocks I II III)" "$tmp/psh.log" && ok ||
+  bad "plan of shadows: expected blocks I,II,III with 99 trials: $(cat "$tmp/psh.log")"
+expect_fail stim_cases "" -- "$mr" study stimuli --family shadows --out "$tmp/sx" --cases 9
 
 # --- plan: any DIR/<method>/<stimulus>.png folder; three methods, two stimuli
 mkdir -p "$tmp/small"

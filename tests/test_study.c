@@ -7,6 +7,56 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+/* ------------------------------------------------------------ families */
+
+/* The family table: one name per row in the option's enum, and the shadows
+ * row renders the four shadow-map methods (each set up to its own method,
+ * never off or the ground truth) against a reference, from suite cases that
+ * exist. Checked without a GPU: the setups and the argument checks. */
+static void test_families(void) {
+    int sh = -1;
+    for (int f = 0; f < mr_study_family_count; f++) {
+        CHECK(mr_study_family_names[f] && strcmp(mr_study_family_names[f], mr_study_families[f].name) == 0);
+        CHECK(mr_study_families[f].has_reference == (mr_study_families[f].reference != NULL));
+        if (strcmp(mr_study_families[f].name, "shadows") == 0) sh = f;
+    }
+    CHECK(mr_study_family_names[mr_study_family_count] == NULL);
+    CHECK_MSG(sh >= 0, "no shadows family");
+    if (sh < 0) return;
+    const mr_study_family *fam = &mr_study_families[sh];
+    CHECK(fam->has_reference && fam->shadow_suite);
+    bool seen[MR_SHADOW_METHOD_COUNT] = {false};
+    int n = 0;
+    for (; fam->methods[n]; n++) {
+        mr_frame_params fp = MR_FRAME_DEFAULTS;
+        fam->setup(&fp, n);
+        mr_shadow_method want;
+        CHECK_MSG(mr_shadow_method_parse(fam->methods[n], &want) && fp.shadow.method == want,
+                  "method %s set up as %d", fam->methods[n], (int)fp.shadow.method);
+        CHECK(fp.shadow.method != MR_SHADOW_OFF && fp.shadow.method != MR_SHADOW_GROUNDTRUTH);
+        CHECK(!seen[fp.shadow.method]);
+        seen[fp.shadow.method] = true;
+    }
+    CHECK(n == 4 && seen[MR_SHADOW_HARD] && seen[MR_SHADOW_PCF] && seen[MR_SHADOW_PCSS] && seen[MR_SHADOW_BP]);
+    for (int c = 0; c < MR_STUDY_SHADOW_CASES; c++) {
+        bool found = false;
+        for (int i = 0; i < MR_SHADOW_SUITE_COUNT; i++)
+            found |= strcmp(mr_shadow_suite_name(i), mr_study_shadow_cases[c]) == 0;
+        CHECK_MSG(found && strcmp(mr_study_shadow_cases[c], "factory") != 0, "case %s", mr_study_shadow_cases[c]);
+    }
+    /* Out-of-range arguments fail before anything is rendered or written. */
+    mr_study_stimuli_params p = MR_STUDY_STIMULI_DEFAULTS;
+    p.family = sh;
+    p.cases = MR_STUDY_SHADOW_CASES + 1;
+    mr_error err = {0};
+    int count = 7;
+    CHECK(!mr_study_stimuli_render(NULL, &p, "/nonexistent/study_stimuli", &count, &err) && err.code == MR_ERR_INVALID);
+    CHECK(count == 0);
+    p.cases = 1;
+    p.gt_samples = 0;
+    CHECK(!mr_study_stimuli_render(NULL, &p, "/nonexistent/study_stimuli", &count, &err) && err.code == MR_ERR_INVALID);
+}
+
 /* ---------------------------------------------------------- statistics */
 
 static void test_consistence_table51(void) {
@@ -525,6 +575,7 @@ static void test_runner(void) {
 }
 
 int main(void) {
+    test_families();
     test_consistence_table51();
     test_agreement_tables();
     test_split_and_indifference();

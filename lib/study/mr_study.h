@@ -57,24 +57,41 @@ bool mr_study_scan(const char *dir, mr_study_set *out, mr_error *err);
 void mr_study_set_free(mr_study_set *s);
 
 /* The families `study stimuli --family` renders, one row each, so a family
- * (shadows) is one more row. Each renders the demo hall (lib/scene) from
- * `views` of its standing viewpoints through mr_render_frame. */
+ * is one more row. Each renders the demo hall (lib/scene) from `views` of
+ * its standing viewpoints through mr_render_frame; the shadows family also
+ * renders both views of `cases` shadow-suite cases (mr_shadow_suite_build). */
 typedef struct mr_study_stimuli_params {
     int family;               /* index into mr_study_families; default 0 (ao) */
     int width, height;        /* image size, px; default 320x240 */
     int views;                /* demo viewpoints, 1..MR_DEMO_VIEWS; default 3 */
     int gt_rays;              /* reference AO: rays per pixel; default 128 */
+    int cases;                /* shadows: suite cases, 0..MR_STUDY_SHADOW_CASES; default 4 */
+    int gt_samples;           /* reference shadows: light samples, 1..1024; default 256 */
 } mr_study_stimuli_params;
-#define MR_STUDY_STIMULI_DEFAULTS {.family = 0, .width = 320, .height = 240, .views = 3, .gt_rays = 128}
-extern const mr_opt mr_study_stimuli_opts[];   /* family, width, height, views, gt-rays */
+/* The shadow-suite cases the shadows family draws from, in this order: one
+ * per category kind (simple overlapping, furniture with contact hardening,
+ * fence, plant); the suite's own factory case is left out (the demo hall
+ * under the default sun is the family's hall stimulus). */
+#define MR_STUDY_SHADOW_CASES 4
+extern const char *const mr_study_shadow_cases[MR_STUDY_SHADOW_CASES];
+#define MR_STUDY_STIMULI_DEFAULTS {.family = 0, .width = 320, .height = 240, .views = 3, .gt_rays = 128, \
+                                   .cases = MR_STUDY_SHADOW_CASES, .gt_samples = MR_SHADOW_DEFAULT_GT_SAMPLES}
+extern const mr_opt mr_study_stimuli_opts[];   /* family, width, height, views, gt-rays, cases, gt-samples */
+
+/* A family's reference of one stimulus into res (its color is saved). */
+typedef bool (*mr_study_reference_fn)(mr_renderer *r, const mr_scene *scene, const mr_view *view,
+                                      const mr_frame_params *base, const mr_study_stimuli_params *p,
+                                      mr_frame_result *res, mr_error *err);
 
 typedef struct mr_study_family {
-    const char *name;         /* "ao", "ghost" */
+    const char *name;         /* "ao", "ghost", "shadows" */
     const char *help;
     const char *const *methods; /* NULL-terminated folder names */
-    bool has_reference;       /* also renders DIR/reference/ */
+    bool has_reference;       /* also renders DIR/reference/ (with `reference`) */
     /* Sets fp up for method m (index into methods). */
     void (*setup)(mr_frame_params *fp, int m);
+    mr_study_reference_fn reference; /* NULL without a reference */
+    bool shadow_suite;        /* stimuli: also the shadow-suite cases (`cases`) */
 } mr_study_family;
 extern const mr_study_family mr_study_families[];
 extern const int mr_study_family_count;
