@@ -78,10 +78,8 @@ int cmd_render(int argc, char **argv) {
         {"out", "OUT.png", "output image (required)", NULL},
         {"size", "WxH", "output size (default: the camera's)", NULL},
         {"video", "IMG", "camera frame to overlay (raw, distorted)", NULL},
-        {"alpha", "A", "video transparency in [0,1]: 0 virtual only, 1 video only (default 0.5)", NULL},
         {"aux", "DIR", "also write depth.pfm (linear view depth), normal.pfm, ao.pfm (1 = unoccluded) and shadow.pfm", NULL},
         {"hidden", "GLOB", "extra node-name glob for the hidden layer", NULL},
-        {"hide-hidden", NULL, "leave the hidden layer out", NULL},
         APP_DRAW_OPTS,
         APP_RIG_OPTS,
         {"lod-cache", "on|off", "read/write LOD levels in <scene>.mrlod (default on)", NULL},
@@ -93,10 +91,11 @@ int cmd_render(int argc, char **argv) {
     mr_gt_params gtp = MR_GT_DEFAULTS;
     mr_rig_params rp = MR_RIG_DEFAULTS;
     mr_draw_params dp = MR_DRAW_DEFAULTS;
-    mr_cli_table tables[] = {APP_AO_TABLE(&fp.ao), APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&fp.ghost),
+    mr_cli_table tables[] = {{"", mr_frame_opts, &fp, NULL, false, {0}}, APP_AO_TABLE(&fp.ao), APP_GT_TABLE(&gtp),
+                             APP_GHOST_TABLE(&fp.ghost),
                              APP_SHADOW_TABLE(&fp.shadow), APP_RIG_TABLE(&rp), APP_DRAW_TABLE(&dp)};
     bool help;
-    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 6, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 7, NULL, 0, NULL,
                    "usage: mrcheck render --scene FILE --view VIEW.json --out OUT.png [--size WxH] "
                    "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive] "
                    "[--shadows off|hard|pcf|pcss|bp|groundtruth ...] "
@@ -109,10 +108,6 @@ int cmd_render(int argc, char **argv) {
     if (!scene_path || !view_path || !out) return mr_cli_errorf(cmd, "--scene, --view and --out are required"), 2;
 
     if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &fp.width, &fp.height)) return 2;
-    double alpha = 0.5;
-    if (mr_cli_get(opts, "alpha") && !mr_cli_double("alpha", mr_cli_get(opts, "alpha"), 0, 1, &alpha)) return 2;
-    fp.alpha = (float)alpha;
-    fp.hide_hidden_layer = mr_cli_flag(opts, "hide-hidden");
     if (!app_draw_lod(opts, &dp)) return 2;
     const char *lod_cache = mr_cli_get(opts, "lod-cache");
     if (lod_cache && strcmp(lod_cache, "on") != 0 && strcmp(lod_cache, "off") != 0)
@@ -120,13 +115,13 @@ int cmd_render(int argc, char **argv) {
     const char *aux = mr_cli_get(opts, "aux");
     fp.want_depth = fp.want_normals = aux != NULL;
     bool groundtruth = false;
-    if (!app_ao_check(cmd, &tables[0], &groundtruth, &gtp)) return 2;
+    if (!app_ao_check(cmd, &tables[1], &groundtruth, &gtp)) return 2;
     fp.ao.want_ao = aux != NULL;
     fp.ao.temporal = false; /* issue 18: a single frame has nothing to accumulate */
     fp.shadow.want_shadow = aux != NULL;
     mr_quilt quilt = {0};
     bool have_quilt;
-    if (!app_rig_check(cmd, &tables[4], opts, &quilt, &have_quilt)) return 2;
+    if (!app_rig_check(cmd, &tables[5], opts, &quilt, &have_quilt)) return 2;
     bool multiview = rp.views > 0 || have_quilt;
     if (multiview && (aux || groundtruth || mr_cli_get(opts, "video")))
         return mr_cli_errorf(cmd, "--aux, --video and --ao groundtruth are for single views, not --views"), 2;
@@ -159,7 +154,7 @@ int cmd_render(int argc, char **argv) {
         mr_image_free(&video);
         return mr_cli_error(cmd, &err);
     }
-    if (!app_shadow_scene_default(cmd, &tables[3], scene, &fp.shadow)) {
+    if (!app_shadow_scene_default(cmd, &tables[4], scene, &fp.shadow)) {
         mr_scene_destroy(&scene);
         mr_image_free(&video);
         return 2;

@@ -103,6 +103,11 @@ static void zero_default_row(const char *name, const mr_opt *o, size_t size, con
 }
 
 static void walk_table(const char *name, const mr_opt *table, size_t size, const void *macro) {
+    /* The scratch copies below hold 1024 bytes. */
+    if (size > 1024) {
+        CHECK_MSG(false, "%s: params struct of %zu bytes, more than this test's buffers", name, size);
+        return;
+    }
     int n = mr_opt_count(table);
     CHECK_MSG(n > 0, "%s is empty", name);
     for (int i = 0; i < n; i++) {
@@ -256,6 +261,8 @@ static void test_tables(void) {
     walk_table("mr_filter_opts", mr_filter_opts, sizeof fp, &fp);
     const mr_map_params mpp = MR_MAP_DEFAULTS;
     walk_table("mr_map_opts", mr_map_opts, sizeof mpp, &mpp);
+    const mr_frame_params frp = MR_FRAME_DEFAULTS;
+    walk_table("mr_frame_opts", mr_frame_opts, sizeof frp, &frp);
     const mr_draw_params dr = MR_DRAW_DEFAULTS;
     walk_table("mr_draw_opts", mr_draw_opts, sizeof dr, &dr);
     const mr_gt_params gt = MR_GT_DEFAULTS;
@@ -404,6 +411,7 @@ static void test_tables(void) {
         N(mr_synth_recording_params, "jpeg", jpeg_quality, 1, 100),
         N(mr_synth_recording_params, "fps", fps, 0.1, 1000),
     };
+    const expect ex_frp[] = {N(mr_frame_params, "alpha", alpha, 0, 1), N(mr_frame_params, "hide-hidden", hide_hidden_layer, 0, 1)};
     const expect ex_gt[] = {N(mr_gt_params, "rays", rays, 1, 1 << 20)};
     const expect ex_bao[] = {
         N(mr_bench_ao_params, "frames", frames, 1, 64),
@@ -435,6 +443,7 @@ static void test_tables(void) {
 #define ROWS(t, ex) check_rows(#t, t, ex, (int)(sizeof ex / sizeof ex[0]))
     ROWS(mr_gt_opts, ex_gt);
     ROWS(mr_draw_opts, ex_dr);
+    ROWS(mr_frame_opts, ex_frp);
     ROWS(mr_map_opts, ex_mp);
     ROWS(mr_bench_shadows_opts, ex_bsh);
     ROWS(mr_bench_multiview_opts, ex_bmv);

@@ -396,6 +396,9 @@ typedef struct mr_frame_params {
 #define MR_FRAME_DEFAULT_BACKGROUND {0.62f, 0.66f, 0.70f}
 #define MR_FRAME_DEFAULT_SHININESS 32.0f /* used where shininess < 1 */
 /* Designated initialisers in declaration order (C; g++ accepts them too). */
+/* Option table of what a user sets directly (alpha, hide-hidden); the
+ * depth cues have their own (mr_ao_opts, mr_ghost_opts, mr_shadow_opts). */
+extern const mr_opt mr_frame_opts[];
 #define MR_FRAME_DEFAULTS {.alpha = MR_FRAME_DEFAULT_ALPHA, .background = MR_FRAME_DEFAULT_BACKGROUND, \
                            .ao = MR_AO_DEFAULTS, .ghost = MR_GHOST_DEFAULTS, .shadow = MR_SHADOW_DEFAULTS}
 

@@ -136,3 +136,12 @@ const mr_opt mr_draw_opts[] = {
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef DR
+
+#define FR(f) offsetof(mr_frame_params, f)
+const mr_opt mr_frame_opts[] = {
+    {"alpha", MR_OPT_FLOAT, FR(alpha), 0, 1, MR_FRAME_DEFAULT_ALPHA, NULL,
+     "video transparency: 0 = virtual only, 1 = video only", 0},
+    {"hide-hidden", MR_OPT_BOOL, FR(hide_hidden_layer), 0, 1, 0, NULL, "leave the hidden layer out", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef FR
