@@ -8,6 +8,7 @@
  * cleanly. */
 #include "mr_scene.h"
 #include "mr_test.h"
+#include "mr_test_lod.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -155,65 +156,6 @@ static void test_far_cull(void) {
 
 /* ---------------------------------------------------------------- LOD */
 
-static double tri_dist2(const double p[3], const float *a, const float *b, const float *c) {
-    /* Brute force: dense barycentric sampling is not exact, so compute the
-     * exact distance by projecting onto the plane and the edges. */
-    double ab[3], ac[3], ap[3];
-    for (int k = 0; k < 3; k++) {
-        ab[k] = b[k] - a[k];
-        ac[k] = c[k] - a[k];
-        ap[k] = p[k] - a[k];
-    }
-    double n[3] = {ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0]};
-    double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    double best = INFINITY;
-    if (nn > 0) {
-        double t = (ap[0] * n[0] + ap[1] * n[1] + ap[2] * n[2]) / nn;
-        double q[3] = {p[0] - t * n[0], p[1] - t * n[1], p[2] - t * n[2]};
-        /* inside test by barycentric signs */
-        const float *v[3] = {a, b, c};
-        bool inside = true;
-        for (int e = 0; e < 3; e++) {
-            const float *p0 = v[e], *p1 = v[(e + 1) % 3];
-            double ed[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]}, qp[3] = {q[0] - p0[0], q[1] - p0[1], q[2] - p0[2]};
-            double cr[3] = {ed[1] * qp[2] - ed[2] * qp[1], ed[2] * qp[0] - ed[0] * qp[2], ed[0] * qp[1] - ed[1] * qp[0]};
-            if (cr[0] * n[0] + cr[1] * n[1] + cr[2] * n[2] < 0) inside = false;
-        }
-        if (inside) best = t * t * nn;
-    }
-    const float *v[3] = {a, b, c};
-    for (int e = 0; e < 3; e++) {
-        const float *p0 = v[e], *p1 = v[(e + 1) % 3];
-        double ed[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-        double ee = ed[0] * ed[0] + ed[1] * ed[1] + ed[2] * ed[2];
-        double t = ee > 0 ? ((p[0] - p0[0]) * ed[0] + (p[1] - p0[1]) * ed[1] + (p[2] - p0[2]) * ed[2]) / ee : 0;
-        t = t < 0 ? 0 : t > 1 ? 1 : t;
-        double d[3] = {p[0] - p0[0] - t * ed[0], p[1] - p0[1] - t * ed[1], p[2] - p0[2] - t * ed[2]};
-        double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        if (d2 < best) best = d2;
-    }
-    return best;
-}
-
-/* Max over dense samples of `from` of the distance to `to` (brute force). */
-static double sampled_distance(const float *pos, const uint32_t *from, uint32_t nf, const uint32_t *to, uint32_t nt, int k) {
-    double worst = 0;
-    for (uint32_t t = 0; t < nf; t += 3) {
-        const float *a = pos + 3 * (size_t)from[t], *b = pos + 3 * (size_t)from[t + 1], *c = pos + 3 * (size_t)from[t + 2];
-        for (int i = 0; i <= k; i++)
-            for (int j = 0; i + j <= k; j++) {
-                double u = (double)i / k, v = (double)j / k, w = 1 - u - v;
-                double p[3] = {w * a[0] + u * b[0] + v * c[0], w * a[1] + u * b[1] + v * c[1], w * a[2] + u * b[2] + v * c[2]};
-                double best = INFINITY;
-                for (uint32_t s = 0; s < nt; s += 3) {
-                    double d2 = tri_dist2(p, pos + 3 * (size_t)to[s], pos + 3 * (size_t)to[s + 1], pos + 3 * (size_t)to[s + 2]);
-                    if (d2 < best) best = d2;
-                }
-                if (sqrt(best) > worst) worst = sqrt(best);
-            }
-    }
-    return worst;
-}
 
 /* A bumpy sphere (radius ~r): curved everywhere, so every level has a real
  * error. */
@@ -292,8 +234,8 @@ static void check_levels(const mr_mesh *mm, const mr_mesh_lods *ml, const mr_lod
         CHECK(l->error >= prev && l->error <= lp->max_error);
         prev = l->error;
         /* The bound holds against brute force in both directions... */
-        double ab = sampled_distance(mm->positions, mm->indices, mm->index_count, l->indices, l->index_count, 3);
-        double ba = sampled_distance(mm->positions, l->indices, l->index_count, mm->indices, mm->index_count, 5);
+        double ab = mr_test_sampled_distance(mm->positions, mm->indices, mm->index_count, l->indices, l->index_count, 3);
+        double ba = mr_test_sampled_distance(mm->positions, l->indices, l->index_count, mm->indices, mm->index_count, 5);
         double brute = fmax(ab, ba);
         CHECK_MSG(brute <= l->error + 1e-7, "%s level %d: sampled %g > bound %g", what, k, brute, l->error);
         /* ...and is not vacuous: within the resolution (<= 10% of the
@@ -342,7 +284,7 @@ static void test_lod_bound(void) {
         uint32_t *b = malloc((size_t)q.index_count * 4);
         for (uint32_t i = 0; i < q.index_count; i++) b[i] = q.indices[i] + nv;
         double e = mr_lod_hausdorff_bound(pos, 2 * nv, q.indices, q.index_count, b, q.index_count, 1e-4, 1.0);
-        double brute = sampled_distance(pos, q.indices, q.index_count, b, q.index_count, 3);
+        double brute = mr_test_sampled_distance(pos, q.indices, q.index_count, b, q.index_count, 3);
         CHECK_MSG(e >= brute - 1e-9 && e <= 0.01 + 2e-4, "shifted sphere: bound %g, sampled %g", e, brute);
         CHECK(brute > 0.003); /* a sphere shifted sideways is that far at its sides */
         /* Nothing within the limit: infinite. */
@@ -408,8 +350,8 @@ static void test_lod_lost_protrusion(void) {
         full[nplate + 3 * k + 2] = g + 4;
     }
     const double eps = 1e-4;
-    double d_fl = sampled_distance(m.positions, full, nfull, m.indices, nplate, 8);
-    double d_lf = sampled_distance(m.positions, m.indices, nplate, full, nfull, 8);
+    double d_fl = mr_test_sampled_distance(m.positions, full, nfull, m.indices, nplate, 8);
+    double d_lf = mr_test_sampled_distance(m.positions, m.indices, nplate, full, nfull, 8);
     CHECK_MSG(fabs(d_fl - h) < 1e-6 && d_lf < 1e-6, "test set-up: sampled full->level %g (want %g), level->full %g (want 0)",
               d_fl, h, d_lf);
     double e_fl = mr_lod_hausdorff_bound(m.positions, m.vertex_count, full, nfull, m.indices, nplate, 1e-4, 1.0);
