@@ -45,31 +45,6 @@ bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err) {
     return true;
 }
 
-/* --ao groundtruth: ray-trace the AO of the surface points the first frame
- * saw, then render again shading with it (no AO pass runs). */
-static bool render_groundtruth(mr_renderer *r, const mr_scene *scene, const mr_view *view, mr_frame_params *fp,
-                               const mr_gt_params *gtp, mr_frame_result *res, mr_error *err) {
-    mr_frame_params gp = *fp;
-    gp.want_depth = gp.want_normals = true;
-    mr_frame_result g = {0};
-    mr_image ao = {0};
-    mr_eval_gt *gt = NULL;
-    double t0 = mr_time_now();
-    bool ok = mr_render_frame(r, view, &gp, &g, err) && (gt = mr_eval_gt_create(scene, fp->hide_hidden_layer, err)) &&
-              mr_eval_ao_groundtruth(gt, view, &g.depth, &g.normal, gtp, &ao, err);
-    mr_frame_result_free(&g);
-    mr_eval_gt_destroy(&gt);
-    if (ok) {
-        mr_log(MR_LOG_INFO, "ground truth: %d rays per pixel in %.0f ms", gtp->rays, (mr_time_now() - t0) * 1e3);
-        mr_frame_result_free(res);
-        fp->ao.external = &ao;
-        ok = mr_render_frame(r, view, fp, res, err);
-        fp->ao.external = NULL;
-    }
-    mr_image_free(&ao);
-    return ok;
-}
-
 int cmd_render(int argc, char **argv) {
     static const char *cmd = "render";
     mr_cli_opt opts[] = {
@@ -189,7 +164,7 @@ int cmd_render(int argc, char **argv) {
                                                        &err)) {
             rc = mr_cli_error(cmd, &err);
         } else if (!mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||
-                   (groundtruth && !render_groundtruth(gfx.renderer, scene, &view, &fp, &gtp, &res, &err)))
+                   (groundtruth && !mr_eval_render_groundtruth_ao(gfx.renderer, scene, &view, &fp, &gtp, &res, &err)))
             rc = mr_cli_error(cmd, &err);
         else if (!mr_image_save_png(out, &res.color, &err) || (aux && !app_write_aux(aux, &res, &err)))
             rc = mr_cli_error(cmd, &err);

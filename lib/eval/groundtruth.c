@@ -405,3 +405,27 @@ bool mr_eval_shadow_groundtruth(const mr_eval_gt *g, const mr_view *view, const 
     pthread_mutex_destroy(&j.lock);
     return true;
 }
+
+bool mr_eval_render_groundtruth_ao(mr_renderer *r, const mr_scene *scene, const mr_view *view,
+                                   const mr_frame_params *fp, const mr_gt_params *gtp, mr_frame_result *res,
+                                   mr_error *err) {
+    mr_frame_params gp = *fp;
+    gp.want_depth = gp.want_normals = true;
+    mr_frame_result g = {0};
+    mr_image ao = {0};
+    mr_eval_gt *gt = NULL;
+    double t0 = mr_time_now();
+    bool ok = mr_render_frame(r, view, &gp, &g, err) && (gt = mr_eval_gt_create(scene, fp->hide_hidden_layer, err)) &&
+              mr_eval_ao_groundtruth(gt, view, &g.depth, &g.normal, gtp, &ao, err);
+    mr_frame_result_free(&g);
+    mr_eval_gt_destroy(&gt);
+    if (ok) {
+        mr_log(MR_LOG_INFO, "ground truth: %d rays per pixel in %.0f ms", gtp->rays, (mr_time_now() - t0) * 1e3);
+        mr_frame_result_free(res);
+        mr_frame_params sp = *fp;
+        sp.ao.external = &ao;
+        ok = mr_render_frame(r, view, &sp, res, err);
+    }
+    mr_image_free(&ao);
+    return ok;
+}

@@ -58,6 +58,15 @@ extern const mr_opt mr_gt_opts[];
 bool mr_eval_ao_groundtruth(const mr_eval_gt *gt, const mr_view *view, const mr_image *depth, const mr_image *normal,
                             const mr_gt_params *params, mr_image *out, mr_error *err);
 
+/* A frame shaded with ray-traced AO instead of an AO pass (`render --ao
+ * groundtruth`, the AO study's reference): one frame for the G-buffer's
+ * surface points and normals, their AO by mr_eval_ao_groundtruth (the
+ * hidden layer left out as fp says), then the frame again shading with it
+ * (fp->ao.external). res may hold an earlier result, which is freed. */
+bool mr_eval_render_groundtruth_ao(mr_renderer *r, const mr_scene *scene, const mr_view *view,
+                                   const mr_frame_params *fp, const mr_gt_params *gtp, mr_frame_result *res,
+                                   mr_error *err);
+
 /* The same for one world-space point p with unit normal n: fraction of
  * `rays` cosine-weighted rays of length `radius` that escape. */
 double mr_eval_ao_point(const mr_eval_gt *gt, mr_dvec3 p, mr_dvec3 n, double radius, int rays, uint64_t seed);

@@ -80,24 +80,9 @@ static bool save(const char *dir, const char *method, const char *stim, const mr
  * surface the G-buffer saw (as `render --ao groundtruth`). */
 static bool ao_reference(mr_renderer *r, const mr_scene *scene, const mr_view *view, const mr_frame_params *base,
                          const mr_study_stimuli_params *p, mr_frame_result *res, mr_error *err) {
-    mr_frame_params gp = *base;
-    gp.want_depth = gp.want_normals = true;
-    mr_frame_result g = {0};
-    mr_image ao = {0};
-    mr_eval_gt *gt = NULL;
     mr_gt_params gtp = MR_GT_DEFAULTS;
     gtp.rays = p->gt_rays;
-    bool ok = mr_render_frame(r, view, &gp, &g, err) && (gt = mr_eval_gt_create(scene, base->hide_hidden_layer, err)) &&
-              mr_eval_ao_groundtruth(gt, view, &g.depth, &g.normal, &gtp, &ao, err);
-    mr_frame_result_free(&g);
-    mr_eval_gt_destroy(&gt);
-    if (ok) {
-        mr_frame_params fp = *base;
-        fp.ao.external = &ao;
-        ok = mr_render_frame(r, view, &fp, res, err);
-    }
-    mr_image_free(&ao);
-    return ok;
+    return mr_eval_render_groundtruth_ao(r, scene, view, base, &gtp, res, err);
 }
 
 /* One stimulus: every method of the family and its reference. */
