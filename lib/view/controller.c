@@ -448,6 +448,7 @@ static void status_line(mr_viewer *v, const mr_viewer_frame *f) {
      * printable ASCII only); "?" when the pose has
      * no covariance (an older recording) or nothing is under the centre. */
     v->sigma_known = f->have_frame && f->have_pose && mr_view_sigma_here(f, &v->sigma_m);
+    if (!v->sigma_known) v->sigma_m = NAN;
     if (f->have_frame && f->have_pose) {
         double mm = v->sigma_m * 1e3;
         if (!v->sigma_known) snprintf(here, sizeof here, " | +/- ? mm here");
