@@ -106,6 +106,7 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
             mr_frame_result res;
             ok = mr_render_frame(r, &view, &fp, &res, err) && mr_image_save_png(path, &res.color, err) &&
                  video_add(p, &vw, &res.color, fps, err);
+            const int rw = ok ? res.color.width : 0, rh = ok ? res.color.height : 0;
             if (ok) mr_frame_result_free(&res);
             /* issue 15: the registration's σ at the model under the centre,
              * when the recording has the pose's covariance (one pixel read
@@ -115,7 +116,7 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
             sp.valid = true;
             sp.world_from_camera = pose;
             if (ok && f->pose.corner_sigma_px > 0 &&
-                mr_renderer_pick(r, res.color.width * 0.5 - 0.5, res.color.height * 0.5 - 0.5, &cp, &(mr_error){0}) &&
+                mr_renderer_pick(r, rw * 0.5 - 0.5, rh * 0.5 - 0.5, &cp, &(mr_error){0}) &&
                 cp.hit && mr_pose_point_sigma(&sp, cp.world, &centre_sigma, NULL))
                 have_centre_sigma = true;
             st.overlays++;
