@@ -226,6 +226,14 @@ else
   bad "mark on the shipped recording failed: $(tail -3 "$tmp/old.err")"
 fi
 
+# 2b'. The export shows the mark's uncertainty (lib/export reads uncertainty_m).
+if [ -n "${um:-}" ] && "$mr" export "$tmp/session" --html "$tmp/rep" >/dev/null 2>"$tmp/rep.err"; then
+  want=$(awk -v u="$um" 'BEGIN { printf "%.0f mm", u * 1000 }')
+  grep -q "<td>$want</td>" "$tmp/rep/index.html" && ok || bad "the report does not show the mark's $want"
+else
+  bad "export of the marked session: $(tail -2 "$tmp/rep.err" 2>/dev/null)"
+fi
+
 # 2c. Issue 15: replay.jsonl tells the sigma at the model under the centre
 #     where the recording has the covariance, and leaves it out where not.
 if "$mr" replay "$d/recording" --scene "$d/scene_planned.json" --out "$tmp/rpu" --from 2 --to 2 >/dev/null 2>"$tmp/rpu.err" &&
