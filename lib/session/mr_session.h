@@ -238,7 +238,8 @@ typedef struct mr_annotations {
 /* Tolerant reader: a torn last line is skipped, a garbage line anywhere is
  * counted and skipped; a line is garbage if it is not a JSON object with a
  * non-empty string "type", or if a present field has the wrong shape (non-finite
- * numbers, pixel not [x,y], world not [x,y,z] or null, a non-rigid pose).
+ * numbers, pixel not [x,y], world not [x,y,z] or null, a non-rigid pose,
+ * uncertainty_m not a number >= 0).
  * Fails only when out of memory. mr_annotations_load: a missing file is
  * zero annotations. */
 bool mr_annotations_parse(const char *text, size_t size, mr_annotations *out, mr_error *err);
