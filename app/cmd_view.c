@@ -70,6 +70,9 @@ typedef struct view_app {
     mr_ui_rect image_rect;
     int rw, rh;
     bool dimmed;
+    /* issue 15: the model under the picture's centre, for "+/- N mm here" */
+    bool centre_hit;
+    mr_dvec3 centre_world;
     /* issue 18: temporal AO (--ao-temporal); a frame after one without a valid pose restarts it */
     bool ao_temporal, ao_had_pose;
     /* stats */
@@ -161,6 +164,12 @@ static cJSON *mark_line(view_app *a, int note) {
     m.world_from_camera = a->mark_frame.pose;
     m.pose_tags_seen = a->mark_frame.tags_seen;
     m.pose_rms_px = a->mark_frame.rms_px;
+    /* issue 15: the registration's σ at the marked point (absent when the
+     * pose has no covariance, e.g. an older recording, or nothing was hit) */
+    mr_viewer_frame sf = {.have_pose = a->mark_frame.have_pose, .world_from_camera = a->mark_frame.pose,
+                          .pose_cov = a->mark_frame.cov, .corner_sigma_px = a->mark_frame.corner_sigma_px,
+                          .have_point = a->mark_pick.hit, .point = a->mark_pick.world};
+    m.has_uncertainty = mr_view_sigma_here(&sf, &m.uncertainty_m);
     return mr_annotation_to_json(&m);
 }
 
@@ -276,6 +285,10 @@ static void render_3d(view_app *a) {
     a->rw = rw;
     a->rh = rh;
     a->image_rect = fit;
+    /* issue 15: what is under the centre (one pixel read back per render) */
+    mr_pick cp = {0};
+    a->centre_hit = c.use_pose && mr_renderer_pick(a->rend, rw * 0.5 - 0.5, rh * 0.5 - 0.5, &cp, &err) && cp.hit;
+    a->centre_world = cp.world;
     mr_frame_result_passes(&a->res, a->passes, sizeof a->passes);
     /* A still camera reuses the last AO: say so, or AO seems to be off. */
     if (a->res.ao_reused) strncat(a->passes, " (ao reused)", sizeof a->passes - strlen(a->passes) - 1);
@@ -388,6 +401,14 @@ static mr_viewer_frame frame_info(view_app *a, char *state_msg, size_t n) {
     f.dimmed = a->dimmed;
     f.passes = a->passes;
     f.fps = a->fps;
+    /* issue 15: the pose's covariance, told at the point being marked while
+     * the note chooser is open, else at the model under the centre */
+    f.world_from_camera = a->frame.pose;
+    f.pose_cov = a->frame.cov;
+    f.corner_sigma_px = a->frame.corner_sigma_px;
+    bool marking = mr_viewer_note_is_open(a->vc);
+    f.have_point = marking ? a->mark_pick.hit : a->centre_hit;
+    f.point = marking ? a->mark_pick.world : a->centre_world;
     return f;
 }
 

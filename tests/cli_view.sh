@@ -171,7 +171,8 @@ fi
 # 2. A mark: tap in the picture, choose a note; the line must be in
 #    annotations.jsonl at once, whole, and survive kill -9 right after.
 rm -f "$tmp/session/annotations.jsonl"
-printf '%s\n' "0.2 key . " "0.6 key ." "1.4 tap @mark" "1.8 tap 150 150" "2.4 tap @note2" "60 quit" >"$tmp/mark.script"
+printf '%s\n' "0.2 key . " "0.6 key ." "1.4 tap @mark" "1.8 tap 150 150" "2.1 state $tmp/mark_state.json" "2.4 tap @note2" \
+  "60 quit" >"$tmp/mark.script"
 # Started directly (no `timeout` wrapper), so $! is the viewer itself.
 "$mr" view --scene "$d/scene_planned.json" --replay "$d" --out "$tmp/session" --config "$tmp/cfg.json" \
   --size 480x360 --paused --script "$tmp/mark.script" >"$tmp/mark.out" 2>"$tmp/mark.err" &
@@ -195,8 +196,54 @@ if [ -s "$ann" ]; then
   fi
   snap=$(echo "$line" | sed -n 's/.*"screen":"\([^"]*\)".*/\1/p')
   [ -n "$snap" ] && [ -s "$tmp/session/$snap" ] && ok || bad "mark snapshot missing ($snap)"
+  # Issue 15: the demo's recording carries the pose covariance, so the mark
+  # carries the registration's sigma at its point, the same the status line
+  # showed for the picked point while the note chooser was open.
+  um=$(echo "$line" | sed -n 's/.*"uncertainty_m":\([-0-9.eE+]*\).*/\1/p')
+  sh=$(jget "$tmp/mark_state.json" sigma_here_mm)
+  awk -v u="${um:-x}" -v s="${sh:-x}" 'BEGIN { exit !(u + 0 > 0 && u + 0 < 10 && s + 0 > 0 && (u * 1e3 - s) ^ 2 < 1e-6 * s * s) }' \
+    && ok || bad "mark uncertainty_m '${um:-}' m against the status line's ${sh:-?} mm (want equal, > 0): $line"
 else
   bad "no annotation written: $(tail -3 "$tmp/mark.err")"
+fi
+
+# 2b. Issue 15, backward compatible: the shipped recording was made before
+#     poses carried a covariance; the status line says "+/- ? mm" and the
+#     mark has no uncertainty_m (unknown, not zero).
+src=$(cd "$(dirname "$0")/.." && pwd)
+printf '%s\n' "0.2 key . " "0.6 key ." "1.4 tap @mark" "1.8 tap 150 150" "2.1 state $tmp/old_state.json" "2.4 tap @note2" \
+  "3.5 quit" >"$tmp/old.script"
+rm -rf "$tmp/old_session"
+if timeout 120 "$mr" view --scene "$src/configs/scenes/demo_planned.json" --replay "$src/recordings/demo" \
+  --out "$tmp/old_session" --config "$tmp/cfg_old.json" --size 480x360 --paused --script "$tmp/old.script" \
+  >"$tmp/old.out" 2>"$tmp/old.err" && [ -s "$tmp/old_session/annotations.jsonl" ]; then
+  oline=$(head -1 "$tmp/old_session/annotations.jsonl")
+  echo "$oline" | grep -q '"pose":{' && ! echo "$oline" | grep -q uncertainty_m && ok \
+    || bad "a mark on a recording without covariance: $oline"
+  [ "$(jget "$tmp/old_state.json" sigma_here_mm)" = null ] && [ "$(jget "$tmp/old_state.json" sigma_state)" = unknown ] \
+    && ok || bad "old recording: sigma_here_mm $(jget "$tmp/old_state.json" sigma_here_mm), want null"
+else
+  bad "mark on the shipped recording failed: $(tail -3 "$tmp/old.err")"
+fi
+
+# 2b'. The export shows the mark's uncertainty (lib/export reads uncertainty_m).
+if [ -n "${um:-}" ] && "$mr" export "$tmp/session" --html "$tmp/rep" >/dev/null 2>"$tmp/rep.err"; then
+  want=$(awk -v u="$um" 'BEGIN { printf "%.0f mm", u * 1000 }')
+  grep -q "<td>$want</td>" "$tmp/rep/index.html" && ok || bad "the report does not show the mark's $want"
+else
+  bad "export of the marked session: $(tail -2 "$tmp/rep.err" 2>/dev/null)"
+fi
+
+# 2c. Issue 15: replay.jsonl tells the sigma at the model under the centre
+#     where the recording has the covariance, and leaves it out where not.
+if "$mr" replay "$d/recording" --scene "$d/scene_planned.json" --out "$tmp/rpu" --from 2 --to 2 >/dev/null 2>"$tmp/rpu.err" &&
+  "$mr" replay "$src/recordings/demo" --scene "$src/configs/scenes/demo_planned.json" --out "$tmp/rpo" --from 2 --to 2 \
+    >/dev/null 2>"$tmp/rpo.err"; then
+  cu=$(sed -n 's/.*"centre_uncertainty_m":\([-0-9.eE+]*\).*/\1/p' "$tmp/rpu/replay.jsonl")
+  awk -v u="${cu:-x}" 'BEGIN { exit !(u + 0 > 0 && u + 0 < 10) }' && ok || bad "replay.jsonl: $(cat "$tmp/rpu/replay.jsonl")"
+  ! grep -q centre_uncertainty_m "$tmp/rpo/replay.jsonl" && ok || bad "replay of an old recording has a sigma"
+else
+  bad "replay failed: $(tail -2 "$tmp/rpu.err" "$tmp/rpo.err")"
 fi
 
 # 3. Real X input (xdotool): a click on the Video toggle turns the overlay off.

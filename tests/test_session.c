@@ -434,6 +434,58 @@ static void test_annotation_append(void) {
     free(lb);
 }
 
+/* Issue 15: a mark carries the registration's 1-sigma at its point as
+ * "uncertainty_m"; absent when unknown (older lines read as unknown). */
+static void test_annotation_uncertainty(void) {
+    mr_annotation m;
+    memset(&m, 0, sizeof m);
+    snprintf(m.type, sizeof m.type, "discrepancy");
+    m.frame_index = 3;
+    m.node_index = -1;
+    m.hit = true;
+    m.world[0] = 1, m.world[1] = 2, m.world[2] = 3;
+    m.has_pose = m.pose_valid = true;
+    m.world_from_camera = mr_m4_identity();
+    for (int k = 0; k < 2; k++) {
+        m.has_uncertainty = k == 1;
+        m.uncertainty_m = k == 1 ? 0.0123 : 0.5;
+        cJSON *o = mr_annotation_to_json(&m);
+        const cJSON *u = cJSON_GetObjectItemCaseSensitive(o, "uncertainty_m");
+        CHECK_MSG(k == 1 ? cJSON_IsNumber(u) && u->valuedouble == 0.0123 : u == NULL,
+                  "case %d: uncertainty_m %s in the line", k, u ? "present" : "missing");
+        char *line = print_line(o);
+        cJSON_Delete(o);
+        mr_annotations an;
+        mr_error err = {0};
+        CHECK(mr_annotations_parse(line, strlen(line), &an, &err) && an.count == 1);
+        if (an.count == 1)
+            CHECK_MSG(an.items[0].has_uncertainty == (k == 1) && (k == 0 || an.items[0].uncertainty_m == 0.0123),
+                      "case %d: read back has %d, %g", k, an.items[0].has_uncertainty, an.items[0].uncertainty_m);
+        mr_annotations_free(&an);
+        free(line);
+    }
+    /* A recording's pose covariance reaches the replay frames (the view's
+     * capture shows it); a line without one (an older recording) has none. */
+    const char *text =
+        "{\"frame\":0,\"t\":0,\"image\":\"frames/000000.png\",\"pose\":{\"valid\":true,\"world_from_camera\":"
+        "[1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1],\"tags_seen\":1,\"rms_px\":0.2,\"corner_sigma_px\":0.3,\"covariance\":"
+        "[1e-6,0,0,0,0,0, 0,1e-6,0,0,0,0, 0,0,1e-6,0,0,0, 0,0,0,4e-6,0,0, 0,0,0,0,4e-6,0, 0,0,0,0,0,4e-6]}}\n"
+        "{\"frame\":1,\"t\":0.1,\"image\":\"frames/000001.png\",\"pose\":{\"valid\":true,\"world_from_camera\":"
+        "[1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1],\"tags_seen\":1,\"rms_px\":0.2}}\n";
+    mr_recording *rec = calloc(1, sizeof *rec);
+    mr_error err = {0};
+    CHECK(rec && mr_recording_parse_frames(rec, text, strlen(text), &err) && rec->frame_count == 2);
+    mr_replay *rp = rec ? mr_replay_from_recording(rec, &err) : NULL;
+    CHECK_MSG(rp != NULL, "replay: %s", err.msg);
+    if (rp) {
+        const mr_replay_frame *f0 = mr_replay_frame_at(rp, 0), *f1 = mr_replay_frame_at(rp, 1);
+        CHECK_MSG(f0->corner_sigma_px == 0.3 && f0->cov[21] == 4e-6 && f0->cov[0] == 1e-6,
+                  "replay frame 0: corner sigma %g, cov[21] %g", f0->corner_sigma_px, f0->cov[21]);
+        CHECK_MSG(f1->corner_sigma_px == 0, "replay frame 1 (no covariance) has corner sigma %g", f1->corner_sigma_px);
+    }
+    mr_replay_close(&rp);
+}
+
 /* The tolerant reader: every kind of bad line counted, a torn tail skipped. */
 static void test_annotations_reader(void) {
     cJSON *a = mark_json(2, true);
@@ -451,6 +503,8 @@ static void test_annotations_reader(void) {
         "{\"type\":\"discrepancy\",\"frame_index\":1.5}\n",              /* not a frame number */
         "{\"type\":\"discrepancy\",\"pose\":{\"world_from_camera\":[2,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1]}}\n",
         "{\"type\":\"discrepancy\",\"timestamp\":\"soon\"}\n",           /* not a number */
+        "{\"type\":\"discrepancy\",\"uncertainty_m\":\"small\"}\n",       /* issue 15: not a number */
+        "{\"type\":\"discrepancy\",\"uncertainty_m\":-0.01}\n",          /* a negative sigma */
     };
     int nbad = (int)(sizeof bad / sizeof bad[0]);
     char text[8192] = "";
@@ -612,6 +666,7 @@ int main(void) {
     test_replay_meta();
     test_annotation_append();
     test_annotations_reader();
+    test_annotation_uncertainty();
     test_annotation_round_trip();
     return mr_test_finish("test_session");
 }

@@ -536,6 +536,76 @@ static void test_tracking_lost(void) {
     }
 }
 
+/* ------------------------------------------ registration uncertainty */
+
+/* Issue 15: "+/- N mm here" from a given covariance and point. The camera
+ * sits at (10, 0, 0) looking down +z (OpenCV axes); the point is on its
+ * axis at depth d. A rotation error w about the camera's x and y moves the
+ * point by d * w across the ray, a translation error tau moves it by tau:
+ * sigma^2 = d^2 (sx^2 + sy^2) + tx^2 + ty^2 + tz^2 (closed form, not the
+ * library's code). */
+static double closed_form_sigma(double d, const double *cov) {
+    return sqrt(d * d * (cov[0] + cov[7]) + cov[21] + cov[28] + cov[35]);
+}
+
+static void test_sigma(rig *r) {
+    double cov[36] = {0};
+    cov[0] = cov[7] = 0.002 * 0.002;                 /* 2 mrad about x and y */
+    cov[14] = 0.01 * 0.01;                           /* roll: no effect on the axis */
+    cov[21] = cov[28] = cov[35] = 0.001 * 0.001;     /* 1 mm per axis */
+    mr_dmat4 wfc = mr_m4_identity();
+    wfc.m[3] = 10.0; /* row-major: the translation column */
+    const double depths[3] = {1.0, 4.0, 20.0};
+    const mr_view_sigma_state want_state[3] = {MR_VIEW_SIGMA_OK, MR_VIEW_SIGMA_WARN, MR_VIEW_SIGMA_BAD};
+    for (int k = 0; k < 3; k++) {
+        double d = depths[k];
+        r->f.world_from_camera = wfc;
+        r->f.pose_cov = cov;
+        r->f.corner_sigma_px = 0.5;
+        r->f.have_point = true;
+        r->f.point = mr_v3(10.0, 0.0, d);
+        double want = closed_form_sigma(d, cov), got = -1;
+        CHECK_MSG(mr_view_sigma_here(&r->f, &got) && fabs(got - want) < 1e-9 * (1 + want),
+                  "sigma at depth %g: %g m, want %g m", d, got, want);
+        step(r);
+        char text[64];
+        double mm = want * 1e3;
+        snprintf(text, sizeof text, mm < 9.95 ? "+/- %.1f mm here" : "+/- %.0f mm here", mm);
+        CHECK_MSG(strstr(mr_viewer_status_text(r->v), text) != NULL, "status line '%s' lacks '%s'",
+                  mr_viewer_status_text(r->v), text);
+        CHECK_MSG(mr_view_sigma_classify(true, want) == want_state[k], "sigma %.1f mm: state %d, want %d", mm,
+                  (int)mr_view_sigma_classify(true, want), (int)want_state[k]);
+        cJSON *st = mr_viewer_state_json(r->v);
+        const cJSON *sh = cJSON_GetObjectItemCaseSensitive(st, "sigma_here_mm");
+        CHECK_MSG(cJSON_IsNumber(sh) && fabs(sh->valuedouble - mm) < 1e-6, "state sigma_here_mm %g, want %g",
+                  cJSON_IsNumber(sh) ? sh->valuedouble : -1.0, mm);
+        cJSON_Delete(st);
+    }
+    CHECK_MSG(mr_view_sigma_classify(false, 0.001) == MR_VIEW_SIGMA_UNKNOWN, "an unknown sigma has a state");
+    /* Unknown: no covariance (an older recording), nothing under the centre,
+     * the point behind the camera. */
+    for (int k = 0; k < 3; k++) {
+        r->f.pose_cov = k == 0 ? NULL : cov;
+        r->f.corner_sigma_px = k == 0 ? 0 : 0.5;
+        r->f.have_point = k != 1;
+        r->f.point = mr_v3(10.0, 0.0, k == 2 ? -3.0 : 3.0);
+        CHECK_MSG(!mr_view_sigma_here(&r->f, NULL), "case %d: a sigma without covariance, point or depth", k);
+        step(r);
+        CHECK_MSG(strstr(mr_viewer_status_text(r->v), "+/- ? mm here") != NULL, "case %d: status line '%s' "
+                  "does not say the sigma is unknown", k, mr_viewer_status_text(r->v));
+        cJSON *st = mr_viewer_state_json(r->v);
+        CHECK_MSG(cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(st, "sigma_here_mm")), "case %d: state has a sigma", k);
+        cJSON_Delete(st);
+    }
+    /* No pose at all: nothing to tell. */
+    r->f.have_pose = r->f.pose_valid = false;
+    step(r);
+    CHECK_MSG(strstr(mr_viewer_status_text(r->v), "mm here") == NULL, "no pose, yet '%s'", mr_viewer_status_text(r->v));
+    r->f.have_pose = r->f.pose_valid = true;
+    r->f.pose_cov = NULL;
+    r->f.have_point = false;
+}
+
 /* ------------------------------------------------------------ layout */
 
 /* Clearance between two rects in pixels (negative: they overlap). */
@@ -761,6 +831,7 @@ int main(void) {
         test_keys(&r);
         test_cycling(&r);
         test_replay(&r);
+        test_sigma(&r);
         mr_viewer_destroy(&r.v);
     }
     test_layout(font);

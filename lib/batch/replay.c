@@ -77,6 +77,8 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
             continue;
         }
         bool has_pose = (!p->raw && f->has_filtered) || f->pose.valid;
+        bool have_centre_sigma = false;
+        double centre_sigma = 0;
         mr_dmat4 pose = !p->raw && f->has_filtered ? f->filtered : f->pose.world_from_camera;
         char name[64], path[4096];
         snprintf(name, sizeof name, "overlay_%06lld.png", (long long)f->index);
@@ -104,7 +106,19 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
             mr_frame_result res;
             ok = mr_render_frame(r, &view, &fp, &res, err) && mr_image_save_png(path, &res.color, err) &&
                  video_add(p, &vw, &res.color, fps, err);
+            const int rw = ok ? res.color.width : 0, rh = ok ? res.color.height : 0;
             if (ok) mr_frame_result_free(&res);
+            /* issue 15: the registration's σ at the model under the centre,
+             * when the recording has the pose's covariance (one pixel read
+             * back from the frame just drawn). */
+            mr_pick cp = {0};
+            mr_pose sp = f->pose;
+            sp.valid = true;
+            sp.world_from_camera = pose;
+            if (ok && f->pose.corner_sigma_px > 0 &&
+                mr_renderer_pick(r, rw * 0.5 - 0.5, rh * 0.5 - 0.5, &cp, &(mr_error){0}) &&
+                cp.hit && mr_pose_point_sigma(&sp, cp.world, &centre_sigma, NULL))
+                have_centre_sigma = true;
             st.overlays++;
         } else {
             /* No pose: the camera frame alone keeps the sequence complete. */
@@ -119,6 +133,7 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
         cJSON_AddStringToObject(o, "image", name);
         cJSON_AddBoolToObject(o, "overlay", has_pose);
         if (has_pose) cJSON_AddItemToObject(o, "world_from_camera", mr_json_from_dmat4(&pose));
+        if (have_centre_sigma) cJSON_AddNumberToObject(o, "centre_uncertainty_m", centre_sigma);
         mr_jsonl_add(&log, o);
         cJSON_Delete(o);
     }

@@ -96,6 +96,9 @@ cJSON *mr_annotation_to_json(const mr_annotation *a) {
     }
     cJSON_AddItemToObject(line, "pose",
                           mr_sess_pose_json(a->pose_valid, &a->world_from_camera, a->pose_tags_seen, a->pose_rms_px));
+    /* Absent, not null, when unknown: the exports read it as optional. */
+    if (a->has_uncertainty && isfinite(a->uncertainty_m) && a->uncertainty_m >= 0)
+        cJSON_AddNumberToObject(line, "uncertainty_m", a->uncertainty_m);
     return line;
 }
 
@@ -145,6 +148,12 @@ static bool parse_annotation(const cJSON *o, mr_annotation *a) {
         double ts = -1;
         if (!get_num(p, "tags_seen", &ts) || !get_num(p, "rms_px", &a->pose_rms_px)) return false;
         a->pose_tags_seen = ts >= 0 && ts < 1e6 ? (int)ts : -1;
+    }
+    const cJSON *u = cJSON_GetObjectItemCaseSensitive(o, "uncertainty_m");
+    if (u && !cJSON_IsNull(u)) {
+        if (!cJSON_IsNumber(u) || !isfinite(u->valuedouble) || u->valuedouble < 0) return false;
+        a->has_uncertainty = true;
+        a->uncertainty_m = u->valuedouble;
     }
     return true;
 }

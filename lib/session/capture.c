@@ -242,7 +242,8 @@ static void *live_reader(void *arg) {
 /* One frame through the one tracker (lib/track), as `mrcheck track` runs
  * it: the view shows the filtered pose of a frame with a valid pose and
  * otherwise keeps the last one it showed. */
-static void track_frame(mr_tracker *trk, const mr_image *img, double t, mr_capture_frame *f, mr_dmat4 *last_pose) {
+static void track_frame(mr_tracker *trk, const mr_image *img, double t, mr_capture_frame *f, mr_dmat4 *last_pose,
+                        mr_pose *last_cov) {
     mr_tracker_result r;
     mr_error e = {0};
     if (!mr_tracker_frame(trk, img, t, &r, &e)) {
@@ -255,6 +256,7 @@ static void track_frame(mr_tracker *trk, const mr_image *img, double t, mr_captu
     if (r.pose.valid) {
         f->pose_valid = true;
         *last_pose = r.has_filtered ? r.filtered : r.pose.world_from_camera;
+        *last_cov = r.pose;
     }
 }
 
@@ -273,6 +275,11 @@ static void *tracker(void *arg) {
     }
     bool have_pose = false, was_frozen = false;
     mr_dmat4 last_pose = mr_m4_identity();
+    /* The covariance that goes with last_pose (only cov and corner_sigma_px
+     * are used): the raw solve's, taken for the filtered pose it was
+     * filtered from (the filter moves the pose by far less than its σ). */
+    mr_pose last_cov;
+    memset(&last_cov, 0, sizeof last_cov);
     mr_image work = {0};
     pthread_mutex_lock(&c->mu);
     while (!c->stop) {
@@ -304,18 +311,23 @@ static void *tracker(void *arg) {
         if (c->p.fixed_pose) {
             f.pose_valid = true;
             last_pose = *c->p.fixed_pose;
+            last_cov.corner_sigma_px = 0; /* a given pose: no uncertainty known */
         } else if (rf && !c->p.retrack && rf->has_pose) {
             /* A recording's own poses: the replay shows what was seen. */
             f.pose_valid = true;
             last_pose = rf->pose;
             f.tags_seen = rf->tags_seen;
             f.rms_px = rf->rms_px;
+            last_cov.corner_sigma_px = rf->corner_sigma_px;
+            memcpy(last_cov.cov, rf->cov, sizeof last_cov.cov);
         } else if (trk) {
-            track_frame(trk, &work, t, &f, &last_pose);
+            track_frame(trk, &work, t, &f, &last_pose, &last_cov);
         }
         if (f.pose_valid) have_pose = true;
         f.have_pose = have_pose;
         f.pose = last_pose;
+        f.corner_sigma_px = have_pose ? last_cov.corner_sigma_px : 0;
+        if (f.corner_sigma_px > 0) memcpy(f.cov, last_cov.cov, sizeof f.cov);
         f.track_ms = (mr_time_now() - t0) * 1e3;
 
         pthread_mutex_lock(&c->mu);

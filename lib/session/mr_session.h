@@ -143,6 +143,10 @@ typedef struct mr_replay_frame {
                                        live view showed it), else the raw one */
     int tags_seen;                  /* recorded tags seen, -1 unknown */
     double rms_px;                  /* recorded RMS of a valid pose, -1 unknown */
+    /* The recorded pose's covariance (mr_pose.cov's convention); recordings
+     * made before it was written have none: corner_sigma_px 0. */
+    double cov[36];
+    double corner_sigma_px;
 } mr_replay_frame;
 
 typedef struct mr_replay mr_replay;
@@ -207,6 +211,9 @@ typedef struct mr_annotation {
     mr_dmat4 world_from_camera;
     int pose_tags_seen;             /* -1 unknown */
     double pose_rms_px;             /* -1 unknown */
+    bool has_uncertainty;           /* "uncertainty_m" present */
+    double uncertainty_m;           /* the registration's 1-σ at world (3D,
+                                       scene units taken as metres) */
     cJSON *json;                    /* the whole line (owned); NULL for one
                                        not read from a file */
 } mr_annotation;
@@ -215,7 +222,8 @@ typedef struct mr_annotation {
  * back (one place for the format): type, time_unix, frame_index,
  * timestamp, note, pixel, hit, world (null when no hit), depth (hit only),
  * node (null when none; then node_index and layer), pose {valid,
- * world_from_camera, tags_seen, rms_px}. The caller may add fields (the
+ * world_from_camera, tags_seen, rms_px}, uncertainty_m (only when
+ * has_uncertainty; older lines have none). The caller may add fields (the
  * view adds "snapshot") before mr_annotation_append. NULL when out of
  * memory. */
 cJSON *mr_annotation_to_json(const mr_annotation *a);
@@ -230,7 +238,8 @@ typedef struct mr_annotations {
 /* Tolerant reader: a torn last line is skipped, a garbage line anywhere is
  * counted and skipped; a line is garbage if it is not a JSON object with a
  * non-empty string "type", or if a present field has the wrong shape (non-finite
- * numbers, pixel not [x,y], world not [x,y,z] or null, a non-rigid pose).
+ * numbers, pixel not [x,y], world not [x,y,z] or null, a non-rigid pose,
+ * uncertainty_m not a number >= 0).
  * Fails only when out of memory. mr_annotations_load: a missing file is
  * zero annotations. */
 bool mr_annotations_parse(const char *text, size_t size, mr_annotations *out, mr_error *err);
@@ -254,6 +263,11 @@ typedef struct mr_capture_frame {
     mr_dmat4 pose;            /* filtered world_from_camera */
     int tags_seen, tags_used;
     double rms_px;            /* reprojection RMS of the pose, pixels */
+    /* The covariance of the pose shown (mr_pose.cov's convention: camera
+     * axes, rad then scene units), held with it while tracking is lost;
+     * corner_sigma_px 0: unknown (a fixed pose, an older recording). */
+    double cov[36];
+    double corner_sigma_px;
     double track_ms;          /* detection + pose + filter for this frame */
     uint64_t seq;             /* increases with every published frame */
 } mr_capture_frame;

@@ -24,6 +24,8 @@ static void from_rec_frame(const mr_rec_frame *f, mr_replay_frame *o) {
     o->has_pose = f->pose.valid;
     o->pose = f->has_filtered ? f->filtered : f->pose.world_from_camera;
     if (!o->has_pose) o->pose = mr_m4_identity();
+    o->corner_sigma_px = o->has_pose ? f->pose.corner_sigma_px : 0;
+    if (o->corner_sigma_px > 0) memcpy(o->cov, f->pose.cov, sizeof o->cov);
 }
 
 /* A plain folder's frames.jsonl (the recording line format, through the

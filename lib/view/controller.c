@@ -1,6 +1,7 @@
 /* The view controller: modes, key map, input queue, layout and the UI of
  * `mrcheck view`, with no window behind it. */
 #include "view_internal.h"
+#include "mr_track.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -412,8 +413,28 @@ void mr_viewer_input(mr_viewer *v, double now, bool busy, mr_view_actions *out) 
 
 /* ------------------------------------------------------------------ UI */
 
+bool mr_view_sigma_here(const mr_viewer_frame *f, double *sigma_m) {
+    if (!f || !f->have_pose || !f->pose_cov || !(f->corner_sigma_px > 0) || !f->have_point) return false;
+    mr_pose p;
+    memset(&p, 0, sizeof p);
+    p.valid = true;
+    p.world_from_camera = f->world_from_camera;
+    memcpy(p.cov, f->pose_cov, sizeof p.cov);
+    p.corner_sigma_px = f->corner_sigma_px;
+    double s3 = 0;
+    if (!mr_pose_point_sigma(&p, f->point, &s3, NULL) || !isfinite(s3)) return false;
+    if (sigma_m) *sigma_m = s3;
+    return true;
+}
+
+mr_view_sigma_state mr_view_sigma_classify(bool known, double sigma_m) {
+    if (!known || !isfinite(sigma_m)) return MR_VIEW_SIGMA_UNKNOWN;
+    double mm = sigma_m * 1e3;
+    return mm < MR_VIEW_SIGMA_OK_MM ? MR_VIEW_SIGMA_OK : mm <= MR_VIEW_SIGMA_WARN_MM ? MR_VIEW_SIGMA_WARN : MR_VIEW_SIGMA_BAD;
+}
+
 static void status_line(mr_viewer *v, const mr_viewer_frame *f) {
-    char line[512], track[128], src[160];
+    char line[512], track[128], src[160], here[48] = "";
     if (!f->have_frame) snprintf(track, sizeof track, "no frame");
     else if (f->pose_valid)
         snprintf(track, sizeof track, "tracking: %d tags, %.2f px", f->tags_seen < 0 ? 0 : f->tags_seen,
@@ -423,12 +444,28 @@ static void status_line(mr_viewer *v, const mr_viewer_frame *f) {
         snprintf(src, sizeof src, "replay %lld/%lld %s %gx", (long long)f->index + 1, (long long)f->count,
                  f->playing ? "playing" : "paused", mr_view_rates[v->s.rate_i]);
     else snprintf(src, sizeof src, "%.150s", f->source_desc ? f->source_desc : "");
-    snprintf(line, sizeof line, "%s%s | %s | %.1f fps | %.200s", v->frozen ? "FROZEN | " : "", src, track, f->fps,
-             v->passes[0] ? v->passes : "-");
-    mr_ui_label(v->ui, v->lay.status, line,
-                f->have_frame && !f->pose_valid ? MR_UI_RGBA(255, 150, 120, 255) : MR_UI_RGBA(235, 240, 245, 255),
-                false);
+    /* The registration's σ where the planner looks ("+/-": the UI font is
+     * printable ASCII only); "?" when the pose has
+     * no covariance (an older recording) or nothing is under the centre. */
+    v->sigma_known = f->have_frame && f->have_pose && mr_view_sigma_here(f, &v->sigma_m);
+    if (!v->sigma_known) v->sigma_m = NAN;
+    if (f->have_frame && f->have_pose) {
+        double mm = v->sigma_m * 1e3;
+        if (!v->sigma_known) snprintf(here, sizeof here, " | +/- ? mm here");
+        else snprintf(here, sizeof here, mm < 9.95 ? " | +/- %.1f mm here" : " | +/- %.0f mm here", mm);
+    }
+    snprintf(line, sizeof line, "%s%s | %s%s | %.1f fps | %.200s", v->frozen ? "FROZEN | " : "", src, track, here,
+             f->fps, v->passes[0] ? v->passes : "-");
+    snprintf(v->status, sizeof v->status, "%s", line);
+    mr_view_sigma_state st = mr_view_sigma_classify(v->sigma_known, v->sigma_m);
+    uint32_t col = MR_UI_RGBA(235, 240, 245, 255);
+    if (f->have_frame && !f->pose_valid) col = MR_UI_RGBA(255, 150, 120, 255);
+    else if (st == MR_VIEW_SIGMA_BAD) col = MR_UI_RGBA(255, 120, 100, 255);
+    else if (st == MR_VIEW_SIGMA_WARN) col = MR_UI_RGBA(255, 210, 110, 255);
+    mr_ui_label(v->ui, v->lay.status, line, col, false);
 }
+
+const char *mr_viewer_status_text(const mr_viewer *v) { return v->status; }
 
 static bool button(mr_viewer *v, mr_view_widget_id id, const char *label, bool on) {
     return v->lay.shown[id] &&
@@ -611,6 +648,10 @@ cJSON *mr_viewer_state_json(const mr_viewer *v) {
     cJSON_AddBoolToObject(j, "tracking_lost_dimmed", v->f.dimmed);
     cJSON_AddNumberToObject(j, "fb_width", v->f.fb_w);
     cJSON_AddNumberToObject(j, "fb_height", v->f.fb_h);
+    if (v->sigma_known) cJSON_AddNumberToObject(j, "sigma_here_mm", v->sigma_m * 1e3);
+    else cJSON_AddNullToObject(j, "sigma_here_mm");
+    static const char *const k_sigma_states[] = {"unknown", "ok", "warn", "bad"};
+    cJSON_AddStringToObject(j, "sigma_state", k_sigma_states[mr_view_sigma_classify(v->sigma_known, v->sigma_m)]);
     cJSON_AddNumberToObject(j, "px_per_mm", mr_ui_px_per_mm(v->ui));
     cJSON_AddNumberToObject(j, "target_px", mr_ui_target_px(v->ui));
     /* Where each widget is (framebuffer pixels x y w h), for tests that

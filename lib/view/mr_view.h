@@ -8,7 +8,8 @@
  * capture threads and carries the actions out; nothing here touches GL,
  * GLFW, files other than the settings file, or app/.
  *
- * Depends on: lib/core, lib/ui, and from lib/render only plain types and
+ * Depends on: lib/core, lib/ui, lib/track's mr_pose_point_sigma (pure
+ * math: the "± N mm here" of the status line), and from lib/render only plain types and
  * names (mr_event, MR_KEY_*, mr_ao_method, mr_ghost_mode,
  * mr_ao_method_name/parse, the option tables' enum names): no GL or GLFW call. One way only: nothing
  * below lib/view includes this header.
@@ -186,7 +187,30 @@ typedef struct mr_viewer_frame {
     bool dimmed;               /* the policy dimmed it */
     const char *passes;        /* the frame's pass list */
     double fps;
+    /* Registration uncertainty (issue 15): the pose shown, its covariance
+     * (mr_pose.cov's convention; NULL or corner_sigma_px 0: unknown, as in
+     * recordings made before it was written) and the world point to tell it
+     * at: the model under the screen centre (mr_renderer_pick) or the point
+     * just picked for a mark; have_point false: nothing there. */
+    mr_dmat4 world_from_camera;
+    const double *pose_cov;    /* 36 */
+    double corner_sigma_px;
+    bool have_point;
+    mr_dvec3 point;            /* world, scene units */
 } mr_viewer_frame;
+
+/* "± N mm here": the registration's 1-σ at f->point (3D, scene units taken
+ * as metres) from the pose covariance through mr_pose_point_sigma. false
+ * (σ unknown) without a valid pose, a covariance or a point, or with the
+ * point behind the camera. */
+bool mr_view_sigma_here(const mr_viewer_frame *f, double *sigma_m);
+/* The colour state of that σ: below MR_VIEW_SIGMA_OK_MM good enough to
+ * judge a discrepancy of a few centimetres, up to MR_VIEW_SIGMA_WARN_MM
+ * doubtful, above it not to be trusted. */
+typedef enum mr_view_sigma_state { MR_VIEW_SIGMA_UNKNOWN = 0, MR_VIEW_SIGMA_OK, MR_VIEW_SIGMA_WARN, MR_VIEW_SIGMA_BAD } mr_view_sigma_state;
+#define MR_VIEW_SIGMA_OK_MM 10.0
+#define MR_VIEW_SIGMA_WARN_MM 30.0
+mr_view_sigma_state mr_view_sigma_classify(bool known, double sigma_m);
 
 /* NULL + err when the font cannot be found (MR_ERR_IO) or memory runs out.
  * Reads the settings file (warnings go to the log). */
@@ -227,7 +251,10 @@ const mr_ui *mr_viewer_ui_ctx(const mr_viewer *v);
 const mr_view_layout *mr_viewer_layout(const mr_viewer *v);
 /* Saves now if changed; false + err if it could not. */
 bool mr_viewer_save_settings(mr_viewer *v, mr_error *err);
-/* The controller's part of a `state` snapshot (settings, modes, widgets). */
+/* The status line as last drawn ("" before the first mr_viewer_ui). */
+const char *mr_viewer_status_text(const mr_viewer *v);
+/* The controller's part of a `state` snapshot (settings, modes, widgets,
+ * "sigma_here_mm" (null: unknown) and "sigma_state"). */
 cJSON *mr_viewer_state_json(const mr_viewer *v);
 
 /* ---------------------------------------------------------------- script */

@@ -43,6 +43,9 @@ struct mr_viewer {
     /* what the last frame showed */
     mr_viewer_frame f;           /* pointers cleared; strings copied below */
     char passes[256];
+    char status[512];            /* the status line as last drawn */
+    bool sigma_known;            /* "± N mm here" of the last frame */
+    double sigma_m;
     mr_view_layout lay;
     int64_t frames;              /* mr_viewer_ui calls */
     /* script */
