@@ -352,7 +352,13 @@ typedef struct mr_shadow_params {
     float light_scale;         /* multiplies the light's size (sun angle, rect, sphere); 0 = 1 */
     bool want_shadow;          /* fill mr_frame_result.shadow */
     bool no_reuse;             /* redraw the maps even when camera and light are unchanged */
+    /* Cascaded sun shadows (issue 12): 1..4 maps over slices of the camera's
+     * visible depth; 0 = auto by the ratio of far to near visible depth
+     * (1 below 16, one more per factor 16, at most 4). Rect and sphere
+     * lights always use one map. */
+    int cascades;
 } mr_shadow_params;
+#define MR_SHADOW_MAX_CASCADES 4
 #define MR_SHADOW_DEFAULT_MAP_SIZE 1024
 #define MR_SHADOW_DEFAULT_TAPS 32
 #define MR_SHADOW_DEFAULT_PCF_RADIUS 3.0f
@@ -426,6 +432,7 @@ typedef struct mr_frame_result {
     mr_image shadow;           /* F32x1 visibility of the casting light in [0,1] (1 = lit,
                                   1 where nothing) when shadow.want_shadow and shadows ran */
     bool shadow_reused;        /* the shadow maps of the previous frame were reused */
+    int shadow_cascades;       /* shadow maps of the casting light this frame (sun cascades; 0: none) */
 } mr_frame_result;
 
 /* Renders one frame of the current scene seen through `view`. */
