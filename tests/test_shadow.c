@@ -546,6 +546,42 @@ static void cascades(mr_renderer *r) {
     mr_renderer_set_scene(r, NULL, NULL);
     mr_scene_destroy(&s);
 
+    /* Stable: wherever the camera walks (sideways and forwards, by odd
+     * amounts), each cascade's corner lies on whole texels of the
+     * scene-fixed light frame, and a small step keeps its size. */
+    {
+        s = hall_scene(&w, 45, 0.5, true);
+        const double steps[4][2] = {{0, 0}, {0.0137, 0.0071}, {0.31, -0.173}, {-1.7, 2.9}};
+        double worst = 0, t0[MR_SHADOW_MAX_CASCADES][2] = {{0}};
+        bool same_size = true;
+        int ncs = 0;
+        for (int i = 0; i < 4; i++) {
+            mr_view sv = hall_view(&w);
+            sv.world_from_camera.m[3] += steps[i][0];
+            sv.world_from_camera.m[11] += steps[i][1];
+            shot sh;
+            if (!render_c(r, s, &sv, MR_SHADOW_HARD, 0, &sh, NULL)) continue;
+            shot_free(&sh);
+            double corner[2], texel[2];
+            ncs = mr_shadow_cascade_grid(r, 0, corner, texel);
+            for (int k = 0; k < ncs; k++) {
+                mr_shadow_cascade_grid(r, k, corner, texel);
+                for (int a = 0; a < 2; a++) {
+                    double q = corner[a] / texel[a];
+                    worst = fmax(worst, fabs(q - round(q)));
+                    if (i == 0) t0[k][a] = texel[a];
+                    if (i == 1 && texel[a] != t0[k][a]) same_size = false;
+                }
+            }
+        }
+        printf("  cascades (%d) on a walking camera: corners off whole texels by at most %.2e texel; a 1.4 cm step "
+               "keeps the size: %s\n", ncs, worst, same_size ? "yes" : "no");
+        CHECK_MSG(ncs >= 2 && worst < 1e-3, "cascade not snapped to texels: %.3g texel off (%d cascades)", worst, ncs);
+        CHECK_MSG(same_size, "a 1.4 cm step changed a cascade's size");
+        mr_renderer_set_scene(r, NULL, NULL);
+        mr_scene_destroy(&s);
+    }
+
     /* No seam: a bare lit floor under a grazing sun (10 degrees), 2..4
      * cascades: every floor pixel lit, across the boundaries too. */
     s = hall_scene(&w, 10, 1, false);

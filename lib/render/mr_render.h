@@ -375,6 +375,11 @@ bool mr_shadow_method_parse(const char *name, mr_shadow_method *out);
 /* The light a frame's shadows come from: the scene's first casting light, or
  * the default sun when the scene has no lights; false when none casts. */
 bool mr_shadow_light(const mr_scene *s, mr_light *out);
+/* The sun cascades of the renderer's last shadow frame (for tests): cascade
+ * k's rectangle corner and texel size in the light's frame fixed to the
+ * scene (the light's axes, origin at the scene's bounds centre). Returns
+ * the cascade count, 0 when the last frame drew a single map. */
+int mr_shadow_cascade_grid(const mr_renderer *r, int k, double corner[2], double texel[2]);
 
 typedef struct mr_frame_params {
     int width, height;         /* output size in pixels; 0 = the camera's */

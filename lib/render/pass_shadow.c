@@ -73,6 +73,7 @@ typedef struct light_frame {
     int ncasc;                                 /* 1: the single fit above; 2..4: casc[] */
     cascade casc[MR_SHADOW_MAX_CASCADES];
     double vis_near, vis_far;                  /* the camera's visible depth range (sun) */
+    double ox, oy;                             /* cascades: the light eye's xy in the scene-fixed frame */
 } light_frame;
 
 /* What a shadow map depends on: a frame with the same key reuses it. */
@@ -219,6 +220,11 @@ static bool visible_depth(const frame *f, double *dn, double *df) {
         for (int k = 0; k < 8; k++)
             corner[k] = mr_m4_point(&f->cam_from_world, mr_v3(k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1],
                                                               k & 4 ? hi[2] : lo[2]));
+        /* A box whose corners' depths lie inside the range found so far
+         * cannot widen it: no clipping (most of a big scene's nodes). */
+        double zlo = INFINITY, zhi = -INFINITY;
+        for (int k = 0; k < 8; k++) zlo = fmin(zlo, corner[k].z), zhi = fmax(zhi, corner[k].z);
+        if (zlo >= lo_z && zhi <= hi_z) continue;
         for (int fc = 0; fc < 6; fc++) {
             mr_dvec3 a[12], b[12];
             int n = 4;
@@ -252,6 +258,8 @@ static void fit_cascades(const frame *f, light_frame *lf, const mr_dmat4 *l0_fro
         d[i] = CASCADE_LAMBDA * dn * pow(dfar / dn, (double)i / n) + (1 - CASCADE_LAMBDA) * (dn + (dfar - dn) * i / n);
     d[0] = dn, d[n] = dfar;
     const mr_camera *c = &f->cam;
+    lf->ox = ox;
+    lf->oy = oy;
     for (int k = 0; k < n; k++) {
         cascade *cs = &lf->casc[k];
         /* The slice and the seam band past it (the next cascade blends in
@@ -460,6 +468,20 @@ static void fit_light(const frame *f, int max_tex, light_frame *lf) {
     int S = map_size(&f->p->shadow);
     if (lf->light.kind == MR_LIGHT_SUN) fit_sun(f, &lf->light, scale, S, max_tex, lf);
     else fit_perspective(f, &lf->light, scale, S, lf);
+}
+
+int mr_shadow_cascade_grid(const mr_renderer *r, int k, double corner[2], double texel[2]) {
+    const struct mr_shadow_state *s = r ? r->shadow : NULL;
+    if (!s || s->lf.ncasc < 2) return 0;
+    if (k >= 0 && k < s->lf.ncasc) {
+        const cascade *cs = &s->lf.casc[k];
+        int S = s->map_size;
+        corner[0] = cs->x0 + s->lf.ox;
+        corner[1] = cs->y0 + s->lf.oy;
+        texel[0] = cs->wx / S;
+        texel[1] = cs->wy / S;
+    }
+    return s->lf.ncasc;
 }
 
 /* ------------------------------------------------------------ the passes */
