@@ -251,6 +251,12 @@
 #define MR_LOC_SHADOW_LIGHT_AREA           16
 #define MR_LOC_SHADOW_KERNEL               20
 #define MR_SHADOW_KERNEL_SIZE              64 /* = MR_SHADOW_MAX_TAPS (checked in pass_shadow.c) */
+/* shadow_vis: sun cascades (after the kernel's 20..83) */
+#define MR_LOC_SHADOW_CASCADES             84
+#define MR_LOC_SHADOW_SPLITS               85 /* vec4: far camera depth of cascades 0..3 */
+#define MR_LOC_SHADOW_BAND                 86 /* seam band: fraction of the split depth */
+#define MR_LOC_SHADOW_RECTS                87 /* vec4[MR_SHADOW_CASCADES_MAX]: 87..90 */
+#define MR_SHADOW_CASCADES_MAX             4  /* = MR_SHADOW_MAX_CASCADES (checked in pass_shadow.c) */
 #define MR_TEX_SHADOW_DEPTH                0
 #define MR_TEX_SHADOW_NORMAL               1
 #define MR_TEX_SHADOW_MAP                  2

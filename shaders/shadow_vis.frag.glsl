@@ -23,7 +23,7 @@ layout(location = MR_LOC_SHADOW_INTR) uniform vec4 u_intr;            // fx fy c
 layout(location = MR_LOC_SHADOW_NEAR) uniform float u_near;
 layout(location = MR_LOC_SHADOW_LIGHT_FROM_CAM) uniform mat4 u_light_from_cam;
 layout(location = MR_LOC_SHADOW_ORTHO) uniform int u_ortho;
-layout(location = MR_LOC_SHADOW_RECT) uniform vec4 u_rect;            // ortho: x0, y0, 1/wx, 1/wy
+layout(location = MR_LOC_SHADOW_RECT) uniform vec4 u_rect0;           // ortho: x0, y0, 1/wx, 1/wy (one map)
 layout(location = MR_LOC_SHADOW_K) uniform float u_k;                 // perspective: uv per unit of x/z
 layout(location = MR_LOC_SHADOW_ZRANGE) uniform vec2 u_zrange;        // nearest caster, farthest receiver
 layout(location = MR_LOC_SHADOW_LIGHT_HALF) uniform float u_half;
@@ -37,12 +37,25 @@ layout(location = MR_LOC_SHADOW_WEIGHT) uniform float u_weight;       // ground 
 layout(location = MR_LOC_SHADOW_MAX_SEARCH) uniform float u_max_search; // texels
 layout(location = MR_LOC_SHADOW_LIGHT_AREA) uniform vec2 u_light_half2; // BP: half extents on the light plane
 layout(location = MR_LOC_SHADOW_KERNEL) uniform vec2 u_kernel[MR_SHADOW_KERNEL_SIZE]; // unit-disk taps
+// Sun cascades: the maps are tiles of one atlas, cascade k at
+// ((k & 1) S, (k >> 1) S); each has its own rectangle in the shared light
+// frame (same axes and depth), so every size below that is in texels or uv
+// follows the chosen cascade's texel. A pixel takes the cascade of its
+// camera depth; over a band past each split both neighbours cover it
+// (the nearer was fitted that far) and the visibility blends linearly.
+layout(location = MR_LOC_SHADOW_CASCADES) uniform int u_cascades;     // 0: one map (u_rect0)
+layout(location = MR_LOC_SHADOW_SPLITS) uniform vec4 u_splits;
+layout(location = MR_LOC_SHADOW_BAND) uniform float u_band;
+layout(location = MR_LOC_SHADOW_RECTS) uniform vec4 u_rects[MR_SHADOW_CASCADES_MAX];
 
 layout(binding = MR_TEX_SHADOW_DEPTH) uniform sampler2D u_depth;      // reversed-Z G-buffer depth
 layout(binding = MR_TEX_SHADOW_MAP) uniform sampler2D u_map;          // R32F linear light depth
 layout(binding = MR_TEX_SHADOW_NORMAL) uniform sampler2D u_normal;    // G-buffer view normal
 
 layout(location = 0) out float o_vis;
+
+vec4 u_rect;     // the cascade's rectangle (ortho: x0, y0, 1/wx, 1/wy)
+ivec2 g_tile;    // the cascade's texel offset in the atlas
 
 bool nn_valid(vec3 n) { return dot(n, n) > 0.25; }
 
@@ -77,7 +90,7 @@ vec2 g_grad;     // dz/duv of the receiver plane
 float g_bias;
 vec3 g_lR;       // receiver in light space (normal-offset)
 
-float tap_depth(ivec2 t) { return texelFetch(u_map, t, 0).r; }
+float tap_depth(ivec2 t) { return texelFetch(u_map, t + g_tile, 0).r; }
 bool inside(ivec2 t) { return all(greaterThanEqual(t, ivec2(0))) && all(lessThan(t, ivec2(u_size))); }
 vec2 texel_centre(ivec2 t) { return (vec2(t) + 0.5) / float(u_size); }
 float ref_depth(ivec2 t) { return g_zR + dot(g_grad, texel_centre(t) - g_uvR) - g_bias; }
@@ -166,12 +179,9 @@ float backprojection(vec3 r, vec2 radius_uv) {
     return 1.0 - min(1.0, occ / area_l);
 }
 
-void main() {
-    ivec2 px = ivec2(gl_FragCoord.xy);
-    vec3 pc = cam_pos(px);
-    if (pc.z <= 0.0) { o_vis = u_weight; return; }
+float visibility(ivec2 px, vec3 pc) {
     vec3 l = light_pos(pc);
-    if (u_ortho == 0 && l.z <= 0.0) { o_vis = u_weight; return; } // behind the light's plane
+    if (u_ortho == 0 && l.z <= 0.0) return 1.0; // behind the light's plane
     // Normal offset: a receiver seen edge-on by the light (a wall under a
     // light straight above) has no plane the map can resolve; lifting it a
     // map texel off its surface, more the more it turns away, keeps it off
@@ -185,7 +195,7 @@ void main() {
         // ground truth) gets none of it: its own far side blocks it, which
         // the map of an edge-on surface cannot tell.
         vec3 to_light = u_ortho != 0 ? normalize(vec3(-u_shear, -1.0)) : normalize(u_offset - (l + u_offset));
-        if (dot(ln, to_light) <= 0.0 && nn_valid(n)) { o_vis = 0.0; return; }
+        if (dot(ln, to_light) <= 0.0 && nn_valid(n)) return 0.0;
         vec3 lo = light_pos(pc + n * (1.5 * tl * edge));
         g_lR = lo;
         g_zR = lo.z;
@@ -239,6 +249,30 @@ void main() {
                 vec2 pen = clamp(light_reach(zb, g_zR) * sc, vec2(0.5 * texel_uv), vec2(max_uv));
                 v = pcf(pen);
             }
+        }
+    }
+    return v;
+}
+
+void use_cascade(int k) {
+    u_rect = u_cascades > 0 ? u_rects[k] : u_rect0;
+    g_tile = ivec2(k & 1, k >> 1) * u_size;
+}
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec3 pc = cam_pos(px);
+    if (pc.z <= 0.0) { o_vis = u_weight; return; }
+    int k = 0;
+    while (k + 1 < u_cascades && pc.z > u_splits[k]) k++;
+    use_cascade(k);
+    float v = visibility(px, pc);
+    // The seam band past the previous split: from its cascade to this one.
+    if (k > 0) {
+        float s = u_splits[k - 1], t = (pc.z - s) / (u_band * s);
+        if (t < 1.0) {
+            use_cascade(k - 1);
+            v = mix(visibility(px, pc), v, clamp(t, 0.0, 1.0));
         }
     }
     o_vis = v * u_weight;

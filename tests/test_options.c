@@ -344,6 +344,7 @@ static void test_tables(void) {
         N(mr_shadow_params, "pcf-radius", pcf_radius, 0.01f, 64),
         N(mr_shadow_params, "samples", gt_samples, 1, 1024),
         N(mr_shadow_params, "light-scale", light_scale, 1e-6f, 1e6f),
+        N(mr_shadow_params, "cascades", cascades, 0, MR_SHADOW_MAX_CASCADES),
     };
     const expect ex_vs[] = {
         N(mr_view_settings, "alpha", alpha, 0, 1),

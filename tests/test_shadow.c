@@ -427,6 +427,212 @@ static void scales(mr_renderer *r) {
     }
 }
 
+/* Cascades (sun): a hall-sized floor seen from eye height at a grazing
+ * angle, a pole 4 ahead of the camera, the sun behind the pole so its
+ * shadow runs towards the camera and its edges along the view. */
+#define HALL 60.0
+static mr_scene *hall_scene(const world *w, double elev_deg, double angle_deg, bool pole) {
+    mr_scene *s = base_scene(w, HALL);
+    if (pole) add_box(s, w, "Pole", 0.4, 2, 0.4, 0, 1, -HALL / 2 + 5, 0);
+    mr_scene_update_bounds(s);
+    s->light_count = 1;
+    mr_light *L = &s->lights[0];
+    memset(L, 0, sizeof *L);
+    double e = elev_deg * 3.14159265358979323846 / 180;
+    L->direction[1] = sin(e);
+    L->direction[2] = cos(e);
+    L->color[0] = L->color[1] = L->color[2] = 0.6f;
+    L->kind = MR_LIGHT_SUN;
+    L->casts = true;
+    L->angle = angle_deg;
+    return s;
+}
+
+static mr_view hall_view(const world *w) {
+    mr_view v = {{W, H, 220, 220, W / 2 - 0.5, H / 2 - 0.5, {0}}, mr_m4_identity()};
+    v.world_from_camera = mr_m4_look_at_cv(wpt(w, 0.3, 1.2, -HALL / 2 + 1), wpt(w, 0.3, 0, -HALL / 2 + 1 + 1.2 / tan(0.26)),
+                                           mr_v3(0, 1, 0));
+    return v;
+}
+
+static bool render_c(mr_renderer *r, const mr_scene *s, const mr_view *v, mr_shadow_method m, int cascades, shot *out,
+                     int *ncasc) {
+    mr_frame_params p = MR_FRAME_DEFAULTS;
+    p.shadow.method = m;
+    p.shadow.want_shadow = true;
+    p.shadow.gt_samples = 64;
+    p.shadow.cascades = cascades;
+    p.want_depth = true;
+    mr_frame_result res;
+    mr_error err = {0};
+    memset(out, 0, sizeof *out);
+    if (!mr_renderer_set_scene(r, s, &err) || !mr_render_frame(r, v, &p, &res, &err)) {
+        CHECK_MSG(false, "render (%s, %d cascades): %s", mr_shadow_method_names[m], cascades, err.msg);
+        return false;
+    }
+    out->vis = res.shadow;
+    out->depth = res.depth;
+    memset(&res.shadow, 0, sizeof res.shadow);
+    memset(&res.depth, 0, sizeof res.depth);
+    if (ncasc) *ncasc = res.shadow_cascades;
+    mr_frame_result_free(&res);
+    return out->vis.data != NULL;
+}
+
+/* The 25-75% width of the pole shadow's edge across x at z (unscaled). */
+static double edge_width_x(const world *w, const mr_view *v, const mr_image *vis, double z) {
+    double x25 = NAN, x75 = NAN, prev = vis_at(w, v, vis, 0, z);
+    for (double x = 0.001; x < 0.7; x += 0.001) {
+        double c = vis_at(w, v, vis, x, z);
+        if (isnan(x25) && prev < 0.25 && c >= 0.25) x25 = x - 0.001 * (c - 0.25) / (c - prev);
+        if (isnan(x75) && prev < 0.75 && c >= 0.75) x75 = x - 0.001 * (c - 0.75) / (c - prev);
+        prev = c;
+    }
+    return x75 - x25;
+}
+
+static void cascades(mr_renderer *r) {
+    world w = {1, {0, 0, 0}};
+    /* A small scene needs one map: the pole under a sun from above. */
+    {
+        mr_scene *small = sun_scene(&w, 45, 8, 1);
+        mr_view sv = look(&w, mr_v3(-1.2, 5, 0.01), mr_v3(-1.2, 0, 0), mr_v3(1, 0, 0));
+        shot sh;
+        int nc = 0;
+        if (render_c(r, small, &sv, MR_SHADOW_PCSS, 0, &sh, &nc)) {
+            printf("  small scene: auto picks %d cascade(s)\n", nc);
+            CHECK_MSG(nc == 1, "a small scene got %d cascades", nc);
+            shot_free(&sh);
+        }
+        mr_renderer_set_scene(r, NULL, NULL);
+        mr_scene_destroy(&small);
+    }
+    mr_scene *s = hall_scene(&w, 45, 0.5, true);
+    mr_view v = hall_view(&w);
+    shot gt, one, many, hard1, hardn;
+    int n_auto = 0, n1 = 0, ngt = 0;
+    /* The pole's shadow near the camera: 0.6 and 1.2 in front of its base. */
+    const double zs[2] = {-HALL / 2 + 5 - 0.6, -HALL / 2 + 5 - 1.2};
+    if (render_c(r, s, &v, MR_SHADOW_GROUNDTRUTH, 4, &gt, &ngt) && render_c(r, s, &v, MR_SHADOW_PCF, 1, &one, &n1) &&
+        render_c(r, s, &v, MR_SHADOW_PCF, 0, &many, &n_auto) && render_c(r, s, &v, MR_SHADOW_HARD, 1, &hard1, NULL) &&
+        render_c(r, s, &v, MR_SHADOW_HARD, 0, &hardn, NULL)) {
+        printf("  hall view: auto picks %d cascades (1 asked: %d, ground truth with %d)\n", n_auto, n1, ngt);
+        CHECK_MSG(n_auto >= 2 && n1 == 1 && ngt == 4, "cascades: auto %d, one %d, four %d", n_auto, n1, ngt);
+        for (int i = 0; i < 2; i++) {
+            double eg = edge_width_x(&w, &v, &gt.vis, zs[i] - (-HALL / 2 + 5) + (-HALL / 2 + 5));
+            double e1 = edge_width_x(&w, &v, &one.vis, zs[i]), en = edge_width_x(&w, &v, &many.vis, zs[i]);
+            printf("  pole edge %.1f before its base, PCF 25-75%% width: 1 cascade %.4f, %d cascades %.4f, "
+                   "ground truth %.4f\n", -HALL / 2 + 5 - zs[i], e1, n_auto, en, eg);
+            CHECK_MSG(en < 0.6 * e1, "cascades do not sharpen the near shadow: %.4f vs %.4f", en, e1);
+            CHECK_MSG(fabs(en - eg) < fabs(e1 - eg), "cascades not closer to ground truth: %.4f %.4f (gt %.4f)", en, e1,
+                      eg);
+        }
+        /* Hard shadows against the ground truth near the camera (depth < 8). */
+        double se1 = 0, sen = 0;
+        int np = 0;
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                float d = px(&gt.depth, x, y);
+                if (!(d > 0 && d < 8)) continue;
+                double g = px(&gt.vis, x, y), a = px(&hard1.vis, x, y) - g, b = px(&hardn.vis, x, y) - g;
+                se1 += a * a, sen += b * b, np++;
+            }
+        double r1 = sqrt(se1 / (np ? np : 1)), rn = sqrt(sen / (np ? np : 1));
+        printf("  hard vs ground truth near the camera (%d px): RMSE 1 cascade %.4f, %d cascades %.4f\n", np, r1, n_auto,
+               rn);
+        CHECK_MSG(np > 1000 && rn < r1, "hard with cascades not closer to the ground truth: %.4f vs %.4f", rn, r1);
+    }
+    shot_free(&gt), shot_free(&one), shot_free(&many), shot_free(&hard1), shot_free(&hardn);
+    mr_renderer_set_scene(r, NULL, NULL);
+    mr_scene_destroy(&s);
+
+    /* Stable: wherever the camera walks (sideways and forwards, by odd
+     * amounts), each cascade's corner lies on whole texels of the
+     * scene-fixed light frame, and a small step keeps its size. */
+    {
+        s = hall_scene(&w, 45, 0.5, true);
+        const double steps[4][2] = {{0, 0}, {0.0137, 0.0071}, {0.31, -0.173}, {-1.7, 2.9}};
+        double worst = 0, t0[MR_SHADOW_MAX_CASCADES][2] = {{0}};
+        bool same_size = true;
+        int ncs = 0;
+        for (int i = 0; i < 4; i++) {
+            mr_view sv = hall_view(&w);
+            sv.world_from_camera.m[3] += steps[i][0];
+            sv.world_from_camera.m[11] += steps[i][1];
+            shot sh;
+            if (!render_c(r, s, &sv, MR_SHADOW_HARD, 0, &sh, NULL)) continue;
+            shot_free(&sh);
+            double corner[2], texel[2];
+            ncs = mr_shadow_cascade_grid(r, 0, corner, texel);
+            for (int k = 0; k < ncs; k++) {
+                mr_shadow_cascade_grid(r, k, corner, texel);
+                for (int a = 0; a < 2; a++) {
+                    double q = corner[a] / texel[a];
+                    worst = fmax(worst, fabs(q - round(q)));
+                    if (i == 0) t0[k][a] = texel[a];
+                    if (i == 1 && texel[a] != t0[k][a]) same_size = false;
+                }
+            }
+        }
+        printf("  cascades (%d) on a walking camera: corners off whole texels by at most %.2e texel; a 1.4 cm step "
+               "keeps the size: %s\n", ncs, worst, same_size ? "yes" : "no");
+        CHECK_MSG(ncs >= 2 && worst < 1e-3, "cascade not snapped to texels: %.3g texel off (%d cascades)", worst, ncs);
+        CHECK_MSG(same_size, "a 1.4 cm step changed a cascade's size");
+        mr_renderer_set_scene(r, NULL, NULL);
+        mr_scene_destroy(&s);
+    }
+
+    /* No seam: a bare lit floor under a grazing sun (10 degrees), 2..4
+     * cascades: every floor pixel lit, across the boundaries too. */
+    s = hall_scene(&w, 10, 1, false);
+    const mr_shadow_method ms[4] = {MR_SHADOW_HARD, MR_SHADOW_PCF, MR_SHADOW_PCSS, MR_SHADOW_BP};
+    for (int c = 2; c <= 4; c++)
+        for (int i = 0; i < 4; i++) {
+            shot sh;
+            int nc = 0;
+            if (!render_c(r, s, &v, ms[i], c, &sh, &nc)) continue;
+            float lo = 1;
+            int n = 0;
+            for (int y = 0; y < H; y++)
+                for (int x = 0; x < W; x++)
+                    if (px(&sh.depth, x, y) > 0) lo = fminf(lo, px(&sh.vis, x, y)), n++;
+            printf("  hall floor, grazing sun, %s, %d cascades: darkest floor pixel %.4f over %d\n",
+                   mr_shadow_method_names[ms[i]], nc, lo, n);
+            CHECK_MSG(nc >= 2 && n > 5000 && lo >= 0.99f, "%s, %d cascades: seam or acne on a lit floor: %.4f",
+                      mr_shadow_method_names[ms[i]], nc, lo);
+            shot_free(&sh);
+        }
+    mr_renderer_set_scene(r, NULL, NULL);
+    mr_scene_destroy(&s);
+
+    /* The same picture at scale 1e-3 and 1e4 and a 1e7 offset. */
+    const world ws[4] = {{1, {0, 0, 0}}, {1e-3, {0, 0, 0}}, {1e4, {0, 0, 0}}, {1, {1e7, 0, -1e7}}};
+    shot ref[2];
+    const mr_shadow_method m2[2] = {MR_SHADOW_PCF, MR_SHADOW_PCSS};
+    for (int i = 0; i < 4; i++) {
+        s = hall_scene(&ws[i], 45, 2, true);
+        v = hall_view(&ws[i]);
+        for (int m = 0; m < 2; m++) {
+            shot sh;
+            int nc = 0;
+            if (!render_c(r, s, &v, m2[m], 0, &sh, &nc)) continue;
+            if (i == 0) {
+                ref[m] = sh;
+                continue;
+            }
+            double e = ref[m].vis.data ? rmse_images(&sh.vis, &ref[m].vis) : 1;
+            printf("  hall, %s, %d cascades at scale %g, offset %g: RMSE %.5f against scale 1\n",
+                   mr_shadow_method_names[m2[m]], nc, ws[i].scale, ws[i].offset.x, e);
+            CHECK_MSG(nc >= 2 && e < 0.01, "cascades at scale %g offset %g: RMSE %.4f (%d cascades)", ws[i].scale,
+                      ws[i].offset.x, e, nc);
+            shot_free(&sh);
+        }
+        mr_renderer_set_scene(r, NULL, NULL);
+        mr_scene_destroy(&s);
+    }
+    shot_free(&ref[0]), shot_free(&ref[1]);
+}
+
 /* Scene configs with bad lights fail with one line. */
 static void bad_configs(void) {
     char dir[4096];
@@ -591,6 +797,7 @@ int main(void) {
         contact_hardening(r);
         acne_and_gaps(r);
         scales(r);
+        cascades(r);
         catcher(r);
         bench_and_suite(gpu, r);
     }

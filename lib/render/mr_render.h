@@ -352,7 +352,13 @@ typedef struct mr_shadow_params {
     float light_scale;         /* multiplies the light's size (sun angle, rect, sphere); 0 = 1 */
     bool want_shadow;          /* fill mr_frame_result.shadow */
     bool no_reuse;             /* redraw the maps even when camera and light are unchanged */
+    /* Cascaded sun shadows (issue 12): 1..4 maps over slices of the camera's
+     * visible depth; 0 = auto by the ratio of far to near visible depth
+     * (1 below 16, one more per factor 16, at most 4). Rect and sphere
+     * lights always use one map. */
+    int cascades;
 } mr_shadow_params;
+#define MR_SHADOW_MAX_CASCADES 4
 #define MR_SHADOW_DEFAULT_MAP_SIZE 1024
 #define MR_SHADOW_DEFAULT_TAPS 32
 #define MR_SHADOW_DEFAULT_PCF_RADIUS 3.0f
@@ -369,6 +375,11 @@ bool mr_shadow_method_parse(const char *name, mr_shadow_method *out);
 /* The light a frame's shadows come from: the scene's first casting light, or
  * the default sun when the scene has no lights; false when none casts. */
 bool mr_shadow_light(const mr_scene *s, mr_light *out);
+/* The sun cascades of the renderer's last shadow frame (for tests): cascade
+ * k's rectangle corner and texel size in the light's frame fixed to the
+ * scene (the light's axes, origin at the scene's bounds centre). Returns
+ * the cascade count, 0 when the last frame drew a single map. */
+int mr_shadow_cascade_grid(const mr_renderer *r, int k, double corner[2], double texel[2]);
 
 typedef struct mr_frame_params {
     int width, height;         /* output size in pixels; 0 = the camera's */
@@ -429,6 +440,7 @@ typedef struct mr_frame_result {
     mr_image shadow;           /* F32x1 visibility of the casting light in [0,1] (1 = lit,
                                   1 where nothing) when shadow.want_shadow and shadows ran */
     bool shadow_reused;        /* the shadow maps of the previous frame were reused */
+    int shadow_cascades;       /* shadow maps of the casting light this frame (sun cascades; 0: none) */
 } mr_frame_result;
 
 /* Renders one frame of the current scene seen through `view`. */

@@ -110,6 +110,8 @@ const mr_opt mr_shadow_opts[] = {
     {"samples", MR_OPT_INT, SH(gt_samples), 1, 1024, MR_SHADOW_DEFAULT_GT_SAMPLES, NULL,
      "groundtruth: light samples (rounded to a square)", 0},
     {"light-scale", MR_OPT_FLOAT, SH(light_scale), 1e-6f, 1e6f, 1, NULL, "multiplies the light's size", 0},
+    {"cascades", MR_OPT_INT, SH(cascades), 0, MR_SHADOW_MAX_CASCADES, 0, NULL,
+     "sun: shadow-map cascades over the visible depth (0 = auto: 1 for a small scene, 2+ for a hall)", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef SH

@@ -34,6 +34,28 @@ _Static_assert(MR_SHADOW_METHOD_ID_HARD == MR_SHADOW_HARD && MR_SHADOW_METHOD_ID
  * cost per pixel stays bounded for huge lights; wider penumbrae saturate. */
 #define MAX_SEARCH_TEXELS 48.0
 
+_Static_assert(MR_SHADOW_CASCADES_MAX == MR_SHADOW_MAX_CASCADES, "shadow cascades");
+/* Cascades: the practical split scheme's blend of the logarithmic and the
+ * uniform split (1 = all logarithmic), and the seam band past each split
+ * (a fraction of its depth) over which both neighbours are fitted and the
+ * visibility blends. One more cascade per factor of CASCADE_RATIO between
+ * the far and the near visible depth. */
+#define CASCADE_LAMBDA 0.75
+#define CASCADE_BAND 0.1
+#define CASCADE_RATIO 16.0
+
+/* One sun cascade: its rectangle in the light frame (light_frame's axes and
+ * depth) and the culling eye that sees it. */
+typedef struct cascade {
+    double x0, y0, wx, wy;   /* the rectangle in light xy (relative to the light eye) */
+    double cx, cy;           /* its centre: the culling eye's xy */
+    double cull_back;
+    mr_dmat4 cull_world_from_camera;
+    mr_camera cam;
+    double near_plane;
+    double split;            /* far camera depth of its slice (the band not counted) */
+} cascade;
+
 /* The fitted light projection of one frame (all double, scene units). */
 typedef struct light_frame {
     mr_light light;
@@ -48,6 +70,10 @@ typedef struct light_frame {
     double znear, zfar;                        /* nearest caster, farthest receiver (light z) */
     double half;                               /* perspective: light half-width; sun: tan(angle/2) */
     double half2[2];                           /* backprojection: half extents on the light */
+    int ncasc;                                 /* 1: the single fit above; 2..4: casc[] */
+    cascade casc[MR_SHADOW_MAX_CASCADES];
+    double vis_near, vis_far;                  /* the camera's visible depth range (sun) */
+    double ox, oy;                             /* cascades: the light eye's xy in the scene-fixed frame */
 } light_frame;
 
 /* What a shadow map depends on: a frame with the same key reuses it. */
@@ -58,11 +84,13 @@ typedef struct map_key {
     mr_light light;
     int map_size;
     float light_scale;
+    int cascades;
 } map_key;
 
 struct mr_shadow_state {
     GLuint prog_map, prog_vis;
     int map_size;
+    int atlas_w, atlas_h;  /* the cascades' tiles (one map: map_size square) */
     target map;            /* R32F linear depth + depth attachment */
     int w, h;
     target vis;            /* R32F visibility at the output size */
@@ -112,6 +140,7 @@ static void make_key(const frame *f, map_key *k) {
     mr_shadow_light(f->r->scene, &k->light);
     k->map_size = map_size(&f->p->shadow);
     k->light_scale = light_scale(&f->p->shadow);
+    k->cascades = f->p->shadow.cascades;
 }
 
 static bool reusable(const frame *f) {
@@ -155,7 +184,128 @@ static double scene_diag(const mr_scene *s) {
     return d > 0 && isfinite(d) ? d : 1.0;
 }
 
-static void fit_sun(const frame *f, const mr_light *L, double scale, int S, light_frame *lf) {
+/* Sutherland-Hodgman: the part of polygon p (n points, camera space) on
+ * the side a.xyz . q >= 0 of a plane through the eye (or z >= a[3] for the
+ * near plane); returns the new count (at most n + 1). */
+static int clip_poly(const mr_dvec3 *p, int n, const double a[4], bool near, mr_dvec3 *out) {
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        mr_dvec3 c = p[i], d = p[(i + 1) % n];
+        double sc = near ? c.z - a[3] : a[0] * c.x + a[1] * c.y + a[2] * c.z;
+        double sd = near ? d.z - a[3] : a[0] * d.x + a[1] * d.y + a[2] * d.z;
+        if (sc >= 0) out[m++] = c;
+        if ((sc >= 0) != (sd >= 0)) out[m++] = mr_v3_add(c, mr_v3_scale(mr_v3_sub(d, c), sc / (sc - sd)));
+    }
+    return m;
+}
+
+/* The camera depth range of what it can see: every drawn node's world box,
+ * its faces clipped to the view frustum (near plane included), the nearest
+ * and farthest camera z left. False if nothing is in view. */
+static bool visible_depth(const frame *f, double *dn, double *df) {
+    const mr_scene *s = f->r->scene;
+    const mr_camera *c = &f->cam;
+    const double ax0 = (-0.5 - c->cx) / c->fx, ax1 = (c->width - 0.5 - c->cx) / c->fx;
+    const double ay0 = (-0.5 - c->cy) / c->fy, ay1 = (c->height - 0.5 - c->cy) / c->fy;
+    /* x >= ax0 z, x <= ax1 z, y >= ay0 z, y <= ay1 z, z >= near */
+    const double planes[5][4] = {{1, 0, -ax0, 0}, {-1, 0, ax1, 0}, {0, 1, -ay0, 0}, {0, -1, ay1, 0},
+                                 {0, 0, 0, f->near_plane}};
+    static const int faces[6][4] = {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}};
+    double lo_z = INFINITY, hi_z = 0;
+    for (int32_t i = 0; i < s->node_count; i++) {
+        if (f->p->hide_hidden_layer && s->nodes[i].layer == MR_LAYER_HIDDEN) continue;
+        double lo[3], hi[3];
+        if (!mr_scene_node_bounds(s, i, lo, hi)) continue;
+        mr_dvec3 corner[8];
+        for (int k = 0; k < 8; k++)
+            corner[k] = mr_m4_point(&f->cam_from_world, mr_v3(k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1],
+                                                              k & 4 ? hi[2] : lo[2]));
+        /* A box whose corners' depths lie inside the range found so far
+         * cannot widen it: no clipping (most of a big scene's nodes). */
+        double zlo = INFINITY, zhi = -INFINITY;
+        for (int k = 0; k < 8; k++) zlo = fmin(zlo, corner[k].z), zhi = fmax(zhi, corner[k].z);
+        if (zlo >= lo_z && zhi <= hi_z) continue;
+        for (int fc = 0; fc < 6; fc++) {
+            mr_dvec3 a[12], b[12];
+            int n = 4;
+            for (int k = 0; k < 4; k++) a[k] = corner[faces[fc][k]];
+            for (int pl = 0; pl < 5 && n > 0; pl++) {
+                n = clip_poly(a, n, planes[pl], pl == 4, b);
+                memcpy(a, b, sizeof(mr_dvec3) * (size_t)n);
+            }
+            for (int k = 0; k < n; k++) lo_z = fmin(lo_z, a[k].z), hi_z = fmax(hi_z, a[k].z);
+        }
+    }
+    *dn = lo_z;
+    *df = hi_z;
+    return isfinite(lo_z) && hi_z > lo_z;
+}
+
+/* Splits the visible depth into n slices (the practical scheme: lambda
+ * blend of the logarithmic and the uniform split) and fits each a
+ * rectangle in the light frame: its frustum slice's extent in light xy,
+ * cut to the scene's (slo..shi), plus the margin the filters and the
+ * ground truth's shear need (reach). Stable: the sizes are rounded up to
+ * steps of 2^(1/8) of the scene's diagonal and the centre snapped to whole
+ * texels of a frame fixed to the scene (l0), so a camera that moves
+ * shifts a cascade by whole texels only and its shadow does not swim; `o`
+ * is the light eye's xy in l0. */
+static void fit_cascades(const frame *f, light_frame *lf, const mr_dmat4 *l0_from_w, mr_dvec3 x, mr_dvec3 z,
+                         double ox, double oy, const double slo[2], const double shi[2], double reach, double diag,
+                         int S, int n) {
+    double dn = lf->vis_near, dfar = lf->vis_far, d[MR_SHADOW_MAX_CASCADES + 1];
+    for (int i = 0; i <= n; i++)
+        d[i] = CASCADE_LAMBDA * dn * pow(dfar / dn, (double)i / n) + (1 - CASCADE_LAMBDA) * (dn + (dfar - dn) * i / n);
+    d[0] = dn, d[n] = dfar;
+    const mr_camera *c = &f->cam;
+    lf->ox = ox;
+    lf->oy = oy;
+    for (int k = 0; k < n; k++) {
+        cascade *cs = &lf->casc[k];
+        /* The slice and the seam band past it (the next cascade blends in
+         * there); a little deeper both ways: pixel depths round. */
+        double z0 = d[k], z1 = k + 1 < n ? fmin(d[k + 1] * (1 + CASCADE_BAND), dfar) : dfar;
+        if (k == 0) z0 *= 0.99;
+        if (k + 1 == n) z1 *= 1.01;
+        double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+        for (int i = 0; i < 8; i++) {
+            double u = i & 1 ? c->width - 0.5 : -0.5, v = i & 2 ? c->height - 0.5 : -0.5, dd = i & 4 ? z1 : z0;
+            mr_dvec3 pc = mr_v3((u - c->cx) / c->fx * dd, (v - c->cy) / c->fy * dd, dd);
+            mr_dvec3 p = mr_m4_point(l0_from_w, mr_m4_point(&f->view->world_from_camera, pc));
+            lo[0] = fmin(lo[0], p.x), hi[0] = fmax(hi[0], p.x);
+            lo[1] = fmin(lo[1], p.y), hi[1] = fmax(hi[1], p.y);
+        }
+        double wa[2], ca[2];
+        for (int a = 0; a < 2; a++) {
+            double l = fmax(lo[a], slo[a]), h = fmin(hi[a], shi[a]);
+            if (!(h > l)) l = slo[a], h = shi[a];
+            double w = (h - l) * 1.02 + 2 * reach + 1e-9 * diag;
+            w = diag * exp2(ceil(log2(w / diag) * 8) / 8); /* steps relative to the scene: scale-free */
+            double texel = w / S;
+            wa[a] = w;
+            ca[a] = round(0.5 * (l + h) / texel) * texel - (a ? oy : ox);
+        }
+        cs->wx = wa[0];
+        cs->wy = wa[1];
+        cs->cx = ca[0];
+        cs->cy = ca[1];
+        cs->x0 = ca[0] - 0.5 * wa[0];
+        cs->y0 = ca[1] - 0.5 * wa[1];
+        cs->split = k + 1 < n ? d[k + 1] : INFINITY;
+        double D = fmax(fmax(wa[0], wa[1]), lf->zfar);
+        cs->cull_back = D;
+        mr_dvec3 eye = mr_m4_point(&lf->world_from_lcam, mr_v3(ca[0], ca[1], -D));
+        cs->cull_world_from_camera = frame_from_axes(x, z, eye);
+        memset(&cs->cam, 0, sizeof cs->cam);
+        cs->cam.width = cs->cam.height = S;
+        cs->cam.fx = 0.5 * S / (0.5 * wa[0] / D * 1.05);
+        cs->cam.fy = 0.5 * S / (0.5 * wa[1] / D * 1.05);
+        cs->cam.cx = cs->cam.cy = 0.5 * S - 0.5;
+        cs->near_plane = 0.5 * D;
+    }
+}
+
+static void fit_sun(const frame *f, const mr_light *L, double scale, int S, int max_tex, light_frame *lf) {
     const mr_scene *s = f->r->scene;
     mr_dvec3 dir = mr_v3_normalize(mr_v3(L->direction[0], L->direction[1], L->direction[2]));
     mr_dvec3 z = mr_v3_scale(dir, -1), x = any_orthogonal(z);
@@ -229,6 +379,19 @@ static void fit_sun(const frame *f, const mr_light *L, double scale, int S, ligh
     lf->cam.fy = 0.5 * S / ty;
     lf->cam.cx = lf->cam.cy = 0.5 * S - 0.5;
     lf->near_plane = 0.5 * D;
+    /* Cascades: asked for, or by the ratio of far to near visible depth;
+     * the atlas of 2 x 2 tiles must fit in a texture. */
+    lf->ncasc = 1;
+    int want = f->p->shadow.cascades;
+    if (want != 1 && 2 * S <= max_tex && visible_depth(f, &lf->vis_near, &lf->vis_far)) {
+        int n = want;
+        if (n <= 0) n = 1 + (int)floor(log(lf->vis_far / lf->vis_near) / log(CASCADE_RATIO));
+        n = n < 1 ? 1 : n > MR_SHADOW_MAX_CASCADES ? MR_SHADOW_MAX_CASCADES : n;
+        if (n >= 2) {
+            fit_cascades(f, lf, &l0_from_w, x, z, 0.5 * (xlo + xhi), 0.5 * (ylo + yhi), lo, hi, lf->half * zspan, diag, S, n);
+            lf->ncasc = n;
+        }
+    }
 }
 
 static void fit_perspective(const frame *f, const mr_light *L, double scale, int S, light_frame *lf) {
@@ -297,13 +460,28 @@ static void fit_perspective(const frame *f, const mr_light *L, double scale, int
     lf->cull_back = 0;
 }
 
-static void fit_light(const frame *f, light_frame *lf) {
+static void fit_light(const frame *f, int max_tex, light_frame *lf) {
     memset(lf, 0, sizeof *lf);
+    lf->ncasc = 1;
     mr_shadow_light(f->r->scene, &lf->light);
     double scale = light_scale(&f->p->shadow);
     int S = map_size(&f->p->shadow);
-    if (lf->light.kind == MR_LIGHT_SUN) fit_sun(f, &lf->light, scale, S, lf);
+    if (lf->light.kind == MR_LIGHT_SUN) fit_sun(f, &lf->light, scale, S, max_tex, lf);
     else fit_perspective(f, &lf->light, scale, S, lf);
+}
+
+int mr_shadow_cascade_grid(const mr_renderer *r, int k, double corner[2], double texel[2]) {
+    const struct mr_shadow_state *s = r ? r->shadow : NULL;
+    if (!s || s->lf.ncasc < 2) return 0;
+    if (k >= 0 && k < s->lf.ncasc) {
+        const cascade *cs = &s->lf.casc[k];
+        int S = s->map_size;
+        corner[0] = cs->x0 + s->lf.ox;
+        corner[1] = cs->y0 + s->lf.oy;
+        texel[0] = cs->wx / S;
+        texel[1] = cs->wy / S;
+    }
+    return s->lf.ncasc;
 }
 
 /* ------------------------------------------------------------ the passes */
@@ -404,12 +582,19 @@ static bool prepare_common(frame *f, mr_error *err) {
         if (!(s->prog_vis = mr_gl_program(files, err))) return false;
     }
     int S = map_size(p);
-    if (s->map_size != S) {
+    GLint max_tex = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
+    fit_light(f, max_tex, &s->lf);
+    /* Cascade k is the tile ((k & 1) S, (k >> 1) S) of one atlas. */
+    int aw = s->lf.ncasc > 1 ? 2 * S : S, ah = s->lf.ncasc > 2 ? 2 * S : S;
+    if (s->map_size != S || s->atlas_w != aw || s->atlas_h != ah) {
         mr_gl_target_free(&s->map);
         s->key_valid = false;
         static const GLenum fmt[1] = {GL_R32F};
-        if (!mr_gl_target_make(&s->map, S, S, fmt, 1, true, err)) return false;
+        if (!mr_gl_target_make(&s->map, aw, ah, fmt, 1, true, err)) return false;
         s->map_size = S;
+        s->atlas_w = aw;
+        s->atlas_h = ah;
     }
     if (s->w != f->r->w || s->h != f->r->h) {
         mr_gl_target_free(&s->vis);
@@ -425,7 +610,6 @@ static bool prepare_common(frame *f, mr_error *err) {
         mr_ao_kernel_generate(MR_AO_KERNEL_POISSON, taps, 0.0f, 1.0f, 0x5ad0u, NULL, s->kernel);
         s->kernel_taps = taps;
     }
-    fit_light(f, &s->lf);
     return true;
 }
 
@@ -437,13 +621,25 @@ static uint32_t vis_reads_now(const frame *f) {
 }
 
 /* Draws the map of one light position: the base eye moved by `offset`
- * (perspective, light axes) or the projection sheared by `shear` (sun). */
+ * (perspective, light axes) or the projection sheared by `shear` (sun);
+ * with cascades, every cascade's tile. */
+static void draw_map_tile(frame *f, int k, const double offset[3], const double shear[2]);
 static void draw_map(frame *f, const double offset[3], const double shear[2]) {
     struct mr_shadow_state *s = f->r->shadow;
+    for (int k = 0; k < s->lf.ncasc; k++) draw_map_tile(f, k, offset, shear);
+}
+
+static void draw_map_tile(frame *f, int k, const double offset[3], const double shear[2]) {
+    struct mr_shadow_state *s = f->r->shadow;
     const light_frame *lf = &s->lf;
+    const cascade *cs = lf->ncasc > 1 ? &lf->casc[k] : NULL;
     int S = s->map_size;
     glBindFramebuffer(GL_FRAMEBUFFER, s->map.fbo);
-    glViewport(0, 0, S, S);
+    glViewport((k & 1) * S, (k >> 1) * S, S, S);
+    if (cs) {
+        glEnable(GL_SCISSOR_TEST); /* the clears below: this tile only */
+        glScissor((k & 1) * S, (k >> 1) * S, S, S);
+    }
     glDisable(GL_FRAMEBUFFER_SRGB);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
@@ -457,18 +653,28 @@ static void draw_map(frame *f, const double offset[3], const double shear[2]) {
     glClearNamedFramebufferfv(s->map.fbo, GL_DEPTH, 0, &depth0);
     glUseProgram(s->prog_map);
     glUniform1i(MR_LOC_SHADOW_MAP_ORTHO, lf->ortho);
-    glUniform4f(MR_LOC_SHADOW_MAP_RECT, (float)lf->x0, (float)lf->y0, (float)(1 / lf->wx), (float)(1 / lf->wy));
+    if (cs) {
+        glDisable(GL_SCISSOR_TEST);
+        glUniform4f(MR_LOC_SHADOW_MAP_RECT, (float)cs->x0, (float)cs->y0, (float)(1 / cs->wx), (float)(1 / cs->wy));
+    } else {
+        glUniform4f(MR_LOC_SHADOW_MAP_RECT, (float)lf->x0, (float)lf->y0, (float)(1 / lf->wx), (float)(1 / lf->wy));
+    }
     glUniform2f(MR_LOC_SHADOW_MAP_DEPTH, 0.0f, (float)(1.0 / (lf->zfar * 1.5)));
-    /* The culling eye of the sun sits cull_back behind the light's plane:
-     * the vertices arrive relative to it. */
-    glUniform3f(MR_LOC_SHADOW_MAP_OFFSET, (float)offset[0], (float)offset[1], (float)(offset[2] + lf->cull_back));
+    /* The culling eye of the sun sits cull_back behind the light's plane
+     * (a cascade's over its square's centre): the vertices arrive relative
+     * to it. */
+    if (cs)
+        glUniform3f(MR_LOC_SHADOW_MAP_OFFSET, (float)(offset[0] - cs->cx), (float)(offset[1] - cs->cy),
+                    (float)(offset[2] + cs->cull_back));
+    else
+        glUniform3f(MR_LOC_SHADOW_MAP_OFFSET, (float)offset[0], (float)offset[1], (float)(offset[2] + lf->cull_back));
     glUniform2f(MR_LOC_SHADOW_MAP_SHEAR, (float)shear[0], (float)shear[1]);
     mr_geo_view v;
     memset(&v, 0, sizeof v);
-    v.cam = lf->cam;
-    v.world_from_camera = lf->cull_world_from_camera;
-    v.cam_from_world = mr_m4_invert_rigid(&lf->cull_world_from_camera);
-    v.near_plane = lf->near_plane;
+    v.cam = cs ? cs->cam : lf->cam;
+    v.world_from_camera = cs ? cs->cull_world_from_camera : lf->cull_world_from_camera;
+    v.cam_from_world = mr_m4_invert_rigid(&v.world_from_camera);
+    v.near_plane = cs ? cs->near_plane : lf->near_plane;
     v.program = s->prog_map;
     v.layers = (1u << MR_LAYER_VISIBLE) | (f->p->hide_hidden_layer ? 0u : 1u << MR_LAYER_HIDDEN);
     mr_geometry_draw(f->r, &v, f->out);
@@ -507,6 +713,22 @@ static void draw_vis(frame *f, int method, const double offset[3], const double 
     glUniformMatrix4fv(MR_LOC_SHADOW_LIGHT_FROM_CAM, 1, GL_FALSE, m);
     glUniform1i(MR_LOC_SHADOW_ORTHO, lf->ortho);
     glUniform4f(MR_LOC_SHADOW_RECT, (float)lf->x0, (float)lf->y0, (float)(1 / lf->wx), (float)(1 / lf->wy));
+    {
+        float rects[4 * MR_SHADOW_MAX_CASCADES] = {0}, splits[4] = {0};
+        int n = lf->ncasc > 1 ? lf->ncasc : 0;
+        for (int k = 0; k < n; k++) {
+            const cascade *cs = &lf->casc[k];
+            rects[4 * k + 0] = (float)cs->x0;
+            rects[4 * k + 1] = (float)cs->y0;
+            rects[4 * k + 2] = (float)(1 / cs->wx);
+            rects[4 * k + 3] = (float)(1 / cs->wy);
+            splits[k] = (float)fmin(cs->split, 1e30);
+        }
+        glUniform1i(MR_LOC_SHADOW_CASCADES, n);
+        glUniform4fv(MR_LOC_SHADOW_SPLITS, 1, splits);
+        glUniform1f(MR_LOC_SHADOW_BAND, (float)CASCADE_BAND);
+        glUniform4fv(MR_LOC_SHADOW_RECTS, MR_SHADOW_MAX_CASCADES, rects);
+    }
     glUniform1f(MR_LOC_SHADOW_K, (float)lf->k);
     glUniform2f(MR_LOC_SHADOW_ZRANGE, (float)lf->znear, (float)lf->zfar);
     glUniform1f(MR_LOC_SHADOW_LIGHT_HALF, (float)lf->half);
@@ -571,6 +793,7 @@ static void run_vis(frame *f) {
         const double zero3[3] = {0, 0, 0}, zero2[2] = {0, 0};
         draw_vis(f, (int)f->p->shadow.method, zero3, zero2, 1.0f);
     }
+    f->out->shadow_cascades = s->lf.ncasc;
     frame_put(f, RES_SHADOW, s->vis.color[0]);
 }
 
