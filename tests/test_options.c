@@ -12,6 +12,8 @@
 #include "mr_bench.h"
 #include "mr_core.h"
 #include "mr_eval.h"
+#include "mr_export.h"
+#include "mr_study.h"
 #include "mr_render.h"
 #include "mr_test.h"
 #include "mr_track.h"
@@ -289,6 +291,16 @@ static void test_tables(void) {
     walk_table("mr_board_calib_opts", mr_board_calib_opts, sizeof bcp, &bcp);
     walk_table("mr_triangulate_opts", mr_triangulate_opts, sizeof trp, &trp);
     walk_table("mr_synth_recording_opts", mr_synth_recording_opts, sizeof srp, &srp);
+    /* The study's and the export's own tables (their rows are pinned by
+     * test_study and test_export). */
+    const mr_study_stimuli_params sst = MR_STUDY_STIMULI_DEFAULTS;
+    const mr_study_plan_params spl = MR_STUDY_PLAN_DEFAULTS;
+    const mr_study_analyze_params san = MR_STUDY_ANALYZE_DEFAULTS;
+    const mr_export_params exp = MR_EXPORT_DEFAULTS;
+    walk_table("mr_study_stimuli_opts", mr_study_stimuli_opts, sizeof sst, &sst);
+    walk_table("mr_study_plan_opts", mr_study_plan_opts, sizeof spl, &spl);
+    walk_table("mr_study_analyze_opts", mr_study_analyze_opts, sizeof san, &san);
+    walk_table("mr_export_opts", mr_export_opts, sizeof exp, &exp);
     const mr_batch_replay_params rp = MR_BATCH_REPLAY_DEFAULTS;
     walk_table("mr_batch_replay_opts", mr_batch_replay_opts, sizeof rp, &rp);
 
