@@ -22,36 +22,31 @@ int cmd_factory(int argc, char **argv) {
     mr_cli_opt opts[] = {
         {"out", "FILE.glb", "output scene (required)", NULL},
         {"triangles", "N", "drawn triangles to aim for, e.g. 1M, 5M, 20M (default 1M)", NULL},
-        {"halls", "N", "number of halls instead (about 0.8M triangles and 2300 nodes each)", NULL},
         {"seed", "S", "random seed (default 1)", NULL},
         {"offset", "X,Z", "move the whole plant (tests far from the origin)", NULL},
         {"views", "DIR", "also write view_floor.json, view_aisle.json, view_overview.json there", NULL},
         {"unique", NULL, "unique CAD-like geometry: every part its own mesh (20k triangles), split at normal seams", NULL},
-        {"unit", "U", "with --unique: scene units per metre (default 1; 1000: millimetres)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
     bool help;
-    if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
+    mr_synth_params sp = MR_SYNTH_DEFAULTS;
+    mr_synth_cad_params cp = MR_SYNTH_CAD_DEFAULTS;
+    mr_cli_table tables[] = {{"", mr_synth_opts, &sp, NULL, false, {0}}, {"", mr_synth_cad_opts, &cp, NULL, false, {0}}};
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 2, NULL, 0, NULL,
                    "usage: mrcheck factory --out FILE.glb [--triangles N | --halls N] [--seed S] [--views DIR] [--unique [--unit U]]", &help))
         return 2;
     if (help) return 0;
     mr_cli_log_level(opts);
     const char *out = mr_cli_get(opts, "out");
     if (!out) return mr_cli_errorf(cmd, "--out is required"), 2;
-    mr_synth_params sp = MR_SYNTH_DEFAULTS;
     const bool unique = mr_cli_get(opts, "unique") != NULL;
-    mr_synth_cad_params cp = MR_SYNTH_CAD_DEFAULTS;
-    if (unique && mr_cli_get(opts, "halls")) return mr_cli_errorf(cmd, "--halls is for the instanced factory, not --unique"), 2;
-    if (!unique && mr_cli_get(opts, "unit")) return mr_cli_errorf(cmd, "--unit needs --unique"), 2;
-    if (mr_cli_get(opts, "unit") && !mr_cli_double("unit", mr_cli_get(opts, "unit"), 1e-6, 1e9, &cp.unit)) return 2;
-    if (mr_cli_get(opts, "halls") && mr_cli_get(opts, "triangles")) return mr_cli_errorf(cmd, "give --halls or --triangles, not both"), 2;
-    if (mr_cli_get(opts, "halls")) {
-        long h;
-        if (!mr_cli_int("halls", mr_cli_get(opts, "halls"), 1, 4096, &h)) return 2;
-        sp.halls = (int)h;
-    } else {
+    const bool halls = mr_cli_table_given(&tables[0], "halls");
+    if (unique && halls) return mr_cli_errorf(cmd, "--halls is for the instanced factory, not --unique"), 2;
+    if (!unique && mr_cli_table_given(&tables[1], "unit")) return mr_cli_errorf(cmd, "--unit needs --unique"), 2;
+    if (halls && mr_cli_get(opts, "triangles")) return mr_cli_errorf(cmd, "give --halls or --triangles, not both"), 2;
+    if (!halls) {
         uint64_t tri = 1000000;
         if (mr_cli_get(opts, "triangles") && !parse_count(mr_cli_get(opts, "triangles"), &tri))
             return mr_cli_errorf(cmd, "--triangles: '%s' is not a count like 5M", mr_cli_get(opts, "triangles")), 2;

@@ -22,16 +22,16 @@ int cmd_record(int argc, char **argv) {
         {"max-frames", "N", "stop after N frames (default: until the input ends or Ctrl-C)", NULL},
         {"rate", "FPS", "pace file inputs at this rate, as a live camera would deliver them", NULL},
         {"gray", NULL, "store grey frames (smaller)", NULL},
-        {"jpeg", "Q", "JPEG quality of the stored frames (default 90)", NULL},
         {"png", NULL, "store lossless PNG frames instead of JPEG", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
     mr_detector_params dp = MR_DETECTOR_DEFAULTS;
-    mr_cli_table tables[] = {APP_TRACK_TABLE(&dp)};
+    mr_recorder_params rp = MR_RECORDER_DEFAULTS;
+    mr_cli_table tables[] = {APP_TRACK_TABLE(&dp), {"", mr_recorder_opts, &rp, NULL, false, {0}}};
     bool help;
-    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 1, NULL, 0, NULL,
+    if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 2, NULL, 0, NULL,
                    "usage: mrcheck record --input /dev/videoN|VIDEO --camera C --markers M --out DIR\n"
                    "Writes meta.json, frames/NNNNNN.jpg and frames.jsonl (detections, raw and filtered pose,\n"
                    "quality) as it goes; every line is flushed and synced, so a crash loses at most one frame.",
@@ -41,11 +41,10 @@ int cmd_record(int argc, char **argv) {
     mr_cli_log_level(opts);
     const char *input = mr_cli_get(opts, "input"), *out = mr_cli_get(opts, "out");
     if (!input || !out) return mr_cli_errorf(cmd, "--input and --out are required (see --help)"), 2;
-    long max_frames = -1, q = 90;
+    long max_frames = -1;
     double rate = 0;
     if (mr_cli_get(opts, "max-frames") && !mr_cli_int("max-frames", mr_cli_get(opts, "max-frames"), 1, 1L << 40, &max_frames)) return 2;
     if (mr_cli_get(opts, "rate") && !mr_cli_double("rate", mr_cli_get(opts, "rate"), 0.01, 10000, &rate)) return 2;
-    if (mr_cli_get(opts, "jpeg") && !mr_cli_int("jpeg", mr_cli_get(opts, "jpeg"), 1, 100, &q)) return 2;
 
     mr_error err = {0};
     mr_recording *rec_in = NULL;
@@ -64,11 +63,9 @@ int cmd_record(int argc, char **argv) {
         mr_source_close(&src);
         return mr_cli_errorf(cmd, "--camera and --markers are required (unless the input is a recording)");
     }
-    mr_recorder_params rp = MR_RECORDER_DEFAULTS;
     rp.camera = t.camera;
     rp.markers = t.markers;
     rp.source = input;
-    rp.jpeg_quality = (int)q;
     rp.frame_ext = mr_cli_flag(opts, "png") ? ".png" : ".jpg";
     mr_recorder *rec = mr_recorder_create(out, &rp, &err);
     if (!rec) {

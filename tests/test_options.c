@@ -261,6 +261,12 @@ static void test_tables(void) {
     const mr_filter_params fp = MR_FILTER_DEFAULTS;
     walk_table("mr_detector_opts", mr_detector_opts, sizeof dp, &dp);
     walk_table("mr_filter_opts", mr_filter_opts, sizeof fp, &fp);
+    const mr_synth_params syp = MR_SYNTH_DEFAULTS;
+    const mr_synth_cad_params scp = MR_SYNTH_CAD_DEFAULTS;
+    const mr_recorder_params rcp = MR_RECORDER_DEFAULTS;
+    walk_table("mr_synth_opts", mr_synth_opts, sizeof syp, &syp);
+    walk_table("mr_synth_cad_opts", mr_synth_cad_opts, sizeof scp, &scp);
+    walk_table("mr_recorder_opts", mr_recorder_opts, sizeof rcp, &rcp);
     const mr_map_params mpp = MR_MAP_DEFAULTS;
     walk_table("mr_map_opts", mr_map_opts, sizeof mpp, &mpp);
     const mr_frame_params frp = MR_FRAME_DEFAULTS;

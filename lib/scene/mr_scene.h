@@ -427,6 +427,7 @@ typedef struct mr_synth_params {
     double origin[3];        /* offset of the whole plant (x and z), metres */
 } mr_synth_params;
 #define MR_SYNTH_DEFAULTS {1, 1, 0.0, 0.0, {0.0, 0.0, 0.0}}
+extern const mr_opt mr_synth_opts[]; /* halls (lib/scene/options.c) */
 
 /* A factory of `halls` halls whose parts (machines, motors, valves, bolts,
  * racks, boxes, pipes, trays, lamps) are shared meshes placed by many
@@ -454,6 +455,7 @@ typedef struct mr_synth_cad_params {
     double origin[3];         /* offset of the whole hall, metres */
 } mr_synth_cad_params;
 #define MR_SYNTH_CAD_DEFAULTS {1, 64, 20000u, 1.0, {0.0, 0.0, 0.0}}
+extern const mr_opt mr_synth_cad_opts[]; /* unit */
 mr_scene *mr_synth_cad_build(const mr_synth_cad_params *params, mr_error *err);
 /* The same three kinds of viewpoint as mr_synth_viewpoint (floor, aisle,
  * overview), in the factory's unit. */

@@ -46,6 +46,8 @@ typedef struct mr_recorder_params {
     bool ground_truth;              /* also open groundtruth.jsonl */
 } mr_recorder_params;
 #define MR_RECORDER_DEFAULTS {NULL, NULL, NULL, NULL, 0, false}
+#define MR_RECORDER_DEFAULT_JPEG_QUALITY 90
+extern const mr_opt mr_recorder_opts[]; /* jpeg (lib/session/options.c) */
 
 /* One frame's tracking result as recorded. */
 typedef struct mr_frame_record {

@@ -79,7 +79,7 @@ mr_recorder *mr_recorder_create(const char *dir, const mr_recorder_params *param
     }
     snprintf(r->dir, sizeof r->dir, "%s", dir);
     snprintf(r->ext, sizeof r->ext, "%s", ext);
-    r->quality = p.jpeg_quality > 0 && p.jpeg_quality <= 100 ? p.jpeg_quality : 90;
+    r->quality = p.jpeg_quality > 0 && p.jpeg_quality <= 100 ? p.jpeg_quality : MR_RECORDER_DEFAULT_JPEG_QUALITY;
     r->fd_gt = -1;
     r->fd_frames = open_append(dir, "frames.jsonl", err);
     if (r->fd_frames >= 0 && p.ground_truth) r->fd_gt = open_append(dir, "groundtruth.jsonl", err);
