@@ -168,6 +168,20 @@ typedef struct gt_job {
     pthread_mutex_t lock;
 } gt_job;
 
+/* The G-buffer's surface at pixel (x, y), depth z, in camera space (through
+ * the display mapping when one is given) with its unit normal (facing the
+ * camera where the buffer has none), lifted off the surface by a little
+ * more than the depth buffer's error so rays do not hit their own
+ * triangle. The AO and the shadow ground truth trace from here. */
+static void surface_point(const mr_camera *cam, const mr_display_map *dm, int x, int y, float z, const float *n3,
+                          mr_dvec3 *pc, mr_dvec3 *nc) {
+    mr_dvec3 p = dm ? mr_display_point(dm, cam, x, y, z) : mr_v3((x - cam->cx) / cam->fx * z, (y - cam->cy) / cam->fy * z, z);
+    mr_dvec3 n = mr_v3_normalize(mr_v3(n3[0], n3[1], n3[2]));
+    if (mr_v3_len(n) == 0) n = mr_v3_normalize(mr_v3_scale(p, -1));
+    *pc = mr_v3_add(p, mr_v3_scale(n, 2e-4 * z));
+    *nc = n;
+}
+
 static void *gt_worker(void *arg) {
     gt_job *j = arg;
     int w = j->depth->width, h = j->depth->height;
@@ -183,16 +197,10 @@ static void *gt_worker(void *arg) {
             float z = dep[i];
             out[i] = 1.0f;
             if (!(z > 0) || !isfinite(z)) continue;
-            mr_dvec3 nc = mr_v3(nor[3 * i], nor[3 * i + 1], nor[3 * i + 2]);
-            mr_dvec3 pc = j->p.display ? mr_display_point(j->p.display, &j->cam, x, y, z)
-                                       : mr_v3((x - j->cam.cx) / j->cam.fx * z, (y - j->cam.cy) / j->cam.fy * z, z);
-            nc = mr_v3_normalize(nc);
-            if (mr_v3_len(nc) == 0) nc = mr_v3_normalize(mr_v3_scale(pc, -1));
+            mr_dvec3 pc, nc;
+            surface_point(&j->cam, j->p.display, x, y, z, nor + 3 * i, &pc, &nc);
             double R = j->p.radius_mode == MR_AO_RADIUS_SCREEN ? j->p.screen_radius * z * j->cam.height / j->cam.fy
                                                                : j->p.radius;
-            /* Lift the origin off the surface by a little more than the
-             * depth buffer's error so rays do not hit their own triangle. */
-            pc = mr_v3_add(pc, mr_v3_scale(nc, 2e-4 * z));
             mr_dvec3 pw = mr_m4_point(&j->rel_from_camera, pc), nw = mr_m4_dir(&j->rel_from_camera, nc);
             double q[3] = {pw.x, pw.y, pw.z}, nv[3] = {nw.x, nw.y, nw.z};
             mr_rng rng;
@@ -337,10 +345,8 @@ static void *sgt_worker(void *arg) {
             float z = dep[i];
             out[i] = 1.0f;
             if (!(z > 0) || !isfinite(z)) continue;
-            mr_dvec3 nc = mr_v3_normalize(mr_v3(nor[3 * i], nor[3 * i + 1], nor[3 * i + 2]));
-            mr_dvec3 pc = mr_v3((x - j->cam.cx) / j->cam.fx * z, (y - j->cam.cy) / j->cam.fy * z, z);
-            if (mr_v3_len(nc) == 0) nc = mr_v3_normalize(mr_v3_scale(pc, -1));
-            pc = mr_v3_add(pc, mr_v3_scale(nc, 2e-4 * z));
+            mr_dvec3 pc, nc;
+            surface_point(&j->cam, NULL, x, y, z, nor + 3 * i, &pc, &nc);
             mr_dvec3 pw = mr_m4_point(&j->rel_from_camera, pc), nw = mr_m4_dir(&j->rel_from_camera, nc);
             double q[3] = {pw.x, pw.y, pw.z};
             mr_rng rng;
