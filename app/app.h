@@ -120,9 +120,6 @@ int cmd_synth(int argc, char **argv);
 int cmd_factory(int argc, char **argv);
 /* issue 16: mrcheck export (cmd_export.c) */
 int cmd_export(int argc, char **argv);
-/* The demo's three marks at the known discrepancies and their BCF and report
- * (demo_marks.c); g is the demo's headless GPU. */
-bool app_demo_marks(const char *dir, app_gfx *g, const mr_scene *built, const mr_scene *planned, mr_error *err);
 int bench_scene(int argc, char **argv);
 /* mrcheck bench map (bench_map.c). */
 int bench_map(int argc, char **argv);

@@ -5,6 +5,7 @@
  * them at alpha = 0.5. */
 #include "app.h"
 #include "app_track.h"
+#include "mr_bench.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -133,7 +134,8 @@ static bool run_demo(const char *dir, mr_error *err) {
         mr_image_free(&frame);
     }
     /* issue 16: marks at the known discrepancies, as BCF and a report */
-    ok = ok && app_demo_marks(dir, &gfx, built, planned, err);
+    mr_bench_gpu bg = {gfx.gpu, gfx.renderer};
+    ok = ok && mr_demo_marks(dir, &bg, built, planned, err);
     if (gfx.gpu) app_gfx_close(&gfx);
     uint64_t tri = planned ? mr_scene_triangle_count(planned) : 0;
     mr_scene_destroy(&built);

@@ -219,6 +219,12 @@ extern const mr_opt mr_synth_recording_opts[];
 /* The calibration set: dir/board.json (the board of mr_demo_board_tag as a
  * marker map) and dir/images/board_NN.png, `images` (>= 1) views of it from
  * around, rendered on the CPU through the demo camera. */
+/* The last part of `mrcheck demo` (demo_marks.c): three marks at the
+ * hall's known discrepancies in dir/session/, as a planner would place them
+ * in `mrcheck view`, then dir/findings.bcf (2.1), dir/findings-3.0.bcf and
+ * dir/report/ through lib/export. */
+bool mr_demo_marks(const char *dir, const mr_bench_gpu *g, const mr_scene *built, const mr_scene *planned,
+                   mr_error *err);
 bool mr_synth_calibration(const char *dir, int images, mr_error *err);
 
 /* ------------------------------------------------------------ multiview */

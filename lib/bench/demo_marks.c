@@ -2,7 +2,7 @@
  * discrepancies, as a planner would place them in `mrcheck view` (camera
  * frame of the as-built hall, the plan overlaid, a pick on the plan), then
  * the findings as BCF 2.1 and 3.0 and as the HTML report (lib/export). */
-#include "app.h"
+#include "mr_bench.h"
 #include "mr_export.h"
 
 #include <math.h>
@@ -31,7 +31,7 @@ static mr_dmat4 pose_towards(mr_dvec3 target) {
  * inside the hall, with a clear line of sight on the plan (the pick at the
  * part's pixel lands on the part, or, for a hidden part, on what hides it
  * just in front). Tried on small renders, nearest first. */
-static mr_dmat4 pose_for(app_gfx *g, const mr_scene *planned, const char *node, mr_dvec3 target, bool hidden) {
+static mr_dmat4 pose_for(const mr_bench_gpu *g, const mr_scene *planned, const char *node, mr_dvec3 target, bool hidden) {
     mr_camera small = mr_demo_camera();
     small = mr_camera_resized(&small, 160, 120);
     memset(small.dist, 0, sizeof small.dist);
@@ -58,7 +58,7 @@ static mr_dmat4 pose_for(app_gfx *g, const mr_scene *planned, const char *node, 
     return pose_towards(target);
 }
 
-static bool one_mark(const char *session, int i, const cJSON *d, app_gfx *g, const mr_scene *built,
+static bool one_mark(const char *session, int i, const cJSON *d, const mr_bench_gpu *g, const mr_scene *built,
                      const mr_scene *planned, mr_error *err) {
     const cJSON *desc = cJSON_GetObjectItemCaseSensitive(d, "description");
     const cJSON *node = cJSON_GetObjectItemCaseSensitive(d, "node");
@@ -140,7 +140,7 @@ static bool one_mark(const char *session, int i, const cJSON *d, app_gfx *g, con
     return ok;
 }
 
-bool app_demo_marks(const char *dir, app_gfx *g, const mr_scene *built, const mr_scene *planned, mr_error *err) {
+bool mr_demo_marks(const char *dir, const mr_bench_gpu *g, const mr_scene *built, const mr_scene *planned, mr_error *err) {
     char path[4096], session[4096];
     mr_path_join(dir, "discrepancies.json", path, sizeof path);
     cJSON *list = mr_json_load(path, err);
