@@ -186,34 +186,7 @@ int cmd_map(int argc, char **argv) {
     bool saved = j && mr_json_save(out, j, &err);
     cJSON_Delete(j);
     if (!saved) goto fail;
-    for (int i = 0; i < res.unsized_count; i++)
-        fprintf(stderr, "mrcheck: map: warning: tag %d has no size (--tag-sizes): not mapped\n", res.unsized[i]);
-    for (int i = 0; i < res.unconnected_count; i++)
-        fprintf(stderr, "mrcheck: map: warning: tag %d is not connected to the mapped part: no shared photo\n",
-                res.unconnected[i]);
-    printf("mapped %d tags from %d of %d photos (%d sightings)%s; reprojection RMS %.3f px", res.tag_count,
-           res.photos_used, res.photos_total, res.observations, res.adjusted ? "" : " by chaining (no adjustment)",
-           res.rms_px);
-    if (res.adjusted) printf(", corner sigma %.3f px", res.sigma_px);
-    printf("; wrote %s\n", out);
-    double worst = 0;
-    int worst_id = -1;
-    for (int i = 0; i < res.tag_count; i++)
-        if (isfinite(res.tags[i].sigma_pos) && res.tags[i].sigma_pos > worst)
-            worst = res.tags[i].sigma_pos, worst_id = res.tags[i].id;
-    if (worst_id >= 0) printf("largest tag sigma: tag %d, %.1f mm\n", worst_id, worst * 1e3);
-    for (int i = 0; i < res.tag_count && mr_log_get_level() >= MR_LOG_INFO; i++)
-        printf("  tag %d: %d photos, sigma %.1f mm %.2f deg, rms %.3f px\n", res.tags[i].id, res.tags[i].photos,
-               res.tags[i].sigma_pos * 1e3, res.tags[i].sigma_deg, res.tags[i].rms_px);
-    for (int q = 0; q < res.control_count; q++) {
-        const mr_map_control_result *c = &res.controls[q];
-        printf("control %s: residual %.1f mm", ctl[q].name,
-               1e3 * sqrt(c->residual[0] * c->residual[0] + c->residual[1] * c->residual[1] + c->residual[2] * c->residual[2]));
-        if (isfinite(c->loo_sigma))
-            printf(", left out %.1f mm (%.1f sigma)",
-                   1e3 * sqrt(c->loo[0] * c->loo[0] + c->loo[1] * c->loo[1] + c->loo[2] * c->loo[2]), c->loo_sigma);
-        printf("%s\n", c->outlier ? " OUTLIER: left out of the gauge" : c->used ? "" : " (tag not mapped)");
-    }
+    mr_map_result_report(&res, &mp, out, stdout);
     rc = 0;
     goto out;
 fail:

@@ -192,3 +192,34 @@ bool mr_map_controls_load(const char *path, mr_map_control **out, int *count, mr
     if (!ok) mr_error_prefix(err, "%s", path);
     return ok;
 }
+
+void mr_map_result_report(const mr_map_result *r, const mr_map_params *params, const char *written, FILE *out) {
+    for (int i = 0; i < r->unsized_count; i++)
+        fprintf(stderr, "mrcheck: map: warning: tag %d has no size (--tag-sizes): not mapped\n", r->unsized[i]);
+    for (int i = 0; i < r->unconnected_count; i++)
+        fprintf(stderr, "mrcheck: map: warning: tag %d is not connected to the mapped part: no shared photo\n",
+                r->unconnected[i]);
+    fprintf(out, "mapped %d tags from %d of %d photos (%d sightings)%s; reprojection RMS %.3f px", r->tag_count,
+           r->photos_used, r->photos_total, r->observations, r->adjusted ? "" : " by chaining (no adjustment)",
+           r->rms_px);
+    if (r->adjusted) fprintf(out, ", corner sigma %.3f px", r->sigma_px);
+    fprintf(out, "; wrote %s\n", written);
+    double worst = 0;
+    int worst_id = -1;
+    for (int i = 0; i < r->tag_count; i++)
+        if (isfinite(r->tags[i].sigma_pos) && r->tags[i].sigma_pos > worst)
+            worst = r->tags[i].sigma_pos, worst_id = r->tags[i].id;
+    if (worst_id >= 0) fprintf(out, "largest tag sigma: tag %d, %.1f mm\n", worst_id, worst * 1e3);
+    for (int i = 0; i < r->tag_count && mr_log_get_level() >= MR_LOG_INFO; i++)
+        fprintf(out, "  tag %d: %d photos, sigma %.1f mm %.2f deg, rms %.3f px\n", r->tags[i].id, r->tags[i].photos,
+               r->tags[i].sigma_pos * 1e3, r->tags[i].sigma_deg, r->tags[i].rms_px);
+    for (int q = 0; q < r->control_count; q++) {
+        const mr_map_control_result *c = &r->controls[q];
+        fprintf(out, "control %s: residual %.1f mm", params->controls[q].name,
+               1e3 * sqrt(c->residual[0] * c->residual[0] + c->residual[1] * c->residual[1] + c->residual[2] * c->residual[2]));
+        if (isfinite(c->loo_sigma))
+            fprintf(out, ", left out %.1f mm (%.1f sigma)",
+                   1e3 * sqrt(c->loo[0] * c->loo[0] + c->loo[1] * c->loo[1] + c->loo[2] * c->loo[2]), c->loo_sigma);
+        fprintf(out, "%s\n", c->outlier ? " OUTLIER: left out of the gauge" : c->used ? "" : " (tag not mapped)");
+    }
+}

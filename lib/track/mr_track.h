@@ -237,6 +237,11 @@ bool mr_map_result_markers(const mr_map_result *r, const char *family, double ta
  * [ids], "unsized" [ids], "control_points" [{name, tag, corner,
  * residual_mm [3], loo_mm [3] or null, loo_sigma, used, outlier}]. */
 cJSON *mr_map_result_to_json(const mr_map_result *r, const mr_marker_map *markers, const mr_map_params *params);
+/* What `mrcheck map` prints: one warning line on stderr per unsized or
+ * unconnected tag, then on out the summary (tags, photos, RMS, the file
+ * written), the largest tag sigma, each tag at --verbose, and each control
+ * point's residual and leave-one-out check. */
+void mr_map_result_report(const mr_map_result *r, const mr_map_params *params, const char *written, FILE *out);
 /* Control points file: {"points": [{"name": "P1", "tag": 3, "corner":
  * "centre"|0..3, "xyz": [x, y, z], "sigma": s}, ...]} (sigma in scene
  * units; defaults to "sigma" at the top level, else 0.002). */
