@@ -94,6 +94,16 @@ PY
   cat "$tmp/measure.out"
   grep -q "distance to the planned point: .* mm +- .* mm" "$tmp/measure.out" && ok || bad "measure printed no distance"
   grep -q '"distance_sigma_mm"' "$tmp/measured.json" && ok || bad "measure wrote no result"
+  # issue 15: against the planned surface (the nearest point of the model).
+  "$mr" measure --recording "$rec" --observations "$tmp/obs.json" --scene "$src/configs/scenes/demo_planned.json" \
+    --out "$tmp/surface.json" >"$tmp/surface.out" 2>&1 && ok || bad "measure --scene: $(cat "$tmp/surface.out")"
+  cat "$tmp/surface.out"
+  grep -q "distance to the planned surface: .* mm +- .* mm (1 sigma), nearest point .* on " "$tmp/surface.out" \
+    && ok || bad "measure --scene printed no surface distance"
+  grep -q '"surface_distance_sigma_mm"' "$tmp/surface.json" && grep -q '"nearest_node"' "$tmp/surface.json" \
+    && ok || bad "measure --scene wrote no surface distance"
+  expect_fail measure_bad_scene "$tmp/m3.json" -- "$mr" measure --recording "$rec" --observations "$tmp/obs.json" \
+    --scene "$tmp/no_such_scene.glb" --out "$tmp/m3.json"
   expect_fail measure_same_pose "$tmp/m2.json" -- "$mr" measure --recording "$rec" --observations "$tmp/same.json" --out "$tmp/m2.json"
   grep -q "baseline angle" "$tmp/measure_same_pose.err" && ok || bad "same pose: $(cat "$tmp/measure_same_pose.err")"
   expect_fail measure_no_frame "$tmp/m2.json" -- "$mr" measure --recording "$rec" --observations "$tmp/noframe.json" --out "$tmp/m2.json"
