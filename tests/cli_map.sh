@@ -48,6 +48,46 @@ PY
   awk -v a="$e_ctl" 'BEGIN { exit !(a < 20) }' && ok || bad "control-point map $e_ctl mm off"
 fi
 
+# issue 15: the same photos as a video (`--video`), and a camera file 4 %
+# off in focal length, refined (`--refine-intrinsics`).
+[ -s "$set_dir/photos.avi" ] && ok || bad "synth --map-photos wrote no photos.avi"
+"$mr" map --video "$set_dir/photos.avi" --camera "$set_dir/camera.json" --tag-size 0.25 --fix 0 --fix-pose "$tmp/fix.json" \
+  --out "$tmp/video.json" >"$tmp/video.out" 2>"$tmp/video.err" && ok || bad "map --video: $(cat "$tmp/video.err")"
+grep -q "mapped 10 tags" "$tmp/video.out" && ok || bad "map --video: $(cat "$tmp/video.out")"
+sed 's/"fx":[[:space:]]*\([0-9.e+-]*\)/"fx": FX(\1)/; s/"fy":[[:space:]]*\([0-9.e+-]*\)/"fy": FY(\1)/' "$set_dir/camera.json" |
+  awk '{ while (match($0, /F[XY]\([0-9.e+-]*\)/)) { v = substr($0, RSTART + 3, RLENGTH - 4); $0 = substr($0, 1, RSTART - 1) sprintf("%.6f", v * 1.04) substr($0, RSTART + RLENGTH) } print }' \
+  >"$tmp/camera_off.json"
+grep -q '"fx"' "$tmp/camera_off.json" && ! cmp -s "$tmp/camera_off.json" "$set_dir/camera.json" && ok || bad "could not write the 4 % off camera"
+off=(--images "$set_dir/images" --camera "$tmp/camera_off.json" --tag-size 0.25 --fix 0 --fix-pose "$tmp/fix.json")
+"$mr" map "${off[@]}" --out "$tmp/off.json" >/dev/null 2>"$tmp/off.err" && ok || bad "map with the off camera: $(cat "$tmp/off.err")"
+"$mr" map "${off[@]}" --refine-intrinsics --out "$tmp/refined.json" >/dev/null 2>"$tmp/refined.err" \
+  && ok || bad "map --refine-intrinsics: $(cat "$tmp/refined.err")"
+if command -v python3 >/dev/null 2>&1; then
+  python3 - "$set_dir/truth.json" "$set_dir/camera.json" "$tmp/video.json" "$tmp/off.json" "$tmp/refined.json" >"$tmp/vr.txt" <<'PY'
+import json, math, sys
+t = {x["id"]: x["world_from_tag"] for x in json.load(open(sys.argv[1]))["tags"]}
+def err(f):
+    e = [math.dist([a[3], a[7], a[11]], [t[x["id"]][3], t[x["id"]][7], t[x["id"]][11]])
+         for x in json.load(open(f))["tags"] for a in [x["world_from_tag"]]]
+    return 1e3 * math.sqrt(sum(d * d for d in e) / len(e))
+fx = json.load(open(sys.argv[2]))["fx"]
+ref = json.load(open(sys.argv[5]))["map"]["camera"]["fx"]
+print(err(sys.argv[3]), err(sys.argv[4]), err(sys.argv[5]), fx, ref)
+PY
+  read -r e_video e_off e_ref fx_true fx_ref < <(tr '\n' ' ' <"$tmp/vr.txt")
+  echo "map --video error RMS ${e_video} mm; camera 4 % off: ${e_off} mm, refined: ${e_ref} mm (fx ${fx_ref}, true ${fx_true})"
+  awk -v a="$e_video" -v b="$e_ours" 'BEGIN { exit !(a < 60 && a < 2 * b + 5) }' && ok || bad "map --video $e_video mm (photos: $e_ours mm)"
+  # 24 photos with ~2.5 tags each pin the focal length down only weakly (with
+  # exact corners too: 260 -> 256 here, 251 with 100 photos; test_map checks
+  # a set that determines it): refining must move it towards the truth and
+  # not make the map worse.
+  awk -v a="$e_ref" -v b="$e_off" 'BEGIN { exit !(a < b) }' && ok || bad "refined $e_ref mm vs off $e_off mm"
+  awk -v r="$fx_ref" -v t="$fx_true" 'BEGIN { d = r / t - 1; exit !(d < 0.035 && d > -0.035) }' && ok || bad "refined fx $fx_ref, true $fx_true"
+fi
+printf 'not a video' >"$tmp/bad.avi"
+expect_fail bad_video "$tmp/x.json" -- "$mr" map --video "$tmp/bad.avi" --camera "$set_dir/camera.json" --tag-size 0.25 --fix 0 --out "$tmp/x.json"
+expect_fail images_and_video "$tmp/x.json" -- "$mr" map --images "$set_dir/images" --video "$set_dir/photos.avi" --camera "$set_dir/camera.json" --tag-size 0.25 --fix 0 --out "$tmp/x.json"
+
 # A disconnected part: photos of tags 0..2 and, apart, of the others would
 # need another set; a fixed tag that is never seen is the bad-input case.
 expect_fail unseen_fix "$tmp/x.json" -- "$mr" map "${common[@]}" --fix 77 --out "$tmp/x.json"
