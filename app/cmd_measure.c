@@ -72,7 +72,8 @@ int cmd_measure(int argc, char **argv) {
         for (int i = 0; i < rec->frame_count; i++)
             if ((double)rec->frames[i].index == fr) f = &rec->frames[i];
         if (!f) {
-            mr_fail(&err, MR_ERR_INVALID, "%s: tap %d: frame %g is not in the recording", obsf, n + 1, fr);
+            mr_fail(&err, MR_ERR_INVALID, "%s: tap %d: frame %g is not in the recording%s", obsf, n + 1, fr,
+                    rec->bad_lines ? " (its frames.jsonl has unreadable lines, skipped)" : "");
             goto fail;
         }
         if (!f->pose.valid) {

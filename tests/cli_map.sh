@@ -88,6 +88,31 @@ printf 'not a video' >"$tmp/bad.avi"
 expect_fail bad_video "$tmp/x.json" -- "$mr" map --video "$tmp/bad.avi" --camera "$set_dir/camera.json" --tag-size 0.25 --fix 0 --out "$tmp/x.json"
 expect_fail images_and_video "$tmp/x.json" -- "$mr" map --images "$set_dir/images" --video "$set_dir/photos.avi" --camera "$set_dir/camera.json" --tag-size 0.25 --fix 0 --out "$tmp/x.json"
 
+# Bad input of issue 15 (Must have 5): one photo; NaN in the camera, the
+# fixed pose, a tag size; a control point 30 cm off (more than 5 sigma) is
+# named as an outlier and left out, the map still written (30 cm: with four
+# points on this small set the leave-one-out sigma is ~30 mm, so 5 cm hides).
+mkdir -p "$tmp/one" && cp "$set_dir/images/photo_000.png" "$tmp/one/"
+expect_fail one_photo "$tmp/x.json" -- "$mr" map --images "$tmp/one" --camera "$set_dir/camera.json" --tag-size 0.25 --fix 0 --out "$tmp/x.json"
+grep -q "two or more photos" "$tmp/one_photo.err" && ok || bad "one photo: $(cat "$tmp/one_photo.err")"
+sed 's/"fx":[^,]*/"fx": NaN/' "$set_dir/camera.json" >"$tmp/cam_nan.json"
+expect_fail nan_camera "$tmp/x.json" -- "$mr" map --images "$set_dir/images" --camera "$tmp/cam_nan.json" --tag-size 0.25 --fix 0 --out "$tmp/x.json"
+printf '{"world_from_tag": [1,0,0,NaN, 0,1,0,0, 0,0,1,0, 0,0,0,1]}' >"$tmp/nanfix.json"
+expect_fail nan_fix_pose "$tmp/x.json" -- "$mr" map "${common[@]}" --fix 0 --fix-pose "$tmp/nanfix.json" --out "$tmp/x.json"
+expect_fail nan_tag_size "$tmp/x.json" -- "$mr" map "${common[@]}" --tag-sizes 3=nan --fix 0 --out "$tmp/x.json"
+if command -v python3 >/dev/null 2>&1; then
+  python3 - "$set_dir/control.json" "$tmp/ctl_off.json" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))
+c["points"][1]["xyz"][1] += 0.30  # 30 cm: beyond 5 sigma of the leave-one-out check (about 30 mm here)
+json.dump(c, open(sys.argv[2], "w"))
+PY
+  "$mr" map "${common[@]}" --control "$tmp/ctl_off.json" --out "$tmp/ctl_off_map.json" >"$tmp/ctl_off.out" 2>&1 \
+    && ok || bad "map with an outlying control point failed: $(cat "$tmp/ctl_off.out")"
+  grep -q "control point P2 disagrees by .* sigma: left out" "$tmp/ctl_off.out" && ok || bad "outlier not named: $(cat "$tmp/ctl_off.out")"
+  [ -s "$tmp/ctl_off_map.json" ] && ok || bad "no map written with an outlier"
+fi
+
 # A disconnected part: photos of tags 0..2 and, apart, of the others would
 # need another set; a fixed tag that is never seen is the bad-input case.
 expect_fail unseen_fix "$tmp/x.json" -- "$mr" map "${common[@]}" --fix 77 --out "$tmp/x.json"
@@ -147,6 +172,22 @@ PY
   expect_fail measure_same_pose "$tmp/m2.json" -- "$mr" measure --recording "$rec" --observations "$tmp/same.json" --out "$tmp/m2.json"
   grep -q "baseline angle" "$tmp/measure_same_pose.err" && ok || bad "same pose: $(cat "$tmp/measure_same_pose.err")"
   expect_fail measure_no_frame "$tmp/m2.json" -- "$mr" measure --recording "$rec" --observations "$tmp/noframe.json" --out "$tmp/m2.json"
+fi
+# NaN in the recording: its camera (meta.json), a tapped frame's pose (frames.jsonl).
+if [ -f "$tmp/obs.json" ]; then
+  mkdir -p "$tmp/rec_nan_meta" "$tmp/rec_nan_pose"
+  sed 's/"fx":[^,]*/"fx": NaN/' "$rec/meta.json" >"$tmp/rec_nan_meta/meta.json"
+  cp "$rec/frames.jsonl" "$tmp/rec_nan_meta/"
+  expect_fail measure_nan_meta "$tmp/m2.json" -- "$mr" measure --recording "$tmp/rec_nan_meta" --observations "$tmp/obs.json" --out "$tmp/m2.json"
+  cp "$rec/meta.json" "$tmp/rec_nan_pose/"
+  f0=$(sed -n 's/.*"taps": *\[{"frame": *\([0-9]*\).*/\1/p' "$tmp/obs.json")
+  sed "/\"frame\": *$f0,/s/\"world_from_camera\": *\[/\"world_from_camera\": [NaN, /" "$rec/frames.jsonl" >"$tmp/rec_nan_pose/frames.jsonl"
+  grep -q NaN "$tmp/rec_nan_pose/frames.jsonl" && ok || bad "could not put a NaN into frame $f0's pose"
+  # The reader warns about the line it skipped, then the tap fails on it.
+  "$mr" measure --recording "$tmp/rec_nan_pose" --observations "$tmp/obs.json" --out "$tmp/m2.json" >/dev/null 2>"$tmp/nanpose.err"
+  rc=$?
+  [ $rc -ne 0 ] && [ $rc -lt 128 ] && [ ! -e "$tmp/m2.json" ] && tail -1 "$tmp/nanpose.err" | grep -q "frame $f0 is not in the recording (its frames.jsonl has unreadable lines" \
+    && ok || bad "NaN pose: rc $rc: $(cat "$tmp/nanpose.err")"
 fi
 printf '{"taps": [{"frame": 0, "px": [NaN, 1]}]}' >"$tmp/nan_obs.json"
 expect_fail measure_nan "$tmp/m2.json" -- "$mr" measure --recording "$rec" --observations "$tmp/nan_obs.json" --out "$tmp/m2.json"
