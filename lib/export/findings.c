@@ -108,7 +108,7 @@ static bool load_one(const char *dir, const mr_export_params *p, mr_finding *f, 
             format_len(f->distance_sigma_m, len, sizeof len);
             ADD(" +- %s (1 sigma", len);
             if (a->has_measurement) ADD(", triangulated from %d taps", a->measurement.taps);
-            if (a->has_measurement && a->measurement.planned_node[0]) ADD(", to the plan's %s", a->measurement.planned_node);
+            if (a->has_measurement && a->measurement.planned_node[0]) ADD(", to the planned %s", a->measurement.planned_node);
             ADD(")");
         }
     } else {
