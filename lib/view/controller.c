@@ -640,6 +640,7 @@ const mr_ui_draw_list *mr_viewer_ui(mr_viewer *v, const mr_viewer_frame *f, mr_v
     column(v, out);
     messages(v, f);
     if (v->note_open) notes(v, f, out);
+    vw_measure_draw(v, f); /* issue 15 */
     if (v->help) help_panel(v);
     float tx, ty;
     const mr_ui_draw_list *dl = mr_ui_end(v->ui);

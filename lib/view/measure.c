@@ -123,6 +123,20 @@ void mr_viewer_measure_distance(mr_viewer *v, mr_dvec3 planned, double dist_m, d
                         m->planned_node[0] ? " at " : "", m->planned_node);
 }
 
+void vw_measure_draw(mr_viewer *v, const mr_viewer_frame *f) {
+    if (!v->measure_mode || !f->have_image || !f->camera || f->camera->width <= 0 || f->camera->height <= 0) return;
+    const mr_measurement *m = &v->measure;
+    mr_ui_rect r = f->image_rect;
+    float s = mr_ui_mm(v->ui, 2.5f), t = fmaxf(2, mr_ui_mm(v->ui, 0.4f));
+    for (int i = 0; i < m->taps; i++) {
+        if (m->frames[i] != f->index) continue; /* another frame's tap is elsewhere in this picture */
+        float x = r.x + (float)((m->px[i][0] + 0.5) * r.w / f->camera->width),
+              y = r.y + (float)((m->px[i][1] + 0.5) * r.h / f->camera->height);
+        mr_ui_draw_rect(mr_ui_list(v->ui), mr_ui_rect_make(x - s, y - t / 2, 2 * s, t), MR_UI_RGBA(60, 170, 255, 255));
+        mr_ui_draw_rect(mr_ui_list(v->ui), mr_ui_rect_make(x - t / 2, y - s, t, 2 * s), MR_UI_RGBA(60, 170, 255, 255));
+    }
+}
+
 void vw_measure_banner(const mr_viewer *v, char *buf, size_t n) {
     const mr_measurement *m = &v->measure;
     if (v->measure_solved)

@@ -70,11 +70,13 @@ mr_view_action *vw_emit(mr_view_actions *out, mr_view_action_type t);
 /* Runs the script commands that are due (before the queued input is taken). */
 void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out);
 /* issue 15, Measure (measure.c): the button / key (start, finish or cancel),
- * Esc, a tap on the picture, the banner text, the state snapshot's part. */
+ * Esc, a tap on the picture, the banner text, the tap's cross, the state
+ * snapshot's part. */
 void vw_measure_toggle(mr_viewer *v, mr_view_actions *out);
 void vw_measure_cancel(mr_viewer *v);
 void vw_measure_tap(mr_viewer *v, const mr_viewer_frame *f, float x, float y);
 void vw_measure_banner(const mr_viewer *v, char *buf, size_t n);
+void vw_measure_draw(mr_viewer *v, const mr_viewer_frame *f); /* a cross at this frame's tap */
 void vw_measure_state_json(const mr_viewer *v, cJSON *j);
 
 #endif
