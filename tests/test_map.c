@@ -263,6 +263,20 @@ static void test_control_points(void) {
     mr_map_result_free(&r);
     ctl[2].world.y -= 0.05;
 
+    /* Four points, each one 30 cm off in turn: that one is named, not a
+     * good one that the bad one's pull makes look as far off (issue 15). */
+    mp.control_count = 4;
+    for (int bad_q = 0; bad_q < 4; bad_q++) {
+        ctl[bad_q].world.y += 0.30;
+        CHECK_MSG(mr_map_build(&s.camera, ph, s.photo_count, &mp, &r, &err), "%s", err.msg);
+        for (int q = 0; q < 4; q++)
+            CHECK_MSG(r.controls[q].outlier == (q == bad_q), "P%d 30 cm off: P%d outlier %d", bad_q + 1, q + 1,
+                      r.controls[q].outlier);
+        mr_map_result_free(&r);
+        ctl[bad_q].world.y -= 0.30;
+    }
+    mp.control_count = 5;
+
     /* Three collinear points fix no rotation. */
     mr_map_control col[3] = {ctl[0], ctl[0], ctl[0]};
     col[1].corner = 0;
