@@ -119,6 +119,7 @@ static bool window_to_image(const view_app *a, double x, double y, double *u, do
 
 /* A tap in mark mode: what is under it, and the screen as it is now. */
 static void begin_mark(view_app *a, double x, double y) {
+    a->mark_measured = false; /* a mark of Mark, not of Measure */
     double u, v;
     if (!window_to_image(a, x, y, &u, &v)) {
         mr_viewer_toast(a->vc, "tap on the picture to mark");
@@ -235,9 +236,9 @@ static void measure_done(view_app *a) {
     else
         mr_viewer_toast(a->vc, "measured point +/- %.1f mm; no planned surface to measure it against%s%s",
                         m.tri.sigma * 1e3, err.msg[0] ? ": " : "", err.msg);
-    mr_viewer_measurement(a->vc, &a->mark_measure);
-    a->mark_measured = true;
     if (!a->have_frame) return;
+    mr_viewer_measurement(a->vc, &a->mark_measure);
+    a->mark_measured = true; /* the mark opened below carries it */
     memset(&a->mark_pick, 0, sizeof a->mark_pick);
     a->mark_pick.node = -1;
     /* The mark's point: where the model is nearest to what was built. */
