@@ -149,7 +149,8 @@ int cmd_map(int argc, char **argv) {
         mp.fix_id = (int)id;
         if (mr_cli_get(opts, "fix-pose")) {
             cJSON *j = mr_json_load(mr_cli_get(opts, "fix-pose"), &err);
-            bool ok = j && mr_json_dmat4(j, "world_from_tag", &fix_pose, &err);
+            if (!j) goto fail; /* the loader's message names the file */
+            bool ok = mr_json_dmat4(j, "world_from_tag", &fix_pose, &err);
             cJSON_Delete(j);
             if (ok && !mr_m4_is_rigid(&fix_pose, 1e-4))
                 ok = mr_fail(&err, MR_ERR_INVALID, "world_from_tag is not a rigid transform");

@@ -1,6 +1,7 @@
 /* mrcheck measure: a real feature tapped in several frames of a recording,
  * triangulated (lib/track's mr_triangulate) and compared with the plan. */
 #include "app_track.h"
+#include "mr_eval.h"
 #include "mr_session.h"
 
 #include <math.h>
@@ -13,15 +14,17 @@ int cmd_measure(int argc, char **argv) {
         {"recording", "DIR", "recording whose frames were tapped (poses and their covariance)", NULL},
         {"observations", "OBS.json", "{\"taps\": [{\"frame\": N, \"px\": [u, v]}, ...], \"planned\": [x, y, z]}", NULL},
         {"out", "RESULT.json", "also write the result there", NULL},
+        {"scene", "S", "the plan (glTF/GLB or scene config): also the distance to its nearest surface point", NULL},
         {NULL, NULL, NULL, NULL},
     };
     mr_triangulate_params tp = MR_TRIANGULATE_DEFAULTS;
     mr_cli_table table = {"", mr_triangulate_opts, &tp, NULL, false, {0}};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 2, opts, &table, 1, NULL, 0, NULL,
-                   "usage: mrcheck measure --recording DIR --observations OBS.json [--out RESULT.json]\n"
+                   "usage: mrcheck measure --recording DIR --observations OBS.json [--scene S] [--out RESULT.json]\n"
                    "Triangulates the feature tapped in two or more frames (linear, then refined, with the taps'\n"
-                   "noise and each frame's pose covariance) and reports its distance to the planned point in mm\n"
+                   "noise and each frame's pose covariance) and reports its distance to the planned point\n"
+                   "(\"planned\" in OBS.json) and, with --scene, to the nearest point of the planned model, in mm\n"
                    "with its 1-sigma uncertainty.",
                    &help))
         return 2;
@@ -32,6 +35,8 @@ int cmd_measure(int argc, char **argv) {
     cJSON *obs = mr_json_load(obsf, &err);
     if (!obs) return mr_cli_error(cmd, &err);
     mr_recording *rec = NULL;
+    mr_scene *scene = NULL;
+    mr_eval_nearest *near = NULL;
     mr_tap taps[64];
     int n = 0, rc = 1;
     double planned[3];
@@ -47,6 +52,10 @@ int cmd_measure(int argc, char **argv) {
     }
     rec = mr_recording_open(dir, &err);
     if (!rec) goto fail;
+    if (mr_cli_get(opts, "scene")) {
+        scene = mr_scene_load(mr_cli_get(opts, "scene"), NULL, &err);
+        if (!scene || !(near = mr_eval_nearest_create(scene, false, &err))) goto fail;
+    }
     int no_cov = 0;
     cJSON_ArrayForEach(t, arr) {
         double fr = -1, px[2];
@@ -63,7 +72,8 @@ int cmd_measure(int argc, char **argv) {
         for (int i = 0; i < rec->frame_count; i++)
             if ((double)rec->frames[i].index == fr) f = &rec->frames[i];
         if (!f) {
-            mr_fail(&err, MR_ERR_INVALID, "%s: tap %d: frame %g is not in the recording", obsf, n + 1, fr);
+            mr_fail(&err, MR_ERR_INVALID, "%s: tap %d: frame %g is not in the recording%s", obsf, n + 1, fr,
+                    rec->bad_lines ? " (its frames.jsonl has unreadable lines, skipped)" : "");
             goto fail;
         }
         if (!f->pose.valid) {
@@ -87,6 +97,19 @@ int cmd_measure(int argc, char **argv) {
         mr_triangulation_distance(&tr, mr_v3(planned[0], planned[1], planned[2]), &dist, &dsig);
         printf("distance to the planned point: %.1f mm +- %.1f mm (1 sigma)\n", dist * 1e3, dsig * 1e3);
     }
+    /* issue 15: the nearest point of the planned surface (exact, lib/eval). */
+    mr_nearest_hit nh = {0};
+    double nsig = NAN;
+    if (near) {
+        if (!mr_eval_nearest_point(near, tr.point, &nh)) {
+            mr_fail(&err, MR_ERR_INVALID, "the scene has no surface to measure against");
+            goto fail;
+        }
+        nsig = mr_eval_nearest_sigma(&nh, tr.cov);
+        printf("distance to the planned surface: %.1f mm +- %.1f mm (1 sigma), nearest point %.4f %.4f %.4f on %s\n",
+               nh.distance * 1e3, nsig * 1e3, nh.point.x, nh.point.y, nh.point.z,
+               nh.node >= 0 ? scene->nodes[nh.node].name : "?");
+    }
     if (out) {
         cJSON *r = cJSON_CreateObject();
         double pt[3] = {tr.point.x, tr.point.y, tr.point.z};
@@ -101,6 +124,13 @@ int cmd_measure(int argc, char **argv) {
             cJSON_AddNumberToObject(r, "distance_mm", dist * 1e3);
             cJSON_AddNumberToObject(r, "distance_sigma_mm", dsig * 1e3);
         }
+        if (nh.found) {
+            double np[3] = {nh.point.x, nh.point.y, nh.point.z};
+            cJSON_AddItemToObject(r, "nearest_planned", mr_json_from_doubles(np, 3));
+            cJSON_AddStringToObject(r, "nearest_node", nh.node >= 0 ? scene->nodes[nh.node].name : "");
+            cJSON_AddNumberToObject(r, "surface_distance_mm", nh.distance * 1e3);
+            cJSON_AddNumberToObject(r, "surface_distance_sigma_mm", nsig * 1e3);
+        }
         bool ok = mr_json_save(out, r, &err);
         cJSON_Delete(r);
         if (!ok) goto fail;
@@ -110,6 +140,8 @@ int cmd_measure(int argc, char **argv) {
 fail:
     rc = mr_cli_error(cmd, &err);
 done:
+    mr_eval_nearest_destroy(&near);
+    mr_scene_destroy(&scene);
     mr_recording_close(&rec);
     cJSON_Delete(obs);
     return rc;

@@ -9,7 +9,9 @@
  * actions out: renders with lib/render, writes snapshots and annotations. */
 #include "app.h"
 
+#include "mr_eval.h"
 #include "mr_session.h"
+#include "mr_track.h"
 #include "mr_ui.h"
 #include "mr_view.h"
 
@@ -73,6 +75,12 @@ typedef struct view_app {
     /* issue 15: the model under the picture's centre, for "+/- N mm here" */
     bool centre_hit;
     mr_dvec3 centre_world;
+    /* issue 15, Measure: the picture's camera, the planned surface's search
+     * (built on the first measurement), the measurement the open mark carries */
+    mr_camera picture_cam;
+    mr_eval_nearest *nearest;
+    bool mark_measured;
+    mr_measurement mark_measure;
     /* issue 18: temporal AO (--ao-temporal); a frame after one without a valid pose restarts it */
     bool ao_temporal, ao_had_pose;
     /* stats */
@@ -111,6 +119,7 @@ static bool window_to_image(const view_app *a, double x, double y, double *u, do
 
 /* A tap in mark mode: what is under it, and the screen as it is now. */
 static void begin_mark(view_app *a, double x, double y) {
+    a->mark_measured = false; /* a mark of Mark, not of Measure */
     double u, v;
     if (!window_to_image(a, x, y, &u, &v)) {
         mr_viewer_toast(a->vc, "tap on the picture to mark");
@@ -170,6 +179,8 @@ static cJSON *mark_line(view_app *a, int note) {
                           .pose_cov = a->mark_frame.cov, .corner_sigma_px = a->mark_frame.corner_sigma_px,
                           .have_point = a->mark_pick.hit, .point = a->mark_pick.world};
     m.has_uncertainty = mr_view_sigma_here(&sf, &m.uncertainty_m);
+    m.has_measurement = a->mark_measured; /* issue 15: a mark made by Measure */
+    m.measurement = a->mark_measure;
     return mr_annotation_to_json(&m);
 }
 
@@ -178,6 +189,7 @@ static void finish_mark(view_app *a, int note) {
         mr_viewer_toast(a->vc, "mark cancelled");
         mr_image_free(&a->mark_screen);
         mr_capture_frame_free(&a->mark_frame);
+        a->mark_measured = false;
         return;
     }
     mr_error err = {0};
@@ -204,6 +216,52 @@ static void finish_mark(view_app *a, int note) {
     cJSON_Delete(line);
     mr_image_free(&a->mark_screen);
     mr_capture_frame_free(&a->mark_frame);
+    a->mark_measured = false;
+}
+
+/* issue 15: a finished measurement. Its distance to the planned surface
+ * (the nearest point of the model, lib/eval), told by the controller; then
+ * a mark of it at the current frame, the note chooser open, the line
+ * carrying the measured_* fields and the nearest planned point as the
+ * mark's point. */
+static void measure_done(view_app *a) {
+    mr_measurement m;
+    if (!mr_viewer_measurement(a->vc, &m)) return;
+    mr_error err = {0};
+    mr_nearest_hit h = {0};
+    if (a->scene && !a->nearest) a->nearest = mr_eval_nearest_create(a->scene, false, &err);
+    if (a->nearest && mr_eval_nearest_point(a->nearest, m.tri.point, &h))
+        mr_viewer_measure_distance(a->vc, h.point, h.distance, mr_eval_nearest_sigma(&h, m.tri.cov),
+                                   h.node >= 0 ? a->scene->nodes[h.node].name : NULL);
+    else
+        mr_viewer_toast(a->vc, "measured point +/- %.1f mm; no planned surface to measure it against%s%s",
+                        m.tri.sigma * 1e3, err.msg[0] ? ": " : "", err.msg);
+    if (!a->have_frame) return;
+    mr_viewer_measurement(a->vc, &a->mark_measure);
+    a->mark_measured = true; /* the mark opened below carries it */
+    memset(&a->mark_pick, 0, sizeof a->mark_pick);
+    a->mark_pick.node = -1;
+    /* The mark's point: where the model is nearest to what was built. */
+    mr_view view = {mr_camera_resized(&a->camera, a->frame.image.width, a->frame.image.height), a->frame.pose};
+    mr_camera pin = view.camera;
+    memset(pin.dist, 0, sizeof pin.dist);
+    double u = pin.cx, v = pin.cy;
+    if (!mr_project_point(&pin, &view.world_from_camera, m.tri.point, &u, &v)) u = pin.cx, v = pin.cy;
+    if (h.found) {
+        mr_dmat4 cfw = mr_m4_invert_rigid(&a->frame.pose);
+        a->mark_pick = (mr_pick){true, h.point, mr_m4_point(&cfw, h.point).z, h.node,
+                                 h.node >= 0 ? a->scene->nodes[h.node].layer : 0};
+    }
+    a->mark_px = u;
+    a->mark_py = v;
+    mr_capture_frame_free(&a->mark_frame);
+    a->mark_frame = a->frame;
+    memset(&a->mark_frame.image, 0, sizeof a->mark_frame.image);
+    if (a->frame.image.data && mr_image_alloc(&a->mark_frame.image, a->frame.image.width, a->frame.image.height,
+                                              a->frame.image.channels, MR_PIX_U8, &err))
+        memcpy(a->mark_frame.image.data, a->frame.image.data, mr_image_bytes(&a->frame.image));
+    a->mark_grab_screen = true;
+    mr_viewer_note_open(a->vc, (float)((u + 0.5) / pin.width), (float)((v + 0.5) / pin.height));
 }
 
 static void set_frozen(view_app *a, bool on) {
@@ -231,6 +289,7 @@ static void carry_out(view_app *a, const mr_view_actions *acts) {
         case MR_VA_SHOT: snprintf(a->shot_path, sizeof a->shot_path, "%s", x->path); break;
         case MR_VA_STATE: snprintf(a->state_path, sizeof a->state_path, "%s", x->path); break;
         case MR_VA_QUIT: a->quit = true; break;
+        case MR_VA_MEASURE_DONE: measure_done(a); break;
         }
     }
 }
@@ -409,6 +468,11 @@ static mr_viewer_frame frame_info(view_app *a, char *state_msg, size_t n) {
     bool marking = mr_viewer_note_is_open(a->vc);
     f.have_point = marking ? a->mark_pick.hit : a->centre_hit;
     f.point = marking ? a->mark_pick.world : a->centre_world;
+    /* issue 15, Measure: taps are made on the undistorted picture */
+    if (a->have_frame && a->frame.image.width > 0) {
+        a->picture_cam = mr_camera_resized(&a->camera, a->frame.image.width, a->frame.image.height);
+        f.camera = &a->picture_cam;
+    }
     return f;
 }
 
@@ -744,6 +808,7 @@ done:
     mr_draw2d_destroy(&a->d2);
     mr_renderer_destroy(&a->rend);
     mr_window_destroy(&a->win);
+    mr_eval_nearest_destroy(&a->nearest);
     mr_scene_destroy(&a->scene);
     mr_marker_map_free(&a->markers);
     free(a);

@@ -45,7 +45,7 @@ int cmd_synth(int argc, char **argv) {
         {"size", "WxH", "frame size (default 640x480, the demo camera scaled)", NULL},
         {"seed", "N", "noise seed (default 1)", NULL},
         {"calibration", "DIR", "instead: write a calibration board and 12 images there", NULL},
-        {"map-photos", "DIR", "instead: write a synthetic photo set for `mrcheck map` there (images/, camera.json, truth.json, control.json)", NULL},
+        {"map-photos", "DIR", "instead: write a synthetic photo set for `mrcheck map` there (images/, photos.avi, camera.json, truth.json, control.json)", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -64,7 +64,7 @@ int cmd_synth(int argc, char **argv) {
     mr_error err = {0};
     if (mr_cli_get(opts, "map-photos")) {
         if (!mr_synth_map_write(mr_cli_get(opts, "map-photos"), NULL, &err)) return mr_cli_error(cmd, &err);
-        printf("wrote %s/images/, camera.json, truth.json, control.json\n", mr_cli_get(opts, "map-photos"));
+        printf("wrote %s/images/, photos.avi, camera.json, truth.json, control.json\n", mr_cli_get(opts, "map-photos"));
         return 0;
     }
     if (mr_cli_get(opts, "calibration")) {

@@ -134,6 +134,9 @@ static mr_dmat4 pose_at(double ex, double ey, double ez, double tx, double ty, d
     return mr_m4_look_at_cv(mr_v3(ex, ey, ez), mr_v3(tx, ty, tz), mr_v3(0, 1, 0));
 }
 
+/* issue 15: a measurement the next write_mark carries (NULL: none). */
+static const mr_measurement *g_mark_measure;
+
 static bool write_mark(const char *dir, int i, const char *note, const mr_dmat4 *pose, double dist, double unc) {
     mr_camera cam = test_camera();
     mr_image img;
@@ -163,6 +166,10 @@ static bool write_mark(const char *dir, int i, const char *note, const mr_dmat4 
     m.world_from_camera = *pose;
     m.pose_tags_seen = 3;
     m.pose_rms_px = 0.4;
+    if (g_mark_measure) {
+        m.has_measurement = true;
+        m.measurement = *g_mark_measure;
+    }
     char stem[32];
     snprintf(stem, sizeof stem, "mark_%04d", i);
     mr_mark_files fl = {.stem = stem, .frame = &img, .screen = &img, .camera = &cam, .distance_m = dist,
@@ -545,6 +552,45 @@ static void test_report(void) {
     CHECK(system(cmd) != 0);
 }
 
+/* issue 15: a mark made by the view's Measure shows its triangulated
+ * distance and that distance's sigma in the report and the BCF topic. */
+static void test_measured(void) {
+    char dir[1200], out[1300], path[1500];
+    snprintf(dir, sizeof dir, "%s/measured", g_tmp);
+    snprintf(out, sizeof out, "%s/report_measured", g_tmp);
+    mr_measurement ms;
+    memset(&ms, 0, sizeof ms);
+    ms.taps = 3;
+    for (int i = 0; i < 3; i++) ms.frames[i] = 10 + i, ms.px[i][0] = 80, ms.px[i][1] = 60;
+    ms.tri.point = mr_v3(1.3, 1, 1);
+    for (int i = 0; i < 3; i++) ms.tri.cov[4 * i] = 1.6e-5;
+    ms.tri.sigma = sqrt(3 * 1.6e-5);
+    ms.tri.angle_deg = 20;
+    ms.has_distance = true;
+    ms.distance_m = 0.301;
+    ms.distance_sigma_m = 0.004;
+    ms.planned = mr_v3(1, 1, 1);
+    snprintf(ms.planned_node, sizeof ms.planned_node, "Machine_2");
+    mr_dmat4 pose = pose_at(0, 1.5, 5, 1, 1, 1);
+    g_mark_measure = &ms;
+    bool ok = write_mark(dir, 1, "machine moved", &pose, -1, 0.002);
+    g_mark_measure = NULL;
+    if (!ok) return;
+    mr_export_params p = MR_EXPORT_DEFAULTS;
+    mr_error err = {0};
+    CHECK_MSG(mr_export_report(dir, out, &p, &err), "report: %s", err.msg);
+    snprintf(path, sizeof path, "%s/index.html", out);
+    size_t n = 0;
+    char *html = mr_file_read(path, &n, 0, &err);
+    CHECK_MSG(html && strstr(html, "<td>301 mm +- 4 mm</td>"), "the summary lacks the measured distance and sigma");
+    CHECK_MSG(html && strstr(html, "Measured distance: 301 mm +- 4 mm (1 sigma, triangulated from 3 taps, to the "
+                                   "planned Machine_2)"),
+              "the finding's text lacks the measurement");
+    free(html);
+    snprintf(path, sizeof path, "%s/m.bcf", g_tmp);
+    CHECK_MSG(mr_export_bcf(dir, path, &p, &err), "bcf: %s", err.msg);
+}
+
 int main(void) {
     if (!mr_test_fresh_dir("export", g_tmp, sizeof g_tmp)) return 1;
     test_camera_conversion();
@@ -552,5 +598,6 @@ int main(void) {
     test_round_trip();
     test_bad_input();
     test_report();
+    test_measured();
     return mr_test_finish("test_export");
 }

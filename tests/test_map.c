@@ -263,6 +263,20 @@ static void test_control_points(void) {
     mr_map_result_free(&r);
     ctl[2].world.y -= 0.05;
 
+    /* Four points, each one 30 cm off in turn: that one is named, not a
+     * good one that the bad one's pull makes look as far off (issue 15). */
+    mp.control_count = 4;
+    for (int bad_q = 0; bad_q < 4; bad_q++) {
+        ctl[bad_q].world.y += 0.30;
+        CHECK_MSG(mr_map_build(&s.camera, ph, s.photo_count, &mp, &r, &err), "%s", err.msg);
+        for (int q = 0; q < 4; q++)
+            CHECK_MSG(r.controls[q].outlier == (q == bad_q), "P%d 30 cm off: P%d outlier %d", bad_q + 1, q + 1,
+                      r.controls[q].outlier);
+        mr_map_result_free(&r);
+        ctl[bad_q].world.y -= 0.30;
+    }
+    mp.control_count = 5;
+
     /* Three collinear points fix no rotation. */
     mr_map_control col[3] = {ctl[0], ctl[0], ctl[0]};
     col[1].corner = 0;
@@ -286,7 +300,53 @@ static void test_control_points(void) {
     mr_synth_map_free(&s);
 }
 
+/* --refine-intrinsics (issue 15, item 1): a camera file 4 % off in focal
+ * length (and 3 % under in the second run) maps worse; refined, the focal
+ * length lands near the truth and the map error and the reprojection RMS
+ * drop. */
+static void test_refine_intrinsics(void) {
+    mr_synth_map_params sp = {MR_SYNTH_MAP_DEFAULTS};
+    room(&sp);
+    sp.tags = 12;
+    sp.photos = 40;
+    mr_synth_map s;
+    mr_error err = {0};
+    CHECK(mr_synth_map_make(&sp, &s, &err));
+    mr_map_photo ph[128];
+    photos_of(&s, ph);
+    const double factors[2] = {1.04, 0.97};
+    for (int k = 0; k < 2; k++) {
+        mr_camera wrong = s.camera;
+        wrong.fx *= factors[k];
+        wrong.fy *= factors[k];
+        mr_map_params mp = MR_MAP_DEFAULTS;
+        mp.tag_size = sp.tag_size;
+        mp.fix_id = 0;
+        mp.fix_pose = &s.truth.tags[0].world_from_tag;
+        mr_map_result off, ref;
+        CHECK_MSG(mr_map_build(&wrong, ph, s.photo_count, &mp, &off, &err), "%s", err.msg);
+        mp.refine_intrinsics = true;
+        CHECK_MSG(mr_map_build(&wrong, ph, s.photo_count, &mp, &ref, &err), "%s", err.msg);
+        CHECK(!off.refined_intrinsics && ref.refined_intrinsics);
+        double e0, m0, d0, z0, e1, m1, d1, z1;
+        map_error(&off, &s.truth, &e0, &m0, &d0, &z0);
+        map_error(&ref, &s.truth, &e1, &m1, &d1, &z1);
+        double fx_err = ref.camera.fx / s.camera.fx - 1, fy_err = ref.camera.fy / s.camera.fy - 1;
+        printf("refine intrinsics (fx %+.0f %%): fx %.1f -> %.1f (true %.1f, %+.2f %%), fy %+.2f %%; map error rms "
+               "%.2f -> %.2f mm; reprojection %.3f -> %.3f px\n",
+               (factors[k] - 1) * 100, wrong.fx, ref.camera.fx, s.camera.fx, fx_err * 100, fy_err * 100, e0 * 1e3,
+               e1 * 1e3, off.rms_px, ref.rms_px);
+        CHECK(fabs(fx_err) < 0.01 && fabs(fy_err) < 0.01);
+        CHECK(e1 < 0.5 * e0);
+        CHECK(ref.rms_px < off.rms_px);
+        mr_map_result_free(&off);
+        mr_map_result_free(&ref);
+    }
+    mr_synth_map_free(&s);
+}
+
 int main(void) {
+    test_refine_intrinsics();
     test_fixed_gauge_and_chaining();
     test_disconnected_mixed_misdetect();
     test_control_points();

@@ -3,7 +3,9 @@
  * key map, AO and ghost cycling, settings (round trip, damaged files,
  * atomic writes), replay controls, the tracking-lost policy, the real
  * layout at several densities and in windows too small for it, scripts. */
+#include "mr_session.h"
 #include "mr_test.h"
+#include "mr_track.h"
 #include "mr_view.h"
 
 #include <errno.h>
@@ -606,7 +608,161 @@ static void test_sigma(rig *r) {
     r->f.have_point = false;
 }
 
+/* ------------------------------------------------- Measure (issue 15) */
+
+/* The rig's frame as seen from `eye` looking at `at`, frame `index`. */
+static void measure_frame(rig *r, int64_t index, mr_dvec3 eye, mr_dvec3 at, const double *cov) {
+    r->f.index = index;
+    r->f.have_pose = r->f.pose_valid = true;
+    r->f.world_from_camera = mr_m4_look_at_cv(eye, at, mr_v3(0, 1, 0));
+    r->f.pose_cov = cov;
+    r->f.corner_sigma_px = cov ? 0.5 : 0;
+}
+
+/* Where world point X shows in the rig's picture (window pixels): the
+ * picture is undistorted, so a plain pinhole. */
+static void window_of(const rig *r, const mr_camera *cam, mr_dvec3 X, float *x, float *y) {
+    mr_dmat4 cfw = mr_m4_invert_rigid(&r->f.world_from_camera);
+    mr_dvec3 q = mr_m4_point(&cfw, X);
+    double u = cam->fx * q.x / q.z + cam->cx, v = cam->fy * q.y / q.z + cam->cy;
+    mr_ui_rect ir = r->f.image_rect;
+    *x = (float)(ir.x + (u + 0.5) * ir.w / cam->width);
+    *y = (float)(ir.y + (v + 0.5) * ir.h / cam->height);
+}
+
+/* obj as one line of a .jsonl file (a line without its newline is torn). */
+static char *line_of(const cJSON *obj) {
+    char *t = cJSON_PrintUnformatted(obj), *l = t ? malloc(strlen(t) + 2) : NULL;
+    if (l) snprintf(l, strlen(t) + 2, "%s\n", t);
+    free(t);
+    return l;
+}
+
+static const char *state_str(const rig *r, const char *key, char *buf, size_t n) {
+    cJSON *st = mr_viewer_state_json(r->v);
+    const cJSON *m = cJSON_GetObjectItemCaseSensitive(st, key);
+    snprintf(buf, n, "%s", cJSON_IsString(m) ? m->valuestring : "");
+    cJSON_Delete(st);
+    return buf;
+}
+
+/* Events in, a measurement and its annotation out: taps of one feature in
+ * three frames (one from nearly the same place as the first: refused on
+ * its own), the button finishes, the distance comes back, the mark's
+ * measured_* fields round-trip through lib/session. Also: Esc and d
+ * cancel, a tap without a tracked pose or outside the picture is not
+ * taken, a second tap in one frame replaces the first. */
+static void test_measure(rig *r) {
+    /* Distorted camera: the picture is shown undistorted, so the
+     * measurement must not undistort the taps again. */
+    mr_camera cam = {640, 480, 500, 500, 319.5, 239.5, {-0.2, 0.05, 0, 0, 0}};
+    r->f.camera = &cam;
+    r->f.image_rect = mr_ui_rect_make(100, 60, 640, 480);
+    double cov[36] = {0};
+    for (int i = 0; i < 3; i++) cov[7 * i] = 1e-6, cov[7 * (i + 3)] = 1e-6; /* 1 mrad, 1 mm */
+    const mr_dvec3 X = mr_v3(0.3, 1.2, 5.0), at = mr_v3(-1.0, 0.4, 5); /* X well off the centre */
+    char msg[256];
+    mr_measurement m;
+    measure_frame(r, 10, mr_v3(-1, 1.5, 0), at, cov);
+    step(r);
+    CHECK(!mr_viewer_measuring(r->v) && !mr_viewer_measurement(r->v, &m));
+    CHECK_MSG(mr_viewer_layout(r->v)->shown[MR_VW_MEASURE], "no Measure button");
+    tap(r, MR_VW_MEASURE);
+    CHECK(mr_viewer_measuring(r->v));
+    float x, y;
+    window_of(r, &cam, X, &x, &y);
+    mr_view_actions acts;
+    tap_at(r, x + 3, y, &acts);
+    tap_at(r, x, y, &acts); /* the same frame: replaces the first */
+    CHECK(mr_viewer_measurement(r->v, &m) && m.taps == 1 && m.frames[0] == 10);
+    CHECK_NEAR(m.px[0][0], (x - 100) - 0.5, 1e-3); /* the picture is 1:1 with the camera */
+    /* Nearly the same place (1 mm to the side): refused with the angle. */
+    measure_frame(r, 11, mr_v3(-0.999, 1.5, 0), at, cov);
+    step(r);
+    window_of(r, &cam, X, &x, &y);
+    tap_at(r, x, y, &acts);
+    CHECK(mr_viewer_measurement(r->v, &m) && m.taps == 2);
+    CHECK_MSG(strstr(state_str(r, "measure_message", msg, sizeof msg), "baseline angle") != NULL, "message '%s'", msg);
+    cJSON *st = mr_viewer_state_json(r->v);
+    CHECK(cJSON_IsFalse(cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(st, "measure"), "solved")));
+    cJSON_Delete(st);
+    /* A frame from far enough away, but tracking lost: the tap is refused. */
+    measure_frame(r, 12, mr_v3(1.5, 1.4, 0.5), at, cov);
+    r->f.pose_valid = false;
+    step(r);
+    window_of(r, &cam, X, &x, &y);
+    tap_at(r, x, y, &acts);
+    CHECK(mr_viewer_measurement(r->v, &m) && m.taps == 2);
+    CHECK_MSG(strstr(state_str(r, "measure_message", msg, sizeof msg), "no tracked pose") != NULL, "message '%s'", msg);
+    r->f.pose_valid = true;
+    step(r);
+    tap_at(r, x, y, &acts);
+    CHECK(mr_viewer_measurement(r->v, &m) && m.taps == 3 && m.frames[2] == 12);
+    CHECK_MSG(mr_v3_len(mr_v3_sub(m.tri.point, X)) < 2e-3, "measured (%g %g %g), want (0.3 1.2 5)", m.tri.point.x,
+              m.tri.point.y, m.tri.point.z);
+    CHECK(m.tri.sigma > 0 && m.tri.sigma < 0.05 && m.tri.angle_deg > 10);
+    CHECK(count(r, MR_VA_MEASURE_DONE, NULL) == 0);
+    /* Finish: one MEASURE_DONE, then the distance comes back. */
+    tap(r, MR_VW_MEASURE);
+    CHECK(count(r, MR_VA_MEASURE_DONE, NULL) == 1 && !mr_viewer_measuring(r->v));
+    mr_viewer_measure_distance(r->v, mr_v3(0.0, 1.2, 5.0), 0.3, 0.004, "Machine_2");
+    CHECK(mr_viewer_measurement(r->v, &m) && m.has_distance && m.distance_m == 0.3);
+    CHECK_MSG(strstr(state_str(r, "measure_message", msg, sizeof msg), "300.0 mm +/- 4.0 mm") != NULL, "'%s'", msg);
+    /* The mark's fields, as the view appends them, read back. */
+    mr_annotation a;
+    memset(&a, 0, sizeof a);
+    snprintf(a.type, sizeof a.type, "discrepancy");
+    a.frame_index = 12;
+    a.node_index = -1;
+    a.world_from_camera = r->f.world_from_camera;
+    a.has_measurement = true;
+    a.measurement = m;
+    cJSON *line = mr_annotation_to_json(&a);
+    char *text = line_of(line);
+    mr_annotations back;
+    mr_error err = {0};
+    CHECK(text && mr_annotations_parse(text, strlen(text), &back, &err) && back.count == 1 && back.bad_lines == 0);
+    if (back.count == 1) {
+        const mr_measurement *b = &back.items[0].measurement;
+        CHECK(back.items[0].has_measurement && b->taps == 3 && b->frames[1] == 11 && b->has_distance);
+        CHECK_NEAR(b->tri.point.x, m.tri.point.x, 1e-12);
+        CHECK_NEAR(b->distance_m, 0.3, 1e-12);
+        CHECK_NEAR(b->distance_sigma_m, 0.004, 1e-12);
+        CHECK_NEAR(b->tri.cov[4], m.tri.cov[4], 1e-15);
+        CHECK(strcmp(b->planned_node, "Machine_2") == 0);
+    }
+    mr_annotations_free(&back);
+    free(text);
+    /* A damaged measurement makes the line garbage, not a half mark. */
+    cJSON_ReplaceItemInObject(line, "measured_sigma_m", cJSON_CreateString("x"));
+    text = line_of(line);
+    CHECK(text && mr_annotations_parse(text, strlen(text), &back, &err) && back.count == 0 && back.bad_lines == 1);
+    mr_annotations_free(&back);
+    free(text);
+    cJSON_Delete(line);
+    /* Esc cancels; d starts and, unsolved, cancels; a tap off the picture is not taken. */
+    key(r, 'd');
+    CHECK(mr_viewer_measuring(r->v));
+    tap_at(r, 50, 400, &acts); /* left of the picture (it starts at x = 100) */
+    CHECK(mr_viewer_measurement(r->v, &m) && m.taps == 0);
+    key(r, MR_KEY_ESCAPE);
+    CHECK(!mr_viewer_measuring(r->v) && !mr_viewer_measurement(r->v, &m));
+    CHECK(count(r, MR_VA_QUIT, NULL) == 0);
+    key(r, 'd');
+    key(r, 'd');
+    CHECK(!mr_viewer_measuring(r->v) && count(r, MR_VA_MEASURE_DONE, NULL) == 0);
+    r->f.camera = NULL;
+    r->f.pose_cov = NULL;
+    r->f.corner_sigma_px = 0;
+    r->f.world_from_camera = mr_m4_identity();
+}
+
 /* ------------------------------------------------------------ layout */
+
+/* The right column in priority order (Measure, issue 15, after Mark). */
+static const mr_view_widget_id k_column[] = {MR_VW_FREEZE, MR_VW_SNAPSHOT, MR_VW_MARK, MR_VW_MEASURE, MR_VW_VIDEO,
+                                             MR_VW_HIDDEN, MR_VW_AO, MR_VW_GHOST, MR_VW_HELP};
+#define K_COLUMN_N ((int)(sizeof k_column / sizeof k_column[0]))
 
 /* Clearance between two rects in pixels (negative: they overlap). */
 static float gap(mr_ui_rect a, mr_ui_rect b) {
@@ -686,7 +842,7 @@ static void test_layout(const char *font_path) {
             mr_view_layout L;
             mr_view_layout_compute(ui, &lp, &L);
             int n = check_layout(&L, ppmm, cases[c].w, cases[c].h, what);
-            int want = 9 + (seek ? 5 : 0) + (notes ? 7 : 0);
+            int want = 10 + (seek ? 5 : 0) + (notes ? 7 : 0);
             if (cases[c].all) {
                 CHECK_MSG(n == want && L.dropped == 0, "%s: %d widgets shown (%d dropped), want all %d", what, n,
                           L.dropped, want);
@@ -694,10 +850,11 @@ static void test_layout(const char *font_path) {
                 CHECK_MSG(n + L.dropped == want && (L.dropped > 0 || !seek), "%s: %d shown + %d dropped, want %d "
                           "in all and some dropped", what, n, L.dropped, want);
                 /* Lower priorities go first: the column is a prefix of
-                 * freeze, snapshot, mark, video, hidden, ao, ghost, help. */
-                for (int i = MR_VW_SNAPSHOT; i <= MR_VW_HELP; i++)
-                    CHECK_MSG(!L.shown[i] || L.shown[i - 1], "%s: %s shown but %s (higher priority) left out", what,
-                              mr_view_widget_name((mr_view_widget_id)i), mr_view_widget_name((mr_view_widget_id)(i - 1)));
+                 * freeze, snapshot, mark, measure, video, hidden, ao, ghost, help. */
+                for (int i = 1; i < K_COLUMN_N; i++)
+                    CHECK_MSG(!L.shown[k_column[i]] || L.shown[k_column[i - 1]], "%s: %s shown but %s (higher "
+                              "priority) left out", what, mr_view_widget_name(k_column[i]),
+                              mr_view_widget_name(k_column[i - 1]));
                 CHECK_MSG(!L.shown[MR_VW_RATE] || L.shown[MR_VW_SEEK], "%s: the rate button kept, the seek bar left out",
                           what);
             }
@@ -741,10 +898,10 @@ static void test_layout_sweep(const char *font_path) {
             mr_view_layout L;
             mr_view_layout_compute(ui, &lp, &L);
             int n = check_layout(&L, ppmm, w, h, what);
-            CHECK_MSG(n + L.dropped == 14, "%s: %d shown + %d dropped, want 14", what, n, L.dropped);
-            for (int i = MR_VW_SNAPSHOT; i <= MR_VW_HELP; i++)
-                CHECK_MSG(!L.shown[i] || L.shown[i - 1], "%s: %s shown but %s left out", what,
-                          mr_view_widget_name((mr_view_widget_id)i), mr_view_widget_name((mr_view_widget_id)(i - 1)));
+            CHECK_MSG(n + L.dropped == 15, "%s: %d shown + %d dropped, want 15", what, n, L.dropped);
+            for (int i = 1; i < K_COLUMN_N; i++)
+                CHECK_MSG(!L.shown[k_column[i]] || L.shown[k_column[i - 1]], "%s: %s shown but %s left out", what,
+                          mr_view_widget_name(k_column[i]), mr_view_widget_name(k_column[i - 1]));
             CHECK_MSG(!L.shown[MR_VW_RATE] || L.shown[MR_VW_SEEK], "%s: the rate button kept, the seek bar left out",
                       what);
             CHECK_MSG(!L.shown[MR_VW_PLAY] || L.shown[MR_VW_ALPHA], "%s: replay buttons without the slider", what);
@@ -832,6 +989,7 @@ int main(void) {
         test_cycling(&r);
         test_replay(&r);
         test_sigma(&r);
+        test_measure(&r);
         mr_viewer_destroy(&r.v);
     }
     test_layout(font);

@@ -293,7 +293,8 @@ typedef struct mr_synth_map {
 bool mr_synth_map_make(const mr_synth_map_params *params, mr_synth_map *out, mr_error *err);
 void mr_synth_map_free(mr_synth_map *s);
 /* A rendered set on disk (`mrcheck synth --map-photos DIR`): DIR/images/
- * photo_NNN.png, camera.json, truth.json (the true marker map) and
+ * photo_NNN.png, the same photos as a video photos.avi (issue 15: `map
+ * --video`), camera.json, truth.json (the true marker map) and
  * control.json (four tag centres, sigma 1 mm). params NULL: a small room
  * (MR_SYNTH_MAP_SET_DEFAULTS); images/ is never overwritten. */
 #define MR_SYNTH_MAP_SET_DEFAULTS \

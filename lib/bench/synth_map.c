@@ -239,6 +239,15 @@ bool mr_synth_map_write(const char *dir, const mr_synth_map_params *params, mr_e
         mr_path_join(dir, name, path, sizeof path);
         ok = mr_image_save_png(path, &s.images[j], err);
     }
+    /* issue 15: the same photos as a video (`mrcheck map --video`). */
+    if (ok && s.photo_count > 0) {
+        mr_path_join(dir, "photos.avi", path, sizeof path);
+        mr_video_writer *vw = mr_video_writer_open(path, s.images[0].width, s.images[0].height, 5.0, err);
+        ok = vw != NULL;
+        for (int j = 0; ok && j < s.photo_count; j++) ok = mr_video_writer_add(vw, &s.images[j], err);
+        if (ok) ok = mr_video_writer_close(&vw, err);
+        else mr_video_writer_abort(&vw);
+    }
     if (ok) {
         cJSON *c = mr_camera_to_json(&s.camera);
         mr_path_join(dir, "camera.json", path, sizeof path);

@@ -243,6 +243,41 @@ bool mr_plot_bars(const char *path, const char *title, const char *const *catego
 bool mr_montage_png(const char *path, const mr_image *const *images, int count, int cols, int tile_w, int tile_h,
                     mr_error *err);
 
+/* ------------------------------ nearest point on the model (nearest.c) */
+/* Issue 15 (`mrcheck measure`, the view's Measure): the distance from a
+ * measured point to the planned surface. Embree's point query prunes with
+ * its float BVH; each candidate triangle's closest point is computed in
+ * double from the scene's vertices and world transforms, so the answer is
+ * exact to double rounding at any offset. The scene is borrowed: it must
+ * outlive the handle. */
+typedef struct mr_eval_nearest mr_eval_nearest;
+/* Every drawn node's triangles (the hidden layer too unless skip_hidden).
+ * NULL + err on failure (MR_ERR_NOMEM, MR_ERR_UNSUPPORTED). */
+mr_eval_nearest *mr_eval_nearest_create(const mr_scene *scene, bool skip_hidden, mr_error *err);
+void mr_eval_nearest_destroy(mr_eval_nearest **n); /* NULLs, accepts NULL */
+int mr_eval_nearest_triangles(const mr_eval_nearest *n); /* triangles it searches */
+
+typedef struct mr_nearest_hit {
+    bool found;
+    mr_dvec3 point;       /* nearest point on the model, world, scene units */
+    double distance;      /* |p - point|, scene units */
+    mr_dvec3 normal;      /* unit normal of its triangle (winding order), world */
+    mr_dvec3 direction;   /* unit direction along which the distance grows:
+                             (p - point) / distance, or the normal when p lies
+                             on the surface */
+    int32_t node, mesh;   /* scene node and mesh of the triangle, -1 none */
+    uint32_t triangle;    /* triangle index within the mesh */
+} mr_nearest_hit;
+/* false (out->found false) for a non-finite p or a scene without
+ * triangles. */
+bool mr_eval_nearest_point(const mr_eval_nearest *n, mr_dvec3 p, mr_nearest_hit *out);
+/* The distance's 1-sigma from the point's 3x3 covariance (row-major, scene
+ * units^2): the covariance projected on hit->direction. NAN without a hit. */
+double mr_eval_nearest_sigma(const mr_nearest_hit *hit, const double cov[9]);
+/* Closest point of triangle abc to p, in double (degenerate triangles give
+ * their nearest vertex). */
+mr_dvec3 mr_closest_point_triangle(mr_dvec3 p, mr_dvec3 a, mr_dvec3 b, mr_dvec3 c);
+
 #ifdef __cplusplus
 }
 #endif

@@ -79,6 +79,10 @@ static bool load_one(const char *dir, const mr_export_params *p, mr_finding *f, 
         f->screen_path[0] = 0;
     f->has_distance = opt_num(line, "distance_m", &f->distance_m);
     f->has_uncertainty = opt_num(line, "uncertainty_m", &f->uncertainty_m);
+    /* issue 15: a mark made by Measure carries its triangulated distance
+     * to the plan and that distance's sigma. */
+    if (!f->has_distance) f->has_distance = opt_num(line, "measured_distance_m", &f->distance_m);
+    f->has_distance_sigma = f->has_distance && opt_num(line, "measured_sigma_m", &f->distance_sigma_m);
     f->depth_m = a->hit ? a->depth * p->unit_m : -1;
 
     /* GUIDs from the line itself: the same mark gives the same topic. */
@@ -100,6 +104,13 @@ static bool load_one(const char *dir, const mr_export_params *p, mr_finding *f, 
     if (f->has_distance) {
         format_len(f->distance_m, len, sizeof len);
         ADD(". Measured distance: %s", len);
+        if (f->has_distance_sigma) {
+            format_len(f->distance_sigma_m, len, sizeof len);
+            ADD(" +- %s (1 sigma", len);
+            if (a->has_measurement) ADD(", triangulated from %d taps", a->measurement.taps);
+            if (a->has_measurement && a->measurement.planned_node[0]) ADD(", to the planned %s", a->measurement.planned_node);
+            ADD(")");
+        }
     } else {
         ADD(". Measured distance: not measured");
     }

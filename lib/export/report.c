@@ -128,6 +128,15 @@ static void fmt_len(bool has, double m, char *out, size_t n) {
     else snprintf(out, n, "%.3f m", m);
 }
 
+/* issue 15: "+- sigma" after a measured distance that has one. */
+static void dist_sigma(const mr_finding *f, char *d, size_t n) {
+    if (!f->has_distance_sigma) return;
+    char s[32];
+    fmt_len(true, f->distance_sigma_m, s, sizeof s);
+    size_t k = strlen(d);
+    if (k < n) snprintf(d + k, n - k, " +- %s", s);
+}
+
 static void fmt_time(double t_unix, char *out, size_t n) {
     if (!(t_unix > 0 && t_unix < 253402300799.0)) {
         snprintf(out, n, "unknown");
@@ -197,6 +206,7 @@ static char *html_doc(const mr_findings *fs, const mr_export_params *p, const bo
         const mr_finding *f = &fs->items[i];
         char d[64], u[64], when[64], seen[64];
         fmt_len(f->has_distance, f->distance_m, d, sizeof d);
+        dist_sigma(f, d, sizeof d);
         fmt_len(f->has_uncertainty, f->uncertainty_m, u, sizeof u);
         fmt_time(f->mark->time_unix, when, sizeof when);
         if (f->depth_m >= 0) snprintf(seen, sizeof seen, "%.2f m", f->depth_m);
@@ -246,6 +256,7 @@ static char *md_doc(const mr_findings *fs, const mr_export_params *p, const bool
         const mr_finding *f = &fs->items[i];
         char d[64], u[64], seen[64];
         fmt_len(f->has_distance, f->distance_m, d, sizeof d);
+        dist_sigma(f, d, sizeof d);
         fmt_len(f->has_uncertainty, f->uncertainty_m, u, sizeof u);
         if (f->depth_m >= 0) snprintf(seen, sizeof seen, "%.2f m", f->depth_m);
         else snprintf(seen, sizeof seen, "n/a");

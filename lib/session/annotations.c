@@ -71,6 +71,77 @@ static bool get_vec(const cJSON *o, const char *key, double *out, int n, bool *h
     return true;
 }
 
+/* issue 15: the view's Measure, flat measured_* fields of the mark. */
+static void measurement_json(cJSON *line, const mr_measurement *m) {
+    const mr_triangulation *t = &m->tri;
+    double pt[3] = {t->point.x, t->point.y, t->point.z};
+    cJSON_AddItemToObject(line, "measured_point", mr_json_from_doubles(pt, 3));
+    cJSON_AddItemToObject(line, "measured_covariance", mr_json_from_doubles(t->cov, 9));
+    cJSON_AddNumberToObject(line, "measured_point_sigma_m", t->sigma);
+    cJSON_AddNumberToObject(line, "measured_angle_deg", t->angle_deg);
+    cJSON_AddNumberToObject(line, "measured_rms_px", t->rms_px);
+    int n = m->taps < 0 ? 0 : m->taps > MR_MEASURE_MAX_TAPS ? MR_MEASURE_MAX_TAPS : m->taps;
+    cJSON *fr = cJSON_AddArrayToObject(line, "measured_frames"), *px = cJSON_AddArrayToObject(line, "measured_pixels");
+    for (int i = 0; i < n; i++) {
+        cJSON_AddItemToArray(fr, cJSON_CreateNumber((double)m->frames[i]));
+        cJSON_AddItemToArray(px, mr_json_from_doubles(m->px[i], 2));
+    }
+    if (!m->has_distance) return;
+    double pl[3] = {m->planned.x, m->planned.y, m->planned.z};
+    cJSON_AddNumberToObject(line, "measured_distance_m", m->distance_m);
+    cJSON_AddNumberToObject(line, "measured_sigma_m", m->distance_sigma_m);
+    cJSON_AddItemToObject(line, "measured_planned", mr_json_from_doubles(pl, 3));
+    cJSON_AddStringToObject(line, "measured_planned_node", m->planned_node);
+}
+
+static bool parse_measurement(const cJSON *o, mr_annotation *a) {
+    mr_measurement *m = &a->measurement;
+    double pt[3], pl[3];
+    bool has = false, hp = false, hc = false;
+    if (!get_vec(o, "measured_point", pt, 3, &has)) return false;
+    if (!has) return true; /* no measurement: the other measured_* fields are ignored */
+    a->has_measurement = true;
+    m->tri.point = mr_v3(pt[0], pt[1], pt[2]);
+    m->tri.sigma = m->tri.angle_deg = m->tri.rms_px = NAN;
+    if (!get_vec(o, "measured_covariance", m->tri.cov, 9, &hc) || !get_num(o, "measured_point_sigma_m", &m->tri.sigma) ||
+        !get_num(o, "measured_angle_deg", &m->tri.angle_deg) || !get_num(o, "measured_rms_px", &m->tri.rms_px))
+        return false;
+    if (!hc) return false; /* a point without its covariance is no measurement */
+    const cJSON *fr = cJSON_GetObjectItemCaseSensitive(o, "measured_frames"),
+                *px = cJSON_GetObjectItemCaseSensitive(o, "measured_pixels");
+    if (fr || px) {
+        if (!cJSON_IsArray(fr) || !cJSON_IsArray(px) || cJSON_GetArraySize(fr) != cJSON_GetArraySize(px) ||
+            cJSON_GetArraySize(fr) > MR_MEASURE_MAX_TAPS)
+            return false;
+        m->taps = cJSON_GetArraySize(fr);
+        for (int i = 0; i < m->taps; i++) {
+            const cJSON *f = cJSON_GetArrayItem(fr, i), *p = cJSON_GetArrayItem(px, i);
+            if (!cJSON_IsNumber(f) || !(f->valuedouble >= 0 && f->valuedouble < 1e15 && f->valuedouble == floor(f->valuedouble)) ||
+                !cJSON_IsArray(p) || cJSON_GetArraySize(p) != 2)
+                return false;
+            m->frames[i] = (int64_t)f->valuedouble;
+            for (int k = 0; k < 2; k++) {
+                const cJSON *x = cJSON_GetArrayItem(p, k);
+                if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble)) return false;
+                m->px[i][k] = x->valuedouble;
+            }
+        }
+    }
+    double d = NAN, ds = NAN;
+    if (!get_num(o, "measured_distance_m", &d) || !get_num(o, "measured_sigma_m", &ds) ||
+        !get_vec(o, "measured_planned", pl, 3, &hp) ||
+        !get_str(o, "measured_planned_node", m->planned_node, sizeof m->planned_node, false))
+        return false;
+    if (isfinite(d)) {
+        if (!(d >= 0) || !(ds >= 0) || !hp) return false;
+        m->has_distance = true;
+        m->distance_m = d;
+        m->distance_sigma_m = ds;
+        m->planned = mr_v3(pl[0], pl[1], pl[2]);
+    }
+    return true;
+}
+
 cJSON *mr_annotation_to_json(const mr_annotation *a) {
     cJSON *line = cJSON_CreateObject();
     if (!line) return NULL;
@@ -99,6 +170,7 @@ cJSON *mr_annotation_to_json(const mr_annotation *a) {
     /* Absent, not null, when unknown: the exports read it as optional. */
     if (a->has_uncertainty && isfinite(a->uncertainty_m) && a->uncertainty_m >= 0)
         cJSON_AddNumberToObject(line, "uncertainty_m", a->uncertainty_m);
+    if (a->has_measurement) measurement_json(line, &a->measurement);
     return line;
 }
 
@@ -155,7 +227,7 @@ static bool parse_annotation(const cJSON *o, mr_annotation *a) {
         a->has_uncertainty = true;
         a->uncertainty_m = u->valuedouble;
     }
-    return true;
+    return parse_measurement(o, a);
 }
 
 typedef struct ann_ctx { mr_annotations *a; int cap; bool oom; } ann_ctx;

@@ -216,6 +216,8 @@ typedef struct mr_annotation {
     bool has_uncertainty;           /* "uncertainty_m" present */
     double uncertainty_m;           /* the registration's 1-σ at world (3D,
                                        scene units taken as metres) */
+    bool has_measurement;           /* issue 15: "measured_point" present */
+    mr_measurement measurement;     /* the view's Measure (measured_* fields) */
     cJSON *json;                    /* the whole line (owned); NULL for one
                                        not read from a file */
 } mr_annotation;
@@ -225,7 +227,13 @@ typedef struct mr_annotation {
  * timestamp, note, pixel, hit, world (null when no hit), depth (hit only),
  * node (null when none; then node_index and layer), pose {valid,
  * world_from_camera, tags_seen, rms_px}, uncertainty_m (only when
- * has_uncertainty; older lines have none). The caller may add fields (the
+ * has_uncertainty; older lines have none), and with has_measurement
+ * (issue 15, the view's Measure) measured_point [x,y,z], measured_covariance
+ * (9, row-major), measured_point_sigma_m, measured_angle_deg,
+ * measured_rms_px, measured_frames [..], measured_pixels [[u,v]..] and,
+ * when it has a distance, measured_distance_m, measured_sigma_m (the
+ * distance's 1-sigma), measured_planned [x,y,z], measured_planned_node.
+ * The caller may add fields (the
  * view adds "snapshot") before mr_annotation_append. NULL when out of
  * memory. */
 cJSON *mr_annotation_to_json(const mr_annotation *a);
@@ -241,7 +249,7 @@ typedef struct mr_annotations {
  * counted and skipped; a line is garbage if it is not a JSON object with a
  * non-empty string "type", or if a present field has the wrong shape (non-finite
  * numbers, pixel not [x,y], world not [x,y,z] or null, a non-rigid pose,
- * uncertainty_m not a number >= 0).
+ * uncertainty_m not a number >= 0, measured_* fields of the wrong shape).
  * Fails only when out of memory. mr_annotations_load: a missing file is
  * zero annotations. */
 bool mr_annotations_parse(const char *text, size_t size, mr_annotations *out, mr_error *err);

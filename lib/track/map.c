@@ -449,6 +449,18 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
         mr_fail(err, MR_ERR_INVALID, "map: no tag seen in any of the %d photos", photo_count);
         goto done;
     }
+    {
+        /* One photo is one view: no tag pose is checked by a second one,
+         * and a map of it is what a single PnP gives (issue 15: refused). */
+        int seeing = 0;
+        for (int j = 0; j < photo_count; j++) seeing += photos[j].count > 0;
+        if (seeing < 2) {
+            mr_fail(err, MR_ERR_INVALID,
+                    "map: only 1 of the %d photos sees a tag; a map needs two or more photos of the tags, taken from "
+                    "different places", photo_count);
+            goto done;
+        }
+    }
     all_ids = malloc((size_t)nall * sizeof *all_ids);
     if (!all_ids) goto nomem;
     {
@@ -892,7 +904,7 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
                 if (p->control_count == 0 || nused < 4) break;
                 /* Leave one out: each used control's prediction by the others. */
                 int worst = -1;
-                double worst_s = 0, lim = p->outlier_sigma > 0 ? p->outlier_sigma : 5.0;
+                double worst_s = 0, worst_rest = INFINITY, lim = p->outlier_sigma > 0 ? p->outlier_sigma : 5.0;
                 for (int q = 0, done_n = 0; q < p->control_count; q++) {
                     if (!ctl_use[q]) continue;
                     progress(p, "leave-one-out", (double)done_n++ / nused);
@@ -925,7 +937,22 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
                     double sig = sqrt(3 * p->controls[q].sigma * p->controls[q].sigma + (isfinite(tr) ? tr : 0));
                     cr->loo_sigma =
                         sqrt(cr->loo[0] * cr->loo[0] + cr->loo[1] * cr->loo[1] + cr->loo[2] * cr->loo[2]) / sig;
-                    if (cr->loo_sigma > lim && cr->loo_sigma > worst_s) worst = q, worst_s = cr->loo_sigma;
+                    /* How well the others agree in the solve without q:
+                     * one bad point bends the map towards itself, so with
+                     * few points a good one can look as far off as the bad
+                     * one (4 points, one 30 cm off: the good one named
+                     * before); the one whose leaving makes the rest agree
+                     * is the outlier. */
+                    double rest = 0;
+                    for (int q2 = 0; q2 < p->control_count; q2++) {
+                        if (!ctl_use[q2] || q2 == q) continue;
+                        mr_dvec3 p2 = mr_m4_point(&wft_loo[tag_of[ctl_tag[q2]]],
+                                                  tag_point(c.size[ctl_tag[q2]], p->controls[q2].corner));
+                        mr_dvec3 d2 = mr_v3_sub(p2, p->controls[q2].world);
+                        rest += mr_v3_dot(d2, d2) / (p->controls[q2].sigma * p->controls[q2].sigma);
+                    }
+                    if (cr->loo_sigma > lim && (worst < 0 || rest < worst_rest))
+                        worst = q, worst_s = cr->loo_sigma, worst_rest = rest;
                 }
                 if (worst < 0) break;
                 /* The worst outlier leaves the gauge; the rest are judged

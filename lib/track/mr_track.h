@@ -353,6 +353,21 @@ bool mr_triangulate(const mr_camera *cam, const mr_tap *taps, int n, const mr_tr
  * sqrt(trace / 3)). */
 void mr_triangulation_distance(const mr_triangulation *t, mr_dvec3 planned, double *dist, double *sigma);
 
+/* A measurement as the view's Measure keeps it and a mark carries it
+ * (issue 15): the taps, the triangulated point, and its distance to the
+ * plan (the nearest point of the planned model, or a picked planned point). */
+#define MR_MEASURE_MAX_TAPS 16
+typedef struct mr_measurement {
+    int taps;
+    int64_t frames[MR_MEASURE_MAX_TAPS];   /* frame index of each tap */
+    double px[MR_MEASURE_MAX_TAPS][2];     /* each tap, camera pixels */
+    mr_triangulation tri;                  /* point, covariance, sigma, angle, rms */
+    bool has_distance;
+    double distance_m, distance_sigma_m;   /* to `planned`, scene units taken as metres, 1-sigma */
+    mr_dvec3 planned;                      /* the planned point it was measured to */
+    char planned_node[96];                 /* that point's node, "" unknown */
+} mr_measurement;
+
 /* ---------------------------------------------------------------- filter */
 
 typedef struct mr_filter_params {

@@ -16,6 +16,7 @@ const mr_view_key_help mr_view_keymap[] = {
     {"m", "mark mode: tap the scene, then pick a note"},
     {"Enter", "in mark mode: mark the image centre"},
     {"1..6", "choose a note / Esc cancels"},
+    {"d", "measure: tap one feature in 2+ frames, d again to finish"},
     {"v", "video on/off"},
     {"h", "hidden layer on/off"},
     {"a", "next ambient occlusion method"},
@@ -34,6 +35,7 @@ const int mr_view_keymap_count = (int)(sizeof mr_view_keymap / sizeof mr_view_ke
 static const char *const k_widget_names[MR_VW_COUNT] = {
     "alpha", "play", "back", "forward", "rate", "seek", "freeze", "snapshot", "mark", "video", "hidden", "ao",
     "ghost", "help", "note1", "note2", "note3", "note4", "note5", "note6", "cancel",
+    "measure", /* issue 15 */
 };
 
 const char *mr_view_widget_name(mr_view_widget_id id) {
@@ -41,6 +43,14 @@ const char *mr_view_widget_name(mr_view_widget_id id) {
 }
 
 /* ---------------------------------------------------------------- layout */
+
+/* The column's i-th widget in priority order: Measure (issue 15) right
+ * after Mark, then the rest as they are numbered. */
+static mr_view_widget_id column_widget(int i) {
+    const int after_mark = MR_VW_MARK - MR_VW_FREEZE + 1;
+    return i < after_mark ? (mr_view_widget_id)(MR_VW_FREEZE + i)
+           : i == after_mark ? MR_VW_MEASURE : (mr_view_widget_id)(MR_VW_FREEZE + i - 1);
+}
 
 /* Shows a widget only when it keeps its full touch target inside the
  * window; a smaller one would be a target nobody can hit. */
@@ -92,7 +102,7 @@ void mr_view_layout_compute(const mr_ui *ui, const mr_view_layout_params *p, mr_
      * more columns when the window is short; what fits in neither is left
      * out from the end (help first). */
     float colw = fmaxf(T * 2.4f, mr_ui_text_width(font, "AO alchemy", th) + 3 * g);
-    const int n = MR_VW_HELP - MR_VW_FREEZE + 1;
+    const int n = MR_VW_HELP - MR_VW_FREEZE + 1 + 1 /* Measure */;
     int per_col = (int)((full.h - g) / (T + g));
     int max_cols = (int)((full.w - g) / (colw + g));
     if (per_col < 0) per_col = 0;
@@ -112,7 +122,7 @@ void mr_view_layout_compute(const mr_ui *ui, const mr_view_layout_params *p, mr_
         int c = i / per_col, r = i % per_col;
         mr_ui_rect b = mr_ui_rect_make(L->column.x + L->column.w - (c + 1) * (colw + g), L->column.y + g + r * (T + g),
                                        colw, T);
-        place(L, (mr_view_widget_id)(MR_VW_FREEZE + i), b, T, p);
+        place(L, column_widget(i), b, T, p);
     }
 
     /* The note chooser, over the picture on the side away from the mark
@@ -342,9 +352,14 @@ static void on_key(mr_viewer *v, int k, mr_view_actions *out) {
     case MR_KEY_DOWN: case '-': set_alpha(v, roundf(v->s.alpha * 10 - 1) / 10, out); break;
     case 'f': set_frozen(v, !v->frozen, out); break;
     case 's': vw_emit(out, MR_VA_SNAPSHOT); break;
-    case 'm': v->mark_mode = !v->mark_mode; break;
+    case 'm':
+        vw_measure_cancel(v);
+        v->mark_mode = !v->mark_mode;
+        break;
+    case 'd': vw_measure_toggle(v, out); break;
     case MR_KEY_ENTER:
-        if (v->mark_mode) mark_at(v, ir.x + ir.w * 0.5, ir.y + ir.h * 0.5, out);
+        if (v->measure_mode) vw_measure_toggle(v, out);
+        else if (v->mark_mode) mark_at(v, ir.x + ir.w * 0.5, ir.y + ir.h * 0.5, out);
         break;
     case 'v': v->s.show_video = !v->s.show_video; changed(v, out); break;
     case 'h': v->s.hide_hidden = !v->s.hide_hidden; changed(v, out); break;
@@ -359,7 +374,8 @@ static void on_key(mr_viewer *v, int k, mr_view_actions *out) {
     case ']': set_rate(v, v->s.rate_i + 1, out); break;
     case MR_KEY_F11: vw_emit(out, MR_VA_FULLSCREEN); break;
     case MR_KEY_ESCAPE:
-        if (v->mark_mode) v->mark_mode = false;
+        if (v->measure_mode) vw_measure_cancel(v);
+        else if (v->mark_mode) v->mark_mode = false;
         else vw_emit(out, MR_VA_QUIT);
         break;
     case 'q': vw_emit(out, MR_VA_QUIT); break;
@@ -503,7 +519,12 @@ static void column(mr_viewer *v, mr_view_actions *out) {
     if (v->lay.column.w > 0) mr_ui_panel(v->ui, v->lay.column);
     if (button(v, MR_VW_FREEZE, v->frozen ? "Frozen" : "Freeze", v->frozen)) set_frozen(v, !v->frozen, out);
     if (button(v, MR_VW_SNAPSHOT, "Snapshot", false)) vw_emit(out, MR_VA_SNAPSHOT);
-    if (button(v, MR_VW_MARK, "Mark", v->mark_mode)) v->mark_mode = !v->mark_mode;
+    if (button(v, MR_VW_MARK, "Mark", v->mark_mode)) {
+        vw_measure_cancel(v);
+        v->mark_mode = !v->mark_mode;
+    }
+    /* issue 15: Measure (measure.c) */
+    if (button(v, MR_VW_MEASURE, v->measure_mode ? "Finish" : "Measure", v->measure_mode)) vw_measure_toggle(v, out);
     if (button(v, MR_VW_VIDEO, "Video", v->s.show_video)) {
         v->s.show_video = !v->s.show_video;
         changed(v, out);
@@ -522,8 +543,9 @@ static void messages(mr_viewer *v, const mr_viewer_frame *f) {
     mr_ui *ui = v->ui;
     float g = mr_ui_mm(ui, 1.2f), th = mr_ui_text_px(ui);
     mr_ui_rect area = v->lay.picture;
-    const char *banners[4];
-    uint32_t colors[4];
+    const char *banners[5];
+    uint32_t colors[5];
+    char measure_banner[160];
     int nb = 0;
     if (f->source_msg && f->source_msg[0]) { banners[nb] = f->source_msg; colors[nb++] = MR_UI_RGBA(200, 40, 40, 230); }
     if (f->scene_msg && f->scene_msg[0]) { banners[nb] = f->scene_msg; colors[nb++] = MR_UI_RGBA(200, 40, 40, 230); }
@@ -537,6 +559,11 @@ static void messages(mr_viewer *v, const mr_viewer_frame *f) {
     if (v->mark_mode && !v->note_open) {
         banners[nb] = "MARK: tap the discrepancy in the picture (Esc cancels)";
         colors[nb++] = MR_UI_RGBA(214, 120, 28, 230);
+    }
+    if (v->measure_mode) { /* issue 15 */
+        vw_measure_banner(v, measure_banner, sizeof measure_banner);
+        banners[nb] = measure_banner;
+        colors[nb++] = MR_UI_RGBA(30, 120, 190, 230);
     }
     for (int i = 0; i < nb; i++) {
         mr_ui_rect b = mr_ui_rect_inset(mr_ui_cut_top(&area, th * 2.0f), g * 0.5f);
@@ -613,12 +640,14 @@ const mr_ui_draw_list *mr_viewer_ui(mr_viewer *v, const mr_viewer_frame *f, mr_v
     column(v, out);
     messages(v, f);
     if (v->note_open) notes(v, f, out);
+    vw_measure_draw(v, f); /* issue 15 */
     if (v->help) help_panel(v);
     float tx, ty;
     const mr_ui_draw_list *dl = mr_ui_end(v->ui);
     if (mr_ui_scene_tap(v->ui, &tx, &ty)) {
         if (v->help) v->help = false;
         else if (v->mark_mode && !v->note_open) mark_at(v, tx, ty, out);
+        else if (v->measure_mode && !v->note_open) vw_measure_tap(v, f, tx, ty);
     }
     v->frames++;
     /* Settings are saved a moment after they change, not per slider step. */
@@ -652,6 +681,7 @@ cJSON *mr_viewer_state_json(const mr_viewer *v) {
     else cJSON_AddNullToObject(j, "sigma_here_mm");
     static const char *const k_sigma_states[] = {"unknown", "ok", "warn", "bad"};
     cJSON_AddStringToObject(j, "sigma_state", k_sigma_states[mr_view_sigma_classify(v->sigma_known, v->sigma_m)]);
+    vw_measure_state_json(v, j); /* issue 15 */
     cJSON_AddNumberToObject(j, "px_per_mm", mr_ui_px_per_mm(v->ui));
     cJSON_AddNumberToObject(j, "target_px", mr_ui_target_px(v->ui));
     /* Where each widget is (framebuffer pixels x y w h), for tests that

@@ -74,6 +74,7 @@ typedef enum mr_view_widget_id {
     MR_VW_ALPHA = 0, MR_VW_PLAY, MR_VW_BACK, MR_VW_FORWARD, MR_VW_RATE, MR_VW_SEEK,
     MR_VW_FREEZE, MR_VW_SNAPSHOT, MR_VW_MARK, MR_VW_VIDEO, MR_VW_HIDDEN, MR_VW_AO, MR_VW_GHOST, MR_VW_HELP,
     MR_VW_NOTE1, MR_VW_NOTE6 = MR_VW_NOTE1 + MR_VIEW_NOTE_COUNT - 1, MR_VW_CANCEL,
+    MR_VW_MEASURE,        /* issue 15: Measure; in the column right after Mark */
     MR_VW_COUNT
 } mr_view_widget_id;
 
@@ -137,6 +138,9 @@ typedef enum mr_view_action_type {
     MR_VA_SHOT,           /* path: save this frame's screen as PNG (scripts) */
     MR_VA_STATE,          /* path: write a state snapshot JSON (scripts) */
     MR_VA_QUIT,
+    MR_VA_MEASURE_DONE,   /* issue 15: a measurement is finished (mr_viewer_measurement);
+                             measure it against the plan, answer with
+                             mr_viewer_measure_distance, and mark it */
 } mr_view_action_type;
 
 typedef struct mr_view_action {
@@ -197,6 +201,10 @@ typedef struct mr_viewer_frame {
     double corner_sigma_px;
     bool have_point;
     mr_dvec3 point;            /* world, scene units */
+    /* issue 15, Measure: the picture's camera (intrinsics at the frame's
+     * image size; the picture is shown undistorted, so its distortion is
+     * not used); NULL: taps cannot be measured */
+    const mr_camera *camera;
 } mr_viewer_frame;
 
 /* "± N mm here": the registration's 1-σ at f->point (3D, scene units taken
@@ -256,6 +264,26 @@ const char *mr_viewer_status_text(const mr_viewer *v);
 /* The controller's part of a `state` snapshot (settings, modes, widgets,
  * "sigma_here_mm" (null: unknown) and "sigma_state"). */
 cJSON *mr_viewer_state_json(const mr_viewer *v);
+
+/* ------------------------------------------------ Measure (issue 15) */
+
+/* The Measure button (key d): the planner taps the same real feature in
+ * two or more frames (replay or live); each tap keeps its frame's pose and
+ * pose covariance, and a second tap in one frame replaces the first. From
+ * two taps on, the point is triangulated (mr_triangulate with the default
+ * tap noise: refused, with the baseline angle, when the taps came from
+ * nearly one pose) and its sigma shown. Measure (or Enter) again finishes a
+ * solved measurement with MR_VA_MEASURE_DONE; Esc, or Measure before a
+ * solution, cancels. A tap needs a tracked pose and f->camera. */
+typedef struct mr_measurement mr_measurement; /* mr_track.h */
+bool mr_viewer_measuring(const mr_viewer *v);
+/* The measurement being made or the last one finished (taps, point,
+ * covariance, and the distance once given); false when there is none. */
+bool mr_viewer_measurement(const mr_viewer *v, mr_measurement *out);
+/* The answer to MR_VA_MEASURE_DONE: the distance (scene units taken as
+ * metres) and its 1-sigma to `planned` (on node `node`, may be NULL),
+ * shown to the planner and kept in the measurement. */
+void mr_viewer_measure_distance(mr_viewer *v, mr_dvec3 planned, double dist_m, double sigma_m, const char *node);
 
 /* ---------------------------------------------------------------- script */
 

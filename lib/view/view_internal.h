@@ -4,6 +4,7 @@
 #define MR_VIEW_INTERNAL_H
 
 #include "mr_view.h"
+#include "mr_track.h"
 
 typedef enum script_op { S_TAP, S_DOWN, S_UP, S_MOVE, S_DRAG, S_KEY, S_RESIZE, S_SHOT, S_STATE, S_QUIT } script_op;
 
@@ -54,10 +55,28 @@ struct mr_viewer {
     double script_t0;
     int64_t script_frame;
     bool script_started;
+    /* issue 15: Measure (measure.c) */
+    bool measure_mode;           /* collecting taps */
+    bool measure_have;           /* a measurement exists (being made or finished) */
+    bool measure_solved;         /* its taps triangulate */
+    mr_measurement measure;
+    mr_dmat4 measure_pose[MR_MEASURE_MAX_TAPS];
+    double measure_cov[MR_MEASURE_MAX_TAPS][36];
+    bool measure_has_cov[MR_MEASURE_MAX_TAPS];
+    char measure_msg[200];       /* its last message (also toasted) */
 };
 
 mr_view_action *vw_emit(mr_view_actions *out, mr_view_action_type t);
 /* Runs the script commands that are due (before the queued input is taken). */
 void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out);
+/* issue 15, Measure (measure.c): the button / key (start, finish or cancel),
+ * Esc, a tap on the picture, the banner text, the tap's cross, the state
+ * snapshot's part. */
+void vw_measure_toggle(mr_viewer *v, mr_view_actions *out);
+void vw_measure_cancel(mr_viewer *v);
+void vw_measure_tap(mr_viewer *v, const mr_viewer_frame *f, float x, float y);
+void vw_measure_banner(const mr_viewer *v, char *buf, size_t n);
+void vw_measure_draw(mr_viewer *v, const mr_viewer_frame *f); /* a cross at this frame's tap */
+void vw_measure_state_json(const mr_viewer *v, cJSON *j);
 
 #endif
