@@ -333,6 +333,7 @@ static void test_tables(void) {
         N(mr_ao_params, "thickness", thickness, 1e-3, 100), /* issue 18 */
         N(mr_ao_params, "temporal", temporal, 0, 1),
         E(mr_ao_params, "noise", noise, "pixel world"),
+        N(mr_ao_params, "mips", mips, 0, 1), /* issue 18 (lane ao) */
     };
     /* multi-view rig (no prefix) */
     const mr_rig_params rg = MR_RIG_DEFAULTS;
