@@ -36,11 +36,15 @@ layout(location = MR_LOC_AO_NOISE_CELL) uniform float u_noise_cell; // grid cell
 layout(location = MR_LOC_AO_NOISE_FRAME) uniform mat4 u_noise_frame; // anchor_from_camera
 
 layout(location = MR_LOC_AO_DISPLAY) uniform vec3 u_display;       // D, E, width; D = 0: pinhole
+// issue 18 (lane ao): the slice methods' depth mip chain
+layout(location = MR_LOC_AO_MIPS) uniform int u_mips;              // levels above 0; 0 = off (level 0 only)
+layout(location = MR_LOC_AO_MIP_NEAR) uniform float u_mip_near;    // samples nearer than this (px) read level 0
 
 layout(binding = MR_TEX_AO_DEPTH) uniform sampler2D u_depth;
 layout(binding = MR_TEX_AO_NORMAL) uniform sampler2D u_normal;
 layout(binding = MR_TEX_AO_POSITIONS) uniform sampler2D u_pos;
 layout(binding = MR_TEX_AO_MASK) uniform sampler2D u_mask;
+layout(binding = MR_TEX_AO_DEPTH_MIP) uniform sampler2D u_depth_mip; // reversed-Z depth, box-filtered levels
 
 layout(location = 0) out float o_ao;
 
@@ -53,6 +57,7 @@ layout(location = 0) out float o_ao;
 #define M_GTAO MR_AO_METHOD_ID_GTAO
 #define M_BITMASK MR_AO_METHOD_ID_BITMASK
 #define M_SCHEER_GT MR_AO_METHOD_ID_SCHEER_GT
+#define M_SCHEER_BM MR_AO_METHOD_ID_SCHEER_BM
 
 bool fetch_pos(ivec2 q, out vec3 p) {
     return ao_view_pos(u_depth, u_pos, u_use_pos != 0, u_near, u_intr, q, p);
@@ -266,7 +271,17 @@ bool slice_sample(vec2 px, vec2 d, int side, int j, float jitter, float rpx, out
     vec2 uv = px + (side == 0 ? d : -d) * off;
     if (!(uv.x > -0.5 && uv.y > -0.5 && uv.x < float(u_full.x) - 0.5 && uv.y < float(u_full.y) - 0.5)) return false;
     if (u_use_pos != 0) return fetch_pos(ivec2(floor(uv + 0.5)), S);
-    float dz = textureLod(u_depth, (uv + 0.5) / vec2(u_full), 0.0).r;
+    float dz;
+    // issue 18: a far sample reads a coarser level of the depth chain, one
+    // whose texels (2^L pixels) stay below the spacing of the samples
+    // around it: level L for offsets in [near 2^(L-1), near 2^L). Nearer
+    // ones read the G-buffer itself, exactly as without the chain.
+    if (u_mips > 0 && off >= u_mip_near) {
+        float lod = min(floor(log2(off / u_mip_near)) + 1.0, float(u_mips));
+        dz = textureLod(u_depth_mip, (uv + 0.5) / vec2(u_full), lod).r;
+    } else {
+        dz = textureLod(u_depth, (uv + 0.5) / vec2(u_full), 0.0).r;
+    }
     if (!(dz > 0.0)) return false;
     float z = u_near / dz;
     if (isinf(z) || isnan(z)) return false;
@@ -408,6 +423,52 @@ float occ_scheer_gt(vec3 P, vec3 n, float r, vec3 rnd, vec2 px) {
     return total > 0.0 ? occ / total : 0.0;
 }
 
+// scheer-bm (issue 18, lane ao): Scheer & Keutel's quasi-normalised
+// attenuation inside the visibility bitmask's sector weights. The samples
+// of a slice side march outwards; each marks the sectors between its front
+// face and `thickness * r` behind it like the bitmask, but only the sectors
+// no nearer sample has claimed count, and they count with that sample's
+// 1/(1 + c l^2), l = |v| / r. A near occluder darkens fully, one at the
+// radius by 1/(1+c); with c = 0 it is the bitmask exactly. With the
+// depth-scaled radius the whole estimate is scale-free (l, the sectors
+// and the thickness are all in units of r).
+float occ_scheer_bm(vec3 P, vec3 n, float r, vec3 rnd, vec2 px) {
+    float rpx = r * u_intr.x / P.z;
+    if (!(rpx >= 1.0)) return 0.0;
+    rpx = min(rpx, float(max(u_full.x, u_full.y)));
+    float a = rnd.x * AO_PI / float(u_slice_count);
+    vec2 rot = vec2(cos(a), sin(a));
+    float th = u_thickness * r;
+    float occ = 0.0, total = 0.0;
+    for (int i = 0; i < u_slice_count; i++) {
+        ao_slice sl = make_slice(P, n, slice_dir(i, rot));
+        float a0 = slice_arc(sl.g - AO_HALF_PI, sl.g), mass = slice_arc(sl.g + AO_HALF_PI, sl.g) - a0;
+        if (!(mass > 1e-6)) continue;
+        float inv_mass = 1.0 / mass;
+        uint bits = 0u;
+        float occw = 0.0;                            // attenuated count of claimed sectors
+        for (int j = 0; j < u_steps; j++)
+            for (int side = 0; side < 2; side++) {
+                vec3 S;
+                if (!slice_sample(px, sl.d, side, j, rnd.y, rpx, S)) continue;
+                vec3 v = S - P;
+                float l = length(v);
+                if (!(l > 0.0) || !(l <= r)) continue;
+                vec3 vb = S + normalize(S) * th - P;
+                float tf = acos(clamp(dot(v, sl.V) / l, -1.0, 1.0));
+                float tb = acos(clamp(dot(vb, sl.V) / max(length(vb), 1e-30), -1.0, 1.0));
+                float sg = side == 0 ? 1.0 : -1.0;
+                uint nb = sector_bits(min(sg * tf, sg * tb), max(sg * tf, sg * tb), sl.g, a0, inv_mass) & ~bits;
+                float ln = l / r;
+                occw += float(bitCount(nb)) / (1.0 + u_c * ln * ln);
+                bits |= nb;
+            }
+        occ += sl.nl * mass * occw / 32.0;
+        total += sl.nl * mass;
+    }
+    return total > 0.0 ? occ / total : 0.0;
+}
+
 void main() {
     ivec2 ap = ivec2(gl_FragCoord.xy);
     ivec2 fp = ap * u_step;
@@ -453,6 +514,7 @@ void main() {
         else if (u_method == M_GTAO) o = occ_gtao(P, n, r, rnd, vec2(fp));
         else if (u_method == M_BITMASK) o = occ_bitmask(P, n, r, rnd, vec2(fp));
         else if (u_method == M_SCHEER_GT) o = occ_scheer_gt(P, n, r, rnd, vec2(fp));
+        else if (u_method == M_SCHEER_BM) o = occ_scheer_bm(P, n, r, rnd, vec2(fp));
         occ = max(occ, o);                           // multi-radius: the darkest radius wins
     }
     float ao = 1.0 - u_strength * occ;

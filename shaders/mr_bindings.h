@@ -99,6 +99,11 @@
 #define MR_LOC_AO_NOISE_CELL               (MR_LOC_AO_NOISE + 1)
 #define MR_LOC_AO_NOISE_FRAME              (MR_LOC_AO_NOISE + 2) /* mat4: 4 locations */
 #define MR_LOC_AO_DISPLAY                  (MR_LOC_AO_NOISE + 6) /* vec3 D, E, width: light-field mapping */
+/* issue 18 (lane ao): the depth mip chain of the slice methods' far samples */
+#define MR_LOC_AO_MIPS                     (MR_LOC_AO_DISPLAY + 1) /* int: levels above 0 in the chain, 0 = off */
+#define MR_LOC_AO_MIP_NEAR                 (MR_LOC_AO_DISPLAY + 2) /* float: offset (px) below which level 0 is read */
+#define MR_TEX_AO_DEPTH_MIP                5  /* ao_main: reversed-Z depth, R32F, box-filtered levels */
+#define MR_TEX_AO_MIP_SRC                  0  /* ao_depth_mip: the G-buffer's depth */
 
 /* ao_outline */
 #define MR_LOC_OUTLINE_RADIUS_MODE         3
@@ -297,6 +302,7 @@
 #define MR_AO_METHOD_ID_GTAO               6
 #define MR_AO_METHOD_ID_BITMASK            7
 #define MR_AO_METHOD_ID_SCHEER_GT          8
+#define MR_AO_METHOD_ID_SCHEER_BM          9 /* issue 18 (lane ao) */
 #define MR_AO_METHOD_MASK_STANDALONE       100
 
 #endif

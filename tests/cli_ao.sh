@@ -14,7 +14,7 @@ demo_or_exit cli_ao "$mr" "$tmp/demo"
 d=$tmp/demo
 r() { "$mr" render --scene "$d/scene_planned.json" --view "$d/views/view_001.json" --size 96x72 "$@"; }
 
-for m in scheer crytek filion hbao alchemy gtao bitmask scheer-gt; do
+for m in scheer crytek filion hbao alchemy gtao bitmask scheer-gt scheer-bm; do
   rm -rf "$tmp/aux_$m"
   if r --out "$tmp/$m.png" --ao "$m" --ao-samples 8 --aux "$tmp/aux_$m" --verbose 2>"$tmp/$m.err"; then
     [ -s "$tmp/aux_$m/ao.pfm" ] && ok || bad "--ao $m wrote no ao.pfm"
@@ -23,6 +23,8 @@ for m in scheer crytek filion hbao alchemy gtao bitmask scheer-gt; do
     bad "--ao $m failed: $(cat "$tmp/$m.err")"
   fi
 done
+# issue 18 (lane ao): the depth mip chain of the slice methods is an option.
+r --out "$tmp/mips.png" --ao scheer-bm --ao-mips --ao-samples 8 2>"$tmp/mips.err" && ok || bad "--ao-mips failed: $(cat "$tmp/mips.err")"
 # No AO pass when AO is off; ao.pfm is then all ones (still written).
 if r --out "$tmp/none.png" --ao none --aux "$tmp/aux_none" --verbose 2>"$tmp/none.err"; then
   grep -q "passes: gbuffer shade;" "$tmp/none.err" && ok || bad "--ao none ran AO: $(cat "$tmp/none.err")"

@@ -415,8 +415,10 @@ static void test_scale_invariance(void) {
     const double scales[] = {1, 1e-3, 1e4, 1};
     const mr_dvec3 offs[] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {1e7, 0, -1e7}};
     /* Every depth-scaled method: scheer, and (issue 18) the slice integrators. */
-    const mr_ao_method methods[] = {MR_AO_SCHEER, MR_AO_GTAO, MR_AO_BITMASK, MR_AO_SCHEER_GT};
+    /* issue 18 (lane ao): scheer-bm, and the slice methods with the depth mip chain */
+    const mr_ao_method methods[] = {MR_AO_SCHEER, MR_AO_GTAO, MR_AO_BITMASK, MR_AO_SCHEER_GT, MR_AO_SCHEER_BM};
     for (size_t mi = 0; mi < sizeof methods / sizeof methods[0]; mi++)
+    for (int mips = 0; mips < (methods[mi] == MR_AO_SCHEER ? 1 : 2); mips++)
     for (int half = 0; half < 2; half++) {
         mr_image ref = {0};
         for (int i = 0; i < 4; i++) {
@@ -425,6 +427,8 @@ static void test_scale_invariance(void) {
             mr_ao_params ao = MR_AO_DEFAULTS;
             ao.method = methods[mi];
             ao.half_res = half;
+            ao.mips = mips;
+            ao.screen_radius = mips ? 0.15 : ao.screen_radius; /* 19 px at 128x96: levels 1 and 2 are read */
             mr_frame_result res;
             if (render_ao(s, &v, &ao, &res)) {
                 CHECK(count_bad(&res.ao) == 0);
@@ -436,8 +440,8 @@ static void test_scale_invariance(void) {
                     if (getenv("MR_TEST_VERBOSE"))
                         printf("%s%s scale %g offset %g: RMSE %.5f\n", mr_ao_method_name(methods[mi]), half ? " half-res" : "",
                                scales[i], offs[i].x, e);
-                    CHECK_MSG(e < 0.01, "%s%s at scale %g offset %g: RMSE %.5f vs scale 1", mr_ao_method_name(methods[mi]),
-                              half ? " half-res" : "", scales[i], offs[i].x, e);
+                    CHECK_MSG(e < 0.01, "%s%s%s at scale %g offset %g: RMSE %.5f vs scale 1", mr_ao_method_name(methods[mi]),
+                              half ? " half-res" : "", mips ? " mips" : "", scales[i], offs[i].x, e);
                 }
                 mr_frame_result_free(&res);
             }
@@ -822,6 +826,8 @@ static void test_golden(void) {
         {"bitmask_view", MR_AO_BITMASK, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
         {"scheer_gt_screen", MR_AO_SCHEER_GT, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
         {"scheer_gt_view", MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, 0, false, 1, MR_AO_MASK_OFF, false},
+        /* issue 18 (lane ao) */
+        {"scheer_bm_screen", MR_AO_SCHEER_BM, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
     };
     mr_dvec3 o = mr_v3(0, 0, 0);
     mr_scene *s = corner_scene(1, o, true);
@@ -1208,29 +1214,140 @@ static void test_slice_wall(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
     mr_scene *s = corner_scene(1, o, true);
     mr_view v = corner_view(1, o, 160, 120);
-    const mr_ao_method ms[3] = {MR_AO_GTAO, MR_AO_BITMASK, MR_AO_SCHEER_GT};
-    for (int mi = 0; mi < 3; mi++)
-        for (int mode = 0; mode < 2; mode++) {
+    /* issue 18 (lane ao): scheer-bm with c = 0 (the bitmask's closed form),
+     * and every method again with the depth mip chain (12 px of radius:
+     * the samples beyond 8 px read level 1) */
+    const mr_ao_method ms[4] = {MR_AO_GTAO, MR_AO_BITMASK, MR_AO_SCHEER_GT, MR_AO_SCHEER_BM};
+    for (int mi = 0; mi < 4; mi++)
+        for (int mode = 0; mode < 4; mode++) {
+            bool mips = mode >= 2;
             mr_ao_params ao = MR_AO_DEFAULTS;
             ao.method = ms[mi];
-            ao.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
+            ao.radius_mode = mode % 2 ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
             ao.radius = 0.6;
             ao.screen_radius = 0.1;
             ao.samples = 64;
+            ao.mips = mips;
             ao.thickness = 2.0f; /* the wall is thick */
             ao.blur_radius = 0;  /* the bilateral blur mixes the wall's AO into the floor's */
             if (ms[mi] == MR_AO_SCHEER_GT) ao.c = 0, ao.bias = 0;
+            if (ms[mi] == MR_AO_SCHEER_BM) ao.c = 0;
             mr_frame_result res;
             if (!render_ao(s, &v, &ao, &res)) continue;
             int n = 0;
-            double e = wall_rmse(&v, &res, &res.ao, ao.radius, mode ? 0 : ao.screen_radius, &n);
+            double e = wall_rmse(&v, &res, &res.ao, ao.radius, mode % 2 ? 0 : ao.screen_radius, &n);
+            const char *mn = mode % 2 ? (mips ? "view mips" : "view") : (mips ? "screen mips" : "screen");
             if (getenv("MR_TEST_VERBOSE"))
-                printf("wall %s %s: RMSE %.4f over %d pixels\n", mr_ao_method_name(ao.method), mode ? "view" : "screen", e, n);
+                printf("wall %s %s: RMSE %.4f over %d pixels\n", mr_ao_method_name(ao.method), mn, e, n);
             CHECK_MSG(n > 100, "only %d floor pixels in front of the wall", n);
             CHECK_MSG(e < 0.025, "%s %s radius beside a wall: RMSE %.4f against the closed form", mr_ao_method_name(ao.method),
-                      mode ? "view" : "screen", e);
+                      mn, e);
             CHECK(count_bad(&res.ao) == 0);
             mr_frame_result_free(&res);
+        }
+    mr_scene_destroy(&s);
+    mr_renderer_set_scene(g_r, NULL, NULL);
+}
+
+/* issue 18 (lane ao): scheer-bm with c = 0 is the bitmask (the same
+ * sectors, each counted once with weight 1); with c > 0 a sector counts
+ * with its nearest sample's 1/(1 + c l^2) <= 1, so the AO is nowhere
+ * darker than the bitmask's and lighter on average, more so as c grows. */
+static double mean_geo(const mr_image *ao, const mr_image *depth) {
+    const float *a = ao->data, *d = depth->data;
+    double s = 0;
+    int n = 0;
+    for (int i = 0; i < ao->width * ao->height; i++)
+        if (d[i] > 0) s += a[i], n++;
+    return n ? s / n : 0;
+}
+
+static void test_scheer_bm(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    mr_view v = corner_view(1, o, 128, 96);
+    const float cs[3] = {0.0f, 1.0f, 4.0f};
+    mr_frame_result bm, r[3];
+    memset(&bm, 0, sizeof bm);
+    mr_ao_params ao = MR_AO_DEFAULTS;
+    ao.method = MR_AO_BITMASK;
+    ao.blur_radius = 0; /* per pixel */
+    ao.screen_radius = 0.15;
+    bool ok = render_ao(s, &v, &ao, &bm);
+    for (int k = 0; k < 3 && ok; k++) {
+        ao.method = MR_AO_SCHEER_BM;
+        ao.c = cs[k];
+        ok = render_ao(s, &v, &ao, &r[k]);
+        if (!ok) {
+            for (int j = 0; j < k; j++) mr_frame_result_free(&r[j]);
+        }
+    }
+    if (ok) {
+        const float *a = bm.ao.data, *b0 = r[0].ao.data, *b1 = r[1].ao.data;
+        double maxd = 0;
+        int darker = 0;
+        for (int i = 0; i < 128 * 96; i++) {
+            maxd = fmax(maxd, fabs((double)a[i] - b0[i]));
+            darker += b1[i] < a[i] - 1e-5f;
+        }
+        double m0 = mean_geo(&r[0].ao, &bm.depth), m1 = mean_geo(&r[1].ao, &bm.depth), m4 = mean_geo(&r[2].ao, &bm.depth);
+        if (getenv("MR_TEST_VERBOSE"))
+            printf("scheer-bm: c=0 vs bitmask max |d| %.2g; mean AO c=0 %.4f, c=1 %.4f, c=4 %.4f; %d pixels darker\n", maxd, m0,
+                   m1, m4, darker);
+        CHECK_MSG(maxd < 1e-5, "scheer-bm with c = 0 differs from the bitmask by up to %.3g", maxd);
+        CHECK_MSG(darker == 0, "scheer-bm with c = 1: %d pixels darker than the bitmask", darker);
+        CHECK_MSG(m1 > m0 + 0.002 && m4 > m1 + 0.002, "scheer-bm mean AO c=0 %.4f, c=1 %.4f, c=4 %.4f: not lighter with c", m0,
+                  m1, m4);
+        for (int k = 0; k < 3; k++) {
+            CHECK(count_bad(&r[k].ao) == 0);
+            mr_frame_result_free(&r[k]);
+        }
+    }
+    if (bm.ao.data || bm.depth.data) mr_frame_result_free(&bm);
+    mr_scene_destroy(&s);
+    mr_renderer_set_scene(g_r, NULL, NULL);
+}
+
+/* issue 18 (lane ao): the depth mip chain changes far samples only. With
+ * a projected radius below MR_AO_MIP_NEAR_PX (0.05 of 96 px = 4.8 px)
+ * every sample reads level 0 and the AO is the same bit for bit; with 29
+ * px the far samples read levels 1..2: the AO moves (the chain is read)
+ * but by little: its box filter of reversed-Z depth is exact on planes
+ * (the wall test holds with mips), and only the averages across the
+ * cube's depth edges differ (RMSE 0.030 gtao, 0.024 bitmask measured;
+ * bound 0.04). */
+static void test_mips(void) {
+    mr_dvec3 o = mr_v3(0, 0, 0);
+    mr_scene *s = corner_scene(1, o, true);
+    mr_view v = corner_view(1, o, 128, 96);
+    const mr_ao_method ms[4] = {MR_AO_GTAO, MR_AO_BITMASK, MR_AO_SCHEER_GT, MR_AO_SCHEER_BM};
+    for (int mi = 0; mi < 4; mi++)
+        for (int far = 0; far < 2; far++) {
+            mr_ao_params ao = MR_AO_DEFAULTS;
+            ao.method = ms[mi];
+            ao.blur_radius = 0;
+            ao.screen_radius = far ? 0.3 : 0.05;
+            mr_frame_result a, b;
+            if (!render_ao(s, &v, &ao, &a)) continue;
+            ao.mips = true;
+            if (!render_ao(s, &v, &ao, &b)) {
+                mr_frame_result_free(&a);
+                continue;
+            }
+            const float *x = a.ao.data, *y = b.ao.data;
+            double maxd = 0;
+            for (int i = 0; i < 128 * 96; i++) maxd = fmax(maxd, fabs((double)x[i] - y[i]));
+            double e = rmse(&a.ao, &b.ao);
+            if (getenv("MR_TEST_VERBOSE"))
+                printf("mips %s %s: max |d| %.3g, RMSE %.4f\n", mr_ao_method_name(ao.method), far ? "far" : "near", maxd, e);
+            if (!far) CHECK_MSG(maxd == 0, "%s: the mip chain changed near samples (max |d| %.3g)", mr_ao_method_name(ao.method), maxd);
+            else {
+                CHECK_MSG(maxd > 1e-4, "%s: far samples do not read the mip chain (max |d| %.3g)", mr_ao_method_name(ao.method), maxd);
+                CHECK_MSG(e < 0.04, "%s: the mip chain moved the AO by RMSE %.4f", mr_ao_method_name(ao.method), e);
+            }
+            CHECK(count_bad(&b.ao) == 0);
+            mr_frame_result_free(&a);
+            mr_frame_result_free(&b);
         }
     mr_scene_destroy(&s);
     mr_renderer_set_scene(g_r, NULL, NULL);
@@ -1417,6 +1534,8 @@ int main(void) {
         test_radii();
         test_slice_wall();
         test_temporal();
+        test_scheer_bm(); /* issue 18 (lane ao) */
+        test_mips();
     }
     mr_renderer_destroy(&g_r);
     mr_gpu_destroy(&g_gpu);

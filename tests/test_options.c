@@ -313,7 +313,7 @@ static void test_tables(void) {
 #define E(t, k, f, names) {k, offsetof(t, f), 0, 0, names}
 #define N(t, k, f, lo, hi) {k, offsetof(t, f), lo, hi, NULL}
     const expect ex_ao[] = {
-        E(mr_ao_params, "", method, "none scheer crytek filion hbao alchemy gtao bitmask scheer-gt"),
+        E(mr_ao_params, "", method, "none scheer crytek filion hbao alchemy gtao bitmask scheer-gt scheer-bm"),
         E(mr_ao_params, "radius-mode", radius_mode, "screen view"),
         N(mr_ao_params, "radius", radius, 1e-30, 1e30),
         N(mr_ao_params, "screen-radius", screen_radius, 1e-6, 10),
@@ -333,6 +333,7 @@ static void test_tables(void) {
         N(mr_ao_params, "thickness", thickness, 1e-3, 100), /* issue 18 */
         N(mr_ao_params, "temporal", temporal, 0, 1),
         E(mr_ao_params, "noise", noise, "pixel world"),
+        N(mr_ao_params, "mips", mips, 0, 1), /* issue 18 (lane ao) */
     };
     /* multi-view rig (no prefix) */
     const mr_rig_params rg = MR_RIG_DEFAULTS;
@@ -368,7 +369,7 @@ static void test_tables(void) {
         N(mr_view_settings, "alpha", alpha, 0, 1),
         N(mr_view_settings, "show_video", show_video, 0, 1),
         N(mr_view_settings, "hide_hidden_layer", hide_hidden, 0, 1),
-        E(mr_view_settings, "ao", ao, "none scheer crytek filion hbao alchemy gtao bitmask scheer-gt"),
+        E(mr_view_settings, "ao", ao, "none scheer crytek filion hbao alchemy gtao bitmask scheer-gt scheer-bm"),
         E(mr_view_settings, "ghost", ghost, "off alpha g0 adaptive"),
     };
     const expect ex_dt[] = {

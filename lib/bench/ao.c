@@ -31,6 +31,7 @@
 
 #define MAX_VIEWS MR_BENCH_AO_MAX_VIEWS
 enum { MAXC = 32, MAXS = 4 };
+enum { SEQ_METHODS = 3, SEQ_CFG = 4, COST_METHODS = 3 }; /* issue 18: the moving sequence, the cost steps */
 
 /* The methods raced. role: Scheer & Keutel's rendering it stands for, or
  * "-". radius: TUNE_RADIUS (tuned with the rest), REF_RADIUS (the
@@ -74,6 +75,11 @@ static const contender k_contenders[] = {
     {"scheer-gt@R", "D2", MR_AO_SCHEER_GT, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
     {"scheer-gt-view", "-", MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
     {"scheer-gt-view@R", "-", MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    /* issue 18 (lane ao): Scheer's attenuation in the bitmask's sector weights */
+    {"scheer-bm", "D2", MR_AO_SCHEER_BM, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
+    {"scheer-bm@R", "D2", MR_AO_SCHEER_BM, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
+    {"scheer-bm-view", "-", MR_AO_SCHEER_BM, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"scheer-bm-view@R", "-", MR_AO_SCHEER_BM, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
 };
 #define NC (int)(sizeof k_contenders / sizeof k_contenders[0])
 _Static_assert(NC <= MAXC, "MAXC bounds the contenders");
@@ -118,7 +124,12 @@ typedef struct ao_bench {
     /* issue 18: the moving sequence (step 6b) */
     int seq_frames;
     char seq_name[1100];
-    double seq_rmse[4][2], seq_ms[4]; /* config x {all frames, second half}, median ms */
+    double seq_rmse[SEQ_METHODS][SEQ_CFG][2], seq_ms[SEQ_METHODS][SEQ_CFG]; /* {all frames, second half}, median ms */
+    /* issue 18 (lane ao): the cost steps (step 6c): [method][full, +mips, half, half+mips] */
+    double cost_ratio[COST_METHODS][4], cost_sync[COST_METHODS][4], cost_floor[COST_METHODS][4], cost_rmse[COST_METHODS][4];
+    int cost_rounds;
+    char cost_view[256], loadavg[128];
+    double deint_full, deint_sub; /* the fetch floor of one full pass, of 16 deinterleaved sub-image passes */
 } ao_bench;
 
 /* Renders `frames` timed frames (plus one warm-up) and returns the median
@@ -322,12 +333,19 @@ static bool ao_tune(ao_bench *b, mr_error *err) {
                  cvals[] = {1, 0.25, 4};
     const int nr = quick ? 3 : 4, ns = quick ? 2 : 9, nb = quick ? 1 : 2;
     const double qs[] = {1, 3};
+    /* issue 18: the assumed thickness of the methods that use it (the
+     * first entry is the default) */
+    const double thick[] = {MR_AO_DEFAULT_THICKNESS, 0.25, 1, 2};
     const view_data *vd = &b->vd[0];
     mr_csv *tune = mr_csv_create(err);
     if (!tune) return false;
     mr_csv_comment(tune, "rmse_own_reference: RMSE on the tuning view against the reference of the method's radius mode");
+    char tc[400];
+    snprintf(tc, sizeof tc, "tuning view: '%s' (not reported); the lowest row of each contender is frozen for every reported view",
+             vd->name);
+    mr_csv_comment(tune, tc);
     mr_csv_header(tune, "contender,role,radius_policy,tuned,radius_mode,radius,screen_radius,strength,bias,c,kernel,r_min,r_max,"
-                        "rmse_own_reference");
+                        "rmse_own_reference,thickness");
     bool ok = true;
     for (int c = 0; ok && c < NC; c++) {
         contender *cs = &b->cs[c];
@@ -335,12 +353,15 @@ static bool ao_tune(ao_bench *b, mr_error *err) {
         bool paper = cs->radius == PAPER;
         /* The radius grid's first entry is the reference's own radius. */
         int na = cs->radius == TUNE_RADIUS ? nr : 1, nbb = paper ? 1 : ns, nk = paper ? 1 : nb,
-            ncv = (cs->method == MR_AO_SCHEER || cs->method == MR_AO_SCHEER_GT) && !paper ? 3 : 1;
+            ncv = (cs->method == MR_AO_SCHEER || cs->method == MR_AO_SCHEER_GT || cs->method == MR_AO_SCHEER_BM) && !paper ? 3 : 1,
+            nth = cs->method == MR_AO_GTAO || cs->method == MR_AO_BITMASK || cs->method == MR_AO_SCHEER_BM ? 4 : 1;
         for (int a = 0; ok && a < na; a++)
             for (int bi = 0; ok && bi < nbb; bi++)
                 for (int k = 0; ok && k < nk; k++)
-                    for (int cv = 0; ok && cv < ncv; cv++) {
+                    for (int cv = 0; ok && cv < ncv; cv++)
+                    for (int ti = 0; ok && ti < nth; ti++) {
                         mr_ao_params p = MR_AO_DEFAULTS;
+                        p.thickness = (float)thick[ti];
                         p.method = cs->method;
                         p.radius_mode = cs->mode;
                         p.radius = b->radius * rscale[a];
@@ -368,6 +389,7 @@ static bool ao_tune(ao_bench *b, mr_error *err) {
                         csv_contender(tune, cs);
                         csv_params(tune, &p);
                         mr_csv_num(tune, "%.5f", m.rmse);
+                        mr_csv_num(tune, "%g", p.thickness);
                         mr_csv_end_row(tune);
                         if (m.rmse < best) {
                             best = m.rmse;
@@ -375,8 +397,9 @@ static bool ao_tune(ao_bench *b, mr_error *err) {
                         }
                     }
         if (ok && b->p.verbose)
-            BENCH_PRINT(b->p.out, "  tuned %-14s radius %g screen %g strength %g bias %g c %g: RMSE %.4f\n", cs->label,
-                        cs->tuned.radius, cs->tuned.screen_radius, cs->tuned.strength, cs->tuned.bias, cs->tuned.c, best);
+            BENCH_PRINT(b->p.out, "  tuned %-14s radius %g screen %g strength %g bias %g c %g thickness %g: RMSE %.4f\n",
+                        cs->label, cs->tuned.radius, cs->tuned.screen_radius, cs->tuned.strength, cs->tuned.bias, cs->tuned.c,
+                        cs->tuned.thickness, best);
     }
     if (!ok) {
         mr_csv_destroy(&tune);
@@ -422,6 +445,7 @@ static bool ao_grid_view(ao_bench *b, int v, mr_csv *csv, mr_error *err) {
     mr_csv_int(csv, 0);
     mr_csv_text(csv, "");
     mr_csv_text(csv, "");
+    mr_csv_text(csv, ""); /* thickness */
     mr_csv_end_row(csv);
     b->pv_rf[v][0] = mf.rmse;
     b->pv_rs[v][0] = msr.rmse;
@@ -461,6 +485,7 @@ static bool ao_grid_view(ao_bench *b, int v, mr_csv *csv, mr_error *err) {
                     mr_csv_num(csv, "%.4f", sync);
                     mr_csv_num(csv, "%.4f", floor_ms);
                     mr_csv_num(csv, "%.3f", floor_ms > 0 ? sync / floor_ms : 0.0);
+                    mr_csv_num(csv, "%g", p.thickness);
                     mr_csv_end_row(csv);
                     b->agg_sync[c][si][res][mk] += sync / nv;
                     b->agg_floor[c][si][res][mk] += floor_ms / nv;
@@ -499,11 +524,16 @@ static bool ao_grid(ao_bench *b, mr_error *err) {
                         "parameters; strength <= 0: the method's default; *_fixed: against ray-traced AO with fixed R, *_screen: with "
                         "the depth-scaled R; sync_ms: the AO passes timed between glFinish (llvmpipe defers rasterisation past "
                         "a timer query); floor_ms: a full-screen pass of as many R32F fetches per AO pixel and nothing else, "
-                        "timed the same way right after the row; floor_ratio = sync_ms / floor_ms");
+                        "timed the same way right after the row; floor_ratio = sync_ms / floor_ms; thickness: the "
+                        "bitmask / gtao / scheer-bm occluder thickness (fraction of the radius)");
+    char tc[400];
+    snprintf(tc, sizeof tc, "parameters tuned on the tuning view '%s' (not reported, bench_ao_tuning.csv) and frozen for these views",
+             b->vd[0].name);
+    mr_csv_comment(csv, tc);
     mr_csv_header(csv, "view,contender,role,radius_policy,tuned,radius_mode,radius,screen_radius,strength,bias,c,kernel,r_min,"
                        "r_max,samples,resolution,mask,width,height,"
                        "gpu_ms_median,frames,rmse_fixed,ssim_fixed,bias_fixed,rmse_screen,ssim_screen,bias_screen,masked_fraction,"
-                       "sync_ms_median,floor_ms_median,floor_ratio");
+                       "sync_ms_median,floor_ms_median,floor_ratio,thickness");
     for (int v = 1; v <= b->nv; v++) {
         if (!ao_grid_view(b, v, csv, err)) {
             mr_csv_destroy(&csv);
@@ -704,24 +734,72 @@ static size_t equal_ms_table(const ao_bench *b, char *md, size_t cap, size_t len
         len += (size_t)snprintf(md + len, cap - len, "| %s | %.4f%s | %.4f%s | %.2f | %.2f |\n", b->cs[c].label, rf,
                                 of ? "*" : "", rs, os ? "*" : "", b->agg_sync[c][s16][0][0], b->agg_ratio[c][s16][0][0]);
     }
+    /* The goal of issue 18: the best scheer-family row against the best of
+     * gtao, bitmask, hbao and filion, at this ms, per reference (rows
+     * outside their curve count with their nearest end). */
+    for (int ref = 1; ref >= 0; ref--) {
+        int bs = -1, bp = -1;
+        double es = INFINITY, ep = INFINITY;
+        for (int c = 0; c < NC; c++) {
+            bool o;
+            double e = rmse_at_ms(b, c, ref == 1, target, &o);
+            mr_ao_method m = b->cs[c].method;
+            bool fam = m == MR_AO_SCHEER || m == MR_AO_SCHEER_GT || m == MR_AO_SCHEER_BM;
+            bool peer = m == MR_AO_GTAO || m == MR_AO_BITMASK || m == MR_AO_HBAO || m == MR_AO_FILION;
+            if (fam && e < es) es = e, bs = c;
+            if (peer && e < ep) ep = e, bp = c;
+        }
+        if (bs >= 0 && bp >= 0)
+            len += (size_t)snprintf(md + len, cap - len,
+                                    "%sAgainst the %s reference at %.2f ms: best scheer family %s %.4f, best of gtao / bitmask "
+                                    "/ hbao / filion %s %.4f: %+.1f %% RMSE.\n",
+                                    ref ? "\n" : "", ref ? "depth-scaled" : "fixed-radius", target, b->cs[bs].label, es,
+                                    b->cs[bp].label, ep, ep > 0 ? 100.0 * (es / ep - 1.0) : 0.0);
+    }
     return len;
 }
 
 /* Step 6b (issue 18): temporal accumulation on a moving sequence, the
  * poses of a recording (--sequence DIR; default the shipped
  * recordings/demo when it is there, else the step is left out) at the
- * bench's size: per frame the depth-scaled reference, and the tuned scheer
- * (D2) and gtao at 16 samples per frame, at 4, and at 4 with accumulation
- * (restarted at the first frame); RMSE per frame against that frame's
- * reference, the AO passes timed between glFinish
- * (bench_ao_sequence.csv). */
+ * bench's size: per frame the depth-scaled reference, and each of the
+ * tuned scheer (D2), gtao and scheer-bm at 4, 8 and 16 samples per frame
+ * and at 4 with accumulation (restarted at the first frame); RMSE per
+ * frame against that frame's reference, the AO passes timed between
+ * glFinish (bench_ao_sequence.csv). Judged at equal ms: the per-frame
+ * curve (4, 8, 16 samples) is interpolated in log ms at the accumulating
+ * run's ms, so accumulation is compared with what the same time buys
+ * without it. */
 enum { SEQ_MAX = 24 };
 static int contender_of(const char *label) {
     for (int c = 0; c < NC; c++)
         if (strcmp(k_contenders[c].label, label) == 0) return c;
     return 0;
 }
-static const char *const k_seq_cfg[4] = {"scheer 16", "scheer 4 + temporal", "gtao 16", "gtao 4 + temporal"};
+static const char *const k_seq_method[SEQ_METHODS] = {"scheer", "gtao", "scheer-bm"};
+static const int k_seq_samples[SEQ_CFG] = {4, 8, 16, 4}; /* the last accumulates */
+
+/* y at x on the curve (xs, ys) of n points, linear in log x between the
+ * nearest points below and above; outside the curve its nearest end. */
+static double interp_log(const double *xs, const double *ys, int n, double x, bool *outside) {
+    int lo = 0, hi = 0;
+    for (int i = 1; i < n; i++) {
+        if (xs[i] < xs[lo]) lo = i;
+        if (xs[i] > xs[hi]) hi = i;
+    }
+    *outside = x < xs[lo] || x > xs[hi];
+    if (x <= xs[lo]) return ys[lo];
+    if (x >= xs[hi]) return ys[hi];
+    int a = lo, c = hi;
+    for (int i = 0; i < n; i++) {
+        if (xs[i] <= x && xs[i] > xs[a]) a = i;
+        if (xs[i] >= x && xs[i] < xs[c]) c = i;
+    }
+    double la = log(fmax(xs[a], 1e-9)), lc = log(fmax(xs[c], 1e-9));
+    if (lc - la < 1e-12) return ys[a];
+    return ys[a] + (log(fmax(x, 1e-9)) - la) / (lc - la) * (ys[c] - ys[a]);
+}
+
 static bool ao_sequence(ao_bench *b, mr_error *err) {
     const char *dir = b->p.sequence ? b->p.sequence : "recordings/demo";
     mr_error oe = {0};
@@ -748,11 +826,15 @@ static bool ao_sequence(ao_bench *b, mr_error *err) {
     mr_csv *csv = mr_csv_create(err);
     if (!csv) return false;
     mr_csv_comment(csv, "temporal accumulation on a moving sequence: RMSE per frame against the frame's depth-scaled "
-                        "reference; sync_ms: the AO passes between glFinish");
+                        "reference; sync_ms: the AO passes between glFinish; parameters: each method's, tuned on the "
+                        "tuning view and frozen");
     mr_csv_header(csv, "sequence,frame,config,samples,temporal,rmse_screen,sync_ms");
-    double rm[4][SEQ_MAX], ms[4][SEQ_MAX];
+    static double rm[SEQ_METHODS][SEQ_CFG][SEQ_MAX], ms[SEQ_METHODS][SEQ_CFG][SEQ_MAX];
+    mr_image depth[SEQ_MAX], ref[SEQ_MAX];
+    memset(depth, 0, sizeof depth);
+    memset(ref, 0, sizeof ref);
     bool ok = mr_renderer_set_scene(b->gfx.renderer, b->scene, err);
-    mr_image depth = {0}, normal = {0}, ref = {0};
+    /* the references, and the per-frame configurations */
     for (int k = 0; ok && k < nf; k++) {
         mr_frame_params fp = MR_FRAME_DEFAULTS;
         fp.width = b->w;
@@ -761,49 +843,42 @@ static bool ao_sequence(ao_bench *b, mr_error *err) {
         mr_frame_result res;
         ok = mr_render_frame(b->gfx.renderer, &views[k], &fp, &res, err);
         if (!ok) break;
-        mr_image_free(&depth);
-        mr_image_free(&normal);
-        depth = res.depth;
-        normal = res.normal;
-        res.depth.data = res.normal.data = NULL;
-        mr_frame_result_free(&res);
         mr_gt_params gp = MR_GT_DEFAULTS;
         gp.rays = b->p.rays;
         gp.radius_mode = MR_AO_RADIUS_SCREEN;
         gp.screen_radius = b->screen_radius;
-        mr_image_free(&ref);
-        ok = mr_eval_ao_groundtruth(b->gt, &views[k], &depth, &normal, &gp, &ref, err);
-        /* the per-frame configurations; the accumulating ones need
-         * consecutive frames in the renderer's one history, so they run
-         * in passes of their own below */
-        for (int c = 0; ok && c < 4; c += 2) {
-            mr_ao_params p = b->cs[contender_of(c < 2 ? "scheer" : "gtao")].tuned;
-            p.samples = 16;
-            p.no_reuse = true;
-            double sync = 0, gms = 0;
-            ok = run_ao(b->gfx.renderer, &views[k], &p, b->w, b->h, 1, &gms, &sync, &b->ao, NULL, err);
-            mr_image_metrics m;
-            ok = ok && mr_image_compare(&b->ao, &ref, &depth, &m, err);
-            if (ok) {
-                rm[c][k] = m.rmse;
-                ms[c][k] = sync;
+        ok = mr_eval_ao_groundtruth(b->gt, &views[k], &res.depth, &res.normal, &gp, &ref[k], err);
+        depth[k] = res.depth;
+        res.depth.data = NULL;
+        mr_frame_result_free(&res);
+        for (int m = 0; ok && m < SEQ_METHODS; m++)
+            for (int c = 0; ok && c < SEQ_CFG - 1; c++) {
+                mr_ao_params p = b->cs[contender_of(k_seq_method[m])].tuned;
+                p.samples = k_seq_samples[c];
+                p.no_reuse = true;
+                double sync = 0, gms = 0;
+                mr_image_metrics mt;
+                ok = run_ao(b->gfx.renderer, &views[k], &p, b->w, b->h, 1, &gms, &sync, &b->ao, NULL, err) &&
+                     mr_image_compare(&b->ao, &ref[k], &depth[k], &mt, err);
+                if (ok) {
+                    rm[m][c][k] = mt.rmse;
+                    ms[m][c][k] = sync;
+                }
             }
-        }
-        mr_image_free(&ref);
     }
     /* The accumulating runs: each a pass over the sequence of its own (the
-     * history must see consecutive frames); the references again per frame. */
-    for (int c = 1; ok && c < 4; c += 2) {
+     * history must see consecutive frames). */
+    const int ct = SEQ_CFG - 1;
+    for (int m = 0; ok && m < SEQ_METHODS; m++)
         for (int k = 0; ok && k < nf; k++) {
-            mr_ao_params p = b->cs[contender_of(c < 2 ? "scheer" : "gtao")].tuned;
-            p.samples = 4;
+            mr_ao_params p = b->cs[contender_of(k_seq_method[m])].tuned;
+            p.samples = k_seq_samples[ct];
             p.temporal = true;
             p.temporal_reset = k == 0;
             mr_frame_params fp = MR_FRAME_DEFAULTS;
             fp.width = b->w;
             fp.height = b->h;
             fp.timing = fp.timing_sync = true;
-            fp.want_depth = fp.want_normals = true;
             fp.ao = p;
             fp.ao.want_ao = true;
             mr_frame_result res;
@@ -812,53 +887,157 @@ static bool ao_sequence(ao_bench *b, mr_error *err) {
             double sync = 0;
             for (int q = 0; q < res.pass_count; q++)
                 if (strncmp(res.passes[q], "ao", 2) == 0) sync += res.cpu_ms[q];
-            mr_gt_params gp = MR_GT_DEFAULTS;
-            gp.rays = b->p.rays;
-            gp.radius_mode = MR_AO_RADIUS_SCREEN;
-            gp.screen_radius = b->screen_radius;
-            mr_image_metrics m;
-            ok = mr_eval_ao_groundtruth(b->gt, &views[k], &res.depth, &res.normal, &gp, &ref, err) &&
-                 mr_image_compare(&res.ao, &ref, &res.depth, &m, err);
-            mr_image_free(&ref);
+            mr_image_metrics mt;
+            ok = mr_image_compare(&res.ao, &ref[k], &depth[k], &mt, err);
             mr_frame_result_free(&res);
             if (ok) {
-                rm[c][k] = m.rmse;
-                ms[c][k] = sync;
+                rm[m][ct][k] = mt.rmse;
+                ms[m][ct][k] = sync;
             }
         }
+    for (int k = 0; k < nf; k++) {
+        mr_image_free(&depth[k]);
+        mr_image_free(&ref[k]);
     }
-    mr_image_free(&depth);
-    mr_image_free(&normal);
-    for (int c = 0; ok && c < 4; c++) {
-        double all = 0, late = 0;
-        int nl = 0;
-        for (int k = 0; k < nf; k++) {
-            mr_csv_quoted(csv, dir);
-            mr_csv_int(csv, k);
-            mr_csv_text(csv, k_seq_cfg[c]);
-            mr_csv_int(csv, c % 2 ? 4 : 16);
-            mr_csv_text(csv, c % 2 ? "on" : "off");
-            mr_csv_num(csv, "%.5f", rm[c][k]);
-            mr_csv_num(csv, "%.4f", ms[c][k]);
-            mr_csv_end_row(csv);
-            all += rm[c][k] / nf;
-            if (k >= nf / 2) {
-                late += rm[c][k];
-                nl++;
+    for (int m = 0; ok && m < SEQ_METHODS; m++)
+        for (int c = 0; c < SEQ_CFG; c++) {
+            char name[64];
+            snprintf(name, sizeof name, "%s %d%s", k_seq_method[m], k_seq_samples[c], c == ct ? " + temporal" : "");
+            double all = 0, late = 0;
+            int nl = 0;
+            for (int k = 0; k < nf; k++) {
+                mr_csv_quoted(csv, dir);
+                mr_csv_int(csv, k);
+                mr_csv_text(csv, name);
+                mr_csv_int(csv, k_seq_samples[c]);
+                mr_csv_text(csv, c == ct ? "on" : "off");
+                mr_csv_num(csv, "%.5f", rm[m][c][k]);
+                mr_csv_num(csv, "%.4f", ms[m][c][k]);
+                mr_csv_end_row(csv);
+                all += rm[m][c][k] / nf;
+                if (k >= nf / 2) {
+                    late += rm[m][c][k];
+                    nl++;
+                }
             }
+            b->seq_rmse[m][c][0] = all;
+            b->seq_rmse[m][c][1] = nl ? late / nl : 0;
+            double t[SEQ_MAX];
+            memcpy(t, ms[m][c], sizeof t);
+            b->seq_ms[m][c] = nf > 0 ? mr_median(t, nf) : 0;
         }
-        b->seq_rmse[c][0] = all;
-        b->seq_rmse[c][1] = nl ? late / nl : 0;
-        double t[SEQ_MAX];
-        memcpy(t, ms[c], sizeof t);
-        b->seq_ms[c] = nf > 0 ? mr_median(t, nf) : 0;
-    }
     b->seq_frames = ok ? nf : 0;
     if (!ok) {
         mr_csv_destroy(&csv);
         return false;
     }
     return save_csv(csv, b->p.out_dir, "bench_ao_sequence.csv", err);
+}
+
+/* Step 6c (issue 18): the cost steps towards the fetch floor. On the first
+ * reported view, at 16 samples, each of the slice methods (tuned, depth-
+ * scaled) at full and half resolution, with and without the depth mip
+ * chain; every configuration timed (glFinish, median of --frames) with its
+ * fetch floor right after, in `rounds` rounds that alternate the
+ * configurations (the machine is shared: side by side, the median of the
+ * rounds' ratios). bench_ao_cost.csv. */
+static const char *const k_cost_method[COST_METHODS] = {"gtao", "bitmask", "scheer-bm"};
+static bool ao_cost(ao_bench *b, mr_error *err) {
+    enum { ROUNDS = 5 };
+    const view_data *vd = &b->vd[b->nv >= 1 ? 1 : 0];
+    mr_csv *csv = mr_csv_create(err);
+    if (!csv) return false;
+    mr_csv_comment(csv, "cost steps at 16 samples on the first reported view: sync_ms (AO passes between glFinish, median "
+                        "of the frames), floor_ms (the fetch floor of as many fetches per AO pixel, right after), "
+                        "ratio = sync / floor; each round runs every configuration once");
+    mr_csv_header(csv, "view,method,resolution,mips,round,sync_ms_median,floor_ms_median,floor_ratio,rmse_screen");
+    bool ok = mr_renderer_set_scene(b->gfx.renderer, b->scene, err);
+    double ratio[COST_METHODS][4][ROUNDS], sync[COST_METHODS][4][ROUNDS], flo[COST_METHODS][4][ROUNDS];
+    for (int rd = 0; ok && rd < ROUNDS; rd++)
+        for (int m = 0; ok && m < COST_METHODS; m++)
+            for (int cfg = 0; ok && cfg < 4; cfg++) {
+                mr_ao_params p = b->cs[contender_of(k_cost_method[m])].tuned;
+                p.samples = 16;
+                p.half_res = cfg >= 2;
+                p.mips = cfg % 2 == 1;
+                double gms = 0, s = 0, fl = 0;
+                mr_image_metrics mt;
+                ok = run_ao(b->gfx.renderer, &vd->view, &p, b->w, b->h, b->p.frames, &gms, &s, &b->ao, NULL, err) &&
+                     fetch_floor(b, &p, &fl, err) && mr_image_compare(&b->ao, &vd->gt_screen, &vd->depth, &mt, err);
+                if (!ok) break;
+                sync[m][cfg][rd] = s;
+                flo[m][cfg][rd] = fl;
+                ratio[m][cfg][rd] = fl > 0 ? s / fl : 0;
+                b->cost_rmse[m][cfg] = mt.rmse;
+                mr_csv_quoted(csv, vd->name);
+                mr_csv_text(csv, k_cost_method[m]);
+                mr_csv_text(csv, p.half_res ? "half" : "full");
+                mr_csv_text(csv, p.mips ? "on" : "off");
+                mr_csv_int(csv, rd);
+                mr_csv_num(csv, "%.4f", s);
+                mr_csv_num(csv, "%.4f", fl);
+                mr_csv_num(csv, "%.3f", ratio[m][cfg][rd]);
+                mr_csv_num(csv, "%.5f", mt.rmse);
+                mr_csv_end_row(csv);
+            }
+    if (!ok) {
+        mr_csv_destroy(&csv);
+        return false;
+    }
+    for (int m = 0; m < COST_METHODS; m++)
+        for (int cfg = 0; cfg < 4; cfg++) {
+            b->cost_ratio[m][cfg] = mr_median(ratio[m][cfg], ROUNDS);
+            b->cost_sync[m][cfg] = mr_median(sync[m][cfg], ROUNDS);
+            b->cost_floor[m][cfg] = mr_median(flo[m][cfg], ROUNDS);
+        }
+    /* Deinterleaved 4 x 4 rendering, probed before it is built: its gain on
+     * a machine is the fetch floor's, the same fetches from 16 sub-images
+     * of a quarter the size each with a quarter the spread (a sub-image
+     * holds every 4th pixel, so its samples lie 4x closer in memory),
+     * against one full-size pass. Each sub-image pass is timed alone
+     * (glFinish around it), so the sum carries 16 synchronisations. */
+    double dfull[ROUNDS], dsub[ROUNDS];
+    const int fn = b->p.frames < 64 ? b->p.frames : 64;
+    const double rpx = b->screen_radius * b->h;
+    for (int rd = 0; ok && rd < ROUNDS; rd++) {
+        double t[64];
+        ok = mr_render_fetch_probe(b->gfx.renderer, b->w, b->h, 16, rpx, fn, t, err);
+        if (!ok) break;
+        dfull[rd] = mr_median(t, fn);
+        ok = mr_render_fetch_probe(b->gfx.renderer, (b->w + 3) / 4, (b->h + 3) / 4, 16, rpx / 4, fn, t, err);
+        if (!ok) break;
+        dsub[rd] = 16 * mr_median(t, fn);
+        for (int q = 0; q < 2; q++) {
+            mr_csv_quoted(csv, vd->name);
+            mr_csv_text(csv, "fetch-floor");
+            mr_csv_text(csv, q ? "deinterleaved-4x4" : "full");
+            mr_csv_text(csv, "-");
+            mr_csv_int(csv, rd);
+            mr_csv_num(csv, "%.4f", q ? dsub[rd] : dfull[rd]);
+            mr_csv_num(csv, "%.4f", dfull[rd]);
+            mr_csv_num(csv, "%.3f", dfull[rd] > 0 ? (q ? dsub[rd] : dfull[rd]) / dfull[rd] : 0.0);
+            mr_csv_text(csv, "");
+            mr_csv_end_row(csv);
+        }
+    }
+    if (!ok) {
+        mr_csv_destroy(&csv);
+        return false;
+    }
+    b->deint_full = mr_median(dfull, ROUNDS);
+    b->deint_sub = mr_median(dsub, ROUNDS);
+    b->cost_rounds = ROUNDS;
+    snprintf(b->cost_view, sizeof b->cost_view, "%s", vd->name);
+    /* the load average (Linux), so a reader can judge how quiet it was */
+    b->loadavg[0] = 0;
+    FILE *la = fopen("/proc/loadavg", "r");
+    if (la) {
+        if (!fgets(b->loadavg, sizeof b->loadavg, la)) b->loadavg[0] = 0;
+        fclose(la);
+        size_t n = strlen(b->loadavg);
+        while (n > 0 && (b->loadavg[n - 1] == '\n' || b->loadavg[n - 1] == ' ')) b->loadavg[--n] = 0;
+    }
+    return save_csv(csv, b->p.out_dir, "bench_ao_cost.csv", err);
 }
 
 /* Step 7: the summary table (bench_ao.md, also printed). */
@@ -919,12 +1098,44 @@ static bool ao_summary(ao_bench *b, mr_error *err) {
     if (b->seq_frames > 0) {
         len += (size_t)snprintf(md + len, sizeof md - len,
                                 "\nTemporal accumulation on the moving sequence %s (%d posed frames, %dx%d; RMSE against "
-                                "each frame's depth-scaled reference; ms: AO passes between glFinish, median):\n\n"
-                                "| configuration | RMSE all frames | RMSE second half | ms |\n|---|---|---|---|\n",
-                                b->seq_name, b->seq_frames, b->w, b->h);
-        for (int c = 0; c < 4; c++)
-            len += (size_t)snprintf(md + len, sizeof md - len, "| %s | %.4f | %.4f | %.2f |\n", k_seq_cfg[c], b->seq_rmse[c][0],
-                                    b->seq_rmse[c][1], b->seq_ms[c]);
+                                "each frame's depth-scaled reference; ms: AO passes between glFinish, median; parameters "
+                                "tuned on '%s' and frozen). At equal ms: the per-frame RMSE (4, 8, 16 samples, second "
+                                "half) interpolated in log ms at the accumulating run's ms, `*` = outside that curve:\n\n"
+                                "| configuration | RMSE all frames | RMSE second half | ms | per-frame RMSE at equal ms |\n"
+                                "|---|---|---|---|---|\n",
+                                b->seq_name, b->seq_frames, b->w, b->h, b->vd[0].name);
+        for (int m = 0; m < SEQ_METHODS; m++)
+            for (int c = 0; c < SEQ_CFG; c++) {
+                char eq[48] = "-";
+                if (c == SEQ_CFG - 1) {
+                    double xs[SEQ_CFG - 1], ys[SEQ_CFG - 1];
+                    for (int q = 0; q < SEQ_CFG - 1; q++) xs[q] = b->seq_ms[m][q], ys[q] = b->seq_rmse[m][q][1];
+                    bool out;
+                    double e = interp_log(xs, ys, SEQ_CFG - 1, b->seq_ms[m][c], &out);
+                    snprintf(eq, sizeof eq, "%.4f%s", e, out ? "*" : "");
+                }
+                len += (size_t)snprintf(md + len, sizeof md - len, "| %s %d%s | %.4f | %.4f | %.2f | %s |\n", k_seq_method[m],
+                                        k_seq_samples[c], c == SEQ_CFG - 1 ? " + temporal" : "", b->seq_rmse[m][c][0],
+                                        b->seq_rmse[m][c][1], b->seq_ms[m][c], eq);
+            }
+    }
+    if (b->cost_rounds > 0) {
+        static const char *const cfg[4] = {"full", "full + mips", "half", "half + mips"};
+        len += (size_t)snprintf(md + len, sizeof md - len,
+                                "\nCost towards the fetch floor, 16 samples, '%s' (medians of %d rounds side by side; load "
+                                "average at the end: %s). x floor = AO passes (glFinish) / a pass of as many R32F fetches "
+                                "per AO pixel and nothing else; RMSE against the depth-scaled reference:\n\n"
+                                "| method | configuration | ms | floor ms | x floor | RMSE d-s |\n|---|---|---|---|---|---|\n",
+                                b->cost_view, b->cost_rounds, b->loadavg[0] ? b->loadavg : "-");
+        for (int m = 0; m < COST_METHODS; m++)
+            for (int c = 0; c < 4; c++)
+                len += (size_t)snprintf(md + len, sizeof md - len, "| %s | %s | %.2f | %.2f | %.2f | %.4f |\n", k_cost_method[m],
+                                        cfg[c], b->cost_sync[m][c], b->cost_floor[m][c], b->cost_ratio[m][c], b->cost_rmse[m][c]);
+        len += (size_t)snprintf(md + len, sizeof md - len,
+                                "\nDeinterleaved 4 x 4, probed: the fetch floor of 16 fetches per pixel over %dx%d in one pass "
+                                "%.2f ms, in 16 sub-image passes of a quarter the size and spread %.2f ms (x %.2f; each sub-pass "
+                                "timed between glFinish).\n",
+                                b->w, b->h, b->deint_full, b->deint_sub, b->deint_full > 0 ? b->deint_sub / b->deint_full : 0.0);
     }
     len += (size_t)snprintf(md + len, sizeof md - len, "\nAO passes against triangle count (scheer, 16 samples, %dx%d):\n\n"
                                                        "| triangles | AO GPU ms | G-buffer GPU ms |\n|---|---|---|\n", b->w, b->h);
@@ -990,7 +1201,8 @@ bool mr_bench_ao(const mr_bench_ao_params *params, mr_error *err) {
     memcpy(b->cs, k_contenders, sizeof b->cs);
     b->t0 = mr_time_now();
     bool ok = ao_setup(b, err) && ao_references(b, err) && ao_tune(b, err) && ao_grid(b, err) && ao_triangles(b, err) &&
-              ao_plots(b, err) && ao_shaded(b, err) && ao_sequence(b, err) && ao_summary(b, err);
+              ao_plots(b, err) && ao_shaded(b, err) && ao_sequence(b, err) && ao_cost(b, err) &&
+              ao_summary(b, err);
     ao_free(b);
     return ok;
 }

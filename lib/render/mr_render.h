@@ -70,6 +70,10 @@ typedef enum mr_ao_method {
                           occluded by samples assumed `thickness` deep */
     MR_AO_SCHEER_GT,   /* scheer-gt: Scheer & Keutel's quasi-normalised attenuation
                           1/(1 + c l^2) on GTAO's slices (see pass_ao.c) */
+    /* issue 18 (lane ao) */
+    MR_AO_SCHEER_BM,   /* scheer-bm: the bitmask's sectors, each counted with the attenuation
+                          1/(1 + c l^2) of the nearest sample that marks it (l = |v| / r),
+                          depth-scaled radius; c = 0 is the bitmask (shaders/ao_main.frag.glsl) */
     MR_AO_METHOD_COUNT
 } mr_ao_method;
 
@@ -172,6 +176,11 @@ typedef struct mr_ao_params {
                                      hashed in (a multi-view rig sets its centre camera, so
                                      all views share it); used when noise_anchor_set */
     bool noise_anchor_set;        /* false: the world frame itself */
+    /* issue 18 (lane ao) */
+    bool mips;                    /* gtao / bitmask / scheer-gt / scheer-bm: samples at least
+                                     MR_AO_MIP_NEAR_PX from the pixel read a box-filtered
+                                     depth mip chain (built only for these methods); off
+                                     by default */
 } mr_ao_params;
 /* Each default is written once, here: the initialiser below, the AO pass
  * (which puts them in where a field is zero or out of range) and option
@@ -191,6 +200,9 @@ typedef struct mr_ao_params {
 #define MR_AO_TEMPORAL_DEPTH_TOL 0.02 /* temporal: relative depth difference that rejects history */
 #define MR_AO_TEMPORAL_NORMAL_COS 0.9 /* temporal: normals further apart reject history */
 #define MR_AO_MAX_SLICES 16 /* gtao / bitmask / scheer-gt: slice directions (a uniform array) */
+#define MR_AO_MIP_NEAR_PX 8.0 /* issue 18: mips: offsets below this (pixels) read level 0;
+                                 level L for [8 * 2^(L-1), 8 * 2^L) */
+#define MR_AO_MIP_LEVELS 4    /* issue 18: mips: levels above 0 in the chain (at most) */
 #define MR_AO_DEFAULTS {.method = MR_AO_NONE, .radius_mode = MR_AO_RADIUS_SCREEN, \
                         .screen_radius = MR_AO_DEFAULT_SCREEN_RADIUS, .samples = MR_AO_DEFAULT_SAMPLES, \
                         .kernel = MR_AO_KERNEL_UNIFORM, .r_min = MR_AO_DEFAULT_R_MIN, .r_max = MR_AO_DEFAULT_R_MAX, \

@@ -9,7 +9,9 @@
 const char *const mr_ao_method_names[MR_AO_METHOD_COUNT + 1] = {"none", "scheer", "crytek", "filion",
                                                                 "hbao", "alchemy",
                                                                 /* issue 18 */
-                                                                "gtao", "bitmask", "scheer-gt", NULL};
+                                                                "gtao", "bitmask", "scheer-gt",
+                                                                /* issue 18 (lane ao) */
+                                                                "scheer-bm", NULL};
 static const char *const k_radius_mode_names[] = {"screen", "view", NULL};
 static const char *const k_kernel_names[] = {"uniform", "stratified", "latin", "poisson", NULL};
 static const char *const k_mask_names[] = {"off", "on", "standalone", NULL};
@@ -51,6 +53,9 @@ const mr_opt mr_ao_opts[] = {
      "standalone mask: AO = 1 - S in the corners before the blur", 0},
     {"noise", MR_OPT_ENUM, AO(noise), 0, 0, MR_AO_NOISE_PIXEL, k_noise_names,
      "kernel rotation from a hash of the pixel or of the world position (stays on the surface across views)", 0},
+    /* issue 18 (lane ao) */
+    {"mips", MR_OPT_BOOL, AO(mips), 0, 1, 0, NULL,
+     "gtao, bitmask, scheer-gt, scheer-bm: far samples read a depth mip chain", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef AO

@@ -17,7 +17,8 @@ _Static_assert(MR_AO_SCHEER == MR_AO_METHOD_ID_SCHEER && MR_AO_CRYTEK == MR_AO_M
                    MR_AO_FILION == MR_AO_METHOD_ID_FILION && MR_AO_HBAO == MR_AO_METHOD_ID_HBAO &&
                    MR_AO_ALCHEMY == MR_AO_METHOD_ID_ALCHEMY && MR_AO_MAX_SAMPLES == MR_AO_KERNEL_SIZE &&
                    MR_AO_GTAO == MR_AO_METHOD_ID_GTAO && MR_AO_BITMASK == MR_AO_METHOD_ID_BITMASK &&
-                   MR_AO_SCHEER_GT == MR_AO_METHOD_ID_SCHEER_GT && MR_AO_MAX_SLICES == MR_AO_SLICES_SIZE,
+                   MR_AO_SCHEER_GT == MR_AO_METHOD_ID_SCHEER_GT && MR_AO_MAX_SLICES == MR_AO_SLICES_SIZE &&
+                   MR_AO_SCHEER_BM == MR_AO_METHOD_ID_SCHEER_BM,
                "shaders/mr_bindings.h and mr_render.h disagree on AO method ids or the kernel size");
 
 enum { AO_PLAN_OFF = 0, AO_PLAN_REUSE, AO_PLAN_RUN, AO_PLAN_EXTERNAL };
@@ -51,6 +52,9 @@ struct mr_ao_state {
     float kernel3[MR_AO_MAX_SAMPLES * 4], kernel2[MR_AO_MAX_SAMPLES * 4];
     float slices[MR_AO_MAX_SLICES * 4]; /* gtao / bitmask / scheer-gt: directions over half a turn */
     GLuint linear_sampler;              /* their bilinear depth reads (texelFetch ignores it) */
+    /* issue 18 (lane ao): the depth mip chain of their far samples */
+    GLuint prog_mip, tex_mip, fbo_mip, mip_sampler;
+    int mip_w, mip_h, mip_levels;
     /* issue 18: temporal accumulation, full resolution, ping-pong */
     GLuint prog_temporal;
     GLuint tex_hist[2], tex_hist_n[2], fbo_hist[2]; /* (AO, frames, view z), normal */
@@ -193,6 +197,13 @@ static void free_targets(mr_ao_state *s) {
     s->valid = false;
 }
 
+static void free_mips(mr_ao_state *s) {
+    glDeleteFramebuffers(1, &s->fbo_mip);
+    glDeleteTextures(1, &s->tex_mip);
+    s->fbo_mip = s->tex_mip = 0;
+    s->mip_w = s->mip_h = s->mip_levels = 0;
+}
+
 static void free_history(mr_ao_state *s) {
     glDeleteFramebuffers(2, s->fbo_hist);
     glDeleteTextures(2, s->tex_hist);
@@ -223,6 +234,9 @@ static void free_state(mr_ao_state *s) {
     free_targets(s);
     free_outlines(s);
     free_history(s);
+    free_mips(s);
+    glDeleteProgram(s->prog_mip);
+    glDeleteSamplers(1, &s->mip_sampler);
     glDeleteProgram(s->prog_temporal);
     glDeleteProgram(s->prog_main);
     glDeleteProgram(s->prog_blur);
@@ -302,7 +316,9 @@ static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
      * traced reference on a view it does not report. */
     static const float k_strength[MR_AO_METHOD_COUNT] = {1.0f, 3.0f, 1.0f, 1.0f, 1.5f, 2.0f,
                                                          /* gtao, bitmask, scheer-gt: visibility integrals, 1 */
-                                                         1.0f, 1.0f, 1.0f};
+                                                         1.0f, 1.0f, 1.0f,
+                                                         /* scheer-bm: attenuated sector counts, 1 */
+                                                         1.0f};
     if (!(p.strength > 0) || !isfinite(p.strength))
         p.strength = p.method > MR_AO_NONE && p.method < MR_AO_METHOD_COUNT ? k_strength[p.method] : 1.0f;
     if (!(p.c >= 0) || !isfinite(p.c)) p.c = MR_AO_DEFAULT_C;
@@ -369,6 +385,7 @@ static void copy_fields(mr_ao_params *d, const mr_ao_params *p) {
     d->noise_cell = p->noise_cell;
     d->noise_anchor = p->noise_anchor;
     d->noise_anchor_set = p->noise_anchor_set;
+    d->mips = p->mips;
 }
 
 static ao_key key_of(const frame *f, const mr_ao_params *resolved, uint64_t scene_gen) {
@@ -605,7 +622,49 @@ void mr_ao_slice_split(int samples, int *slices, int *steps) {
     *steps = st > 0 ? st : 1;
 }
 
-static bool slice_method(mr_ao_method m) { return m == MR_AO_GTAO || m == MR_AO_BITMASK || m == MR_AO_SCHEER_GT; }
+static bool slice_method(mr_ao_method m) {
+    return m == MR_AO_GTAO || m == MR_AO_BITMASK || m == MR_AO_SCHEER_GT || m == MR_AO_SCHEER_BM;
+}
+
+/* issue 18: the depth mip chain, only for a slice method with mips on and
+ * the positions path off (that path reads the nearest pixel's position).
+ * Level 0 is a copy of the G-buffer's reversed-Z depth (ao_depth_mip), the
+ * levels above it glGenerateTextureMipmap's box filter. Returns the levels
+ * above 0 that the shader may read, 0 when there is no chain. */
+static int build_depth_mips(frame *f, mr_ao_state *s, const ao_inputs *in) {
+    const mr_ao_params *p = &s->p;
+    if (!p->mips || !slice_method(p->method) || p->positions || p->mask == MR_AO_MASK_STANDALONE) return 0;
+    int w = f->r->w, h = f->r->h;
+    if (!s->prog_mip) {
+        static const char *const m[] = {"fullscreen.vert.glsl", "ao_depth_mip.frag.glsl", NULL};
+        mr_error e = {0};
+        if (!(s->prog_mip = mr_gl_program(m, &e))) return 0; /* no chain: level 0 only, as without mips */
+    }
+    if (s->mip_w != w || s->mip_h != h) {
+        free_mips(s);
+        int levels = 0;
+        while (levels < MR_AO_MIP_LEVELS && (w >> (levels + 1)) >= 1 && (h >> (levels + 1)) >= 1) levels++;
+        glCreateTextures(GL_TEXTURE_2D, 1, &s->tex_mip);
+        glTextureStorage2D(s->tex_mip, levels + 1, GL_R32F, w, h);
+        glCreateFramebuffers(1, &s->fbo_mip);
+        glNamedFramebufferTexture(s->fbo_mip, GL_COLOR_ATTACHMENT0, s->tex_mip, 0);
+        s->mip_w = w;
+        s->mip_h = h;
+        s->mip_levels = levels;
+    }
+    if (!s->mip_sampler) {
+        glCreateSamplers(1, &s->mip_sampler);
+        glSamplerParameteri(s->mip_sampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
+        glSamplerParameteri(s->mip_sampler, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glSamplerParameteri(s->mip_sampler, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glSamplerParameteri(s->mip_sampler, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    glUseProgram(s->prog_mip);
+    glBindTextureUnit(MR_TEX_AO_MIP_SRC, in->depth);
+    fullscreen(f, s->fbo_mip, w, h);
+    glGenerateTextureMipmap(s->tex_mip);
+    return s->mip_levels;
+}
 
 /* World noise: the camera-space position goes to the anchor's frame
  * (composed in double, so only the small anchor-relative part is float)
@@ -632,7 +691,14 @@ static void noise_uniforms(const frame *f, const mr_ao_params *p) {
 
 static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
     const mr_ao_params *p = &s->p;
+    int mips = build_depth_mips(f, s, in);
     glUseProgram(s->prog_main);
+    glUniform1i(MR_LOC_AO_MIPS, mips);
+    glUniform1f(MR_LOC_AO_MIP_NEAR, (float)MR_AO_MIP_NEAR_PX);
+    if (mips > 0) {
+        glBindTextureUnit(MR_TEX_AO_DEPTH_MIP, s->tex_mip);
+        glBindSampler(MR_TEX_AO_DEPTH_MIP, s->mip_sampler);
+    }
     common_uniforms(f, s, in);
     glUniform1i(MR_LOC_AO_METHOD, p->mask == MR_AO_MASK_STANDALONE ? MR_AO_METHOD_MASK_STANDALONE : (int)p->method);
     glUniform1i(MR_LOC_AO_SAMPLES, p->samples);
@@ -684,6 +750,10 @@ static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
     glUniform3f(MR_LOC_AO_DISPLAY, dm ? (float)dm->distance : 0.0f, dm ? (float)dm->eye_half : 0.0f, (float)f->r->w);
     fullscreen(f, s->fbo_ao[0], s->aw, s->ah);
     glBindSampler(MR_TEX_AO_DEPTH, 0);
+    if (mips > 0) {
+        glBindSampler(MR_TEX_AO_DEPTH_MIP, 0);
+        glBindTextureUnit(MR_TEX_AO_DEPTH_MIP, 0);
+    }
     s->cur = 0;
     s->result = s->tex_ao[0];
     s->valid = true;
