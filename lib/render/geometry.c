@@ -503,8 +503,12 @@ static size_t select_recs(mr_renderer *r, const mr_geo_view *vw, double fmax_t, 
 }
 
 /* Steps 3-4 for sorted records: instance data through vw's camera,
- * commands, submission. Adds to the frame's statistics. */
-static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *out, const geo_rec *sorted, size_t nrec) {
+ * commands, submission. Adds to the frame's statistics. replicate >= 1
+ * (issue 14's layered experiment): every instance drawn that many times
+ * (attribute divisor = replicate), the caller sets the projections; 0: a
+ * plain draw. */
+static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *out, const geo_rec *sorted, size_t nrec,
+                      int replicate) {
     const mr_scene *s = r->scene;
     struct mr_geo *g = r->geo;
     const mr_draw_params *dp = &r->draw;
@@ -550,12 +554,18 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     if (ninst == 0 || !have_room) return; /* nothing to draw costs nothing */
 
     /* 4. Submission. */
+    if (replicate >= 1) {
+        for (uint32_t c = 0; c < ncmd; c++) g->cmds[c].instance_count *= (uint32_t)replicate;
+        for (int p = 0; p < 2; p++) glVertexArrayBindingDivisor(g->vao[p], 1, (GLuint)replicate);
+    }
     glNamedBufferSubData(g->inst_buf, 0, (GLsizeiptr)ninst * (GLsizeiptr)sizeof(gpu_instance), g->inst);
     glNamedBufferData(g->cmd_buf, (GLsizeiptr)ncmd * (GLsizeiptr)sizeof(draw_cmd), g->cmds, GL_STREAM_DRAW);
     glUseProgram(vw->program);
-    float proj[16];
-    mr_gl_projection(&vw->cam, vw->near_plane, proj);
-    glUniformMatrix4fv(MR_LOC_PROJECTION, 1, GL_FALSE, proj);
+    if (replicate == 0) {
+        float proj[16];
+        mr_gl_projection(&vw->cam, vw->near_plane, proj);
+        glUniformMatrix4fv(MR_LOC_PROJECTION, 1, GL_FALSE, proj);
+    }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, g->cmd_buf);
     uint32_t calls = 0;
     for (int32_t grp = 0; grp < g->group_count; grp++) {
@@ -580,6 +590,8 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     glBindVertexArray(0);
+    if (replicate > 1)
+        for (int p = 0; p < 2; p++) glVertexArrayBindingDivisor(g->vao[p], 1, 1);
     r->stats.gl_draw_calls += calls;
     if (out) {
         out->triangles += tris;
@@ -595,7 +607,7 @@ static void submit_nodes(mr_renderer *r, const mr_geo_view *vw, mr_frame_result 
     double fmax_t = g->lod && !r->draw.no_lod ? mr_geometry_lod_fmax(&vw->cam) : 0;
     size_t nrec = select_recs(r, vw, fmax_t, nodes, nvis, g->sorted);
     r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
-    emit_recs(r, vw, out, g->sorted, nrec);
+    emit_recs(r, vw, out, g->sorted, nrec, 0);
 }
 
 /* ---------------------------------------------------- occlusion culling
@@ -800,7 +812,7 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
             for (int k = 0; k < MR_LAYER_COUNT; k++)
                 if (layer_mask & (1u << k)) r->stats.nodes_drawable += g->drawable[k];
             r->stats.nodes_visible += (uint32_t)l->nvis;
-            emit_recs(r, vw, out, l->recs, l->nrec);
+            emit_recs(r, vw, out, l->recs, l->nrec, 0);
             return;
         }
     }
@@ -884,6 +896,14 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     r->stats.nodes_occluded += (uint32_t)(nrest - nkeep);
     r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
     submit_nodes(r, vw, out, rest, nkeep);
+}
+
+bool mr_geometry_draw_replicated(mr_renderer *r, const mr_geo_view *vw, int replicate) {
+    if (!r->scene || !r->geo || !r->share) return false;
+    const share_list *l = shared_list(r, vw->layers);
+    if (!l) return false;
+    emit_recs(r, vw, NULL, l->recs, l->nrec, replicate);
+    return true;
 }
 
 /* ------------------------------------------------------ auxiliary streams */

@@ -626,6 +626,17 @@ mr_frustum mr_rig_cull_frustum(const mr_rig *rig, const mr_view *centre, int wid
 bool mr_render_rig_begin(mr_renderer *r, const mr_rig *rig, const mr_view *centre, int width, int height,
                          mr_error *err);
 void mr_render_rig_end(mr_renderer *r);
+/* issue 14, the layered-rendering experiment: the G-buffer pass's geometry
+ * work (depth only, the rig frame's shared cull) for all views into one
+ * quilt depth target, either as the per-view loop does it (one draw per
+ * view with that view's instance matrices) or layered: one instanced draw
+ * per 16 views whose copies go to their eyes and tiles through
+ * gl_ViewportIndex (GL_ARB_shader_viewport_layer_array). ms[0..frames-1]:
+ * wall-clock per run, glFinish'ed; depth (NULL: not read): the quilt's
+ * reversed-Z depth, rows bottom-up. Not used by mr_render_rig: the frame's
+ * other passes still run per view (see docs/bench/multiview). */
+bool mr_rig_geometry_time(mr_renderer *r, const mr_rig *rig, const mr_view *centre, int w, int h, bool layered,
+                          int frames, double *ms, mr_image *depth, mr_error *err);
 
 /* -------------------------------------------------------------- picking */
 

@@ -305,6 +305,8 @@ bool mr_render_rig_begin(mr_renderer *r, const mr_rig *rig, const mr_view *centr
             sh->world_from_camera[k] = v.world_from_camera;
         }
     }
+    static unsigned serial;
+    sh->serial = ++serial ? serial : ++serial; /* never 0 */
     sh->views = rig->views;
     sh->near_plane = near_plane;
     sh->centre_cam = sh->cam[0];
@@ -320,6 +322,115 @@ bool mr_render_rig_begin(mr_renderer *r, const mr_rig *rig, const mr_view *centr
     }
     r->rig = sh;
     return true;
+}
+
+bool mr_rig_geometry_time(mr_renderer *r, const mr_rig *rig, const mr_view *centre, int w, int h, bool layered,
+                          int frames, double *ms, mr_image *depth, mr_error *err) {
+    if (!r->scene) return mr_fail(err, MR_ERR_INVALID, "the layered experiment needs a scene");
+    if (frames < 1 || frames > 64) return mr_fail(err, MR_ERR_INVALID, "frames must be in [1, 64]");
+    GLint max_vp = 0;
+    glGetIntegerv(GL_MAX_VIEWPORTS, &max_vp);
+    int per_draw = max_vp < MR_RIG_LAYERED_MAX ? max_vp : MR_RIG_LAYERED_MAX;
+    if (layered && per_draw < 2) return mr_fail(err, MR_ERR_GL, "the GPU has no viewport arrays");
+    mr_quilt_layout l;
+    if (!mr_quilt_layout_make(NULL, rig->views, w, h, &l, err)) return false;
+    const char *const files[] = {"rig_layered.vert.glsl", "rig_layered.frag.glsl", NULL};
+    GLuint prog = mr_gl_program(files, err);
+    if (!prog) return false;
+    GLuint tex = mr_gl_make_tex(GL_DEPTH_COMPONENT32F, l.width, l.height, GL_NEAREST), fbo;
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, tex, 0);
+    glNamedFramebufferDrawBuffer(fbo, GL_NONE);
+    bool ok = glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    if (!ok) mr_fail(err, MR_ERR_GL, "layered experiment: framebuffer incomplete");
+    /* Shared culling as in a rig frame (per_view_work left aside: both
+     * ways draw the same list, only the submission differs). */
+    mr_rig shared = *rig;
+    shared.per_view_work = false;
+    ok = ok && mr_render_rig_begin(r, &shared, centre, w, h, err);
+    if (ok && !r->share) ok = mr_fail(err, MR_ERR_INVALID, "the layered experiment needs 2 or more views");
+    mr_view *vs = ok ? malloc((size_t)rig->views * sizeof *vs) : NULL;
+    if (ok && !vs) ok = mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    for (int i = 0; ok && i < rig->views; i++) vs[i] = mr_rig_view(rig, centre, i, w, h);
+    double near_plane = ok ? r->rig->near_plane : 1;
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glUseProgram(prog);
+    for (int f = 0; ok && f < frames; f++) {
+        glFinish();
+        double t0 = mr_time_now();
+        static const float zero = 0;
+        glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &zero);
+        if (!layered) {
+            /* The per-view loop: each view's own instance matrices. */
+            glUniform1i(MR_LOC_RIG_VIEWS, 1);
+            glUniform1f(MR_LOC_RIG_SHIFT, 0.0f);
+            for (int i = 0; i < rig->views; i++) {
+                int x0, y0;
+                mr_quilt_tile_origin(&l, i, &x0, &y0);
+                glViewportIndexedf(0, (float)x0, (float)(l.height - y0 - h), (float)w, (float)h);
+                mr_geo_view gv;
+                memset(&gv, 0, sizeof gv);
+                gv.cam = vs[i].camera;
+                gv.world_from_camera = vs[i].world_from_camera;
+                gv.cam_from_world = mr_m4_invert_rigid(&vs[i].world_from_camera);
+                gv.near_plane = near_plane;
+                gv.program = prog;
+                gv.layers = 1u << MR_LAYER_VISIBLE | 1u << MR_LAYER_HIDDEN;
+                gv.shared = true;
+                mr_geometry_draw(r, &gv, NULL);
+            }
+        } else {
+            /* Layered: the centre camera's instances once per batch of
+             * views, each copy moved to its eye and viewport. */
+            mr_geo_view gv;
+            memset(&gv, 0, sizeof gv);
+            gv.cam = r->rig->centre_cam;
+            gv.world_from_camera = centre->world_from_camera;
+            gv.cam_from_world = r->rig->centre_from_world;
+            gv.near_plane = near_plane;
+            gv.program = prog;
+            gv.layers = 1u << MR_LAYER_VISIBLE | 1u << MR_LAYER_HIDDEN;
+            for (int i0 = 0; ok && i0 < rig->views; i0 += per_draw) {
+                int n = rig->views - i0 < per_draw ? rig->views - i0 : per_draw;
+                float proj[16 * MR_RIG_LAYERED_MAX], shift[MR_RIG_LAYERED_MAX];
+                for (int k = 0; k < n; k++) {
+                    int x0, y0;
+                    mr_quilt_tile_origin(&l, i0 + k, &x0, &y0);
+                    glViewportIndexedf((GLuint)k, (float)x0, (float)(l.height - y0 - h), (float)w, (float)h);
+                    mr_gl_projection(&vs[i0 + k].camera, near_plane, proj + 16 * k);
+                    shift[k] = (float)mr_rig_shift(rig, i0 + k);
+                }
+                glUniformMatrix4fv(MR_LOC_PROJECTION, n, GL_FALSE, proj);
+                glUniform1fv(MR_LOC_RIG_SHIFT, n, shift);
+                glUniform1i(MR_LOC_RIG_VIEWS, n);
+                ok = mr_geometry_draw_replicated(r, &gv, n);
+                if (!ok) mr_fail(err, MR_ERR_GL, "layered experiment: no shared list");
+            }
+        }
+        glFinish();
+        ms[f] = (mr_time_now() - t0) * 1e3;
+    }
+    glDisable(GL_DEPTH_TEST);
+    glViewport(0, 0, w, h);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (ok && depth) {
+        /* Framebuffer rows bottom-up: tile row 0 (views 0..) at the bottom. */
+        ok = mr_image_alloc(depth, l.width, l.height, 1, MR_PIX_F32, err);
+        if (ok) glGetTextureImage(tex, 0, GL_DEPTH_COMPONENT, GL_FLOAT, (GLsizei)mr_image_bytes(depth), depth->data);
+    }
+    mr_render_rig_end(r);
+    free(vs);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(1, &tex);
+    glDeleteProgram(prog);
+    GLenum e = glGetError();
+    if (ok && e != GL_NO_ERROR) ok = mr_fail(err, MR_ERR_GL, "GL error 0x%x in the layered experiment", e);
+    return ok;
 }
 
 bool mr_render_rig(mr_renderer *r, const mr_rig *rig, const mr_view *centre, const mr_frame_params *params,

@@ -99,6 +99,7 @@ struct mr_shadow_state {
     light_frame lf;
     bool key_valid;
     map_key key;
+    unsigned rig_serial;   /* issue 14: the rig frame whose first view drew the maps (0: none) */
     float kernel[2 * MR_SHADOW_MAX_TAPS];
     int kernel_taps;
     GLuint catcher_flags;  /* R8UI, node i at (i % ROW, i / ROW): 1 = shadow catcher */
@@ -154,7 +155,10 @@ static void make_key(const frame *f, map_key *k) {
 
 static bool reusable(const frame *f) {
     const struct mr_shadow_state *s = f->r->shadow;
-    if (!s || !s->key_valid || f->p->shadow.no_reuse || !s->map.fbo) return false;
+    if (!s || !s->key_valid || !s->map.fbo) return false;
+    /* no_reuse: nothing from an earlier frame; a rig frame's views still
+     * share the maps its first view drew (issue 14). */
+    if (f->p->shadow.no_reuse && !(f->r->rig && s->rig_serial == f->r->rig->serial)) return false;
     map_key k;
     make_key(f, &k);
     return memcmp(&k, &s->key, sizeof k) == 0;
@@ -736,6 +740,7 @@ static void run_map(frame *f) {
     draw_map(f, zero3, zero2);
     make_key(f, &s->key);
     s->key_valid = true;
+    s->rig_serial = f->r->rig ? f->r->rig->serial : 0;
     frame_put(f, RES_SHADOW_MAP, s->map.color[0]);
 }
 

@@ -146,6 +146,10 @@ bool mr_geometry_share_begin(mr_renderer *r, const mr_frustum *cull, const mr_dm
                              double fmax_t, mr_error *err);
 void mr_geometry_share_end(mr_renderer *r);
 double mr_geometry_lod_fmax(const mr_camera *c);
+/* The layered experiment: the shared list of vw->layers through vw's
+ * camera, each instance drawn `replicate` times (attribute divisor); the
+ * caller's program and uniforms place the copies. False outside a share. */
+bool mr_geometry_draw_replicated(mr_renderer *r, const mr_geo_view *vw, int replicate);
 /* What a rig frame's views have in common, for fitting what is made once
  * per frame (the shadow maps): the centre camera, the two outer views
  * (every view's frustum lies in their hull, slice by slice) and the union
@@ -158,6 +162,7 @@ typedef struct mr_rig_share {
     double near_plane;           /* the nearest of the views' */
     double planes[5][4];         /* centre camera: a.xyz . p + a.w >= 0 inside (the last: z >= near) */
     int views;
+    unsigned serial;             /* this rig frame's number, from 1 */
 } mr_rig_share;
 /* The near plane mr_render_frame picks for an eye (renderer.c). */
 double mr_render_near_plane(const mr_scene *s, const mr_dmat4 *world_from_camera);
