@@ -156,6 +156,7 @@ typedef struct shared_row {
     const char *scene;
     int views;
     double ms_per_view_work, ms_shared, cull_per_view_work, cull_shared;
+    double geo_loop, geo_layered; /* the G-buffer geometry alone, per-view loop vs layered */
     int maps_per_view_work, maps_shared, culls_per_view_work, culls_shared;
 } shared_row;
 
@@ -213,6 +214,15 @@ static bool bench_shared(const mr_bench_multiview_params *p, mr_scene *const sce
             rw->maps_per_view_work = rr[1].shadow_maps;
             rw->culls_shared = rr[0].frustum_culls;
             rw->culls_per_view_work = rr[1].frustum_culls;
+            /* The layered experiment: the first run of each compiles the
+             * shader variants; alternating pairs of runs after it. */
+            double gl[2][65];
+            for (int f = 0; ok && f <= frames; f++)
+                for (int m = 0; ok && m < 2; m++)
+                    ok = mr_rig_geometry_time(r, &rig[0], c, fp.width, fp.height, m == 1, 1, &gl[m][f], NULL, err);
+            if (!ok) break;
+            rw->geo_loop = mr_median(gl[0] + 1, frames);
+            rw->geo_layered = mr_median(gl[1] + 1, frames);
             if (p->progress) fprintf(stderr, "bench multiview: shared work, %s, %d views done\n", rw->scene, rw->views);
             nrows++;
         }
@@ -225,7 +235,7 @@ static bool bench_shared(const mr_bench_multiview_params *p, mr_scene *const sce
     mr_csv_comment(csv, "mrcheck bench multiview: shared work per rig frame (issue 14), pcf shadows, no AO");
     mr_csv_header(csv, "scene,views,width,height,ms_frame_per_view_work,ms_frame_shared,speedup,cull_ms_per_view_work,"
                        "cull_ms_shared,shadow_maps_per_view_work,shadow_maps_shared,frustum_culls_per_view_work,"
-                       "frustum_culls_shared");
+                       "frustum_culls_shared,gbuffer_geometry_ms_loop,gbuffer_geometry_ms_layered");
     for (int i = 0; i < nrows; i++) {
         const shared_row *rw = &rows[i];
         mr_csv_quoted(csv, rw->scene);
@@ -241,6 +251,8 @@ static bool bench_shared(const mr_bench_multiview_params *p, mr_scene *const sce
         mr_csv_int(csv, rw->maps_shared);
         mr_csv_int(csv, rw->culls_per_view_work);
         mr_csv_int(csv, rw->culls_shared);
+        mr_csv_num(csv, "%.2f", rw->geo_loop);
+        mr_csv_num(csv, "%.2f", rw->geo_layered);
         mr_csv_end_row(csv);
     }
     mr_path_join(p->out_dir, "bench_multiview_shared.csv", path, sizeof path);
@@ -274,15 +286,19 @@ static bool bench_shared(const mr_bench_multiview_params *p, mr_scene *const sce
        "cone, focused on the scene's centre), pcf shadows (sun, cascades as the scene needs), no AO, read back; median "
        "of %d frames, the two ways alternating. Shared: one frustum cull + LOD choice for the union of the views' "
        "frusta and one shadow map fitted to the union per frame; per-view work: each view culls and fits and draws its "
-       "own maps (--views-per-view-work). cull ms: CPU culling, LOD and instance data, all views.\n\n",
+       "own maps (--views-per-view-work). cull ms: CPU culling, LOD and instance data, all views. Layered "
+       "experiment: the G-buffer pass's geometry alone (depth only, the shared list) for all views into one quilt, "
+       "one draw per view with its own instance matrices (loop) against one instanced draw per 16 views through "
+       "gl_ViewportIndex (layered); not part of the frame times.\n\n",
        mr_gpu_description(p->gfx.gpu), p->view_w, p->view_h, p->frames);
     MD("| scene | views | ms/frame per-view work | ms/frame shared | speed-up | cull ms per-view | cull ms shared | "
-       "shadow maps per-view | shared | culls per-view | shared |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+       "shadow maps per-view | shared | culls per-view | shared | geometry ms loop | geometry ms layered |\n"
+       "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int i = 0; i < nrows; i++)
-        MD("| %s | %d | %.1f | %.1f | %.2f | %.2f | %.2f | %d | %d | %d | %d |\n", rows[i].scene, rows[i].views,
-           rows[i].ms_per_view_work, rows[i].ms_shared, rows[i].ms_per_view_work / rows[i].ms_shared,
+        MD("| %s | %d | %.1f | %.1f | %.2f | %.2f | %.2f | %d | %d | %d | %d | %.1f | %.1f |\n", rows[i].scene,
+           rows[i].views, rows[i].ms_per_view_work, rows[i].ms_shared, rows[i].ms_per_view_work / rows[i].ms_shared,
            rows[i].cull_per_view_work, rows[i].cull_shared, rows[i].maps_per_view_work, rows[i].maps_shared,
-           rows[i].culls_per_view_work, rows[i].culls_shared);
+           rows[i].culls_per_view_work, rows[i].culls_shared, rows[i].geo_loop, rows[i].geo_layered);
 #undef MD
     mr_path_join(p->out_dir, "bench_multiview_shared.md", path, sizeof path);
     ok = ok && mr_file_write_atomic(path, md, len < cap ? len : cap - 1, err);
