@@ -20,11 +20,12 @@ const mr_opt mr_rig_opts[] = {
      "multi-view: total view cone in degrees", 0},
     {"view-fov", MR_OPT_DOUBLE, RIG(fov_deg), 0.01, 179, MR_RIG_DEFAULT_FOV, NULL,
      "multi-view: vertical field of view at the focal plane in degrees", 0},
-    {"views-per-view-work", MR_OPT_BOOL, RIG(per_view_work), 0, 1, 0, NULL,
-     "multi-view: cull and fit the shadow maps per view instead of once per frame (for comparison)", 0},
     {"focal-distance", MR_OPT_DOUBLE, RIG(focal_distance), 1e-30, 1e30, 0, NULL,
      "multi-view: distance of the focal (zero-parallax) plane in scene units (auto: the scene's centre)",
      MR_OPT_ZERO_AUTO},
+    /* issue 14 */
+    {"views-per-view-work", MR_OPT_BOOL, RIG(per_view_work), 0, 1, 0, NULL,
+     "multi-view: cull and fit the shadow maps per view instead of once per frame (for comparison)", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef RIG
