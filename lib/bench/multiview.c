@@ -497,14 +497,6 @@ bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err) 
         }
         mr_renderer_set_scene(r, NULL, NULL);
     }
-    if (ok) {
-        /* issue 14: the shared work, on the same two scenes. */
-        mr_scene *sc[2] = {hall.planned, synth};
-        const char *nm[2] = {tnames[0], tnames[2]};
-        mr_view vs[2] = {centre, centre};
-        vs[1].world_from_camera = mr_synth_viewpoint(&sp, MR_SYNTH_VIEW_AISLE);
-        ok = bench_shared(&p, sc, nm, vs, err);
-    }
     mr_scene_destroy(&synth);
     mr_demo_free(&hall);
     if (!ok) return false;

@@ -72,7 +72,7 @@ const mr_opt mr_bench_multiview_opts[] = {
     {"rays", MR_OPT_INT, MV(rays), 1, 1 << 16, 64, NULL, "reference rays per pixel", 0},
     {"quick", MR_OPT_BOOL, MV(quick), 0, 1, 0, NULL, "views 1 and 8 only", 0},
     {"shared-only", MR_OPT_BOOL, MV(shared_only), 0, 1, 0, NULL,
-     "only the shared-work table (issue 14: one cull and shadow map per rig frame vs per view)", 0},
+     "instead: the shared-work table (issue 14: one cull and shadow map per rig frame vs per view, layered rendering)", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef MV
