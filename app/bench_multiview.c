@@ -22,7 +22,7 @@ int bench_multiview(int argc, char **argv) {
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck bench multiview [--budget WxH] [--view-size WxH] [--table-size WxH] [--frames N] "
-                   "[--rays N] [--quick] [--out DIR]",
+                   "[--rays N] [--quick] [--shared-only] [--out DIR]",
                    &help))
         return 2;
     if (help) return 0;

@@ -160,6 +160,10 @@ int cmd_render(int argc, char **argv) {
             else if (!mr_cli_flag(opts, "quiet"))
                 printf("rendered %d views of %dx%d into %s/ (quilt %dx%d, focal distance %g) in %.0f ms\n", rr.views,
                        ql.tile_w, ql.tile_h, out, ql.cols, ql.rows, focal, rr.ms_total);
+            /* issue 14: what the views shared. */
+            if (rc == 0 && mr_cli_flag(opts, "verbose"))
+                fprintf(stderr, "mrcheck: render: %d views: %d frustum culls, %d shadow map passes, culling %.2f ms\n",
+                        rr.views, rr.frustum_culls, rr.shadow_maps, rr.cull_ms);
         } else if (lf_band > 0 && !app_lightfield_view(gfx.renderer, scene, &rp, (int)lf_band, &view, &fp, &view, &lf_map,
                                                        &err)) {
             rc = mr_cli_error(cmd, &err);

@@ -104,7 +104,11 @@ for b in "${benches[@]}"; do
         # Not in the default list: about 30 minutes here (13 cases x 2 views).
         run bench_shadows docs/bench/shadows $mr bench shadows --out docs/bench/shadows --quiet ;;
     multiview)
-        run bench_multiview docs/bench/multiview $mr bench multiview --out docs/bench/multiview --quiet ;;
+        run bench_multiview docs/bench/multiview $mr bench multiview --out docs/bench/multiview --quiet
+        # issue 14: the shared work (about 10 minutes here, mostly the
+        # synthetic factory's 48 views drawn per-view and shared).
+        run bench_multiview_shared docs/bench/multiview/shared \
+            $mr bench multiview --shared-only --out docs/bench/multiview/shared --quiet ;;
     map)
         # CPU only, about 10 s: the full photo counts 10..200, 5 seeds.
         run bench_map docs/bench/map $mr bench map --out docs/bench/map ;;

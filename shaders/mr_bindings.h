@@ -305,4 +305,11 @@
 #define MR_AO_METHOD_ID_SCHEER_BM          9 /* issue 18 (lane ao) */
 #define MR_AO_METHOD_MASK_STANDALONE       100
 
+/* issue 14: rig_layered (the layered-rendering experiment): all of a rig
+ * frame's views in one instanced draw, gl_ViewportIndex = instance % views;
+ * the projections take MR_LOC_PROJECTION .. + MR_RIG_LAYERED_MAX - 1. */
+#define MR_RIG_LAYERED_MAX                 16
+#define MR_LOC_RIG_SHIFT                   20 /* .. 35: camera x shift of each view */
+#define MR_LOC_RIG_VIEWS                   40
+
 #endif

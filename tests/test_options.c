@@ -343,6 +343,7 @@ static void test_tables(void) {
         N(mr_rig_params, "view-cone", cone_deg, 0, 179),
         N(mr_rig_params, "view-fov", fov_deg, 0.01, 179),
         N(mr_rig_params, "focal-distance", focal_distance, 1e-30, 1e30),
+        N(mr_rig_params, "views-per-view-work", per_view_work, 0, 1), /* issue 14 */
     };
     check_rows("mr_rig_opts", mr_rig_opts, ex_rg, (int)(sizeof ex_rg / sizeof ex_rg[0]));
     const expect ex_gh[] = {
@@ -413,6 +414,7 @@ static void test_tables(void) {
         N(mr_bench_multiview_params, "frames", frames, 1, 64),
         N(mr_bench_multiview_params, "rays", rays, 1, 1 << 16),
         N(mr_bench_multiview_params, "quick", quick, 0, 1),
+        N(mr_bench_multiview_params, "shared-only", shared_only, 0, 1), /* issue 14 */
     };
     const expect ex_bmp[] = {
         N(mr_bench_map_params, "seeds", seeds, 1, 1000),

@@ -248,6 +248,12 @@ typedef struct mr_bench_multiview_params {
     bool quick;                 /* views 1 and 8 only */
     bool progress;              /* a line per row on stderr */
     FILE *out;                  /* the tables; NULL: silent */
+    bool shared_only;           /* issue 14: instead of the tables above, the
+                                   shared-work table (bench_multiview_shared.*:
+                                   8, 24, 48 views at view_w x view_h on the demo
+                                   hall and the synthetic factory, shared vs
+                                   per-view culling and shadow maps, and the
+                                   layered experiment) */
 } mr_bench_multiview_params;
 #define MR_BENCH_MULTIVIEW_DEFAULTS .out_dir = "bench-out", .budget_w = 1024, .budget_h = 768, .view_w = 160, \
                                     .view_h = 120, .table_w = 1024, .table_h = 768, .frames = 3, .rays = 64

@@ -148,6 +148,165 @@ static double diag_of(const mr_scene *s) {
     return sqrt(d2);
 }
 
+/* issue 14: the shared work. Median ms of a rig frame (all views, read
+ * back) with one cull and one shadow map per frame against the old per-view
+ * work, side by side in one run (alternating, so load drifts hit both), on
+ * the demo hall and the synthetic factory (many nodes: culling counts). */
+typedef struct shared_row {
+    const char *scene;
+    int views;
+    double ms_per_view_work, ms_shared, cull_per_view_work, cull_shared;
+    double geo_loop, geo_layered; /* the G-buffer geometry alone, per-view loop vs layered */
+    int maps_per_view_work, maps_shared, culls_per_view_work, culls_shared;
+} shared_row;
+
+static bool bench_shared(const mr_bench_multiview_params *p, mr_scene *const scenes[2], const char *const names[2],
+                         const mr_view views[2], mr_error *err) {
+    mr_renderer *r = p->gfx.renderer;
+    static const int k_n[3] = {8, 24, 48};
+    shared_row rows[6];
+    int nrows = 0;
+    bool ok = true;
+    for (int sc = 0; ok && sc < 2; sc++) {
+        ok = mr_renderer_set_scene(r, scenes[sc], err);
+        for (int k = 0; ok && k < 3; k++) {
+            shared_row *rw = &rows[nrows];
+            memset(rw, 0, sizeof *rw);
+            rw->scene = names[sc];
+            rw->views = k_n[k];
+            mr_rig_params rp = MR_RIG_DEFAULTS;
+            rp.views = k_n[k];
+            mr_rig rig[2];
+            /* Focused on the scene's centre; the pinhole views' own fov. */
+            const mr_view *c = &views[sc];
+            rp.fov_deg = 2 * atan(0.5 * c->camera.height / c->camera.fy) / DEG;
+            double focal = mr_rig_auto_focal_distance(scenes[sc], c);
+            if (!(focal > 0)) focal = 10;
+            ok = mr_rig_make(&rp, (double)p->view_w / p->view_h, focal, &rig[0], err);
+            rig[1] = rig[0];
+            rig[1].per_view_work = true;
+            mr_frame_params fp = MR_FRAME_DEFAULTS;
+            fp.width = p->view_w;
+            fp.height = p->view_h;
+            fp.shadow.method = MR_SHADOW_PCF;
+            /* Every frame draws its maps (a moving rig): nothing is handed
+             * over from the last frame, only between a frame's views. */
+            fp.shadow.no_reuse = true;
+            mr_quilt_layout l;
+            ok = ok && mr_quilt_layout_make(NULL, rig[0].views, fp.width, fp.height, &l, err);
+            double t[2][64], cm[2][64];
+            int frames = p->frames > 64 ? 64 : p->frames;
+            mr_rig_result rr[2];
+            for (int f = -1; ok && f < frames; f++)
+                for (int m = 0; ok && m < 2; m++) {
+                    mr_image q = {0};
+                    double t0 = now_ms();
+                    ok = mr_render_rig(r, &rig[m], c, &fp, &l, NULL, &q, &rr[m], err);
+                    mr_image_free(&q);
+                    if (f >= 0) t[m][f] = now_ms() - t0, cm[m][f] = rr[m].cull_ms;
+                }
+            if (!ok) break;
+            rw->ms_shared = mr_median(t[0], frames);
+            rw->ms_per_view_work = mr_median(t[1], frames);
+            rw->cull_shared = mr_median(cm[0], frames);
+            rw->cull_per_view_work = mr_median(cm[1], frames);
+            rw->maps_shared = rr[0].shadow_maps;
+            rw->maps_per_view_work = rr[1].shadow_maps;
+            rw->culls_shared = rr[0].frustum_culls;
+            rw->culls_per_view_work = rr[1].frustum_culls;
+            /* The layered experiment: the first run of each compiles the
+             * shader variants; alternating pairs of runs after it. */
+            double gl[2][65];
+            for (int f = 0; ok && f <= frames; f++)
+                for (int m = 0; ok && m < 2; m++)
+                    ok = mr_rig_geometry_time(r, &rig[0], c, fp.width, fp.height, m == 1, 1, &gl[m][f], NULL, err);
+            if (!ok) break;
+            rw->geo_loop = mr_median(gl[0] + 1, frames);
+            rw->geo_layered = mr_median(gl[1] + 1, frames);
+            if (p->progress) fprintf(stderr, "bench multiview: shared work, %s, %d views done\n", rw->scene, rw->views);
+            nrows++;
+        }
+        mr_renderer_set_scene(r, NULL, NULL);
+    }
+    if (!ok) return false;
+    char path[4096];
+    mr_csv *csv = mr_csv_create(err);
+    if (!csv) return false;
+    mr_csv_comment(csv, "mrcheck bench multiview: shared work per rig frame (issue 14), pcf shadows, no AO");
+    mr_csv_header(csv, "scene,views,width,height,ms_frame_per_view_work,ms_frame_shared,speedup,cull_ms_per_view_work,"
+                       "cull_ms_shared,shadow_maps_per_view_work,shadow_maps_shared,frustum_culls_per_view_work,"
+                       "frustum_culls_shared,gbuffer_geometry_ms_loop,gbuffer_geometry_ms_layered");
+    for (int i = 0; i < nrows; i++) {
+        const shared_row *rw = &rows[i];
+        mr_csv_quoted(csv, rw->scene);
+        mr_csv_int(csv, rw->views);
+        mr_csv_int(csv, p->view_w);
+        mr_csv_int(csv, p->view_h);
+        mr_csv_num(csv, "%.2f", rw->ms_per_view_work);
+        mr_csv_num(csv, "%.2f", rw->ms_shared);
+        mr_csv_num(csv, "%.3f", rw->ms_per_view_work / rw->ms_shared);
+        mr_csv_num(csv, "%.3f", rw->cull_per_view_work);
+        mr_csv_num(csv, "%.3f", rw->cull_shared);
+        mr_csv_int(csv, rw->maps_per_view_work);
+        mr_csv_int(csv, rw->maps_shared);
+        mr_csv_int(csv, rw->culls_per_view_work);
+        mr_csv_int(csv, rw->culls_shared);
+        mr_csv_num(csv, "%.2f", rw->geo_loop);
+        mr_csv_num(csv, "%.2f", rw->geo_layered);
+        mr_csv_end_row(csv);
+    }
+    mr_path_join(p->out_dir, "bench_multiview_shared.csv", path, sizeof path);
+    ok = mr_csv_save(csv, path, err);
+    mr_csv_destroy(&csv);
+    double xs[4][3], ys[4][3];
+    int cnt[4] = {0};
+    for (int i = 0; i < nrows; i++) {
+        int sc = i / 3;
+        for (int m = 0; m < 2; m++) {
+            xs[2 * sc + m][cnt[2 * sc + m]] = rows[i].views;
+            ys[2 * sc + m][cnt[2 * sc + m]++] = m ? rows[i].ms_per_view_work : rows[i].ms_shared;
+        }
+    }
+    char sn[4][96];
+    mr_plot_series ser[4];
+    for (int k = 0; k < 4; k++) {
+        snprintf(sn[k], sizeof sn[k], "%s, %s", names[k / 2], k & 1 ? "per-view work" : "shared");
+        ser[k] = (mr_plot_series){.name = sn[k], .x = xs[k], .y = ys[k], .count = cnt[k], .dashed = (k & 1) != 0,
+                                  .mark = k & 1 ? MR_PLOT_MARK_SQUARE : MR_PLOT_MARK_CIRCLE};
+    }
+    mr_plot_params pp = {.title = "mrcheck bench multiview: ms per rig frame, shared vs per-view culling and shadow maps",
+                         .xlabel = "views", .ylabel = "ms per frame", .log_x = true, .log_y = true};
+    mr_path_join(p->out_dir, "bench_multiview_shared.svg", path, sizeof path);
+    ok = ok && mr_plot_write(path, &pp, ser, 4, err);
+    size_t cap = 8192, len = 0;
+    char *md = malloc(cap);
+    if (!md) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+#define MD(...) do { if (len < cap) len += (size_t)snprintf(md + len, cap - len, __VA_ARGS__); } while (0)
+    MD("# mrcheck bench multiview: shared work (issue 14)\n\nGPU: %s. A rig frame of N views of %dx%d (35 degree "
+       "cone, focused on the scene's centre), pcf shadows (sun, cascades as the scene needs), no AO, read back; median "
+       "of %d frames, the two ways alternating. Shared: one frustum cull + LOD choice for the union of the views' "
+       "frusta and one shadow map fitted to the union per frame; per-view work: each view culls and fits and draws its "
+       "own maps (--views-per-view-work). cull ms: CPU culling, LOD and instance data, all views. Layered "
+       "experiment: the G-buffer pass's geometry alone (depth only, the shared list) for all views into one quilt, "
+       "one draw per view with its own instance matrices (loop) against one instanced draw per 16 views through "
+       "gl_ViewportIndex (layered); not part of the frame times.\n\n",
+       mr_gpu_description(p->gfx.gpu), p->view_w, p->view_h, p->frames);
+    MD("| scene | views | ms/frame per-view work | ms/frame shared | speed-up | cull ms per-view | cull ms shared | "
+       "shadow maps per-view | shared | culls per-view | shared | geometry ms loop | geometry ms layered |\n"
+       "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (int i = 0; i < nrows; i++)
+        MD("| %s | %d | %.1f | %.1f | %.2f | %.2f | %.2f | %d | %d | %d | %d | %.1f | %.1f |\n", rows[i].scene,
+           rows[i].views, rows[i].ms_per_view_work, rows[i].ms_shared, rows[i].ms_per_view_work / rows[i].ms_shared,
+           rows[i].cull_per_view_work, rows[i].cull_shared, rows[i].maps_per_view_work, rows[i].maps_shared,
+           rows[i].culls_per_view_work, rows[i].culls_shared, rows[i].geo_loop, rows[i].geo_layered);
+#undef MD
+    mr_path_join(p->out_dir, "bench_multiview_shared.md", path, sizeof path);
+    ok = ok && mr_file_write_atomic(path, md, len < cap ? len : cap - 1, err);
+    if (ok) BENCH_PRINT(p->out, "%.*s\nwrote %s/bench_multiview_shared{.csv,.svg,.md}\n", (int)len, md, p->out_dir);
+    free(md);
+    return ok;
+}
+
 typedef struct row {
     const char *mode;
     int views, w, h;
@@ -177,6 +336,22 @@ bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err) 
     mr_scene *scene = hall.planned;
     mr_view centre = p.view ? *p.view : mr_demo_view(0);
     memset(centre.camera.dist, 0, sizeof centre.camera.dist);
+    if (p.shared_only) {
+        /* issue 14: the shared-work table alone. */
+        mr_synth_params sp = MR_SYNTH_DEFAULTS;
+        mr_scene *synth = mr_synth_build(&sp, err);
+        bool ok = synth != NULL;
+        if (ok) {
+            mr_scene *sc[2] = {scene, synth};
+            const char *nm[2] = {"demo hall (planned)", "synthetic factory"};
+            mr_view vs[2] = {centre, centre};
+            vs[1].world_from_camera = mr_synth_viewpoint(&sp, MR_SYNTH_VIEW_AISLE);
+            ok = bench_shared(&p, sc, nm, vs, err);
+        }
+        mr_scene_destroy(&synth);
+        mr_demo_free(&hall);
+        return ok;
+    }
     double radius = 0.02 * diag_of(scene);
     mr_eval_gt *gt = NULL;
     bool ok = mr_renderer_set_scene(r, scene, err) && (gt = mr_eval_gt_create(scene, false, err)) != NULL;

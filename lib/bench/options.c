@@ -71,6 +71,8 @@ const mr_opt mr_bench_multiview_opts[] = {
     {"frames", MR_OPT_INT, MV(frames), 1, 64, 3, NULL, "timed runs, median reported", 0},
     {"rays", MR_OPT_INT, MV(rays), 1, 1 << 16, 64, NULL, "reference rays per pixel", 0},
     {"quick", MR_OPT_BOOL, MV(quick), 0, 1, 0, NULL, "views 1 and 8 only", 0},
+    {"shared-only", MR_OPT_BOOL, MV(shared_only), 0, 1, 0, NULL,
+     "instead: the shared-work table (issue 14: one cull and shadow map per rig frame vs per view, layered rendering)", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef MV

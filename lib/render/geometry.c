@@ -111,6 +111,7 @@ void mr_geometry_begin_frame(mr_renderer *r) { memset(&r->stats, 0, sizeof r->st
 /* ------------------------------------------------------------- upload */
 
 void mr_geometry_free(mr_renderer *r) {
+    mr_geometry_share_end(r); /* its lists index this geometry */
     struct mr_geo *g = r->geo;
     if (g) {
         glDeleteVertexArrays(2, g->vao);
@@ -450,34 +451,31 @@ static bool fill_instance(const mr_geo_view *vw, const mr_node *n, const mr_mesh
     return true;
 }
 
-/* Steps 2-4 for a list of visible nodes: LOD choice, bucketing, instance
- * records and commands, submission. Adds to the frame's statistics. */
-static void submit_nodes(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *out, const int32_t *nodes,
-                         int32_t nvis) {
+/* Largest pixels per unit of x/z over the image (its corners, with the
+ * margin): the LOD choice's projected-error factor. */
+double mr_geometry_lod_fmax(const mr_camera *c) {
+    double ax = fmax(fabs((-1.5 - c->cx) / c->fx), fabs((c->width + 0.5 - c->cx) / c->fx));
+    double ay = fmax(fabs((-1.5 - c->cy) / c->fy), fabs((c->height + 0.5 - c->cy) / c->fy));
+    return fmax(c->fx, c->fy) * sqrt(1 + ax * ax + ay * ay);
+}
+
+/* Step 2 for a list of visible nodes: LOD choice (the depth row of
+ * vw->cam_from_world, its near plane and fmax_t decide) and bucketing of
+ * the (node, mesh) pairs into dst, sorted by key; returns their count. */
+static size_t select_recs(mr_renderer *r, const mr_geo_view *vw, double fmax_t, const int32_t *nodes, int32_t nvis,
+                          geo_rec *dst) {
     const mr_scene *s = r->scene;
     struct mr_geo *g = r->geo;
     const mr_draw_params *dp = &r->draw;
-    double t0 = mr_time_now();
-
-    /* 2. LOD choice and bucketing of (node, mesh) pairs. */
     /* No absolute cap by default: the projected error alone decides, which
      * knows no unit (a hall in millimetres picks the levels it picks in
      * metres); an explicit tolerance, in the scene's own units, caps it. */
     double tol = dp->lod_tolerance == 0 ? INFINITY : dp->lod_tolerance;
     double pix = dp->lod_pixels == 0 ? MR_DRAW_DEFAULT_LOD_PIXELS : dp->lod_pixels;
     bool use_lod = g->lod && !dp->no_lod && tol > 0;
-    double fmax_t = 0;
-    if (use_lod) {
-        /* Largest |x/z|, |y/z| over the image corners (with the margin). */
-        double ax = fmax(fabs((-1.5 - vw->cam.cx) / vw->cam.fx), fabs((vw->cam.width + 0.5 - vw->cam.cx) / vw->cam.fx));
-        double ay = fmax(fabs((-1.5 - vw->cam.cy) / vw->cam.fy), fabs((vw->cam.height + 0.5 - vw->cam.cy) / vw->cam.fy));
-        fmax_t = fmax(vw->cam.fx, vw->cam.fy) * sqrt(1 + ax * ax + ay * ay);
-    }
     size_t nkeys = (size_t)g->mesh_count * LEVELS;
     memset(g->key_count, 0, (nkeys + 1) * sizeof *g->key_count);
     size_t nrec = 0;
-    uint64_t tri_full = 0;
-    uint32_t lod_inst = 0;
     for (int32_t vi = 0; vi < nvis; vi++) {
         int32_t ni = nodes[vi];
         const mr_node *n = &s->nodes[ni];
@@ -488,11 +486,6 @@ static void submit_nodes(mr_renderer *r, const mr_geo_view *vw, mr_frame_result 
             const geo_mesh *gm = &g->meshes[mi];
             if (gm->count[0] == 0) continue;
             int level = use_lod && gm->level_count > 1 && isfinite(ppu) ? choose_level(gm, g->node_scale[ni], ppu, tol, pix) : 0;
-            lod_inst += level > 0;
-            r->stats.level_instances[level]++;
-            if (level > 0 && gm->error[level] * g->node_scale[ni] > r->stats.lod_max_error)
-                r->stats.lod_max_error = gm->error[level] * g->node_scale[ni];
-            tri_full += gm->count[0] / 3;
             uint32_t key = (uint32_t)g->rank[mi] * LEVELS + (uint32_t)level;
             g->recs[nrec++] = (geo_rec){ni, mi, key};
             g->key_count[key]++;
@@ -505,18 +498,37 @@ static void submit_nodes(mr_renderer *r, const mr_geo_view *vw, mr_frame_result 
         g->key_count[k] = sum;
         sum += c;
     }
-    for (size_t i = 0; i < nrec; i++) g->sorted[g->key_count[g->recs[i].key]++] = g->recs[i];
+    for (size_t i = 0; i < nrec; i++) dst[g->key_count[g->recs[i].key]++] = g->recs[i];
+    return nrec;
+}
+
+/* Steps 3-4 for sorted records: instance data through vw's camera,
+ * commands, submission. Adds to the frame's statistics. replicate >= 1
+ * (issue 14's layered experiment): every instance drawn that many times
+ * (attribute divisor = replicate), the caller sets the projections; 0: a
+ * plain draw. */
+static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *out, const geo_rec *sorted, size_t nrec,
+                      int replicate) {
+    const mr_scene *s = r->scene;
+    struct mr_geo *g = r->geo;
+    const mr_draw_params *dp = &r->draw;
+    double t0 = mr_time_now();
 
     /* 3. Instance data and commands, one per bucket (or per instance). */
-    uint32_t ninst = 0, ncmd = 0, last_key = UINT32_MAX;
-    uint64_t tris = 0;
+    uint32_t ninst = 0, ncmd = 0, last_key = UINT32_MAX, lod_inst = 0;
+    uint64_t tris = 0, tri_full = 0;
     memset(g->group_cmds, 0, (size_t)g->group_count * sizeof *g->group_cmds);
     for (int32_t k = 0; k < g->group_count; k++) g->group_first[k] = -1;
     for (size_t i = 0; i < nrec; i++) {
-        const geo_rec *rc = &g->sorted[i];
+        const geo_rec *rc = &sorted[i];
         const geo_mesh *gm = &g->meshes[rc->mesh];
-        if (!fill_instance(vw, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, rc->node, &g->inst[ninst])) continue;
         int level = (int)(rc->key % LEVELS);
+        lod_inst += level > 0;
+        r->stats.level_instances[level]++;
+        if (level > 0 && gm->error[level] * g->node_scale[rc->node] > r->stats.lod_max_error)
+            r->stats.lod_max_error = gm->error[level] * g->node_scale[rc->node];
+        tri_full += gm->count[0] / 3;
+        if (!fill_instance(vw, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, rc->node, &g->inst[ninst])) continue;
         /* Same bucket as the last command (records skipped as degenerate
          * leave no gap: the command's instances stay contiguous). */
         bool extend = !dp->no_instancing && ncmd > 0 && last_key == rc->key;
@@ -542,12 +554,18 @@ static void submit_nodes(mr_renderer *r, const mr_geo_view *vw, mr_frame_result 
     if (ninst == 0 || !have_room) return; /* nothing to draw costs nothing */
 
     /* 4. Submission. */
+    if (replicate >= 1) {
+        for (uint32_t c = 0; c < ncmd; c++) g->cmds[c].instance_count *= (uint32_t)replicate;
+        for (int p = 0; p < 2; p++) glVertexArrayBindingDivisor(g->vao[p], 1, (GLuint)replicate);
+    }
     glNamedBufferSubData(g->inst_buf, 0, (GLsizeiptr)ninst * (GLsizeiptr)sizeof(gpu_instance), g->inst);
     glNamedBufferData(g->cmd_buf, (GLsizeiptr)ncmd * (GLsizeiptr)sizeof(draw_cmd), g->cmds, GL_STREAM_DRAW);
     glUseProgram(vw->program);
-    float proj[16];
-    mr_gl_projection(&vw->cam, vw->near_plane, proj);
-    glUniformMatrix4fv(MR_LOC_PROJECTION, 1, GL_FALSE, proj);
+    if (replicate == 0) {
+        float proj[16];
+        mr_gl_projection(&vw->cam, vw->near_plane, proj);
+        glUniformMatrix4fv(MR_LOC_PROJECTION, 1, GL_FALSE, proj);
+    }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, g->cmd_buf);
     uint32_t calls = 0;
     for (int32_t grp = 0; grp < g->group_count; grp++) {
@@ -572,11 +590,24 @@ static void submit_nodes(mr_renderer *r, const mr_geo_view *vw, mr_frame_result 
     }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     glBindVertexArray(0);
+    if (replicate > 1)
+        for (int p = 0; p < 2; p++) glVertexArrayBindingDivisor(g->vao[p], 1, 1);
     r->stats.gl_draw_calls += calls;
     if (out) {
         out->triangles += tris;
         out->draw_calls += calls;
     }
+}
+
+/* Steps 2-4 for a list of visible nodes through one view. */
+static void submit_nodes(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *out, const int32_t *nodes,
+                         int32_t nvis) {
+    struct mr_geo *g = r->geo;
+    double t0 = mr_time_now();
+    double fmax_t = g->lod && !r->draw.no_lod ? mr_geometry_lod_fmax(&vw->cam) : 0;
+    size_t nrec = select_recs(r, vw, fmax_t, nodes, nvis, g->sorted);
+    r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
+    emit_recs(r, vw, out, g->sorted, nrec, 0);
 }
 
 /* ---------------------------------------------------- occlusion culling
@@ -694,6 +725,77 @@ static bool occluded(const struct mr_geo *g, int levels, const double rect[4], d
     return true;
 }
 
+/* ------------------------------------------- shared culling (issue 14)
+ *
+ * A multi-view rig's views differ by a translation along the camera's x
+ * axis only. Between share_begin and share_end, a draw through one of them
+ * (mr_geo_view.shared) culls once per layer set against the union volume
+ * and picks LOD levels once (the views' depth row is the same; the nearest
+ * near plane and the largest pixel factor of all views make the choice the
+ * finest any view would make); every view then only writes its own
+ * camera-relative instance matrices and draws that list. */
+
+#define SHARE_LISTS 4
+
+typedef struct share_list {
+    uint32_t mask;
+    int32_t nvis;
+    size_t nrec;
+    geo_rec *recs;
+} share_list;
+
+struct mr_geo_share {
+    mr_frustum cull;
+    mr_geo_view lod_view;
+    double fmax_t;
+    int n;
+    share_list list[SHARE_LISTS];
+};
+
+bool mr_geometry_share_begin(mr_renderer *r, const mr_frustum *cull, const mr_dmat4 *cam_from_world, double near_plane,
+                             double fmax_t, mr_error *err) {
+    mr_geometry_share_end(r);
+    if (!r->geo) return true; /* nothing to draw: nothing to share */
+    struct mr_geo_share *sh = calloc(1, sizeof *sh);
+    if (!sh) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    sh->cull = *cull;
+    sh->lod_view.cam_from_world = *cam_from_world;
+    sh->lod_view.near_plane = near_plane;
+    sh->fmax_t = fmax_t;
+    r->share = sh;
+    return true;
+}
+
+void mr_geometry_share_end(mr_renderer *r) {
+    struct mr_geo_share *sh = r->share;
+    if (!sh) return;
+    for (int i = 0; i < sh->n; i++) free(sh->list[i].recs);
+    free(sh);
+    r->share = NULL;
+}
+
+/* The shared list of this draw's layers (culled and chosen on first use);
+ * NULL: none can be made (then the draw culls on its own). */
+static const share_list *shared_list(mr_renderer *r, uint32_t mask) {
+    struct mr_geo_share *sh = r->share;
+    struct mr_geo *g = r->geo;
+    for (int i = 0; i < sh->n; i++)
+        if (sh->list[i].mask == mask) return &sh->list[i];
+    if (sh->n == SHARE_LISTS) return NULL;
+    share_list *l = &sh->list[sh->n];
+    l->recs = malloc((g->max_recs + 1) * sizeof *l->recs);
+    if (!l->recs) return NULL;
+    double t0 = mr_time_now();
+    mr_bvh_stats bst;
+    l->nvis = mr_bvh_cull(g->bvh, r->draw.no_cull ? NULL : &sh->cull, mask, g->visible, &bst);
+    r->stats.frustum_culls++;
+    l->nrec = select_recs(r, &sh->lod_view, sh->fmax_t, g->visible, l->nvis, l->recs);
+    l->mask = mask;
+    sh->n++;
+    r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
+    return l;
+}
+
 void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *out) {
     uint32_t layer_mask = vw->layers;
     const mr_scene *s = r->scene;
@@ -702,10 +804,24 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     const mr_draw_params *dp = &r->draw;
     double t0 = mr_time_now();
 
+    /* A rig's view draws the frame's shared list (occlusion culling reads
+     * each view's own depth, so it stays per view). */
+    if (vw->shared && r->share && !(dp->occlusion && !dp->no_cull)) {
+        const share_list *l = shared_list(r, layer_mask);
+        if (l) {
+            for (int k = 0; k < MR_LAYER_COUNT; k++)
+                if (layer_mask & (1u << k)) r->stats.nodes_drawable += g->drawable[k];
+            r->stats.nodes_visible += (uint32_t)l->nvis;
+            emit_recs(r, vw, out, l->recs, l->nrec, 0);
+            return;
+        }
+    }
+
     /* 1. Frustum culling. */
     mr_frustum fr = mr_frustum_from_camera(&vw->cam, &vw->world_from_camera, vw->near_plane, 1.0);
     mr_bvh_stats bst;
     int32_t nvis = mr_bvh_cull(g->bvh, dp->no_cull ? NULL : &fr, layer_mask, g->visible, &bst);
+    r->stats.frustum_culls++;
     uint32_t ndrawable = 0;
     for (int l = 0; l < MR_LAYER_COUNT; l++)
         if (layer_mask & (1u << l)) ndrawable += g->drawable[l];
@@ -780,6 +896,14 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     r->stats.nodes_occluded += (uint32_t)(nrest - nkeep);
     r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
     submit_nodes(r, vw, out, rest, nkeep);
+}
+
+bool mr_geometry_draw_replicated(mr_renderer *r, const mr_geo_view *vw, int replicate) {
+    if (!r->scene || !r->geo || !r->share) return false;
+    const share_list *l = shared_list(r, vw->layers);
+    if (!l) return false;
+    emit_recs(r, vw, NULL, l->recs, l->nrec, replicate);
+    return true;
 }
 
 /* ------------------------------------------------------ auxiliary streams */

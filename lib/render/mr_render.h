@@ -479,6 +479,8 @@ typedef struct mr_rig_params {
     double focal_distance;  /* D in scene units; 0 = the median depth the centre
                                view sees in its middle third (mr_rig_focal_from_depth),
                                else the scene's centre (mr_rig_auto_focal_distance) */
+    bool per_view_work;     /* issue 14: cull and fit the shadow maps per view, as
+                               before the shared work (for comparison) */
 } mr_rig_params;
 #define MR_RIG_DEFAULT_CONE 35.0
 #define MR_RIG_DEFAULT_FOV 14.0
@@ -495,6 +497,7 @@ typedef struct mr_rig {
     double distance;        /* D, scene units */
     double size;            /* half-height of the focal plane's rectangle, scene units */
     double aspect;          /* view aspect: half-width / half-height of that rectangle */
+    bool per_view_work;     /* from mr_rig_params */
 } mr_rig;
 
 /* D = size / tan(fov/2): the focal distance at which a focal plane of
@@ -605,10 +608,47 @@ double mr_display_column_error(const mr_display_map *m, const mr_camera *cam, in
 typedef struct mr_rig_result {
     double ms_total;        /* wall-clock, all views, glFinish'ed */
     int views;
+    /* issue 14: the shared work, summed over the views */
+    int frustum_culls;      /* BVH culls (G-buffer and shadow maps) */
+    int shadow_maps;        /* shadow_map passes run */
+    double cull_ms;         /* CPU: culling, LOD, instance data */
 } mr_rig_result;
 bool mr_render_rig(mr_renderer *r, const mr_rig *rig, const mr_view *centre, const mr_frame_params *params,
                    const mr_quilt_layout *layout, const char *views_dir, mr_image *quilt, mr_rig_result *res,
                    mr_error *err);
+
+/* issue 14: the work a rig frame shares. The views (width x height pixels,
+ * mr_rig_view) are translated along the centre camera's x axis and share
+ * its orientation, so every view's frustum lies in one convex volume: the
+ * bottom/top planes (the same slopes) and the near plane (the nearest of
+ * the views') are shared; left is the plane through the leftmost eye with
+ * the smallest left slope of any view, right the one through the rightmost
+ * eye with the largest right slope (margin_px widens each view's image as
+ * mr_frustum_from_camera does). A point of view i's frustum has x - s_i >=
+ * l_i z, so x - s_min >= l_min z for z >= 0; with an infinite far plane
+ * this is the convex hull of the views' frusta. */
+mr_frustum mr_rig_cull_frustum(const mr_rig *rig, const mr_view *centre, int width, int height, double near_plane,
+                               double margin_px);
+/* Between begin and end, mr_render_frame of the rig's views shares one
+ * cull and LOD choice for the union (every view draws that list through
+ * its own camera) and, with shadows, one shadow map per frame (fitted to
+ * the union: the outer views' frusta and the union's visible depth; the
+ * other views reuse it). Nothing is shared with rig->per_view_work or
+ * fewer than 2 views. mr_render_rig calls them. */
+bool mr_render_rig_begin(mr_renderer *r, const mr_rig *rig, const mr_view *centre, int width, int height,
+                         mr_error *err);
+void mr_render_rig_end(mr_renderer *r);
+/* issue 14, the layered-rendering experiment: the G-buffer pass's geometry
+ * work (depth only, the rig frame's shared cull) for all views into one
+ * quilt depth target, either as the per-view loop does it (one draw per
+ * view with that view's instance matrices) or layered: one instanced draw
+ * per 16 views whose copies go to their eyes and tiles through
+ * gl_ViewportIndex (GL_ARB_shader_viewport_layer_array). ms[0..frames-1]:
+ * wall-clock per run, glFinish'ed; depth (NULL: not read): the quilt's
+ * reversed-Z depth, rows bottom-up. Not used by mr_render_rig: the frame's
+ * other passes still run per view (see docs/bench/multiview). */
+bool mr_rig_geometry_time(mr_renderer *r, const mr_rig *rig, const mr_view *centre, int w, int h, bool layered,
+                          int frames, double *ms, mr_image *depth, mr_error *err);
 
 /* -------------------------------------------------------------- picking */
 
@@ -817,6 +857,8 @@ typedef struct mr_draw_stats {
     uint32_t level_instances[MR_LOD_MAX_LEVELS + 1]; /* instances drawn at
                                   each level: 0 full detail, 1 the finest
                                   simplified level, ... */
+    uint32_t frustum_culls;    /* issue 14: BVH frustum culls run (a rig
+                                  frame's shared list: once, in its first view) */
 } mr_draw_stats;
 
 /* Sets how geometry is submitted from the next frame on (NULL: defaults). */

@@ -1,7 +1,7 @@
 /* Multi-view rigs and quilts for 3D displays: the frusta, the views as
  * pinhole cameras, the quilt layout and its file name (pure functions), and
  * the loop that renders a rig's views with one renderer. */
-#include "mr_render.h"
+#include "render_internal.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -23,6 +23,9 @@ const mr_opt mr_rig_opts[] = {
     {"focal-distance", MR_OPT_DOUBLE, RIG(focal_distance), 1e-30, 1e30, 0, NULL,
      "multi-view: distance of the focal (zero-parallax) plane in scene units (auto: the scene's centre)",
      MR_OPT_ZERO_AUTO},
+    /* issue 14 */
+    {"views-per-view-work", MR_OPT_BOOL, RIG(per_view_work), 0, 1, 0, NULL,
+     "multi-view: cull and fit the shadow maps per view instead of once per frame (for comparison)", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef RIG
@@ -47,6 +50,7 @@ bool mr_rig_make(const mr_rig_params *p, double aspect, double distance, mr_rig 
     rig->distance = distance;
     rig->size = distance * tan(0.5 * rig->fov);
     rig->aspect = aspect;
+    rig->per_view_work = p->per_view_work;
     return true;
 }
 
@@ -231,6 +235,205 @@ void mr_quilt_file_name(const char *name, const mr_quilt_layout *q, char *out, s
     snprintf(out, n, "%s_qs%dx%da%.4g.png", name, q->cols, q->rows, q->aspect);
 }
 
+/* The union volume in the centre camera's axes: a.xyz . p + a.w >= 0. */
+static void rig_planes(const mr_rig *rig, const mr_view *centre, int w, int h, double near_plane, double margin_px,
+                       double planes[5][4]) {
+    double a0 = INFINITY, a1 = -INFINITY, e0 = INFINITY, e1 = -INFINITY, b0 = 0, b1 = 0;
+    for (int i = 0; i < rig->views; i++) {
+        mr_view v = mr_rig_view(rig, centre, i, w, h);
+        const mr_camera *c = &v.camera;
+        double s = mr_rig_shift(rig, i);
+        /* As mr_frustum_from_camera: the image edges at -0.5 and w - 0.5. */
+        a0 = fmin(a0, (-0.5 - margin_px - c->cx) / c->fx);
+        a1 = fmax(a1, (c->width - 0.5 + margin_px - c->cx) / c->fx);
+        b0 = (-0.5 - margin_px - c->cy) / c->fy;
+        b1 = (c->height - 0.5 + margin_px - c->cy) / c->fy;
+        e0 = fmin(e0, s);
+        e1 = fmax(e1, s);
+    }
+    const double p[5][4] = {
+        {1, 0, -a0, -e0}, /* x - e0 >= a0 z */
+        {-1, 0, a1, e1},  /* x - e1 <= a1 z */
+        {0, 1, -b0, 0},
+        {0, -1, b1, 0},
+        {0, 0, 1, -near_plane},
+    };
+    memcpy(planes, p, sizeof p);
+}
+
+mr_frustum mr_rig_cull_frustum(const mr_rig *rig, const mr_view *centre, int width, int height, double near_plane,
+                               double margin_px) {
+    double cp[5][4];
+    rig_planes(rig, centre, width, height, near_plane, margin_px, cp);
+    mr_frustum f;
+    memset(&f, 0, sizeof f);
+    const double *M = centre->world_from_camera.m;
+    mr_dvec3 t = mr_v3(M[3], M[7], M[11]);
+    for (int i = 0; i < 5; i++) {
+        /* p_cam = R^T (P - t): n . p_cam + w = (R n) . P - (R n) . t + w. */
+        double nw[3];
+        for (int r = 0; r < 3; r++) nw[r] = M[r * 4 + 0] * cp[i][0] + M[r * 4 + 1] * cp[i][1] + M[r * 4 + 2] * cp[i][2];
+        double len = sqrt(nw[0] * nw[0] + nw[1] * nw[1] + nw[2] * nw[2]);
+        for (int k = 0; k < 3; k++) f.planes[i][k] = nw[k] / len;
+        f.planes[i][3] = (cp[i][3] - (nw[0] * t.x + nw[1] * t.y + nw[2] * t.z)) / len;
+    }
+    f.plane_count = 5;
+    return f;
+}
+
+void mr_render_rig_end(mr_renderer *r) {
+    mr_geometry_share_end(r);
+    free((void *)r->rig);
+    r->rig = NULL;
+}
+
+bool mr_render_rig_begin(mr_renderer *r, const mr_rig *rig, const mr_view *centre, int width, int height,
+                         mr_error *err) {
+    mr_render_rig_end(r);
+    if (rig->views < 2 || rig->per_view_work || !r->scene) return true;
+    mr_rig_share *sh = calloc(1, sizeof *sh);
+    if (!sh) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    /* The views' near planes (each eye's own, as mr_render_frame picks
+     * it): the nearest bounds them all; the LOD factor: the largest. */
+    double near_plane = INFINITY, fmax_t = 0;
+    for (int i = 0; i < rig->views; i++) {
+        mr_view v = mr_rig_view(rig, centre, i, width, height);
+        near_plane = fmin(near_plane, mr_render_near_plane(r->scene, &v.world_from_camera));
+        fmax_t = fmax(fmax_t, mr_geometry_lod_fmax(&v.camera));
+        if (i == 0 || i == rig->views - 1) {
+            int k = i == 0 ? 0 : 1;
+            sh->cam[k] = v.camera;
+            sh->world_from_camera[k] = v.world_from_camera;
+        }
+    }
+    static unsigned serial;
+    sh->serial = ++serial ? serial : ++serial; /* never 0 */
+    sh->views = rig->views;
+    sh->near_plane = near_plane;
+    sh->centre_cam = sh->cam[0];
+    sh->centre_cam.cx = 0.5 * width - 0.5; /* no shear */
+    sh->world_from_centre = centre->world_from_camera;
+    sh->centre_from_world = mr_m4_invert_rigid(&centre->world_from_camera);
+    rig_planes(rig, centre, width, height, near_plane, 0.0, sh->planes);
+    /* The same margin as each view's own culling (geometry.c). */
+    mr_frustum fr = mr_rig_cull_frustum(rig, centre, width, height, near_plane, 1.0);
+    if (!mr_geometry_share_begin(r, &fr, &sh->centre_from_world, near_plane, fmax_t, err)) {
+        free(sh);
+        return false;
+    }
+    r->rig = sh;
+    return true;
+}
+
+bool mr_rig_geometry_time(mr_renderer *r, const mr_rig *rig, const mr_view *centre, int w, int h, bool layered,
+                          int frames, double *ms, mr_image *depth, mr_error *err) {
+    if (!r->scene) return mr_fail(err, MR_ERR_INVALID, "the layered experiment needs a scene");
+    if (frames < 1 || frames > 64) return mr_fail(err, MR_ERR_INVALID, "frames must be in [1, 64]");
+    GLint max_vp = 0;
+    glGetIntegerv(GL_MAX_VIEWPORTS, &max_vp);
+    int per_draw = max_vp < MR_RIG_LAYERED_MAX ? max_vp : MR_RIG_LAYERED_MAX;
+    if (layered && per_draw < 2) return mr_fail(err, MR_ERR_GL, "the GPU has no viewport arrays");
+    mr_quilt_layout l;
+    if (!mr_quilt_layout_make(NULL, rig->views, w, h, &l, err)) return false;
+    const char *const files[] = {"rig_layered.vert.glsl", "rig_layered.frag.glsl", NULL};
+    GLuint prog = mr_gl_program(files, err);
+    if (!prog) return false;
+    GLuint tex = mr_gl_make_tex(GL_DEPTH_COMPONENT32F, l.width, l.height, GL_NEAREST), fbo;
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, tex, 0);
+    glNamedFramebufferDrawBuffer(fbo, GL_NONE);
+    bool ok = glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    if (!ok) mr_fail(err, MR_ERR_GL, "layered experiment: framebuffer incomplete");
+    /* Shared culling as in a rig frame (per_view_work left aside: both
+     * ways draw the same list, only the submission differs). */
+    mr_rig shared = *rig;
+    shared.per_view_work = false;
+    ok = ok && mr_render_rig_begin(r, &shared, centre, w, h, err);
+    if (ok && !r->share) ok = mr_fail(err, MR_ERR_INVALID, "the layered experiment needs 2 or more views");
+    mr_view *vs = ok ? malloc((size_t)rig->views * sizeof *vs) : NULL;
+    if (ok && !vs) ok = mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    for (int i = 0; ok && i < rig->views; i++) vs[i] = mr_rig_view(rig, centre, i, w, h);
+    double near_plane = ok ? r->rig->near_plane : 1;
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glUseProgram(prog);
+    for (int f = 0; ok && f < frames; f++) {
+        glFinish();
+        double t0 = mr_time_now();
+        static const float zero = 0;
+        glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &zero);
+        if (!layered) {
+            /* The per-view loop: each view's own instance matrices. */
+            glUniform1i(MR_LOC_RIG_VIEWS, 1);
+            glUniform1f(MR_LOC_RIG_SHIFT, 0.0f);
+            for (int i = 0; i < rig->views; i++) {
+                int x0, y0;
+                mr_quilt_tile_origin(&l, i, &x0, &y0);
+                glViewportIndexedf(0, (float)x0, (float)(l.height - y0 - h), (float)w, (float)h);
+                mr_geo_view gv;
+                memset(&gv, 0, sizeof gv);
+                gv.cam = vs[i].camera;
+                gv.world_from_camera = vs[i].world_from_camera;
+                gv.cam_from_world = mr_m4_invert_rigid(&vs[i].world_from_camera);
+                gv.near_plane = near_plane;
+                gv.program = prog;
+                gv.layers = 1u << MR_LAYER_VISIBLE | 1u << MR_LAYER_HIDDEN;
+                gv.shared = true;
+                mr_geometry_draw(r, &gv, NULL);
+            }
+        } else {
+            /* Layered: the centre camera's instances once per batch of
+             * views, each copy moved to its eye and viewport. */
+            mr_geo_view gv;
+            memset(&gv, 0, sizeof gv);
+            gv.cam = r->rig->centre_cam;
+            gv.world_from_camera = centre->world_from_camera;
+            gv.cam_from_world = r->rig->centre_from_world;
+            gv.near_plane = near_plane;
+            gv.program = prog;
+            gv.layers = 1u << MR_LAYER_VISIBLE | 1u << MR_LAYER_HIDDEN;
+            for (int i0 = 0; ok && i0 < rig->views; i0 += per_draw) {
+                int n = rig->views - i0 < per_draw ? rig->views - i0 : per_draw;
+                float proj[16 * MR_RIG_LAYERED_MAX], shift[MR_RIG_LAYERED_MAX];
+                for (int k = 0; k < n; k++) {
+                    int x0, y0;
+                    mr_quilt_tile_origin(&l, i0 + k, &x0, &y0);
+                    glViewportIndexedf((GLuint)k, (float)x0, (float)(l.height - y0 - h), (float)w, (float)h);
+                    mr_gl_projection(&vs[i0 + k].camera, near_plane, proj + 16 * k);
+                    shift[k] = (float)mr_rig_shift(rig, i0 + k);
+                }
+                glUniformMatrix4fv(MR_LOC_PROJECTION, n, GL_FALSE, proj);
+                glUniform1fv(MR_LOC_RIG_SHIFT, n, shift);
+                glUniform1i(MR_LOC_RIG_VIEWS, n);
+                ok = mr_geometry_draw_replicated(r, &gv, n);
+                if (!ok) mr_fail(err, MR_ERR_GL, "layered experiment: no shared list");
+            }
+        }
+        glFinish();
+        ms[f] = (mr_time_now() - t0) * 1e3;
+    }
+    glDisable(GL_DEPTH_TEST);
+    glViewport(0, 0, w, h);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (ok && depth) {
+        /* Framebuffer rows bottom-up: tile row 0 (views 0..) at the bottom. */
+        ok = mr_image_alloc(depth, l.width, l.height, 1, MR_PIX_F32, err);
+        if (ok) glGetTextureImage(tex, 0, GL_DEPTH_COMPONENT, GL_FLOAT, (GLsizei)mr_image_bytes(depth), depth->data);
+    }
+    mr_render_rig_end(r);
+    free(vs);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(1, &tex);
+    glDeleteProgram(prog);
+    GLenum e = glGetError();
+    if (ok && e != GL_NO_ERROR) ok = mr_fail(err, MR_ERR_GL, "GL error 0x%x in the layered experiment", e);
+    return ok;
+}
+
 bool mr_render_rig(mr_renderer *r, const mr_rig *rig, const mr_view *centre, const mr_frame_params *params,
                    const mr_quilt_layout *layout, const char *views_dir, mr_image *quilt, mr_rig_result *res,
                    mr_error *err) {
@@ -248,10 +451,16 @@ bool mr_render_rig(mr_renderer *r, const mr_rig *rig, const mr_view *centre, con
     fp.ao.noise_anchor = centre->world_from_camera;
     fp.ao.noise_anchor_set = true;
     double t0 = mr_time_now();
+    if (!mr_render_rig_begin(r, rig, centre, layout->tile_w, layout->tile_h, err)) goto fail;
     for (int i = 0; i < rig->views; i++) {
         mr_view v = mr_rig_view(rig, centre, i, layout->tile_w, layout->tile_h);
         mr_frame_result fr;
         if (!mr_render_frame(r, &v, &fp, &fr, err)) goto fail;
+        mr_draw_stats ds;
+        mr_renderer_draw_stats(r, &ds);
+        res->frustum_culls += (int)ds.frustum_culls;
+        res->cull_ms += ds.cull_ms;
+        for (int k = 0; k < fr.pass_count; k++) res->shadow_maps += strcmp(fr.passes[k], "shadow_map") == 0;
         bool ok = !quilt || mr_quilt_put(layout, quilt, i, &fr.color, err);
         if (ok && views_dir) {
             char name[32], path[4096];
@@ -262,10 +471,12 @@ bool mr_render_rig(mr_renderer *r, const mr_rig *rig, const mr_view *centre, con
         mr_frame_result_free(&fr);
         if (!ok) goto fail;
     }
+    mr_render_rig_end(r);
     res->ms_total = (mr_time_now() - t0) * 1e3;
     res->views = rig->views;
     return true;
 fail:
+    mr_render_rig_end(r);
     if (quilt) mr_image_free(quilt);
     return false;
 }

@@ -85,6 +85,8 @@ typedef struct map_key {
     int map_size;
     float light_scale;
     int cascades;
+    int rig_views;         /* issue 14: a rig frame's maps, fitted to all its views */
+    mr_dmat4 rig_outer;    /* its last view (with world_from_camera: the first) */
 } map_key;
 
 struct mr_shadow_state {
@@ -97,6 +99,7 @@ struct mr_shadow_state {
     light_frame lf;
     bool key_valid;
     map_key key;
+    unsigned rig_serial;   /* issue 14: the rig frame whose first view drew the maps (0: none) */
     float kernel[2 * MR_SHADOW_MAX_TAPS];
     int kernel_taps;
     GLuint catcher_flags;  /* R8UI, node i at (i % ROW, i / ROW): 1 = shadow catcher */
@@ -137,6 +140,13 @@ static void make_key(const frame *f, map_key *k) {
     k->scene = f->r->scene;
     k->world_from_camera = f->view->world_from_camera;
     k->cam = f->cam;
+    if (f->r->rig) {
+        /* issue 14: every view of a rig frame fits the same maps. */
+        k->world_from_camera = f->r->rig->world_from_camera[0];
+        k->cam = f->r->rig->cam[0];
+        k->rig_views = f->r->rig->views;
+        k->rig_outer = f->r->rig->world_from_camera[1];
+    }
     mr_shadow_light(f->r->scene, &k->light);
     k->map_size = map_size(&f->p->shadow);
     k->light_scale = light_scale(&f->p->shadow);
@@ -145,7 +155,10 @@ static void make_key(const frame *f, map_key *k) {
 
 static bool reusable(const frame *f) {
     const struct mr_shadow_state *s = f->r->shadow;
-    if (!s || !s->key_valid || f->p->shadow.no_reuse || !s->map.fbo) return false;
+    if (!s || !s->key_valid || !s->map.fbo) return false;
+    /* no_reuse: nothing from an earlier frame; a rig frame's views still
+     * share the maps its first view drew (issue 14). */
+    if (f->p->shadow.no_reuse && !(f->r->rig && s->rig_serial == f->r->rig->serial)) return false;
     map_key k;
     make_key(f, &k);
     return memcmp(&k, &s->key, sizeof k) == 0;
@@ -156,6 +169,43 @@ static bool reusable(const frame *f) {
 static mr_dvec3 any_orthogonal(mr_dvec3 d) {
     mr_dvec3 a = fabs(d.x) < 0.9 ? mr_v3(1, 0, 0) : mr_v3(0, 0, 1);
     return mr_v3_normalize(mr_v3_sub(a, mr_v3_scale(d, mr_v3_dot(a, d))));
+}
+
+/* What the light is fitted to (issue 14): one frame's camera, or a rig
+ * frame's outer views (the other views' frusta lie in their hull, slice by
+ * slice) with the union volume in the centre camera's axes. */
+typedef struct fit_views {
+    int n;
+    const mr_camera *cam[2];
+    const mr_dmat4 *world_from_camera[2];
+    const mr_dmat4 *cam_from_world; /* the axes of planes and depths */
+    double near_plane;
+    double planes[5][4];            /* a.xyz . p + a.w >= 0; the last: z >= near */
+} fit_views;
+
+static void fit_views_of(const frame *f, fit_views *fv) {
+    memset(fv, 0, sizeof *fv);
+    const mr_rig_share *rs = f->r->rig;
+    if (rs) {
+        fv->n = 2;
+        for (int i = 0; i < 2; i++) fv->cam[i] = &rs->cam[i], fv->world_from_camera[i] = &rs->world_from_camera[i];
+        fv->cam_from_world = &rs->centre_from_world;
+        fv->near_plane = rs->near_plane;
+        memcpy(fv->planes, rs->planes, sizeof fv->planes);
+        return;
+    }
+    const mr_camera *c = &f->cam;
+    fv->n = 1;
+    fv->cam[0] = c;
+    fv->world_from_camera[0] = &f->view->world_from_camera;
+    fv->cam_from_world = &f->cam_from_world;
+    fv->near_plane = f->near_plane;
+    const double ax0 = (-0.5 - c->cx) / c->fx, ax1 = (c->width - 0.5 - c->cx) / c->fx;
+    const double ay0 = (-0.5 - c->cy) / c->fy, ay1 = (c->height - 0.5 - c->cy) / c->fy;
+    /* x >= ax0 z, x <= ax1 z, y >= ay0 z, y <= ay1 z, z >= near */
+    const double planes[5][4] = {{1, 0, -ax0, 0}, {-1, 0, ax1, 0}, {0, 1, -ay0, 0}, {0, -1, ay1, 0},
+                                 {0, 0, 1, -f->near_plane}};
+    memcpy(fv->planes, planes, sizeof planes);
 }
 
 /* world_from_lcam with axes x, y = z cross x, z at origin o. */
@@ -185,14 +235,14 @@ static double scene_diag(const mr_scene *s) {
 }
 
 /* Sutherland-Hodgman: the part of polygon p (n points, camera space) on
- * the side a.xyz . q >= 0 of a plane through the eye (or z >= a[3] for the
- * near plane); returns the new count (at most n + 1). */
-static int clip_poly(const mr_dvec3 *p, int n, const double a[4], bool near, mr_dvec3 *out) {
+ * the side a.xyz . q + a.w >= 0 of a plane; returns the new count (at most
+ * n + 1). */
+static int clip_poly(const mr_dvec3 *p, int n, const double a[4], mr_dvec3 *out) {
     int m = 0;
     for (int i = 0; i < n; i++) {
         mr_dvec3 c = p[i], d = p[(i + 1) % n];
-        double sc = near ? c.z - a[3] : a[0] * c.x + a[1] * c.y + a[2] * c.z;
-        double sd = near ? d.z - a[3] : a[0] * d.x + a[1] * d.y + a[2] * d.z;
+        double sc = a[0] * c.x + a[1] * c.y + a[2] * c.z + a[3];
+        double sd = a[0] * d.x + a[1] * d.y + a[2] * d.z + a[3];
         if (sc >= 0) out[m++] = c;
         if ((sc >= 0) != (sd >= 0)) out[m++] = mr_v3_add(c, mr_v3_scale(mr_v3_sub(d, c), sc / (sc - sd)));
     }
@@ -200,16 +250,12 @@ static int clip_poly(const mr_dvec3 *p, int n, const double a[4], bool near, mr_
 }
 
 /* The camera depth range of what it can see: every drawn node's world box,
- * its faces clipped to the view frustum (near plane included), the nearest
- * and farthest camera z left. False if nothing is in view. */
-static bool visible_depth(const frame *f, double *dn, double *df) {
+ * its faces clipped to the view frustum (near plane included; a rig's
+ * union volume), the nearest and farthest camera z left. False if nothing
+ * is in view. */
+static bool visible_depth(const frame *f, const fit_views *fv, double *dn, double *df) {
     const mr_scene *s = f->r->scene;
-    const mr_camera *c = &f->cam;
-    const double ax0 = (-0.5 - c->cx) / c->fx, ax1 = (c->width - 0.5 - c->cx) / c->fx;
-    const double ay0 = (-0.5 - c->cy) / c->fy, ay1 = (c->height - 0.5 - c->cy) / c->fy;
-    /* x >= ax0 z, x <= ax1 z, y >= ay0 z, y <= ay1 z, z >= near */
-    const double planes[5][4] = {{1, 0, -ax0, 0}, {-1, 0, ax1, 0}, {0, 1, -ay0, 0}, {0, -1, ay1, 0},
-                                 {0, 0, 0, f->near_plane}};
+    const double (*planes)[4] = fv->planes;
     static const int faces[6][4] = {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}};
     double lo_z = INFINITY, hi_z = 0;
     for (int32_t i = 0; i < s->node_count; i++) {
@@ -218,7 +264,7 @@ static bool visible_depth(const frame *f, double *dn, double *df) {
         if (!mr_scene_node_bounds(s, i, lo, hi)) continue;
         mr_dvec3 corner[8];
         for (int k = 0; k < 8; k++)
-            corner[k] = mr_m4_point(&f->cam_from_world, mr_v3(k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1],
+            corner[k] = mr_m4_point(fv->cam_from_world, mr_v3(k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1],
                                                               k & 4 ? hi[2] : lo[2]));
         /* A box whose corners' depths lie inside the range found so far
          * cannot widen it: no clipping (most of a big scene's nodes). */
@@ -230,7 +276,7 @@ static bool visible_depth(const frame *f, double *dn, double *df) {
             int n = 4;
             for (int k = 0; k < 4; k++) a[k] = corner[faces[fc][k]];
             for (int pl = 0; pl < 5 && n > 0; pl++) {
-                n = clip_poly(a, n, planes[pl], pl == 4, b);
+                n = clip_poly(a, n, planes[pl], b);
                 memcpy(a, b, sizeof(mr_dvec3) * (size_t)n);
             }
             for (int k = 0; k < n; k++) lo_z = fmin(lo_z, a[k].z), hi_z = fmax(hi_z, a[k].z);
@@ -250,14 +296,13 @@ static bool visible_depth(const frame *f, double *dn, double *df) {
  * texels of a frame fixed to the scene (l0), so a camera that moves
  * shifts a cascade by whole texels only and its shadow does not swim; `o`
  * is the light eye's xy in l0. */
-static void fit_cascades(const frame *f, light_frame *lf, const mr_dmat4 *l0_from_w, mr_dvec3 x, mr_dvec3 z,
+static void fit_cascades(const fit_views *fv, light_frame *lf, const mr_dmat4 *l0_from_w, mr_dvec3 x, mr_dvec3 z,
                          double ox, double oy, const double slo[2], const double shi[2], double reach, double diag,
                          int S, int n) {
     double dn = lf->vis_near, dfar = lf->vis_far, d[MR_SHADOW_MAX_CASCADES + 1];
     for (int i = 0; i <= n; i++)
         d[i] = CASCADE_LAMBDA * dn * pow(dfar / dn, (double)i / n) + (1 - CASCADE_LAMBDA) * (dn + (dfar - dn) * i / n);
     d[0] = dn, d[n] = dfar;
-    const mr_camera *c = &f->cam;
     lf->ox = ox;
     lf->oy = oy;
     for (int k = 0; k < n; k++) {
@@ -268,10 +313,11 @@ static void fit_cascades(const frame *f, light_frame *lf, const mr_dmat4 *l0_fro
         if (k == 0) z0 *= 0.99;
         if (k + 1 == n) z1 *= 1.01;
         double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-        for (int i = 0; i < 8; i++) {
+        for (int i = 0; i < 8 * fv->n; i++) {
+            const mr_camera *c = fv->cam[i / 8];
             double u = i & 1 ? c->width - 0.5 : -0.5, v = i & 2 ? c->height - 0.5 : -0.5, dd = i & 4 ? z1 : z0;
             mr_dvec3 pc = mr_v3((u - c->cx) / c->fx * dd, (v - c->cy) / c->fy * dd, dd);
-            mr_dvec3 p = mr_m4_point(l0_from_w, mr_m4_point(&f->view->world_from_camera, pc));
+            mr_dvec3 p = mr_m4_point(l0_from_w, mr_m4_point(fv->world_from_camera[i / 8], pc));
             lo[0] = fmin(lo[0], p.x), hi[0] = fmax(hi[0], p.x);
             lo[1] = fmin(lo[1], p.y), hi[1] = fmax(hi[1], p.y);
         }
@@ -316,8 +362,8 @@ static void fit_sun(const frame *f, const mr_light *L, double scale, int S, int 
     scene_corners(s, corners);
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     double eye_far = 0;
-    mr_dvec3 eye = mr_v3(f->view->world_from_camera.m[3], f->view->world_from_camera.m[7],
-                         f->view->world_from_camera.m[11]);
+    fit_views fv;
+    fit_views_of(f, &fv);
     for (int i = 0; i < 8; i++) {
         mr_dvec3 p = mr_m4_point(&l0_from_w, corners[i]);
         const double *pp = &p.x;
@@ -325,18 +371,22 @@ static void fit_sun(const frame *f, const mr_light *L, double scale, int S, int 
             lo[a] = fmin(lo[a], pp[a]);
             hi[a] = fmax(hi[a], pp[a]);
         }
-        eye_far = fmax(eye_far, mr_v3_len(mr_v3_sub(corners[i], eye)));
+        /* The farthest over the rig's eyes is at an outer one (convex). */
+        for (int e = 0; e < fv.n; e++) {
+            const double *m = fv.world_from_camera[e]->m;
+            eye_far = fmax(eye_far, mr_v3_len(mr_v3_sub(corners[i], mr_v3(m[3], m[7], m[11]))));
+        }
     }
     /* The camera's frustum out to the farthest corner of the scene, in light
      * xy: receivers outside it cannot be seen, so the map's texels go to
      * the visible part (casters towards the light are kept through z). */
     double flo[2] = {INFINITY, INFINITY}, fhi[2] = {-INFINITY, -INFINITY};
-    const mr_camera *c = &f->cam;
-    for (int i = 0; i < 8; i++) {
+    for (int i = 0; i < 8 * fv.n; i++) {
+        const mr_camera *c = fv.cam[i / 8];
         double u = i & 1 ? c->width - 0.5 : -0.5, v = i & 2 ? c->height - 0.5 : -0.5;
-        double d = i & 4 ? eye_far : f->near_plane;
+        double d = i & 4 ? eye_far : fv.near_plane;
         mr_dvec3 pc = mr_v3((u - c->cx) / c->fx * d, (v - c->cy) / c->fy * d, d);
-        mr_dvec3 pw = mr_m4_point(&f->view->world_from_camera, pc);
+        mr_dvec3 pw = mr_m4_point(fv.world_from_camera[i / 8], pc);
         mr_dvec3 pl = mr_m4_point(&l0_from_w, pw);
         flo[0] = fmin(flo[0], pl.x); fhi[0] = fmax(fhi[0], pl.x);
         flo[1] = fmin(flo[1], pl.y); fhi[1] = fmax(fhi[1], pl.y);
@@ -383,12 +433,12 @@ static void fit_sun(const frame *f, const mr_light *L, double scale, int S, int 
      * the atlas of 2 x 2 tiles must fit in a texture. */
     lf->ncasc = 1;
     int want = f->p->shadow.cascades;
-    if (want != 1 && 2 * S <= max_tex && visible_depth(f, &lf->vis_near, &lf->vis_far)) {
+    if (want != 1 && 2 * S <= max_tex && visible_depth(f, &fv, &lf->vis_near, &lf->vis_far)) {
         int n = want;
         if (n <= 0) n = 1 + (int)floor(log(lf->vis_far / lf->vis_near) / log(CASCADE_RATIO));
         n = n < 1 ? 1 : n > MR_SHADOW_MAX_CASCADES ? MR_SHADOW_MAX_CASCADES : n;
         if (n >= 2) {
-            fit_cascades(f, lf, &l0_from_w, x, z, 0.5 * (xlo + xhi), 0.5 * (ylo + yhi), lo, hi, lf->half * zspan, diag, S, n);
+            fit_cascades(&fv, lf, &l0_from_w, x, z, 0.5 * (xlo + xhi), 0.5 * (ylo + yhi), lo, hi, lf->half * zspan, diag, S, n);
             lf->ncasc = n;
         }
     }
@@ -584,7 +634,9 @@ static bool prepare_common(frame *f, mr_error *err) {
     int S = map_size(p);
     GLint max_tex = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
-    fit_light(f, max_tex, &s->lf);
+    /* A reused map keeps the light it was fitted with (a rig frame's other
+     * views: issue 14). */
+    if (!reusable(f)) fit_light(f, max_tex, &s->lf);
     /* Cascade k is the tile ((k & 1) S, (k >> 1) S) of one atlas. */
     int aw = s->lf.ncasc > 1 ? 2 * S : S, ah = s->lf.ncasc > 2 ? 2 * S : S;
     if (s->map_size != S || s->atlas_w != aw || s->atlas_h != ah) {
@@ -688,6 +740,7 @@ static void run_map(frame *f) {
     draw_map(f, zero3, zero2);
     make_key(f, &s->key);
     s->key_valid = true;
+    s->rig_serial = f->r->rig ? f->r->rig->serial : 0;
     frame_put(f, RES_SHADOW_MAP, s->map.color[0]);
 }
 

@@ -48,6 +48,10 @@ struct mr_renderer {
     mr_gpu *gpu;
     const mr_scene *scene;
     struct mr_geo *geo;    /* geometry.c: buffers, BVH, per-frame scratch */
+    /* issue 14: a multi-view rig's shared culling (geometry.c) and its
+     * views' common fitting set (multiview.c); NULL outside a rig frame. */
+    struct mr_geo_share *share;
+    const struct mr_rig_share *rig;
     mr_draw_params draw;   /* how geometry is submitted */
     mr_draw_stats stats;   /* of the current / last frame */
     GLuint *textures;
@@ -111,6 +115,7 @@ typedef struct mr_geo_view {
     double near_plane;
     GLuint program;             /* its MR_LOC_PROJECTION receives the projection */
     uint32_t layers;            /* 1 << mr_layer of the nodes drawn */
+    bool shared;                /* issue 14: a rig view: draws the rig frame's shared list */
 } mr_geo_view;
 /* The frame's camera with a program and layers. */
 mr_geo_view mr_frame_view(const frame *f, GLuint program, uint32_t layers);
@@ -131,6 +136,36 @@ void mr_geometry_free(mr_renderer *r);
 void mr_geometry_draw(mr_renderer *r, const mr_geo_view *view, mr_frame_result *out);
 /* Resets the frame's draw statistics (called by mr_render_frame). */
 void mr_geometry_begin_frame(mr_renderer *r);
+
+/* issue 14: multi-view rigs. Until share_end, draws with .shared set cull
+ * once per layer set against `cull` and choose LOD levels once (with the
+ * depth row of cam_from_world, near_plane and fmax_t, the largest
+ * mr_geometry_lod_fmax of the views), then each draws that list through
+ * its own camera. */
+bool mr_geometry_share_begin(mr_renderer *r, const mr_frustum *cull, const mr_dmat4 *cam_from_world, double near_plane,
+                             double fmax_t, mr_error *err);
+void mr_geometry_share_end(mr_renderer *r);
+double mr_geometry_lod_fmax(const mr_camera *c);
+/* The layered experiment: the shared list of vw->layers through vw's
+ * camera, each instance drawn `replicate` times (attribute divisor); the
+ * caller's program and uniforms place the copies. False outside a share. */
+bool mr_geometry_draw_replicated(mr_renderer *r, const mr_geo_view *vw, int replicate);
+/* What a rig frame's views have in common, for fitting what is made once
+ * per frame (the shadow maps): the centre camera, the two outer views
+ * (every view's frustum lies in their hull, slice by slice) and the union
+ * volume's planes in the centre camera's axes. */
+typedef struct mr_rig_share {
+    mr_camera centre_cam;        /* at the output size, no shear */
+    mr_dmat4 world_from_centre, centre_from_world;
+    mr_camera cam[2];            /* views 0 and N-1 */
+    mr_dmat4 world_from_camera[2];
+    double near_plane;           /* the nearest of the views' */
+    double planes[5][4];         /* centre camera: a.xyz . p + a.w >= 0 inside (the last: z >= near) */
+    int views;
+    unsigned serial;             /* this rig frame's number, from 1 */
+} mr_rig_share;
+/* The near plane mr_render_frame picks for an eye (renderer.c). */
+double mr_render_near_plane(const mr_scene *s, const mr_dmat4 *world_from_camera);
 
 /* Extra per-vertex streams for passes that draw the scene with their own
  * program (AO outline volumes, ghost curvature): one buffer per vertex pool,

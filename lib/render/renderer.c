@@ -97,6 +97,9 @@ mr_geo_view mr_frame_view(const frame *f, GLuint program, uint32_t layers) {
     v.near_plane = f->near_plane;
     v.program = program;
     v.layers = layers;
+    /* issue 14: a rig frame's pinhole views share one cull (the display
+     * mapping's bands reach past the rig's union volume). */
+    v.shared = f->r->share != NULL && !f->p->display;
     return v;
 }
 
@@ -130,6 +133,7 @@ void mr_renderer_destroy(mr_renderer **rp) {
     glBindVertexArray(0);
     for (size_t i = 0; i < PASS_COUNT; i++)
         if (k_passes[i]->destroy) k_passes[i]->destroy(r);
+    mr_render_rig_end(r); /* issue 14: a rig frame left open */
     mr_geometry_free(r);
     glDeleteVertexArrays(1, &r->empty_vao);
     glDeleteQueries(MR_MAX_PASSES, r->queries);
@@ -162,6 +166,12 @@ static double choose_near(const mr_scene *s, mr_dvec3 eye) {
     if (!(diag > 0) || !isfinite(diag)) diag = 1;
     double n = 0.5 * sqrt(d2);
     return n > 1e-6 * diag ? n : 1e-6 * diag;
+}
+
+
+double mr_render_near_plane(const mr_scene *s, const mr_dmat4 *world_from_camera) {
+    mr_dvec3 eye = mr_v3(world_from_camera->m[3], world_from_camera->m[7], world_from_camera->m[11]);
+    return s ? choose_near(s, eye) : 1e-3;
 }
 
 
