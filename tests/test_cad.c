@@ -87,9 +87,11 @@ static void test_split_cylinder(void) {
             printf("  cylinder at unit %g: %u triangles:", units[u], mm->index_count / 3);
             for (int k = 0; k < ml->level_count; k++) printf(" %u@%.3g", ml->levels[k].index_count / 3, ml->levels[k].error / size);
             printf("\n");
-            CHECK_MSG(ml->level_count >= 3, "unit %g: %d levels", units[u], ml->level_count);
+            /* Levels are certified in a chain (lod.c: the steps' errors add
+             * up), so the 1 % budget runs out after two or three levels. */
+            CHECK_MSG(ml->level_count >= 2, "unit %g: %d levels", units[u], ml->level_count);
             if (ml->level_count > 0)
-                CHECK_MSG(ml->levels[ml->level_count - 1].index_count * 4 <= mm->index_count,
+                CHECK_MSG(ml->levels[ml->level_count - 1].index_count * 2 <= mm->index_count,
                           "unit %g: coarsest level %u of %u triangles", units[u],
                           ml->levels[ml->level_count - 1].index_count / 3, mm->index_count / 3);
             for (int k = 0; k < ml->level_count; k++) {
@@ -100,7 +102,9 @@ static void test_split_cylinder(void) {
                 double brute = fmax(ab, ba);
                 CHECK_MSG(brute <= l->error * (1 + 1e-6) + 1e-7 * size, "cylinder unit %g level %d: sampled %g > bound %g",
                           units[u], k, brute, l->error);
-                CHECK_MSG(l->error <= 1.25 * brute + 0.05 * MR_LOD_DEFAULT_REL_ERROR * size,
+                /* Not vacuous: the chained bound is a sum of steps, each
+                 * within a quarter of its truth (+ resolution). */
+                CHECK_MSG(l->error <= 2.5 * brute + 0.05 * MR_LOD_DEFAULT_REL_ERROR * size,
                           "cylinder unit %g level %d: bound %g vs sampled %g", units[u], k, l->error, brute);
             }
         }
@@ -132,10 +136,12 @@ static void test_cad_levels(void) {
             CHECK_MSG(ml->level_count >= 1, "unit %g, part %d: %d levels", units[u], (int)i, ml->level_count);
             if (ml->level_count < 1) continue;
             const mr_lod_level *last = &ml->levels[ml->level_count - 1];
-            /* Engages: the coarsest level keeps at most 45 % of these
-             * coarsely tessellated parts' triangles (41 % here; without the
-             * weld, meshoptimizer's own seam handling keeps 47 %). */
-            CHECK_MSG(last->index_count * 100 <= m->index_count * 45, "unit %g, part %d: coarsest %u of %u triangles", units[u],
+            /* Engages: the coarsest level keeps at most half of these
+             * coarsely tessellated parts' triangles (46 % with the chained
+             * bound, 41 % with each level certified against the full mesh;
+             * without the weld, meshoptimizer's own seam handling stalls
+             * sooner). */
+            CHECK_MSG(last->index_count * 100 <= m->index_count * 50, "unit %g, part %d: coarsest %u of %u triangles", units[u],
                       (int)i, last->index_count / 3, m->index_count / 3);
             printf("  unit %g part %d: %u triangles, size %g:", units[u], (int)i, m->index_count / 3, size);
             for (int k = 0; k < ml->level_count; k++) printf(" %u@%.3g", ml->levels[k].index_count / 3, ml->levels[k].error / size);
@@ -150,10 +156,10 @@ static void test_cad_levels(void) {
                 double brute = fmax(ab, ba);
                 CHECK_MSG(brute <= l->error * (1 + 1e-6) + 1e-7 * size, "unit %g part %d level %d: sampled %g > bound %g",
                           units[u], (int)i, k, brute, l->error);
-                /* Not vacuous: within the resolution (5 % of the level's
-                 * error budget, so at most 5 % of 1 % of the size) plus what
-                 * sampling misses. */
-                CHECK_MSG(l->error <= 1.25 * brute + 0.05 * MR_LOD_DEFAULT_REL_ERROR * size,
+                /* Not vacuous: a sum of chained steps, each within a
+                 * quarter of its truth plus the resolution (5 % of the
+                 * level's error budget) plus what sampling misses. */
+                CHECK_MSG(l->error <= 2.5 * brute + 0.05 * MR_LOD_DEFAULT_REL_ERROR * size,
                           "unit %g part %d level %d: bound %g vs sampled %g", units[u], (int)i, k, l->error, brute);
             }
         }

@@ -113,6 +113,9 @@ static void test_submission_modes_same_image(void) {
     occl.occlusion = true;
     uint32_t occluded = 0;
     off.no_cull = off.no_batch = off.no_instancing = off.no_lod = true;
+    /* The submission modes alone (auto occlusion would split each draw in
+     * two submissions: occluders, then the rest; test_occlusion_auto). */
+    on.occlusion_auto = nobatch.occlusion_auto = noinst.occlusion_auto = false;
     nobatch.no_batch = true;
     noinst.no_instancing = true;
     double worst = 0;
@@ -179,6 +182,56 @@ static void test_submission_modes_same_image(void) {
     CHECK_MSG(worst <= 0.002, "images differ: %.4f of pixels", worst);
     CHECK(culled > 0);
     CHECK(calls_flat);
+    mr_renderer_set_scene(g_r, NULL, &err);
+    mr_scene_destroy(&s);
+}
+
+/* issue 17: occlusion culling by default where it pays. The decision
+ * follows the measured gain; what is deterministic is checked: the first
+ * frame measures, a frame where the test skips nothing costs more than it
+ * saves so the next frames do not test, and one frame in 32 tries again;
+ * every image equals the one without occlusion culling. */
+static void test_occlusion_auto(void) {
+    mr_scene *s = test_plant(0, 0);
+    mr_error err = {0};
+    if (!s || !mr_renderer_set_scene(g_r, s, &err)) {
+        CHECK_MSG(false, "%s", err.msg);
+        mr_scene_destroy(&s);
+        return;
+    }
+    mr_camera cam = {200, 150, 150, 150, 99.5, 74.5, {0}};
+    /* From high above: the whole plant in view, nothing hides anything. */
+    mr_view view = {cam, mr_m4_look_at_cv(mr_v3(12, 60, 8.01), mr_v3(12, 0, 8), mr_v3(0, 0, 1))};
+    mr_draw_params dflt = MR_DRAW_DEFAULTS, plain = MR_DRAW_DEFAULTS;
+    CHECK(dflt.occlusion_auto && !dflt.occlusion);
+    plain.occlusion_auto = false;
+    mr_frame_result ref;
+    mr_draw_stats st;
+    if (!frame(&view, &plain, 200, 150, &ref, &st)) {
+        mr_scene_destroy(&s);
+        return;
+    }
+    CHECK_MSG(st.occlusion_frames == 0 && st.nodes_visible >= 64, "plain: %u tests, %u visible", st.occlusion_frames,
+              st.nodes_visible);
+    /* Fresh state: the scene again. */
+    CHECK(mr_renderer_set_scene(g_r, s, &err));
+    int tested = 0, first = -1, second = -1;
+    for (int f = 0; f < 40; f++) {
+        mr_frame_result res;
+        if (!frame(&view, &dflt, 200, 150, &res, &st)) break;
+        CHECK_MSG(mismatch(&ref.color, &res.color, 0) == 0, "auto occlusion frame %d differs", f);
+        CHECK(st.nodes_occluded == 0);
+        if (st.occlusion_frames) {
+            tested++;
+            if (first < 0) first = f;
+            else if (second < 0) second = f;
+        }
+        mr_frame_result_free(&res);
+    }
+    CHECK_MSG(first == 0, "the first frame measures (first test at frame %d)", first);
+    CHECK_MSG(second >= 8, "nothing to gain: the test goes off (second test at frame %d)", second);
+    CHECK_MSG(tested >= 2 && tested <= 3, "off, with a trial every 32 frames: %d tests in 40 frames", tested);
+    mr_frame_result_free(&ref);
     mr_renderer_set_scene(g_r, NULL, &err);
     mr_scene_destroy(&s);
 }
@@ -410,6 +463,7 @@ int main(void) {
 #define RUN(f) f(); printf("%s: %.2f s\n", #f, mr_time_now() - t); t = mr_time_now()
         RUN(test_submission_modes_same_image);
         RUN(test_far_plant);
+        RUN(test_occlusion_auto); /* issue 17 */
         RUN(test_lod_tolerance);
         RUN(test_degenerate_instance);
         RUN(test_100k_nodes_frame);

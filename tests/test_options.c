@@ -396,6 +396,7 @@ static void test_tables(void) {
         N(mr_draw_params, "lod-tolerance", lod_tolerance, 1e-12, 1e12),
         N(mr_draw_params, "lod-pixels", lod_pixels, 1e-3, 1e4),
         N(mr_draw_params, "occlusion", occlusion, 0, 1),
+        N(mr_draw_params, "occlusion-auto", occlusion_auto, 0, 1), /* issue 17 */
     };
     const expect ex_mp[] = {
         N(mr_map_params, "tag-size", tag_size, 1e-9, 1e9),

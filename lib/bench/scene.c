@@ -16,15 +16,19 @@
 typedef struct bench_config {
     const char *name;
     bool no_cull, no_batch, no_instancing, no_lod, occlusion;
+    bool no_occl_auto; /* issue 17: automatic occlusion culling off */
 } bench_config;
 
+/* "all" is the defaults, automatic occlusion culling included (issue 17);
+ * "none" switches everything off; "all+occl" forces occlusion on. */
 static const bench_config k_configs[] = {
-    {"all", false, false, false, false, false},
-    {"no-cull", true, false, false, false, false},
-    {"no-batch", false, true, true, false, false},
-    {"no-lod", false, false, false, true, false},
-    {"none", true, true, true, true, false},
-    {"all+occl", false, false, false, false, true},
+    {"all", false, false, false, false, false, false},
+    {"no-cull", true, false, false, false, false, false},
+    {"no-batch", false, true, true, false, false, false},
+    {"no-lod", false, false, false, true, false, false},
+    {"none", true, true, true, true, false, true},
+    {"all+occl", false, false, false, false, true, false},
+    {"no-occl-auto", false, false, false, false, false, true},
 };
 #define N_CONFIGS (int)(sizeof k_configs / sizeof k_configs[0])
 
@@ -39,7 +43,7 @@ typedef struct row {
 /* Frame time (floor view solid, overview dashed) against drawn scene
  * triangles, log-log, one colour per configuration. */
 static bool write_plot(const char *path, const row *rows, int n, mr_error *err) {
-    static const char *const colours[N_CONFIGS] = {"#1b7837", "#c51b7d", "#e08214", "#4575b4", "#555555", "#8c510a"};
+    static const char *const colours[N_CONFIGS] = {"#1b7837", "#c51b7d", "#e08214", "#4575b4", "#555555", "#8c510a", "#35978f"};
     enum { NS = N_CONFIGS * 2 };
     mr_plot_series ser[NS];
     double *xs = calloc((size_t)NS * (n + 1), sizeof *xs), *ys = calloc((size_t)NS * (n + 1), sizeof *ys);
@@ -290,6 +294,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                 dp.no_instancing = k_configs[c].no_instancing;
                 dp.no_lod = k_configs[c].no_lod;
                 dp.occlusion = k_configs[c].occlusion;
+                dp.occlusion_auto = !k_configs[c].no_occl_auto;
                 row *r = &rows[nrows];
                 r->tri_scene = (double)li.triangles;
                 r->view = v;

@@ -83,6 +83,12 @@ struct mr_geo {
     float *depth, *hz;
     size_t depth_cap, hz_cap, hz_off[24];
     int hz_w[24], hz_h[24];
+    /* issue 17: the automatic decision (see occlusion_wanted) */
+    bool occ_auto_on;              /* test this frame */
+    int occ_probe;                 /* frames until the next trial while off */
+    double occ_gain_ms;            /* smoothed measured gain (saved - cost) */
+    double occ_rb_ms;              /* read-back of a finished frame, ms (< 0: not measured) */
+    int occ_rb_w, occ_rb_h;
 };
 
 /* ------------------------------------------------------------- params */
@@ -209,6 +215,8 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     if (!g) return mr_fail(err, MR_ERR_NOMEM, "out of memory uploading the scene");
     r->geo = g;
     g->lod = lod;
+    g->occ_auto_on = true; /* the first frames measure */
+    g->occ_rb_ms = -1;
     size_t nm = (size_t)s->mesh_count, nn = (size_t)s->node_count;
     g->mesh_count = s->mesh_count;
     g->meshes = calloc(nm + 1, sizeof *g->meshes);
@@ -796,6 +804,33 @@ static const share_list *shared_list(mr_renderer *r, uint32_t mask) {
     return l;
 }
 
+/* Automatic occlusion culling (issue 17): the test pays when the triangles
+ * it skips cost more to draw than the test costs. Both are measured on the
+ * frames that run it: the read-back waits for the occluders to be drawn, so
+ * its time minus that of a read-back alone (measured once per size, after a
+ * glFinish) is what drawing the occluders cost, hence a cost per triangle;
+ * the gain is the skipped triangles (at the frame's LOD ratio) times that,
+ * minus the read-back alone and the CPU test. Smoothed over frames, with
+ * hysteresis: the test stays on while the gain is positive and goes off
+ * when it turns negative by more than 10 % of the read-back; while off, one
+ * frame in 32 tries it again (the view may have moved into a hall). */
+#define OCC_PROBE_FRAMES 32
+
+static void occlusion_learn(struct mr_geo *g, double sync_ms, double cpu_ms, uint64_t occluder_tris,
+                            uint64_t skipped_tris) {
+    double rb = g->occ_rb_ms > 0 ? g->occ_rb_ms : 0;
+    double per_tri = occluder_tris > 0 ? fmax(sync_ms - rb, 0) / (double)occluder_tris : 0;
+    double gain = (double)skipped_tris * per_tri - rb - cpu_ms;
+    g->occ_gain_ms = g->occ_probe >= 0 ? gain : 0.5 * g->occ_gain_ms + 0.5 * gain; /* a trial starts afresh */
+    if (g->occ_gain_ms < -0.1 * rb - 1e-3) {
+        g->occ_auto_on = false;
+        g->occ_probe = OCC_PROBE_FRAMES;
+    } else {
+        g->occ_auto_on = true;
+        g->occ_probe = -1; /* on: every frame measures */
+    }
+}
+
 void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *out) {
     uint32_t layer_mask = vw->layers;
     const mr_scene *s = r->scene;
@@ -835,7 +870,12 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
      * reversed Z (a pass drawing without depth, e.g. an x-ray view of the
      * hidden layer, gets plain frustum culling). */
     bool depth_ok = false;
-    if (dp->occlusion && !dp->no_cull && nvis >= 64 && w == vw->cam.width && h == vw->cam.height) {
+    bool want = dp->occlusion;
+    if (!want && dp->occlusion_auto && !dp->no_cull && nvis >= 64) {
+        if (g->occ_auto_on) want = true;
+        else if (--g->occ_probe <= 0) want = true; /* a trial frame */
+    }
+    if (want && !dp->no_cull && nvis >= 64 && w == vw->cam.width && h == vw->cam.height) {
         GLint fbo = 0, type = GL_NONE, func = 0;
         GLboolean mask = GL_FALSE;
         glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fbo);
@@ -866,9 +906,25 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
         else rest[nrest++] = g->visible[i];
     }
     r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
+    uint64_t tris_before = r->stats.triangles, full_before = r->stats.triangles_full;
     submit_nodes(r, vw, out, g->visible, nocc);
+    uint64_t occluder_tris = r->stats.triangles - tris_before, occluder_full = r->stats.triangles_full - full_before;
+    bool learn = !dp->occlusion && dp->occlusion_auto;
+    r->stats.occlusion_frames++;
 
     /* 3. Their depth as a pyramid; the rest tested against it. */
+    if (learn && (g->occ_rb_ms < 0 || g->occ_rb_w != w || g->occ_rb_h != h) && (size_t)w * h <= g->depth_cap) {
+        /* Once per size: what a read-back costs alone (a sync point). */
+        glFinish();
+        double tr = mr_time_now();
+        GLint fb = 0;
+        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fb);
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, (GLuint)fb);
+        glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, g->depth);
+        g->occ_rb_ms = (mr_time_now() - tr) * 1e3;
+        g->occ_rb_w = w;
+        g->occ_rb_h = h;
+    }
     t0 = mr_time_now();
     size_t npx = (size_t)w * h;
     if (npx > g->depth_cap) {
@@ -885,16 +941,32 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     glBindFramebuffer(GL_READ_FRAMEBUFFER, (GLuint)draw_fbo);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, g->depth);
+    double t_sync = mr_time_now();
     int levels = build_pyramid(g, g->depth, w, h);
     int32_t nkeep = 0;
+    uint64_t skipped_full = 0;
     for (int32_t i = 0; i < nrest; i++) {
         double rect[4], nd;
         const double *bb = mr_bvh_bounds(g->bvh, rest[i]);
-        if (levels > 0 && box_screen(vw, bb, rect, &nd) && occluded(g, levels, rect, nd, w, h)) continue;
+        if (levels > 0 && box_screen(vw, bb, rect, &nd) && occluded(g, levels, rect, nd, w, h)) {
+            if (learn) {
+                const mr_node *n = &s->nodes[rest[i]];
+                for (int32_t mi = n->mesh_first; mi >= 0 && mi < n->mesh_first + n->mesh_count && mi < g->mesh_count; mi++)
+                    skipped_full += g->meshes[mi].count[0] / 3;
+            }
+            continue;
+        }
         rest[nkeep++] = rest[i];
     }
     r->stats.nodes_occluded += (uint32_t)(nrest - nkeep);
-    r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
+    double t_end = mr_time_now();
+    r->stats.cull_ms += (t_end - t0) * 1e3;
+    if (learn) {
+        /* Skipped triangles at the occluders' LOD ratio (full-detail counts
+         * would overstate the gain where LOD engages). */
+        double ratio = occluder_full > 0 ? (double)occluder_tris / (double)occluder_full : 1;
+        occlusion_learn(g, (t_sync - t0) * 1e3, (t_end - t_sync) * 1e3, occluder_tris, (uint64_t)(skipped_full * ratio));
+    }
     submit_nodes(r, vw, out, rest, nkeep);
 }
 

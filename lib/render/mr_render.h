@@ -830,9 +830,13 @@ typedef struct mr_draw_params {
                               occluders first, then a hierarchical-Z test
                               of the rest on the CPU; exact (same image),
                               costs a depth read-back; default off */
+    /* issue 17: occlusion culling where it pays, decided per frame from its
+     * measured gain (geometry.c, "auto"); ignored where occlusion is on;
+     * default on. */
+    bool occlusion_auto;
 } mr_draw_params;
 #define MR_DRAW_DEFAULT_LOD_PIXELS 1.0
-#define MR_DRAW_DEFAULTS {.no_cull = false, .lod_tolerance = 0.0, .lod_pixels = 0.0} /* 0 = the defaults above */
+#define MR_DRAW_DEFAULTS {.no_cull = false, .lod_tolerance = 0.0, .lod_pixels = 0.0, .occlusion_auto = true} /* 0 = the defaults above */
 /* Option table (lib/render/options.c): --cull --batch --instancing
  * --occlusion (on|off), --lod-tolerance, --lod-pixels. Whether levels are
  * built at all (--lod auto|on|off) is the loading's choice, not a draw
@@ -846,6 +850,7 @@ typedef struct mr_draw_stats {
     uint32_t nodes_drawable;   /* nodes of the drawn layers that draw something */
     uint32_t nodes_visible;    /* of those, not culled */
     uint32_t nodes_occluded;   /* culled by occlusion (when enabled) */
+    uint32_t occlusion_frames; /* draws that ran the occlusion test (auto or on) */
     uint32_t instances;        /* mesh instances submitted */
     uint32_t commands;         /* indirect draw commands */
     uint32_t gl_draw_calls;    /* GL draw calls issued */

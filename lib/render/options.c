@@ -140,6 +140,9 @@ const mr_opt mr_draw_opts[] = {
      "largest projected error of a level in pixels", MR_OPT_ZERO_DEFAULT},
     {"occlusion", MR_OPT_BOOL, DR(occlusion), 0, 1, 0, NULL, "occlusion culling (exact; costs a depth read-back)",
      MR_OPT_ONOFF},
+    /* issue 17 */
+    {"occlusion-auto", MR_OPT_BOOL, DR(occlusion_auto), 0, 1, 1, NULL,
+     "occlusion culling where it pays: decided per frame from its measured gain", MR_OPT_ONOFF},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef DR

@@ -7,18 +7,25 @@
  * between the level and the full mesh, found by branch and bound:
  *
  *  - every vertex of each surface is queried exactly against the other
- *    surface (a uniform grid of triangles, exact point-triangle distance);
- *    the largest distance L is a lower bound of the Hausdorff distance;
+ *    surface (a uniform grid of triangles, exact point-triangle distance;
+ *    a vertex the other surface uses is on it); the largest distance L is a
+ *    lower bound of the Hausdorff distance;
  *  - a triangle T is then bounded without sampling: the distance to one
  *    triangle t is a convex function, so over all of T it is at most the
- *    largest distance of T's corners to t, and the distance to the whole
- *    surface is at most that (min over a few candidate t: the corners'
- *    nearest triangles). Where that bound exceeds L + resolution, T is
- *    bisected along its longest edge and the halves are bounded again.
+ *    largest distance of T's corners to t; likewise for any convex region
+ *    near the other surface, plus how far that region is from it: a
+ *    neighbour folded flat about the shared edge (hinge), a planar fan, the
+ *    1-ring of a vertex projected onto its plane (curved surfaces). The
+ *    smallest of these over a few candidates (the corners' nearest
+ *    triangles) bounds T. Only where it exceeds what is enough (the level's
+ *    error budget, or L + a quarter) is T split (in four if thin, else
+ *    across its longest edge) and the pieces bounded again.
  *
- * The result is a true upper bound, within `resolution` of the truth, which
- * tests check against dense brute-force sampling; the renderer never uses a
- * level whose bound (times the node's stretch) exceeds the tolerance. */
+ * Levels are chained: each is certified against the one it was simplified
+ * from and the errors add (triangle inequality), so the work per level is
+ * the size of its source. The result is a true upper bound, which tests
+ * check against dense brute-force sampling; the renderer never uses a level
+ * whose bound (times the node's stretch) exceeds the tolerance. */
 #include "mr_scene.h"
 
 #include <math.h>
@@ -103,6 +110,14 @@ typedef struct tri_grid {
                           both are coplanar and their union is convex, else
                           UINT32_MAX (see convex_partners) */
     double ptol;       /* coplanarity tolerance used for partner */
+    /* Hinges: per triangle edge with a partner, the partner's opposite
+     * corner rotated about the shared edge into this triangle's plane
+     * (hinge_p) and how far that moved it (hinge_s): see convex_partners. */
+    double *hinge_p, *hinge_s;
+    /* Curved fans (see ring_bound), prepared on first use per vertex:
+     * ring_n the plane's unit normal, ring_s the slack (INFINITY: no claim,
+     * NAN: not prepared yet). */
+    double *ring_n, *ring_s;
     uint32_t *vt_start, *vt_items; /* triangles around each vertex (CSR) */
 } tri_grid;
 
@@ -122,6 +137,10 @@ static void grid_free(tri_grid *g) {
     free(g->start);
     free(g->items);
     free(g->partner);
+    free(g->hinge_p);
+    free(g->hinge_s);
+    free(g->ring_n);
+    free(g->ring_s);
     free(g->vt_start);
     free(g->vt_items);
     memset(g, 0, sizeof *g);
@@ -210,19 +229,50 @@ static bool convex_pair(dv a, dv b, dv c, dv d, double tol) {
     return dv_dot(y1, y2) <= 0;
 }
 
+/* Folds `far` (the opposite corner of the triangle across edge ab) about
+ * the line ab into the plane of (a, b, own), on the side away from own:
+ * *f, and how far it moved (*moved). Every point of the far triangle moves
+ * at most that much under the fold (linearly with its distance from ab), so
+ * the distance to the real pair is at most the distance to the flat pair
+ * (convex if the flat quad is) + moved. A curved surface tessellated finely
+ * has small folds: pieces straddling its edges need no subdivision. */
+static bool hinge_fold(dv a, dv b, dv own, dv far, dv *f, double *moved) {
+    dv ab = dv_sub(b, a);
+    double l2 = dv_dot(ab, ab);
+    if (!(l2 > 0)) return false;
+    dv e = {ab.x / sqrt(l2), ab.y / sqrt(l2), ab.z / sqrt(l2)};
+    dv wc = dv_sub(own, a);
+    wc = dv_mad(wc, e, -dv_dot(wc, e));
+    double wl = sqrt(dv_dot(wc, wc));
+    dv wd = dv_sub(far, a);
+    double along = dv_dot(wd, e);
+    wd = dv_mad(wd, e, -along);
+    double h = sqrt(dv_dot(wd, wd));
+    if (!(wl > 0) || !(h > 0)) return false;
+    *f = dv_mad(dv_mad(a, e, along), wc, -h / wl);
+    dv mv = dv_sub(far, *f);
+    *moved = sqrt(dv_dot(mv, mv));
+    return isfinite(*moved);
+}
+
 static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
     g->ptol = tol;
     /* Triangles around each vertex, for fan bounds. */
     g->vt_start = calloc((size_t)vertex_count + 2, sizeof *g->vt_start);
     g->vt_items = malloc(((size_t)g->tri_count * 3 + 1) * sizeof *g->vt_items);
-    if (!g->vt_start || !g->vt_items) return false;
+    g->ring_n = malloc(((size_t)vertex_count * 3 + 1) * sizeof *g->ring_n);
+    g->ring_s = malloc(((size_t)vertex_count + 1) * sizeof *g->ring_s);
+    if (!g->vt_start || !g->vt_items || !g->ring_n || !g->ring_s) return false;
+    for (uint32_t v = 0; v < vertex_count; v++) g->ring_s[v] = NAN;
     for (size_t i = 0; i < (size_t)g->tri_count * 3; i++) g->vt_start[g->idx[i] + 2]++;
     for (uint32_t v = 0; v < vertex_count; v++) g->vt_start[v + 2] += g->vt_start[v + 1];
     for (size_t i = 0; i < (size_t)g->tri_count * 3; i++) g->vt_items[g->vt_start[g->idx[i] + 1]++] = (uint32_t)(i / 3);
     size_t ne = (size_t)g->tri_count * 3;
     g->partner = malloc((ne + 1) * sizeof *g->partner);
+    g->hinge_p = malloc((ne * 3 + 1) * sizeof *g->hinge_p);
+    g->hinge_s = malloc((ne + 1) * sizeof *g->hinge_s);
     edge_rec *e = malloc((ne + 1) * sizeof *e);
-    if (!g->partner || !e) {
+    if (!g->partner || !g->hinge_p || !g->hinge_s || !e) {
         free(e);
         return false;
     }
@@ -238,9 +288,20 @@ static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
         if (i + 2 < ne && e[i + 2].a == e[i].a && e[i + 2].b == e[i].b) continue; /* non-manifold edge */
         uint32_t t1 = e[i].tri, t2 = e[i + 1].tri;
         uint32_t c = g->idx[3 * t1 + (e[i].slot + 2) % 3], d = g->idx[3 * t2 + (e[i + 1].slot + 2) % 3];
-        if (convex_pair(vtx(g->pos, e[i].a), vtx(g->pos, e[i].b), vtx(g->pos, c), vtx(g->pos, d), tol)) {
-            g->partner[3 * (size_t)t1 + e[i].slot] = t2;
-            g->partner[3 * (size_t)t2 + e[i + 1].slot] = t1;
+        dv pa = vtx(g->pos, e[i].a), pb = vtx(g->pos, e[i].b), pc = vtx(g->pos, c), pd = vtx(g->pos, d);
+        /* Each side gets the other's corner folded flat onto its own plane. */
+        for (int side = 0; side < 2; side++) {
+            dv own = side ? pd : pc, far = side ? pc : pd;
+            uint32_t t = side ? t2 : t1, q = side ? t1 : t2, slot = side ? e[i + 1].slot : e[i].slot;
+            dv f;
+            double moved;
+            if (!hinge_fold(pa, pb, own, far, &f, &moved) || !convex_pair(pa, pb, own, f, tol)) continue;
+            g->partner[3 * (size_t)t + slot] = q;
+            size_t h = 3 * (size_t)t + slot;
+            g->hinge_p[3 * h] = f.x;
+            g->hinge_p[3 * h + 1] = f.y;
+            g->hinge_p[3 * h + 2] = f.z;
+            g->hinge_s[h] = moved;
         }
     }
     free(e);
@@ -400,50 +461,229 @@ static double fan_bound(const tri_grid *o, uint32_t v, uint32_t ref, dv a, dv b,
     return m + slack;
 }
 
+/* The whole fan of triangles around vertex v, projected orthogonally onto
+ * the plane through v normal to their area-weighted normal. If that
+ * projection is a convex polygon (consistently oriented, angles at v within
+ * a full turn, its area equal to its hull's), the distance to it is convex,
+ * and the distance to the real fan is at most that + the largest height of
+ * a fan vertex above the plane (each point of a fan triangle moves by its
+ * height, affine over the triangle). So a piece lying over the 1-ring of a
+ * vertex of a curved surface is bounded from its corners. Prepared once per
+ * vertex; returns INFINITY where it does not apply. */
+static void ring_prepare(const tri_grid *o, uint32_t v) {
+    double *nrm = o->ring_n + 3 * (size_t)v;
+    o->ring_s[v] = INFINITY;
+    uint32_t k0 = o->vt_start[v], k1 = o->vt_start[v + 1];
+    if (k1 - k0 < 3 || k1 - k0 > 16) return;
+    dv n = {0, 0, 0}, pv = vtx(o->pos, v);
+    for (uint32_t k = k0; k < k1; k++) {
+        uint32_t t = o->vt_items[k];
+        dv p0 = vtx(o->pos, o->idx[3 * t]), p1 = vtx(o->pos, o->idx[3 * t + 1]), p2 = vtx(o->pos, o->idx[3 * t + 2]);
+        dv f1 = dv_sub(p1, p0), f2 = dv_sub(p2, p0);
+        n = dv_mad(n, (dv){f1.y * f2.z - f1.z * f2.y, f1.z * f2.x - f1.x * f2.z, f1.x * f2.y - f1.y * f2.x}, 1);
+    }
+    double nl = sqrt(dv_dot(n, n));
+    if (!(nl > 0)) return;
+    n = (dv){n.x / nl, n.y / nl, n.z / nl};
+    /* In-plane axes. */
+    dv u = fabs(n.x) < 0.6 ? (dv){0, -n.z, n.y} : (dv){n.z, 0, -n.x};
+    double ul = sqrt(dv_dot(u, u));
+    u = (dv){u.x / ul, u.y / ul, u.z / ul};
+    dv w = {n.y * u.z - n.z * u.y, n.z * u.x - n.x * u.z, n.x * u.y - n.y * u.x};
+    double pts[48][2], area = 0, angle = 0, height = 0;
+    int np = 0;
+    for (uint32_t k = k0; k < k1; k++) {
+        uint32_t t = o->vt_items[k];
+        double q[3][2];
+        int iv = 0;
+        for (int j = 0; j < 3; j++) {
+            uint32_t vi = o->idx[3 * t + (uint32_t)j];
+            if (vi == v) iv = j;
+            dv d = dv_sub(vtx(o->pos, vi), pv);
+            height = fmax(height, fabs(dv_dot(d, n)));
+            q[j][0] = pts[np][0] = dv_dot(d, u);
+            q[j][1] = pts[np][1] = dv_dot(d, w);
+            np++;
+        }
+        double cr = cross2(q[0], q[1], q[2]);
+        if (!(cr > 0)) return; /* flipped or degenerate in projection: no claim */
+        area += 0.5 * cr;
+        const double *x0 = q[iv], *x1 = q[(iv + 1) % 3], *x2 = q[(iv + 2) % 3];
+        double ax = x1[0] - x0[0], ay = x1[1] - x0[1], bx = x2[0] - x0[0], by = x2[1] - x0[1];
+        angle += atan2(ax * by - ay * bx, ax * bx + ay * by);
+    }
+    if (angle > 2 * 3.14159265358979323846 + 1e-9) return;
+    qsort(pts, (size_t)np, sizeof pts[0], cmp_pt2);
+    double hull[97][2];
+    int h = 0;
+    for (int i = 0; i < np; i++) {
+        while (h >= 2 && cross2(hull[h - 2], hull[h - 1], pts[i]) <= 0) h--;
+        hull[h][0] = pts[i][0];
+        hull[h][1] = pts[i][1];
+        h++;
+    }
+    for (int i = np - 2, lo = h + 1; i >= 0; i--) {
+        while (h >= lo && cross2(hull[h - 2], hull[h - 1], pts[i]) <= 0) h--;
+        hull[h][0] = pts[i][0];
+        hull[h][1] = pts[i][1];
+        h++;
+    }
+    double harea = 0, perim = 0;
+    for (int i = 0; i + 1 < h; i++) {
+        harea += 0.5 * (hull[i][0] * hull[i + 1][1] - hull[i + 1][0] * hull[i][1]);
+        perim += hypot(hull[i + 1][0] - hull[i][0], hull[i + 1][1] - hull[i][1]);
+    }
+    if (!(harea > 0) || !(fabs(harea - area) <= 1e-6 * harea)) return;
+    nrm[0] = n.x;
+    nrm[1] = n.y;
+    nrm[2] = n.z;
+    /* + the sliver float rounding may leave uncovered, + the positions'
+     * rounding (as for the planar fans). */
+    o->ring_s[v] = height + 2 * fabs(harea - area) / perim + 2 * o->ptol;
+}
+
+static double ring_bound(const tri_grid *o, uint32_t v, dv a, dv b, dv c, double enough) {
+    if (isnan(o->ring_s[v])) ring_prepare(o, v);
+    double slack = o->ring_s[v];
+    if (!(slack < enough)) return INFINITY;
+    dv n = {o->ring_n[3 * (size_t)v], o->ring_n[3 * (size_t)v + 1], o->ring_n[3 * (size_t)v + 2]}, pv = vtx(o->pos, v);
+    const dv q[3] = {a, b, c};
+    /* The projected fan lies in the plane: a corner's height is a lower
+     * bound of its distance to it. */
+    for (int j = 0; j < 3; j++)
+        if (fabs(dv_dot(dv_sub(q[j], pv), n)) + slack > enough) return INFINITY;
+    double m = 0;
+    for (int j = 0; j < 3; j++) {
+        double best = INFINITY;
+        for (uint32_t k = o->vt_start[v]; k < o->vt_start[v + 1]; k++) {
+            uint32_t t = o->vt_items[k];
+            dv p[3];
+            for (int i = 0; i < 3; i++) {
+                dv x = vtx(o->pos, o->idx[3 * t + (uint32_t)i]);
+                p[i] = dv_mad(x, n, -dv_dot(dv_sub(x, pv), n));
+            }
+            best = fmin(best, dist2_point_tri(q[j], p[0], p[1], p[2]));
+        }
+        m = fmax(m, sqrt(best));
+    }
+    return m + slack;
+}
+
 typedef struct bb_ctx {
     const tri_grid *other;
-    double lower;      /* largest exact point distance seen */
+    double lower;      /* largest exact point distance seen (both directions) */
     double upper;      /* largest accepted bound */
     double resolution, limit;
+    double accept;     /* a piece whose bound is at most this needs no more work */
+    double rel;        /* ... nor one within this fraction (+ resolution) of lower */
     uint64_t work;
 } bb_ctx;
 
-/* Bound of the distance from triangle (a, b, c) to the other surface. */
+/* Largest corner distance from (a, b, c) to triangle t: by convexity of the
+ * distance to one triangle, its largest value over the whole piece. */
+static double corner_max(const tri_grid *o, dv a, dv b, dv c, uint32_t t, double d[3]) {
+    d[0] = dist_to_tri(o, a, t);
+    d[1] = dist_to_tri(o, b, t);
+    d[2] = dist_to_tri(o, c, t);
+    return fmax(d[0], fmax(d[1], d[2]));
+}
+
+/* Largest distance of the piece's corners from the plane of triangle t: a
+ * lower bound of any bound from a region in that plane (a triangle, a flat
+ * pair, a planar fan), so where it already exceeds what is enough, those
+ * bounds need not be tried. */
+static double plane_gap(const tri_grid *o, uint32_t t, dv a, dv b, dv c) {
+    dv r0 = vtx(o->pos, o->idx[3 * t]), r1 = vtx(o->pos, o->idx[3 * t + 1]), r2 = vtx(o->pos, o->idx[3 * t + 2]);
+    dv e1 = dv_sub(r1, r0), e2 = dv_sub(r2, r0);
+    dv n = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
+    double nl = sqrt(dv_dot(n, n));
+    if (!(nl > 0)) return 0;
+    double g = fmax(fabs(dv_dot(dv_sub(a, r0), n)), fmax(fabs(dv_dot(dv_sub(b, r0), n)), fabs(dv_dot(dv_sub(c, r0), n))));
+    /* Slightly under the exact value, so float rounding never skips a
+     * bound that would have held (skipping only costs time anyway). */
+    return 0.999 * g / nl;
+}
+
+/* Bound of the distance from triangle (a, b, c) to the other surface.
+ * va, vb, vc: the corners' vertex ids where they are vertices of the mesh
+ * (UINT32_MAX for midpoints): a vertex the other surface uses lies on it,
+ * and every triangle around it there is a candidate. */
 static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double dc, uint32_t ta, uint32_t tb,
-                      uint32_t tc, int depth) {
+                      uint32_t tc, uint32_t va, uint32_t vb, uint32_t vc, int depth) {
     for (;;) {
         x->work++;
         if (!isfinite(da) || !isfinite(db) || !isfinite(dc)) {
             x->upper = INFINITY;
             return;
         }
+        /* Enough: within what is asked (accept), or within resolution of
+         * the largest distance known to be real (lower). */
+        double enough = fmax(x->accept, x->lower * (1 + x->rel) + x->resolution);
         /* Convexity: over the triangle, distance to one triangle t is at
          * most the largest corner distance to t. */
-        double ub = INFINITY;
-        const uint32_t cand[3] = {ta, tb, tc};
+        double ub = INFINITY, dd[3];
+        const uint32_t cand[3] = {ta, tb, tc}, vid[3] = {va, vb, vc};
         const tri_grid *o = x->other;
         for (int k = 0; k < 3; k++) {
             uint32_t t = cand[k];
             if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
-            double ta_ = dist_to_tri(o, a, t), tb_ = dist_to_tri(o, b, t), tc_ = dist_to_tri(o, c, t);
-            double m = fmax(ta_, fmax(tb_, tc_));
+            double m = corner_max(o, a, b, c, t, dd);
             if (m < ub) ub = m;
-            /* The convex union with a coplanar neighbour. */
-            for (int j = 0; j < 3 && o->partner; j++) {
-                uint32_t q = o->partner[3 * (size_t)t + (size_t)j];
-                if (q == UINT32_MAX) continue;
-                /* + 2 ptol: "coplanar" allows float rounding, so the union
-                 * is convex only up to that distance. */
-                double mq = fmax(fmin(ta_, dist_to_tri(o, a, q)),
-                                 fmax(fmin(tb_, dist_to_tri(o, b, q)), fmin(tc_, dist_to_tri(o, c, q)))) + 2 * o->ptol;
+        }
+        /* The convex union with a coplanar neighbour. */
+        for (int k = 0; k < 3 && ub > enough && o->partner; k++) {
+            uint32_t t = cand[k];
+            if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
+            if (plane_gap(o, t, a, b, c) > enough) continue;
+            corner_max(o, a, b, c, t, dd);
+            for (int j = 0; j < 3; j++) {
+                size_t h = 3 * (size_t)t + (size_t)j;
+                if (o->partner[h] == UINT32_MAX) continue;
+                /* The flat pair (t and the folded partner) is convex: its
+                 * distance is largest at a corner; + what the fold moved,
+                 * + 2 ptol: "coplanar" allows float rounding, so the flat
+                 * union is convex only up to that distance. */
+                dv e0 = vtx(o->pos, o->idx[3 * t + (size_t)j]), e1 = vtx(o->pos, o->idx[3 * t + (size_t)(j + 1) % 3]);
+                dv f = {o->hinge_p[3 * h], o->hinge_p[3 * h + 1], o->hinge_p[3 * h + 2]};
+                double slack = o->hinge_s[h] + 2 * o->ptol;
+                if (slack >= ub) continue;
+                double mq = fmax(fmin(dd[0], sqrt(dist2_point_tri(a, e1, e0, f))),
+                                 fmax(fmin(dd[1], sqrt(dist2_point_tri(b, e1, e0, f))),
+                                      fmin(dd[2], sqrt(dist2_point_tri(c, e1, e0, f))))) + slack;
                 if (mq < ub) ub = mq;
             }
         }
-        /* Planar fans around the candidates' vertices, where still needed. */
-        for (int k = 0; k < 3 && ub > x->lower + x->resolution && o->vt_start; k++) {
+        /* Curved fans around the candidates' vertices and the shared
+         * corners. */
+        for (int k = 0; k < 3 && ub > enough && o->ring_s; k++) {
             uint32_t t = cand[k];
             if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
-            for (int j = 0; j < 3 && ub > x->lower + x->resolution; j++) {
+            for (int j = 0; j < 3 && ub > enough; j++) {
+                double rb = ring_bound(o, o->idx[3 * t + (uint32_t)j], a, b, c, enough);
+                if (rb < ub) ub = rb;
+            }
+        }
+        for (int k = 0; k < 3 && ub > enough && o->ring_s; k++)
+            if (vid[k] != UINT32_MAX && o->vt_start[vid[k] + 1] > o->vt_start[vid[k]]) {
+                double rb = ring_bound(o, vid[k], a, b, c, enough);
+                if (rb < ub) ub = rb;
+            }
+        /* Triangles around corners shared with the other surface. */
+        for (int k = 0; k < 3 && ub > enough && o->vt_start; k++) {
+            uint32_t v = vid[k];
+            if (v == UINT32_MAX) continue;
+            for (uint32_t j = o->vt_start[v], n = 0; j < o->vt_start[v + 1] && n < 24 && ub > enough; j++, n++) {
+                if (plane_gap(o, o->vt_items[j], a, b, c) > enough) continue;
+                double m = corner_max(o, a, b, c, o->vt_items[j], dd);
+                if (m < ub) ub = m;
+            }
+        }
+        /* Planar fans around the candidates' vertices, where still needed. */
+        for (int k = 0; k < 3 && ub > enough && o->vt_start; k++) {
+            uint32_t t = cand[k];
+            if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
+            if (plane_gap(o, t, a, b, c) > enough) continue;
+            for (int j = 0; j < 3 && ub > enough; j++) {
                 double fb = fan_bound(o, o->idx[3 * t + (uint32_t)j], t, a, b, c);
                 if (fb < ub) ub = fb;
             }
@@ -457,9 +697,30 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
         if (lip < ub) ub = lip;
         /* Past the work cap a piece keeps the bound it has: still a bound,
          * only looser, so a pathological mesh costs seconds, not hours. */
-        if (ub <= x->lower + x->resolution || depth >= 40 || longest <= x->resolution || x->work > 4000000ull) {
+        if (ub <= enough || depth >= 40 || longest <= x->resolution || x->work > 4000000ull) {
             if (ub > x->upper) x->upper = ub;
             return;
+        }
+        /* A thin piece (a long strip across a curved surface's fine
+         * strips) is split in four: halving its longest edge would leave
+         * its width, and the number of strips it spans, as it was. */
+        dv cr = {ab.y * ca.z - ab.z * ca.y, ab.z * ca.x - ab.x * ca.z, ab.x * ca.y - ab.y * ca.x};
+        double alt = sqrt(dv_dot(cr, cr)) / longest; /* the smallest altitude */
+        if (longest > 4 * alt) {
+            dv mab = dv_mad(a, ab, 0.5), mbc = dv_mad(b, bc, 0.5), mca = dv_mad(c, ca, 0.5);
+            uint32_t tab, tbc, tca;
+            double dab = grid_nearest(x->other, mab, x->limit, &tab), dbc = grid_nearest(x->other, mbc, x->limit, &tbc),
+                   dca = grid_nearest(x->other, mca, x->limit, &tca);
+            x->lower = fmax(x->lower, fmax(dab, fmax(dbc, dca)));
+            bound_tri(x, a, mab, mca, da, dab, dca, ta, tab, tca, va, UINT32_MAX, UINT32_MAX, depth + 1);
+            bound_tri(x, mab, b, mbc, dab, db, dbc, tab, tb, tbc, UINT32_MAX, vb, UINT32_MAX, depth + 1);
+            bound_tri(x, mca, mbc, c, dca, dbc, dc, tca, tbc, tc, UINT32_MAX, UINT32_MAX, vc, depth + 1);
+            a = mab; b = mbc; c = mca;
+            da = dab; db = dbc; dc = dca;
+            ta = tab; tb = tbc; tc = tca;
+            va = vb = vc = UINT32_MAX;
+            depth++;
+            continue;
         }
         /* Bisect the longest edge: query the midpoint exactly. */
         dv m;
@@ -468,55 +729,71 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
             m = dv_mad(a, ab, 0.5);
             double dm = grid_nearest(x->other, m, x->limit, &tm);
             if (dm > x->lower) x->lower = dm;
-            bound_tri(x, a, m, c, da, dm, dc, ta, tm, tc, depth + 1);
-            a = m; da = dm; ta = tm; /* second half: m, b, c */
+            bound_tri(x, a, m, c, da, dm, dc, ta, tm, tc, va, UINT32_MAX, vc, depth + 1);
+            a = m; da = dm; ta = tm; va = UINT32_MAX; /* second half: m, b, c */
         } else if (lbc >= lca) {
             m = dv_mad(b, bc, 0.5);
             double dm = grid_nearest(x->other, m, x->limit, &tm);
             if (dm > x->lower) x->lower = dm;
-            bound_tri(x, a, b, m, da, db, dm, ta, tb, tm, depth + 1);
-            b = m; db = dm; tb = tm; /* a, m, c */
+            bound_tri(x, a, b, m, da, db, dm, ta, tb, tm, va, vb, UINT32_MAX, depth + 1);
+            b = m; db = dm; tb = tm; vb = UINT32_MAX; /* a, m, c */
         } else {
             m = dv_mad(c, ca, 0.5);
             double dm = grid_nearest(x->other, m, x->limit, &tm);
             if (dm > x->lower) x->lower = dm;
-            bound_tri(x, a, b, m, da, db, dm, ta, tb, tm, depth + 1);
-            a = m; da = dm; ta = tm; /* m, b, c */
+            bound_tri(x, a, b, m, da, db, dm, ta, tb, tm, va, vb, UINT32_MAX, depth + 1);
+            a = m; da = dm; ta = tm; va = UINT32_MAX; /* m, b, c */
         }
         depth++;
     }
 }
 
-/* One direction: from surface `from` to the grid's surface. */
-static double directed_bound(const float *pos, uint32_t nv, const uint32_t *from, uint32_t from_count,
-                             const tri_grid *to, double resolution, double limit) {
-    bb_ctx x = {to, 0, 0, resolution, limit, 0};
-    double *d = malloc((size_t)nv * sizeof *d);
-    uint32_t *near = malloc((size_t)nv * sizeof *near);
-    if (!d || !near) {
-        free(d);
-        free(near);
-        return INFINITY;
-    }
+/* Exact distance of every vertex of `from` to the other surface, and its
+ * nearest triangle there; a vertex the other surface uses is on it (0, any
+ * triangle around it). Raises *lower. false if out of memory. */
+static bool vertex_distances(const float *pos, uint32_t nv, const uint32_t *from, uint32_t from_count,
+                             const tri_grid *to, double limit, double *d, uint32_t *near, double *lower) {
     for (uint32_t v = 0; v < nv; v++) d[v] = -1;
     for (uint32_t i = 0; i < from_count; i++) {
         uint32_t v = from[i];
         if (d[v] >= 0) continue;
+        if (to->vt_start && to->vt_start[v + 1] > to->vt_start[v]) {
+            d[v] = 0;
+            near[v] = to->vt_items[to->vt_start[v]];
+            continue;
+        }
         d[v] = grid_nearest(to, vtx(pos, v), limit, &near[v]);
-        if (d[v] > x.lower) x.lower = d[v];
+        if (d[v] > *lower) *lower = d[v];
     }
-    x.upper = x.lower;
+    return true;
+}
+
+/* One direction: from surface `from` to the grid's surface, given the
+ * vertices' distances. */
+static double directed_bound(const float *pos, const uint32_t *from, uint32_t from_count, const tri_grid *to,
+                             const double *d, const uint32_t *near, double *lower, double resolution, double accept,
+                             double limit) {
+    /* Within a quarter of the truth: a level's bound only decides from how
+     * far it is drawn, and refining the last quarter costs more than all
+     * the rest. Tight mode (accept 0, mr_lod_hausdorff_bound) keeps the
+     * old contract: within resolution. */
+    bb_ctx x = {to, *lower, *lower, resolution, limit, accept, accept > 0 ? 0.25 : 0, 0};
     for (uint32_t t = 0; t + 2 < from_count && isfinite(x.upper); t += 3) {
         uint32_t i0 = from[t], i1 = from[t + 1], i2 = from[t + 2];
-        bound_tri(&x, vtx(pos, i0), vtx(pos, i1), vtx(pos, i2), d[i0], d[i1], d[i2], near[i0], near[i1], near[i2], 0);
+        bound_tri(&x, vtx(pos, i0), vtx(pos, i1), vtx(pos, i2), d[i0], d[i1], d[i2], near[i0], near[i1], near[i2], i0,
+                  i1, i2, 0);
     }
-    free(d);
-    free(near);
+    *lower = x.lower;
     return x.upper;
 }
 
-double mr_lod_hausdorff_bound(const float *positions, uint32_t vertex_count, const uint32_t *a, uint32_t a_count,
-                              const uint32_t *b, uint32_t b_count, double resolution, double limit) {
+/* The two-sided bound. Vertex distances of both directions come first, so
+ * that the largest real distance (lower) is known before any triangle is
+ * bounded: no piece is refined below what the Hausdorff distance already is
+ * (the vertices of a simplified level lie on the full mesh, so that
+ * direction alone would know no lower bound but 0). */
+static double hausdorff(const float *positions, uint32_t vertex_count, const uint32_t *a, uint32_t a_count,
+                        const uint32_t *b, uint32_t b_count, double resolution, double accept, double limit) {
     if (!positions || vertex_count == 0 || !a || !b || a_count < 3 || b_count < 3) return INFINITY;
     for (uint32_t i = 0; i < a_count; i++)
         if (a[i] >= vertex_count) return INFINITY;
@@ -532,20 +809,44 @@ double mr_lod_hausdorff_bound(const float *positions, uint32_t vertex_count, con
     if (!(resolution > 0)) resolution = 1e-6 * fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
     if (!(resolution > 0)) resolution = 1e-12;
     if (!(limit > 0)) limit = INFINITY;
+    if (!(accept > 0)) accept = 0;
     tri_grid ga, gb;
     /* Positions are float: a few ulps of the extent. */
     double ptol = 1e-6 * fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
     bool ok = grid_build(&ga, positions, a, a_count, lo, hi) && grid_build(&gb, positions, b, b_count, lo, hi);
-    if (!ok || !convex_partners(&ga, ptol, vertex_count) || !convex_partners(&gb, ptol, vertex_count)) {
-        grid_free(&ga);
-        grid_free(&gb);
-        return INFINITY;
+    double *da = malloc((size_t)vertex_count * sizeof *da), *db = malloc((size_t)vertex_count * sizeof *db);
+    uint32_t *na = malloc((size_t)vertex_count * sizeof *na), *nb = malloc((size_t)vertex_count * sizeof *nb);
+    double r = INFINITY;
+    if (ok && da && db && na && nb && convex_partners(&ga, ptol, vertex_count) &&
+        convex_partners(&gb, ptol, vertex_count)) {
+        double lower = 0;
+        vertex_distances(positions, vertex_count, a, a_count, &gb, limit, da, na, &lower);
+        vertex_distances(positions, vertex_count, b, b_count, &ga, limit, db, nb, &lower);
+        if (isfinite(lower)) {
+            double ab = directed_bound(positions, a, a_count, &gb, da, na, &lower, resolution, accept, limit);
+            double ba = isfinite(ab) ? directed_bound(positions, b, b_count, &ga, db, nb, &lower, resolution, accept, limit)
+                                     : INFINITY;
+            r = fmax(ab, ba);
+        }
     }
-    double ab = directed_bound(positions, vertex_count, a, a_count, &gb, resolution, limit);
-    double ba = isfinite(ab) ? directed_bound(positions, vertex_count, b, b_count, &ga, resolution, limit) : INFINITY;
+    free(da);
+    free(db);
+    free(na);
+    free(nb);
     grid_free(&ga);
     grid_free(&gb);
-    return fmax(ab, ba);
+    return r;
+}
+
+double mr_lod_hausdorff_bound(const float *positions, uint32_t vertex_count, const uint32_t *a, uint32_t a_count,
+                              const uint32_t *b, uint32_t b_count, double resolution, double limit) {
+    return hausdorff(positions, vertex_count, a, a_count, b, b_count, resolution, 0, limit);
+}
+
+double mr_lod_hausdorff_bound_within(const float *positions, uint32_t vertex_count, const uint32_t *a,
+                                     uint32_t a_count, const uint32_t *b, uint32_t b_count, double accept,
+                                     double resolution, double limit) {
+    return hausdorff(positions, vertex_count, a, a_count, b, b_count, resolution, accept, limit);
 }
 
 /* ---------------------------------------------------------- building */
@@ -796,14 +1097,20 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
         }
         if (n < 3) break;
         if (n > (size_t)(src_n * 0.85)) continue; /* too little saved: try the next, larger error */
-        /* Certified against the full mesh (welded: the same surface), not
-         * chained through the previous level: the triangle inequality would
-         * be cheaper but adds up the slack of every step. Resolution: a
-         * small part of the level's error budget; it only ever adds to the
-         * bound. */
+        /* Certified against the source level (welded), chained by the
+         * triangle inequality: H(level, full) <= H(level, source) +
+         * H(source, full), the latter certified before. Each step then
+         * costs what its source has (a geometric series over the levels;
+         * measured: 2.4x faster than each level against the full mesh), at
+         * the price of a looser bound (the steps' errors add up; up to
+         * about twice the sampled truth on the tests' shapes). Pieces are
+         * refined only where their bound exceeds the step's budget and is
+         * more than a quarter over the largest real distance found.
+         * Resolution: a small part of the level's error budget; it only
+         * ever adds to the bound. */
         double res = fmax(0.05 * target, 1e-6 * scale);
-        double e = mr_lod_hausdorff_bound(w.cpos, w.ccount, w.idx, (uint32_t)w.count, dst, (uint32_t)n, res,
-                                          2 * cap);
+        double e = src_err + mr_lod_hausdorff_bound_within(w.cpos, w.ccount, src, (uint32_t)src_n, dst, (uint32_t)n,
+                                                           res, res, 2 * cap);
         if (!(e + 2 * w.slack <= cap)) break; /* coarser levels only get worse */
         mr_lod_level *l = &out->levels[out->level_count];
         l->indices = malloc(n * sizeof *l->indices);
@@ -930,7 +1237,7 @@ mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *e
 /* -------------------------------------------------------------- cache */
 
 #define CACHE_MAGIC "MRLOD\r\n\x1a"
-#define CACHE_VERSION 2u /* bump whenever simplification or certification changes */
+#define CACHE_VERSION 3u /* bump whenever simplification or certification changes */
 
 void mr_lod_cache_path(const char *scene_path, char *out, size_t n) {
     snprintf(out, n, "%s.mrlod", scene_path ? scene_path : "scene");

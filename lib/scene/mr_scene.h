@@ -415,6 +415,14 @@ void mr_lod_cache_path(const char *scene_path, char *out, size_t n);
  * lies farther than `limit` from the other surface. */
 double mr_lod_hausdorff_bound(const float *positions, uint32_t vertex_count, const uint32_t *a, uint32_t a_count,
                               const uint32_t *b, uint32_t b_count, double resolution, double limit);
+/* The same bound, refined only where it exceeds `accept` (and the largest
+ * real distance found + resolution): still a true upper bound, at most
+ * max(accept, truth + resolution) where refinement reaches, and much
+ * cheaper when accept is the error one is prepared to certify (the LOD
+ * build passes each level's error budget). */
+double mr_lod_hausdorff_bound_within(const float *positions, uint32_t vertex_count, const uint32_t *a,
+                                     uint32_t a_count, const uint32_t *b, uint32_t b_count, double accept,
+                                     double resolution, double limit);
 
 /* ------------------------------------ synthetic factories (synth.c) */
 
