@@ -235,6 +235,7 @@ struct BufRef {
 struct Source {
     std::vector<BufRef> bufs;
     std::vector<std::unique_ptr<Mapping>> maps;  // external .bin files
+    std::map<std::pair<int, int>, int> moved_indices;  // (mesh, primitive) -> index accessor without bufferView
     const Mapping *container = nullptr;          // the mapped .glb/.gltf, if it is one
     size_t input_bytes = 0;                      // file + external buffers: the bound on zero-filled accessors
     size_t since_drop = 0;
@@ -267,7 +268,7 @@ Glb glb_split(const unsigned char *b, size_t size) {
     Glb g;
     if (size < 20) fail(MR_ERR_PARSE, "invalid GLB: %zu bytes is too short for a GLB header", size);
     uint32_t version = rd32(b + 4), length = rd32(b + 8);
-    if (version != 2) fail(MR_ERR_UNSUPPORTED, "invalid GLB: version %u (only 2 is supported)", version);
+    if (version != 2) fail(MR_ERR_PARSE, "invalid GLB: version %u (only 2 is supported)", version);
     if (length > size)
         fail(MR_ERR_PARSE, "invalid GLB: truncated (the header says %u bytes, there are %zu)", length, size);
     if (length < 20) fail(MR_ERR_PARSE, "invalid GLB: the header's length %u is too short", length);
@@ -336,9 +337,31 @@ std::string take_buffers(const char *json, size_t len, const Glb *glb, const cha
         if (cJSON_IsString(r) && !extension_ok(r->valuestring))
             fail(MR_ERR_UNSUPPORTED, "requires glTF extension %s (not supported)", r->valuestring);
     }
-    cJSON *bufs = cJSON_GetObjectItemCaseSensitive(j.j, "buffers");
-    if (!cJSON_IsArray(bufs)) return std::string(json, len);
     bool changed = false;
+    // tinygltf refuses index accessors without a bufferView, which draco
+    // primitives have (their indices are in the draco data) and the
+    // specification allows: such indices are kept aside here.
+    const cJSON *accs = cJSON_GetObjectItemCaseSensitive(j.j, "accessors");
+    const cJSON *mesh;
+    int mi = 0;
+    cJSON_ArrayForEach(mesh, cJSON_GetObjectItemCaseSensitive(j.j, "meshes")) {
+        cJSON *prim;
+        int pi = 0;
+        cJSON_ArrayForEach(prim, cJSON_GetObjectItemCaseSensitive(mesh, "primitives")) {
+            const cJSON *ix = cJSON_GetObjectItemCaseSensitive(prim, "indices");
+            if (cJSON_IsNumber(ix) && ix->valuedouble >= 0 && ix->valuedouble < (double)cJSON_GetArraySize(accs)) {
+                const cJSON *a = cJSON_GetArrayItem(accs, (int)ix->valuedouble);
+                if (cJSON_IsObject(a) && !cJSON_GetObjectItemCaseSensitive(a, "bufferView")) {
+                    src->moved_indices[std::make_pair(mi, pi)] = (int)ix->valuedouble;
+                    cJSON_DeleteItemFromObjectCaseSensitive(prim, "indices");
+                    changed = true;
+                }
+            }
+            pi++;
+        }
+        mi++;
+    }
+    cJSON *bufs = cJSON_GetObjectItemCaseSensitive(j.j, "buffers");
     int i = 0;
     cJSON *b;
     cJSON_ArrayForEach(b, bufs) {
@@ -926,8 +949,8 @@ struct Loader {
         auto pos_it = p.attributes.find("POSITION");
         if (pos_it != p.attributes.end() && pos_it->second >= 0 && (size_t)pos_it->second < m.accessors.size() &&
             m.accessors[(size_t)pos_it->second].count != nv)
-            fail(MR_ERR_PARSE, "mesh '%s': draco has %u points, the POSITION accessor says %zu", name, nv,
-                 m.accessors[(size_t)pos_it->second].count);
+            warning(std::string("mesh '") + name + "': draco decoded " + std::to_string(nv) +
+                    " points, the POSITION accessor says " + std::to_string(m.accessors[(size_t)pos_it->second].count));
         g.m.vertex_count = nv;
         g.m.positions = xmalloc<float>((size_t)nv * 3);
         if (!mr_draco_attribute(d.d, pid, 3, g.m.positions, why, sizeof why))
@@ -956,7 +979,7 @@ struct Loader {
         if (!order.empty()) mr_draco_indices(d.d, order.data());
     }
 
-    void primitive(const tinygltf::Primitive &p, const char *name, int prim_idx) {
+    void primitive(const tinygltf::Primitive &p, const char *name, int mesh_idx, int prim_idx) {
         int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
         if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP) {
             warning(std::string("mesh '") + name + "' primitive " + std::to_string(prim_idx) +
@@ -1010,8 +1033,10 @@ struct Loader {
                     read(uview, 2, g.m.uvs, "TEXCOORD_0", name);
                 }
             }
-            if (p.indices >= 0) {
-                View iv = accessor_view(p.indices, "index", name);
+            auto moved = src.moved_indices.find(std::make_pair(mesh_idx, prim_idx));
+            const int indices = moved != src.moved_indices.end() ? moved->second : p.indices;
+            if (indices >= 0) {
+                View iv = accessor_view(indices, "index", name);
                 if (iv.ncomp != 1 || (iv.comp != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
                                       iv.comp != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
                                       iv.comp != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
@@ -1069,7 +1094,7 @@ struct Loader {
         if (gm.name.empty()) std::snprintf(name, sizeof name, "mesh_%d", mi);
         else std::snprintf(name, sizeof name, "%s", gm.name.c_str());
         int32_t first = s->mesh_count;
-        for (size_t k = 0; k < gm.primitives.size(); k++) primitive(gm.primitives[k], name, (int)k);
+        for (size_t k = 0; k < gm.primitives.size(); k++) primitive(gm.primitives[k], name, mi, (int)k);
         int32_t count = s->mesh_count - first;
         mesh_map[(size_t)mi] = count > 0 ? std::make_pair(first, count) : std::make_pair(-1, 0);
         return mesh_map[(size_t)mi];
