@@ -320,6 +320,88 @@ std::string url_decode(const std::string &s) {
     return out;
 }
 
+// Top-level members of a JSON object: key -> [begin, end) of its value.
+// The whole text is only scanned (strings and nesting), never built as a
+// tree: a CAD file's JSON can be large, and take_buffers needs only a few
+// small members of it. False if the text is not an object; tinygltf then
+// says what is wrong.
+struct Span {
+    size_t b, e;
+};
+
+bool skip_string(const char *s, size_t n, size_t *i) {
+    for (size_t k = *i + 1; k < n; k++) {
+        if (s[k] == '\\') k++;
+        else if (s[k] == '"') {
+            *i = k + 1;
+            return true;
+        }
+    }
+    return false;
+}
+
+bool skip_value(const char *s, size_t n, size_t *i) {
+    size_t k = *i;
+    if (k >= n) return false;
+    if (s[k] == '"') return skip_string(s, n, i);
+    if (s[k] == '{' || s[k] == '[') {
+        int depth = 0;
+        while (k < n) {
+            char c = s[k];
+            if (c == '"') {
+                if (!skip_string(s, n, &k)) return false;
+                continue;
+            }
+            if (c == '{' || c == '[') depth++;
+            else if (c == '}' || c == ']') {
+                if (--depth == 0) {
+                    *i = k + 1;
+                    return true;
+                }
+            }
+            k++;
+        }
+        return false;
+    }
+    while (k < n && !std::strchr(",}] \t\r\n", s[k])) k++;
+    if (k == *i) return false;
+    *i = k;
+    return true;
+}
+
+bool top_level(const char *s, size_t n, std::map<std::string, Span> *out) {
+    auto ws = [&](size_t &k) {
+        while (k < n && (s[k] == ' ' || s[k] == '\t' || s[k] == '\r' || s[k] == '\n')) k++;
+    };
+    size_t k = 0;
+    ws(k);
+    if (k >= n || s[k] != '{') return false;
+    k++;
+    ws(k);
+    if (k < n && s[k] == '}') return true;
+    while (k < n) {
+        ws(k);
+        if (k >= n || s[k] != '"') return false;
+        size_t ks = k;
+        if (!skip_string(s, n, &k)) return false;
+        std::string key(s + ks + 1, k - ks - 2);
+        ws(k);
+        if (k >= n || s[k] != ':') return false;
+        k++;
+        ws(k);
+        size_t vb = k;
+        if (!skip_value(s, n, &k)) return false;
+        out->emplace(key, Span{vb, k});
+        ws(k);
+        if (k < n && s[k] == ',') {
+            k++;
+            continue;
+        }
+        return k < n && s[k] == '}';
+    }
+    return false;
+}
+
 // Takes the buffers out of tinygltf's hands: the GLB's BIN chunk and
 // external .bin files are mapped into src->bufs and replaced in the JSON by
 // a 1-byte data URI, so tinygltf copies nothing big (its API has no way to
@@ -327,44 +409,69 @@ std::string url_decode(const std::string &s) {
 // all) are marked, which also ends tinygltf's misleading "Invalid
 // `byteLength'" on gltfpack -c output. data: URIs stay with tinygltf. A
 // required extension we do not read is refused here, by name, before any
-// buffer error can hide it. Returns the JSON to parse.
+// buffer error can hide it. Only the members changed are re-printed and
+// spliced into the text. Returns the JSON to parse.
 std::string take_buffers(const char *json, size_t len, const Glb *glb, const char *base_dir, Source *src) {
-    JsonGuard j{cJSON_ParseWithLength(json, len)};
-    if (!j.j || !cJSON_IsObject(j.j)) return std::string(json, len);  // tinygltf says what is wrong
-    const cJSON *req = cJSON_GetObjectItemCaseSensitive(j.j, "extensionsRequired");
-    const cJSON *r;
-    cJSON_ArrayForEach(r, req) {
-        if (cJSON_IsString(r) && !extension_ok(r->valuestring))
-            fail(MR_ERR_UNSUPPORTED, "requires glTF extension %s (not supported)", r->valuestring);
-    }
-    bool changed = false;
-    // tinygltf refuses index accessors without a bufferView, which draco
-    // primitives have (their indices are in the draco data) and the
-    // specification allows: such indices are kept aside here.
-    const cJSON *accs = cJSON_GetObjectItemCaseSensitive(j.j, "accessors");
-    const cJSON *mesh;
-    int mi = 0;
-    cJSON_ArrayForEach(mesh, cJSON_GetObjectItemCaseSensitive(j.j, "meshes")) {
-        cJSON *prim;
-        int pi = 0;
-        cJSON_ArrayForEach(prim, cJSON_GetObjectItemCaseSensitive(mesh, "primitives")) {
-            const cJSON *ix = cJSON_GetObjectItemCaseSensitive(prim, "indices");
-            if (cJSON_IsNumber(ix) && ix->valuedouble >= 0 && ix->valuedouble < (double)cJSON_GetArraySize(accs)) {
-                const cJSON *a = cJSON_GetArrayItem(accs, (int)ix->valuedouble);
-                if (cJSON_IsObject(a) && !cJSON_GetObjectItemCaseSensitive(a, "bufferView")) {
-                    src->moved_indices[std::make_pair(mi, pi)] = (int)ix->valuedouble;
-                    cJSON_DeleteItemFromObjectCaseSensitive(prim, "indices");
-                    changed = true;
-                }
-            }
-            pi++;
+    std::map<std::string, Span> top;
+    if (!top_level(json, len, &top)) return std::string(json, len);  // tinygltf says what is wrong
+    auto member = [&](const char *key) -> cJSON * {
+        auto it = top.find(key);
+        return it == top.end() ? nullptr : cJSON_ParseWithLength(json + it->second.b, it->second.e - it->second.b);
+    };
+    std::map<size_t, std::pair<Span, std::string>> splice;  // by begin: the new text of a member's value
+    auto replace = [&](const char *key, const cJSON *v) {
+        char *t = cJSON_PrintUnformatted(v);
+        if (!t) throw std::bad_alloc();
+        const Span sp = top[key];
+        splice[sp.b] = std::make_pair(sp, std::string(t));
+        cJSON_free(t);
+    };
+    {
+        JsonGuard req{member("extensionsRequired")};
+        const cJSON *r;
+        cJSON_ArrayForEach(r, req.j) {
+            if (cJSON_IsString(r) && !extension_ok(r->valuestring))
+                fail(MR_ERR_UNSUPPORTED, "requires glTF extension %s (not supported)", r->valuestring);
         }
-        mi++;
     }
-    cJSON *bufs = cJSON_GetObjectItemCaseSensitive(j.j, "buffers");
+    // tinygltf refuses index accessors without a bufferView, which draco
+    // primitives have (their indices are in the draco data; the
+    // specification allows them anywhere): such indices are kept aside.
+    bool draco = false;
+    {
+        JsonGuard used{member("extensionsUsed")};
+        const cJSON *u;
+        cJSON_ArrayForEach(u, used.j) draco = draco || (cJSON_IsString(u) && !std::strcmp(u->valuestring, "KHR_draco_mesh_compression"));
+    }
+    if (draco) {
+        JsonGuard accs{member("accessors")}, meshes{member("meshes")};
+        bool changed = false;
+        const cJSON *mesh;
+        int mi = 0;
+        cJSON_ArrayForEach(mesh, meshes.j) {
+            cJSON *prim;
+            int pi = 0;
+            cJSON_ArrayForEach(prim, cJSON_GetObjectItemCaseSensitive(mesh, "primitives")) {
+                const cJSON *ix = cJSON_GetObjectItemCaseSensitive(prim, "indices");
+                if (cJSON_IsNumber(ix) && ix->valuedouble >= 0 && ix->valuedouble < (double)cJSON_GetArraySize(accs.j)) {
+                    const cJSON *a = cJSON_GetArrayItem(accs.j, (int)ix->valuedouble);
+                    if (cJSON_IsObject(a) && !cJSON_GetObjectItemCaseSensitive(a, "bufferView")) {
+                        src->moved_indices[std::make_pair(mi, pi)] = (int)ix->valuedouble;
+                        cJSON_DeleteItemFromObjectCaseSensitive(prim, "indices");
+                        changed = true;
+                    }
+                }
+                pi++;
+            }
+            mi++;
+        }
+        if (changed) replace("meshes", meshes.j);
+    }
+    JsonGuard bufs{member("buffers")};
+    bool changed = false;
     int i = 0;
     cJSON *b;
-    cJSON_ArrayForEach(b, bufs) {
+    cJSON_ArrayForEach(b, bufs.j) {
         if (!cJSON_IsObject(b)) fail(MR_ERR_PARSE, "buffer %d is not an object", i);
         const cJSON *bl = cJSON_GetObjectItemCaseSensitive(b, "byteLength");
         if (!cJSON_IsNumber(bl) || !(bl->valuedouble >= 0) || bl->valuedouble > 9.0e15 ||
@@ -415,12 +522,18 @@ std::string take_buffers(const char *json, size_t len, const Glb *glb, const cha
         src->bufs.push_back(ref);
         i++;
     }
-    if (!changed) return std::string(json, len);
-    char *out = cJSON_PrintUnformatted(j.j);
-    if (!out) throw std::bad_alloc();
-    std::string s(out);
-    cJSON_free(out);
-    return s;
+    if (changed) replace("buffers", bufs.j);
+    if (splice.empty()) return std::string(json, len);
+    std::string out;
+    out.reserve(len + 256);
+    size_t at = 0;
+    for (const auto &kv : splice) {
+        out.append(json + at, kv.second.first.b - at);
+        out += kv.second.second;
+        at = kv.second.first.e;
+    }
+    out.append(json + at, len - at);
+    return out;
 }
 
 // ------------------------------------------------------------ accessors
@@ -642,6 +755,26 @@ struct Loader {
         return View{p + a.byteOffset, stride, a.count, a.componentType, ncomp, a.normalized, idx};
     }
 
+    // Element loop for component type C; norm_max > 0: normalised by the
+    // specification's rule (signed types clamp at -1).
+    template <typename C, typename T>
+    static void convert(const View &v, int n, int k_n, T *out, double norm_max) {
+        const bool norm = v.normalized && norm_max > 0;
+        const double inv = norm ? 1.0 / norm_max : 1.0;
+        for (size_t i = 0; i < v.count; i++) {
+            const unsigned char *p = v.base + i * v.stride;
+            T *q = out + i * (size_t)n;
+            for (int k = 0; k < k_n; k++) {
+                C c;
+                std::memcpy(&c, p + (size_t)k * sizeof(C), sizeof(C));
+                double d = (double)c * inv;
+                if (norm && std::is_signed<C>::value && d < -1.0) d = -1.0;
+                q[k] = (T)d;
+            }
+            for (int k = k_n; k < n; k++) q[k] = T(0);
+        }
+    }
+
     // Reads n components per element into out[count*n] (missing components
     // 0), converting any component type, then applies sparse substitution.
     template <typename T>
@@ -652,11 +785,16 @@ struct Loader {
         } else if (v.comp == TINYGLTF_COMPONENT_TYPE_FLOAT && std::is_same<T, float>::value && k_n == n) {
             for (size_t i = 0; i < v.count; i++) std::memcpy(out + i * (size_t)n, v.base + i * v.stride, 4 * (size_t)n);
         } else {
-            for (size_t i = 0; i < v.count; i++) {
-                const unsigned char *p = v.base + i * v.stride;
-                T *q = out + i * (size_t)n;
-                for (int k = 0; k < k_n; k++) q[k] = (T)comp_value(p + (size_t)(k * cs), v.comp, v.normalized);
-                for (int k = k_n; k < n; k++) q[k] = T(0);
+            // One loop per component type: quantised files (gltfpack) must
+            // load at least as fast as float ones.
+            switch (v.comp) {
+            case TINYGLTF_COMPONENT_TYPE_BYTE: convert<int8_t>(v, n, k_n, out, 127.0); break;
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: convert<uint8_t>(v, n, k_n, out, 255.0); break;
+            case TINYGLTF_COMPONENT_TYPE_SHORT: convert<int16_t>(v, n, k_n, out, 32767.0); break;
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: convert<uint16_t>(v, n, k_n, out, 65535.0); break;
+            case TINYGLTF_COMPONENT_TYPE_INT: convert<int32_t>(v, n, k_n, out, 0); break;
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: convert<uint32_t>(v, n, k_n, out, 0); break;
+            default: convert<float>(v, n, k_n, out, 0); break;
             }
         }
         const tinygltf::Accessor &a = m.accessors[(size_t)v.index];
