@@ -616,7 +616,12 @@ struct Loader {
     mr_scene *s;
     Source &src;
     bool quantized = false;  // KHR_mesh_quantization used: integer attributes allowed
-    std::map<int, std::vector<unsigned char>> meshopt;  // decoded EXT_meshopt_compression views
+    // Decoded EXT_meshopt_compression views, each freed once the accessors
+    // of primitives that read it are read (view_uses), so a compressed file
+    // never holds all its decoded bytes at once; a view read again after
+    // that is decoded again.
+    std::map<int, std::unique_ptr<unsigned char[]>> meshopt;
+    std::vector<int> view_uses;
     std::vector<const char *> globs;
     std::vector<std::pair<int32_t, int32_t>> mesh_map;  // glTF mesh -> (first, count); first -2: not yet
     std::vector<int32_t> tex_map;                        // glTF texture -> scene texture; -2: not yet
@@ -640,9 +645,9 @@ struct Loader {
 
     // EXT_meshopt_compression: the bufferView's bytes decoded from its
     // compressed stream (once; views are shared by accessors).
-    const std::vector<unsigned char> &meshopt_view(int bvi, const tinygltf::Value &x) {
+    const unsigned char *meshopt_view(int bvi, const tinygltf::Value &x) {
         auto it = meshopt.find(bvi);
-        if (it != meshopt.end()) return it->second;
+        if (it != meshopt.end()) return it->second.get();
         const tinygltf::BufferView &bv = m.bufferViews[(size_t)bvi];
         double buf = -1, off = 0, len = -1, stride = 0, count = -1;
         if (!x.IsObject() || !ext_num(x, "buffer", &buf) || !ext_num(x, "byteLength", &len) ||
@@ -672,20 +677,21 @@ struct Loader {
         if (bv.byteLength > out_n)
             fail(MR_ERR_PARSE, "bufferView %d: byteLength %zu is more than its meshopt data decodes to (%zu)", bvi,
                  bv.byteLength, out_n);
-        std::vector<unsigned char> out(out_n ? out_n : 1);
+        // Not zeroed: the decoder writes every byte, or fails.
+        std::unique_ptr<unsigned char[]> out(new unsigned char[out_n ? out_n : 1]);
         const unsigned char *in = b.p + o;
         int rc;
         if (mode == "ATTRIBUTES") {
             if (st % 4 != 0) fail(MR_ERR_PARSE, "bufferView %d: meshopt ATTRIBUTES stride %zu is not a multiple of 4", bvi, st);
-            rc = meshopt_decodeVertexBuffer(out.data(), cnt, st, in, n);
+            rc = meshopt_decodeVertexBuffer(out.get(), cnt, st, in, n);
             if (rc == 0 && filter == "OCTAHEDRAL") {
                 if (st != 4 && st != 8) fail(MR_ERR_PARSE, "bufferView %d: OCTAHEDRAL filter needs stride 4 or 8", bvi);
-                meshopt_decodeFilterOct(out.data(), cnt, st);
+                meshopt_decodeFilterOct(out.get(), cnt, st);
             } else if (rc == 0 && filter == "QUATERNION") {
                 if (st != 8) fail(MR_ERR_PARSE, "bufferView %d: QUATERNION filter needs stride 8", bvi);
-                meshopt_decodeFilterQuat(out.data(), cnt, st);
+                meshopt_decodeFilterQuat(out.get(), cnt, st);
             } else if (rc == 0 && filter == "EXPONENTIAL") {
-                meshopt_decodeFilterExp(out.data(), cnt, st);
+                meshopt_decodeFilterExp(out.get(), cnt, st);
             } else if (filter != "NONE") {
                 fail(MR_ERR_UNSUPPORTED, "bufferView %d: meshopt filter %s (not supported)", bvi, filter.c_str());
             }
@@ -693,14 +699,14 @@ struct Loader {
             if (st != 2 && st != 4) fail(MR_ERR_PARSE, "bufferView %d: meshopt %s stride must be 2 or 4", bvi, mode.c_str());
             if (mode == "TRIANGLES" && cnt % 3 != 0)
                 fail(MR_ERR_PARSE, "bufferView %d: meshopt TRIANGLES count %zu is not a multiple of 3", bvi, cnt);
-            rc = mode == "TRIANGLES" ? meshopt_decodeIndexBuffer(out.data(), cnt, st, in, n)
-                                     : meshopt_decodeIndexSequence(out.data(), cnt, st, in, n);
+            rc = mode == "TRIANGLES" ? meshopt_decodeIndexBuffer(out.get(), cnt, st, in, n)
+                                     : meshopt_decodeIndexSequence(out.get(), cnt, st, in, n);
         } else {
             fail(MR_ERR_UNSUPPORTED, "bufferView %d: meshopt mode %s (not supported)", bvi, mode.c_str());
         }
         if (rc != 0) fail(MR_ERR_PARSE, "bufferView %d: malformed meshopt %s stream (decoder error %d)", bvi, mode.c_str(), rc);
         src.consumed(n);
-        return meshopt.emplace(bvi, std::move(out)).first->second;
+        return meshopt.emplace(bvi, std::move(out)).first->second.get();
     }
 
     // The bytes of bufferView bvi, bounds-checked; *len gets its byteLength.
@@ -709,7 +715,7 @@ struct Loader {
         const tinygltf::BufferView &bv = m.bufferViews[(size_t)bvi];
         *len = bv.byteLength;
         auto x = bv.extensions.find("EXT_meshopt_compression");
-        if (x != bv.extensions.end()) return meshopt_view(bvi, x->second).data();
+        if (x != bv.extensions.end()) return meshopt_view(bvi, x->second);
         if (bv.buffer < 0 || (size_t)bv.buffer >= src.bufs.size())
             fail(MR_ERR_PARSE, "bufferView %d refers to a missing buffer", bvi);
         const BufRef &b = src.bufs[(size_t)bv.buffer];
@@ -722,6 +728,34 @@ struct Loader {
     }
 
     // ------------------------------------------------------ accessors
+
+    // The accessor of a primitive attribute or its indices has been read:
+    // its decoded meshopt view goes once no other primitive needs it.
+    void done(int accessor) {
+        if (accessor < 0 || (size_t)accessor >= m.accessors.size()) return;
+        int bv = m.accessors[(size_t)accessor].bufferView;
+        if (bv < 0 || (size_t)bv >= view_uses.size()) return;
+        if (--view_uses[(size_t)bv] <= 0) meshopt.erase(bv);
+    }
+
+    void count_view_uses() {
+        view_uses.assign(m.bufferViews.size(), 0);
+        auto use = [&](int a) {
+            if (a < 0 || (size_t)a >= m.accessors.size()) return;
+            int bv = m.accessors[(size_t)a].bufferView;
+            if (bv >= 0 && (size_t)bv < view_uses.size()) view_uses[(size_t)bv]++;
+        };
+        for (size_t mi = 0; mi < m.meshes.size(); mi++)
+            for (size_t pi = 0; pi < m.meshes[mi].primitives.size(); pi++) {
+                const tinygltf::Primitive &p = m.meshes[mi].primitives[pi];
+                for (const char *k : {"POSITION", "NORMAL", "TEXCOORD_0"}) {
+                    auto it = p.attributes.find(k);
+                    if (it != p.attributes.end()) use(it->second);
+                }
+                auto moved = src.moved_indices.find(std::make_pair((int)mi, (int)pi));
+                use(moved != src.moved_indices.end() ? moved->second : p.indices);
+            }
+    }
 
     View accessor_view(int idx, const char *what, const char *mesh) {
         if (idx < 0 || (size_t)idx >= m.accessors.size())
@@ -1149,6 +1183,7 @@ struct Loader {
             g.m.vertex_count = nv;
             g.m.positions = xmalloc<float>((size_t)nv * 3);
             read(pv, 3, g.m.positions, "POSITION", name);
+            done(pos_it->second);
 
             auto nrm_it = p.attributes.find("NORMAL");
             if (nrm_it != p.attributes.end()) {
@@ -1160,6 +1195,7 @@ struct Loader {
                     read(nview, 3, g.m.normals, "NORMAL", name);
                     check_normals(g, name, nview.comp != TINYGLTF_COMPONENT_TYPE_FLOAT);
                 }
+                done(nrm_it->second);
             }
             auto uv_it = p.attributes.find("TEXCOORD_0");
             if (uv_it != p.attributes.end()) {
@@ -1170,6 +1206,7 @@ struct Loader {
                     g.m.uvs = xmalloc<float>((size_t)nv * 2);
                     read(uview, 2, g.m.uvs, "TEXCOORD_0", name);
                 }
+                done(uv_it->second);
             }
             auto moved = src.moved_indices.find(std::make_pair(mesh_idx, prim_idx));
             const int indices = moved != src.moved_indices.end() ? moved->second : p.indices;
@@ -1181,6 +1218,7 @@ struct Loader {
                     fail(MR_ERR_PARSE, "mesh '%s': indices must be unsigned byte/short/int scalars", name);
                 order.resize(iv.count);
                 read(iv, 1, order.data(), "index", name);
+                done(indices);
                 have_order = true;
             }
         }
@@ -1332,6 +1370,7 @@ struct Loader {
     }
 
     void run() {
+        count_view_uses();
         mesh_map.assign(m.meshes.size(), std::make_pair(-2, 0));
         tex_map.assign(m.textures.size(), -2);
         materials();
