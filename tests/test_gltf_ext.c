@@ -308,6 +308,9 @@ static void test_meshopt(void) {
     /* Lies and damage: counts of 2^31, streams cut short, garbage. */
     snprintf(json, sizeof json, fmt, k_head, bn, vn, "2147483648", vp, in, "TRIANGLES");
     expect_refused(json, bin, bn, "meshopt", __LINE__);
+    /* 1e8 vertices (1.2 GB) from a 100-byte stream: refused before allocating. */
+    snprintf(json, sizeof json, fmt, k_head, bn, vn, "100000000", vp, in, "TRIANGLES");
+    expect_refused(json, bin, bn, "can hold", __LINE__);
     snprintf(json, sizeof json, fmt, k_head, bn, vn - 5, "16", vp, in, "TRIANGLES");
     expect_refused(json, bin, bn, "malformed meshopt", __LINE__);
     snprintf(json, sizeof json, fmt, k_head, bn, vn, "16", vp, in, "SPIRALS");
