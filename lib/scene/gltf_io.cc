@@ -239,7 +239,9 @@ struct Source {
     const Mapping *container = nullptr;          // the mapped .glb/.gltf, if it is one
     size_t input_bytes = 0;                      // file + external buffers: the bound on zero-filled accessors
     size_t since_drop = 0;
+    size_t total_read = 0;  // bytes of accessors and streams read: the load's progress
     void consumed(size_t n) {
+        total_read += n;
         since_drop += n;
         if (since_drop < ((size_t)64 << 20)) return;
         since_drop = 0;
@@ -870,6 +872,21 @@ struct Loader {
 
     void warning(const std::string &w) { warn += w + "\n"; }
 
+    // The "nodes" stage's fraction: of the nodes visited or of the file's
+    // bytes read, whichever is further (a few huge meshes, or many nodes);
+    // reported when it moved by 1 %.
+    double progress_shown = 0;
+    size_t nodes_visited = 0;
+    void progress_nodes(size_t visited) {
+        if (!progress) return;
+        nodes_visited = std::max(nodes_visited, visited);
+        double f = m.nodes.empty() ? 0 : (double)nodes_visited / (double)m.nodes.size();
+        if (src.input_bytes) f = std::max(f, std::min(1.0, (double)src.total_read / (double)src.input_bytes));
+        if (f < progress_shown + 0.01) return;
+        progress_shown = f;
+        progress(progress_user, "nodes", f);
+    }
+
     // Any channel count, 8 or 16 bits -> RGBA8.
     bool image_to_rgba8(const tinygltf::Image &img, mr_image *out, std::string *why) {
         int w = img.width, h = img.height, c = img.component;
@@ -1272,6 +1289,7 @@ struct Loader {
         int32_t first = s->mesh_count;
         for (size_t k = 0; k < gm.primitives.size(); k++) primitive(gm.primitives[k], name, mi, (int)k);
         int32_t count = s->mesh_count - first;
+        progress_nodes(0);
         mesh_map[(size_t)mi] = count > 0 ? std::make_pair(first, count) : std::make_pair(-1, 0);
         return mesh_map[(size_t)mi];
     }
@@ -1335,7 +1353,7 @@ struct Loader {
         for (size_t i = roots.size(); i-- > 0;) stack.push_back(Item{roots[i], -1});
         size_t visited = 0;
         while (!stack.empty()) {
-            if ((++visited & 4095) == 0) report("nodes", visited, m.nodes.size());
+            if ((++visited & 4095) == 0) progress_nodes(visited);
             Item it = stack.back();
             stack.pop_back();
             if (it.node < 0 || (size_t)it.node >= m.nodes.size())
