@@ -11,6 +11,7 @@ pkgs=(
   libopencv-dev libopencv-contrib-dev
   libceres-dev libzip-dev
   unzip
+  gltfpack libdraco-dev
 )
 missing=()
 for p in "${pkgs[@]}"; do

@@ -6,10 +6,20 @@
 
 #include <tiny_gltf.h>  // never TINYGLTF_IMPLEMENTATION: we link the shared lib
 
+#include "draco_internal.h"
+#include <meshoptimizer.h>
+
 #include <stb_image.h>
 #include <stb_image_write.h>
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <climits>
 #include <cmath>
 #include <cstdarg>
@@ -17,9 +27,11 @@
 #include <cstring>
 #include <exception>
 #include <map>
+#include <memory>
 #include <new>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -160,6 +172,372 @@ bool fs_no_write(std::string *err, const std::string &, const std::vector<unsign
     return false;
 }
 
+// ------------------------------------------------------------ buffers
+
+// A read-only file mapping (the file itself, or an external .bin): big
+// files are mapped, never copied, so a load's peak memory is about what it
+// decodes, not file + copy + decoded (issue 17, item 6).
+struct Mapping {
+    void *addr = nullptr;
+    size_t len = 0;
+    Mapping() = default;
+    Mapping(const Mapping &) = delete;
+    Mapping &operator=(const Mapping &) = delete;
+    ~Mapping() {
+        if (addr) munmap(addr, len);
+    }
+    // Gives back the pages read so far (they stay in the page cache and come
+    // back if read again): resident file pages count in our RSS.
+    void drop() const {
+        if (addr) madvise(addr, len, MADV_DONTNEED);
+    }
+};
+
+// Largest file we map: GLB lengths are 32-bit, and tinygltf takes the JSON's
+// length as unsigned int.
+const size_t k_max_file = (size_t)UINT32_MAX;
+
+void map_file(const std::string &path, Mapping *mp) {
+    int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) fail(MR_ERR_IO, "cannot open %s: %s", path.c_str(), std::strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        fail(MR_ERR_IO, "%s is not a regular file", path.c_str());
+    }
+    if ((unsigned long long)st.st_size > (unsigned long long)k_max_file) {
+        close(fd);
+        fail(MR_ERR_UNSUPPORTED, "%s is %.2f GB, over glTF's 4 GiB limit (GLB lengths are 32-bit)", path.c_str(),
+             (double)st.st_size / 1e9);
+    }
+    size_t n = (size_t)st.st_size;
+    if (n == 0) {
+        close(fd);
+        fail(MR_ERR_PARSE, "%s is empty", path.c_str());
+    }
+    void *p = mmap(nullptr, n, PROT_READ, MAP_PRIVATE, fd, 0);
+    close(fd);
+    if (p == MAP_FAILED) fail(MR_ERR_NOMEM, "cannot map %s (%zu bytes): %s", path.c_str(), n, std::strerror(errno));
+    madvise(p, n, MADV_SEQUENTIAL);  // meshes are read in file order, mostly
+    mp->addr = p;
+    mp->len = n;
+}
+
+// One glTF buffer as the loader sees it: bytes we own or map, never a
+// tinygltf copy (data: URIs excepted: tinygltf decodes those).
+struct BufRef {
+    const unsigned char *p = nullptr;
+    size_t n = 0;
+    bool fallback = false;  // EXT_meshopt_compression's fallback: no data
+    bool data_uri = false;  // filled from tinygltf's decoded vector
+};
+
+struct Source {
+    std::vector<BufRef> bufs;
+    std::vector<std::unique_ptr<Mapping>> maps;  // external .bin files
+    std::map<std::pair<int, int>, int> moved_indices;  // (mesh, primitive) -> index accessor without bufferView
+    const Mapping *container = nullptr;          // the mapped .glb/.gltf, if it is one
+    size_t input_bytes = 0;                      // file + external buffers: the bound on zero-filled accessors
+    size_t since_drop = 0;
+    size_t total_read = 0;  // bytes of accessors and streams read: the load's progress
+    void consumed(size_t n) {
+        total_read += n;
+        since_drop += n;
+        if (since_drop < ((size_t)64 << 20)) return;
+        since_drop = 0;
+        if (container) container->drop();
+        for (const std::unique_ptr<Mapping> &m : maps) m->drop();
+    }
+};
+
+uint32_t rd32(const unsigned char *p) {
+    uint32_t v;
+    std::memcpy(&v, p, 4);
+    return v;  // GLB is little-endian, like every machine we build for
+}
+
+struct Glb {
+    const char *json = nullptr;
+    size_t json_len = 0;
+    const unsigned char *bin = nullptr;
+    size_t bin_len = 0;
+    bool has_bin = false;
+};
+
+// The GLB container, checked here rather than by tinygltf, which would copy
+// the BIN chunk into a vector.
+Glb glb_split(const unsigned char *b, size_t size) {
+    Glb g;
+    if (size < 20) fail(MR_ERR_PARSE, "invalid GLB: %zu bytes is too short for a GLB header", size);
+    uint32_t version = rd32(b + 4), length = rd32(b + 8);
+    if (version != 2) fail(MR_ERR_PARSE, "invalid GLB: version %u (only 2 is supported)", version);
+    if (length > size)
+        fail(MR_ERR_PARSE, "invalid GLB: truncated (the header says %u bytes, there are %zu)", length, size);
+    if (length < 20) fail(MR_ERR_PARSE, "invalid GLB: the header's length %u is too short", length);
+    size = length;
+    uint32_t jl = rd32(b + 12), jt = rd32(b + 16);
+    if (jt != 0x4E4F534Au) fail(MR_ERR_PARSE, "invalid GLB: the first chunk is not JSON");
+    if (jl > size - 20)
+        fail(MR_ERR_PARSE, "invalid GLB: the JSON chunk (%u bytes) runs past the end of the file (%zu bytes)", jl, size);
+    g.json = reinterpret_cast<const char *>(b + 20);
+    g.json_len = jl;
+    size_t off = 20 + (size_t)jl;
+    while (size - off >= 8) {
+        uint32_t cl = rd32(b + off), ct = rd32(b + off + 4);
+        if (cl > size - off - 8)
+            fail(MR_ERR_PARSE, "invalid GLB: the chunk at byte %zu (%u bytes) runs past the end of the file (%zu bytes)",
+                 off, cl, size);
+        if (ct == 0x004E4942u && !g.has_bin) {
+            g.bin = b + off + 8;
+            g.bin_len = cl;
+            g.has_bin = true;
+        }
+        off += 8 + (size_t)cl;
+    }
+    return g;
+}
+
+struct JsonGuard {
+    cJSON *j;
+    ~JsonGuard() { cJSON_Delete(j); }
+};
+
+// Required extensions: those we read, and those that change nothing we read.
+bool extension_ok(const std::string &e) {
+    return e == "KHR_materials_unlit" || e == "KHR_materials_emissive_strength" || e == "KHR_mesh_quantization" ||
+           e == "EXT_meshopt_compression" || e == "KHR_draco_mesh_compression" || e == "KHR_texture_transform";
+}
+
+std::string url_decode(const std::string &s) {
+    std::string out;
+    for (size_t i = 0; i < s.size(); i++) {
+        if (s[i] == '%' && i + 2 < s.size() && std::isxdigit((unsigned char)s[i + 1]) &&
+            std::isxdigit((unsigned char)s[i + 2])) {
+            out += (char)std::stoi(s.substr(i + 1, 2), nullptr, 16);
+            i += 2;
+        } else {
+            out += s[i];
+        }
+    }
+    return out;
+}
+
+// Top-level members of a JSON object: key -> [begin, end) of its value.
+// The whole text is only scanned (strings and nesting), never built as a
+// tree: a CAD file's JSON can be large, and take_buffers needs only a few
+// small members of it. False if the text is not an object; tinygltf then
+// says what is wrong.
+struct Span {
+    size_t b, e;
+};
+
+bool skip_string(const char *s, size_t n, size_t *i) {
+    for (size_t k = *i + 1; k < n; k++) {
+        if (s[k] == '\\') k++;
+        else if (s[k] == '"') {
+            *i = k + 1;
+            return true;
+        }
+    }
+    return false;
+}
+
+bool skip_value(const char *s, size_t n, size_t *i) {
+    size_t k = *i;
+    if (k >= n) return false;
+    if (s[k] == '"') return skip_string(s, n, i);
+    if (s[k] == '{' || s[k] == '[') {
+        int depth = 0;
+        while (k < n) {
+            char c = s[k];
+            if (c == '"') {
+                if (!skip_string(s, n, &k)) return false;
+                continue;
+            }
+            if (c == '{' || c == '[') depth++;
+            else if (c == '}' || c == ']') {
+                if (--depth == 0) {
+                    *i = k + 1;
+                    return true;
+                }
+            }
+            k++;
+        }
+        return false;
+    }
+    while (k < n && !std::strchr(",}] \t\r\n", s[k])) k++;
+    if (k == *i) return false;
+    *i = k;
+    return true;
+}
+
+bool top_level(const char *s, size_t n, std::map<std::string, Span> *out) {
+    auto ws = [&](size_t &k) {
+        while (k < n && (s[k] == ' ' || s[k] == '\t' || s[k] == '\r' || s[k] == '\n')) k++;
+    };
+    size_t k = 0;
+    ws(k);
+    if (k >= n || s[k] != '{') return false;
+    k++;
+    ws(k);
+    if (k < n && s[k] == '}') return true;
+    while (k < n) {
+        ws(k);
+        if (k >= n || s[k] != '"') return false;
+        size_t ks = k;
+        if (!skip_string(s, n, &k)) return false;
+        std::string key(s + ks + 1, k - ks - 2);
+        ws(k);
+        if (k >= n || s[k] != ':') return false;
+        k++;
+        ws(k);
+        size_t vb = k;
+        if (!skip_value(s, n, &k)) return false;
+        out->emplace(key, Span{vb, k});
+        ws(k);
+        if (k < n && s[k] == ',') {
+            k++;
+            continue;
+        }
+        return k < n && s[k] == '}';
+    }
+    return false;
+}
+
+// Takes the buffers out of tinygltf's hands: the GLB's BIN chunk and
+// external .bin files are mapped into src->bufs and replaced in the JSON by
+// a 1-byte data URI, so tinygltf copies nothing big (its API has no way to
+// hand it a buffer it does not own). Meshopt fallback buffers (no data at
+// all) are marked, which also ends tinygltf's misleading "Invalid
+// `byteLength'" on gltfpack -c output. data: URIs stay with tinygltf. A
+// required extension we do not read is refused here, by name, before any
+// buffer error can hide it. Only the members changed are re-printed and
+// spliced into the text. Returns the JSON to parse.
+std::string take_buffers(const char *json, size_t len, const Glb *glb, const char *base_dir, Source *src) {
+    std::map<std::string, Span> top;
+    if (!top_level(json, len, &top)) return std::string(json, len);  // tinygltf says what is wrong
+    auto member = [&](const char *key) -> cJSON * {
+        auto it = top.find(key);
+        return it == top.end() ? nullptr : cJSON_ParseWithLength(json + it->second.b, it->second.e - it->second.b);
+    };
+    std::map<size_t, std::pair<Span, std::string>> splice;  // by begin: the new text of a member's value
+    auto replace = [&](const char *key, const cJSON *v) {
+        char *t = cJSON_PrintUnformatted(v);
+        if (!t) throw std::bad_alloc();
+        const Span sp = top[key];
+        splice[sp.b] = std::make_pair(sp, std::string(t));
+        cJSON_free(t);
+    };
+    {
+        JsonGuard req{member("extensionsRequired")};
+        const cJSON *r;
+        cJSON_ArrayForEach(r, req.j) {
+            if (cJSON_IsString(r) && !extension_ok(r->valuestring))
+                fail(MR_ERR_UNSUPPORTED, "requires glTF extension %s (not supported)", r->valuestring);
+        }
+    }
+    // tinygltf refuses index accessors without a bufferView, which draco
+    // primitives have (their indices are in the draco data; the
+    // specification allows them anywhere): such indices are kept aside.
+    bool draco = false;
+    {
+        JsonGuard used{member("extensionsUsed")};
+        const cJSON *u;
+        cJSON_ArrayForEach(u, used.j) draco = draco || (cJSON_IsString(u) && !std::strcmp(u->valuestring, "KHR_draco_mesh_compression"));
+    }
+    if (draco) {
+        JsonGuard accs{member("accessors")}, meshes{member("meshes")};
+        bool changed = false;
+        const cJSON *mesh;
+        int mi = 0;
+        cJSON_ArrayForEach(mesh, meshes.j) {
+            cJSON *prim;
+            int pi = 0;
+            cJSON_ArrayForEach(prim, cJSON_GetObjectItemCaseSensitive(mesh, "primitives")) {
+                const cJSON *ix = cJSON_GetObjectItemCaseSensitive(prim, "indices");
+                if (cJSON_IsNumber(ix) && ix->valuedouble >= 0 && ix->valuedouble < (double)cJSON_GetArraySize(accs.j)) {
+                    const cJSON *a = cJSON_GetArrayItem(accs.j, (int)ix->valuedouble);
+                    if (cJSON_IsObject(a) && !cJSON_GetObjectItemCaseSensitive(a, "bufferView")) {
+                        src->moved_indices[std::make_pair(mi, pi)] = (int)ix->valuedouble;
+                        cJSON_DeleteItemFromObjectCaseSensitive(prim, "indices");
+                        changed = true;
+                    }
+                }
+                pi++;
+            }
+            mi++;
+        }
+        if (changed) replace("meshes", meshes.j);
+    }
+    JsonGuard bufs{member("buffers")};
+    bool changed = false;
+    int i = 0;
+    cJSON *b;
+    cJSON_ArrayForEach(b, bufs.j) {
+        if (!cJSON_IsObject(b)) fail(MR_ERR_PARSE, "buffer %d is not an object", i);
+        const cJSON *bl = cJSON_GetObjectItemCaseSensitive(b, "byteLength");
+        if (!cJSON_IsNumber(bl) || !(bl->valuedouble >= 0) || bl->valuedouble > 9.0e15 ||
+            std::floor(bl->valuedouble) != bl->valuedouble)
+            fail(MR_ERR_PARSE, "buffer %d: byteLength must be a non-negative integer", i);
+        BufRef ref;
+        ref.n = (size_t)bl->valuedouble;
+        const cJSON *uri = cJSON_GetObjectItemCaseSensitive(b, "uri");
+        const char *u = cJSON_IsString(uri) ? uri->valuestring : "";
+        const cJSON *mx = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(b, "extensions"),
+                                                           "EXT_meshopt_compression");
+        if (std::strncmp(u, "data:", 5) == 0) {
+            ref.data_uri = true;
+            src->bufs.push_back(ref);
+            i++;
+            continue;
+        }
+        if (u[0]) {
+            std::string name = url_decode(u);
+            if (!base_dir) fail(MR_ERR_PARSE, "buffer %d: external file '%s' is not allowed here", i, name.c_str());
+            char full[4096];
+            mr_path_join(base_dir, name.c_str(), full, sizeof full);
+            std::unique_ptr<Mapping> mp(new Mapping);
+            map_file(full, mp.get());
+            if (mp->len < ref.n)
+                fail(MR_ERR_PARSE, "buffer %d: '%s' has %zu bytes, fewer than its byteLength %zu", i, name.c_str(),
+                     mp->len, ref.n);
+            ref.p = static_cast<const unsigned char *>(mp->addr);
+            src->input_bytes += mp->len;
+            src->maps.push_back(std::move(mp));
+        } else if (cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(mx, "fallback"))) {
+            ref.fallback = true;
+        } else if (glb && i == 0 && glb->has_bin) {
+            if (ref.n > glb->bin_len)
+                fail(MR_ERR_PARSE, "buffer 0: byteLength %zu runs past the end of the GLB's BIN chunk (%zu bytes)", ref.n,
+                     glb->bin_len);
+            ref.p = glb->bin;
+        } else {
+            fail(MR_ERR_PARSE, "buffer %d has no data (no uri%s)", i,
+                 glb ? (glb->has_bin ? ", and only buffer 0 is the GLB's BIN chunk" : ", and the GLB has no BIN chunk")
+                     : "");
+        }
+        cJSON_DeleteItemFromObjectCaseSensitive(b, "uri");
+        cJSON_DeleteItemFromObjectCaseSensitive(b, "byteLength");
+        cJSON_AddStringToObject(b, "uri", "data:application/octet-stream;base64,AA==");
+        cJSON_AddNumberToObject(b, "byteLength", 1);
+        changed = true;
+        src->bufs.push_back(ref);
+        i++;
+    }
+    if (changed) replace("buffers", bufs.j);
+    if (splice.empty()) return std::string(json, len);
+    std::string out;
+    out.reserve(len + 256);
+    size_t at = 0;
+    for (const auto &kv : splice) {
+        out.append(json + at, kv.second.first.b - at);
+        out += kv.second.second;
+        at = kv.second.first.e;
+    }
+    out.append(json + at, len - at);
+    return out;
+}
+
 // ------------------------------------------------------------ accessors
 
 int component_size(int type) {
@@ -185,75 +563,67 @@ int type_components(int type) {
     }
 }
 
-// A validated window onto accessor data: element i starts at base + i*stride
-// and all count elements lie inside the buffer.
+// One component as a number: normalised integers as the specification
+// maps them (unsigned c/max, signed max(c/max, -1)), others as they are.
+double comp_value(const unsigned char *p, int comp, bool norm) {
+    switch (comp) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        double v = (double)(int8_t)p[0];
+        return norm ? std::max(v / 127.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return norm ? p[0] / 255.0 : (double)p[0];
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        int16_t v;
+        std::memcpy(&v, p, 2);
+        return norm ? std::max(v / 32767.0, -1.0) : (double)v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t v;
+        std::memcpy(&v, p, 2);
+        return norm ? v / 65535.0 : (double)v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_INT: {
+        int32_t v;
+        std::memcpy(&v, p, 4);
+        return (double)v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+        uint32_t v;
+        std::memcpy(&v, p, 4);
+        return (double)v;
+    }
+    default: {
+        float f;
+        std::memcpy(&f, p, 4);
+        return (double)f;
+    }
+    }
+}
+
+// A validated window onto accessor data: element i starts at base +
+// i*stride and all count elements lie inside their buffer. base is NULL for
+// an accessor without a bufferView (zeros, then its sparse values).
 struct View {
     const unsigned char *base;
     size_t stride, count;
     int comp, ncomp;
     bool normalized;
+    int index;
 };
-
-View accessor_view(const tinygltf::Model &m, int idx, const char *what, const char *mesh) {
-    if (idx < 0 || (size_t)idx >= m.accessors.size())
-        fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d does not exist", mesh, what, idx);
-    const tinygltf::Accessor &a = m.accessors[(size_t)idx];
-    if (a.sparse.isSparse)
-        fail(MR_ERR_UNSUPPORTED, "mesh '%s': %s accessor %d is sparse (not supported)", mesh, what, idx);
-    if (a.bufferView < 0 || (size_t)a.bufferView >= m.bufferViews.size())
-        fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d has no valid bufferView", mesh, what, idx);
-    const tinygltf::BufferView &bv = m.bufferViews[(size_t)a.bufferView];
-    if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size())
-        fail(MR_ERR_PARSE, "mesh '%s': bufferView %d refers to a missing buffer", mesh, a.bufferView);
-    const tinygltf::Buffer &b = m.buffers[(size_t)bv.buffer];
-    int csize = component_size(a.componentType), ncomp = type_components(a.type);
-    if (csize == 0 || ncomp == 0)
-        fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d has an unknown component type or type", mesh, what, idx);
-    size_t elem = (size_t)csize * (size_t)ncomp;
-    size_t stride = bv.byteStride ? bv.byteStride : elem;
-    if (stride < elem)
-        fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d: byteStride %zu is smaller than an element (%zu)", mesh,
-             what, idx, stride, elem);
-    if (a.count == 0) fail(MR_ERR_INVALID, "mesh '%s': %s accessor %d is empty", mesh, what, idx);
-    if (bv.byteOffset > b.data.size() || bv.byteLength > b.data.size() - bv.byteOffset)
-        fail(MR_ERR_PARSE, "mesh '%s': bufferView %d lies outside its buffer", mesh, a.bufferView);
-    // byteOffset + stride*(count-1) + elem <= byteLength, without overflow.
-    if (a.byteOffset > bv.byteLength || elem > bv.byteLength - a.byteOffset ||
-        (a.count - 1) > (bv.byteLength - a.byteOffset - elem) / stride)
-        fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d (%zu elements) runs past the end of bufferView %d", mesh,
-             what, idx, a.count, a.bufferView);
-    return View{b.data.data() + bv.byteOffset + a.byteOffset, stride, a.count, a.componentType, ncomp,
-                a.normalized};
-}
-
-// Reads `n` float components per element (FLOAT, or normalised unsigned
-// byte/short where allowed) into out[count*n].
-void read_floats(const View &v, int n, bool allow_unorm, float *out) {
-    for (size_t i = 0; i < v.count; i++) {
-        const unsigned char *p = v.base + i * v.stride;
-        for (int k = 0; k < n; k++) {
-            float f;
-            if (v.comp == TINYGLTF_COMPONENT_TYPE_FLOAT) {
-                std::memcpy(&f, p + 4 * k, 4);
-            } else if (allow_unorm && v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) {
-                f = (float)p[k] / 255.0f;
-            } else {
-                uint16_t u;
-                std::memcpy(&u, p + 2 * k, 2);
-                f = (float)u / 65535.0f;
-            }
-            out[i * (size_t)n + (size_t)k] = f;
-        }
-    }
-}
-
-bool is_float_vec(const View &v, int n) { return v.comp == TINYGLTF_COMPONENT_TYPE_FLOAT && v.ncomp == n; }
 
 // -------------------------------------------------------------- loader
 
 struct Loader {
     const tinygltf::Model &m;
     mr_scene *s;
+    Source &src;
+    bool quantized = false;  // KHR_mesh_quantization used: integer attributes allowed
+    // Decoded EXT_meshopt_compression views, each freed once the accessors
+    // of primitives that read it are read (view_uses), so a compressed file
+    // never holds all its decoded bytes at once; a view read again after
+    // that is decoded again.
+    std::map<int, std::unique_ptr<unsigned char[]>> meshopt;
+    std::vector<int> view_uses;
     std::vector<const char *> globs;
     std::vector<std::pair<int32_t, int32_t>> mesh_map;  // glTF mesh -> (first, count); first -2: not yet
     std::vector<int32_t> tex_map;                        // glTF texture -> scene texture; -2: not yet
@@ -262,13 +632,260 @@ struct Loader {
     void (*progress)(void *, const char *, double) = nullptr;
     void *progress_user = nullptr;
 
-    Loader(const tinygltf::Model &model, mr_scene *scene) : m(model), s(scene) {}
+    Loader(const tinygltf::Model &model, mr_scene *scene, Source &source) : m(model), s(scene), src(source) {}
+
+    // ------------------------------------------------ bytes of bufferViews
+
+    // A number in an extension object; false if absent.
+    static bool ext_num(const tinygltf::Value &o, const char *key, double *out) {
+        if (!o.Has(key)) return false;
+        const tinygltf::Value &v = o.Get(key);
+        if (!v.IsNumber()) return false;
+        *out = v.GetNumberAsDouble();
+        return std::isfinite(*out);
+    }
+
+    // EXT_meshopt_compression: the bufferView's bytes decoded from its
+    // compressed stream (once; views are shared by accessors).
+    const unsigned char *meshopt_view(int bvi, const tinygltf::Value &x) {
+        auto it = meshopt.find(bvi);
+        if (it != meshopt.end()) return it->second.get();
+        const tinygltf::BufferView &bv = m.bufferViews[(size_t)bvi];
+        double buf = -1, off = 0, len = -1, stride = 0, count = -1;
+        if (!x.IsObject() || !ext_num(x, "buffer", &buf) || !ext_num(x, "byteLength", &len) ||
+            !ext_num(x, "byteStride", &stride) || !ext_num(x, "count", &count) || !x.Has("mode") ||
+            !x.Get("mode").IsString())
+            fail(MR_ERR_PARSE, "bufferView %d: EXT_meshopt_compression needs buffer, byteLength, byteStride, count and mode",
+                 bvi);
+        if (x.Has("byteOffset") && !ext_num(x, "byteOffset", &off))
+            fail(MR_ERR_PARSE, "bufferView %d: EXT_meshopt_compression byteOffset is not a number", bvi);
+        const std::string mode = x.Get("mode").Get<std::string>();
+        const std::string filter = x.Has("filter") && x.Get("filter").IsString() ? x.Get("filter").Get<std::string>() : "NONE";
+        if (!(buf >= 0 && buf < (double)src.bufs.size()) || !(off >= 0 && off <= 9e15) || !(len >= 0 && len <= 9e15) ||
+            !(count >= 0 && count <= 9e15) || !(stride >= 1 && stride <= 256))
+            fail(MR_ERR_PARSE, "bufferView %d: EXT_meshopt_compression has an out-of-range buffer, offset, length, stride or count",
+                 bvi);
+        const BufRef &b = src.bufs[(size_t)buf];
+        size_t o = (size_t)off, n = (size_t)len, st = (size_t)stride, cnt = (size_t)count;
+        if (b.fallback || !b.p || o > b.n || n > b.n - o)
+            fail(MR_ERR_PARSE, "bufferView %d: its meshopt stream lies outside buffer %d", bvi, (int)buf);
+        // Never allocate what the stream cannot hold: meshopt's codecs expand
+        // at most 64:1 (vertex), 12:1 (triangles) or 4:1 (sequences), so a
+        // lying count fails here in bounded memory.
+        if (cnt > SIZE_MAX / st || cnt * st > 64 * n + 65536)
+            fail(MR_ERR_PARSE, "bufferView %d: meshopt count %zu x stride %zu is more than its %zu-byte stream can hold", bvi,
+                 cnt, st, n);
+        size_t out_n = cnt * st;
+        if (bv.byteLength > out_n)
+            fail(MR_ERR_PARSE, "bufferView %d: byteLength %zu is more than its meshopt data decodes to (%zu)", bvi,
+                 bv.byteLength, out_n);
+        // Not zeroed: the decoder writes every byte, or fails.
+        std::unique_ptr<unsigned char[]> out(new unsigned char[out_n ? out_n : 1]);
+        const unsigned char *in = b.p + o;
+        int rc;
+        if (mode == "ATTRIBUTES") {
+            if (st % 4 != 0) fail(MR_ERR_PARSE, "bufferView %d: meshopt ATTRIBUTES stride %zu is not a multiple of 4", bvi, st);
+            rc = meshopt_decodeVertexBuffer(out.get(), cnt, st, in, n);
+            if (rc == 0 && filter == "OCTAHEDRAL") {
+                if (st != 4 && st != 8) fail(MR_ERR_PARSE, "bufferView %d: OCTAHEDRAL filter needs stride 4 or 8", bvi);
+                meshopt_decodeFilterOct(out.get(), cnt, st);
+            } else if (rc == 0 && filter == "QUATERNION") {
+                if (st != 8) fail(MR_ERR_PARSE, "bufferView %d: QUATERNION filter needs stride 8", bvi);
+                meshopt_decodeFilterQuat(out.get(), cnt, st);
+            } else if (rc == 0 && filter == "EXPONENTIAL") {
+                meshopt_decodeFilterExp(out.get(), cnt, st);
+            } else if (filter != "NONE") {
+                fail(MR_ERR_UNSUPPORTED, "bufferView %d: meshopt filter %s (not supported)", bvi, filter.c_str());
+            }
+        } else if (mode == "TRIANGLES" || mode == "INDICES") {
+            if (st != 2 && st != 4) fail(MR_ERR_PARSE, "bufferView %d: meshopt %s stride must be 2 or 4", bvi, mode.c_str());
+            if (mode == "TRIANGLES" && cnt % 3 != 0)
+                fail(MR_ERR_PARSE, "bufferView %d: meshopt TRIANGLES count %zu is not a multiple of 3", bvi, cnt);
+            rc = mode == "TRIANGLES" ? meshopt_decodeIndexBuffer(out.get(), cnt, st, in, n)
+                                     : meshopt_decodeIndexSequence(out.get(), cnt, st, in, n);
+        } else {
+            fail(MR_ERR_UNSUPPORTED, "bufferView %d: meshopt mode %s (not supported)", bvi, mode.c_str());
+        }
+        if (rc != 0) fail(MR_ERR_PARSE, "bufferView %d: malformed meshopt %s stream (decoder error %d)", bvi, mode.c_str(), rc);
+        src.consumed(n);
+        return meshopt.emplace(bvi, std::move(out)).first->second.get();
+    }
+
+    // The bytes of bufferView bvi, bounds-checked; *len gets its byteLength.
+    const unsigned char *view_bytes(int bvi, size_t *len) {
+        if (bvi < 0 || (size_t)bvi >= m.bufferViews.size()) fail(MR_ERR_PARSE, "bufferView %d does not exist", bvi);
+        const tinygltf::BufferView &bv = m.bufferViews[(size_t)bvi];
+        *len = bv.byteLength;
+        auto x = bv.extensions.find("EXT_meshopt_compression");
+        if (x != bv.extensions.end()) return meshopt_view(bvi, x->second);
+        if (bv.buffer < 0 || (size_t)bv.buffer >= src.bufs.size())
+            fail(MR_ERR_PARSE, "bufferView %d refers to a missing buffer", bvi);
+        const BufRef &b = src.bufs[(size_t)bv.buffer];
+        if (b.fallback)
+            fail(MR_ERR_PARSE, "bufferView %d reads meshopt fallback buffer %d, which has no data", bvi, bv.buffer);
+        if (bv.byteOffset > b.n || bv.byteLength > b.n - bv.byteOffset)
+            fail(MR_ERR_PARSE, "bufferView %d (offset %zu, %zu bytes) lies outside its buffer (%zu bytes)", bvi,
+                 bv.byteOffset, bv.byteLength, b.n);
+        return b.p + bv.byteOffset;
+    }
+
+    // ------------------------------------------------------ accessors
+
+    // The accessor of a primitive attribute or its indices has been read:
+    // its decoded meshopt view goes once no other primitive needs it.
+    void done(int accessor) {
+        if (accessor < 0 || (size_t)accessor >= m.accessors.size()) return;
+        int bv = m.accessors[(size_t)accessor].bufferView;
+        if (bv < 0 || (size_t)bv >= view_uses.size()) return;
+        if (--view_uses[(size_t)bv] <= 0) meshopt.erase(bv);
+    }
+
+    void count_view_uses() {
+        view_uses.assign(m.bufferViews.size(), 0);
+        auto use = [&](int a) {
+            if (a < 0 || (size_t)a >= m.accessors.size()) return;
+            int bv = m.accessors[(size_t)a].bufferView;
+            if (bv >= 0 && (size_t)bv < view_uses.size()) view_uses[(size_t)bv]++;
+        };
+        for (size_t mi = 0; mi < m.meshes.size(); mi++)
+            for (size_t pi = 0; pi < m.meshes[mi].primitives.size(); pi++) {
+                const tinygltf::Primitive &p = m.meshes[mi].primitives[pi];
+                for (const char *k : {"POSITION", "NORMAL", "TEXCOORD_0"}) {
+                    auto it = p.attributes.find(k);
+                    if (it != p.attributes.end()) use(it->second);
+                }
+                auto moved = src.moved_indices.find(std::make_pair((int)mi, (int)pi));
+                use(moved != src.moved_indices.end() ? moved->second : p.indices);
+            }
+    }
+
+    View accessor_view(int idx, const char *what, const char *mesh) {
+        if (idx < 0 || (size_t)idx >= m.accessors.size())
+            fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d does not exist", mesh, what, idx);
+        const tinygltf::Accessor &a = m.accessors[(size_t)idx];
+        int csize = component_size(a.componentType), ncomp = type_components(a.type);
+        if (csize == 0 || ncomp == 0)
+            fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d has an unknown component type or type", mesh, what, idx);
+        if (a.count == 0) fail(MR_ERR_INVALID, "mesh '%s': %s accessor %d is empty", mesh, what, idx);
+        size_t elem = (size_t)csize * (size_t)ncomp;
+        if (a.bufferView < 0) {
+            // Zeros (then sparse values) by the specification; a count the
+            // file could not describe is a lie, refused before allocating.
+            if (a.count > src.input_bytes)
+                fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d claims %zu elements without a bufferView, more than the file's %zu bytes could describe",
+                     mesh, what, idx, a.count, src.input_bytes);
+            return View{nullptr, elem, a.count, a.componentType, ncomp, a.normalized, idx};
+        }
+        size_t len = 0;
+        const unsigned char *p = view_bytes(a.bufferView, &len);
+        const tinygltf::BufferView &bv = m.bufferViews[(size_t)a.bufferView];
+        size_t stride = bv.byteStride ? bv.byteStride : elem;
+        if (stride < elem)
+            fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d: byteStride %zu is smaller than an element (%zu)", mesh,
+                 what, idx, stride, elem);
+        // byteOffset + stride*(count-1) + elem <= byteLength, without overflow.
+        if (a.byteOffset > len || elem > len - a.byteOffset || (a.count - 1) > (len - a.byteOffset - elem) / stride)
+            fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d (%zu elements) runs past the end of bufferView %d", mesh,
+                 what, idx, a.count, a.bufferView);
+        src.consumed(a.count * stride);
+        return View{p + a.byteOffset, stride, a.count, a.componentType, ncomp, a.normalized, idx};
+    }
+
+    // Element loop for component type C; norm_max > 0: normalised by the
+    // specification's rule (signed types clamp at -1).
+    template <typename C, typename T>
+    static void convert(const View &v, int n, int k_n, T *out, double norm_max) {
+        const bool norm = v.normalized && norm_max > 0;
+        const double inv = norm ? 1.0 / norm_max : 1.0;
+        for (size_t i = 0; i < v.count; i++) {
+            const unsigned char *p = v.base + i * v.stride;
+            T *q = out + i * (size_t)n;
+            for (int k = 0; k < k_n; k++) {
+                C c;
+                std::memcpy(&c, p + (size_t)k * sizeof(C), sizeof(C));
+                double d = (double)c * inv;
+                if (norm && std::is_signed<C>::value && d < -1.0) d = -1.0;
+                q[k] = (T)d;
+            }
+            for (int k = k_n; k < n; k++) q[k] = T(0);
+        }
+    }
+
+    // Reads n components per element into out[count*n] (missing components
+    // 0), converting any component type, then applies sparse substitution.
+    template <typename T>
+    void read(const View &v, int n, T *out, const char *what, const char *mesh) {
+        const int k_n = std::min(n, v.ncomp), cs = component_size(v.comp);
+        if (!v.base) {
+            std::fill(out, out + v.count * (size_t)n, T(0));
+        } else if (v.comp == TINYGLTF_COMPONENT_TYPE_FLOAT && std::is_same<T, float>::value && k_n == n) {
+            for (size_t i = 0; i < v.count; i++) std::memcpy(out + i * (size_t)n, v.base + i * v.stride, 4 * (size_t)n);
+        } else {
+            // One loop per component type: quantised files (gltfpack) must
+            // load at least as fast as float ones.
+            switch (v.comp) {
+            case TINYGLTF_COMPONENT_TYPE_BYTE: convert<int8_t>(v, n, k_n, out, 127.0); break;
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: convert<uint8_t>(v, n, k_n, out, 255.0); break;
+            case TINYGLTF_COMPONENT_TYPE_SHORT: convert<int16_t>(v, n, k_n, out, 32767.0); break;
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: convert<uint16_t>(v, n, k_n, out, 65535.0); break;
+            case TINYGLTF_COMPONENT_TYPE_INT: convert<int32_t>(v, n, k_n, out, 0); break;
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: convert<uint32_t>(v, n, k_n, out, 0); break;
+            default: convert<float>(v, n, k_n, out, 0); break;
+            }
+        }
+        const tinygltf::Accessor &a = m.accessors[(size_t)v.index];
+        if (!a.sparse.isSparse) return;
+        // Sparse: count (index, value) pairs replace elements.
+        const auto &sp = a.sparse;
+        if (sp.count <= 0 || (size_t)sp.count > v.count)
+            fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d: sparse count %d is not in [1, %zu]", mesh, what, v.index,
+                 sp.count, v.count);
+        size_t cnt = (size_t)sp.count, ilen = 0, vlen = 0;
+        int is = component_size(sp.indices.componentType);
+        if (sp.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+            sp.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+            sp.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+            fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d: sparse indices must be unsigned", mesh, what, v.index);
+        const unsigned char *ip = view_bytes(sp.indices.bufferView, &ilen);
+        const unsigned char *vp = view_bytes(sp.values.bufferView, &vlen);
+        size_t elem = (size_t)cs * (size_t)v.ncomp;
+        if (sp.indices.byteOffset < 0 || (size_t)sp.indices.byteOffset > ilen ||
+            cnt > (ilen - (size_t)sp.indices.byteOffset) / (size_t)is || sp.values.byteOffset < 0 ||
+            (size_t)sp.values.byteOffset > vlen || cnt > (vlen - (size_t)sp.values.byteOffset) / elem)
+            fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d: sparse data runs past the end of its bufferViews", mesh, what,
+                 v.index);
+        ip += sp.indices.byteOffset;
+        vp += sp.values.byteOffset;
+        for (size_t i = 0; i < cnt; i++) {
+            size_t j = (size_t)comp_value(ip + i * (size_t)is, sp.indices.componentType, false);
+            if (j >= v.count)
+                fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d: sparse index %zu is out of range", mesh, what, v.index, j);
+            for (int k = 0; k < k_n; k++)
+                out[j * (size_t)n + (size_t)k] = (T)comp_value(vp + i * elem + (size_t)(k * cs), v.comp, v.normalized);
+        }
+    }
+
 
     void report(const char *stage, size_t done, size_t total) {
         if (progress && total > 0) progress(progress_user, stage, (double)done / (double)total);
     }
 
     void warning(const std::string &w) { warn += w + "\n"; }
+
+    // The "nodes" stage's fraction: of the nodes visited or of the file's
+    // bytes read, whichever is further (a few huge meshes, or many nodes);
+    // reported when it moved by 1 %.
+    double progress_shown = 0;
+    size_t nodes_visited = 0;
+    void progress_nodes(size_t visited) {
+        if (!progress) return;
+        nodes_visited = std::max(nodes_visited, visited);
+        double f = m.nodes.empty() ? 0 : (double)nodes_visited / (double)m.nodes.size();
+        if (src.input_bytes) f = std::max(f, std::min(1.0, (double)src.total_read / (double)src.input_bytes));
+        if (f < progress_shown + 0.01) return;
+        progress_shown = f;
+        progress(progress_user, "nodes", f);
+    }
 
     // Any channel count, 8 or 16 bits -> RGBA8.
     bool image_to_rgba8(const tinygltf::Image &img, mr_image *out, std::string *why) {
@@ -332,15 +949,13 @@ struct Loader {
         std::string why;
         if (img.image.empty() && img.bufferView >= 0) {
             // Deferred decode (see image_loader), now with bounds checks.
-            const tinygltf::BufferView *bv =
-                (size_t)img.bufferView < m.bufferViews.size() ? &m.bufferViews[(size_t)img.bufferView] : nullptr;
-            const tinygltf::Buffer *b = bv && bv->buffer >= 0 && (size_t)bv->buffer < m.buffers.size()
-                                            ? &m.buffers[(size_t)bv->buffer]
-                                            : nullptr;
-            if (!b || bv->byteOffset > b->data.size() || bv->byteLength > b->data.size() - bv->byteOffset)
-                why = "image bufferView lies outside its buffer";
-            else
-                decode_image(b->data.data() + bv->byteOffset, bv->byteLength, &img, &why);
+            try {
+                size_t len = 0;
+                const unsigned char *bytes = view_bytes(img.bufferView, &len);
+                decode_image(bytes, len, &img, &why);
+            } catch (const Fail &f) {
+                why = "image bufferView lies outside its buffer (" + f.msg + ")";
+            }
         } else if (img.image.empty()) {
             why = "image data not available" + (img.uri.empty() ? std::string() : " ('" + img.uri.substr(0, 64) + "')");
         }
@@ -361,6 +976,31 @@ struct Loader {
         return idx;
     }
 
+    // KHR_texture_transform as the 2x3 matrix of uv_xform; empty: none.
+    std::vector<double> texture_transform(const tinygltf::TextureInfo &ti, const std::string &mat) {
+        auto x = ti.extensions.find("KHR_texture_transform");
+        if (ti.index < 0 || x == ti.extensions.end() || !x->second.IsObject()) return {};
+        const tinygltf::Value &o = x->second;
+        double off[2] = {0, 0}, sc[2] = {1, 1}, rot = 0;
+        for (int k = 0; k < 2; k++) {
+            if (o.Has("offset") && o.Get("offset").IsArray() && o.Get("offset").ArrayLen() == 2 &&
+                o.Get("offset").Get(k).IsNumber())
+                off[k] = o.Get("offset").Get(k).GetNumberAsDouble();
+            if (o.Has("scale") && o.Get("scale").IsArray() && o.Get("scale").ArrayLen() == 2 &&
+                o.Get("scale").Get(k).IsNumber())
+                sc[k] = o.Get("scale").Get(k).GetNumberAsDouble();
+        }
+        if (o.Has("rotation") && o.Get("rotation").IsNumber()) rot = o.Get("rotation").GetNumberAsDouble();
+        if (!std::isfinite(off[0]) || !std::isfinite(off[1]) || !std::isfinite(sc[0]) || !std::isfinite(sc[1]) ||
+            !std::isfinite(rot)) {
+            warning("material '" + mat + "': non-finite KHR_texture_transform ignored");
+            return {};
+        }
+        if (o.Has("texCoord")) warning("material '" + mat + "': KHR_texture_transform texCoord ignored (TEXCOORD_0 is used)");
+        double c = std::cos(rot), sn = std::sin(rot);
+        return {c * sc[0], sn * sc[1], off[0], -sn * sc[0], c * sc[1], off[1]};
+    }
+
     void materials() {
         for (size_t i = 0; i < m.materials.size(); i++) {
             const tinygltf::Material &gm = m.materials[i];
@@ -374,12 +1014,13 @@ struct Loader {
                 mat.base_color[k] = std::isfinite(v) ? (float)std::min(1.0, std::max(0.0, v)) : 1.0f;
             }
             mat.base_color_texture = texture(gm.pbrMetallicRoughness.baseColorTexture.index);
+            uv_xform.push_back(texture_transform(gm.pbrMetallicRoughness.baseColorTexture, gm.name));
             if (mr_scene_add_material(s, &mat) < 0) throw std::bad_alloc();
         }
     }
 
     // Triangle list from a primitive's vertex order (indices or 0..n-1).
-    static std::vector<uint32_t> triangulate(const std::vector<uint32_t> &idx, int mode, const char *mesh) {
+    static std::vector<uint32_t> triangulate(std::vector<uint32_t> idx, int mode, const char *mesh) {
         if (mode == TINYGLTF_MODE_TRIANGLES) {
             if (idx.size() % 3 != 0)
                 fail(MR_ERR_INVALID, "mesh '%s': %zu indices is not a multiple of 3", mesh, idx.size());
@@ -407,7 +1048,127 @@ struct Loader {
         return out;
     }
 
-    void primitive(const tinygltf::Primitive &p, const char *name, int prim_idx) {
+    // KHR_texture_transform of each material's base colour texture, as
+    // u' = t[0]*u + t[1]*v + t[2], v' = t[3]*u + t[4]*v + t[5] (offset,
+    // rotation, scale: T*R*S by the extension). gltfpack dequantises
+    // integer texture coordinates through it.
+    std::vector<std::vector<double>> uv_xform;
+
+    static bool is_int8_16(int comp) {
+        return comp == TINYGLTF_COMPONENT_TYPE_BYTE || comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+               comp == TINYGLTF_COMPONENT_TYPE_SHORT || comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+    }
+
+    // Layouts the specification allows (KHR_mesh_quantization widens them).
+    bool position_ok(const View &v) const {
+        return v.ncomp == 3 && ((v.comp == TINYGLTF_COMPONENT_TYPE_FLOAT && !v.normalized) || (quantized && is_int8_16(v.comp)));
+    }
+    bool normal_ok(const View &v) const {
+        return v.ncomp == 3 && (v.comp == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+                                (quantized && v.normalized &&
+                                 (v.comp == TINYGLTF_COMPONENT_TYPE_BYTE || v.comp == TINYGLTF_COMPONENT_TYPE_SHORT)));
+    }
+    bool uv_ok(const View &v) const {
+        return v.ncomp == 2 && (v.comp == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+                                (v.normalized && (v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                                  v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT)) ||
+                                (quantized && is_int8_16(v.comp)));
+    }
+
+    void check_normals(MeshGuard &g, const char *name, bool renormalise) {
+        size_t nv = g.m.vertex_count;
+        for (size_t i = 0; i < nv * 3; i++)
+            if (!std::isfinite(g.m.normals[i])) {
+                warning(std::string("mesh '") + name + "' has non-finite normals; regenerated");
+                std::free(g.m.normals);
+                g.m.normals = nullptr;
+                return;
+            }
+        if (!renormalise) return;
+        // Quantised normals are unit only up to their rounding.
+        for (size_t i = 0; i < nv; i++) {
+            float *q = g.m.normals + 3 * i;
+            float l = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+            if (l > 0) q[0] /= l, q[1] /= l, q[2] /= l;
+        }
+    }
+
+    bool check_uvs(MeshGuard &g, const char *name) {
+        for (size_t i = 0; i < (size_t)g.m.vertex_count * 2; i++)
+            if (!std::isfinite(g.m.uvs[i])) {
+                warning(std::string("mesh '") + name + "' has non-finite texture coordinates; ignored");
+                std::free(g.m.uvs);
+                g.m.uvs = nullptr;
+                return false;
+            }
+        return true;
+    }
+
+    // KHR_draco_mesh_compression: the primitive's geometry from its draco
+    // bufferView (the accessors then give only types and counts).
+    void draco_primitive(const tinygltf::Primitive &p, const tinygltf::Value &x, const char *name, MeshGuard &g,
+                         std::vector<uint32_t> &order) {
+        double bvd = -1;
+        if (!x.IsObject() || !ext_num(x, "bufferView", &bvd) || !x.Has("attributes") || !x.Get("attributes").IsObject())
+            fail(MR_ERR_PARSE, "mesh '%s': KHR_draco_mesh_compression needs a bufferView and attributes", name);
+        if (!(bvd >= 0 && bvd < (double)m.bufferViews.size()))
+            fail(MR_ERR_PARSE, "mesh '%s': draco bufferView %g does not exist", name, bvd);
+        size_t len = 0;
+        const unsigned char *bytes = view_bytes((int)bvd, &len);
+        char why[256] = "";
+        struct Free {
+            mr_draco *d;
+            ~Free() { mr_draco_free(d); }
+        } d{mr_draco_decode(bytes, len, why, sizeof why)};
+        if (!d.d) fail(MR_ERR_PARSE, "mesh '%s': bad KHR_draco_mesh_compression data (%s)", name, why);
+        src.consumed(len);
+        const tinygltf::Value &attrs = x.Get("attributes");
+        auto id_of = [&](const char *key) -> int {
+            if (!attrs.Has(key)) return -1;
+            const tinygltf::Value &v = attrs.Get(key);
+            double id = v.IsNumber() ? v.GetNumberAsDouble() : -1;
+            if (!(id >= 0 && id < 1e9))
+                fail(MR_ERR_PARSE, "mesh '%s': draco attribute id of %s is not a number", name, key);
+            return (int)id;
+        };
+        int pid = id_of("POSITION");
+        if (pid < 0) fail(MR_ERR_PARSE, "mesh '%s': draco data without POSITION", name);
+        uint32_t nv = mr_draco_points(d.d);
+        if (nv == 0) fail(MR_ERR_INVALID, "mesh '%s': draco mesh has no points", name);
+        auto pos_it = p.attributes.find("POSITION");
+        if (pos_it != p.attributes.end() && pos_it->second >= 0 && (size_t)pos_it->second < m.accessors.size() &&
+            m.accessors[(size_t)pos_it->second].count != nv)
+            warning(std::string("mesh '") + name + "': draco decoded " + std::to_string(nv) +
+                    " points, the POSITION accessor says " + std::to_string(m.accessors[(size_t)pos_it->second].count));
+        g.m.vertex_count = nv;
+        g.m.positions = xmalloc<float>((size_t)nv * 3);
+        if (!mr_draco_attribute(d.d, pid, 3, g.m.positions, why, sizeof why))
+            fail(MR_ERR_PARSE, "mesh '%s': POSITION: %s", name, why);
+        int nid = id_of("NORMAL");
+        if (nid >= 0) {
+            g.m.normals = xmalloc<float>((size_t)nv * 3);
+            if (!mr_draco_attribute(d.d, nid, 3, g.m.normals, why, sizeof why)) {
+                warning(std::string("mesh '") + name + "': NORMAL: " + why + "; regenerated");
+                std::free(g.m.normals);
+                g.m.normals = nullptr;
+            } else {
+                check_normals(g, name, true);
+            }
+        }
+        int tid = id_of("TEXCOORD_0");
+        if (tid >= 0) {
+            g.m.uvs = xmalloc<float>((size_t)nv * 2);
+            if (!mr_draco_attribute(d.d, tid, 2, g.m.uvs, why, sizeof why)) {
+                warning(std::string("mesh '") + name + "': TEXCOORD_0: " + why + "; ignored");
+                std::free(g.m.uvs);
+                g.m.uvs = nullptr;
+            }
+        }
+        order.resize((size_t)mr_draco_faces(d.d) * 3);
+        if (!order.empty()) mr_draco_indices(d.d, order.data());
+    }
+
+    void primitive(const tinygltf::Primitive &p, const char *name, int mesh_idx, int prim_idx) {
         int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
         if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP) {
             warning(std::string("mesh '") + name + "' primitive " + std::to_string(prim_idx) +
@@ -417,96 +1178,85 @@ struct Loader {
         if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
             fail(MR_ERR_PARSE, "mesh '%s' primitive %d: unknown mode %d", name, prim_idx, mode);
         auto pos_it = p.attributes.find("POSITION");
-        if (pos_it == p.attributes.end()) {
+        auto dx = p.extensions.find("KHR_draco_mesh_compression");
+        if (pos_it == p.attributes.end() && dx == p.extensions.end()) {
             warning(std::string("mesh '") + name + "' primitive " + std::to_string(prim_idx) +
                     " has no POSITION; skipped");
             return;
         }
-        View pv = accessor_view(m, pos_it->second, "POSITION", name);
-        if (!is_float_vec(pv, 3) || pv.normalized)
-            fail(MR_ERR_PARSE, "mesh '%s': POSITION must be FLOAT VEC3", name);
-        if (pv.count > UINT32_MAX) fail(MR_ERR_UNSUPPORTED, "mesh '%s': too many vertices", name);
-        uint32_t nv = (uint32_t)pv.count;
-
         MeshGuard g;
-        g.m.vertex_count = nv;
-        g.m.positions = xmalloc<float>((size_t)nv * 3);
-        read_floats(pv, 3, false, g.m.positions);
+        std::vector<uint32_t> order;
+        bool have_order = false;
+        if (dx != p.extensions.end()) {
+            draco_primitive(p, dx->second, name, g, order);
+            have_order = true;
+        } else {
+            View pv = accessor_view(pos_it->second, "POSITION", name);
+            if (!position_ok(pv))
+                fail(MR_ERR_PARSE, "mesh '%s': POSITION must be FLOAT VEC3%s", name,
+                     quantized ? " or 8/16-bit integer VEC3" : " (integers need KHR_mesh_quantization)");
+            if (pv.count > UINT32_MAX) fail(MR_ERR_UNSUPPORTED, "mesh '%s': too many vertices", name);
+            uint32_t nv = (uint32_t)pv.count;
+            g.m.vertex_count = nv;
+            g.m.positions = xmalloc<float>((size_t)nv * 3);
+            read(pv, 3, g.m.positions, "POSITION", name);
+            done(pos_it->second);
+
+            auto nrm_it = p.attributes.find("NORMAL");
+            if (nrm_it != p.attributes.end()) {
+                View nview = accessor_view(nrm_it->second, "NORMAL", name);
+                if (!normal_ok(nview) || nview.count != nv) {
+                    warning(std::string("mesh '") + name + "': NORMAL has an unsupported layout; regenerated");
+                } else {
+                    g.m.normals = xmalloc<float>((size_t)nv * 3);
+                    read(nview, 3, g.m.normals, "NORMAL", name);
+                    check_normals(g, name, nview.comp != TINYGLTF_COMPONENT_TYPE_FLOAT);
+                }
+                done(nrm_it->second);
+            }
+            auto uv_it = p.attributes.find("TEXCOORD_0");
+            if (uv_it != p.attributes.end()) {
+                View uview = accessor_view(uv_it->second, "TEXCOORD_0", name);
+                if (!uv_ok(uview) || uview.count != nv) {
+                    warning(std::string("mesh '") + name + "': TEXCOORD_0 has an unsupported layout; ignored");
+                } else {
+                    g.m.uvs = xmalloc<float>((size_t)nv * 2);
+                    read(uview, 2, g.m.uvs, "TEXCOORD_0", name);
+                }
+                done(uv_it->second);
+            }
+            auto moved = src.moved_indices.find(std::make_pair(mesh_idx, prim_idx));
+            const int indices = moved != src.moved_indices.end() ? moved->second : p.indices;
+            if (indices >= 0) {
+                View iv = accessor_view(indices, "index", name);
+                if (iv.ncomp != 1 || (iv.comp != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                                      iv.comp != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                                      iv.comp != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+                    fail(MR_ERR_PARSE, "mesh '%s': indices must be unsigned byte/short/int scalars", name);
+                order.resize(iv.count);
+                read(iv, 1, order.data(), "index", name);
+                done(indices);
+                have_order = true;
+            }
+        }
+        const uint32_t nv = g.m.vertex_count;
         for (size_t i = 0; i < (size_t)nv * 3; i++)
             if (!std::isfinite(g.m.positions[i])) fail(MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
-
-        auto nrm_it = p.attributes.find("NORMAL");
-        if (nrm_it != p.attributes.end()) {
-            View nview = accessor_view(m, nrm_it->second, "NORMAL", name);
-            if (!is_float_vec(nview, 3) || nview.count != nv) {
-                warning(std::string("mesh '") + name + "': NORMAL is not FLOAT VEC3 per vertex; regenerated");
-            } else {
-                g.m.normals = xmalloc<float>((size_t)nv * 3);
-                read_floats(nview, 3, false, g.m.normals);
-                for (size_t i = 0; i < (size_t)nv * 3; i++)
-                    if (!std::isfinite(g.m.normals[i])) {
-                        warning(std::string("mesh '") + name + "' has non-finite normals; regenerated");
-                        std::free(g.m.normals);
-                        g.m.normals = nullptr;
-                        break;
-                    }
-            }
-        }
-        auto uv_it = p.attributes.find("TEXCOORD_0");
-        if (uv_it != p.attributes.end()) {
-            View uview = accessor_view(m, uv_it->second, "TEXCOORD_0", name);
-            bool ok_type = uview.ncomp == 2 && (uview.comp == TINYGLTF_COMPONENT_TYPE_FLOAT ||
-                                                (uview.normalized && (uview.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
-                                                                      uview.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT)));
-            if (!ok_type || uview.count != nv) {
-                warning(std::string("mesh '") + name + "': TEXCOORD_0 has an unsupported layout; ignored");
-            } else {
-                g.m.uvs = xmalloc<float>((size_t)nv * 2);
-                read_floats(uview, 2, true, g.m.uvs);
-                for (size_t i = 0; i < (size_t)nv * 2; i++)
-                    if (!std::isfinite(g.m.uvs[i])) {
-                        warning(std::string("mesh '") + name + "' has non-finite texture coordinates; ignored");
-                        std::free(g.m.uvs);
-                        g.m.uvs = nullptr;
-                        break;
-                    }
-            }
-        }
-
-        std::vector<uint32_t> order;
-        if (p.indices >= 0) {
-            View iv = accessor_view(m, p.indices, "index", name);
-            if (iv.ncomp != 1 || (iv.comp != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-                                  iv.comp != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-                                  iv.comp != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
-                fail(MR_ERR_PARSE, "mesh '%s': indices must be unsigned byte/short/int scalars", name);
-            order.resize(iv.count);
-            for (size_t i = 0; i < iv.count; i++) {
-                const unsigned char *q = iv.base + i * iv.stride;
-                uint32_t v;
-                if (iv.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) {
-                    v = q[0];
-                } else if (iv.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) {
-                    uint16_t u;
-                    std::memcpy(&u, q, 2);
-                    v = u;
-                } else {
-                    std::memcpy(&v, q, 4);
-                }
-                if (v >= nv)
-                    fail(MR_ERR_INVALID, "mesh '%s': index %u at position %zu is out of range (%u vertices)", name, v,
-                         i, nv);
-                order[i] = v;
-            }
+        if (have_order) {
+            for (size_t i = 0; i < order.size(); i++)
+                if (order[i] >= nv)
+                    fail(MR_ERR_INVALID, "mesh '%s': index %u at position %zu is out of range (%u vertices)", name,
+                         order[i], i, nv);
         } else {
             order.resize(nv);
             for (uint32_t i = 0; i < nv; i++) order[i] = i;
         }
-        std::vector<uint32_t> tris = triangulate(order, mode, name);
+        std::vector<uint32_t> tris = triangulate(std::move(order), mode, name);
         if (tris.size() > UINT32_MAX) fail(MR_ERR_UNSUPPORTED, "mesh '%s': too many indices", name);
         g.m.index_count = (uint32_t)tris.size();
         g.m.indices = xmalloc<uint32_t>(tris.size());
         if (!tris.empty()) std::memcpy(g.m.indices, tris.data(), tris.size() * sizeof(uint32_t));
+        std::vector<uint32_t>().swap(tris);
 
         g.m.material = -1;
         if (p.material >= 0) {
@@ -515,6 +1265,15 @@ struct Loader {
             else
                 warning(std::string("mesh '") + name + "' uses missing material " + std::to_string(p.material));
         }
+        if (g.m.uvs && g.m.material >= 0 && !uv_xform[(size_t)g.m.material].empty()) {
+            const std::vector<double> &t = uv_xform[(size_t)g.m.material];
+            for (size_t i = 0; i < nv; i++) {
+                double u = g.m.uvs[2 * i], v = g.m.uvs[2 * i + 1];
+                g.m.uvs[2 * i] = (float)(t[0] * u + t[1] * v + t[2]);
+                g.m.uvs[2 * i + 1] = (float)(t[3] * u + t[4] * v + t[5]);
+            }
+        }
+        if (g.m.uvs) check_uvs(g, name);
         std::snprintf(g.m.name, sizeof g.m.name, "%s", name);
         mr_error e;
         if (mr_scene_add_mesh(s, &g.m, &e) < 0) throw Fail{e.code, e.msg};
@@ -528,8 +1287,9 @@ struct Loader {
         if (gm.name.empty()) std::snprintf(name, sizeof name, "mesh_%d", mi);
         else std::snprintf(name, sizeof name, "%s", gm.name.c_str());
         int32_t first = s->mesh_count;
-        for (size_t k = 0; k < gm.primitives.size(); k++) primitive(gm.primitives[k], name, (int)k);
+        for (size_t k = 0; k < gm.primitives.size(); k++) primitive(gm.primitives[k], name, mi, (int)k);
         int32_t count = s->mesh_count - first;
+        progress_nodes(0);
         mesh_map[(size_t)mi] = count > 0 ? std::make_pair(first, count) : std::make_pair(-1, 0);
         return mesh_map[(size_t)mi];
     }
@@ -593,7 +1353,7 @@ struct Loader {
         for (size_t i = roots.size(); i-- > 0;) stack.push_back(Item{roots[i], -1});
         size_t visited = 0;
         while (!stack.empty()) {
-            if ((++visited & 4095) == 0) report("nodes", visited, m.nodes.size());
+            if ((++visited & 4095) == 0) progress_nodes(visited);
             Item it = stack.back();
             stack.pop_back();
             if (it.node < 0 || (size_t)it.node >= m.nodes.size())
@@ -628,6 +1388,7 @@ struct Loader {
     }
 
     void run() {
+        count_view_uses();
         mesh_map.assign(m.meshes.size(), std::make_pair(-2, 0));
         tex_map.assign(m.textures.size(), -2);
         materials();
@@ -637,21 +1398,37 @@ struct Loader {
     }
 };
 
-// Required extensions that change nothing we read.
-bool extension_ok(const std::string &e) {
-    return e == "KHR_materials_unlit" || e == "KHR_materials_emissive_strength";
+bool uses_extension(const tinygltf::Model &m, const char *e) {
+    for (const std::string &u : m.extensionsUsed)
+        if (u == e) return true;
+    for (const std::string &u : m.extensionsRequired)
+        if (u == e) return true;
+    return false;
 }
 
+// container: the mapped file that data lies in, if it is one (its pages are
+// given back as meshes are read).
 mr_scene *load_memory(const void *data, size_t size, const char *base_dir, const mr_scene_params *params,
-                      const std::vector<std::string> &extra_globs, const char *label) {
+                      const std::vector<std::string> &extra_globs, const char *label, const Mapping *container) {
     if (!data || size == 0) fail(MR_ERR_PARSE, "empty glTF data");
-    if (size > UINT_MAX) fail(MR_ERR_NOMEM, "glTF data too large (%zu bytes)", size);
+    if (size > k_max_file) fail(MR_ERR_UNSUPPORTED, "glTF data too large (%zu bytes, over 4 GiB)", size);
     const unsigned char *bytes = static_cast<const unsigned char *>(data);
     if (size >= 3 && bytes[0] == 0xEF && bytes[1] == 0xBB && bytes[2] == 0xBF) {  // UTF-8 BOM
         bytes += 3;
         size -= 3;
     }
     bool binary = size >= 4 && std::memcmp(bytes, "glTF", 4) == 0;
+    Source src;
+    src.container = container;
+    src.input_bytes = size;
+    Glb glb;
+    std::string json;
+    if (binary) {
+        glb = glb_split(bytes, size);
+        json = take_buffers(glb.json, glb.json_len, &glb, base_dir, &src);
+    } else {
+        json = take_buffers(reinterpret_cast<const char *>(bytes), size, nullptr, base_dir, &src);
+    }
 
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(image_loader, nullptr);
@@ -663,19 +1440,35 @@ mr_scene *load_memory(const void *data, size_t size, const char *base_dir, const
     tinygltf::Model model;
     std::string terr, twarn;
     std::string dir = base_dir ? base_dir : "";
-    bool ok = binary ? gltf.LoadBinaryFromMemory(&model, &terr, &twarn, bytes, (unsigned)size, dir)
-                     : gltf.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char *>(bytes),
-                                                (unsigned)size, dir);
+    bool ok = json.size() <= UINT_MAX &&
+              gltf.LoadASCIIFromString(&model, &terr, &twarn, json.data(), (unsigned)json.size(), dir);
     if (!ok) {
         std::string msg = one_line(terr.empty() ? twarn : terr);
         fail(MR_ERR_PARSE, "invalid %s: %s", binary ? "GLB" : "glTF", msg.empty() ? "parse error" : msg.c_str());
     }
+    std::string().swap(json);
     for (const std::string &e : model.extensionsRequired)
         if (!extension_ok(e)) fail(MR_ERR_UNSUPPORTED, "requires glTF extension %s (not supported)", e.c_str());
+    // take_buffers saw the same array unless it could not read the JSON.
+    if (src.bufs.size() != model.buffers.size()) {
+        if (!src.bufs.empty()) fail(MR_ERR_PARSE, "the buffers could not be read");
+        for (const tinygltf::Buffer &b : model.buffers) {
+            BufRef r;
+            r.data_uri = true;
+            src.bufs.push_back(r);
+            (void)b;
+        }
+    }
+    for (size_t i = 0; i < src.bufs.size(); i++)
+        if (src.bufs[i].data_uri) {
+            src.bufs[i].p = model.buffers[i].data.data();
+            src.bufs[i].n = model.buffers[i].data.size();
+        }
     mr_scene *scene = mr_scene_create();
     if (!scene) throw std::bad_alloc();
     SceneGuard guard(scene);
-    Loader L(model, scene);
+    Loader L(model, scene, src);
+    L.quantized = uses_extension(model, "KHR_mesh_quantization");
     if (params) {
         L.progress = params->progress;
         L.progress_user = params->progress_user;
@@ -756,11 +1549,6 @@ void light_size(const cJSON *l, mr_light &L, const char *path) {
     if (!(n > 1e-9)) fail(MR_ERR_INVALID, "%s: a rect light's 'axis' is parallel to its direction", path);
     for (int k = 0; k < 3; k++) L.axis_u[k] = u[k] / n;
 }
-
-struct JsonGuard {
-    cJSON *j;
-    ~JsonGuard() { cJSON_Delete(j); }
-};
 
 // "demo": "planned" | "built": the procedural demo hall (with its tag
 // plates), built in memory, so the shipped configs work on a fresh clone
@@ -877,22 +1665,20 @@ mr_scene *load_config(const cJSON *cfg, const char *path, const mr_scene_params 
 
 mr_scene *load_path(const char *path, const mr_scene_params *params, const std::vector<std::string> &extra_globs,
                     bool allow_config) {
-    mr_error e;
     size_t size = 0;
     if (params && params->progress) params->progress(params->progress_user, "read", 0.0);
-    void *data = mr_file_read(path, &size, (size_t)2 << 30, &e);
-    if (!data) throw Fail{e.code, e.msg};
-    struct Free {
-        void *p;
-        ~Free() { std::free(p); }
-    } data_guard{data};
-    if (size == 0) fail(MR_ERR_PARSE, "%s is empty", path);
+    // Mapped, not read: a big .glb's bytes are paged in as meshes are read
+    // and given back after (Source::consumed), never all resident at once.
+    Mapping fm;
+    map_file(path, &fm);
+    const void *data = fm.addr;
+    size = fm.len;
     char dir[4096];
     mr_path_dir(path, dir, sizeof dir);
     mr_scene *s = nullptr;
     try {
         if (size >= 4 && std::memcmp(data, "glTF", 4) == 0) {
-            s = load_memory(data, size, dir, params, extra_globs, path);
+            s = load_memory(data, size, dir, params, extra_globs, path, &fm);
         } else {
             size_t bom = size >= 3 && std::memcmp(data, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
         JsonGuard j{cJSON_ParseWithLength(static_cast<const char *>(data) + bom, size - bom)};
@@ -900,7 +1686,7 @@ mr_scene *load_path(const char *path, const mr_scene_params *params, const std::
                 fail(MR_ERR_PARSE, "%s: not a glTF file or scene config (neither GLB nor a JSON object)", path);
             const cJSON *g = cJSON_GetObjectItemCaseSensitive(j.j, "gltf");
             if (cJSON_GetObjectItemCaseSensitive(j.j, "asset")) {
-                s = load_memory(data, size, dir, params, extra_globs, path);
+                s = load_memory(data, size, dir, params, extra_globs, path, &fm);
             } else if (cJSON_IsString(g) || cJSON_GetObjectItemCaseSensitive(j.j, "demo")) {
                 if (!allow_config) fail(MR_ERR_INVALID, "%s: a scene config cannot point to another scene config", path);
                 s = load_config(j.j, path, params, extra_globs);
@@ -1095,7 +1881,7 @@ bool report(mr_error *err, mr_err_code code, const std::string &msg) {
 mr_scene *mr_scene_load_gltf_memory(const void *data, size_t size, const char *base_dir,
                                     const mr_scene_params *params, mr_error *err) {
     try {
-        return load_memory(data, size, base_dir, params, std::vector<std::string>(), "glTF");
+        return load_memory(data, size, base_dir, params, std::vector<std::string>(), "glTF", nullptr);
     } catch (const Fail &f) {
         report(err, f.code, f.msg);
     } catch (const std::bad_alloc &) {

@@ -129,8 +129,9 @@ typedef struct mr_scene_params {
     const char *const *hidden_globs; /* node-name globs for the hidden layer */
     int hidden_glob_count;
     /* Called now and then during a load with the stage ("read", "parse",
-     * "nodes": meshes are read when a node first uses them) and its fraction
-     * done in [0,1]; NULL: none. */
+     * "nodes": meshes are read when a node first uses them; its fraction is
+     * of the nodes or of the file's bytes read, whichever is further) and
+     * its fraction done in [0,1]; NULL: none. */
     void (*progress)(void *user, const char *stage, double fraction);
     void *progress_user;
 } mr_scene_params;

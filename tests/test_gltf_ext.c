@@ -1,0 +1,495 @@
+/* test_gltf_ext.c — what the field's tools write (issue 17, item 7) and big
+ * or lying files (item 6): KHR_mesh_quantization, EXT_meshopt_compression
+ * (encoded here with meshoptimizer), KHR_draco_mesh_compression (encoded
+ * with libdraco, tests/draco_encode.cc), KHR_texture_transform, accessors
+ * without a bufferView, sparse accessors, GLB BIN chunks; then truncated
+ * and lying files (sizes past the end, counts of 2^31, byteLength lies,
+ * bad meshopt streams, bad draco data), which must fail with one line, no
+ * crash and bounded memory, and files over 2 and 4 GiB (sparse files: no
+ * disk used). */
+#include "mr_test.h"
+
+#include <fcntl.h>
+#include <math.h>
+#include <meshoptimizer.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "mr_scene.h"
+
+unsigned char *test_draco_encode(const float *pos, unsigned nv, const unsigned *idx, unsigned ntri, int bits,
+                                 size_t *out_n, int *pos_id);
+
+static char g_tmp[1024];
+
+static bool one_line(const mr_error *e) { return e->msg[0] && !strchr(e->msg, '\n'); }
+
+static double peak_rss_mb(void) {
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_maxrss / 1024.0;
+}
+
+/* GLB container around json and bin (both padded to 4 bytes). */
+static unsigned char *make_glb(const char *json, const void *bin, size_t bin_n, size_t *out_n) {
+    size_t jn = strlen(json), jp = (jn + 3) & ~(size_t)3, bp = (bin_n + 3) & ~(size_t)3;
+    size_t n = 12 + 8 + jp + (bin ? 8 + bp : 0);
+    unsigned char *g = calloc(1, n);
+    uint32_t h[5] = {0x46546C67u, 2, (uint32_t)n, (uint32_t)jp, 0x4E4F534Au};
+    memcpy(g, h, 20);
+    memcpy(g + 20, json, jn);
+    memset(g + 20 + jn, ' ', jp - jn);
+    if (bin) {
+        uint32_t c[2] = {(uint32_t)bp, 0x004E4942u};
+        memcpy(g + 20 + jp, c, 8);
+        memcpy(g + 28 + jp, bin, bin_n);
+    }
+    *out_n = n;
+    return g;
+}
+
+static mr_scene *load_glb(const char *json, const void *bin, size_t bin_n, mr_error *err) {
+    size_t n;
+    unsigned char *g = make_glb(json, bin, bin_n, &n);
+    mr_scene *s = mr_scene_load_gltf_memory(g, n, NULL, NULL, err);
+    free(g);
+    return s;
+}
+
+/* Refused with one line containing needle, in bounded memory. */
+static void expect_refused(const char *json, const void *bin, size_t bin_n, const char *needle, int line) {
+    mr_error err = {0};
+    double before = peak_rss_mb();
+    mr_scene *s = load_glb(json, bin, bin_n, &err);
+    CHECK_MSG(s == NULL, "line %d: loaded", line);
+    CHECK_MSG(one_line(&err), "line %d: message '%s'", line, err.msg);
+    if (needle) CHECK_MSG(strstr(err.msg, needle) != NULL, "line %d: '%s' lacks '%s'", line, err.msg, needle);
+    CHECK_MSG(peak_rss_mb() - before < 64, "line %d: peak RSS grew by %.0f MB", line, peak_rss_mb() - before);
+    mr_scene_destroy(&s);
+}
+
+static const float k_grid_step = 0.25f;
+
+/* A 4x4 vertex grid in z = 0: 16 vertices, 18 triangles. */
+static void grid(float pos[48], uint32_t idx[54]) {
+    for (int y = 0; y < 4; y++)
+        for (int x = 0; x < 4; x++) {
+            pos[(y * 4 + x) * 3 + 0] = x * k_grid_step;
+            pos[(y * 4 + x) * 3 + 1] = y * k_grid_step;
+            pos[(y * 4 + x) * 3 + 2] = 0.1f * (float)(x * y);
+        }
+    int k = 0;
+    for (int y = 0; y < 3; y++)
+        for (int x = 0; x < 3; x++) {
+            uint32_t a = (uint32_t)(y * 4 + x), b = a + 1, c = a + 4, d = a + 5;
+            idx[k++] = a, idx[k++] = b, idx[k++] = d;
+            idx[k++] = a, idx[k++] = d, idx[k++] = c;
+        }
+}
+
+static const char *k_head = "\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"scene\":0,"
+                            "\"nodes\":[{\"name\":\"N\",\"mesh\":0}],";
+
+/* KHR_mesh_quantization: integer positions (plain and normalised), byte
+ * normals, and the node transform that dequantises them. */
+static void test_quantization(void) {
+    /* 3 ushort positions (stride 8, padded), 3 normalised byte normals (stride 4), normalised short positions. */
+    unsigned char bin[24 + 12 + 24];
+    memset(bin, 0, sizeof bin);
+    const uint16_t up[3][4] = {{0, 0, 0, 0}, {16383, 0, 0, 0}, {0, 16383, 7, 0}};
+    memcpy(bin, up, 24);
+    const int8_t nb[3][4] = {{0, 0, 127, 0}, {0, 0, -128, 0}, {127, 127, 0, 0}};
+    memcpy(bin + 24, nb, 12);
+    const int16_t sp[3][4] = {{0, 0, 0, 0}, {32767, 0, 0, 0}, {0, -32768, 0, 0}};
+    memcpy(bin + 36, sp, 24);
+    char json[4096];
+    const char *fmt = "{%s\"extensionsUsed\":[\"KHR_mesh_quantization\"],\"extensionsRequired\":[\"KHR_mesh_quantization\"],"
+                      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":%d,\"NORMAL\":1}}]}],"
+                      "\"buffers\":[{\"byteLength\":60}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":24,\"byteStride\":8},"
+                      "{\"buffer\":0,\"byteOffset\":24,\"byteLength\":12,\"byteStride\":4},"
+                      "{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24,\"byteStride\":8}],"
+                      "\"accessors\":[{\"bufferView\":0,\"componentType\":5123,\"count\":3,\"type\":\"VEC3\"},"
+                      "{\"bufferView\":1,\"componentType\":5120,\"normalized\":true,\"count\":3,\"type\":\"VEC3\"},"
+                      "{\"bufferView\":2,\"componentType\":5122,\"normalized\":true,\"count\":3,\"type\":\"VEC3\"}]}";
+    snprintf(json, sizeof json, fmt, k_head, 0);
+    mr_error err = {0};
+    mr_scene *s = load_glb(json, bin, sizeof bin, &err);
+    CHECK_MSG(s != NULL, "quantized: %s", err.msg);
+    if (s) {
+        const mr_mesh *m = &s->meshes[0];
+        CHECK(m->vertex_count == 3 && m->normals != NULL);
+        /* Stored relative to the mesh origin (the bounds centre). */
+        CHECK_NEAR(m->positions[3] - m->positions[0], 16383.0, 1e-3);
+        CHECK_NEAR(m->positions[7] - m->positions[1], 16383.0, 1e-3);
+        CHECK_NEAR(m->positions[8] - m->positions[2], 7.0, 1e-4);
+        if (m->normals) {
+            CHECK_NEAR(m->normals[2], 1.0, 1e-6);
+            CHECK_NEAR(m->normals[5], -1.0, 1e-6); /* -128 clamps to -1 */
+            CHECK_NEAR(m->normals[6], sqrt(0.5), 1e-6); /* renormalised */
+        }
+    }
+    mr_scene_destroy(&s);
+    snprintf(json, sizeof json, fmt, k_head, 2);
+    s = load_glb(json, bin, sizeof bin, &err);
+    CHECK_MSG(s != NULL, "normalised short positions: %s", err.msg);
+    if (s) {
+        const mr_mesh *m = &s->meshes[0];
+        CHECK_NEAR(m->positions[3] - m->positions[0], 1.0, 1e-6);
+        CHECK_NEAR(m->positions[7] - m->positions[1], -1.0, 1e-6); /* -32768 -> -1 */
+    }
+    mr_scene_destroy(&s);
+    /* Without the extension, integer positions stay refused (core glTF). */
+    char plain[4096];
+    snprintf(plain, sizeof plain, fmt, k_head, 0);
+    char *ext = strstr(plain, "\"extensionsUsed\"");
+    char *end = strstr(plain, "\"meshes\"");
+    memmove(ext, end, strlen(end) + 1);
+    expect_refused(plain, bin, sizeof bin, "KHR_mesh_quantization", __LINE__);
+}
+
+/* Accessors without a bufferView are zeros; sparse values replace elements. */
+static void test_sparse_and_zeros(void) {
+    /* sparse indices (ushort 1, 2) and values (2 float3). */
+    unsigned char bin[4 + 24];
+    const uint16_t si[2] = {1, 2};
+    const float sv[6] = {1, 0, 0, 0, 2, 0};
+    memcpy(bin, si, 4);
+    memcpy(bin + 4, sv, 24);
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{%s\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+             "\"buffers\":[{\"byteLength\":28}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":4},"
+             "{\"buffer\":0,\"byteOffset\":4,\"byteLength\":24}],"
+             "\"accessors\":[{\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"sparse\":{\"count\":2,"
+             "\"indices\":{\"bufferView\":0,\"componentType\":5123},\"values\":{\"bufferView\":1}}}]}",
+             k_head);
+    mr_error err = {0};
+    mr_scene *s = load_glb(json, bin, sizeof bin, &err);
+    CHECK_MSG(s != NULL, "sparse without bufferView: %s", err.msg);
+    if (s) {
+        const mr_mesh *m = &s->meshes[0];
+        float o[3] = {(float)-m->origin[0], (float)-m->origin[1], (float)-m->origin[2]};
+        (void)o;
+        /* vertex 0 zero, 1 (1,0,0), 2 (0,2,0): relative differences */
+        CHECK_NEAR(m->positions[3] - m->positions[0], 1.0, 1e-6);
+        CHECK_NEAR(m->positions[7] - m->positions[1], 2.0, 1e-6);
+        CHECK_NEAR(m->positions[4] - m->positions[1], 0.0, 1e-6);
+    }
+    mr_scene_destroy(&s);
+    /* Sparse index out of range, sparse count past the values, count 2^31. */
+    char bad[4096];
+    const uint16_t si_bad[2] = {1, 9};
+    unsigned char bin2[28];
+    memcpy(bin2, bin, 28);
+    memcpy(bin2, si_bad, 4);
+    expect_refused(json, bin2, sizeof bin2, "sparse index", __LINE__);
+    snprintf(bad, sizeof bad, "%s", json);
+    char *c = strstr(bad, "\"count\":2");
+    c[8] = '3';
+    expect_refused(bad, bin, sizeof bin, "sparse", __LINE__);
+    snprintf(bad, sizeof bad,
+             "{%s\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+             "\"accessors\":[{\"componentType\":5126,\"count\":2147483648,\"type\":\"VEC3\"}]}",
+             k_head);
+    expect_refused(bad, NULL, 0, "without a bufferView", __LINE__);
+}
+
+/* The GLB container and its lies. */
+static void test_glb_lies(void) {
+    float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    char json[4096];
+    const char *fmt = "{%s\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+                      "\"buffers\":[{\"byteLength\":%s}],\"bufferViews\":[{\"buffer\":0,\"byteOffset\":%s,\"byteLength\":36}],"
+                      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%s,\"type\":\"VEC3\"}]}";
+    snprintf(json, sizeof json, fmt, k_head, "36", "0", "3");
+    mr_error err = {0};
+    mr_scene *s = load_glb(json, pos, sizeof pos, &err);
+    CHECK_MSG(s != NULL && s->mesh_count == 1, "plain GLB: %s", err.msg);
+    mr_scene_destroy(&s);
+    snprintf(json, sizeof json, fmt, k_head, "4294967296", "0", "3");
+    expect_refused(json, pos, sizeof pos, "byteLength", __LINE__);
+    snprintf(json, sizeof json, fmt, k_head, "36", "4294967200", "3");
+    expect_refused(json, pos, sizeof pos, "outside its buffer", __LINE__);
+    snprintf(json, sizeof json, fmt, k_head, "36", "0", "2147483648");
+    expect_refused(json, pos, sizeof pos, "runs past the end", __LINE__);
+    /* Truncations: every prefix fails with one line (or loads, never crashes). */
+    snprintf(json, sizeof json, fmt, k_head, "36", "0", "3");
+    size_t n;
+    unsigned char *g = make_glb(json, pos, sizeof pos, &n);
+    int refused = 0;
+    for (size_t cut = 0; cut < n; cut += 7) {
+        mr_scene *t = mr_scene_load_gltf_memory(g, cut, NULL, NULL, &err);
+        if (!t) {
+            refused++;
+            CHECK_MSG(one_line(&err), "cut %zu: '%s'", cut, err.msg);
+        }
+        mr_scene_destroy(&t);
+    }
+    CHECK(refused > 0);
+    /* The header's length past the data, and a JSON chunk past the end. */
+    mr_scene *t = mr_scene_load_gltf_memory(g, n - 4, NULL, NULL, &err);
+    CHECK_MSG(!t && strstr(err.msg, "truncated"), "'%s'", err.msg);
+    mr_scene_destroy(&t);
+    uint32_t big = 0x7FFFFFF0u;
+    memcpy(g + 12, &big, 4);
+    memcpy(g + 8, &big, 4);
+    t = mr_scene_load_gltf_memory(g, n, NULL, NULL, &err);
+    CHECK_MSG(!t && one_line(&err), "'%s'", err.msg);
+    mr_scene_destroy(&t);
+    free(g);
+    /* A buffer without uri that is not the BIN chunk. */
+    snprintf(json, sizeof json,
+             "{%s\"buffers\":[{\"byteLength\":36},{\"byteLength\":8}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+             "\"bufferViews\":[{\"buffer\":1,\"byteLength\":8}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}",
+             k_head);
+    expect_refused(json, pos, sizeof pos, "buffer 1 has no data", __LINE__);
+    /* Anything still unsupported is refused by name. */
+    snprintf(json, sizeof json, "{%s\"extensionsRequired\":[\"EXT_mesh_gpu_instancing\"],\"buffers\":[{\"byteLength\":99}]}", k_head);
+    expect_refused(json, NULL, 0, "EXT_mesh_gpu_instancing", __LINE__);
+    /* Buffers as data: URIs with the glTF buffer MIME type. */
+    const char *du = "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+                     "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+                     "\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/gltf-buffer;base64,"
+                     "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}],"
+                     "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+                     "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}";
+    s = mr_scene_load_gltf_memory(du, strlen(du), NULL, NULL, &err);
+    CHECK_MSG(s != NULL && s->mesh_count == 1 && s->meshes[0].vertex_count == 3, "data URI: %s", err.msg);
+    mr_scene_destroy(&s);
+}
+
+/* EXT_meshopt_compression: vertex and index streams from meshoptimizer's
+ * encoders, with the fallback buffer gltfpack writes; then broken streams. */
+static void test_meshopt(void) {
+    float pos[48];
+    uint32_t idx[54];
+    grid(pos, idx);
+    unsigned char vb[1024], ib[1024];
+    size_t vn = meshopt_encodeVertexBuffer(vb, sizeof vb, pos, 16, 12);
+    size_t in = meshopt_encodeIndexBuffer(ib, sizeof ib, idx, 54);
+    CHECK(vn > 0 && in > 0);
+    size_t vp = (vn + 3) & ~(size_t)3;
+    unsigned char bin[2048];
+    memcpy(bin, vb, vn);
+    memset(bin + vn, 0, vp - vn);
+    memcpy(bin + vp, ib, in);
+    size_t bn = vp + in;
+    char json[4096];
+    const char *fmt =
+        "{%s\"extensionsUsed\":[\"EXT_meshopt_compression\"],\"extensionsRequired\":[\"EXT_meshopt_compression\"],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+        "\"buffers\":[{\"byteLength\":%zu},{\"byteLength\":300,\"extensions\":{\"EXT_meshopt_compression\":{\"fallback\":true}}}],"
+        "\"bufferViews\":[{\"buffer\":1,\"byteLength\":192,\"byteStride\":12,\"extensions\":{\"EXT_meshopt_compression\":"
+        "{\"buffer\":0,\"byteLength\":%zu,\"byteStride\":12,\"count\":%s,\"mode\":\"ATTRIBUTES\"}}},"
+        "{\"buffer\":1,\"byteOffset\":192,\"byteLength\":108,\"extensions\":{\"EXT_meshopt_compression\":"
+        "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":2,\"count\":54,\"mode\":\"%s\"}}}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":16,\"type\":\"VEC3\"},"
+        "{\"bufferView\":1,\"componentType\":5123,\"count\":54,\"type\":\"SCALAR\"}]}";
+    snprintf(json, sizeof json, fmt, k_head, bn, vn, "16", vp, in, "TRIANGLES");
+    mr_error err = {0};
+    mr_scene *s = load_glb(json, bin, bn, &err);
+    CHECK_MSG(s != NULL, "meshopt: %s", err.msg);
+    if (s) {
+        const mr_mesh *m = &s->meshes[0];
+        CHECK(m->vertex_count == 16 && m->index_count == 54);
+        double worst = 0;
+        for (int i = 0; i < 48 && m->vertex_count == 16; i++)
+            worst = fmax(worst, fabs(m->positions[i] + m->origin[i % 3] - pos[i]));
+        CHECK_MSG(worst < 1e-6, "meshopt positions off by %g", worst); /* the vertex codec is lossless */
+        bool same = m->index_count == 54;
+        for (int i = 0; same && i < 54; i++) same = m->indices[i] < 16;
+        CHECK(same);
+    }
+    mr_scene_destroy(&s);
+    /* Lies and damage: counts of 2^31, streams cut short, garbage. */
+    snprintf(json, sizeof json, fmt, k_head, bn, vn, "2147483648", vp, in, "TRIANGLES");
+    expect_refused(json, bin, bn, "meshopt", __LINE__);
+    /* 1e8 vertices (1.2 GB) from a 100-byte stream: refused before allocating. */
+    snprintf(json, sizeof json, fmt, k_head, bn, vn, "100000000", vp, in, "TRIANGLES");
+    expect_refused(json, bin, bn, "can hold", __LINE__);
+    snprintf(json, sizeof json, fmt, k_head, bn, vn - 5, "16", vp, in, "TRIANGLES");
+    expect_refused(json, bin, bn, "malformed meshopt", __LINE__);
+    snprintf(json, sizeof json, fmt, k_head, bn, vn, "16", vp, in, "SPIRALS");
+    expect_refused(json, bin, bn, "SPIRALS", __LINE__);
+    snprintf(json, sizeof json, fmt, k_head, bn + 64, vn, "16", vp, in, "TRIANGLES");
+    expect_refused(json, bin, bn, "byteLength", __LINE__);
+    snprintf(json, sizeof json, fmt, k_head, bn, vn, "16", vp, in, "TRIANGLES");
+    unsigned char junk[2048];
+    memcpy(junk, bin, bn);
+    for (size_t i = 0; i < vn; i++) junk[i] = (unsigned char)(i * 37 + 11);
+    expect_refused(json, junk, bn, "meshopt", __LINE__);
+    for (int trial = 0; trial < 200; trial++) { /* random damage: one line or a load, never a crash */
+        memcpy(junk, bin, bn);
+        junk[(size_t)(trial * 7919) % bn] ^= (unsigned char)(1 + trial % 255);
+        mr_scene *t = load_glb(json, junk, bn, &err);
+        if (!t) CHECK_MSG(one_line(&err), "trial %d: '%s'", trial, err.msg);
+        mr_scene_destroy(&t);
+    }
+    /* A view of the fallback buffer without the extension has no data. */
+    char nofb[4096];
+    snprintf(nofb, sizeof nofb,
+             "{%s\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+             "\"buffers\":[{\"byteLength\":4},{\"byteLength\":36,\"extensions\":{\"EXT_meshopt_compression\":{\"fallback\":true}}}],"
+             "\"bufferViews\":[{\"buffer\":1,\"byteLength\":36}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}",
+             k_head);
+    expect_refused(nofb, "abcd", 4, "fallback", __LINE__);
+}
+
+/* KHR_draco_mesh_compression on real draco data; then damaged data. */
+static void test_draco(void) {
+    float pos[48];
+    uint32_t idx[54];
+    grid(pos, idx);
+    size_t dn = 0;
+    int pid = -1;
+    unsigned char *d = test_draco_encode(pos, 16, idx, 18, 14, &dn, &pid);
+    CHECK(d != NULL && dn > 0);
+    if (!d) return;
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{%s\"extensionsUsed\":[\"KHR_draco_mesh_compression\"],\"extensionsRequired\":[\"KHR_draco_mesh_compression\"],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"extensions\":"
+             "{\"KHR_draco_mesh_compression\":{\"bufferView\":0,\"attributes\":{\"POSITION\":%d}}}}]}],"
+             "\"buffers\":[{\"byteLength\":%zu}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":%zu}],"
+             "\"accessors\":[{\"componentType\":5126,\"count\":16,\"type\":\"VEC3\"},"
+             "{\"componentType\":5125,\"count\":54,\"type\":\"SCALAR\"}]}",
+             k_head, pid, dn, dn);
+    mr_error err = {0};
+    mr_scene *s = load_glb(json, d, dn, &err);
+    CHECK_MSG(s != NULL, "draco: %s", err.msg);
+    if (s) {
+        const mr_mesh *m = &s->meshes[0];
+        CHECK_MSG(m->vertex_count == 16 && m->index_count == 54, "%u vertices, %u indices", m->vertex_count,
+                  m->index_count);
+        /* Every decoded vertex is one of the grid's within 14-bit quantisation
+         * of the largest extent (0.9): 0.9 / 16383 / 2 per axis. */
+        double tol = 0.9 / 16383.0 * 0.5 * 1.01, worst = 0;
+        for (uint32_t v = 0; v < m->vertex_count; v++) {
+            double best = 1e9;
+            for (int k = 0; k < 16; k++) {
+                double e = 0;
+                for (int c = 0; c < 3; c++) e = fmax(e, fabs(m->positions[v * 3 + c] + m->origin[c] - pos[k * 3 + c]));
+                best = fmin(best, e);
+            }
+            worst = fmax(worst, best);
+        }
+        CHECK_MSG(worst <= tol, "draco vertex off by %g (tolerance %g)", worst, tol);
+    }
+    mr_scene_destroy(&s);
+    /* Damage: cut short, garbage, random flips. */
+    expect_refused(json, d, dn / 2, NULL, __LINE__);
+    unsigned char *junk = malloc(dn);
+    for (size_t i = 0; i < dn; i++) junk[i] = (unsigned char)(i * 53 + 7);
+    expect_refused(json, junk, dn, "draco", __LINE__);
+    for (int trial = 0; trial < 200; trial++) {
+        memcpy(junk, d, dn);
+        junk[(size_t)(trial * 7919) % dn] ^= (unsigned char)(1 + trial % 255);
+        mr_scene *t = load_glb(json, junk, dn, &err);
+        if (!t) CHECK_MSG(one_line(&err), "trial %d: '%s'", trial, err.msg);
+        mr_scene_destroy(&t);
+    }
+    free(junk);
+    free(d);
+}
+
+/* KHR_texture_transform maps the texture coordinates (T * R * S). */
+static void test_texture_transform(void) {
+    float bin[9 + 6] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1};
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{%s\"extensionsUsed\":[\"KHR_texture_transform\"],"
+             "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":"
+             "{\"KHR_texture_transform\":{\"offset\":[0.5,0.25],\"rotation\":1.5707963267948966,\"scale\":[2,4]}}}}}],"
+             "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"missing.png\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":0}]}],"
+             "\"buffers\":[{\"byteLength\":60}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},"
+             "{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+             "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"}]}",
+             k_head);
+    mr_error err = {0};
+    mr_scene *s = load_glb(json, bin, sizeof bin, &err);
+    CHECK_MSG(s != NULL, "texture transform: %s", err.msg);
+    if (s && s->meshes[0].uvs) {
+        const float *uv = s->meshes[0].uvs;
+        /* (1,0): scale -> (2,0), rotate 90 deg (u' = cos u + sin v, v' = -sin u + cos v) -> (0,-2), offset -> (0.5,-1.75) */
+        CHECK_NEAR(uv[2], 0.5, 1e-5);
+        CHECK_NEAR(uv[3], -1.75, 1e-5);
+        /* (0,1): scale -> (0,4), rotate -> (4,0), offset -> (4.5,0.25) */
+        CHECK_NEAR(uv[4], 4.5, 1e-5);
+        CHECK_NEAR(uv[5], 0.25, 1e-5);
+    } else {
+        CHECK_MSG(0, "no uvs");
+    }
+    mr_scene_destroy(&s);
+}
+
+/* Files over 2 GiB load (mapped, only the pages read are touched) and over
+ * 4 GiB are refused with one line: sparse files, so no disk is used. */
+static void test_big_files(void) {
+    char path[1200];
+    snprintf(path, sizeof path, "%s/big.glb", g_tmp);
+    const size_t total = (size_t)2200 << 20; /* 2.2 GiB */
+    char json[1024];
+    size_t bin_n = total - 4096 - 8 - 20;
+    snprintf(json, sizeof json,
+             "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+             "\"buffers\":[{\"byteLength\":%zu}],\"bufferViews\":[{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":36}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}",
+             bin_n, bin_n - 36);
+    unsigned char head[4096 + 28];
+    memset(head, ' ', sizeof head);
+    uint32_t h[5] = {0x46546C67u, 2, (uint32_t)total, 4096, 0x4E4F534Au};
+    memcpy(head, h, 20);
+    memcpy(head + 20, json, strlen(json));
+    uint32_t c[2] = {(uint32_t)bin_n, 0x004E4942u};
+    memcpy(head + 20 + 4096, c, 8);
+    int fd = open(path, O_CREAT | O_TRUNC | O_WRONLY, 0644);
+    CHECK(fd >= 0);
+    if (fd < 0) return;
+    const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    bool wrote = write(fd, head, 4096 + 28) == 4096 + 28 && ftruncate(fd, (off_t)total) == 0 &&
+                 pwrite(fd, tri, 36, (off_t)(total - 36)) == 36;
+    close(fd);
+    CHECK(wrote);
+    mr_error err = {0};
+    double before = peak_rss_mb();
+    mr_scene *s = mr_scene_load(path, NULL, &err);
+    CHECK_MSG(s != NULL && s->mesh_count == 1, "2.2 GiB GLB: %s", err.msg);
+    CHECK_MSG(peak_rss_mb() - before < 64, "2.2 GiB sparse GLB grew peak RSS by %.0f MB", peak_rss_mb() - before);
+    mr_scene_destroy(&s);
+    /* The header's length is 32-bit: over 4 GiB cannot be a GLB. */
+    fd = open(path, O_WRONLY);
+    bool grew = fd >= 0 && ftruncate(fd, (off_t)((size_t)4400 << 20)) == 0;
+    if (fd >= 0) close(fd);
+    CHECK(grew);
+    s = mr_scene_load(path, NULL, &err);
+    CHECK_MSG(s == NULL && one_line(&err) && strstr(err.msg, "4 GiB"), "4.3 GiB: '%s'", err.msg);
+    mr_scene_destroy(&s);
+    unlink(path);
+}
+
+int main(void) {
+    const char *tmp = getenv("MR_TEST_TMP");
+    snprintf(g_tmp, sizeof g_tmp, "%s/gltf_ext", tmp && tmp[0] ? tmp : "/tmp/mrcheck_test");
+    mr_error err = {0};
+    if (!mr_mkdirs(g_tmp, &err)) {
+        printf("cannot create %s: %s\n", g_tmp, err.msg);
+        return 1;
+    }
+    mr_log_set_level(MR_LOG_ERROR);
+    test_quantization();
+    test_sparse_and_zeros();
+    test_glb_lies();
+    test_meshopt();
+    test_draco();
+    test_texture_transform();
+    test_big_files();
+    return mr_test_finish("test_gltf_ext");
+}

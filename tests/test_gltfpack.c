@@ -1,0 +1,209 @@
+/* test_gltfpack.c — gltfpack's output reads as the file it was made from
+ * (issue 17, item 7). The demo hall and a generated CAD part are written
+ * as .glb, packed with Debian's gltfpack (KHR_mesh_quantization +
+ * KHR_texture_transform by default; EXT_meshopt_compression with -c), and
+ * rendered: depth and colour match the unpacked file's within the
+ * quantisation error derived below. Load times are printed (median of 5;
+ * never asserted). gltfpack is a dependency (scripts/deps.sh): a missing
+ * gltfpack fails, it does not skip.
+ *
+ * The tolerance: gltfpack quantises positions to 14 bits (-vp 14) on a grid
+ * no coarser than the scene's largest extent E / (2^14 - 1), rounding to the
+ * nearest step, so every vertex moves by at most step/2 per axis, |d| <=
+ * (sqrt 3 / 2) step = eps. A surface moved by eps moves its depth along a
+ * ray by at most eps / cos(theta) (theta between the normal and the ray);
+ * pixels at grazing angles (cos < 0.25) and within one pixel of a depth
+ * edge (where the coverage may change: eps is far below a pixel here, which
+ * the test checks) are left out. Normals are 8-bit (-vn 8): a unit normal
+ * moves by <= sqrt(3) / 254 ~ 0.007, Lambert shading by as much of the
+ * light, which sRGB at most ~13x amplifies near black: colours within 8
+ * levels where depth matched (texels at quantised UVs can flip: 1 % may). */
+#include "mr_test.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mr_eval.h"
+#include "mr_render.h"
+#include "mr_scene.h"
+
+static char g_tmp[1024];
+
+static bool have_gltfpack(void) { return system("command -v gltfpack >/dev/null 2>&1") == 0; }
+
+static bool pack(const char *in, const char *out, bool compress) {
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "gltfpack %s -i '%s' -o '%s' >'%s.log' 2>&1", compress ? "-c" : "", in, out, out);
+    int rc = system(cmd);
+    CHECK_MSG(rc == 0, "gltfpack %s failed (%d): see %s.log", compress ? "-c" : "", rc, out);
+    return rc == 0;
+}
+
+static mr_scene *load_timed(const char *path, double *median_ms) {
+    double t[5];
+    mr_scene *s = NULL;
+    for (int i = 0; i < 5; i++) {
+        mr_scene_destroy(&s);
+        mr_error err = {0};
+        double t0 = mr_time_now();
+        s = mr_scene_load(path, NULL, &err);
+        t[i] = (mr_time_now() - t0) * 1e3;
+        CHECK_MSG(s != NULL, "%s: %s", path, err.msg);
+        if (!s) return NULL;
+    }
+    *median_ms = mr_median(t, 5);
+    return s;
+}
+
+static bool render(mr_renderer *r, const mr_scene *s, const mr_view *v, mr_frame_result *out) {
+    mr_error err = {0};
+    mr_frame_params fp = MR_FRAME_DEFAULTS;
+    fp.want_depth = true;
+    fp.want_normals = true;
+    bool ok = mr_renderer_set_scene(r, s, &err) && mr_render_frame(r, v, &fp, out, &err);
+    CHECK_MSG(ok, "render: %s", err.msg);
+    return ok;
+}
+
+/* Compares b with the reference a as the header says. */
+static void compare(const char *what, const mr_frame_result *a, const mr_frame_result *b, const mr_view *v,
+                    double eps) {
+    const int w = a->depth.width, h = a->depth.height;
+    const float *za = a->depth.data, *zb = b->depth.data, *na = a->normal.data;
+    const unsigned char *ca = a->color.data, *cb = b->color.data;
+    double zmin = INFINITY;
+    for (int i = 0; i < w * h; i++)
+        if (za[i] > 0) zmin = fmin(zmin, za[i]);
+    const double eps_px = eps * v->camera.fx / zmin;
+    CHECK_MSG(eps_px < 0.5, "%s: the quantisation error is %.2f px: the view is too close for this test", what, eps_px);
+    int checked = 0, bad_z = 0, bad_c = 0, covered = 0;
+    double worst_ratio = 0;
+    for (int y = 1; y < h - 1; y++)
+        for (int x = 1; x < w - 1; x++) {
+            int i = y * w + x;
+            if (za[i] > 0) covered++;
+            bool edge = false;
+            for (int dy = -1; dy <= 1 && !edge; dy++)
+                for (int dx = -1; dx <= 1 && !edge; dx++) {
+                    int j = i + dy * w + dx;
+                    edge = (za[j] > 0) != (za[i] > 0) || fabs(za[j] - za[i]) > 0.02 * za[i];
+                }
+            if (edge || !(za[i] > 0)) continue;
+            /* cos theta: the normal (camera axes) against the ray through the
+             * pixel; the smallest of the 3x3 neighbourhood, as the normals are
+             * interpolated shading normals, not the faces' own. */
+            double rx = (x + 0.5 - v->camera.cx) / v->camera.fx, ry = (y + 0.5 - v->camera.cy) / v->camera.fy;
+            double rl = sqrt(rx * rx + ry * ry + 1), c = 1;
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    const float *n = na + 3 * (i + dy * w + dx);
+                    c = fmin(c, fabs(n[0] * rx + n[1] * ry + n[2]) / rl);
+                }
+            if (c < 0.25) continue;
+            checked++;
+            double tol = eps / c * 1.0001 + 2e-6 * za[i]; /* + float depth rounding */
+            double dz = fabs((double)za[i] - zb[i]);
+            if (!(zb[i] > 0) || dz > tol) bad_z++;
+            worst_ratio = fmax(worst_ratio, dz / tol);
+            int dc = 0;
+            for (int k = 0; k < 3; k++) dc = abs(ca[3 * i + k] - cb[3 * i + k]) > dc ? abs(ca[3 * i + k] - cb[3 * i + k]) : dc;
+            if (dc > 8) bad_c++;
+        }
+    printf("%s: %d px compared of %d covered, eps %.3g (%.3f px), depth off %d (worst %.2f of tolerance), colour off %d\n",
+           what, checked, covered, eps, eps_px, bad_z, worst_ratio, bad_c);
+    CHECK_MSG(checked > w * h / 4, "%s: only %d pixels to compare", what, checked);
+    CHECK_MSG(bad_z == 0, "%s: %d pixels deeper or shallower than the quantisation allows", what, bad_z);
+    CHECK_MSG(bad_c <= checked / 100, "%s: %d pixels differ in colour by more than 8 levels", what, bad_c);
+}
+
+static void check_packed(mr_renderer *r, const char *name, const mr_scene *src, const mr_view *v) {
+    char path[1200], packed[1200], packed_c[1200];
+    snprintf(path, sizeof path, "%s/%s.glb", g_tmp, name);
+    snprintf(packed, sizeof packed, "%s/%s_packed.glb", g_tmp, name);
+    snprintf(packed_c, sizeof packed_c, "%s/%s_packed_c.glb", g_tmp, name);
+    mr_error err = {0};
+    CHECK_MSG(mr_scene_save_glb(src, path, &err), "%s", err.msg);
+    if (!pack(path, packed, false) || !pack(path, packed_c, true)) return;
+    double ms[3] = {0, 0, 0};
+    mr_scene *a = load_timed(path, &ms[0]), *b = load_timed(packed, &ms[1]), *c = load_timed(packed_c, &ms[2]);
+    printf("%s: load (median of 5) unpacked %.1f ms, gltfpack %.1f ms, gltfpack -c %.1f ms\n", name, ms[0], ms[1], ms[2]);
+    if (a && b && c) {
+        /* gltfpack drops degenerate triangles (the CAD part's poles); the images tell the rest. */
+        uint64_t ta = mr_scene_triangle_count(a), tb = mr_scene_triangle_count(b), tc = mr_scene_triangle_count(c);
+        printf("%s: %llu triangles, packed %llu, -c %llu\n", name, (unsigned long long)ta, (unsigned long long)tb,
+               (unsigned long long)tc);
+        CHECK_MSG(tb <= ta && tb > ta / 2 && tc == tb, "%s: triangles %llu, %llu, %llu", name,
+                  (unsigned long long)ta, (unsigned long long)tb, (unsigned long long)tc);
+        double e = 0;
+        for (int k = 0; k < 3; k++) e = fmax(e, a->bounds_max[k] - a->bounds_min[k]);
+        const double eps = sqrt(3.0) / 2.0 * e / 16383.0;
+        mr_frame_result fa, fb, fc;
+        memset(&fa, 0, sizeof fa);
+        memset(&fb, 0, sizeof fb);
+        memset(&fc, 0, sizeof fc);
+        if (r && render(r, a, v, &fa) && render(r, b, v, &fb) && render(r, c, v, &fc)) {
+            char what[256];
+            snprintf(what, sizeof what, "%s gltfpack", name);
+            compare(what, &fa, &fb, v, eps);
+            snprintf(what, sizeof what, "%s gltfpack -c", name);
+            compare(what, &fa, &fc, v, eps);
+        }
+        mr_frame_result_free(&fa);
+        mr_frame_result_free(&fb);
+        mr_frame_result_free(&fc);
+        if (r) mr_renderer_set_scene(r, NULL, &err);
+    }
+    mr_scene_destroy(&a);
+    mr_scene_destroy(&b);
+    mr_scene_destroy(&c);
+}
+
+int main(void) {
+    const char *tmp = getenv("MR_TEST_TMP");
+    snprintf(g_tmp, sizeof g_tmp, "%s/gltfpack", tmp && tmp[0] ? tmp : "/tmp/mrcheck_test");
+    mr_error err = {0};
+    if (!mr_mkdirs(g_tmp, &err)) {
+        printf("cannot create %s: %s\n", g_tmp, err.msg);
+        return 1;
+    }
+    mr_log_set_level(MR_LOG_ERROR);
+    if (!have_gltfpack()) {
+        CHECK_MSG(0, "gltfpack is not installed (scripts/deps.sh installs it)");
+        return mr_test_finish("test_gltfpack");
+    }
+    mr_gpu *gpu = mr_gpu_create_headless(NULL, &err);
+    mr_renderer *r = gpu ? mr_renderer_create(gpu, &err) : NULL;
+    const bool no_gpu = r == NULL;
+    mr_error gpu_err = err;
+    const int w = 160, h = 120;
+    mr_camera cam = {w, h, 0.9 * w, 0.9 * w, (w - 1) / 2.0, (h - 1) / 2.0, {0, 0, 0, 0, 0}};
+
+    mr_demo_hall hall;
+    memset(&hall, 0, sizeof hall);
+    CHECK_MSG(mr_demo_build_tagged(NULL, 0, &hall, &err), "%s", err.msg);
+    if (hall.planned) {
+        mr_view v = mr_demo_view(0);
+        v.camera = cam;
+        check_packed(r, "hall", hall.planned, &v);
+    }
+    mr_demo_free(&hall);
+
+    mr_synth_cad_params cp = MR_SYNTH_CAD_DEFAULTS;
+    cp.parts = 2;
+    cp.part_triangles = 20000;
+    mr_scene *cad = mr_synth_cad_build(&cp, &err);
+    CHECK_MSG(cad != NULL, "%s", err.msg);
+    if (cad) {
+        mr_view v;
+        v.camera = cam;
+        v.world_from_camera = mr_synth_cad_viewpoint(&cp, MR_SYNTH_VIEW_OVERVIEW);
+        check_packed(r, "cad", cad, &v);
+    }
+    mr_scene_destroy(&cad);
+    mr_renderer_destroy(&r);
+    mr_gpu_destroy(&gpu);
+    if (no_gpu) return mr_test_no_gpu("test_gltfpack", &gpu_err);
+    return mr_test_finish("test_gltfpack");
+}
