@@ -152,7 +152,7 @@ vec2 on_light(vec3 r, vec2 xy, float z) {
 // whose greatest depth blocks everywhere (one surface: a depth range of a
 // few texels) hides the part of the light that its footprint covers at both
 // its least and its greatest depth, the whole light: umbra.
-layout(location = MR_LOC_SHADOW_PYRAMID) uniform ivec2 u_pyr;         // P, top level
+layout(location = MR_LOC_SHADOW_PYRAMID) uniform ivec2 u_pyr;         // P, top level (-1: none, full search)
 layout(binding = MR_TEX_SHADOW_MINMAX) uniform sampler2D u_minmax;    // RG32F min / max depth pyramid
 ivec2 g_ptile;   // the cascade's pyramid tile origin at level 0
 float g_clear;   // the blocker clearance (scene depth)
@@ -224,13 +224,14 @@ float backprojection(vec3 r) {
     float area_l = 4.0 * lh.x * lh.y;
     float S = float(u_size);
     int top = u_pyr.y;
+    bool hier = top >= 0;
     g_clear = 2.0 * (u_ortho != 0 ? 1.0 / (S * min(u_rect.z, u_rect.w)) : g_zR / (S * u_k));
     // The search area: from the tile's least depth, then each level's least
     // depth under the area found so far.
-    float zmin = cell_mm(top, ivec2(0)).x;
+    float zmin = hier ? cell_mm(top, ivec2(0)).x : u_zrange.x;
     vec2 rad = bp_reach(zmin);
     ivec2 t0 = texel_of(g_uvR - rad), t1 = texel_of(g_uvR + rad);
-    for (int it = 0; it < 4; it++) {
+    for (int it = 0; hier && it < 4; it++) {
         if (zmin >= bp_thr_range(t0, t1).y) return 1.0; // nothing there is nearer than the receiver
         int side = max(t1.x - t0.x, t1.y - t0.y) + 1;
         // Cells of at least half the area's side: at most 3 x 3 of them.
@@ -247,21 +248,21 @@ float backprojection(vec3 r) {
         t1 = texel_of(g_uvR + rad);
         if (l == 0) break;
     }
-    if (zmin >= bp_thr_range(t0, t1).y) return 1.0;
+    if (hier && zmin >= bp_thr_range(t0, t1).y) return 1.0;
     // Off the map is lit.
     t0 = max(t0, ivec2(0));
     t1 = min(t1, ivec2(u_size - 1));
     if (any(greaterThan(t0, t1))) return 1.0;
     int side = max(t1.x - t0.x, t1.y - t0.y) + 1;
-    int lc = clamp(int(ceil(log2(float(side) / 8.0))), 0, top); // at most 9 x 9 cells
+    int lc = hier ? clamp(int(ceil(log2(float(side) / 8.0))), 0, top) : 0; // at most 9 x 9 cells
     int cs = 1 << lc;
     float occ = 0.0;
     ivec2 c0 = t0 >> lc, c1 = t1 >> lc;
     for (int cy = c0.y; cy <= c1.y; cy++)
         for (int cx = c0.x; cx <= c1.x; cx++) {
             ivec2 c = ivec2(cx, cy);
-            vec2 mm = cell_mm(lc, c);
             ivec2 a = max(c * cs, t0), b = min(c * cs + (cs - 1), t1);
+            vec2 mm = hier ? cell_mm(lc, c) : vec2(0.0, 1e30);
             vec2 thr = bp_thr_range(a, b);
             if (mm.x >= thr.y) continue; // no texel of the cell blocks
             float tlc = u_ortho != 0 ? 1.0 / (S * min(u_rect.z, u_rect.w)) : mm.x / (S * u_k);

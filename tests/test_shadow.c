@@ -88,9 +88,12 @@ typedef struct shot {
     bool reused;
 } shot;
 
+static bool g_bp_no_pyramid; /* render(): backprojection's full search */
+
 static bool render(mr_renderer *r, const mr_scene *s, const mr_view *v, mr_shadow_method m, int samples, shot *out) {
     mr_frame_params p = MR_FRAME_DEFAULTS;
     p.shadow.method = m;
+    p.shadow.bp_no_pyramid = g_bp_no_pyramid;
     p.shadow.want_shadow = true;
     p.shadow.gt_samples = samples;
     p.want_depth = true;
@@ -469,6 +472,22 @@ static void bp_steep_receivers(mr_renderer *r) {
                           "bp over kept maps differs from bp over new ones");
             }
             if (ai == 0) shot_free(&p2), shot_free(&b2), shot_free(&b3);
+            /* The pyramid only prunes: the full search finds the same. */
+            shot full = {0};
+            g_bp_no_pyramid = true;
+            if (render(r, s, &v, MR_SHADOW_BP, 0, &full)) {
+                double worst = 0;
+                int differ = 0;
+                for (size_t i = 0; i < (size_t)W * H; i++) {
+                    double dd = fabs((double)((const float *)full.vis.data)[i] - ((const float *)bp.vis.data)[i]);
+                    worst = fmax(worst, dd);
+                    differ += dd > 1e-4;
+                }
+                printf("  bp with the pyramid against the full search: %d pixels differ, by at most %.2e\n", differ, worst);
+                CHECK_MSG(worst < 1e-3, "the pyramid changed bp's result: %d pixels, by up to %.4f", differ, worst);
+            }
+            g_bp_no_pyramid = false;
+            shot_free(&full);
         }
         shot_free(&gt);
         shot_free(&bp);

@@ -766,7 +766,8 @@ static void draw_vis(frame *f, int method, const double offset[3], const double 
     glUniform2f(MR_LOC_SHADOW_SHEAR, (float)shear[0], (float)shear[1]);
     glUniform1f(MR_LOC_SHADOW_WEIGHT, weight);
     glUniform1f(MR_LOC_SHADOW_MAX_SEARCH, (float)(method == MR_SHADOW_METHOD_ID_BP ? BP_MAX_SEARCH_TEXELS : MAX_SEARCH_TEXELS));
-    glUniform2i(MR_LOC_SHADOW_PYRAMID, s->pyr_side, s->pyr_levels - 1);
+    /* A top level of -1: no pyramid (bp_no_pyramid), the full search. */
+    glUniform2i(MR_LOC_SHADOW_PYRAMID, s->pyr_side, p->bp_no_pyramid ? -1 : s->pyr_levels - 1);
     if (method == MR_SHADOW_METHOD_ID_BP) glBindTextureUnit(MR_TEX_SHADOW_MINMAX, frame_get(f, RES_SHADOW_PYRAMID));
     glUniform2fv(MR_LOC_SHADOW_KERNEL, s->kernel_taps, s->kernel);
     glBindTextureUnit(MR_TEX_SHADOW_DEPTH, frame_get(f, RES_DEPTH));
