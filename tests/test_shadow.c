@@ -472,20 +472,26 @@ static void bp_steep_receivers(mr_renderer *r) {
                           "bp over kept maps differs from bp over new ones");
             }
             if (ai == 0) shot_free(&p2), shot_free(&b2), shot_free(&b3);
-            /* The pyramid only prunes: the full search finds the same. */
-            shot full = {0};
-            g_bp_no_pyramid = true;
-            if (render(r, s, &v, MR_SHADOW_BP, 0, &full)) {
+            /* The pyramid only prunes: the full search finds the same (at a
+             * quarter of the pixels: the full search is slow). */
+            shot full = {0}, pyr = {0};
+            mr_view vq = v;
+            vq.camera = mr_camera_resized(&v.camera, W / 2, H / 2);
+            if (render(r, s, &vq, MR_SHADOW_BP, 0, &pyr)) {
+                g_bp_no_pyramid = true;
+                bool okf = render(r, s, &vq, MR_SHADOW_BP, 0, &full);
+                g_bp_no_pyramid = false;
                 double worst = 0;
                 int differ = 0;
-                for (size_t i = 0; i < (size_t)W * H; i++) {
-                    double dd = fabs((double)((const float *)full.vis.data)[i] - ((const float *)bp.vis.data)[i]);
+                for (size_t i = 0; okf && i < (size_t)(W / 2) * (H / 2); i++) {
+                    double dd = fabs((double)((const float *)full.vis.data)[i] - ((const float *)pyr.vis.data)[i]);
                     worst = fmax(worst, dd);
                     differ += dd > 1e-4;
                 }
                 printf("  bp with the pyramid against the full search: %d pixels differ, by at most %.2e\n", differ, worst);
-                CHECK_MSG(worst < 1e-3, "the pyramid changed bp's result: %d pixels, by up to %.4f", differ, worst);
+                CHECK_MSG(okf && worst < 1e-3, "the pyramid changed bp's result: %d pixels, by up to %.4f", differ, worst);
             }
+            shot_free(&pyr);
             g_bp_no_pyramid = false;
             shot_free(&full);
         }
@@ -860,6 +866,7 @@ static void bench_and_suite(mr_gpu *gpu, mr_renderer *r) {
     p.first = 2;
     p.count = 1;
     p.views = 1;
+    p.gt_samples_max = 4; /* the rows, not the ground truth's quality */
     mr_error err = {0};
     CHECK_MSG(mr_bench_shadows(&p, &err), "bench shadows: %s", err.msg);
     char path[4200];

@@ -85,6 +85,13 @@ static void apply(const setting *st, float pcf_radius, mr_shadow_params *sp) {
     sp->light_scale = st->light;
 }
 
+/* The setting as run: the ground truth's samples under the cap. */
+static setting capped(const setting *st, int gt_max) {
+    setting c = *st;
+    if (gt_max > 0 && c.samples > gt_max) c.samples = gt_max;
+    return c;
+}
+
 /* Renders frames times (the ground truth once: it is its own median) and
  * measures the last visibility against ref. vis_out (optional) keeps it. */
 static bool run_one(const mr_bench_shadows_params *p, const mr_view *view, const mr_shadow_params *sp,
@@ -272,7 +279,7 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
             mr_image keep[MR_SHADOW_METHOD_COUNT];
             memset(keep, 0, sizeof keep);
             for (int si = 0; ok && si < NS; si++) {
-                const setting *st = &k_settings[si];
+                const setting cst = capped(&k_settings[si], p.gt_samples_max), *st = &cst;
                 int li = light_index(st->light);
                 if (!have_ref[li]) {
                     mr_image d = {0};
@@ -408,7 +415,9 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
                setting_value(&k_settings[si]), med_ms[si], med_rmse[si]);
             rank[nk++] = si;
         }
-        MD("\nLight size (median RMSE over S, reported categories; each against a reference with that light):\n\n"
+        MD("\nLight size (median RMSE over S over the reported categories at the default settings: hard, pcf and pcss "
+           "a 1024 map and 32 taps, bp a 512 map, the GPU ground truth 64 samples; each against a reference with that "
+           "light):\n\n"
            "| method | light x0.5 | light x1 | light x2 |\n|---|---|---|---|\n");
         for (int m = MR_SHADOW_HARD; m < MR_SHADOW_METHOD_COUNT; m++) {
             double v[3] = {NAN, NAN, NAN};
