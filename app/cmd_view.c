@@ -62,6 +62,10 @@ typedef struct view_app {
     /* --shadows (else the scene config's "shadows", else off) */
     mr_shadow_method shadows;
     bool shadows_given;
+    /* The saved shadows setting at start; once the C key changes it, the
+     * setting wins over --shadows and the scene config's. */
+    mr_shadow_method shadows_start;
+    bool shadows_keyed;
     int snap_count, mark_count;
     char shot_path[1024], state_path[1024];
     /* the rendered frame */
@@ -295,9 +299,12 @@ static void carry_out(view_app *a, const mr_view_actions *acts) {
 }
 
 /* Renders the 3D frame when something it depends on changed. */
-/* The shadow method of a frame: --shadows, else the scene config's. */
-static mr_shadow_method view_shadows(const view_app *a) {
-    mr_shadow_method m = MR_SHADOW_OFF;
+/* The shadow method of a frame: the C key's once pressed, else --shadows,
+ * else the scene config's, else the saved setting. */
+static mr_shadow_method view_shadows(view_app *a) {
+    mr_shadow_method m = mr_viewer_settings(a->vc)->shadows;
+    if (m != a->shadows_start) a->shadows_keyed = true;
+    if (a->shadows_keyed) return m;
     if (a->shadows_given) return a->shadows;
     if (a->scene && a->scene->shadow_method[0] && !mr_shadow_method_parse(a->scene->shadow_method, &m)) m = MR_SHADOW_OFF;
     return m;
@@ -661,6 +668,7 @@ static int open_window(view_app *a, const mr_cli_opt *opts, int ww, int wh, int 
     if (ao >= 0) s.ao = (mr_ao_method)ao;
     if (ghost >= 0) s.ghost = (mr_ghost_mode)ghost;
     mr_viewer_set_settings(a->vc, &s);
+    a->shadows_start = s.shadows;
     if (*script) mr_viewer_set_script(a->vc, script);
     return 0;
 }

@@ -265,8 +265,15 @@
 #define MR_TEX_SHADOW_DEPTH                0
 #define MR_TEX_SHADOW_NORMAL               1
 #define MR_TEX_SHADOW_MAP                  2
-#define MR_TEX_SHADOW_MAP_MIN              3
-#define MR_TEX_SHADOW_MAP_MAX              4
+#define MR_TEX_SHADOW_MINMAX               3  /* backprojection: RG32F min / max depth pyramid */
+#define MR_LOC_SHADOW_PYRAMID              17 /* ivec2: a tile's pyramid side P (level 0), its top level */
+/* shadow_minmax (compute): the backprojection's min / max depth pyramid */
+#define MR_LOC_SHADOW_MM_LEVEL             0
+#define MR_LOC_SHADOW_MM_SIZE              1
+#define MR_LOC_SHADOW_MM_PYR               2
+#define MR_TEX_SHADOW_MM_MAP               0
+#define MR_IMG_SHADOW_MM_SRC               0
+#define MR_IMG_SHADOW_MM_DST               1
 /* shadow_vis's methods: mr_shadow_method's values (checked in pass_shadow.c) */
 #define MR_SHADOW_METHOD_ID_HARD           1
 #define MR_SHADOW_METHOD_ID_PCF            2

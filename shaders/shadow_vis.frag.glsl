@@ -128,53 +128,153 @@ vec2 on_light(vec3 r, vec2 xy, float z) {
     return u_ortho != 0 ? (xy - r.xy) / t : r.xy + (xy - r.xy) * r.z / t;
 }
 
-// Backprojection: every blocking texel of the search square is a
+// Backprojection: every blocking texel of the search area is a
 // light-parallel micro-patch at its depth; its projection through the
 // receiver onto the light, clipped to the light, occludes that area. Gap
 // filling: a patch reaches to its right and lower neighbour's edge when the
-// neighbour blocks too (projected at the farther of the two depths), so a
-// tilted blocker leaves no cracks between the patches of its texels.
-float backprojection(vec3 r, vec2 radius_uv) {
+// neighbour blocks too (projected at the neighbour's depth), so a tilted
+// blocker leaves no cracks between the patches of its texels.
+//
+// A texel blocks when it lies nearer the light than the receiver's plane
+// there and than the receiver point itself, both by a clearance of two
+// texels. The receiver point matters where the plane falls away from the
+// light (a wall the sun grazes): extrapolated over the search area the plane
+// runs deeper than the receiver, and a patch between the two depths is
+// behind the receiver, yet its projection (through a point it does not face)
+// would be huge or flipped and black out the light.
+//
+// The search area comes from the min / max depth pyramid (Guennebaud et al.
+// 2006): the blockers of a receiver lie in the pyramid from it to the light,
+// no nearer than the least depth under the area, so the area is the
+// pyramid's slice at that depth; a finer level's least depth under the
+// smaller area shrinks it again. Traversed by pyramid cells: a cell whose
+// least depth is behind every texel's threshold is skipped whole; a cell
+// whose greatest depth blocks everywhere (one surface: a depth range of a
+// few texels) hides the part of the light that its footprint covers at both
+// its least and its greatest depth, the whole light: umbra.
+layout(location = MR_LOC_SHADOW_PYRAMID) uniform ivec2 u_pyr;         // P, top level (-1: none, full search)
+layout(binding = MR_TEX_SHADOW_MINMAX) uniform sampler2D u_minmax;    // RG32F min / max depth pyramid
+ivec2 g_ptile;   // the cascade's pyramid tile origin at level 0
+float g_clear;   // the blocker clearance (scene depth)
+
+vec2 cell_mm(int l, ivec2 c) {
+    int n = u_pyr.x >> l;
+    if (any(lessThan(c, ivec2(0))) || any(greaterThanEqual(c, ivec2(n)))) return vec2(1e30);
+    return texelFetch(u_minmax, (g_ptile >> l) + c, l).rg;
+}
+
+// Depth under which texel t blocks the receiver.
+float bp_thr(ivec2 t) { return min(ref_depth(t), g_zR - g_bias) - g_clear; }
+// The least and the greatest bp_thr over the texels t0..t1 (it is linear).
+vec2 bp_thr_range(ivec2 t0, ivec2 t1) {
+    vec2 c = 0.5 * (texel_centre(t0) + texel_centre(t1)), h = 0.5 * (texel_centre(t1) - texel_centre(t0));
+    float m = g_zR + dot(g_grad, c - g_uvR), e = dot(abs(g_grad), h);
+    return vec2(min(m - e, g_zR), min(m + e, g_zR)) - g_bias - g_clear;
+}
+bool bp_blocks(ivec2 t, float z) { return inside(t) && z > 0.0 && z < bp_thr(t); }
+
+// The search area's half extents (uv) for blockers no nearer than z.
+vec2 bp_reach(float z) {
+    float f = u_ortho != 0 ? max(g_zR - z, 0.0) : max(1.0 / z - 1.0 / g_zR, 0.0);
+    return min(u_light_half2 * f * uv_scale(), vec2(u_max_search / float(u_size)));
+}
+
+float bp_patch(vec3 r, ivec2 t, float z, vec2 lh) {
+    float S = float(u_size);
+    vec2 lo = vec2(t) / S, hi = (vec2(t) + 1.0) / S;
+    ivec2 tx = t + ivec2(1, 0), ty = t + ivec2(0, 1);
+    float zx = inside(tx) ? tap_depth(tx) : z, zy = inside(ty) ? tap_depth(ty) : z;
+    // Only neighbours of the same surface (a depth step under four
+    // texels' length, i.e. tilted less than ~76 degrees) are joined:
+    // across a depth edge the gap is real.
+    float tl = u_ortho != 0 ? 1.0 / (S * min(u_rect.z, u_rect.w)) : z / (S * u_k);
+    bool bx = bp_blocks(tx, zx) && abs(zx - z) < 4.0 * tl;
+    bool by = bp_blocks(ty, zy) && abs(zy - z) < 4.0 * tl;
+    // Corners on the light of the patch (at its own depth).
+    vec2 a = on_light(r, map_xy(lo, z), z), b = on_light(r, map_xy(hi, z), z);
+    vec2 pmin = min(a, b), pmax = max(a, b);
+    // Gap filling: stretch to the neighbour's shared edge.
+    if (bx) {
+        float ex = on_light(r, map_xy(vec2(hi.x, lo.y), zx), zx).x;
+        pmin.x = min(pmin.x, ex); pmax.x = max(pmax.x, ex);
+    }
+    if (by) {
+        float ey = on_light(r, map_xy(vec2(lo.x, hi.y), zy), zy).y;
+        pmin.y = min(pmin.y, ey); pmax.y = max(pmax.y, ey);
+    }
+    vec2 e = max(min(pmax, lh) - max(pmin, -lh), vec2(0.0));
+    return e.x * e.y;
+}
+
+// The part of the light (as its area) that the texels t0..t1 cover from
+// the receiver at every depth in [za, zb]: their footprint projected at
+// both depths, intersected, clipped to the light.
+float bp_cover(vec3 r, ivec2 t0, ivec2 t1, float za, float zb, vec2 lh) {
+    float S = float(u_size);
+    vec2 lo = vec2(t0) / S, hi = (vec2(t1) + 1.0) / S;
+    vec2 a0 = on_light(r, map_xy(lo, za), za), a1 = on_light(r, map_xy(hi, za), za);
+    vec2 b0 = on_light(r, map_xy(lo, zb), zb), b1 = on_light(r, map_xy(hi, zb), zb);
+    vec2 c0 = max(max(min(a0, a1), min(b0, b1)), -lh), c1 = min(min(max(a0, a1), max(b0, b1)), lh);
+    vec2 e = max(c1 - c0, vec2(0.0));
+    return e.x * e.y;
+}
+
+float backprojection(vec3 r) {
     vec2 lh = u_light_half2;
     float area_l = 4.0 * lh.x * lh.y;
-    ivec2 t0 = texel_of(g_uvR - radius_uv), t1 = texel_of(g_uvR + radius_uv);
-    float occ = 0.0;
     float S = float(u_size);
-    for (int y = t0.y; y <= t1.y; y++)
-        for (int x = t0.x; x <= t1.x; x++) {
-            ivec2 t = ivec2(x, y);
-            if (!inside(t)) continue;
-            float z = tap_depth(t);
-            // A patch must stand clear of the receiver's plane by two texels:
-            // closer, its projection through the receiver covers the whole
-            // light, so one texel of the receiver's own surface that the
-            // plane fit misses would black it out (PCSS only loses a tap).
-            float tlr = u_ortho != 0 ? 1.0 / (S * min(u_rect.z, u_rect.w)) : g_zR / (S * u_k);
-            if (!(z < ref_depth(t) - 2.0 * tlr) || z <= 0.0) continue;
-            vec2 lo = vec2(t) / S, hi = (vec2(t) + 1.0) / S;
-            ivec2 tx = t + ivec2(1, 0), ty = t + ivec2(0, 1);
-            float zx = inside(tx) ? tap_depth(tx) : z, zy = inside(ty) ? tap_depth(ty) : z;
-            // Only neighbours of the same surface (a depth step under four
-            // texels' length, i.e. tilted less than ~76 degrees) are
-            // joined: across a depth edge the gap is real.
-            float tl = u_ortho != 0 ? 1.0 / (S * min(u_rect.z, u_rect.w)) : z / (S * u_k);
-            bool bx = inside(tx) && zx < ref_depth(tx) && abs(zx - z) < 4.0 * tl;
-            bool by = inside(ty) && zy < ref_depth(ty) && abs(zy - z) < 4.0 * tl;
-            // Corners on the light of the patch (at its own depth).
-            vec2 a = on_light(r, map_xy(lo, z), z), b = on_light(r, map_xy(hi, z), z);
-            vec2 pmin = min(a, b), pmax = max(a, b);
-            // Gap filling: stretch to the neighbour's shared edge.
-            if (bx) {
-                float ex = on_light(r, map_xy(vec2(hi.x, lo.y), zx), zx).x;
-                pmin.x = min(pmin.x, ex); pmax.x = max(pmax.x, ex);
-            }
-            if (by) {
-                float ey = on_light(r, map_xy(vec2(lo.x, hi.y), zy), zy).y;
-                pmin.y = min(pmin.y, ey); pmax.y = max(pmax.y, ey);
-            }
-            vec2 c0 = max(pmin, -lh), c1 = min(pmax, lh);
-            vec2 e = max(c1 - c0, vec2(0.0));
-            occ += e.x * e.y;
+    int top = u_pyr.y;
+    bool hier = top >= 0;
+    g_clear = 2.0 * (u_ortho != 0 ? 1.0 / (S * min(u_rect.z, u_rect.w)) : g_zR / (S * u_k));
+    // The search area: from the tile's least depth, then each level's least
+    // depth under the area found so far.
+    float zmin = hier ? cell_mm(top, ivec2(0)).x : u_zrange.x;
+    vec2 rad = bp_reach(zmin);
+    ivec2 t0 = texel_of(g_uvR - rad), t1 = texel_of(g_uvR + rad);
+    for (int it = 0; hier && it < 4; it++) {
+        if (zmin >= bp_thr_range(t0, t1).y) return 1.0; // nothing there is nearer than the receiver
+        int side = max(t1.x - t0.x, t1.y - t0.y) + 1;
+        // Cells of at least half the area's side: at most 3 x 3 of them.
+        int l = clamp(int(ceil(log2(0.5 * float(side)))), 0, top);
+        ivec2 c0 = t0 >> l, c1 = t1 >> l;
+        float zl = 1e30;
+        for (int y = c0.y; y <= c1.y; y++)
+            for (int x = c0.x; x <= c1.x; x++) zl = min(zl, cell_mm(l, ivec2(x, y)).x);
+        bool tighter = zl > zmin;
+        zmin = max(zmin, zl);
+        if (!tighter) break;
+        rad = min(rad, bp_reach(zmin));
+        t0 = texel_of(g_uvR - rad);
+        t1 = texel_of(g_uvR + rad);
+        if (l == 0) break;
+    }
+    if (hier && zmin >= bp_thr_range(t0, t1).y) return 1.0;
+    // Off the map is lit.
+    t0 = max(t0, ivec2(0));
+    t1 = min(t1, ivec2(u_size - 1));
+    if (any(greaterThan(t0, t1))) return 1.0;
+    int side = max(t1.x - t0.x, t1.y - t0.y) + 1;
+    int lc = hier ? clamp(int(ceil(log2(float(side) / 8.0))), 0, top) : 0; // at most 9 x 9 cells
+    int cs = 1 << lc;
+    float occ = 0.0;
+    ivec2 c0 = t0 >> lc, c1 = t1 >> lc;
+    for (int cy = c0.y; cy <= c1.y; cy++)
+        for (int cx = c0.x; cx <= c1.x; cx++) {
+            ivec2 c = ivec2(cx, cy);
+            ivec2 a = max(c * cs, t0), b = min(c * cs + (cs - 1), t1);
+            vec2 mm = hier ? cell_mm(lc, c) : vec2(0.0, 1e30);
+            vec2 thr = bp_thr_range(a, b);
+            if (mm.x >= thr.y) continue; // no texel of the cell blocks
+            float tlc = u_ortho != 0 ? 1.0 / (S * min(u_rect.z, u_rect.w)) : mm.x / (S * u_k);
+            if (mm.y < thr.x && mm.x > 0.0 && mm.y - mm.x < 6.0 * tlc * float(cs) &&
+                bp_cover(r, a, b, mm.x, mm.y, lh) >= area_l * 0.9999)
+                return 0.0; // umbra
+            for (int y = a.y; y <= b.y; y++)
+                for (int x = a.x; x <= b.x; x++) {
+                    ivec2 t = ivec2(x, y);
+                    float z = tap_depth(t);
+                    if (bp_blocks(t, z)) occ += bp_patch(r, t, z, lh);
+                }
         }
     return 1.0 - min(1.0, occ / area_l);
 }
@@ -240,7 +340,7 @@ float visibility(ivec2 px, vec3 pc) {
         vec2 sc = uv_scale();
         vec2 search = min(light_reach(u_zrange.x, g_zR) * sc, vec2(max_uv));
         if (u_method == MR_SHADOW_METHOD_ID_BP) {
-            v = backprojection(g_lR, search);
+            v = backprojection(g_lR);
         } else {
             float zb = blocker_depth(search);
             if (zb < 0.0) {
@@ -257,6 +357,7 @@ float visibility(ivec2 px, vec3 pc) {
 void use_cascade(int k) {
     u_rect = u_cascades > 0 ? u_rects[k] : u_rect0;
     g_tile = ivec2(k & 1, k >> 1) * u_size;
+    g_ptile = ivec2(k & 1, k >> 1) * u_pyr.x;
 }
 
 void main() {

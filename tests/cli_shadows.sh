@@ -30,6 +30,10 @@ if need_device $? "$tmp/pcss.err" "render --shadows pcss"; then
   cmp -s "$tmp/lit.png" "$tmp/pcss.png" && ok || bad "the config's lights and pcss differ from the default sun's"
   "$mr" render --scene "$tmp/lit.json" --view "$v" --out "$tmp/lit_off.png" --size 160x120 --shadows off --verbose \
     2>"$tmp/lit_off.err" && grep -q "passes: gbuffer shade;" "$tmp/lit_off.err" && ok || bad "--shadows off over the config"
+  # Backprojection: its depth pyramid runs after the map (and for bp only).
+  "$mr" render --scene "$s" --view "$v" --out "$tmp/bp.png" --size 160x120 --shadows bp --verbose 2>"$tmp/bp.err" \
+    && grep -q "passes: gbuffer shadow_map shadow_pyramid shadow shade;" "$tmp/bp.err" && ok \
+    || bad "bp pass list: $(cat "$tmp/bp.err")"
   # Replay with shadows: same frames as without, but shadowed.
   "$mr" replay "$src/recordings/demo" --scene "$s" --out "$tmp/replay" --to 0 --shadows pcf 2>"$tmp/replay.err" \
     && [ -s "$tmp/replay/overlay_000000.png" ] && ok || bad "replay --shadows pcf: $(cat "$tmp/replay.err")"
@@ -39,6 +43,8 @@ fi
 expect_fail method "$tmp/bad1.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/bad1.png" --shadows soft
 expect_fail mapsize "$tmp/bad2.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/bad2.png" --shadows pcf --shadows-map-size 10
 expect_fail taps "$tmp/bad3.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/bad3.png" --shadows pcss --shadows-taps 0
+expect_fail lightneg "$tmp/bad4.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/bad4.png" --shadows pcss --shadows-light-scale -1
+expect_fail lightnan "$tmp/bad5.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/bad5.png" --shadows pcss --shadows-light-scale nan
 i=0
 for cfg in '{"demo": "planned", "lights": [{"direction": [0,1,0], "kind": "rect", "position": [0,4,0], "size": [-1, 1]}]}' \
            '{"demo": "planned", "lights": [{"direction": [0,1,0], "kind": "sphere", "position": [0,4,0], "size": "NaN"}]}' \

@@ -372,6 +372,7 @@ static void test_tables(void) {
         N(mr_view_settings, "hide_hidden_layer", hide_hidden, 0, 1),
         E(mr_view_settings, "ao", ao, "none scheer crytek filion hbao alchemy gtao bitmask scheer-gt scheer-bm"),
         E(mr_view_settings, "ghost", ghost, "off alpha g0 adaptive"),
+        E(mr_view_settings, "shadows", shadows, "off hard pcf pcss bp"),
     };
     const expect ex_dt[] = {
         N(mr_detector_params, "decimate", decimate, 1, 16),
@@ -515,6 +516,11 @@ static void test_tables(void) {
     CHECK_MSG(mr_opt_find(mr_view_settings_opts, "ao")->names == mr_ao_method_names &&
                   mr_opt_find(mr_view_settings_opts, "ghost")->names == mr_ghost_mode_names,
               "the view's settings do not share the renderer's names");
+    /* The view's shadow methods: the renderer's, in its order, less the ground truth. */
+    const mr_opt *vs_sh = mr_opt_find(mr_view_settings_opts, "shadows");
+    bool same_names = vs_sh && mr_opt_enum_count(vs_sh) == MR_SHADOW_BP + 1;
+    for (int i = 0; same_names && i <= MR_SHADOW_BP; i++) same_names = strcmp(vs_sh->names[i], mr_shadow_method_names[i]) == 0;
+    CHECK_MSG(same_names, "the view's shadow methods are not the renderer's off..bp");
 }
 
 /* The facility itself, on a small struct of its own. */

@@ -368,13 +368,23 @@ static void test_cycling(rig *r) {
         CHECK_MSG(mr_viewer_settings(r->v)->ghost == order[i], "ghost press %d gave %s, want %s", i + 1,
                   mr_view_ghost_name(mr_viewer_settings(r->v)->ghost), mr_view_ghost_name(order[i]));
     }
+    /* Shadows: C cycles off, hard, pcf, pcss, bp and back to off (never
+     * the ground truth), each press asking for a render. */
+    static const mr_shadow_method sorder[] = {MR_SHADOW_HARD, MR_SHADOW_PCF, MR_SHADOW_PCSS, MR_SHADOW_BP,
+                                              MR_SHADOW_OFF, MR_SHADOW_HARD};
+    for (int i = 0; i < 6; i++) {
+        key(r, 'c');
+        CHECK_MSG(mr_viewer_settings(r->v)->shadows == sorder[i], "shadows press %d gave %s, want %s", i + 1,
+                  mr_shadow_method_names[mr_viewer_settings(r->v)->shadows], mr_shadow_method_names[sorder[i]]);
+        CHECK_MSG(count(r, MR_VA_RENDER, NULL) == 1, "a shadow method change asked for no render");
+    }
 }
 
 /* ---------------------------------------------------------- settings */
 
 static bool same(const mr_view_settings *a, const mr_view_settings *b) {
     return a->alpha == b->alpha && a->show_video == b->show_video && a->hide_hidden == b->hide_hidden &&
-           a->rate_i == b->rate_i && a->ao == b->ao && a->ghost == b->ghost;
+           a->rate_i == b->rate_i && a->ao == b->ao && a->ghost == b->ghost && a->shadows == b->shadows;
 }
 
 static void test_settings(void) {
@@ -385,9 +395,9 @@ static void test_settings(void) {
     mr_view_settings_load(path, &s, warn, sizeof warn);
     CHECK_MSG(same(&s, &d) && !warn[0], "a missing settings file: not the defaults, or a warning '%s'", warn);
     CHECK(d.alpha == 0.5f && d.show_video && !d.hide_hidden && d.rate_i == 2 && d.ao == MR_AO_NONE &&
-          d.ghost == MR_GHOST_OFF);
+          d.ghost == MR_GHOST_OFF && d.shadows == MR_SHADOW_OFF);
     /* Round trip of every field, in a folder that does not exist yet. */
-    mr_view_settings w = {0.25f, false, true, 4, MR_AO_HBAO, MR_GHOST_G0};
+    mr_view_settings w = {0.25f, false, true, 4, MR_AO_HBAO, MR_GHOST_G0, MR_SHADOW_PCSS};
     mr_error err = {0};
     g_rn.renames = 0;
     CHECK_MSG(mr_view_settings_save(path, &w, &err), "save: %s", err.msg);
@@ -426,6 +436,8 @@ static void test_settings(void) {
         {"{\"alpha\": 0.25, \"show_video\": 1}", "show_video a number", true},
         {"{\"alpha\": 0.25, \"ao\": \"magic\"}", "an unknown AO method", true},
         {"{\"alpha\": 0.25, \"ghost\": 3}", "ghost a number", true},
+        {"{\"alpha\": 0.25, \"shadows\": \"groundtruth\"}", "shadows the ground truth (not offered)", true},
+        {"{\"alpha\": 0.25, \"shadows\": \"soft\"}", "an unknown shadow method", true},
         {"{\"alpha\": 0.25, \"rate\": 3}", "a rate not on the list", true},
         {"{\"alpha\": 0.25, \"hide_hidden_layer\": null}", "hide_hidden_layer null", true},
     };
@@ -435,7 +447,7 @@ static void test_settings(void) {
         CHECK_MSG(warn[0], "settings with %s gave no warning", bad[i].what);
         CHECK_MSG(s.alpha == (bad[i].keeps_alpha ? 0.25f : d.alpha), "settings with %s: alpha %g", bad[i].what, s.alpha);
         CHECK_MSG(s.show_video == d.show_video && s.hide_hidden == d.hide_hidden && s.rate_i == d.rate_i &&
-                      s.ao == d.ao && s.ghost == d.ghost,
+                      s.ao == d.ao && s.ghost == d.ghost && s.shadows == d.shadows,
                   "settings with %s: a damaged field did not fall back to its default", bad[i].what);
     }
     /* The controller reads the file at start and saves a moment after a

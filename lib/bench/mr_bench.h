@@ -44,6 +44,7 @@ typedef struct mr_bench_shadows_params {
     int first, count;    /* suite cases first .. first + count - 1; 0, 0 = all 13 */
     int views;           /* 1 or 2 (default) views per case */
     FILE *out;           /* progress and the table, or NULL */
+    int gt_samples_max;  /* caps the GPU ground truth's light samples (tests: time); 0 = no cap */
 } mr_bench_shadows_params;
 #define MR_BENCH_SHADOWS_DEFAULTS .out_dir = "bench-out", .width = 320, .height = 240, .frames = 3, .rays = 256
 bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err);

@@ -1,18 +1,20 @@
 /* mrcheck bench shadows (mr_bench_shadows): soft shadows, error against run
  * time, on the shadow suite (Hecher's categories, mr_shadow_suite_build).
  *
- * Every method runs over its settings (hard: map size; PCF and PCSS: taps;
- * backprojection: map size; the GPU ground truth: light samples), each row
+ * Every method runs over its settings (hard: map size; PCF and PCSS: taps
+ * and map size; backprojection: map size; the GPU ground truth: light
+ * samples; every method: the light's size at half and double), each row
  * with the GPU ms of the shadow passes (timer queries, median of N frames,
  * maps redrawn every frame) and the error of the visibility buffer against
  * Embree's ground truth (mr_eval_shadow_groundtruth) over the shadow region
  * S: the geometry pixels where the reference or the method is below 0.99.
  * RMSE over S, the thesis's sqrt(D) / |S| (D the sum of squared
- * differences over S) and SSIM over S. PCF's kernel radius, its one free
- * parameter, is tuned on the tuning cases (one per group: simple,
- * furniture, fence, plant; view 0, 32 taps) for the lowest mean RMSE and
- * reported with it everywhere; the tuning cases are marked in the CSV and
- * left out of the plot and the summary. Measurements only. */
+ * differences over S) and SSIM over S. Tuned on the tuning cases (one per
+ * group: simple, furniture, fence, plant), which run first: PCF's kernel
+ * radius (view 0, 32 taps) and then each method's reported setting (the
+ * lowest mean RMSE there at the case's light size); the other cases are
+ * reported with those. The tuning cases are marked in the CSV and the
+ * table and left out of the plot and the summary. Measurements only. */
 #include "bench_internal.h"
 
 #include <math.h>
@@ -21,20 +23,47 @@
 
 typedef struct setting {
     mr_shadow_method method;
-    const char *key;   /* what varies */
-    int value;
-    bool is_default;   /* the montage's and the table's column */
+    const char *key;   /* what varies: map, taps, samples or light */
+    int map, taps, samples;
+    float light;       /* light size factor (1: the case's light) */
+    bool is_default;   /* the tuning's fallback (no tuning case run) */
 } setting;
 
+/* Per method: its own knob (map size, taps, light samples), the map size
+ * for the filters, and the light's size at half and double (against a
+ * reference with that light). */
+#define SET(m, k, map, taps, smp, light, def) {MR_SHADOW_##m, k, map, taps, smp, light, def}
 static const setting k_settings[] = {
-    {MR_SHADOW_HARD, "map", 512, false},   {MR_SHADOW_HARD, "map", 1024, true},  {MR_SHADOW_HARD, "map", 2048, false},
-    {MR_SHADOW_PCF, "taps", 8, false},     {MR_SHADOW_PCF, "taps", 16, false},   {MR_SHADOW_PCF, "taps", 32, true},
-    {MR_SHADOW_PCF, "taps", 64, false},    {MR_SHADOW_PCSS, "taps", 8, false},   {MR_SHADOW_PCSS, "taps", 16, false},
-    {MR_SHADOW_PCSS, "taps", 32, true},    {MR_SHADOW_PCSS, "taps", 64, false},  {MR_SHADOW_BP, "map", 256, false},
-    {MR_SHADOW_BP, "map", 512, true},      {MR_SHADOW_BP, "map", 1024, false},   {MR_SHADOW_GROUNDTRUTH, "samples", 16, false},
-    {MR_SHADOW_GROUNDTRUTH, "samples", 64, true}, {MR_SHADOW_GROUNDTRUTH, "samples", 256, false},
+    SET(HARD, "map", 512, 0, 0, 1, false),         SET(HARD, "map", 1024, 0, 0, 1, true),
+    SET(HARD, "map", 2048, 0, 0, 1, false),        SET(HARD, "light", 1024, 0, 0, 0.5f, false),
+    SET(HARD, "light", 1024, 0, 0, 2, false),
+    SET(PCF, "taps", 1024, 8, 0, 1, false),        SET(PCF, "taps", 1024, 16, 0, 1, false),
+    SET(PCF, "taps", 1024, 32, 0, 1, true),        SET(PCF, "taps", 1024, 64, 0, 1, false),
+    SET(PCF, "map", 512, 32, 0, 1, false),         SET(PCF, "map", 2048, 32, 0, 1, false),
+    SET(PCF, "light", 1024, 32, 0, 0.5f, false),   SET(PCF, "light", 1024, 32, 0, 2, false),
+    SET(PCSS, "taps", 1024, 8, 0, 1, false),       SET(PCSS, "taps", 1024, 16, 0, 1, false),
+    SET(PCSS, "taps", 1024, 32, 0, 1, true),       SET(PCSS, "taps", 1024, 64, 0, 1, false),
+    SET(PCSS, "map", 512, 32, 0, 1, false),        SET(PCSS, "map", 2048, 32, 0, 1, false),
+    SET(PCSS, "light", 1024, 32, 0, 0.5f, false),  SET(PCSS, "light", 1024, 32, 0, 2, false),
+    SET(BP, "map", 256, 0, 0, 1, false),           SET(BP, "map", 512, 0, 0, 1, true),
+    SET(BP, "map", 1024, 0, 0, 1, false),          SET(BP, "light", 512, 0, 0, 0.5f, false),
+    SET(BP, "light", 512, 0, 0, 2, false),
+    SET(GROUNDTRUTH, "samples", 1024, 0, 16, 1, false), SET(GROUNDTRUTH, "samples", 1024, 0, 64, 1, true),
+    SET(GROUNDTRUTH, "samples", 1024, 0, 256, 1, false), SET(GROUNDTRUTH, "light", 1024, 0, 64, 0.5f, false),
+    SET(GROUNDTRUTH, "light", 1024, 0, 64, 2, false),
 };
+#undef SET
 #define NS (int)(sizeof k_settings / sizeof k_settings[0])
+/* The reference's light sizes: k_light_scales[i] for the rows with that light. */
+static const float k_light_scales[3] = {1, 0.5f, 2};
+static int light_index(float l) { return l == 1 ? 0 : l < 1 ? 1 : 2; }
+static double setting_value(const setting *st) {
+    if (strcmp(st->key, "map") == 0) return st->map;
+    if (strcmp(st->key, "taps") == 0) return st->taps;
+    if (strcmp(st->key, "samples") == 0) return st->samples;
+    return st->light;
+}
+/* The tuning categories: one per group (simple, furniture, fence, plant). */
 static const bool k_tuning_case[MR_SHADOW_SUITE_COUNT] = {[0] = true, [4] = true, [8] = true, [10] = true};
 static const float k_pcf_radii[] = {1, 2, 4, 8};
 
@@ -50,9 +79,17 @@ static void apply(const setting *st, float pcf_radius, mr_shadow_params *sp) {
     sp->pcf_radius = pcf_radius;
     sp->want_shadow = true;
     sp->no_reuse = true;
-    if (strcmp(st->key, "map") == 0) sp->map_size = st->value;
-    if (strcmp(st->key, "taps") == 0) sp->taps = st->value;
-    if (strcmp(st->key, "samples") == 0) sp->gt_samples = st->value;
+    sp->map_size = st->map;
+    if (st->taps) sp->taps = st->taps;
+    if (st->samples) sp->gt_samples = st->samples;
+    sp->light_scale = st->light;
+}
+
+/* The setting as run: the ground truth's samples under the cap. */
+static setting capped(const setting *st, int gt_max) {
+    setting c = *st;
+    if (gt_max > 0 && c.samples > gt_max) c.samples = gt_max;
+    return c;
 }
 
 /* Renders frames times (the ground truth once: it is its own median) and
@@ -107,9 +144,10 @@ static bool run_one(const mr_bench_shadows_params *p, const mr_view *view, const
     return ok;
 }
 
-/* The Embree reference of one view (and the depth the region needs). */
-static bool reference(const mr_bench_shadows_params *p, const mr_scene *s, const mr_view *view, mr_image *ref,
-                      mr_image *depth, mr_error *err) {
+/* The Embree reference of one view with the light's size times
+ * light_scale (and the depth the region needs). */
+static bool reference(const mr_bench_shadows_params *p, const mr_scene *s, const mr_view *view, float light_scale,
+                      mr_image *ref, mr_image *depth, mr_error *err) {
     mr_frame_params fp = MR_FRAME_DEFAULTS;
     fp.width = p->width;
     fp.height = p->height;
@@ -122,6 +160,7 @@ static bool reference(const mr_bench_shadows_params *p, const mr_scene *s, const
     if (g && !ok) mr_fail(err, MR_ERR_INVALID, "the case has no casting light");
     mr_shadow_gt_params gp = MR_SHADOW_GT_DEFAULTS;
     gp.rays = p->rays > 0 ? p->rays : 256;
+    gp.light_scale = light_scale;
     mr_view v = *view;
     v.camera = mr_camera_resized(&view->camera, res.depth.width, res.depth.height);
     ok = ok && mr_eval_shadow_groundtruth(g, &v, &res.depth, &res.normal, &L, &gp, ref, err);
@@ -151,17 +190,27 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
                         "(method - reference)^2; ssim_S = mean SSIM over S.\n"
                         "gpu_ms = median GPU time of the shadow passes (maps redrawn every frame); the ground "
                         "truth's is one frame.\n"
-                        "tuning = 1: a case PCF's kernel radius was tuned on (left out of the plot and summary).");
+                        "setting = what varies, value = its value: map (shadow-map side; filters at 32 taps), taps "
+                        "(1024 map), samples (GPU ground truth's light samples, 1024 map), light (the light's size "
+                        "times value, against a reference with that light; hard, pcf, pcss at a 1024 map and 32 "
+                        "taps, bp at 512, the GPU ground truth at 64 samples).\n"
+                        "tuning = 1: a tuning category (simple_constant, furniture_constant, fence_constant, "
+                        "plant_constant): PCF's kernel radius and each method's reported setting (the lowest mean "
+                        "RMSE there, light size 1) were chosen on these; they are left out of the plot and the "
+                        "summary.");
     mr_csv_header(csv, "case,varying,overlap,view,tuning,method,setting,value,pcf_radius,gpu_ms,S_pixels,rmse_S,"
                        "sqrtD_over_S,ssim_S");
     /* Per setting: the values over reported (case, view) pairs. */
     int maxr = MR_SHADOW_SUITE_COUNT * 2;
     double *agg_ms = calloc((size_t)NS * maxr, sizeof(double)), *agg_rmse = calloc((size_t)NS * maxr, sizeof(double));
     int agg_n[NS] = {0};
-    /* Per case: the default settings' ms and RMSE (markdown table). */
-    double tab_ms[MR_SHADOW_SUITE_COUNT][MR_SHADOW_METHOD_COUNT], tab_rmse[MR_SHADOW_SUITE_COUNT][MR_SHADOW_METHOD_COUNT];
+    /* Per case and setting, view 0 (the markdown table); per setting, the
+     * RMSE summed over the tuning cases' views. */
+    static double tab_ms[MR_SHADOW_SUITE_COUNT][NS], tab_rmse[MR_SHADOW_SUITE_COUNT][NS];
     for (int i = 0; i < MR_SHADOW_SUITE_COUNT; i++)
-        for (int m = 0; m < MR_SHADOW_METHOD_COUNT; m++) tab_ms[i][m] = tab_rmse[i][m] = NAN;
+        for (int m = 0; m < NS; m++) tab_ms[i][m] = tab_rmse[i][m] = NAN;
+    double tune_sum[NS] = {0};
+    int tune_n[NS] = {0};
     bool ok = csv && agg_ms && agg_rmse;
     if (!agg_ms || !agg_rmse) mr_fail(err, MR_ERR_NOMEM, "out of memory");
 
@@ -176,9 +225,9 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
         mr_shadow_suite_case sc;
         mr_image ref = {0}, depth = {0};
         ok = mr_shadow_suite_build(ci, &sc, err) && mr_renderer_set_scene(p.gfx.renderer, sc.scene, err) &&
-             reference(&p, sc.scene, &sc.views[0], &ref, &depth, err);
+             reference(&p, sc.scene, &sc.views[0], 1.0f, &ref, &depth, err);
         for (int k = 0; ok && k < nr; k++) {
-            setting st = {MR_SHADOW_PCF, "taps", 32, true};
+            setting st = {MR_SHADOW_PCF, "taps", 1024, 32, 0, 1, true};
             mr_shadow_params sp;
             apply(&st, k_pcf_radii[k], &sp);
             measure m;
@@ -195,22 +244,56 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
         if (sum_r[k] < best) best = sum_r[k], pcf_radius = k_pcf_radii[k];
     BENCH_PRINT(p.out, "bench shadows: PCF radius %.0f texels (tuned on %d cases)\n", pcf_radius, n_r);
 
-    /* 2. Every case, view, method and setting. */
-    for (int ci = first; ok && ci < first + count; ci++) {
+    /* 2. Every case, view, method and setting; the tuning cases first, so
+     * that each method's setting is chosen on them before the others run
+     * (their montages show the chosen settings). */
+    int order[MR_SHADOW_SUITE_COUNT], no = 0;
+    for (int pass = 0; pass < 2; pass++)
+        for (int ci = first; ci < first + count; ci++)
+            if (k_tuning_case[ci] == (pass == 0)) order[no++] = ci;
+    int chosen[MR_SHADOW_METHOD_COUNT];
+    bool tuned = false;
+    for (int m = 0; m < MR_SHADOW_METHOD_COUNT; m++) chosen[m] = -1;
+    for (int si = 0; si < NS; si++)
+        if (k_settings[si].is_default) chosen[k_settings[si].method] = si;
+    for (int oi = 0; ok && oi < no; oi++) {
+        int ci = order[oi];
+        if (!k_tuning_case[ci] && !tuned) {
+            /* Each method's setting with the lowest mean RMSE on the tuning
+             * cases, light size 1 (the other lights are other problems). */
+            for (int m = MR_SHADOW_HARD; m < MR_SHADOW_METHOD_COUNT; m++) {
+                double bm = INFINITY;
+                for (int si = 0; si < NS; si++)
+                    if (k_settings[si].method == (mr_shadow_method)m && k_settings[si].light == 1 && tune_n[si] > 0 &&
+                        tune_sum[si] / tune_n[si] < bm)
+                        bm = tune_sum[si] / tune_n[si], chosen[m] = si;
+            }
+            tuned = true;
+        }
         mr_shadow_suite_case sc;
         ok = mr_shadow_suite_build(ci, &sc, err) && mr_renderer_set_scene(p.gfx.renderer, sc.scene, err);
         for (int vi = 0; ok && vi < nviews; vi++) {
-            mr_image ref = {0}, depth = {0};
+            mr_image ref[3], depth = {0};
+            bool have_ref[3] = {false, false, false};
+            memset(ref, 0, sizeof ref);
             mr_image keep[MR_SHADOW_METHOD_COUNT];
             memset(keep, 0, sizeof keep);
-            ok = reference(&p, sc.scene, &sc.views[vi], &ref, &depth, err);
             for (int si = 0; ok && si < NS; si++) {
-                const setting *st = &k_settings[si];
+                const setting cst = capped(&k_settings[si], p.gt_samples_max), *st = &cst;
+                int li = light_index(st->light);
+                if (!have_ref[li]) {
+                    mr_image d = {0};
+                    ok = reference(&p, sc.scene, &sc.views[vi], k_light_scales[li], &ref[li], &d, err);
+                    if (!ok) break;
+                    if (!depth.data) depth = d;
+                    else mr_image_free(&d);
+                    have_ref[li] = true;
+                }
                 mr_shadow_params sp;
                 apply(st, pcf_radius, &sp);
                 measure m;
-                bool want = vi == 0 && st->is_default;
-                ok = run_one(&p, &sc.views[vi], &sp, &ref, &depth, &m, want ? &keep[st->method] : NULL, err);
+                bool want = vi == 0 && si == chosen[st->method];
+                ok = run_one(&p, &sc.views[vi], &sp, &ref[li], &depth, &m, want ? &keep[st->method] : NULL, err);
                 if (!ok) break;
                 mr_csv_text(csv, sc.name);
                 mr_csv_int(csv, sc.varying);
@@ -219,7 +302,7 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
                 mr_csv_int(csv, k_tuning_case[ci]);
                 mr_csv_text(csv, mr_shadow_method_names[st->method]);
                 mr_csv_text(csv, st->key);
-                mr_csv_int(csv, st->value);
+                mr_csv_num(csv, "%g", setting_value(st));
                 mr_csv_num(csv, "%.0f", pcf_radius);
                 mr_csv_num(csv, "%.3f", m.ms);
                 mr_csv_int(csv, m.s_count);
@@ -231,22 +314,25 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
                     agg_ms[si * maxr + agg_n[si]] = m.ms;
                     agg_rmse[si * maxr + agg_n[si]] = m.rmse;
                     agg_n[si]++;
+                } else {
+                    tune_sum[si] += m.rmse;
+                    tune_n[si]++;
                 }
-                if (st->is_default && vi == 0) {
-                    tab_ms[ci][st->method] = m.ms;
-                    tab_rmse[ci][st->method] = m.rmse;
+                if (vi == 0) {
+                    tab_ms[ci][si] = m.ms;
+                    tab_rmse[ci][si] = m.rmse;
                 }
             }
             if (ok && vi == 0) {
                 /* reference, hard, pcf, pcss, bp, ground truth (GPU) */
-                const mr_image *tiles[6] = {&ref, &keep[1], &keep[2], &keep[3], &keep[4], &keep[5]};
+                const mr_image *tiles[6] = {&ref[0], &keep[1], &keep[2], &keep[3], &keep[4], &keep[5]};
                 char path[4096], name[128];
                 snprintf(name, sizeof name, "bench_shadows_%s.png", sc.name);
                 mr_path_join(p.out_dir, name, path, sizeof path);
                 ok = mr_montage_png(path, tiles, 6, 3, p.width, p.height, err);
             }
             for (int k = 0; k < MR_SHADOW_METHOD_COUNT; k++) mr_image_free(&keep[k]);
-            mr_image_free(&ref);
+            for (int k = 0; k < 3; k++) mr_image_free(&ref[k]);
             mr_image_free(&depth);
         }
         if (ok) BENCH_PRINT(p.out, "bench shadows: %s done\n", sc.name);
@@ -258,7 +344,8 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
         mr_path_join(p.out_dir, "bench_shadows.csv", path, sizeof path);
         ok = mr_csv_save(csv, path, err);
     }
-    /* The plot: median RMSE over S against median ms, one curve per method. */
+    /* The plot: median RMSE over S against median ms over the reported
+     * cases, one curve per method through its settings (light size 1). */
     double xs[MR_SHADOW_METHOD_COUNT][8], ys[MR_SHADOW_METHOD_COUNT][8];
     mr_plot_series ser[MR_SHADOW_METHOD_COUNT];
     memset(ser, 0, sizeof ser);
@@ -269,15 +356,15 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
         med_rmse[si] = agg_n[si] ? mr_median(agg_rmse + si * maxr, agg_n[si]) : NAN;
     }
     for (int m = MR_SHADOW_HARD; m < MR_SHADOW_METHOD_COUNT; m++) {
-        mr_plot_series *s = &ser[nser++];
-        s->name = mr_shadow_method_names[m];
-        s->x = xs[m];
-        s->y = ys[m];
+        mr_plot_series *sr = &ser[nser++];
+        sr->name = mr_shadow_method_names[m];
+        sr->x = xs[m];
+        sr->y = ys[m];
         for (int si = 0; si < NS; si++)
-            if (k_settings[si].method == (mr_shadow_method)m && s->count < 8) {
-                xs[m][s->count] = med_ms[si];
-                ys[m][s->count] = med_rmse[si];
-                s->count++;
+            if (k_settings[si].method == (mr_shadow_method)m && k_settings[si].light == 1 && sr->count < 8) {
+                xs[m][sr->count] = med_ms[si];
+                ys[m][sr->count] = med_rmse[si];
+                sr->count++;
             }
     }
     if (ok) {
@@ -287,42 +374,71 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
         mr_path_join(p.out_dir, "bench_shadows.svg", path, sizeof path);
         ok = mr_plot_write(path, &pp, ser, nser, err);
     }
-    /* The markdown table: default settings, per case. */
+    /* The markdown table: the chosen settings, per case. */
     if (ok) {
-        size_t cap = 16384, len = 0;
+        size_t cap = 32768, len = 0;
         char *md = malloc(cap);
         ok = md != NULL;
         if (!ok) mr_fail(err, MR_ERR_NOMEM, "out of memory");
 #define MD(...) \
     do { if (md && len < cap) len += (size_t)snprintf(md + len, cap - len, __VA_ARGS__); } while (0)
+        char set_desc[512] = "";
+        size_t sl = 0;
+        for (int m = MR_SHADOW_HARD; m < MR_SHADOW_METHOD_COUNT && sl < sizeof set_desc; m++) {
+            const setting *st = &k_settings[chosen[m]];
+            sl += (size_t)snprintf(set_desc + sl, sizeof set_desc - sl, "%s%s: %s %g", m > MR_SHADOW_HARD ? ", " : "",
+                                   mr_shadow_method_names[m], st->key, setting_value(st));
+        }
         MD("# bench shadows\n\nGPU ms of the shadow passes / RMSE over the shadow region S against Embree's ground truth "
-           "(%d rays), view 0 of each case, %dx%d, default settings (hard: 1024 map, PCF and PCSS: 32 taps, PCF radius "
-           "%.0f texels tuned on the cases marked *, backprojection: 512 map, GPU ground truth: 64 samples). Full grid "
-           "in bench_shadows.csv, error against time in bench_shadows.svg.\n\n",
-           p.rays > 0 ? p.rays : 256, p.width, p.height, pcf_radius);
+           "(%d rays), view 0 of each case, %dx%d. Tuning categories (marked *): simple_constant, furniture_constant, "
+           "fence_constant, plant_constant; %s PCF's kernel radius (%.0f texels) and each method's setting "
+           "(the lowest mean RMSE at the case's light size: %s); the other categories are reported with those. Full "
+           "grid (map size, taps, light samples, light size 0.5 and 2) in bench_shadows.csv, error against time in "
+           "bench_shadows.svg, one montage per case (reference, hard, pcf, pcss, bp, GPU ground truth).\n\n",
+           p.rays > 0 ? p.rays : 256, p.width, p.height,
+           n_r ? "on them were chosen" : "none of them ran here, so the defaults stand for",
+           pcf_radius, set_desc);
         MD("| case | hard | pcf | pcss | bp | groundtruth (GPU) |\n|---|---|---|---|---|---|\n");
-        for (int ci = first; ci < first + count; ci++) {
+        for (int oi = 0; oi < no; oi++) {
+            int ci = order[oi];
             MD("| %s%s |", mr_shadow_suite_name(ci), k_tuning_case[ci] ? " *" : "");
-            for (int m = MR_SHADOW_HARD; m < MR_SHADOW_METHOD_COUNT; m++) MD(" %.2f ms / %.4f |", tab_ms[ci][m], tab_rmse[ci][m]);
+            for (int m = MR_SHADOW_HARD; m < MR_SHADOW_METHOD_COUNT; m++)
+                MD(" %.2f ms / %.4f |", tab_ms[ci][chosen[m]], tab_rmse[ci][chosen[m]]);
             MD("\n");
         }
-        MD("\nMedian over the reported cases and views, default settings:\n\n| method | GPU ms | RMSE over S |\n|---|---|---|\n");
-        int order[MR_SHADOW_METHOD_COUNT], no = 0;
-        for (int si = 0; si < NS; si++)
-            if (k_settings[si].is_default) {
-                MD("| %s | %.2f | %.4f |\n", mr_shadow_method_names[k_settings[si].method], med_ms[si], med_rmse[si]);
-                order[no++] = si;
+        MD("\nMedian over the reported categories and views, chosen settings:\n\n| method | setting | GPU ms | RMSE over S |"
+           "\n|---|---|---|---|\n");
+        int rank[MR_SHADOW_METHOD_COUNT], nk = 0;
+        for (int m = MR_SHADOW_HARD; m < MR_SHADOW_METHOD_COUNT; m++) {
+            int si = chosen[m];
+            MD("| %s | %s %g | %.2f | %.4f |\n", mr_shadow_method_names[m], k_settings[si].key,
+               setting_value(&k_settings[si]), med_ms[si], med_rmse[si]);
+            rank[nk++] = si;
+        }
+        MD("\nLight size (median RMSE over S over the reported categories at the default settings: hard, pcf and pcss "
+           "a 1024 map and 32 taps, bp a 512 map, the GPU ground truth 64 samples; each against a reference with that "
+           "light):\n\n"
+           "| method | light x0.5 | light x1 | light x2 |\n|---|---|---|---|\n");
+        for (int m = MR_SHADOW_HARD; m < MR_SHADOW_METHOD_COUNT; m++) {
+            double v[3] = {NAN, NAN, NAN};
+            for (int si = 0; si < NS; si++) {
+                const setting *st = &k_settings[si];
+                if (st->method != (mr_shadow_method)m) continue;
+                if (strcmp(st->key, "light") == 0) v[light_index(st->light)] = med_rmse[si];
+                else if (st->is_default) v[0] = med_rmse[si];
             }
+            MD("| %s | %.4f | %.4f | %.4f |\n", mr_shadow_method_names[m], v[1], v[0], v[2]);
+        }
         /* The ranking by error (worst first), next to Hecher's PCF < PCSS < BP < GT. */
-        for (int a = 0; a < no; a++)
-            for (int b = a + 1; b < no; b++)
-                if (med_rmse[order[b]] > med_rmse[order[a]]) {
-                    int t = order[a];
-                    order[a] = order[b];
-                    order[b] = t;
+        for (int a = 0; a < nk; a++)
+            for (int b = a + 1; b < nk; b++)
+                if (med_rmse[rank[b]] > med_rmse[rank[a]]) {
+                    int t = rank[a];
+                    rank[a] = rank[b];
+                    rank[b] = t;
                 }
         MD("\nRanking by RMSE (worst first): ");
-        for (int a = 0; a < no; a++) MD("%s%s", a ? " < " : "", mr_shadow_method_names[k_settings[order[a]].method]);
+        for (int a = 0; a < nk; a++) MD("%s%s", a ? " < " : "", mr_shadow_method_names[k_settings[rank[a]].method]);
         MD("; Hecher's study: PCF < PCSS < BP < GT.\n");
 #undef MD
         if (md) {

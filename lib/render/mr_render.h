@@ -369,6 +369,9 @@ typedef struct mr_shadow_params {
      * (1 below 16, one more per factor 16, at most 4). Rect and sphere
      * lights always use one map. */
     int cascades;
+    /* Backprojection without its depth pyramid: every texel of the square
+     * the light reaches from the nearest caster (tests compare the two). */
+    bool bp_no_pyramid;
 } mr_shadow_params;
 #define MR_SHADOW_MAX_CASCADES 4
 #define MR_SHADOW_DEFAULT_MAP_SIZE 1024

@@ -7,6 +7,11 @@
  *   (unlisted)   the same camera, light, scene and map settings as the last
  *                map: hands that map over (a frozen camera with a static
  *                light draws no map)
+ *   shadow_pyramid  needed: backprojection, and the map is new (or its
+ *                pyramid was not built); reads shadow.map, writes
+ *                shadow.pyramid: the min / max depth mip pyramid that bounds
+ *                the backprojection's search (Guennebaud et al. 2006)
+ *   (unlisted)   backprojection over a kept map: hands its pyramid over
  *   shadow       needed: any method but off and a casting light; reads
  *                depth (+ shadow.map), writes shadow.visibility; the ground
  *                truth draws its own maps here, one per light sample, and
@@ -33,6 +38,9 @@ _Static_assert(MR_SHADOW_METHOD_ID_HARD == MR_SHADOW_HARD && MR_SHADOW_METHOD_ID
 /* The blocker search and the filters reach at most this far (texels): the
  * cost per pixel stays bounded for huge lights; wider penumbrae saturate. */
 #define MAX_SEARCH_TEXELS 48.0
+/* Backprojection's search is bounded by the depth pyramid instead; this cap
+ * only keeps a huge light's cost finite. */
+#define BP_MAX_SEARCH_TEXELS 128.0
 
 _Static_assert(MR_SHADOW_CASCADES_MAX == MR_SHADOW_MAX_CASCADES, "shadow cascades");
 /* Cascades: the practical split scheme's blend of the logarithmic and the
@@ -103,6 +111,10 @@ struct mr_shadow_state {
     float kernel[2 * MR_SHADOW_MAX_TAPS];
     int kernel_taps;
     GLuint catcher_flags;  /* R8UI, node i at (i % ROW, i / ROW): 1 = shadow catcher */
+    GLuint prog_minmax;    /* the depth pyramid (backprojection) */
+    GLuint pyramid;        /* RG32F min / max, a P x P pyramid per map tile */
+    int pyr_side, pyr_levels, pyr_w, pyr_h;
+    bool pyr_valid;        /* built from the map now held */
     const mr_scene *catcher_scene;
 };
 
@@ -542,6 +554,8 @@ void mr_pass_shadow_free(mr_renderer *r) {
     mr_gl_target_free(&s->map);
     mr_gl_target_free(&s->vis);
     glDeleteTextures(1, &s->catcher_flags);
+    glDeleteTextures(1, &s->pyramid);
+    glDeleteProgram(s->prog_minmax);
     glDeleteProgram(s->prog_map);
     glDeleteProgram(s->prog_vis);
     free(s);
@@ -666,10 +680,20 @@ static bool prepare_common(frame *f, mr_error *err) {
 }
 
 static bool need_map(const frame *f) { return casts(f) && map_method(f->p->shadow.method) && !reusable(f); }
+/* The pyramid is built from the map of this frame: a new map, or a kept
+ * one whose pyramid was never built (the method was not bp then). */
+static bool need_pyramid(const frame *f) {
+    return casts(f) && f->p->shadow.method == MR_SHADOW_BP &&
+           (need_map(f) || !f->r->shadow || !f->r->shadow->pyr_valid);
+}
+static bool need_pyramid_reuse(const frame *f) {
+    return casts(f) && f->p->shadow.method == MR_SHADOW_BP && !need_pyramid(f);
+}
 static bool need_map_reuse(const frame *f) { return casts(f) && map_method(f->p->shadow.method) && reusable(f); }
 static bool need_vis(const frame *f) { return casts(f); }
 static uint32_t vis_reads_now(const frame *f) {
-    return RES(RES_DEPTH) | RES(RES_NORMAL) | (map_method(f->p->shadow.method) ? RES(RES_SHADOW_MAP) : 0);
+    return RES(RES_DEPTH) | RES(RES_NORMAL) | (map_method(f->p->shadow.method) ? RES(RES_SHADOW_MAP) : 0) |
+           (f->p->shadow.method == MR_SHADOW_BP ? RES(RES_SHADOW_PYRAMID) : 0);
 }
 
 /* Draws the map of one light position: the base eye moved by `offset`
@@ -741,6 +765,7 @@ static void run_map(frame *f) {
     make_key(f, &s->key);
     s->key_valid = true;
     s->rig_serial = f->r->rig ? f->r->rig->serial : 0;
+    s->pyr_valid = false;
     frame_put(f, RES_SHADOW_MAP, s->map.color[0]);
 }
 
@@ -793,7 +818,10 @@ static void draw_vis(frame *f, int method, const double offset[3], const double 
     glUniform3f(MR_LOC_SHADOW_OFFSET, (float)offset[0], (float)offset[1], (float)offset[2]);
     glUniform2f(MR_LOC_SHADOW_SHEAR, (float)shear[0], (float)shear[1]);
     glUniform1f(MR_LOC_SHADOW_WEIGHT, weight);
-    glUniform1f(MR_LOC_SHADOW_MAX_SEARCH, (float)MAX_SEARCH_TEXELS);
+    glUniform1f(MR_LOC_SHADOW_MAX_SEARCH, (float)(method == MR_SHADOW_METHOD_ID_BP ? BP_MAX_SEARCH_TEXELS : MAX_SEARCH_TEXELS));
+    /* A top level of -1: no pyramid (bp_no_pyramid), the full search. */
+    glUniform2i(MR_LOC_SHADOW_PYRAMID, s->pyr_side, p->bp_no_pyramid ? -1 : s->pyr_levels - 1);
+    if (method == MR_SHADOW_METHOD_ID_BP) glBindTextureUnit(MR_TEX_SHADOW_MINMAX, frame_get(f, RES_SHADOW_PYRAMID));
     glUniform2fv(MR_LOC_SHADOW_KERNEL, s->kernel_taps, s->kernel);
     glBindTextureUnit(MR_TEX_SHADOW_DEPTH, frame_get(f, RES_DEPTH));
     glBindTextureUnit(MR_TEX_SHADOW_NORMAL, frame_get(f, RES_NORMAL));
@@ -836,6 +864,7 @@ static void run_groundtruth(frame *f) {
         glDisable(GL_BLEND);
     }
     s->key_valid = false; /* the map holds the last sample's */
+    s->pyr_valid = false;
 }
 
 static void run_vis(frame *f) {
@@ -849,6 +878,54 @@ static void run_vis(frame *f) {
     f->out->shadow_cascades = s->lf.ncasc;
     frame_put(f, RES_SHADOW, s->vis.color[0]);
 }
+
+/* ------------------------------------------------ the depth pyramid (bp) */
+
+static bool prepare_pyramid(frame *f, mr_error *err) {
+    if (!prepare_common(f, err)) return false;
+    struct mr_shadow_state *s = f->r->shadow;
+    if (!s->prog_minmax) {
+        const char *const files[] = {"shadow_minmax.comp.glsl", NULL};
+        if (!(s->prog_minmax = mr_gl_program(files, err))) return false;
+    }
+    /* A tile's pyramid is the next power of two of the map's side, so each
+     * level halves exactly; tiles sit as the map's cascades do. */
+    int S = s->map_size, P = 1, levels = 1;
+    while (P < S) P *= 2, levels++;
+    int pw = s->atlas_w / S * P, ph = s->atlas_h / S * P;
+    if (s->pyramid && s->pyr_side == P && s->pyr_w == pw && s->pyr_h == ph) return true;
+    glDeleteTextures(1, &s->pyramid);
+    glCreateTextures(GL_TEXTURE_2D, 1, &s->pyramid);
+    glTextureStorage2D(s->pyramid, levels, GL_RG32F, pw, ph);
+    glTextureParameteri(s->pyramid, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
+    glTextureParameteri(s->pyramid, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    s->pyr_side = P;
+    s->pyr_levels = levels;
+    s->pyr_w = pw;
+    s->pyr_h = ph;
+    s->pyr_valid = false;
+    return true;
+}
+
+static void run_pyramid(frame *f) {
+    struct mr_shadow_state *s = f->r->shadow;
+    glUseProgram(s->prog_minmax);
+    glUniform1i(MR_LOC_SHADOW_MM_SIZE, s->map_size);
+    glUniform1i(MR_LOC_SHADOW_MM_PYR, s->pyr_side);
+    glBindTextureUnit(MR_TEX_SHADOW_MM_MAP, frame_get(f, RES_SHADOW_MAP));
+    for (int l = 0; l < s->pyr_levels; l++) {
+        int w = s->pyr_w >> l, h = s->pyr_h >> l;
+        glUniform1i(MR_LOC_SHADOW_MM_LEVEL, l);
+        glBindImageTexture(MR_IMG_SHADOW_MM_SRC, s->pyramid, l > 0 ? l - 1 : 0, GL_FALSE, 0, GL_READ_ONLY, GL_RG32F);
+        glBindImageTexture(MR_IMG_SHADOW_MM_DST, s->pyramid, l, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
+        glDispatchCompute((GLuint)(w + 7) / 8, (GLuint)(h + 7) / 8, 1);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+    }
+    s->pyr_valid = true;
+    frame_put(f, RES_SHADOW_PYRAMID, s->pyramid);
+}
+
+static void run_pyramid_reuse(frame *f) { frame_put(f, RES_SHADOW_PYRAMID, f->r->shadow->pyramid); }
 
 bool mr_pass_shadow_read_back(frame *f, mr_error *err) {
     if (!f->p->shadow.want_shadow || !frame_get(f, RES_SHADOW)) return true;
@@ -865,7 +942,13 @@ const pass_desc mr_pass_desc_shadow_map = {
 const pass_desc mr_pass_desc_shadow_map_reuse = {
     .name = NULL, .needed = need_map_reuse, .prepare = prepare_common, .run = run_map_reuse,
     .writes = RES(RES_SHADOW_MAP)};
+const pass_desc mr_pass_desc_shadow_pyramid = {
+    .name = "shadow_pyramid", .needed = need_pyramid, .prepare = prepare_pyramid, .run = run_pyramid,
+    .reads = RES(RES_SHADOW_MAP), .writes = RES(RES_SHADOW_PYRAMID)};
+const pass_desc mr_pass_desc_shadow_pyramid_reuse = {
+    .name = NULL, .needed = need_pyramid_reuse, .prepare = prepare_pyramid, .run = run_pyramid_reuse,
+    .writes = RES(RES_SHADOW_PYRAMID)};
 const pass_desc mr_pass_desc_shadow = {
     .name = "shadow", .needed = need_vis, .prepare = prepare_common, .run = run_vis,
-    .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_SHADOW_MAP), .reads_now = vis_reads_now,
+    .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_SHADOW_MAP) | RES(RES_SHADOW_PYRAMID), .reads_now = vis_reads_now,
     .writes = RES(RES_SHADOW)};

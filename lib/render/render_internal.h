@@ -39,6 +39,8 @@ typedef enum res_id {
     /* shadows (pass_shadow.c) */
     RES_SHADOW_MAP,     /* "shadow.map": R32F linear light depth of the casting light */
     RES_SHADOW,         /* "shadow.visibility": R32F visibility of the casting light, 1 = lit */
+    /* backprojection's depth pyramid (pass_shadow.c) */
+    RES_SHADOW_PYRAMID, /* "shadow.pyramid": RG32F min / max light depth mip pyramid */
     RES_COUNT
 } res_id;
 #define RES(x) (1u << (x))
@@ -193,6 +195,7 @@ extern const pass_desc mr_pass_desc_ao_temporal; /* pass_ao.c, issue 18 */
 extern const pass_desc mr_pass_desc_ghost_hidden, mr_pass_desc_ghost_curvature, mr_pass_desc_ghost_importance,
     mr_pass_desc_ghost_g0, mr_pass_desc_ghost_analysis, mr_pass_desc_ghost_emphasis;            /* pass_ghost.c */
 extern const pass_desc mr_pass_desc_shadow_map, mr_pass_desc_shadow_map_reuse, mr_pass_desc_shadow; /* pass_shadow.c */
+extern const pass_desc mr_pass_desc_shadow_pyramid, mr_pass_desc_shadow_pyramid_reuse;                 /* pass_shadow.c */
 
 /* Helpers the pass files share. */
 

@@ -58,6 +58,7 @@ const char *const mr_resource_names[RES_COUNT] = {
     [RES_HIDDEN_SHADED] = "hidden.shaded", [RES_SHADED] = "shaded", [RES_IMAGE] = "image",
     [RES_CURVATURE] = "curvature", [RES_GHOST_MASK] = "ghost.mask",
     [RES_SHADOW_MAP] = "shadow.map", [RES_SHADOW] = "shadow.visibility",
+    [RES_SHADOW_PYRAMID] = "shadow.pyramid",
 };
 
 /* The registry: one row per pass, in the order they run; each row's
@@ -75,6 +76,8 @@ static const pass_desc *const k_passes[] = {
     /* Shadows before the shading, which scales the casting light by them. */
     &mr_pass_desc_shadow_map,
     &mr_pass_desc_shadow_map_reuse,
+    &mr_pass_desc_shadow_pyramid,
+    &mr_pass_desc_shadow_pyramid_reuse,
     &mr_pass_desc_shadow,
     &mr_pass_desc_shade,
     &mr_pass_desc_overlay,

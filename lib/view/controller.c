@@ -21,6 +21,7 @@ const mr_view_key_help mr_view_keymap[] = {
     {"h", "hidden layer on/off"},
     {"a", "next ambient occlusion method"},
     {"g", "next ghosting mode"},
+    {"c", "next shadow method (off, hard, pcf, pcss, bp)"},
     {"space", "replay: play / pause"},
     {". / Right", "replay: step forward"},
     {", / Left", "replay: step back"},
@@ -323,6 +324,11 @@ static void next_ghost(mr_viewer *v, mr_view_actions *out) {
     changed(v, out);
 }
 
+static void next_shadows(mr_viewer *v, mr_view_actions *out) {
+    v->s.shadows = (mr_shadow_method)mr_opt_enum_next(mr_opt_find(mr_view_settings_opts, "shadows"), (int)v->s.shadows);
+    changed(v, out);
+}
+
 static void mark_at(mr_viewer *v, double x, double y, mr_view_actions *out) {
     mr_view_action *a = vw_emit(out, MR_VA_MARK_AT);
     a->x = x;
@@ -365,6 +371,7 @@ static void on_key(mr_viewer *v, int k, mr_view_actions *out) {
     case 'h': v->s.hide_hidden = !v->s.hide_hidden; changed(v, out); break;
     case 'a': next_ao(v, out); break;
     case 'g': next_ghost(v, out); break;
+    case 'c': next_shadows(v, out); break;
     case ' ': toggle_play(v, out); break;
     case '.': case MR_KEY_RIGHT: step(v, 1, out); break;
     case ',': case MR_KEY_LEFT: step(v, -1, out); break;
@@ -666,6 +673,7 @@ cJSON *mr_viewer_state_json(const mr_viewer *v) {
     cJSON_AddBoolToObject(j, "hide_hidden_layer", v->s.hide_hidden);
     cJSON_AddStringToObject(j, "ao", mr_ao_method_name(v->s.ao));
     cJSON_AddStringToObject(j, "ghost", mr_view_ghost_name(v->s.ghost));
+    cJSON_AddStringToObject(j, "shadows", mr_shadow_method_names[(int)v->s.shadows >= 0 && v->s.shadows < MR_SHADOW_METHOD_COUNT ? v->s.shadows : 0]);
     cJSON_AddBoolToObject(j, "frozen", v->frozen);
     cJSON_AddBoolToObject(j, "mark_mode", v->mark_mode);
     cJSON_AddBoolToObject(j, "help", v->help);

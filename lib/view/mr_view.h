@@ -42,14 +42,17 @@ typedef struct mr_view_settings {
     int rate_i;           /* index into mr_view_rates; default 2 (1x) */
     mr_ao_method ao;      /* default MR_AO_NONE */
     mr_ghost_mode ghost;  /* default MR_GHOST_OFF */
+    mr_shadow_method shadows; /* off, hard, pcf, pcss or bp (the C key cycles); default off */
 } mr_view_settings;
 #define MR_VIEW_DEFAULT_ALPHA 0.5f
 #define MR_VIEW_DEFAULT_RATE_I 2
 #define MR_VIEW_SETTINGS_DEFAULTS {.alpha = MR_VIEW_DEFAULT_ALPHA, .show_video = true, .hide_hidden = false, \
-                                   .rate_i = MR_VIEW_DEFAULT_RATE_I, .ao = MR_AO_NONE, .ghost = MR_GHOST_OFF}
+                                   .rate_i = MR_VIEW_DEFAULT_RATE_I, .ao = MR_AO_NONE, .ghost = MR_GHOST_OFF, \
+                                   .shadows = MR_SHADOW_OFF}
 /* The option table of the settings file (keys alpha, show_video,
- * hide_hidden_layer, ao, ghost); the A and G keys cycle through the ao and
- * ghost rows' names. The rate is stored as a rate, not as rate_i, so it is
+ * hide_hidden_layer, ao, ghost, shadows); the A, G and C keys cycle through
+ * the ao, ghost and shadows rows' names (shadows: off, hard, pcf, pcss,
+ * bp; the ground truth is for the bench, too slow to look around in). The rate is stored as a rate, not as rate_i, so it is
  * read and written beside the table. */
 extern const mr_opt mr_view_settings_opts[];
 

@@ -9,6 +9,11 @@
 const double mr_view_rates[MR_VIEW_RATE_COUNT] = {0.25, 0.5, 1.0, 2.0, 4.0};
 const char *const mr_view_notes[MR_VIEW_NOTE_COUNT] = {"missing", "extra", "moved", "wrong size", "clash", "other"};
 
+/* The shadow methods fit to look around in, in mr_shadow_method's order
+ * (the ground truth, last there, is left out: seconds per frame). */
+static const char *const k_view_shadow_names[] = {"off", "hard", "pcf", "pcss", "bp", NULL};
+_Static_assert(MR_SHADOW_BP == 4 && MR_SHADOW_OFF == 0, "k_view_shadow_names follows mr_shadow_method");
+
 #define VS(f) offsetof(mr_view_settings, f)
 const mr_opt mr_view_settings_opts[] = {
     {"alpha", MR_OPT_FLOAT, VS(alpha), 0, 1, MR_VIEW_DEFAULT_ALPHA, NULL,
@@ -17,6 +22,7 @@ const mr_opt mr_view_settings_opts[] = {
     {"hide_hidden_layer", MR_OPT_BOOL, VS(hide_hidden), 0, 1, 0, NULL, "leave the hidden layer out", 0},
     {"ao", MR_OPT_ENUM, VS(ao), 0, 0, MR_AO_NONE, mr_ao_method_names, "ambient occlusion method", 0},
     {"ghost", MR_OPT_ENUM, VS(ghost), 0, 0, MR_GHOST_OFF, mr_ghost_mode_names, "ghosting mode", 0},
+    {"shadows", MR_OPT_ENUM, VS(shadows), 0, 0, MR_SHADOW_OFF, k_view_shadow_names, "soft shadow method", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef VS
