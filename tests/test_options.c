@@ -426,6 +426,7 @@ static void test_tables(void) {
         N(mr_synth_recording_params, "frames", frames, 1, 100000),
         N(mr_synth_recording_params, "noise", noise, 0, 100),
         N(mr_synth_recording_params, "motion-blur", motion_blur, 1, 16),
+        N(mr_synth_recording_params, "shutter", shutter_s, 0, 1),
         N(mr_synth_recording_params, "exposure", exposure, 0, 0.9),
         N(mr_synth_recording_params, "jpeg", jpeg_quality, 1, 100),
         N(mr_synth_recording_params, "fps", fps, 0.1, 1000),
