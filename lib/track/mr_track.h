@@ -420,18 +420,21 @@ bool mr_pose_filter_last(const mr_pose_filter *f, mr_dmat4 *out);
  *
  * Adaptive decimation (issue 16), when detector.decimate is left 0: the
  * detector's decimation for a frame is picked from the tags of the frame
- * before, by the shortest edge e (px, full resolution) of the smallest one
- * detected: 4 for e >= 64, 3 for e >= 48, 2 for e >= 16, 1 below, so the
- * smallest tag keeps >= 16 px after decimation at 3 and 4, >= 8 at 2 (the
- * 20 px tags of the shipped recording are found at 2 as at 1; edge refinement,
- * on by default, fits the corners at full resolution again: the accuracy of
- * decimation 2 at a fraction of the time on large tags). On the first frame
- * and after a frame without tags it is the conservative
- * MR_DETECTOR_DEFAULT_DECIMATE (2), and a pick coarser than that gives way
- * to 2 on every MR_TRACKER_PROBE_FRAMES-th frame: a probe that sees smaller
- * tags a coarse decimation would miss. A frame that finds no tag at
- * a coarser decimation than that, after a frame with tags, is detected once
- * more at 2 (a miss costs one more detection, never the frame). An explicit
+ * before, by the shortest edge e (px, full resolution) of the second
+ * largest tag detected (the only one's, if one): 4 for e >= 64, 3 for
+ * e >= 48, 2 for e >= 16, 1 below, so two tags keep >= 16 px after
+ * decimation at 3 and 4, >= 8 at 2 (the 20 px tags of the shipped
+ * recording are found at 2 as at 1). Two tags keep the pose multi-tag (no
+ * mirror ambiguity); smaller, further tags add little to the pose and may
+ * be lost at 3 or 4. Edge refinement (on by default) fits the corners at
+ * full resolution again: decimation 2's accuracy at a fraction of the time
+ * on large tags. On the first frame and after a frame without tags it is
+ * the conservative MR_DETECTOR_DEFAULT_DECIMATE (2), and a pick coarser
+ * than that gives way to 2 on every MR_TRACKER_PROBE_FRAMES-th frame (a
+ * probe for tags that came into view). A frame that finds fewer than two
+ * tags at a coarser decimation than 2, and fewer than the frame before, is
+ * detected once more at 2 (a miss costs one more detection, never the frame
+ * or a multi-tag pose). An explicit
  * detector.decimate (--decimate) fixes it. r.decimate says which was used.
  *
  * Usage (all a caller needs):
@@ -479,8 +482,8 @@ typedef struct mr_tracker_result {
     bool frozen;                    /* the filter holds its pose */
     double decimate;                /* the detector's decimation on this frame
                                        (mr_tracker_frame; 0 from mr_tracker_detections) */
-    bool redetected;                /* adaptive decimation found nothing and the
-                                       frame was detected again at the default */
+    bool redetected;                /* adaptive decimation lost the last frame's tags
+                                       and the frame was detected again at 2 */
 } mr_tracker_result;
 /* Adaptive decimation (above): the probe interval, and the rule. */
 #define MR_TRACKER_PROBE_FRAMES 8

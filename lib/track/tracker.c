@@ -21,7 +21,7 @@ struct mr_tracker {
     bool adaptive;
     double next_dec;            /* picked from the last frame's tags; 0 = conservative */
     int since_probe;            /* frames since the last conservative one */
-    bool had_tags;              /* the last frame found tags */
+    int last_n;                 /* tags the last frame found */
 };
 
 static bool copy_markers(const mr_marker_map *src, mr_marker_map *dst, mr_error *err) {
@@ -87,7 +87,7 @@ void mr_tracker_reset(mr_tracker *t) {
     t->prev_t = 0;
     t->next_dec = 0;
     t->since_probe = 0;
-    t->had_tags = false;
+    t->last_n = 0;
     if (t->filter) {
         mr_pose_filter_freeze(t->filter, false);
         mr_pose_filter_reset(t->filter);
@@ -109,14 +109,21 @@ double mr_tracker_pick_decimate(double e) {
     return e >= 64 ? 4 : e >= 48 ? 3 : e >= 16 ? 2 : 1;
 }
 
-/* Shortest edge (px) of the smallest detected tag. */
-static double min_edge_px(const mr_detection *d, int n) {
-    double e = INFINITY;
-    for (int i = 0; i < n; i++)
+/* The tag size the decimation is picked by: the shortest edge (px) of the
+ * second largest tag detected (of the only one, if one). Two tags keep the
+ * pose multi-tag (no single tag's mirror ambiguity); smaller, further tags
+ * add little to the pose and would hold the decimation down for all. */
+static double pick_edge_px(const mr_detection *d, int n) {
+    double first = 0, second = 0;
+    for (int i = 0; i < n; i++) {
+        double e = INFINITY;
         for (int k = 0; k < 4; k++)
             e = fmin(e, hypot(d[i].corners[(k + 1) % 4][0] - d[i].corners[k][0],
                               d[i].corners[(k + 1) % 4][1] - d[i].corners[k][1]));
-    return e;
+        if (e > first) second = first, first = e;
+        else if (e > second) second = e;
+    }
+    return n == 1 ? first : second;
 }
 
 /* The decimation for this frame, no coarser than the frame allows (the
@@ -144,8 +151,9 @@ bool mr_tracker_frame(mr_tracker *t, const mr_image *image, double timestamp, mr
         t->since_probe = cons ? 0 : t->since_probe + 1;
     }
     const mr_detection *d = mr_detector_detect(t->det, image, &n, err);
-    if (d && t->adaptive && n == 0 && t->had_tags && dec > MR_DETECTOR_DEFAULT_DECIMATE) {
-        /* A coarse decimation lost the tags of the last frame: look again. */
+    if (d && t->adaptive && n < 2 && n < t->last_n && dec > MR_DETECTOR_DEFAULT_DECIMATE) {
+        /* A coarse decimation lost the tags of the last frame (or all but
+         * one: a single tag's pose may be its mirror): look again. */
         dec = MR_DETECTOR_DEFAULT_DECIMATE;
         mr_detector_set_decimate(t->det, dec);
         d = mr_detector_detect(t->det, image, &n, err);
@@ -157,8 +165,8 @@ bool mr_tracker_frame(mr_tracker *t, const mr_image *image, double timestamp, mr
         return false;
     }
     if (t->adaptive) {
-        t->had_tags = n > 0;
-        t->next_dec = n > 0 ? mr_tracker_pick_decimate(min_edge_px(d, n)) : 0;
+        t->last_n = n;
+        t->next_dec = n > 0 ? mr_tracker_pick_decimate(pick_edge_px(d, n)) : 0;
     }
     bool ok = mr_tracker_detections(t, d, n, image->width, image->height, timestamp, out, err);
     out->decimate = mr_detector_decimate(t->det);
