@@ -204,7 +204,8 @@ typedef struct mr_synth_recording_params {
     int width, height; /* px, at least 64x48; default 640x480 (the demo camera) */
     double noise;     /* sensor noise sigma in grey levels, >= 0; default 2 */
     int motion_blur;  /* sub-frames averaged over the shutter, 1 (none)..16; default 3 */
-    double shutter_s; /* exposure time, 0..1 s; default 1/60 (indoor tablet auto-exposure) */
+    double shutter;   /* exposure time 1/shutter s, 1..100000; default 60 (1/60 s, an indoor
+                         tablet's auto-exposure) */
     double exposure;  /* relative exposure swing along the path, 0..<1; default 0.25 */
     int jpeg_quality; /* of the stored frames; default 80 (the shipped recording < 5 MB) */
     uint64_t seed;    /* noise seed; default 1 */
@@ -212,7 +213,7 @@ typedef struct mr_synth_recording_params {
     bool progress;    /* "synth: frame i/n" on stderr */
 } mr_synth_recording_params;
 #define MR_SYNTH_RECORDING_DEFAULTS \
-    .frames = 0, .width = 640, .height = 480, .noise = 2.0, .motion_blur = 3, .shutter_s = 1.0 / 60, .exposure = 0.25, \
+    .frames = 0, .width = 640, .height = 480, .noise = 2.0, .motion_blur = 3, .shutter = 60, .exposure = 0.25, \
     .jpeg_quality = 80, .seed = 1, .fps = 10.0
 bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params, const mr_bench_gpu *gfx, mr_error *err);
 /* Steps of the walking path (pauses and walks), the default frame count. */

@@ -113,7 +113,7 @@ bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params
     mr_synth_recording_params p = params ? *params : (mr_synth_recording_params){MR_SYNTH_RECORDING_DEFAULTS};
     if (!bench_gpu_check(gfx, "synth", err)) return false;
     if (p.frames < 0 || p.width < 64 || p.height < 48 || p.motion_blur < 1 || p.motion_blur > 16 || p.noise < 0 ||
-        p.exposure < 0 || p.exposure >= 1 || p.fps <= 0 || !(p.shutter_s >= 0 && p.shutter_s <= 1))
+        p.exposure < 0 || p.exposure >= 1 || p.fps <= 0 || !(p.shutter >= 1 && p.shutter <= 1e5))
         return mr_fail(err, MR_ERR_INVALID, "synth: parameters out of range");
     mr_demo_hall hall;
     if (!mr_demo_build_tagged(NULL, 0, &hall, err)) return false;
@@ -163,10 +163,10 @@ bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params
         bool still = false;
         mr_dmat4 truth = path_pose(s, &still);
         double t = s / p.fps;
-        /* Sub-frames over the open shutter, shutter_s before the frame's
+        /* Sub-frames over the open shutter, 1/shutter s before the frame's
          * time (1/60 s: an indoor tablet's auto-exposure at walking pace). */
         for (int k = 0; ok && k < p.motion_blur; k++) {
-            double sk = p.motion_blur > 1 ? s - p.shutter_s * p.fps * (double)k / (p.motion_blur - 1) : s;
+            double sk = p.motion_blur > 1 ? s - p.fps / p.shutter * (double)k / (p.motion_blur - 1) : s;
             mr_view v = {wide, path_pose(sk < 0 ? 0 : sk, NULL)};
             mr_frame_params fp = MR_FRAME_DEFAULTS;
             fp.width = wide.width * scale;
