@@ -88,6 +88,9 @@ static bool run_demo(const char *dir, mr_error *err) {
     mr_demo_free(&hall);
     if (!ok) return false;
     double t_build = mr_time_now() - t0;
+    /* tracking: recording + calibration set (demo_track.c); first, as the
+     * marks at the end are placed on the recording's tracked frames */
+    if (!app_demo_track(dir, err)) return false;
 
     /* Render from the files just written, as a user's run would. */
     mr_scene *built = NULL, *planned = NULL;
@@ -148,7 +151,6 @@ static bool run_demo(const char *dir, mr_error *err) {
     printf("  camera frames (as built):     %s/frames/frame_000..%03d.png\n", dir, mr_demo_view_count() - 1);
     printf("  overlays (planned, alpha 0.5): %s/overlay/overlay_000..%03d.png\n", dir, mr_demo_view_count() - 1);
     printf("  virtual only (planned):        %s/virtual/virtual_000..%03d.png\n", dir, mr_demo_view_count() - 1);
-    if (!app_demo_track(dir, err)) return false; /* tracking: recording + calibration set (demo_track.c) */
     printf("done in %.1f s\n", mr_time_now() - t0);
     return true;
 }

@@ -82,6 +82,7 @@ int cmd_synth(int argc, char **argv) {
     }
     double t0 = mr_time_now();
     if (!synth_recording(mr_cli_get(opts, "out"), &p, &err)) return mr_cli_error(cmd, &err);
-    printf("wrote %s/ (%d frames, %dx%d) in %.1f s\n", mr_cli_get(opts, "out"), p.frames, p.width, p.height, mr_time_now() - t0);
+    printf("wrote %s/ (%d frames, %dx%d) in %.1f s\n", mr_cli_get(opts, "out"), p.frames > 0 ? p.frames : mr_synth_path_frames(),
+           p.width, p.height, mr_time_now() - t0);
     return 0;
 }

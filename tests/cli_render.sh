@@ -110,5 +110,11 @@ done
 [ -s "$tmp/demo/report/index.html" ] && [ -s "$tmp/demo/report/img/mark_3_overlay.png" ] && ok || bad "demo: no report"
 grep -q "Machine_2" "$tmp/demo/report/index.html" && grep -q "Column_1_0" "$tmp/demo/report/index.html" && ok ||
   bad "demo: the report does not name the discrepancies"
+# The marks are placed on frames of the demo's recording at the tracker's
+# poses, so each carries the registration's uncertainty and its frame.
+ann=$tmp/demo/session/annotations.jsonl
+[ "$(grep -c '"uncertainty_m":' "$ann" 2>/dev/null)" = 3 ] && ok || bad "demo: marks without uncertainty_m: $(cat "$ann" 2>&1 | head -c 300)"
+[ "$(grep -cE 'recording frame [0-9]+, \+/- [0-9]+ mm' "$tmp/demo.log")" = 3 ] && ok ||
+  bad "demo: not three marks on tracked recording frames: $(grep mark "$tmp/demo.log")"
 
 cli_finish cli_render

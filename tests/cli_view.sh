@@ -207,14 +207,21 @@ else
   bad "no annotation written: $(tail -3 "$tmp/mark.err")"
 fi
 
-# 2b. Issue 15, backward compatible: the shipped recording was made before
-#     poses carried a covariance; the status line says "+/- ? mm" and the
+# 2b. Issue 15, backward compatible: a recording made before poses carried
+#     a covariance (the shipped one with its covariance taken out: it has
+#     carried one since issue 16); the status line says "+/- ? mm" and the
 #     mark has no uncertainty_m (unknown, not zero).
 src=$(cd "$(dirname "$0")/.." && pwd)
+oldrec=$tmp/old_recording
+rm -rf "$oldrec" && mkdir -p "$oldrec"
+cp "$src/recordings/demo/meta.json" "$src/recordings/demo/groundtruth.jsonl" "$oldrec/"
+ln -s "$src/recordings/demo/frames" "$oldrec/frames"
+sed -e 's/,"corner_sigma_px":[^,]*,"covariance":\[[^]]*\]//' "$src/recordings/demo/frames.jsonl" >"$oldrec/frames.jsonl"
+grep -q covariance "$oldrec/frames.jsonl" && bad "the covariance was not taken out of the old recording" || ok
 printf '%s\n' "0.2 key . " "0.6 key ." "1.4 tap @mark" "1.8 tap 150 150" "2.1 state $tmp/old_state.json" "2.4 tap @note2" \
   "3.5 quit" >"$tmp/old.script"
 rm -rf "$tmp/old_session"
-if timeout 120 "$mr" view --scene "$src/configs/scenes/demo_planned.json" --replay "$src/recordings/demo" \
+if timeout 120 "$mr" view --scene "$src/configs/scenes/demo_planned.json" --replay "$oldrec" \
   --out "$tmp/old_session" --config "$tmp/cfg_old.json" --size 480x360 --paused --script "$tmp/old.script" \
   >"$tmp/old.out" 2>"$tmp/old.err" && [ -s "$tmp/old_session/annotations.jsonl" ]; then
   oline=$(head -1 "$tmp/old_session/annotations.jsonl")
@@ -237,7 +244,7 @@ fi
 # 2c. Issue 15: replay.jsonl tells the sigma at the model under the centre
 #     where the recording has the covariance, and leaves it out where not.
 if "$mr" replay "$d/recording" --scene "$d/scene_planned.json" --out "$tmp/rpu" --from 2 --to 2 >/dev/null 2>"$tmp/rpu.err" &&
-  "$mr" replay "$src/recordings/demo" --scene "$src/configs/scenes/demo_planned.json" --out "$tmp/rpo" --from 2 --to 2 \
+  "$mr" replay "$oldrec" --scene "$src/configs/scenes/demo_planned.json" --out "$tmp/rpo" --from 2 --to 2 \
     >/dev/null 2>"$tmp/rpo.err"; then
   cu=$(sed -n 's/.*"centre_uncertainty_m":\([-0-9.eE+]*\).*/\1/p' "$tmp/rpu/replay.jsonl")
   awk -v u="${cu:-x}" 'BEGIN { exit !(u + 0 > 0 && u + 0 < 10) }' && ok || bad "replay.jsonl: $(cat "$tmp/rpu/replay.jsonl")"

@@ -267,12 +267,14 @@ static void test_runner(const char *tmp) {
     const char *cols = "detector,decimate,threads,refine,frames,ms_median,ms_p95,detect_ms_median,t_err_mm_median,"
                        "t_err_pct_median,r_err_deg_median,reproj_rms_px_median,detection_rate,detection_rate_56px,"
                        "detection_rate_still,pose_rate,flip_rate,jitter_raw_mm,jitter_raw_deg,jitter_filtered_mm,"
-                       "jitter_filtered_deg\n";
+                       "jitter_filtered_deg,pose_rate_20px,decimate_mean\n";
     CHECK_MSG(csv && strncmp(csv, cols, strlen(cols)) == 0, "bench_tracking.csv must start with the documented header");
     int rows = csv ? count(csv, "\n") - 1 : 0, april = csv ? count(csv, "\napriltag,") : 0, aruco = csv ? count(csv, "\nopencv-aruco,") : 0;
-    CHECK_MSG(rows == 10 && april == 6 && aruco == 4, "quick: 6 apriltag + 4 aruco rows, got %d rows (%d, %d)", rows, april, aruco);
-    CHECK_MSG(csv && count(csv, ",4,") >= 10, "every row must count the 4 frames used");
-    CHECK_MSG(csv && count(csv, ",") == 20 * 11, "every line must have 21 cells");
+    int adaptive = csv ? count(csv, "\napriltag-adaptive,") : 0;
+    CHECK_MSG(rows == 11 && april == 6 && adaptive == 1 && aruco == 4,
+              "quick: 6 apriltag + 1 adaptive + 4 aruco rows, got %d rows (%d, %d, %d)", rows, april, adaptive, aruco);
+    CHECK_MSG(csv && count(csv, ",4,") >= 11, "every row must count the 4 frames used");
+    CHECK_MSG(csv && count(csv, ",") == 22 * 12, "every line must have 23 cells");
     mr_path_join(out, "bench_tracking.svg", path, sizeof path);
     read_svg(path, "bench_tracking.svg");
     p.recording = "/nonexistent/recording";

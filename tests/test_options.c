@@ -431,6 +431,7 @@ static void test_tables(void) {
         N(mr_synth_recording_params, "frames", frames, 1, 100000),
         N(mr_synth_recording_params, "noise", noise, 0, 100),
         N(mr_synth_recording_params, "motion-blur", motion_blur, 1, 16),
+        N(mr_synth_recording_params, "shutter", shutter, 1, 100000),
         N(mr_synth_recording_params, "exposure", exposure, 0, 0.9),
         N(mr_synth_recording_params, "jpeg", jpeg_quality, 1, 100),
         N(mr_synth_recording_params, "fps", fps, 0.1, 1000),
@@ -494,8 +495,9 @@ static void test_tables(void) {
     check_rows("mr_detector_opts", mr_detector_opts, ex_dt, (int)(sizeof ex_dt / sizeof ex_dt[0]));
     check_rows("mr_filter_opts", mr_filter_opts, ex_fi, (int)(sizeof ex_fi / sizeof ex_fi[0]));
     /* The defaults the 0s stand for, written a second time as the contract:
-     * the same as the detector's and the filter's own (test_track). */
-    const double want_dt[] = {2.0, 1, 1, 0.25}, want_fi[] = {0.5, 2.0, 1.0, 0.5, 1.0, 0.5, 20.0, 0.5};
+     * the same as the detector's and the filter's own (test_track);
+     * decimate's 0 is auto, the tracker's adaptive decimation. */
+    const double want_dt[] = {0.0, 1, 1, 0.25}, want_fi[] = {0.5, 2.0, 1.0, 0.5, 1.0, 0.5, 20.0, 0.5};
     for (int i = 0; i < 4; i++)
         CHECK_MSG(mr_detector_opts[i].def == want_dt[i], "mr_detector_opts.%s: default %g, expected %g",
                   mr_detector_opts[i].key, mr_detector_opts[i].def, want_dt[i]);

@@ -132,7 +132,8 @@ static void test_calibration_set(void) {
     CHECK_MSG(!mr_synth_calibration(dir, 0, &err) && err.code == MR_ERR_INVALID, "zero calibration images accepted");
 }
 
-/* Three frames over the whole walking path at 5 fps. */
+/* Three frames over the whole walking path at 5 path steps per second:
+ * the timestamps on the path's clock, (total - 1) / 2 steps apart. */
 static int test_recording(void) {
     mr_error err = {0};
     mr_gpu *gpu = mr_gpu_create_headless(NULL, &err);
@@ -149,8 +150,11 @@ static int test_recording(void) {
     mr_bench_gpu none = {gpu, NULL};
     CHECK_MSG(!mr_synth_recording(dir, &p, &none, &err) && err.code == MR_ERR_INVALID, "no renderer accepted");
     mr_synth_recording_params bad = p;
-    bad.frames = 0;
-    CHECK_MSG(!mr_synth_recording(dir, &bad, &gfx, &err) && err.code == MR_ERR_INVALID, "0 frames accepted");
+    bad.frames = -1;
+    CHECK_MSG(!mr_synth_recording(dir, &bad, &gfx, &err) && err.code == MR_ERR_INVALID, "-1 frames accepted");
+    bad = p;
+    bad.shutter = 0;
+    CHECK_MSG(!mr_synth_recording(dir, &bad, &gfx, &err) && err.code == MR_ERR_INVALID, "shutter 0 (an endless exposure) accepted");
     CHECK_MSG(!mr_is_recording(dir), "a refused call left a recording behind");
     bool ok = r && mr_synth_recording(dir, &p, &gfx, &err);
     CHECK_MSG(ok, "synthetic recording: %s", err.msg);
@@ -169,7 +173,9 @@ static int test_recording(void) {
         for (int i = 0; i < rec->frame_count && i < 3; i++) {
             const mr_rec_frame *f = &rec->frames[i];
             CHECK_MSG(f->has_gt, "frame %d has no ground-truth line", i);
-            CHECK_MSG(fabs(f->t - i / 5.0) < 1e-9, "frame %d at t = %g, want %g (5 fps)", i, f->t, i / 5.0);
+            const double want_t = i * (mr_synth_path_frames() - 1) / 2.0 / 5.0;
+            CHECK_MSG(fabs(f->t - want_t) < 1e-9, "frame %d at t = %g, want %g (the path's clock at 5 steps/s)", i, f->t,
+                      want_t);
             if (i != 1) {
                 const double *e = ends[i / 2];
                 mr_dvec3 o = mr_m4_point(&f->gt, mr_v3(0, 0, 0));

@@ -11,6 +11,7 @@
 #include "mr_session.h"
 #include "mr_test.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -74,7 +75,11 @@ static void test_composition(void) {
     mr_error err = {0};
     mr_detector *det = mr_detector_create(NULL, &err);
     mr_pose_filter *filt = mr_pose_filter_create(NULL, &err);
-    mr_tracker *t = make(NULL), *t2 = make(NULL);
+    /* At the detector's fixed default: the adaptive decimation is
+     * test_adaptive's. */
+    mr_tracker_params fixed = MR_TRACKER_DEFAULTS;
+    fixed.detector.decimate = MR_DETECTOR_DEFAULT_DECIMATE;
+    mr_tracker *t = make(&fixed), *t2 = make(&fixed);
     if (!det || !filt || !t || !t2) return;
     const mr_image *frames[] = {&g_f0, &g_f52, &g_f0, &g_f52};
     const double ts[] = {0, 0.1, 0.2, 1.5};
@@ -185,6 +190,72 @@ static void test_resized_frame(void) {
     mr_image_free(&half);
 }
 
+/* Shortest edge of the second largest detection (the only one's if one). */
+static double second_edge(const mr_detection *d, int n) {
+    double a = 0, b = 0;
+    for (int i = 0; i < n; i++) {
+        double e = INFINITY;
+        for (int k = 0; k < 4; k++)
+            e = fmin(e, hypot(d[i].corners[(k + 1) % 4][0] - d[i].corners[k][0], d[i].corners[(k + 1) % 4][1] - d[i].corners[k][1]));
+        if (e > a) b = a, a = e;
+        else if (e > b) b = e;
+    }
+    return n == 1 ? a : b;
+}
+
+/* Adaptive decimation (mr_track.h): the rule, the first frame at 2, each
+ * next frame at the rule's pick from the frame before, a probe at 2 every
+ * MR_TRACKER_PROBE_FRAMES frames, a lost frame detected again at 2, the
+ * pose at a coarse decimation as good, and --decimate fixing it. Large
+ * tags: frame 0 at three times its size (pixels tripled, the intrinsics
+ * scaled). */
+static void test_adaptive(void) {
+    CHECK(mr_tracker_pick_decimate(70) == 4 && mr_tracker_pick_decimate(64) == 4 && mr_tracker_pick_decimate(50) == 3 &&
+          mr_tracker_pick_decimate(30) == 2 && mr_tracker_pick_decimate(16) == 2 && mr_tracker_pick_decimate(10) == 1 &&
+          mr_tracker_pick_decimate(NAN) == MR_DETECTOR_DEFAULT_DECIMATE);
+    mr_image big;
+    mr_image_alloc(&big, g_f0.width * 3, g_f0.height * 3, 1, MR_PIX_U8, NULL);
+    for (int y = 0; y < big.height; y++)
+        for (int x = 0; x < big.width; x++)
+            ((unsigned char *)big.data)[(size_t)y * big.width + x] =
+                ((const unsigned char *)g_f0.data)[(size_t)(y / 3) * g_f0.width + x / 3];
+    mr_tracker *t = make(NULL);
+    mr_tracker_result r;
+    mr_error err = {0};
+    CHECK(t && mr_tracker_frame(t, &big, 0, &r, &err) && r.decimate == MR_DETECTOR_DEFAULT_DECIMATE && r.pose.valid);
+    double want = mr_tracker_pick_decimate(second_edge(r.detections, r.detection_count));
+    mr_dmat4 first = r.pose.world_from_camera;
+    CHECK_MSG(want > MR_DETECTOR_DEFAULT_DECIMATE, "frame 0 tripled: tags of %.1f px pick %g, want coarser than 2",
+              second_edge(r.detections, r.detection_count), want);
+    int probes = 0;
+    for (int i = 1; t && i <= MR_TRACKER_PROBE_FRAMES; i++) {
+        CHECK(mr_tracker_frame(t, &big, 0.1 * i, &r, &err) && r.pose.valid);
+        probes += r.decimate == MR_DETECTOR_DEFAULT_DECIMATE;
+        CHECK_MSG(r.decimate == want || r.decimate == MR_DETECTOR_DEFAULT_DECIMATE, "frame %d at decimation %g, want %g", i,
+                  r.decimate, want);
+        double dist = mr_pose_dist(&r.pose.world_from_camera, &first);
+        /* the tags are ~10 units away: 1% of that (blocky tripled pixels) */
+        CHECK_MSG(r.pose.tags_used >= 2 && dist < 0.1, "frame %d at decimation %g: pose %.3f units from decimation 2's", i,
+                  r.decimate, dist);
+    }
+    CHECK_MSG(probes == 1, "%d probes at decimation 2 in %d frames, want 1", probes, MR_TRACKER_PROBE_FRAMES);
+    /* The original size after large tags: decimation 4 loses them (7 px),
+     * the frame is detected again at 2. */
+    CHECK_MSG(want == 4, "frame 0 tripled picks %g, want 4", want);
+    CHECK(t && mr_tracker_frame(t, &g_f0, 1.0, &r, &err));
+    CHECK_MSG(r.redetected && r.decimate == MR_DETECTOR_DEFAULT_DECIMATE && r.detection_count >= 2 && r.pose.valid,
+              "small tags after large ones: decimation %g, %d tags (redetected %d)", r.decimate, r.detection_count,
+              r.redetected);
+    mr_tracker_destroy(&t);
+    /* A given decimation stays. */
+    mr_tracker_params p = MR_TRACKER_DEFAULTS;
+    p.detector.decimate = 1.5;
+    t = make(&p);
+    for (int i = 0; t && i < 3; i++) CHECK(mr_tracker_frame(t, &big, 0.1 * i, &r, &err) && r.decimate == 1.5 && !r.redetected);
+    mr_tracker_destroy(&t);
+    mr_image_free(&big);
+}
+
 static void test_detect_only_and_errors(void) {
     mr_error err = {0};
     mr_tracker *t = mr_tracker_create(NULL, &err);
@@ -241,6 +312,7 @@ int main(void) {
     test_composition();
     test_freeze_hold();
     test_resized_frame();
+    test_adaptive();
     test_detect_only_and_errors();
     mr_image_free(&g_f0);
     mr_image_free(&g_f52);

@@ -1,9 +1,11 @@
 /* The last part of `mrcheck demo`: three marks at the hall's known
- * discrepancies, as a planner would place them in `mrcheck view` (camera
- * frame of the as-built hall, the plan overlaid, a pick on the plan), then
+ * discrepancies, as a planner would place them in `mrcheck view` while
+ * walking the demo's recording (a frame of it, the tracker's pose of that
+ * frame with its covariance, the plan overlaid, a pick on the plan), then
  * the findings as BCF 2.1 and 3.0 and as the HTML report (lib/export). */
 #include "mr_bench.h"
 #include "mr_export.h"
+#include "mr_session.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -58,8 +60,73 @@ static mr_dmat4 pose_for(const mr_bench_gpu *g, const mr_scene *planned, const c
     return pose_towards(target);
 }
 
+/* Whether the plan, seen from view, shows the part at target's pixel (or,
+ * for a hidden part, what hides it just in front): a pick on a small render. */
+static bool clear_view(const mr_bench_gpu *g, const mr_scene *planned, const char *node, const mr_view *view,
+                       mr_dvec3 target, bool hidden) {
+    mr_view v = *view;
+    v.camera = mr_camera_resized(&view->camera, 160, 120);
+    memset(v.camera.dist, 0, sizeof v.camera.dist);
+    mr_dmat4 cw = mr_m4_invert_rigid(&v.world_from_camera);
+    mr_dvec3 pc = mr_m4_point(&cw, target);
+    if (!(pc.z > 0.5)) return false;
+    mr_frame_params fp = MR_FRAME_DEFAULTS;
+    mr_frame_result res = {0};
+    mr_pick pick = {0};
+    mr_error e = {0};
+    bool ok = mr_render_frame(g->renderer, &v, &fp, &res, &e) &&
+              mr_renderer_pick(g->renderer, v.camera.fx * pc.x / pc.z + v.camera.cx, v.camera.fy * pc.y / pc.z + v.camera.cy,
+                               &pick, &e);
+    mr_frame_result_free(&res);
+    if (!ok || !pick.hit || pick.node < 0 || pick.node >= planned->node_count) return false;
+    double d = mr_v3_len(mr_v3_sub(target, mr_v3(v.world_from_camera.m[3], v.world_from_camera.m[7], v.world_from_camera.m[11])));
+    return hidden ? pick.depth < d && pick.depth > d - 1.0 : strcmp(planned->nodes[pick.node].name, node) == 0;
+}
+
+/* The recording's frame to mark target on: a tracked pose with its
+ * covariance from at least two tags, target well inside the image and
+ * within 12 m, a clear view of the part on the plan; of those the one with
+ * the smallest registration sigma at target (mr_pose_point_sigma). -1: none. */
+#define MARK_CANDIDATES 8
+static int pick_frame(const mr_recording *rec, const mr_bench_gpu *g, const mr_scene *planned, const char *node,
+                      mr_dvec3 target, bool hidden, double *sigma_out) {
+    int cand[MARK_CANDIDATES];
+    double cs[MARK_CANDIDATES];
+    int nc = 0;
+    for (int i = 0; i < rec->frame_count; i++) {
+        const mr_pose *p = &rec->frames[i].pose;
+        if (!p->valid || p->tags_used < 2 || !(p->corner_sigma_px > 0)) continue;
+        mr_camera cam = rec->camera;
+        mr_dmat4 cw = mr_m4_invert_rigid(&p->world_from_camera);
+        mr_dvec3 pc = mr_m4_point(&cw, target);
+        if (!(pc.z > 0.5) || mr_v3_len(pc) > 12) continue;
+        double u = cam.fx * pc.x / pc.z + cam.cx, v = cam.fy * pc.y / pc.z + cam.cy;
+        if (u < 0.15 * cam.width || u > 0.85 * cam.width || v < 0.15 * cam.height || v > 0.85 * cam.height) continue;
+        double sigma = 0;
+        if (!mr_pose_point_sigma(p, target, &sigma, NULL) || !isfinite(sigma)) continue;
+        /* keep the MARK_CANDIDATES smallest, sorted */
+        int k = nc < MARK_CANDIDATES ? nc++ : MARK_CANDIDATES - 1;
+        if (k == MARK_CANDIDATES - 1 && nc == MARK_CANDIDATES && sigma >= cs[k]) continue;
+        while (k > 0 && cs[k - 1] > sigma) {
+            cand[k] = cand[k - 1];
+            cs[k] = cs[k - 1];
+            k--;
+        }
+        cand[k] = i;
+        cs[k] = sigma;
+    }
+    for (int k = 0; k < nc; k++) {
+        mr_view v = {rec->camera, rec->frames[cand[k]].pose.world_from_camera};
+        if (clear_view(g, planned, node, &v, target, hidden)) {
+            *sigma_out = cs[k];
+            return cand[k];
+        }
+    }
+    return -1;
+}
+
 static bool one_mark(const char *session, int i, const cJSON *d, const mr_bench_gpu *g, const mr_scene *built,
-                     const mr_scene *planned, mr_error *err) {
+                     const mr_scene *planned, const mr_recording *rec, mr_error *err) {
     const cJSON *desc = cJSON_GetObjectItemCaseSensitive(d, "description");
     const cJSON *node = cJSON_GetObjectItemCaseSensitive(d, "node");
     double at[3], delta[3] = {0, 0, 0};
@@ -76,22 +143,35 @@ static bool one_mark(const char *session, int i, const cJSON *d, const mr_bench_
         if (strcmp(planned->nodes[n].name, node_name) == 0) ni = n;
     bool hidden = ni >= 0 && planned->nodes[ni].layer == MR_LAYER_HIDDEN;
     if (!mr_renderer_set_scene(g->renderer, planned, err)) return false;
-    mr_view view = {cam, pose_for(g, planned, node_name, target, hidden)};
-
-    /* The camera frame of the as-built hall (lens, blur, noise), as in the
-     * demo's frames. */
-    const int margin = 48, scale = 2;
-    mr_view wide = view;
-    wide.camera = mr_demo_wide_camera(&cam, margin);
-    mr_frame_params fp = MR_FRAME_DEFAULTS;
-    fp.width = wide.camera.width * scale;
-    fp.height = wide.camera.height * scale;
+    /* A frame of the recording, with the tracker's pose and its sigma. */
+    double sigma = -1;
+    int fi = rec ? pick_frame(rec, g, planned, node_name, target, hidden, &sigma) : -1;
+    mr_view view = {cam, mr_m4_identity()};
     mr_frame_result res = {0};
     mr_image frame = {0};
-    mr_rng rng;
-    mr_rng_seed(&rng, 2000u + (uint64_t)i);
-    bool ok = mr_renderer_set_scene(g->renderer, built, err) && mr_render_frame(g->renderer, &wide, &fp, &res, err) &&
-              mr_demo_camera_frame(&cam, &res.color, 1, margin, scale, 1.0, 2.5, &rng, &frame, err);
+    bool ok = true;
+    const mr_pose *tracked = fi >= 0 ? &rec->frames[fi].pose : NULL;
+    if (tracked) {
+        cam = rec->camera;
+        view.camera = cam;
+        view.world_from_camera = tracked->world_from_camera;
+        ok = mr_recording_load_image(rec, fi, false, &frame, err);
+    } else {
+        /* No frame of the recording sees it well: a rendered camera frame
+         * of the as-built hall (lens, blur, noise) from where a planner
+         * would stand, its pose known, not tracked (no uncertainty). */
+        view.world_from_camera = pose_for(g, planned, node_name, target, hidden);
+        const int margin = 48, scale = 2;
+        mr_view wide = view;
+        wide.camera = mr_demo_wide_camera(&cam, margin);
+        mr_frame_params fp = MR_FRAME_DEFAULTS;
+        fp.width = wide.camera.width * scale;
+        fp.height = wide.camera.height * scale;
+        mr_rng rng;
+        mr_rng_seed(&rng, 2000u + (uint64_t)i);
+        ok = mr_renderer_set_scene(g->renderer, built, err) && mr_render_frame(g->renderer, &wide, &fp, &res, err) &&
+             mr_demo_camera_frame(&cam, &res.color, 1, margin, scale, 1.0, 2.5, &rng, &frame, err);
+    }
     mr_frame_result_free(&res);
     /* The check: the plan over the frame, and the pick on the plan. */
     mr_frame_params op = MR_FRAME_DEFAULTS;
@@ -104,12 +184,16 @@ static bool one_mark(const char *session, int i, const cJSON *d, const mr_bench_
     double px = cam.fx * pc.x / pc.z + cam.cx, py = cam.fy * pc.y / pc.z + cam.cy;
     mr_pick pick = {0};
     ok = ok && mr_renderer_pick(g->renderer, px, py, &pick, err);
+    /* The sigma where the pick landed, as the view shows it there. */
+    double s_hit = 0;
+    if (ok && tracked && pick.hit && mr_pose_point_sigma(tracked, pick.world, &s_hit, NULL) && isfinite(s_hit))
+        sigma = s_hit;
     mr_annotation m;
     memset(&m, 0, sizeof m);
     snprintf(m.type, sizeof m.type, "discrepancy");
     m.time_unix = 1764619200.0 + 60.0 * i; /* fixed: the demo's output is the same every run */
-    m.frame_index = i;
-    m.timestamp = 0;
+    m.frame_index = tracked ? rec->frames[fi].index : i;
+    m.timestamp = tracked ? rec->frames[fi].t : 0;
     snprintf(m.note, sizeof m.note, "%s", cJSON_IsString(desc) ? desc->valuestring : "discrepancy");
     m.has_pixel = true;
     m.pixel[0] = px, m.pixel[1] = py;
@@ -124,17 +208,21 @@ static bool one_mark(const char *session, int i, const cJSON *d, const mr_bench_
     }
     m.has_pose = m.pose_valid = true;
     m.world_from_camera = view.world_from_camera;
-    m.pose_tags_seen = -1;
-    m.pose_rms_px = -1;
+    m.pose_tags_seen = tracked ? tracked->tags_seen : -1;
+    m.pose_rms_px = tracked ? tracked->rms_px : -1;
     char stem[32];
     snprintf(stem, sizeof stem, "mark_%04d", i + 1);
     mr_mark_files fl = {.stem = stem, .frame = &frame, .screen = &res.color, .camera = &cam,
                         .distance_m = has_delta ? mr_v3_len(mr_v3(delta[0], delta[1], delta[2])) : -1,
-                        .uncertainty_m = -1};
+                        .uncertainty_m = tracked ? sigma : -1};
     ok = ok && mr_export_mark_write(session, &m, &fl, err);
-    if (ok)
-        printf("  mark %d at (%.2f, %.2f, %.2f) on %s: %s\n", i + 1, target.x, target.y, target.z,
-               cJSON_IsString(node) ? node->valuestring : "?", m.note);
+    if (ok && tracked)
+        printf("  mark %d at (%.2f, %.2f, %.2f) on %s, recording frame %lld, +/- %.0f mm: %s\n", i + 1, target.x,
+               target.y, target.z, cJSON_IsString(node) ? node->valuestring : "?", (long long)m.frame_index, sigma * 1e3,
+               m.note);
+    else if (ok)
+        printf("  mark %d at (%.2f, %.2f, %.2f) on %s (no recorded frame sees it: a rendered view): %s\n", i + 1,
+               target.x, target.y, target.z, cJSON_IsString(node) ? node->valuestring : "?", m.note);
     mr_frame_result_free(&res);
     mr_image_free(&frame);
     return ok;
@@ -145,6 +233,11 @@ bool mr_demo_marks(const char *dir, const mr_bench_gpu *g, const mr_scene *built
     mr_path_join(dir, "discrepancies.json", path, sizeof path);
     cJSON *list = mr_json_load(path, err);
     if (!list) return false;
+    /* The demo's own recording (written before the marks), if it is there. */
+    mr_path_join(dir, "recording", path, sizeof path);
+    mr_error re = {0};
+    mr_recording *rec = mr_is_recording(path) ? mr_recording_open(path, &re) : NULL;
+    if (!rec && re.code) mr_log(MR_LOG_WARN, "demo: %s: %s (marks on rendered views)", path, re.msg);
     mr_path_join(dir, "session", session, sizeof session);
     /* The demo rebuilds its session: an earlier run's marks would add up. */
     mr_path_join(session, "annotations.jsonl", path, sizeof path);
@@ -152,8 +245,9 @@ bool mr_demo_marks(const char *dir, const mr_bench_gpu *g, const mr_scene *built
     bool ok = mr_mkdirs(session, err);
     printf("marks at the known discrepancies (%s/session/):\n", dir);
     for (int i = 0; ok && i < cJSON_GetArraySize(list); i++)
-        ok = one_mark(session, i, cJSON_GetArrayItem(list, i), g, built, planned, err);
+        ok = one_mark(session, i, cJSON_GetArrayItem(list, i), g, built, planned, rec, err);
     cJSON_Delete(list);
+    mr_recording_close(&rec);
     mr_export_params p = MR_EXPORT_DEFAULTS;
     p.scene = planned;
     p.title = "mrcheck demo: the hall as built against the plan";

@@ -200,21 +200,26 @@ extern const mr_opt mr_bench_map_opts[]; /* seeds, max-photos, noise, misdetect 
  * field is taken as given (noise, exposure and seed 0 are meaningful), out
  * of range: MR_ERR_INVALID. */
 typedef struct mr_synth_recording_params {
-    int frames;       /* spread over the path, >= 1; default 120 (one per path step) */
+    int frames;       /* spread over the path (timestamps on the path's clock); 0 = default:
+                         one per path step, mr_synth_path_frames() */
     int width, height; /* px, at least 64x48; default 640x480 (the demo camera) */
     double noise;     /* sensor noise sigma in grey levels, >= 0; default 2 */
-    int motion_blur;  /* sub-frames averaged per frame, 1 (none)..16; default 3 */
+    int motion_blur;  /* sub-frames averaged over the shutter, 1 (none)..16; default 3 */
+    double shutter;   /* exposure time 1/shutter s, 1..100000; default 60 (1/60 s, an indoor
+                         tablet's auto-exposure) */
     double exposure;  /* relative exposure swing along the path, 0..<1; default 0.25 */
-    int jpeg_quality; /* of the stored frames; default 90 */
+    int jpeg_quality; /* of the stored frames; default 80 (the shipped recording < 5 MB) */
     uint64_t seed;    /* noise seed; default 1 */
-    double fps;       /* frame rate of the timestamps, > 0; default 10 */
+    double fps;       /* path steps per second (the frame rate at one frame per step), > 0; default 10 */
     bool progress;    /* "synth: frame i/n" on stderr */
 } mr_synth_recording_params;
 #define MR_SYNTH_RECORDING_DEFAULTS \
-    .frames = 120, .width = 640, .height = 480, .noise = 2.0, .motion_blur = 3, .exposure = 0.25, .jpeg_quality = 90, \
-    .seed = 1, .fps = 10.0
+    .frames = 0, .width = 640, .height = 480, .noise = 2.0, .motion_blur = 3, .shutter = 60, .exposure = 0.25, \
+    .jpeg_quality = 80, .seed = 1, .fps = 10.0
 bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params, const mr_bench_gpu *gfx, mr_error *err);
-/* frames, noise, motion-blur, exposure, jpeg, fps (the seed, 64 bits, and
+/* Steps of the walking path (pauses and walks), the default frame count. */
+int mr_synth_path_frames(void);
+/* frames, noise, motion-blur, shutter, exposure, jpeg, fps (the seed, 64 bits, and
  * the size stay the command's own options). */
 extern const mr_opt mr_synth_recording_opts[];
 /* The calibration set: dir/board.json (the board of mr_demo_board_tag as a

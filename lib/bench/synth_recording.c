@@ -15,30 +15,45 @@
 /* ------------------------------------------------------------ the path */
 
 /* Keyframes of the check walk (issue 16): eye, look-at target and how many
- * frames to pause there (the camera is still: jitter is measured there)
- * before walking `walk` frames to the next keyframe. From the yellow lathe
- * and the roller conveyor in the east, past the robot cell that was
- * installed 0.30 m off its plan, along the west roller conveyor, to the
- * missing column and the partition with the raised pipe behind it. Each
- * pause faces one of the hall's tag posts (four tags on two faces, 3.5-5 m
- * away), which stay in view while walking on. */
+ * path steps (0.1 s each at the default 10 fps) to pause there (the camera
+ * is still: jitter is measured there) before walking `walk` steps to the
+ * next keyframe. From the yellow lathe and the roller conveyor in the east,
+ * past the robot cell that was installed 0.30 m off its plan, along the
+ * west roller conveyor, to the missing column and the partition with the
+ * raised pipe behind it. Each pause faces one of the hall's tag posts (four
+ * tags on two faces, 3.5-5 m away), which stay in view while walking on.
+ * The walks are paced as a person walks with a tablet: 5.6, 8.9 and 4.0 m
+ * in 5.1, 8.1 and 3.7 s, about 1.1 m/s on average and 1.4 m/s at most
+ * (walk_u); the first recording covered the same distances in 2.9, 2.9 and
+ * 1.6 s, up to 4.5 m/s, a run, whose blur no detector setting could read. */
 typedef struct keyframe { double eye[3], at[3]; int pause, walk; } keyframe;
 static const keyframe k_path[] = {
-    {{11.5, 1.60, 4.0}, {9.0, 1.3, -0.5}, 10, 36},    /* lathe, roller conveyor, post 0 */
-    {{6.0, 1.60, 5.0}, {0.8, 1.2, 0.3}, 14, 36},      /* the moved robot cell, post 1 */
-    {{-2.5, 1.60, 2.5}, {-8.0, 1.1, 0.5}, 10, 20},    /* west conveyor, post 2 */
-    {{-6.5, 1.60, 3.0}, {-12.0, 1.8, 6.0}, 24, 0},    /* missing column, partition, post 3 */
+    {{11.5, 1.60, 4.0}, {9.0, 1.3, -0.5}, 10, 51},    /* lathe, roller conveyor, post 0 */
+    {{6.0, 1.60, 5.0}, {0.8, 1.2, 0.3}, 12, 81},      /* the moved robot cell, post 1 */
+    {{-2.5, 1.60, 2.5}, {-8.0, 1.1, 0.5}, 10, 37},    /* west conveyor, post 2 */
+    {{-6.5, 1.60, 3.0}, {-12.0, 1.8, 6.0}, 16, 0},    /* missing column, partition, post 3 */
 };
 #define PATH_KEYS (int)(sizeof k_path / sizeof k_path[0])
 
-static int path_frames(void) {
+int mr_synth_path_frames(void) {
     int n = 0;
     for (int i = 0; i < PATH_KEYS; i++) n += k_path[i].pause + k_path[i].walk;
     return n;
 }
 
-/* Pose at path position s in [0, path_frames()) (fractional), and whether
- * the camera stands still there. */
+/* Walked fraction at x in [0,1] of a walk: speeding up over the first
+ * fifth, a steady pace, slowing down over the last fifth (peak speed 1.25x
+ * the mean; a smoothstep's 1.5x is a lunge). */
+static double walk_u(double x) {
+    const double a = 0.2, v = 1.0 / (1.0 - a);
+    x = x < 0 ? 0 : x > 1 ? 1 : x;
+    if (x < a) return v * x * x / (2 * a);
+    if (x > 1 - a) return 1 - v * (1 - x) * (1 - x) / (2 * a);
+    return v * (x - a / 2);
+}
+
+/* Pose at path position s in [0, mr_synth_path_frames()) (fractional), and
+ * whether the camera stands still there. */
 static mr_dmat4 path_pose(double s, bool *still) {
     int base = 0;
     for (int i = 0; i < PATH_KEYS; i++) {
@@ -51,8 +66,7 @@ static mr_dmat4 path_pose(double s, bool *still) {
         if (s < base + k->pause + k->walk) {
             const keyframe *n = &k_path[i + 1];
             /* walk frames end one step before the next pause */
-            double u = (s - base - k->pause + 1) / (k->walk + 1);
-            u = u * u * (3 - 2 * u); /* ease in and out */
+            double u = walk_u((s - base - k->pause + 1) / (k->walk + 1));
             double e[3], a[3];
             for (int c = 0; c < 3; c++) {
                 e[c] = k->eye[c] + u * (n->eye[c] - k->eye[c]);
@@ -98,8 +112,8 @@ static bool track_frame(mr_tracker *trk, const mr_image *gray, mr_frame_record *
 bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params, const mr_bench_gpu *gfx, mr_error *err) {
     mr_synth_recording_params p = params ? *params : (mr_synth_recording_params){MR_SYNTH_RECORDING_DEFAULTS};
     if (!bench_gpu_check(gfx, "synth", err)) return false;
-    if (p.frames < 1 || p.width < 64 || p.height < 48 || p.motion_blur < 1 || p.motion_blur > 16 || p.noise < 0 ||
-        p.exposure < 0 || p.exposure >= 1 || p.fps <= 0)
+    if (p.frames < 0 || p.width < 64 || p.height < 48 || p.motion_blur < 1 || p.motion_blur > 16 || p.noise < 0 ||
+        p.exposure < 0 || p.exposure >= 1 || p.fps <= 0 || !(p.shutter >= 1 && p.shutter <= 1e5))
         return mr_fail(err, MR_ERR_INVALID, "synth: parameters out of range");
     mr_demo_hall hall;
     if (!mr_demo_build_tagged(NULL, 0, &hall, err)) return false;
@@ -138,19 +152,21 @@ bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params
     memset(ideal, 0, sizeof ideal);
     mr_rng rng;
     mr_rng_seed(&rng, p.seed);
-    int total = path_frames();
+    const int total = mr_synth_path_frames();
+    const int frames = p.frames > 0 ? p.frames : total;
     int with_pose = 0;
-    for (int i = 0; ok && i < p.frames; i++) {
-        /* Spread the requested frames over the whole path. */
-        double s = p.frames > 1 ? (double)i * (total - 1) / (p.frames - 1) : 0;
-        double step = p.frames > 1 ? (double)(total - 1) / (p.frames - 1) : 1;
+    for (int i = 0; ok && i < frames; i++) {
+        /* Spread the frames over the whole path; the timestamps are the
+         * path's clock (one step per 1/fps), so fewer frames are further
+         * apart in time, never a faster walk. */
+        double s = frames > 1 ? (double)i * (total - 1) / (frames - 1) : 0;
         bool still = false;
         mr_dmat4 truth = path_pose(s, &still);
-        double t = i / p.fps;
-        /* Sub-frames over an open shutter of a quarter of the frame
-         * interval (1/40 s at 10 fps, an indoor auto-exposure). */
+        double t = s / p.fps;
+        /* Sub-frames over the open shutter, 1/shutter s before the frame's
+         * time (1/60 s: an indoor tablet's auto-exposure at walking pace). */
         for (int k = 0; ok && k < p.motion_blur; k++) {
-            double sk = p.motion_blur > 1 ? s - 0.25 * step * (double)k / (p.motion_blur - 1) : s;
+            double sk = p.motion_blur > 1 ? s - p.fps / p.shutter * (double)k / (p.motion_blur - 1) : s;
             mr_view v = {wide, path_pose(sk < 0 ? 0 : sk, NULL)};
             mr_frame_params fp = MR_FRAME_DEFAULTS;
             fp.width = wide.width * scale;
@@ -178,12 +194,12 @@ bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params
         }
         mr_image_free(&frame);
         mr_image_free(&gray);
-        if (ok && i % 10 == 0) mr_log(MR_LOG_INFO, "synth: frame %d/%d, %d tags", i, p.frames, n);
-        if (ok && p.progress) fprintf(stderr, "\rsynth: frame %d/%d", i + 1, p.frames);
+        if (ok && i % 10 == 0) mr_log(MR_LOG_INFO, "synth: frame %d/%d, %d tags", i, frames, n);
+        if (ok && p.progress) fprintf(stderr, "\rsynth: frame %d/%d", i + 1, frames);
     }
     if (p.progress) fprintf(stderr, "\r\033[K");
     for (int k = 0; k < 16; k++) mr_image_free(&ideal[k]);
-    if (ok) mr_log(MR_LOG_INFO, "synth: %d frames, %d with a pose", p.frames, with_pose);
+    if (ok) mr_log(MR_LOG_INFO, "synth: %d frames, %d with a pose", frames, with_pose);
     mr_recorder_close(&rec);
     mr_tracker_destroy(&trk);
     mr_renderer_set_scene(gfx->renderer, NULL, NULL); /* the caller's renderer keeps no scene of ours */

@@ -12,6 +12,7 @@
 typedef struct setting {
     char name[48];
     bool aruco;
+    bool adaptive;              /* the tracker's own detector, adaptive decimation (mrcheck track's default) */
     double decimate;
     int threads;
     int refine;                 /* apriltag: edge refinement 0/1; aruco: mr_aruco_refine */
@@ -21,6 +22,8 @@ typedef struct result {
     double ms_med, ms_p95, det_ms_med;
     double t_err_mm, t_err_pct, r_err_deg, rms_px;
     double det_rate, det_rate56, det_rate_still, pose_rate, flip_rate;
+    double pose_rate20;         /* frames with a pose / frames where a tag of >= 20 px is in view */
+    double dec_mean;            /* mean decimation used (adaptive) */
     double jit_raw_mm, jit_raw_deg, jit_filt_mm, jit_filt_deg;
     int frames;
 } result;
@@ -81,10 +84,23 @@ typedef struct track_out {
     mr_pose pose;     /* raw */
     mr_dmat4 filtered; /* = the raw pose when there is no filtered one */
     double detect_ms, ms;
+    double decimate;   /* the tracker's own detector: what it used */
 } track_out;
 
 static bool track_step(tracker *t, const mr_image *img, double ts, track_out *o, mr_error *err) {
     double t0 = mr_time_now();
+    if (!t->det && !t->ar) {
+        /* The tracker's own detector: mr_tracker_frame as `track` runs it. */
+        mr_tracker_result r;
+        bool ok = mr_tracker_frame(t->trk, img, ts, &r, err);
+        o->ms = o->detect_ms = (mr_time_now() - t0) * 1e3;
+        o->dets = r.detections;
+        o->count = r.detection_count;
+        o->pose = r.pose;
+        o->filtered = ok && r.has_filtered ? r.filtered : r.pose.world_from_camera;
+        o->decimate = r.decimate;
+        return ok;
+    }
     o->count = 0;
     o->dets = t->ar ? mr_aruco_detect(t->ar, img, &o->count, err) : mr_detector_detect(t->det, img, &o->count, err);
     double t1 = mr_time_now();
@@ -107,7 +123,7 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
     if (s->aruco) {
         ar = mr_aruco_create((mr_aruco_refine)s->refine, err);
         if (!ar) return false;
-    } else {
+    } else if (!s->adaptive) {
         mr_detector_params dp = MR_DETECTOR_DEFAULTS;
         dp.family = rec->markers.family;
         dp.decimate = s->decimate;
@@ -129,13 +145,15 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
     bool ok = trk && ms && dms && te && tp && re && rm && seg_raw && seg_f;
     if (!ok && trk) mr_fail(err, MR_ERR_NOMEM, "out of memory");
     int nposes = 0, nflip = 0, vis = 0, vis_hit = 0, vis56 = 0, vis56_hit = 0, vis_st = 0, vis_st_hit = 0, seg_n = 0;
+    int f20 = 0, f20_hit = 0;
+    double dec_sum = 0;
     jitter_acc jr = {0}, jf = {0};
     tracker tk = {det, ar, trk};
     /* one untimed warm-up frame: thread pools, first allocations */
     int wn;
     if (ok && nf > 0) {
         if (ar) mr_aruco_detect(ar, &imgs[0], &wn, NULL);
-        else mr_detector_detect(det, &imgs[0], &wn, NULL);
+        else if (det) mr_detector_detect(det, &imgs[0], &wn, NULL);
     }
     for (int i = 0; ok && i < nf; i++) {
         const mr_rec_frame *f = &rec->frames[fidx[i]];
@@ -150,9 +168,12 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
         /* detection rate against the tags the ground truth sees */
         double dist_sum = 0;
         int dist_n = 0;
+        bool has20 = false;
+        dec_sum += tr.decimate;
         for (int m = 0; m < rec->markers.count; m++) {
             double edge;
             if (!gt_visible(&cam, &rec->markers, &rec->markers.tags[m], &f->gt, &edge) || edge < 10) continue;
+            has20 = has20 || edge >= 20;
             bool hit = false;
             for (int k = 0; k < n; k++) hit = hit || d[k].id == rec->markers.tags[m].id;
             vis++;
@@ -166,6 +187,8 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
                 vis_st_hit += hit;
             }
         }
+        f20 += has20;
+        f20_hit += has20 && pose.valid;
         const mr_dmat4 filtered = tr.filtered;
         if (pose.valid) {
             for (int k = 0; k < pose.tags_used && k < MR_POSE_MAX_IDS; k++) {
@@ -217,6 +240,8 @@ static bool run_setting(const setting *s, const mr_recording *rec, const mr_imag
         res->det_rate_still = vis_st ? (double)vis_st_hit / vis_st : NAN;
         res->pose_rate = nf ? (double)nposes / nf : 0;
         res->flip_rate = nposes ? (double)nflip / nposes : NAN;
+        res->pose_rate20 = f20 ? (double)f20_hit / f20 : NAN;
+        res->dec_mean = s->adaptive && nf ? dec_sum / nf : s->aruco ? NAN : s->decimate;
         res->jit_raw_mm = jr.n ? 1e3 * sqrt(jr.sum_t2 / jr.n) : NAN;
         res->jit_raw_deg = jr.n ? sqrt(jr.sum_r2 / jr.n) : NAN;
         res->jit_filt_mm = jf.n ? 1e3 * sqrt(jf.sum_t2 / jf.n) : NAN;
@@ -266,15 +291,16 @@ static bool write_svg(const char *path, const char *title, const setting *s, con
                  r[i].t_err_mm, r[i].t_err_pct, 100 * r[i].flip_rate);
         snprintf(nums[i], sizeof nums[i], "%d", i + 1);
         ser[i] = (mr_plot_series){.name = names[i], .x = &r[i].ms_med, .y = &r[i].t_err_mm, .count = 1,
-                                  .color = s[i].aruco ? "#e08a2c" : s[i].threads > 1 ? "#2c8a3b" : "#3b6fb6",
+                                  .color = s[i].aruco ? "#e08a2c" : s[i].adaptive ? "#c0392b" : s[i].threads > 1 ? "#2c8a3b" : "#3b6fb6",
                                   .no_line = true, .point_label = nums[i]};
     }
-    static const char *const notes[3] = {"blue: apriltag, 1 thread", "green: apriltag, 2 threads",
+    static const char *const notes[4] = {"blue: apriltag, 1 thread", "green: apriltag, 2 threads",
+                                         "red: the tracker's adaptive decimation (default)",
                                          "orange: OpenCV aruco DICT_APRILTAG_36h11"};
     mr_plot_params pp = {.title = title, .xlabel = "median ms per frame (detection + pose, log scale)",
                          .ylabel = "median translation error, mm (log scale)", .log_x = true, .log_y = true,
                          .x_min = xmin, .x_max = xmax, .y_min = ymin, .y_max = ymax, .width = 1000,
-                         .height = 120 + 18 * (n + 3), .legend_width = 330, .notes = notes, .note_count = 3};
+                         .height = 120 + 18 * (n + 3), .legend_width = 330, .notes = notes, .note_count = 4};
     if (pp.height < 600) pp.height = 600;
     bool ok = mr_plot_write(path, &pp, ser, n, err);
     free(ser);
@@ -329,6 +355,15 @@ bool mr_bench_tracking(const mr_bench_tracking_params *params, mr_error *err) {
                 s->refine = rf;
                 snprintf(s->name, sizeof s->name, "apriltag d%g t%d r%d", decs[di], th, rf);
             }
+    /* The tracker as `track` runs it by default: adaptive decimation. */
+    {
+        setting *s = &set[ns++];
+        memset(s, 0, sizeof *s);
+        s->adaptive = true;
+        s->threads = 1;
+        s->refine = 1;
+        snprintf(s->name, sizeof s->name, "tracker adaptive t1 r1");
+    }
     for (int m = 0; m < 4; m++) {
         setting *s = &set[ns++];
         memset(s, 0, sizeof *s);
@@ -344,29 +379,30 @@ bool mr_bench_tracking(const mr_bench_tracking_params *params, mr_error *err) {
         mr_csv_header(csv, "detector,decimate,threads,refine,frames,ms_median,ms_p95,detect_ms_median,t_err_mm_median,"
                            "t_err_pct_median,r_err_deg_median,reproj_rms_px_median,detection_rate,detection_rate_56px,"
                            "detection_rate_still,pose_rate,flip_rate,jitter_raw_mm,jitter_raw_deg,jitter_filtered_mm,"
-                           "jitter_filtered_deg");
+                           "jitter_filtered_deg,pose_rate_20px,decimate_mean");
         BENCH_PRINT(out, "bench tracking: %s, %d frames %dx%d, %s\n", dir, nf, imgs[0].width, imgs[0].height,
                "ms = detection + pose per frame (median / p95)");
-        BENCH_PRINT(out, "%-22s %7s %7s %8s %7s %7s %6s %6s %6s %6s %6s %6s %13s %13s\n", "setting", "ms med", "ms p95", "t err mm",
-               "t err %", "r err", "rms px", "det", "det56", "still", "pose", "flip", "jitter raw", "jitter filt");
+        BENCH_PRINT(out, "%-22s %7s %7s %8s %7s %7s %6s %6s %6s %6s %6s %6s %13s %13s %6s %5s\n", "setting", "ms med", "ms p95", "t err mm",
+               "t err %", "r err", "rms px", "det", "det56", "still", "pose", "flip", "jitter raw", "jitter filt", "pose20", "dec");
     }
     for (int i = 0; ok && i < ns; i++) {
         ok = run_setting(&set[i], rec, imgs, fidx, nf, &fparams, &res[i], err);
         if (!ok) break;
         const result *r = &res[i];
-        BENCH_PRINT(out, "%-22s %7.2f %7.2f %8.1f %7.2f %7.3f %6.3f %5.1f%% %5.1f%% %5.1f%% %5.1f%% %5.1f%% %5.2fmm/%.3f° %5.2fmm/%.3f°\n",
+        BENCH_PRINT(out, "%-22s %7.2f %7.2f %8.1f %7.2f %7.3f %6.3f %5.1f%% %5.1f%% %5.1f%% %5.1f%% %5.1f%% %5.2fmm/%.3f° %5.2fmm/%.3f° %5.1f%% %5.2f\n",
                set[i].name, r->ms_med, r->ms_p95, r->t_err_mm, r->t_err_pct, r->r_err_deg, r->rms_px, 100 * r->det_rate,
                100 * r->det_rate56, 100 * r->det_rate_still, 100 * r->pose_rate, 100 * r->flip_rate, r->jit_raw_mm, r->jit_raw_deg, r->jit_filt_mm,
-               r->jit_filt_deg);
+               r->jit_filt_deg, 100 * r->pose_rate20, r->dec_mean);
         if (out) fflush(out);
-        mr_csv_text(csv, set[i].aruco ? "opencv-aruco" : "apriltag");
-        mr_csv_num(csv, "%g", set[i].aruco ? 1.0 : set[i].decimate);
+        mr_csv_text(csv, set[i].aruco ? "opencv-aruco" : set[i].adaptive ? "apriltag-adaptive" : "apriltag");
+        mr_csv_num(csv, "%g", set[i].aruco ? 1.0 : set[i].adaptive ? 0.0 : set[i].decimate);
         mr_csv_int(csv, set[i].threads);
         mr_csv_text(csv, set[i].aruco ? mr_aruco_refine_name((mr_aruco_refine)set[i].refine) : set[i].refine ? "1" : "0");
         mr_csv_int(csv, r->frames);
         const double v[] = {r->ms_med,     r->ms_p95,       r->det_ms_med, r->t_err_mm,  r->t_err_pct,  r->r_err_deg,
                             r->rms_px,     r->det_rate,     r->det_rate56, r->det_rate_still, r->pose_rate, r->flip_rate,
-                            r->jit_raw_mm, r->jit_raw_deg,  r->jit_filt_mm, r->jit_filt_deg};
+                            r->jit_raw_mm, r->jit_raw_deg,  r->jit_filt_mm, r->jit_filt_deg,
+                            r->pose_rate20, r->dec_mean};
         for (int k = 0; k < (int)(sizeof v / sizeof v[0]); k++) mr_csv_num(csv, k == 3 ? "%.3f" : "%.4f", v[k]); /* t_err_mm: %.3f */
         mr_csv_end_row(csv);
     }

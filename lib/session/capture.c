@@ -320,6 +320,15 @@ static void *tracker(void *arg) {
             f.rms_px = rf->rms_px;
             last_cov.corner_sigma_px = rf->corner_sigma_px;
             memcpy(last_cov.cov, rf->cov, sizeof last_cov.cov);
+        } else if (trk && rf) {
+            /* A recording retracked: the tracker reads the JPEG's luma (the
+             * Y plane, what `track` and the bench read), not grey from the
+             * RGB decode on screen. */
+            mr_image luma = {0};
+            mr_error le = {0};
+            bool have_luma = mr_replay_load_image(c->rp, index, true, &luma, &le);
+            track_frame(trk, have_luma ? &luma : &work, t, &f, &last_pose, &last_cov);
+            mr_image_free(&luma);
         } else if (trk) {
             track_frame(trk, &work, t, &f, &last_pose, &last_cov);
         }

@@ -131,6 +131,14 @@ bool mr_image_to_gray(const mr_image *src, mr_image *dst, mr_error *err) {
     return true;
 }
 
+bool mr_detector_set_decimate(mr_detector *d, double decimate) {
+    if (!isfinite(decimate) || decimate < 1.0 || decimate > 16.0) return false;
+    d->td->quad_decimate = (float)decimate;
+    return true;
+}
+
+double mr_detector_decimate(const mr_detector *d) { return d->td->quad_decimate; }
+
 static int cmp_det(const void *a, const void *b) {
     const mr_detection *x = a, *y = b;
     if (x->id != y->id) return x->id < y->id ? -1 : 1;

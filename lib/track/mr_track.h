@@ -105,6 +105,10 @@ void mr_detector_destroy(mr_detector **det);
  * detector and valid until the next call; NULL + err on failure (a frame
  * that is too small, a bad image). Zero detections is success. */
 const mr_detection *mr_detector_detect(mr_detector *det, const mr_image *img, int *count, mr_error *err);
+/* The decimation of the next detection, in [1, 16] (false otherwise); the
+ * tracker's adaptive decimation sets it per frame. */
+bool mr_detector_set_decimate(mr_detector *det, double decimate);
+double mr_detector_decimate(const mr_detector *det);
 
 /* ------------------------------------------------- marker-map building */
 
@@ -429,6 +433,25 @@ bool mr_pose_filter_last(const mr_pose_filter *f, mr_dmat4 *out);
  * timestamp going backwards (a seek) also drops it. Without it, the solver
  * takes the candidate most tags agree with, then the lowest error.
  *
+ * Adaptive decimation (issue 16), when detector.decimate is left 0: the
+ * detector's decimation for a frame is picked from the tags of the frame
+ * before, by the shortest edge e (px, full resolution) of the second
+ * largest tag detected (the only one's, if one): 4 for e >= 64, 3 for
+ * e >= 48, 2 for e >= 16, 1 below, so two tags keep >= 16 px after
+ * decimation at 3 and 4, >= 8 at 2 (the 20 px tags of the shipped
+ * recording are found at 2 as at 1). Two tags keep the pose multi-tag (no
+ * mirror ambiguity); smaller, further tags add little to the pose and may
+ * be lost at 3 or 4. Edge refinement (on by default) fits the corners at
+ * full resolution again: decimation 2's accuracy at a fraction of the time
+ * on large tags. On the first frame and after a frame without tags it is
+ * the conservative MR_DETECTOR_DEFAULT_DECIMATE (2), and a pick coarser
+ * than that gives way to 2 on every MR_TRACKER_PROBE_FRAMES-th frame (a
+ * probe for tags that came into view). A frame that finds fewer than two
+ * tags at a coarser decimation than 2, and fewer than the frame before, is
+ * detected once more at 2 (a miss costs one more detection, never the frame
+ * or a multi-tag pose). An explicit
+ * detector.decimate (--decimate) fixes it. r.decimate says which was used.
+ *
  * Usage (all a caller needs):
  *
  *   mr_tracker_params tp = MR_TRACKER_DEFAULTS;
@@ -472,7 +495,14 @@ typedef struct mr_tracker_result {
     bool filter_reset;              /* the filter restarted on this frame (first
                                        pose, jump, gap) */
     bool frozen;                    /* the filter holds its pose */
+    double decimate;                /* the detector's decimation on this frame
+                                       (mr_tracker_frame; 0 from mr_tracker_detections) */
+    bool redetected;                /* adaptive decimation lost the last frame's tags
+                                       and the frame was detected again at 2 */
 } mr_tracker_result;
+/* Adaptive decimation (above): the probe interval, and the rule. */
+#define MR_TRACKER_PROBE_FRAMES 8
+double mr_tracker_pick_decimate(double min_edge_px);
 
 typedef struct mr_tracker mr_tracker;
 /* NULL + err on bad parameters (an invalid camera, an unknown family). */

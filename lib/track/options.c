@@ -12,8 +12,10 @@
 
 #define DT(f) offsetof(mr_detector_params, f)
 const mr_opt mr_detector_opts[] = {
-    {"decimate", MR_OPT_DOUBLE, DT(decimate), 1, 16, MR_DETECTOR_DEFAULT_DECIMATE, NULL, "detector decimation",
-     MR_OPT_ZERO_DEFAULT},
+    /* 0 = auto: the tracker's adaptive decimation (mr_track.h); a bare
+     * detector takes MR_DETECTOR_DEFAULT_DECIMATE for it. */
+    {"decimate", MR_OPT_DOUBLE, DT(decimate), 1, 16, 0, NULL,
+     "detector decimation (auto: adaptive, from the tags of the frame before)", MR_OPT_ZERO_AUTO},
     /* The detector takes up to 256; the command line has always stopped at 64. */
     {"threads", MR_OPT_INT, DT(threads), 1, 64, MR_DETECTOR_DEFAULT_THREADS, NULL, "detector threads",
      MR_OPT_ZERO_DEFAULT},

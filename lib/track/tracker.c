@@ -17,6 +17,11 @@ struct mr_tracker {
     double prev_max_age_s;      /* resolved, > 0 */
     mr_pose prev;               /* last valid raw pose */
     double prev_t;
+    /* adaptive decimation (mr_track.h): on unless a decimation was given */
+    bool adaptive;
+    double next_dec;            /* picked from the last frame's tags; 0 = conservative */
+    int since_probe;            /* frames since the last conservative one */
+    int last_n;                 /* tags the last frame found */
 };
 
 static bool copy_markers(const mr_marker_map *src, mr_marker_map *dst, mr_error *err) {
@@ -51,6 +56,7 @@ mr_tracker *mr_tracker_create(const mr_tracker_params *params, mr_error *err) {
     }
     mr_detector_params dp = p.detector;
     if (!dp.family && t->has_markers) dp.family = t->markers.family;
+    t->adaptive = dp.decimate == 0;
     t->det = mr_detector_create(&dp, err);
     if (!t->det) goto fail;
     if (!p.no_filter) {
@@ -79,6 +85,9 @@ void mr_tracker_destroy(mr_tracker **t) {
 void mr_tracker_reset(mr_tracker *t) {
     memset(&t->prev, 0, sizeof t->prev);
     t->prev_t = 0;
+    t->next_dec = 0;
+    t->since_probe = 0;
+    t->last_n = 0;
     if (t->filter) {
         mr_pose_filter_freeze(t->filter, false);
         mr_pose_filter_reset(t->filter);
@@ -95,15 +104,74 @@ const mr_camera *mr_tracker_camera(const mr_tracker *t) { return t->has_camera ?
 
 const mr_marker_map *mr_tracker_markers(const mr_tracker *t) { return t->has_markers ? &t->markers : NULL; }
 
+double mr_tracker_pick_decimate(double e) {
+    if (!(e >= 0)) return MR_DETECTOR_DEFAULT_DECIMATE;
+    return e >= 64 ? 4 : e >= 48 ? 3 : e >= 16 ? 2 : 1;
+}
+
+/* The tag size the decimation is picked by: the shortest edge (px) of the
+ * second largest tag detected (of the only one, if one). Two tags keep the
+ * pose multi-tag (no single tag's mirror ambiguity); smaller, further tags
+ * add little to the pose and would hold the decimation down for all. */
+static double pick_edge_px(const mr_detection *d, int n) {
+    double first = 0, second = 0;
+    for (int i = 0; i < n; i++) {
+        double e = INFINITY;
+        for (int k = 0; k < 4; k++)
+            e = fmin(e, hypot(d[i].corners[(k + 1) % 4][0] - d[i].corners[k][0],
+                              d[i].corners[(k + 1) % 4][1] - d[i].corners[k][1]));
+        if (e > first) second = first, first = e;
+        else if (e > second) second = e;
+    }
+    return n == 1 ? first : second;
+}
+
+/* The decimation for this frame, no coarser than the frame allows (the
+ * detector refuses fewer than 8 decimated px a side). */
+static double frame_decimate(const mr_tracker *t, const mr_image *image, bool *conservative) {
+    const double cons = MR_DETECTOR_DEFAULT_DECIMATE;
+    double dec = t->next_dec > 0 ? t->next_dec : cons;
+    /* The probe: finer never misses what coarser finds, so only a coarse
+     * pick is interrupted. */
+    if (dec > cons && t->since_probe >= MR_TRACKER_PROBE_FRAMES - 1) dec = cons;
+    *conservative = dec <= cons;
+    double most = fmin(image->width, image->height) / 8.0;
+    if (dec > most) dec = most < 1 ? 1 : floor(most);
+    return dec;
+}
+
 bool mr_tracker_frame(mr_tracker *t, const mr_image *image, double timestamp, mr_tracker_result *out, mr_error *err) {
     int n = 0;
+    double dec = 0;
+    bool redetected = false;
+    if (t->adaptive && image && image->width > 0 && image->height > 0) {
+        bool cons;
+        dec = frame_decimate(t, image, &cons);
+        mr_detector_set_decimate(t->det, dec);
+        t->since_probe = cons ? 0 : t->since_probe + 1;
+    }
     const mr_detection *d = mr_detector_detect(t->det, image, &n, err);
+    if (d && t->adaptive && n < 2 && n < t->last_n && dec > MR_DETECTOR_DEFAULT_DECIMATE) {
+        /* A coarse decimation lost the tags of the last frame (or all but
+         * one: a single tag's pose may be its mirror): look again. */
+        dec = MR_DETECTOR_DEFAULT_DECIMATE;
+        mr_detector_set_decimate(t->det, dec);
+        d = mr_detector_detect(t->det, image, &n, err);
+        redetected = true;
+    }
     if (!d) {
         memset(out, 0, sizeof *out);
         out->filtered = mr_m4_identity();
         return false;
     }
-    return mr_tracker_detections(t, d, n, image->width, image->height, timestamp, out, err);
+    if (t->adaptive) {
+        t->last_n = n;
+        t->next_dec = n > 0 ? mr_tracker_pick_decimate(pick_edge_px(d, n)) : 0;
+    }
+    bool ok = mr_tracker_detections(t, d, n, image->width, image->height, timestamp, out, err);
+    out->decimate = mr_detector_decimate(t->det);
+    out->redetected = redetected;
+    return ok;
 }
 
 bool mr_tracker_detections(mr_tracker *t, const mr_detection *dets, int count, int width, int height, double timestamp,
