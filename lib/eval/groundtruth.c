@@ -1,6 +1,7 @@
 /* Ray-traced ambient-occlusion ground truth with Embree 3: cosine-weighted
  * hemisphere rays of length R from each visible surface point; the result
  * is the fraction that escapes. */
+#include "eval_internal.h"
 #include "mr_eval.h"
 
 #include <math.h>
@@ -58,25 +59,12 @@ mr_eval_gt *mr_eval_gt_create(const mr_scene *s, bool skip_hidden, mr_error *err
             if (m->index_count < 3 || m->vertex_count == 0) continue;
             mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
             mr_dmat4 M = mr_m4_mul(&rel, &T);
-            RTCGeometry geom = rtcNewGeometry(g->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-            float *v = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                               m->vertex_count);
-            unsigned *idx = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                    3 * sizeof(unsigned), m->index_count / 3);
-            if (!v || !idx) {
-                rtcReleaseGeometry(geom);
+            RTCGeometry geom = mr_eval_embree_mesh(g->device, m, &M, NULL);
+            if (!geom) {
                 mr_eval_gt_destroy(&g);
                 mr_fail(err, MR_ERR_NOMEM, "embree: out of memory for mesh %s", m->name);
                 return NULL;
             }
-            for (uint32_t i = 0; i < m->vertex_count; i++) {
-                mr_dvec3 p = mr_m4_point(&M, mr_v3(m->positions[3 * i], m->positions[3 * i + 1], m->positions[3 * i + 2]));
-                v[3 * i] = (float)p.x;
-                v[3 * i + 1] = (float)p.y;
-                v[3 * i + 2] = (float)p.z;
-            }
-            memcpy(idx, m->indices, (size_t)(m->index_count / 3) * 3 * sizeof(unsigned));
-            rtcCommitGeometry(geom);
             rtcAttachGeometry(g->scene, geom);
             rtcReleaseGeometry(geom);
         }

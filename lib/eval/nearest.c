@@ -5,6 +5,7 @@
  * world transforms. The query radius shrinks to the best distance plus a
  * margin that covers the float BVH's rounding, so pruning never drops a
  * triangle that could be nearer. */
+#include "eval_internal.h"
 #include "mr_eval.h"
 
 #include <float.h>
@@ -83,30 +84,12 @@ mr_eval_nearest *mr_eval_nearest_create(const mr_scene *s, bool skip_hidden, mr_
             }
             mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
             mr_dmat4 W = mr_m4_mul(&nd->world, &T), rel = mr_m4_mul(&shift, &W);
-            RTCGeometry geom = rtcNewGeometry(n->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-            float *v = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                               m->vertex_count);
-            unsigned *idx = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                    3 * sizeof(unsigned), m->index_count / 3);
-            if (!v || !idx) {
-                rtcReleaseGeometry(geom);
+            RTCGeometry geom = mr_eval_embree_mesh(n->device, m, &rel, &n->extent);
+            if (!geom) {
                 mr_eval_nearest_destroy(&n);
                 mr_fail(err, MR_ERR_NOMEM, "embree: out of memory for mesh %s", m->name);
                 return NULL;
             }
-            for (uint32_t i = 0; i < m->vertex_count; i++) {
-                mr_dvec3 p = mr_m4_point(&rel, mr_v3(m->positions[3 * i], m->positions[3 * i + 1], m->positions[3 * i + 2]));
-                v[3 * i] = (float)p.x;
-                v[3 * i + 1] = (float)p.y;
-                v[3 * i + 2] = (float)p.z;
-                double e = fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z)));
-                if (isfinite(e) && e > n->extent) n->extent = e;
-            }
-            /* Indices out of range would be read by Embree: clamp them to a
-             * vertex (a degenerate triangle is harmless). */
-            for (uint32_t i = 0; i < m->index_count / 3 * 3; i++)
-                idx[i] = m->indices[i] < m->vertex_count ? m->indices[i] : 0;
-            rtcCommitGeometry(geom);
             unsigned id = rtcAttachGeometry(n->scene, geom);
             rtcReleaseGeometry(geom);
             /* Ids are handed out 0, 1, 2, ... in attach order. */

@@ -373,6 +373,31 @@ static int cmp_pt2(const void *x, const void *y) {
     return p[1] < q[1] ? -1 : p[1] > q[1];
 }
 
+/* Convex hull (monotone chain) of np <= 48 points (sorted in place): its
+ * area and perimeter. */
+static void hull_area2(double (*pts)[2], int np, double *area, double *perim) {
+    qsort(pts, (size_t)np, sizeof pts[0], cmp_pt2);
+    double hull[97][2];
+    int h = 0;
+    for (int i = 0; i < np; i++) {
+        while (h >= 2 && cross2(hull[h - 2], hull[h - 1], pts[i]) <= 0) h--;
+        hull[h][0] = pts[i][0];
+        hull[h][1] = pts[i][1];
+        h++;
+    }
+    for (int i = np - 2, lo = h + 1; i >= 0; i--) {
+        while (h >= lo && cross2(hull[h - 2], hull[h - 1], pts[i]) <= 0) h--;
+        hull[h][0] = pts[i][0];
+        hull[h][1] = pts[i][1];
+        h++;
+    }
+    *area = *perim = 0;
+    for (int i = 0; i + 1 < h; i++) {
+        *area += 0.5 * (hull[i][0] * hull[i + 1][1] - hull[i + 1][0] * hull[i][1]);
+        *perim += hypot(hull[i + 1][0] - hull[i][0], hull[i + 1][1] - hull[i][1]);
+    }
+}
+
 /* Bound over the piece (a, b, c) from the fan of triangles around vertex v
  * that lie in the plane of triangle `ref`: if their union is a convex
  * polygon (it equals its convex hull: same orientation, angles at v within
@@ -425,28 +450,8 @@ static double fan_bound(const tri_grid *o, uint32_t v, uint32_t ref, dv a, dv b,
         }
     }
     if (nf < 2 || angle > 2 * 3.14159265358979323846 + 1e-9) return INFINITY;
-    /* Convex hull (monotone chain) of the fan's points, its area and
-     * perimeter. */
-    qsort(pts, (size_t)np, sizeof pts[0], cmp_pt2);
-    double hull[97][2];
-    int h = 0;
-    for (int i = 0; i < np; i++) {
-        while (h >= 2 && cross2(hull[h - 2], hull[h - 1], pts[i]) <= 0) h--;
-        hull[h][0] = pts[i][0];
-        hull[h][1] = pts[i][1];
-        h++;
-    }
-    for (int i = np - 2, lo = h + 1; i >= 0; i--) {
-        while (h >= lo && cross2(hull[h - 2], hull[h - 1], pts[i]) <= 0) h--;
-        hull[h][0] = pts[i][0];
-        hull[h][1] = pts[i][1];
-        h++;
-    }
-    double harea = 0, perim = 0;
-    for (int i = 0; i + 1 < h; i++) {
-        harea += 0.5 * (hull[i][0] * hull[i + 1][1] - hull[i + 1][0] * hull[i][1]);
-        perim += hypot(hull[i + 1][0] - hull[i][0], hull[i + 1][1] - hull[i][1]);
-    }
+    double harea, perim; /* the fan's convex hull */
+    hull_area2(pts, np, &harea, &perim);
     if (!(harea > 0) || !(fabs(harea - area) <= 1e-6 * harea)) return INFINITY;
     /* What float rounding may leave uncovered: a sliver of the area
      * mismatch is at most 2 * area / perimeter wide; plus the plane slack. */
@@ -513,26 +518,8 @@ static void ring_prepare(const tri_grid *o, uint32_t v) {
         angle += atan2(ax * by - ay * bx, ax * bx + ay * by);
     }
     if (angle > 2 * 3.14159265358979323846 + 1e-9) return;
-    qsort(pts, (size_t)np, sizeof pts[0], cmp_pt2);
-    double hull[97][2];
-    int h = 0;
-    for (int i = 0; i < np; i++) {
-        while (h >= 2 && cross2(hull[h - 2], hull[h - 1], pts[i]) <= 0) h--;
-        hull[h][0] = pts[i][0];
-        hull[h][1] = pts[i][1];
-        h++;
-    }
-    for (int i = np - 2, lo = h + 1; i >= 0; i--) {
-        while (h >= lo && cross2(hull[h - 2], hull[h - 1], pts[i]) <= 0) h--;
-        hull[h][0] = pts[i][0];
-        hull[h][1] = pts[i][1];
-        h++;
-    }
-    double harea = 0, perim = 0;
-    for (int i = 0; i + 1 < h; i++) {
-        harea += 0.5 * (hull[i][0] * hull[i + 1][1] - hull[i + 1][0] * hull[i][1]);
-        perim += hypot(hull[i + 1][0] - hull[i][0], hull[i + 1][1] - hull[i][1]);
-    }
+    double harea, perim;
+    hull_area2(pts, np, &harea, &perim);
     if (!(harea > 0) || !(fabs(harea - area) <= 1e-6 * harea)) return;
     nrm[0] = n.x;
     nrm[1] = n.y;
