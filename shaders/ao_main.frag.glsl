@@ -45,6 +45,17 @@ layout(binding = MR_TEX_AO_NORMAL) uniform sampler2D u_normal;
 layout(binding = MR_TEX_AO_POSITIONS) uniform sampler2D u_pos;
 layout(binding = MR_TEX_AO_MASK) uniform sampler2D u_mask;
 layout(binding = MR_TEX_AO_DEPTH_MIP) uniform sampler2D u_depth_mip; // reversed-Z depth, box-filtered levels
+// issue 18 (lane deint): deinterleaved AO. The target is a 4x4 atlas of
+// quarter-size layers; the fragment in tile o at texel t is AO pixel
+// 4 t + o, and every depth it samples comes from its own tile (the AO
+// pixels congruent to o mod 4), so a layer's reads stay in one small block.
+layout(location = MR_LOC_AO_DEINT) uniform int u_deint;           // 0 off, 1 on
+layout(location = MR_LOC_AO_DEINT_Q) uniform ivec2 u_dq;          // one layer's size
+layout(location = MR_LOC_AO_DEINT_NEAR) uniform float u_dnear;    // nearer samples read the G-buffer itself
+layout(binding = MR_TEX_AO_DEINT_DEPTH) uniform sampler2D u_dz;   // reversed-Z depth atlas (ao_deint_split)
+ivec2 g_layer = ivec2(0);                                         // this fragment's tile
+ivec2 g_tmax = ivec2(0);                                          // its last texel (the image's edge)
+ivec2 g_fp = ivec2(0);                                            // the fragment's G-buffer pixel
 
 layout(location = 0) out float o_ao;
 
@@ -60,6 +71,24 @@ layout(location = 0) out float o_ao;
 #define M_SCHEER_BM MR_AO_METHOD_ID_SCHEER_BM
 
 bool fetch_pos(ivec2 q, out vec3 p) {
+    // A sample nearer than u_dnear would snap onto the layer's grid (4 AO
+    // pixels) by a large part of its offset: it reads the G-buffer, which
+    // near the pixel is as cache-coherent as the layer.
+    ivec2 dq = abs(q - g_fp);
+    if (u_deint != 0 && u_use_pos == 0 && float(max(dq.x, dq.y)) >= u_dnear) {
+        // The layer's AO pixel nearest to q (a sample moves by up to 2 AO
+        // pixels), un-projected at that pixel's own position.
+        ivec2 t = ivec2(floor((vec2(q) / float(u_step) - vec2(g_layer)) * 0.25 + 0.5));
+        t = clamp(t, ivec2(0), g_tmax);
+        ivec2 fq = (4 * t + g_layer) * u_step;
+        p = vec3(0.0);
+        float d = texelFetch(u_dz, g_layer * u_dq + t, 0).r;
+        if (!(d > 0.0)) return false;
+        float z = u_near / d;
+        if (isinf(z) || isnan(z)) return false;
+        p = vec3((vec2(fq) - u_intr.zw) / u_intr.xy * z, z);
+        return true;
+    }
     return ao_view_pos(u_depth, u_pos, u_use_pos != 0, u_near, u_intr, q, p);
 }
 
@@ -279,6 +308,13 @@ bool slice_sample(vec2 px, vec2 d, int side, int j, float jitter, float rpx, out
     if (u_mips > 0 && off >= u_mip_near) {
         float lod = min(floor(log2(off / u_mip_near)) + 1.0, float(u_mips));
         dz = textureLod(u_depth_mip, (uv + 0.5) / vec2(u_full), lod).r;
+    } else if (u_deint != 0 && off >= u_dnear) {
+        // Bilinear inside the layer's tile (clamped to it, so no texel of
+        // another layer mixes in); the point is taken at the position the
+        // filtered coordinate stands for: on a plane still exactly on it.
+        vec2 tf = clamp((uv / float(u_step) - vec2(g_layer)) * 0.25, vec2(0.0), vec2(g_tmax));
+        uv = (4.0 * tf + vec2(g_layer)) * float(u_step);
+        dz = textureLod(u_dz, (vec2(g_layer * u_dq) + tf + 0.5) / vec2(4 * u_dq), 0.0).r;
     } else {
         dz = textureLod(u_depth, (uv + 0.5) / vec2(u_full), 0.0).r;
     }
@@ -471,7 +507,16 @@ float occ_scheer_bm(vec3 P, vec3 n, float r, vec3 rnd, vec2 px) {
 
 void main() {
     ivec2 ap = ivec2(gl_FragCoord.xy);
+    if (u_deint != 0) {
+        g_layer = min(ap / u_dq, ivec2(3));
+        ivec2 t = ap - g_layer * u_dq;
+        ap = 4 * t + g_layer;
+        ivec2 an = (u_full + u_step - 1) / u_step;   // the AO image's size
+        if (any(greaterThanEqual(ap, an))) { o_ao = 1.0; return; } // a layer's padding texel
+        g_tmax = (an - 1 - g_layer) / 4;
+    }
     ivec2 fp = ap * u_step;
+    g_fp = fp;
     vec3 P;
     if (!fetch_pos(fp, P)) { o_ao = 1.0; return; }   // sky: unoccluded
     if (u_use_mask != 0 || u_method == M_MASK_STANDALONE) {
@@ -484,6 +529,13 @@ void main() {
     }
     vec3 n = ao_normal(u_normal, fp, P);
     vec3 rnd = ao_rand3(ap);
+    if (u_deint != 0) {
+        // One rotation per layer, the 16 layers spread by a 4x4 Bayer
+        // order (neighbours differ most), so the blur's window sees all 16.
+        const int bayer[16] = int[16](0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5);
+        float b = float(bayer[g_layer.y * 4 + g_layer.x]);
+        rnd = vec3((b + 0.5) / 16.0, fract(0.31 + b * 0.6180339887), fract(0.17 + b * 0.7548776662));
+    }
     if (u_noise != 0) {
         // The surface point's cell in the anchor's frame, the same in every
         // view that shares the anchor: a grid of u_noise_cell scene units

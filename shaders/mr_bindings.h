@@ -104,6 +104,15 @@
 #define MR_LOC_AO_MIP_NEAR                 (MR_LOC_AO_DISPLAY + 2) /* float: offset (px) below which level 0 is read */
 #define MR_TEX_AO_DEPTH_MIP                5  /* ao_main: reversed-Z depth, R32F, box-filtered levels */
 #define MR_TEX_AO_MIP_SRC                  0  /* ao_depth_mip: the G-buffer's depth */
+/* issue 18 (lane deint): deinterleaved AO, 4x4 quarter-size layers in a tiled atlas */
+#define MR_LOC_AO_DEINT                    (MR_LOC_AO_DISPLAY + 3) /* int: 1 = the target is the layer atlas */
+#define MR_LOC_AO_DEINT_Q                  (MR_LOC_AO_DISPLAY + 4) /* ivec2: one layer's size (AO pixels / 4) */
+#define MR_LOC_AO_DEINT_NEAR               (MR_LOC_AO_DISPLAY + 5) /* float: offsets (G-buffer px) below this read the G-buffer */
+#define MR_TEX_AO_DEINT_DEPTH              6  /* ao_main: reversed-Z depth atlas, R32F, 4x4 tiles */
+#define MR_TEX_AO_DEINT_SRC                0  /* ao_deint_split: the G-buffer's depth; ao_deint_merge: the AO atlas */
+#define MR_LOC_AO_DEINT_SPLIT_Q            0  /* ao_deint_split / merge: ivec2 layer size */
+#define MR_LOC_AO_DEINT_SPLIT_STEP         1  /* ao_deint_split: int G-buffer pixels per AO pixel */
+#define MR_LOC_AO_DEINT_SPLIT_FULL         2  /* ao_deint_split: ivec2 G-buffer size */
 
 /* ao_outline */
 #define MR_LOC_OUTLINE_RADIUS_MODE         3

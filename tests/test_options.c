@@ -334,6 +334,7 @@ static void test_tables(void) {
         N(mr_ao_params, "temporal", temporal, 0, 1),
         E(mr_ao_params, "noise", noise, "pixel world"),
         N(mr_ao_params, "mips", mips, 0, 1), /* issue 18 (lane ao) */
+        N(mr_ao_params, "deinterleave", deinterleave, 0, 1), /* issue 18 (lane deint) */
     };
     /* multi-view rig (no prefix) */
     const mr_rig_params rg = MR_RIG_DEFAULTS;

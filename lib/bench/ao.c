@@ -126,7 +126,8 @@ typedef struct ao_bench {
     char seq_name[1100];
     double seq_rmse[SEQ_METHODS][SEQ_CFG][2], seq_ms[SEQ_METHODS][SEQ_CFG]; /* {all frames, second half}, median ms */
     /* issue 18 (lane ao): the cost steps (step 6c): [method][full, +mips, half, half+mips] */
-    double cost_ratio[COST_METHODS][4], cost_sync[COST_METHODS][4], cost_floor[COST_METHODS][4], cost_rmse[COST_METHODS][4];
+    /* issue 18 (lane deint): [4] full + deinterleave, [5] half + deinterleave */
+    double cost_ratio[COST_METHODS][6], cost_sync[COST_METHODS][6], cost_floor[COST_METHODS][6], cost_rmse[COST_METHODS][6];
     int cost_rounds;
     char cost_view[256], loadavg[128];
     double deint_full, deint_sub; /* the fetch floor of one full pass, of 16 deinterleaved sub-image passes */
@@ -937,7 +938,8 @@ static bool ao_sequence(ao_bench *b, mr_error *err) {
 /* Step 6c (issue 18): the cost steps towards the fetch floor. On the first
  * reported view, at 16 samples, each of the slice methods (tuned, depth-
  * scaled) at full and half resolution, with and without the depth mip
- * chain; every configuration timed (glFinish, median of --frames) with its
+ * chain, and (issue 18, lane deint) deinterleaved at full and half
+ * resolution; every configuration timed (glFinish, median of --frames) with its
  * fetch floor right after, in `rounds` rounds that alternate the
  * configurations (the machine is shared: side by side, the median of the
  * rounds' ratios). bench_ao_cost.csv. */
@@ -952,14 +954,15 @@ static bool ao_cost(ao_bench *b, mr_error *err) {
                         "ratio = sync / floor; each round runs every configuration once");
     mr_csv_header(csv, "view,method,resolution,mips,round,sync_ms_median,floor_ms_median,floor_ratio,rmse_screen");
     bool ok = mr_renderer_set_scene(b->gfx.renderer, b->scene, err);
-    double ratio[COST_METHODS][4][ROUNDS], sync[COST_METHODS][4][ROUNDS], flo[COST_METHODS][4][ROUNDS];
+    double ratio[COST_METHODS][6][ROUNDS], sync[COST_METHODS][6][ROUNDS], flo[COST_METHODS][6][ROUNDS];
     for (int rd = 0; ok && rd < ROUNDS; rd++)
         for (int m = 0; ok && m < COST_METHODS; m++)
-            for (int cfg = 0; ok && cfg < 4; cfg++) {
+            for (int cfg = 0; ok && cfg < 6; cfg++) {
                 mr_ao_params p = b->cs[contender_of(k_cost_method[m])].tuned;
                 p.samples = 16;
-                p.half_res = cfg >= 2;
-                p.mips = cfg % 2 == 1;
+                p.half_res = cfg == 2 || cfg == 3 || cfg == 5;
+                p.mips = cfg == 1 || cfg == 3;
+                p.deinterleave = cfg >= 4; /* issue 18 (lane deint) */
                 double gms = 0, s = 0, fl = 0;
                 mr_image_metrics mt;
                 ok = run_ao(b->gfx.renderer, &vd->view, &p, b->w, b->h, b->p.frames, &gms, &s, &b->ao, NULL, err) &&
@@ -971,7 +974,8 @@ static bool ao_cost(ao_bench *b, mr_error *err) {
                 b->cost_rmse[m][cfg] = mt.rmse;
                 mr_csv_quoted(csv, vd->name);
                 mr_csv_text(csv, k_cost_method[m]);
-                mr_csv_text(csv, p.half_res ? "half" : "full");
+                mr_csv_text(csv, p.deinterleave ? (p.half_res ? "half+deinterleave" : "full+deinterleave")
+                                                : (p.half_res ? "half" : "full"));
                 mr_csv_text(csv, p.mips ? "on" : "off");
                 mr_csv_int(csv, rd);
                 mr_csv_num(csv, "%.4f", s);
@@ -985,7 +989,7 @@ static bool ao_cost(ao_bench *b, mr_error *err) {
         return false;
     }
     for (int m = 0; m < COST_METHODS; m++)
-        for (int cfg = 0; cfg < 4; cfg++) {
+        for (int cfg = 0; cfg < 6; cfg++) {
             b->cost_ratio[m][cfg] = mr_median(ratio[m][cfg], ROUNDS);
             b->cost_sync[m][cfg] = mr_median(sync[m][cfg], ROUNDS);
             b->cost_floor[m][cfg] = mr_median(flo[m][cfg], ROUNDS);
@@ -1120,7 +1124,8 @@ static bool ao_summary(ao_bench *b, mr_error *err) {
             }
     }
     if (b->cost_rounds > 0) {
-        static const char *const cfg[4] = {"full", "full + mips", "half", "half + mips"};
+        static const char *const cfg[6] = {"full", "full + mips", "half", "half + mips", "full + deinterleave",
+                                           "half + deinterleave"};
         len += (size_t)snprintf(md + len, sizeof md - len,
                                 "\nCost towards the fetch floor, 16 samples, '%s' (medians of %d rounds side by side; load "
                                 "average at the end: %s). x floor = AO passes (glFinish) / a pass of as many R32F fetches "
@@ -1128,7 +1133,7 @@ static bool ao_summary(ao_bench *b, mr_error *err) {
                                 "| method | configuration | ms | floor ms | x floor | RMSE d-s |\n|---|---|---|---|---|---|\n",
                                 b->cost_view, b->cost_rounds, b->loadavg[0] ? b->loadavg : "-");
         for (int m = 0; m < COST_METHODS; m++)
-            for (int c = 0; c < 4; c++)
+            for (int c = 0; c < 6; c++)
                 len += (size_t)snprintf(md + len, sizeof md - len, "| %s | %s | %.2f | %.2f | %.2f | %.4f |\n", k_cost_method[m],
                                         cfg[c], b->cost_sync[m][c], b->cost_floor[m][c], b->cost_ratio[m][c], b->cost_rmse[m][c]);
         len += (size_t)snprintf(md + len, sizeof md - len,

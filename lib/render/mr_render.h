@@ -181,6 +181,12 @@ typedef struct mr_ao_params {
                                      MR_AO_MIP_NEAR_PX from the pixel read a box-filtered
                                      depth mip chain (built only for these methods); off
                                      by default */
+    /* issue 18 (lane deint) */
+    bool deinterleave;            /* the AO pass over 4x4 quarter-size layers of the depth
+                                     (a tiled atlas), one kernel rotation per layer, then
+                                     re-interleaved before the blur; all methods, not with
+                                     the positions path or the standalone mask (ignored
+                                     there); off by default */
 } mr_ao_params;
 /* Each default is written once, here: the initialiser below, the AO pass
  * (which puts them in where a field is zero or out of range) and option
@@ -203,6 +209,8 @@ typedef struct mr_ao_params {
 #define MR_AO_MIP_NEAR_PX 8.0 /* issue 18: mips: offsets below this (pixels) read level 0;
                                  level L for [8 * 2^(L-1), 8 * 2^L) */
 #define MR_AO_MIP_LEVELS 4    /* issue 18: mips: levels above 0 in the chain (at most) */
+#define MR_AO_DEINT_NEAR 2     /* issue 18 (lane deint): deinterleave: samples nearer than this many
+                                 layer spacings (4 AO pixels each) read the G-buffer itself */
 #define MR_AO_DEFAULTS {.method = MR_AO_NONE, .radius_mode = MR_AO_RADIUS_SCREEN, \
                         .screen_radius = MR_AO_DEFAULT_SCREEN_RADIUS, .samples = MR_AO_DEFAULT_SAMPLES, \
                         .kernel = MR_AO_KERNEL_UNIFORM, .r_min = MR_AO_DEFAULT_R_MIN, .r_max = MR_AO_DEFAULT_R_MAX, \

@@ -56,6 +56,9 @@ const mr_opt mr_ao_opts[] = {
     /* issue 18 (lane ao) */
     {"mips", MR_OPT_BOOL, AO(mips), 0, 1, 0, NULL,
      "gtao, bitmask, scheer-gt, scheer-bm: far samples read a depth mip chain", 0},
+    /* issue 18 (lane deint) */
+    {"deinterleave", MR_OPT_BOOL, AO(deinterleave), 0, 1, 0, NULL,
+     "AO over 4x4 deinterleaved quarter-size depth layers, one rotation per layer", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef AO

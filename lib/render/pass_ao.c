@@ -55,6 +55,11 @@ struct mr_ao_state {
     /* issue 18 (lane ao): the depth mip chain of their far samples */
     GLuint prog_mip, tex_mip, fbo_mip, mip_sampler;
     int mip_w, mip_h, mip_levels;
+    /* issue 18 (lane deint): deinterleaved AO: the depth and AO atlases
+     * (4x4 tiles of dq_w x dq_h) and the programs that fill and empty them */
+    GLuint prog_split, prog_merge, tex_dz, fbo_dz, tex_dao, fbo_dao;
+    int dq_w, dq_h;
+    bool deint; /* this frame's AO goes through the atlas */
     /* issue 18: temporal accumulation, full resolution, ping-pong */
     GLuint prog_temporal;
     GLuint tex_hist[2], tex_hist_n[2], fbo_hist[2]; /* (AO, frames, view z), normal */
@@ -204,6 +209,15 @@ static void free_mips(mr_ao_state *s) {
     s->mip_w = s->mip_h = s->mip_levels = 0;
 }
 
+static void free_deint(mr_ao_state *s) {
+    glDeleteFramebuffers(1, &s->fbo_dz);
+    glDeleteTextures(1, &s->tex_dz);
+    glDeleteFramebuffers(1, &s->fbo_dao);
+    glDeleteTextures(1, &s->tex_dao);
+    s->fbo_dz = s->tex_dz = s->fbo_dao = s->tex_dao = 0;
+    s->dq_w = s->dq_h = 0;
+}
+
 static void free_history(mr_ao_state *s) {
     glDeleteFramebuffers(2, s->fbo_hist);
     glDeleteTextures(2, s->tex_hist);
@@ -235,6 +249,9 @@ static void free_state(mr_ao_state *s) {
     free_outlines(s);
     free_history(s);
     free_mips(s);
+    free_deint(s);
+    glDeleteProgram(s->prog_split);
+    glDeleteProgram(s->prog_merge);
     glDeleteProgram(s->prog_mip);
     glDeleteSamplers(1, &s->mip_sampler);
     glDeleteProgram(s->prog_temporal);
@@ -386,6 +403,7 @@ static void copy_fields(mr_ao_params *d, const mr_ao_params *p) {
     d->noise_anchor = p->noise_anchor;
     d->noise_anchor_set = p->noise_anchor_set;
     d->mips = p->mips;
+    d->deinterleave = p->deinterleave;
 }
 
 static ao_key key_of(const frame *f, const mr_ao_params *resolved, uint64_t scene_gen) {
@@ -428,6 +446,17 @@ static bool mr_pass_need_ao_blur(const frame *f) {
     if (!runs(f)) return false;
     mr_ao_params p = resolve(&f->p->ao, f->r->scene);
     return blur_wanted(&p);
+}
+/* issue 18 (lane deint): the atlas path, for every method but not the
+ * positions path (its texture is not split) or the standalone mask (it
+ * samples nothing). */
+static bool deint_wanted(const mr_ao_params *p) {
+    return p->deinterleave && !p->positions && p->mask != MR_AO_MASK_STANDALONE;
+}
+static bool mr_pass_need_ao_deint(const frame *f) {
+    if (!runs(f)) return false;
+    mr_ao_params p = resolve(&f->p->ao, f->r->scene);
+    return deint_wanted(&p);
 }
 static bool mr_pass_need_ao_upsample(const frame *f) { return runs(f) && f->p->ao.half_res; }
 static bool mr_pass_need_ao_reuse(const frame *f) { return plan_of(f, f->r->ao) == AO_PLAN_REUSE; }
@@ -475,7 +504,38 @@ static bool prepare_state(frame *f, mr_ao_state *s, mr_error *err) {
     }
     s->last = key_of(f, &s->p, s->scene_gen);
     s->valid = false; /* until the passes have run */
+    s->deint = deint_wanted(&s->p);
     return true;
+}
+
+/* issue 18 (lane deint): programs and atlases for deinterleaved AO; the
+ * atlas is 4x4 tiles of ceil(AO size / 4), so a layer's padding texel (an
+ * AO size not divisible by 4) stays inside its own tile. */
+static bool ensure_deint(mr_ao_state *s, mr_error *err) {
+    if (!s->prog_split) {
+        static const char *const a[] = {"fullscreen.vert.glsl", "ao_deint_split.frag.glsl", NULL};
+        static const char *const b[] = {"fullscreen.vert.glsl", "ao_deint_merge.frag.glsl", NULL};
+        if (!(s->prog_split = mr_gl_program(a, err)) || !(s->prog_merge = mr_gl_program(b, err))) {
+            mr_error_prefix(err, "ambient occlusion (deinterleave): ");
+            return false;
+        }
+    }
+    int qw = (s->aw + 3) / 4, qh = (s->ah + 3) / 4;
+    if (s->dq_w != qw || s->dq_h != qh) {
+        free_deint(s);
+        s->tex_dz = mr_gl_make_tex(GL_R32F, 4 * qw, 4 * qh, GL_NEAREST);
+        s->fbo_dz = fbo_for(s->tex_dz);
+        s->tex_dao = mr_gl_make_tex(GL_R32F, 4 * qw, 4 * qh, GL_NEAREST);
+        s->fbo_dao = fbo_for(s->tex_dao);
+        s->dq_w = qw;
+        s->dq_h = qh;
+    }
+    return true;
+}
+
+static bool mr_pass_prepare_ao_deint(frame *f, mr_error *err) {
+    mr_ao_state *s = state_of(&f->r->ao, err);
+    return s && prepare_state(f, s, err) && ensure_deint(s, err);
 }
 
 /* Called for ao_mask and ao: the second call finds everything in place. */
@@ -689,6 +749,27 @@ static void noise_uniforms(const frame *f, const mr_ao_params *p) {
     glUniform1f(MR_LOC_AO_NOISE_CELL, grid ? (float)p->noise_cell : (float)MR_AO_NOISE_CELL_PX);
 }
 
+/* issue 18 (lane deint): the G-buffer's depth into the 16 layers. */
+static void stage_split(frame *f, mr_ao_state *s, const ao_inputs *in) {
+    glUseProgram(s->prog_split);
+    glUniform2i(MR_LOC_AO_DEINT_SPLIT_Q, s->dq_w, s->dq_h);
+    glUniform1i(MR_LOC_AO_DEINT_SPLIT_STEP, s->step);
+    glUniform2i(MR_LOC_AO_DEINT_SPLIT_FULL, f->r->w, f->r->h);
+    glBindTextureUnit(MR_TEX_AO_DEINT_SRC, in->depth);
+    fullscreen(f, s->fbo_dz, 4 * s->dq_w, 4 * s->dq_h);
+}
+
+/* ... and the AO atlas back into the interleaved AO image. */
+static void stage_merge(frame *f, mr_ao_state *s) {
+    glUseProgram(s->prog_merge);
+    glUniform2i(MR_LOC_AO_DEINT_SPLIT_Q, s->dq_w, s->dq_h);
+    glBindTextureUnit(MR_TEX_AO_DEINT_SRC, s->tex_dao);
+    fullscreen(f, s->fbo_ao[0], s->aw, s->ah);
+    glBindTextureUnit(MR_TEX_AO_DEINT_SRC, 0);
+    s->cur = 0;
+    s->result = s->tex_ao[0];
+}
+
 static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
     const mr_ao_params *p = &s->p;
     int mips = build_depth_mips(f, s, in);
@@ -748,7 +829,20 @@ static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
      * per-column formula; D = 0 is the pinhole. */
     const mr_display_map *dm = f->p->display;
     glUniform3f(MR_LOC_AO_DISPLAY, dm ? (float)dm->distance : 0.0f, dm ? (float)dm->eye_half : 0.0f, (float)f->r->w);
-    fullscreen(f, s->fbo_ao[0], s->aw, s->ah);
+    /* issue 18 (lane deint): one draw over the atlas, every tile a layer */
+    bool deint = s->deint && s->tex_dz;
+    glUniform1i(MR_LOC_AO_DEINT, deint ? 1 : 0);
+    glUniform2i(MR_LOC_AO_DEINT_Q, s->dq_w > 0 ? s->dq_w : 1, s->dq_h > 0 ? s->dq_h : 1);
+    glUniform1f(MR_LOC_AO_DEINT_NEAR, (float)(MR_AO_DEINT_NEAR * 4 * s->step));
+    if (deint) {
+        glBindTextureUnit(MR_TEX_AO_DEINT_DEPTH, s->tex_dz);
+        if (slice_method(p->method)) glBindSampler(MR_TEX_AO_DEINT_DEPTH, s->linear_sampler);
+        fullscreen(f, s->fbo_dao, 4 * s->dq_w, 4 * s->dq_h);
+        glBindSampler(MR_TEX_AO_DEINT_DEPTH, 0);
+        glBindTextureUnit(MR_TEX_AO_DEINT_DEPTH, 0);
+    } else {
+        fullscreen(f, s->fbo_ao[0], s->aw, s->ah);
+    }
     glBindSampler(MR_TEX_AO_DEPTH, 0);
     if (mips > 0) {
         glBindSampler(MR_TEX_AO_DEPTH_MIP, 0);
@@ -788,6 +882,17 @@ static void stage_upsample(frame *f, mr_ao_state *s, const ao_inputs *in) {
 static void mr_pass_ao(frame *f) {
     ao_inputs in = main_inputs(f);
     stage_main(f, f->r->ao, &in);
+    frame_put(f, RES_AO, f->r->ao->result);
+}
+
+/* issue 18 (lane deint) */
+static void mr_pass_ao_deint_split(frame *f) {
+    ao_inputs in = main_inputs(f);
+    stage_split(f, f->r->ao, &in);
+}
+
+static void mr_pass_ao_deint_merge(frame *f) {
+    stage_merge(f, f->r->ao);
     frame_put(f, RES_AO, f->r->ao->result);
 }
 
@@ -943,6 +1048,7 @@ bool mr_ao_hidden_prepare(frame *f, mr_error *err) {
         if (!prepare_state(f, s, err)) return false;
         s->p.mask = MR_AO_MASK_OFF; /* outlines of D are not drawn */
         s->p.positions = false;     /* D has no positions attachment */
+        s->deint = deint_wanted(&s->p); /* issue 18 (lane deint) */
     }
     f->ao_hidden_plan = pl;
     return true;
@@ -952,7 +1058,12 @@ GLuint mr_ao_hidden_run(frame *f, GLuint depth, GLuint normal) {
     mr_ao_state *s = f->r->ao_hidden;
     if (f->ao_hidden_plan == AO_PLAN_RUN) {
         ao_inputs in = {depth, normal, 0, s->tex_mask};
+        /* issue 18 (lane deint): D's own atlases */
+        mr_error e = {0};
+        if (s->deint && !ensure_deint(s, &e)) s->deint = false;
+        if (s->deint) stage_split(f, s, &in);
         stage_main(f, s, &in);
+        if (s->deint) stage_merge(f, s);
         if (blur_wanted(&s->p)) stage_blur(f, s, &in);
         if (s->step > 1) stage_upsample(f, s, &in);
     }
@@ -968,6 +1079,13 @@ const pass_desc mr_pass_desc_ao = {
     .name = "ao", .needed = mr_pass_need_ao, .prepare = mr_pass_prepare_ao, .run = mr_pass_ao, AO_DESTROY,
     .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_POSITIONS) | RES(RES_AO_MASK), .writes = RES(RES_AO),
     .reads_now = mr_pass_ao_reads};
+/* issue 18 (lane deint): around the AO pass, only with deinterleave on. */
+const pass_desc mr_pass_desc_ao_deint_split = {
+    .name = "ao_deint_split", .needed = mr_pass_need_ao_deint, .prepare = mr_pass_prepare_ao_deint,
+    .run = mr_pass_ao_deint_split, AO_DESTROY, .reads = RES(RES_DEPTH)};
+const pass_desc mr_pass_desc_ao_deint_merge = {
+    .name = "ao_deint_merge", .needed = mr_pass_need_ao_deint, .run = mr_pass_ao_deint_merge, AO_DESTROY,
+    .reads = RES(RES_AO), .writes = RES(RES_AO)};
 const pass_desc mr_pass_desc_ao_blur = {
     .name = "ao_blur", .needed = mr_pass_need_ao_blur, .run = mr_pass_ao_blur, AO_DESTROY,
     .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_AO), .writes = RES(RES_AO)};

@@ -190,7 +190,8 @@ void mr_geometry_aux_draw(mr_renderer *r, const mr_geo_view *view, const mr_geo_
  * lists them in order. */
 extern const pass_desc mr_pass_desc_gbuffer, mr_pass_desc_shade, mr_pass_desc_overlay;         /* passes.c */
 extern const pass_desc mr_pass_desc_ao_mask, mr_pass_desc_ao, mr_pass_desc_ao_blur, mr_pass_desc_ao_upsample,
-    mr_pass_desc_ao_reuse, mr_pass_desc_ao_external;                                            /* pass_ao.c */
+    mr_pass_desc_ao_reuse, mr_pass_desc_ao_external;
+extern const pass_desc mr_pass_desc_ao_deint_split, mr_pass_desc_ao_deint_merge; /* issue 18 (lane deint) */                                            /* pass_ao.c */
 extern const pass_desc mr_pass_desc_ao_temporal; /* pass_ao.c, issue 18 */
 extern const pass_desc mr_pass_desc_ghost_hidden, mr_pass_desc_ghost_curvature, mr_pass_desc_ghost_importance,
     mr_pass_desc_ghost_g0, mr_pass_desc_ghost_analysis, mr_pass_desc_ghost_emphasis;            /* pass_ghost.c */

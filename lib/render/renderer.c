@@ -66,7 +66,9 @@ const char *const mr_resource_names[RES_COUNT] = {
 static const pass_desc *const k_passes[] = {
     &mr_pass_desc_gbuffer,
     &mr_pass_desc_ao_mask,
+    &mr_pass_desc_ao_deint_split, /* issue 18 (lane deint) */
     &mr_pass_desc_ao,
+    &mr_pass_desc_ao_deint_merge, /* issue 18 (lane deint) */
     &mr_pass_desc_ao_blur,
     &mr_pass_desc_ao_upsample,
     &mr_pass_desc_ao_temporal, /* issue 18 */
