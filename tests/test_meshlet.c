@@ -106,6 +106,20 @@ static mr_scene *big_scene(double ox, bool with_sheet) {
         n.mesh_count = 1;
         mr_scene_add_node(s, &n);
     }
+    /* Small balls after the big meshes: their commands follow the
+     * meshlets' (a per-node submission must find room for both). */
+    mr_mesh c = sphere(0.2, 8, 4);
+    int32_t mc = mr_scene_add_mesh(s, &c, &err);
+    for (int k = 0; k < 40 && mc >= 0; k++) {
+        mr_node n;
+        memset(&n, 0, sizeof n);
+        snprintf(n.name, sizeof n.name, "Small_%d", k);
+        n.parent = -1;
+        n.world = mr_m4_translate(ox + (k % 8) - 3.5, 3.2, (k / 8) - 2.0);
+        n.mesh_first = mc;
+        n.mesh_count = 1;
+        mr_scene_add_node(s, &n);
+    }
     mr_scene_update_bounds(s);
     return s;
 }
@@ -164,6 +178,8 @@ static void views_same(double ox) {
     mr_draw_params on = MR_DRAW_DEFAULTS, off = MR_DRAW_DEFAULTS, cone = MR_DRAW_DEFAULTS;
     on.occlusion_auto = off.occlusion_auto = cone.occlusion_auto = false;
     off.no_cluster_cull = true;
+    mr_draw_params each = on; /* one command per node and mesh, one GL call per command */
+    each.no_batch = each.no_instancing = true;
     cone.cluster_cone = true;
     if (!s || !mr_renderer_set_scene(g_r, s, &err)) {
         CHECK_MSG(false, "%s", err.msg);
@@ -181,6 +197,13 @@ static void views_same(double ox) {
             break;
         }
         CHECK_MSG(same_depth(&a, &b), "offset %g view %d: depth differs with cluster culling", ox, i);
+        if (i % 8 == 0) {
+            mr_frame_result e;
+            if (frame(&v, &each, &e, NULL)) {
+                CHECK_MSG(same_depth(&e, &b), "offset %g view %d: per-node submission differs", ox, i);
+                mr_frame_result_free(&e);
+            }
+        }
         CHECK(sa.clusters_tested > 0 && sb.clusters_tested == 0);
         CHECK(sa.triangles <= sb.triangles);
         fewer += sa.triangles < sb.triangles;

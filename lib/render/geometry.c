@@ -561,14 +561,7 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
                               const geo_mesh *gm, int level, double scale, uint32_t inst, uint32_t *ncmd) {
     struct mr_geo *g = r->geo;
     const geo_cluster *cl = g->clusters + gm->cl_first[level];
-    uint32_t cnt = gm->cl_count[level];
-    if (*ncmd + cnt + 1 > g->cmd_cap) {
-        size_t cap = g->cmd_cap * 2 + cnt + 1;
-        draw_cmd *c = realloc(g->cmds, cap * sizeof *c);
-        if (!c) return 0;
-        g->cmds = c;
-        g->cmd_cap = cap;
-    }
+    uint32_t cnt = gm->cl_count[level]; /* emit_recs made room for cnt commands */
     mr_dmat4 cn = mr_m4_mul(&vw->cam_from_world, &n->world);
     mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
     mr_dmat4 mvm = mr_m4_mul(&cn, &T);
@@ -581,6 +574,9 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
         double l = sqrt(pl[k][0] * pl[k][0] + pl[k][1] * pl[k][1] + pl[k][2] * pl[k][2]);
         for (int j = 0; j < 3; j++) pl[k][j] /= l;
     }
+    /* A pass with depth clamping (the shadow map) draws what lies before
+     * its near plane too: there only the side planes cull. */
+    double near_cut = glIsEnabled(GL_DEPTH_CLAMP) ? -INFINITY : vw->near_plane;
     bool cone = r->draw.cluster_cone;
     if (cone) {
         double col[3][3], s2[3];
@@ -606,7 +602,7 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
         for (int i = 0; i < 3; i++)
             p[i] = a[i * 4] * q->center[0] + a[i * 4 + 1] * q->center[1] + a[i * 4 + 2] * q->center[2] + a[i * 4 + 3];
         double rad = (double)q->radius * scale * (1 + 1e-6) + 1e-9 * fabs(p[2]);
-        bool keep = p[2] > vw->near_plane - rad;
+        bool keep = p[2] > near_cut - rad;
         for (int j = 0; j < 4 && keep; j++) keep = pl[j][0] * p[0] + pl[j][1] * p[1] + pl[j][2] * p[2] >= -rad;
         if (keep && cone && q->cutoff < 1) {
             /* meshopt: back-facing when dot(normalize(apex - eye), axis) >=
@@ -703,7 +699,20 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     const mr_draw_params *dp = &r->draw;
     double t0 = mr_time_now();
 
-    /* 3. Instance data and commands, one per bucket (or per instance). */
+    /* 3. Instance data and commands, one per bucket (or per instance);
+     * an instance of a mesh level with meshlets can take one command per
+     * meshlet (issue 17, lane meshlet). */
+    bool clusters = !dp->no_cluster_cull && replicate == 0 && g->cluster_count > 0;
+    size_t need = nrec + 1;
+    for (size_t i = 0; clusters && i < nrec; i++) need += g->meshes[sorted[i].mesh].cl_count[sorted[i].key % LEVELS];
+    if (need > g->cmd_cap) {
+        draw_cmd *c = realloc(g->cmds, need * sizeof *c);
+        if (!c) clusters = false; /* whole levels then: nrec + 1 commands fit */
+        else {
+            g->cmds = c;
+            g->cmd_cap = need;
+        }
+    }
     uint32_t ninst = 0, ncmd = 0, last_key = UINT32_MAX, lod_inst = 0;
     uint64_t tris = 0, tri_full = 0;
     memset(g->group_cmds, 0, (size_t)g->group_count * sizeof *g->group_cmds);
@@ -718,7 +727,7 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
             r->stats.lod_max_error = gm->error[level] * g->node_scale[rc->node];
         tri_full += gm->count[0] / 3;
         if (!fill_instance(vw, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, rc->node, &g->inst[ninst])) continue;
-        if (gm->cl_count[level] > 0 && !dp->no_cluster_cull && replicate == 0) {
+        if (clusters && gm->cl_count[level] > 0) {
             /* issue 17 (lane meshlet): this instance's visible meshlets */
             tris += emit_clusters(r, vw, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, level, g->node_scale[rc->node],
                                   ninst, &ncmd);
