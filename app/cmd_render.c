@@ -183,6 +183,10 @@ int cmd_render(int argc, char **argv) {
                     "commands, %llu of %llu triangles, culling %.2f ms; peak RSS %.0f MB\n", ds.nodes_visible,
                     ds.nodes_drawable, ds.instances, ds.lod_instances, ds.commands, (unsigned long long)ds.triangles,
                     (unsigned long long)ds.triangles_full, ds.cull_ms, mr_peak_rss_bytes() / 1048576.0);
+            /* issue 17 (lane meshlet) */
+            if (ds.clusters_tested)
+                fprintf(stderr, "mrcheck: render: clusters: %llu of %llu meshlets drawn\n",
+                        (unsigned long long)ds.clusters_drawn, (unsigned long long)ds.clusters_tested);
         }
         mr_frame_result_free(&res);
         app_gfx_close(&gfx);

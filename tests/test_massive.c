@@ -113,6 +113,7 @@ static void test_submission_modes_same_image(void) {
     occl.occlusion = true;
     uint32_t occluded = 0;
     off.no_cull = off.no_batch = off.no_instancing = off.no_lod = true;
+    off.no_cluster_cull = true; /* issue 17 (lane meshlet): whole meshes, one call per instance */
     /* The submission modes alone (auto occlusion would split each draw in
      * two submissions: occluders, then the rest; test_occlusion_auto). */
     on.occlusion_auto = nobatch.occlusion_auto = noinst.occlusion_auto = false;

@@ -399,6 +399,10 @@ static void test_tables(void) {
         N(mr_draw_params, "lod-pixels", lod_pixels, 1e-3, 1e4),
         N(mr_draw_params, "occlusion", occlusion, 0, 1),
         N(mr_draw_params, "occlusion-auto", occlusion_auto, 0, 1), /* issue 17 */
+        /* issue 17 (lane meshlet) */
+        N(mr_draw_params, "cluster-cull", no_cluster_cull, 0, 1),
+        N(mr_draw_params, "cluster-triangles", cluster_triangles, 64, 1 << 30),
+        N(mr_draw_params, "cluster-cone", cluster_cone, 0, 1),
     };
     const expect ex_mp[] = {
         N(mr_map_params, "tag-size", tag_size, 1e-9, 1e9),

@@ -17,18 +17,21 @@ typedef struct bench_config {
     const char *name;
     bool no_cull, no_batch, no_instancing, no_lod, occlusion;
     bool no_occl_auto; /* issue 17: automatic occlusion culling off */
+    bool no_cluster;   /* issue 17 (lane meshlet): cluster culling off */
 } bench_config;
 
 /* "all" is the defaults, automatic occlusion culling included (issue 17);
  * "none" switches everything off; "all+occl" forces occlusion on. */
 static const bench_config k_configs[] = {
-    {"all", false, false, false, false, false, false},
-    {"no-cull", true, false, false, false, false, false},
-    {"no-batch", false, true, true, false, false, false},
-    {"no-lod", false, false, false, true, false, false},
-    {"none", true, true, true, true, false, true},
-    {"all+occl", false, false, false, false, true, false},
-    {"no-occl-auto", false, false, false, false, false, true},
+    {"all", false, false, false, false, false, false, false},
+    {"no-cull", true, false, false, false, false, false, false},
+    {"no-batch", false, true, true, false, false, false, false},
+    {"no-lod", false, false, false, true, false, false, false},
+    {"none", true, true, true, true, false, true, true},
+    {"all+occl", false, false, false, false, true, false, false},
+    {"no-occl-auto", false, false, false, false, false, true, false},
+    /* issue 17 (lane meshlet): big meshes drawn whole, no meshlet culling */
+    {"no-cluster", false, false, false, false, false, false, true},
 };
 #define N_CONFIGS (int)(sizeof k_configs / sizeof k_configs[0])
 
@@ -295,6 +298,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                 dp.no_lod = k_configs[c].no_lod;
                 dp.occlusion = k_configs[c].occlusion;
                 dp.occlusion_auto = !k_configs[c].no_occl_auto;
+                dp.no_cluster_cull = k_configs[c].no_cluster;
                 row *r = &rows[nrows];
                 r->tri_scene = (double)li.triangles;
                 r->view = v;

@@ -19,6 +19,7 @@
 #include "render_internal.h"
 
 #include <math.h>
+#include <meshoptimizer.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -49,7 +50,18 @@ typedef struct geo_mesh {
     double error[LEVELS];          /* certified error of each level, mesh units */
     float color[4];
     uint32_t has_tex;
+    uint32_t cl_first[LEVELS], cl_count[LEVELS]; /* meshlets of each level in mr_geo.clusters */
 } geo_mesh;
+
+/* One meshlet (issue 17, lane meshlet): its contiguous index range in the
+ * shared index buffer and meshopt's bounds, in the mesh's own (vertex)
+ * coordinates: float is enough there, the instance's camera-relative
+ * double transform carries them to the camera. */
+typedef struct geo_cluster {
+    uint32_t first, count;         /* index range (global offset, indices) */
+    float center[3], radius;       /* bounding sphere */
+    float apex[3], axis[3], cutoff; /* back-facing cone */
+} geo_cluster;
 
 typedef struct geo_rec {
     int32_t node, mesh;
@@ -89,6 +101,10 @@ struct mr_geo {
     double occ_gain_ms;            /* smoothed measured gain (saved - cost) */
     double occ_rb_ms;              /* read-back of a finished frame, ms (< 0: not measured) */
     int occ_rb_w, occ_rb_h;
+    /* issue 17 (lane meshlet) */
+    geo_cluster *clusters;
+    uint32_t cluster_count;
+    size_t cmd_cap;                /* g->cmds (clusters add commands) */
 };
 
 /* ------------------------------------------------------------- params */
@@ -141,6 +157,7 @@ void mr_geometry_free(mr_renderer *r) {
         free(g->occ_rest);
         free(g->depth);
         free(g->hz);
+        free(g->clusters);
         free(g);
         r->geo = NULL;
     }
@@ -206,6 +223,70 @@ static bool ensure_instances(struct mr_geo *g, uint32_t need) {
     g->inst_cap = cap;
     for (int p = 0; p < 2; p++) glVertexArrayVertexBuffer(g->vao[p], 1, g->inst_buf, 0, sizeof(gpu_instance));
     return glGetError() == GL_NO_ERROR;
+}
+
+/* Index data of one level into the shared index buffer. A level of at
+ * least cluster_triangles triangles is split into meshlets first
+ * (meshopt_buildMeshlets: up to 64 vertices, 124 triangles) and its indices
+ * are written meshlet by meshlet, so each meshlet is one contiguous range
+ * that a draw can keep or skip (same triangles, another order). Done at
+ * upload, not cached: a few hundred ms per million triangles. */
+#define CL_VERTS 64
+#define CL_TRIS 124
+
+static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int32_t mi, int level,
+                         const uint32_t *indices, mr_error *err) {
+    geo_mesh *gm = &g->meshes[mi];
+    size_t n = gm->count[level];
+    int32_t thr = r->draw.cluster_triangles > 0 ? r->draw.cluster_triangles : MR_DRAW_DEFAULT_CLUSTER_TRIANGLES;
+    gm->cl_first[level] = gm->cl_count[level] = 0;
+    if (n / 3 < (size_t)thr || !m->positions || m->vertex_count == 0) {
+        glNamedBufferSubData(g->ibo, (GLintptr)gm->first[level] * 4, (GLsizeiptr)n * 4, indices);
+        return true;
+    }
+    size_t maxm = meshopt_buildMeshletsBound(n, CL_VERTS, CL_TRIS);
+    struct meshopt_Meshlet *ml = malloc(maxm * sizeof *ml);
+    unsigned int *mv = malloc(maxm * CL_VERTS * sizeof *mv);
+    unsigned char *mt = malloc(maxm * CL_TRIS * 3);
+    uint32_t *out = malloc(n * sizeof *out);
+    bool ok = ml && mv && mt && out;
+    size_t cnt = ok ? meshopt_buildMeshlets(ml, mv, mt, indices, n, m->positions, m->vertex_count, 12, CL_VERTS, CL_TRIS, 0.0f) : 0;
+    geo_cluster *cl = ok ? realloc(g->clusters, ((size_t)g->cluster_count + cnt + 1) * sizeof *cl) : NULL;
+    if (!cl) {
+        free(ml);
+        free(mv);
+        free(mt);
+        free(out);
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory building the meshlets of mesh '%s'", m->name);
+    }
+    g->clusters = cl;
+    gm->cl_first[level] = g->cluster_count;
+    gm->cl_count[level] = (uint32_t)cnt;
+    size_t w = 0;
+    for (size_t c = 0; c < cnt; c++) {
+        const struct meshopt_Meshlet *me = &ml[c];
+        geo_cluster *gc = &cl[g->cluster_count + c];
+        gc->first = gm->first[level] + (uint32_t)w;
+        gc->count = me->triangle_count * 3;
+        for (size_t t = 0; t < (size_t)me->triangle_count * 3; t++) out[w++] = mv[me->vertex_offset + mt[me->triangle_offset + t]];
+        struct meshopt_Bounds b = meshopt_computeMeshletBounds(mv + me->vertex_offset, mt + me->triangle_offset, me->triangle_count,
+                                                        m->positions, m->vertex_count, 12);
+        memcpy(gc->center, b.center, sizeof gc->center);
+        gc->radius = b.radius;
+        memcpy(gc->apex, b.cone_apex, sizeof gc->apex);
+        memcpy(gc->axis, b.cone_axis, sizeof gc->axis);
+        gc->cutoff = b.cone_cutoff;
+    }
+    g->cluster_count += (uint32_t)cnt;
+    free(ml);
+    free(mv);
+    free(mt);
+    /* meshopt drops degenerate triangles only if they repeat an index;
+     * whatever it wrote is what the level draws. */
+    gm->count[level] = (uint32_t)w;
+    glNamedBufferSubData(g->ibo, (GLintptr)gm->first[level] * 4, (GLsizeiptr)w * 4, out);
+    free(out);
+    return true;
 }
 
 static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_error *err) {
@@ -331,11 +412,17 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
         if (m->vertex_count)
             glNamedBufferSubData(g->vbo[gm->pool], (GLintptr)gm->base_vertex * stride[gm->pool],
                                  (GLsizeiptr)(need * sizeof *tmp), tmp);
-        if (m->index_count) glNamedBufferSubData(g->ibo, (GLintptr)gm->first[0] * 4, (GLsizeiptr)m->index_count * 4, m->indices);
+        if (m->index_count && !upload_level(r, g, m, (int32_t)i, 0, m->indices, err)) {
+            free(tmp);
+            return false;
+        }
         const mr_mesh_lods *ml = lod ? &lod->meshes[i] : NULL;
         for (int32_t k = 0, l = 1; ml && k < ml->level_count && k < MR_LOD_MAX_LEVELS; k++) {
             if (!ml->levels[k].indices || ml->levels[k].index_count == 0) continue;
-            glNamedBufferSubData(g->ibo, (GLintptr)gm->first[l] * 4, (GLsizeiptr)gm->count[l] * 4, ml->levels[k].indices);
+            if (!upload_level(r, g, m, (int32_t)i, l, ml->levels[k].indices, err)) {
+                free(tmp);
+                return false;
+            }
             l++;
         }
     }
@@ -364,6 +451,7 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     g->key_count = malloc((nm * LEVELS + 1) * sizeof *g->key_count);
     g->inst = malloc((recs + 1) * sizeof *g->inst);
     g->cmds = malloc((recs + 1) * sizeof *g->cmds);
+    g->cmd_cap = recs + 1;
     if (!g->visible || !g->occ_rest || !g->recs || !g->sorted || !g->key_count || !g->inst || !g->cmds)
         return mr_fail(err, MR_ERR_NOMEM, "out of memory for %zu mesh instances", recs);
     glCreateBuffers(1, &g->cmd_buf);
@@ -459,6 +547,95 @@ static bool fill_instance(const mr_geo_view *vw, const mr_node *n, const mr_mesh
     return true;
 }
 
+/* Meshlet culling of one instance (issue 17, lane meshlet), in camera
+ * space: the instance's model-view is composed in double from the
+ * camera-relative transforms (fill_instance), so a plant 1e7 units away
+ * tests as precisely as one at the origin. A sphere is kept unless it lies
+ * wholly behind the near plane or outside one of the four side planes of
+ * the image (with the margin of mr_geometry_lod_fmax, 1.5 pixels); radii
+ * grow by the node's stretch bound. The cone test (cluster_cone) is exact
+ * only under a similarity, so it runs only for those (mirrors excluded).
+ * Surviving consecutive meshlets merge into one command. Returns the
+ * triangles submitted. */
+static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_node *n, const mr_mesh *m,
+                              const geo_mesh *gm, int level, double scale, uint32_t inst, uint32_t *ncmd) {
+    struct mr_geo *g = r->geo;
+    const geo_cluster *cl = g->clusters + gm->cl_first[level];
+    uint32_t cnt = gm->cl_count[level]; /* emit_recs made room for cnt commands */
+    mr_dmat4 cn = mr_m4_mul(&vw->cam_from_world, &n->world);
+    mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
+    mr_dmat4 mvm = mr_m4_mul(&cn, &T);
+    const double *a = mvm.m; /* row-major: a[row * 4 + col] */
+    const mr_camera *c = &vw->cam;
+    double u0 = -1.5, u1 = c->width + 0.5, v0 = -1.5, v1 = c->height + 0.5;
+    /* Inward side planes through the camera centre: n . p >= 0 inside. */
+    double pl[4][3] = {{c->fx, 0, c->cx - u0}, {-c->fx, 0, u1 - c->cx}, {0, c->fy, c->cy - v0}, {0, -c->fy, v1 - c->cy}};
+    for (int k = 0; k < 4; k++) {
+        double l = sqrt(pl[k][0] * pl[k][0] + pl[k][1] * pl[k][1] + pl[k][2] * pl[k][2]);
+        for (int j = 0; j < 3; j++) pl[k][j] /= l;
+    }
+    /* A pass with depth clamping (the shadow map) draws what lies before
+     * its near plane too: there only the side planes cull. */
+    double near_cut = glIsEnabled(GL_DEPTH_CLAMP) ? -INFINITY : vw->near_plane;
+    bool cone = r->draw.cluster_cone;
+    if (cone) {
+        double col[3][3], s2[3];
+        for (int j = 0; j < 3; j++) {
+            for (int i = 0; i < 3; i++) col[j][i] = a[i * 4 + j];
+            s2[j] = col[j][0] * col[j][0] + col[j][1] * col[j][1] + col[j][2] * col[j][2];
+        }
+        double det = col[0][0] * (col[1][1] * col[2][2] - col[1][2] * col[2][1]) -
+                     col[1][0] * (col[0][1] * col[2][2] - col[0][2] * col[2][1]) +
+                     col[2][0] * (col[0][1] * col[1][2] - col[0][2] * col[1][1]);
+        for (int j = 0; j < 3 && cone; j++) {
+            if (fabs(s2[j] - s2[0]) > 1e-6 * s2[0]) cone = false;
+            double d = col[j][0] * col[(j + 1) % 3][0] + col[j][1] * col[(j + 1) % 3][1] + col[j][2] * col[(j + 1) % 3][2];
+            if (fabs(d) > 1e-6 * s2[0]) cone = false;
+        }
+        if (!(det > 0)) cone = false;
+    }
+    uint64_t tris = 0, drawn = 0;
+    uint32_t last_end = UINT32_MAX;
+    for (uint32_t k = 0; k < cnt; k++) {
+        const geo_cluster *q = &cl[k];
+        double p[3];
+        for (int i = 0; i < 3; i++)
+            p[i] = a[i * 4] * q->center[0] + a[i * 4 + 1] * q->center[1] + a[i * 4 + 2] * q->center[2] + a[i * 4 + 3];
+        double rad = (double)q->radius * scale * (1 + 1e-6) + 1e-9 * fabs(p[2]);
+        bool keep = p[2] > near_cut - rad;
+        for (int j = 0; j < 4 && keep; j++) keep = pl[j][0] * p[0] + pl[j][1] * p[1] + pl[j][2] * p[2] >= -rad;
+        if (keep && cone && q->cutoff < 1) {
+            /* meshopt: back-facing when dot(normalize(apex - eye), axis) >=
+             * cutoff; here the eye is the camera-space origin. A small
+             * slack keeps edge-on clusters. */
+            double ap[3], ax[3], la = 0, lx = 0, d = 0;
+            for (int i = 0; i < 3; i++) {
+                ap[i] = a[i * 4] * q->apex[0] + a[i * 4 + 1] * q->apex[1] + a[i * 4 + 2] * q->apex[2] + a[i * 4 + 3];
+                ax[i] = a[i * 4] * q->axis[0] + a[i * 4 + 1] * q->axis[1] + a[i * 4 + 2] * q->axis[2];
+                la += ap[i] * ap[i];
+                lx += ax[i] * ax[i];
+                d += ap[i] * ax[i];
+            }
+            if (la > 0 && lx > 0 && d / sqrt(la * lx) >= (double)q->cutoff + 1e-3) keep = false;
+        }
+        if (!keep) continue;
+        drawn++;
+        tris += q->count / 3;
+        if (last_end == q->first) {
+            g->cmds[*ncmd - 1].count += q->count;
+        } else {
+            g->cmds[*ncmd] = (draw_cmd){q->count, 1, q->first, gm->base_vertex, inst};
+            if (g->group_first[gm->group] < 0) g->group_first[gm->group] = (int32_t)*ncmd;
+            g->group_cmds[gm->group]++;
+            (*ncmd)++;
+        }
+        last_end = q->first + q->count;
+    }
+    r->stats.clusters_tested += cnt;
+    r->stats.clusters_drawn += drawn;
+    return tris;
+}
+
 /* Largest pixels per unit of x/z over the image (its corners, with the
  * margin): the LOD choice's projected-error factor. */
 double mr_geometry_lod_fmax(const mr_camera *c) {
@@ -522,7 +699,20 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     const mr_draw_params *dp = &r->draw;
     double t0 = mr_time_now();
 
-    /* 3. Instance data and commands, one per bucket (or per instance). */
+    /* 3. Instance data and commands, one per bucket (or per instance);
+     * an instance of a mesh level with meshlets can take one command per
+     * meshlet (issue 17, lane meshlet). */
+    bool clusters = !dp->no_cluster_cull && replicate == 0 && g->cluster_count > 0;
+    size_t need = nrec + 1;
+    for (size_t i = 0; clusters && i < nrec; i++) need += g->meshes[sorted[i].mesh].cl_count[sorted[i].key % LEVELS];
+    if (need > g->cmd_cap) {
+        draw_cmd *c = realloc(g->cmds, need * sizeof *c);
+        if (!c) clusters = false; /* whole levels then: nrec + 1 commands fit */
+        else {
+            g->cmds = c;
+            g->cmd_cap = need;
+        }
+    }
     uint32_t ninst = 0, ncmd = 0, last_key = UINT32_MAX, lod_inst = 0;
     uint64_t tris = 0, tri_full = 0;
     memset(g->group_cmds, 0, (size_t)g->group_count * sizeof *g->group_cmds);
@@ -537,6 +727,14 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
             r->stats.lod_max_error = gm->error[level] * g->node_scale[rc->node];
         tri_full += gm->count[0] / 3;
         if (!fill_instance(vw, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, rc->node, &g->inst[ninst])) continue;
+        if (clusters && gm->cl_count[level] > 0) {
+            /* issue 17 (lane meshlet): this instance's visible meshlets */
+            tris += emit_clusters(r, vw, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, level, g->node_scale[rc->node],
+                                  ninst, &ncmd);
+            last_key = UINT32_MAX; /* its commands take no other instance */
+            ninst++;
+            continue;
+        }
         /* Same bucket as the last command (records skipped as degenerate
          * leave no gap: the command's instances stay contiguous). */
         bool extend = !dp->no_instancing && ncmd > 0 && last_key == rc->key;

@@ -845,8 +845,23 @@ typedef struct mr_draw_params {
      * measured gain (geometry.c, "auto"); ignored where occlusion is on;
      * default on. */
     bool occlusion_auto;
+    /* issue 17 (lane meshlet): cluster culling of big meshes. Levels with
+     * at least cluster_triangles triangles are split into meshlets at
+     * upload (their index ranges reordered, meshlet by meshlet); each drawn
+     * instance tests its meshlets' bounding spheres against the view
+     * frustum and submits the surviving ranges. 0 = the default below; it
+     * takes effect at the next scene upload. */
+    bool no_cluster_cull;       /* default off: clusters are culled */
+    int32_t cluster_triangles;  /* 0 = MR_DRAW_DEFAULT_CLUSTER_TRIANGLES */
+    /* The back-facing cone test of meshopt's meshlet bounds. The G-buffer
+     * draws both faces of every triangle (glTF doubleSided is not kept:
+     * every material counts as double-sided), so a back-facing cluster of
+     * an open surface is visible; only for scenes of closed solids seen
+     * from outside. Default off. */
+    bool cluster_cone;
 } mr_draw_params;
 #define MR_DRAW_DEFAULT_LOD_PIXELS 1.0
+#define MR_DRAW_DEFAULT_CLUSTER_TRIANGLES 16384
 #define MR_DRAW_DEFAULTS {.no_cull = false, .lod_tolerance = 0.0, .lod_pixels = 0.0, .occlusion_auto = true} /* 0 = the defaults above */
 /* Option table (lib/render/options.c): --cull --batch --instancing
  * --occlusion (on|off), --lod-tolerance, --lod-pixels. Whether levels are
@@ -875,6 +890,9 @@ typedef struct mr_draw_stats {
                                   simplified level, ... */
     uint32_t frustum_culls;    /* issue 14: BVH frustum culls run (a rig
                                   frame's shared list: once, in its first view) */
+    /* issue 17 (lane meshlet): meshlets of big meshes tested and drawn */
+    uint64_t clusters_tested;
+    uint64_t clusters_drawn;
 } mr_draw_stats;
 
 /* Sets how geometry is submitted from the next frame on (NULL: defaults). */

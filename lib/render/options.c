@@ -146,6 +146,13 @@ const mr_opt mr_draw_opts[] = {
     /* issue 17 */
     {"occlusion-auto", MR_OPT_BOOL, DR(occlusion_auto), 0, 1, 1, NULL,
      "occlusion culling where it pays: decided per frame from its measured gain", MR_OPT_ONOFF},
+    /* issue 17 (lane meshlet) */
+    {"cluster-cull", MR_OPT_BOOL, DR(no_cluster_cull), 0, 1, 1, NULL,
+     "frustum culling of the meshlets of big meshes", MR_OPT_NEGATE | MR_OPT_ONOFF},
+    {"cluster-triangles", MR_OPT_INT, DR(cluster_triangles), 64, 1 << 30, MR_DRAW_DEFAULT_CLUSTER_TRIANGLES, NULL,
+     "triangles from which a mesh level is split into meshlets (at upload)", MR_OPT_ZERO_DEFAULT},
+    {"cluster-cone", MR_OPT_BOOL, DR(cluster_cone), 0, 1, 0, NULL,
+     "also cull back-facing meshlets (closed solids only: both faces are drawn)", MR_OPT_ONOFF},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef DR
