@@ -32,58 +32,21 @@ int cmd_measure(int argc, char **argv) {
     const char *dir = mr_cli_get(opts, "recording"), *obsf = mr_cli_get(opts, "observations"), *out = mr_cli_get(opts, "out");
     if (!dir || !obsf) return mr_cli_errorf(cmd, "--recording and --observations are required (see --help)"), 2;
     mr_error err = {0};
-    cJSON *obs = mr_json_load(obsf, &err);
-    if (!obs) return mr_cli_error(cmd, &err);
     mr_recording *rec = NULL;
     mr_scene *scene = NULL;
     mr_eval_nearest *near = NULL;
-    mr_tap taps[64];
-    int n = 0, rc = 1;
-    double planned[3];
-    bool has_planned = cJSON_GetObjectItemCaseSensitive(obs, "planned") != NULL;
-    const cJSON *arr = cJSON_GetObjectItemCaseSensitive(obs, "taps"), *t;
-    if (has_planned && !mr_json_numbers(obs, "planned", planned, 3, &err)) {
-        mr_error_prefix(&err, "%s", obsf);
-        goto fail;
-    }
-    if (!cJSON_IsArray(arr)) {
-        mr_fail(&err, MR_ERR_PARSE, "%s: \"taps\" must be an array of {\"frame\", \"px\"}", obsf);
-        goto fail;
-    }
+    int rc = 1;
+    mr_observations o;
     rec = mr_recording_open(dir, &err);
-    if (!rec) goto fail;
+    if (!rec || !mr_observations_load(obsf, rec, &o, &err)) goto fail;
     if (mr_cli_get(opts, "scene")) {
         scene = mr_scene_load(mr_cli_get(opts, "scene"), NULL, &err);
         if (!scene || !(near = mr_eval_nearest_create(scene, false, &err))) goto fail;
     }
-    int no_cov = 0;
-    cJSON_ArrayForEach(t, arr) {
-        double fr = -1, px[2];
-        if (n == 64) {
-            mr_fail(&err, MR_ERR_INVALID, "%s: more than 64 taps", obsf);
-            goto fail;
-        }
-        if (!cJSON_IsObject(t) || !mr_json_number(t, "frame", &fr, true, &err) || !mr_json_numbers(t, "px", px, 2, &err)) {
-            if (!cJSON_IsObject(t)) mr_fail(&err, MR_ERR_PARSE, "not an object");
-            mr_error_prefix(&err, "%s: tap %d", obsf, n + 1);
-            goto fail;
-        }
-        const mr_rec_frame *f = NULL;
-        for (int i = 0; i < rec->frame_count; i++)
-            if ((double)rec->frames[i].index == fr) f = &rec->frames[i];
-        if (!f) {
-            mr_fail(&err, MR_ERR_INVALID, "%s: tap %d: frame %g is not in the recording%s", obsf, n + 1, fr,
-                    rec->bad_lines ? " (its frames.jsonl has unreadable lines, skipped)" : "");
-            goto fail;
-        }
-        if (!f->pose.valid) {
-            mr_fail(&err, MR_ERR_INVALID, "%s: tap %d: frame %g has no tracked pose", obsf, n + 1, fr);
-            goto fail;
-        }
-        bool cov = f->pose.corner_sigma_px > 0;
-        no_cov += !cov;
-        taps[n++] = (mr_tap){f->pose.world_from_camera, cov ? f->pose.cov : NULL, {px[0], px[1]}};
-    }
+    const mr_tap *taps = o.taps;
+    int n = o.count, no_cov = o.no_cov;
+    bool has_planned = o.has_planned;
+    const double *planned = o.planned;
     mr_triangulation tr;
     if (!mr_triangulate(&rec->camera, taps, n, &tp, &tr, &err)) goto fail;
     /* After the solve, so that a refusal stays one line. */
@@ -143,6 +106,5 @@ done:
     mr_eval_nearest_destroy(&near);
     mr_scene_destroy(&scene);
     mr_recording_close(&rec);
-    cJSON_Delete(obs);
     return rc;
 }

@@ -116,6 +116,21 @@ typedef struct mr_recording {
 /* Reads meta.json, frames.jsonl and groundtruth.jsonl (if present). */
 mr_recording *mr_recording_open(const char *dir, mr_error *err);
 void mr_recording_close(mr_recording **rec);
+
+/* A measurement's taps (`mrcheck measure --observations OBS.json`:
+ * {"taps": [{"frame": N, "px": [u, v]}, ...], "planned": [x, y, z]}) read
+ * against the recording whose frames were tapped: each tap takes its
+ * frame's pose and, where the recording carries one, its covariance
+ * (no_cov counts the frames without). One clear error for a tap that names
+ * a frame not in the recording or without a pose. */
+#define MR_OBSERVATIONS_MAX 64
+typedef struct mr_observations {
+    mr_tap taps[MR_OBSERVATIONS_MAX];
+    int count, no_cov;
+    bool has_planned;
+    double planned[3];
+} mr_observations;
+bool mr_observations_load(const char *path, const mr_recording *rec, mr_observations *o, mr_error *err);
 /* Parses frames.jsonl / groundtruth.jsonl text into rec (used by open and
  * by the fuzz target). Never fails on content: bad lines are counted. */
 bool mr_recording_parse_frames(mr_recording *rec, const char *text, size_t size, mr_error *err);
