@@ -147,13 +147,7 @@ double mr_eval_ao_point(const mr_eval_gt *g, mr_dvec3 p, mr_dvec3 n, double radi
 
 typedef struct gt_job {
     const mr_eval_gt *g;
-    const mr_image *depth, *normal;
-    mr_image *out;
-    mr_camera cam;
-    mr_dmat4 rel_from_camera; /* Embree frame from camera */
     mr_gt_params p;
-    int next_row;
-    pthread_mutex_t lock;
 } gt_job;
 
 /* The G-buffer's surface at pixel (x, y), depth z, in camera space (through
@@ -170,15 +164,31 @@ static void surface_point(const mr_camera *cam, const mr_display_map *dm, int x,
     *nc = n;
 }
 
-static void *gt_worker(void *arg) {
-    gt_job *j = arg;
-    int w = j->depth->width, h = j->depth->height;
-    const float *dep = j->depth->data, *nor = j->normal->data;
-    float *out = j->out->data;
+/* The pixels both ground truths trace from, split over threads by rows
+ * (mutex-counted): each visible pixel's surface point and normal in the
+ * Embree frame go to `pixel`, whose value is written; 1 where nothing is
+ * visible. */
+typedef struct gt_rows {
+    const mr_image *depth, *normal;
+    mr_image *out;
+    mr_camera cam;
+    const mr_display_map *display;
+    mr_dmat4 rel_from_camera; /* Embree frame from camera */
+    float (*pixel)(const struct gt_rows *r, size_t i, float z, mr_dvec3 pw, mr_dvec3 nw);
+    const void *ctx;
+    int next_row;
+    pthread_mutex_t lock;
+} gt_rows;
+
+static void *rows_worker(void *arg) {
+    gt_rows *r = arg;
+    int w = r->depth->width, h = r->depth->height;
+    const float *dep = r->depth->data, *nor = r->normal->data;
+    float *out = r->out->data;
     for (;;) {
-        pthread_mutex_lock(&j->lock);
-        int y = j->next_row++;
-        pthread_mutex_unlock(&j->lock);
+        pthread_mutex_lock(&r->lock);
+        int y = r->next_row++;
+        pthread_mutex_unlock(&r->lock);
         if (y >= h) break;
         for (int x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
@@ -186,17 +196,41 @@ static void *gt_worker(void *arg) {
             out[i] = 1.0f;
             if (!(z > 0) || !isfinite(z)) continue;
             mr_dvec3 pc, nc;
-            surface_point(&j->cam, j->p.display, x, y, z, nor + 3 * i, &pc, &nc);
-            double R = j->p.radius_mode == MR_AO_RADIUS_SCREEN ? j->p.screen_radius * z * j->cam.height / j->cam.fy
-                                                               : j->p.radius;
-            mr_dvec3 pw = mr_m4_point(&j->rel_from_camera, pc), nw = mr_m4_dir(&j->rel_from_camera, nc);
-            double q[3] = {pw.x, pw.y, pw.z}, nv[3] = {nw.x, nw.y, nw.z};
-            mr_rng rng;
-            mr_rng_seed(&rng, j->p.seed * 0x9E3779B97F4A7C15ull + i);
-            out[i] = (float)visibility(j->g, q, nv, R, j->p.rays, &rng);
+            surface_point(&r->cam, r->display, x, y, z, nor + 3 * i, &pc, &nc);
+            out[i] = r->pixel(r, i, z, mr_m4_point(&r->rel_from_camera, pc), mr_m4_dir(&r->rel_from_camera, nc));
         }
     }
     return NULL;
+}
+
+/* Runs `pixel` over every pixel of depth/normal into out (allocated by the
+ * caller), seen from view, on `threads` threads (0: one per core). */
+static void rows_run(gt_rows *r, const mr_eval_gt *g, const mr_view *view, int threads) {
+    r->cam = mr_camera_resized(&view->camera, r->depth->width, r->depth->height);
+    mr_dmat4 shift = mr_m4_translate(-g->origin[0], -g->origin[1], -g->origin[2]);
+    r->rel_from_camera = mr_m4_mul(&shift, &view->world_from_camera);
+    r->next_row = 0;
+    pthread_mutex_init(&r->lock, NULL);
+    int nt = threads > 0 ? threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    if (nt < 1) nt = 1;
+    if (nt > 64) nt = 64;
+    pthread_t th[64];
+    int started = 0;
+    for (int i = 1; i < nt; i++)
+        if (pthread_create(&th[started], NULL, rows_worker, r) == 0) started++;
+    rows_worker(r);
+    for (int i = 0; i < started; i++) pthread_join(th[i], NULL);
+    pthread_mutex_destroy(&r->lock);
+}
+
+static float ao_pixel(const gt_rows *r, size_t i, float z, mr_dvec3 pw, mr_dvec3 nw) {
+    const gt_job *j = r->ctx;
+    double R = j->p.radius_mode == MR_AO_RADIUS_SCREEN ? j->p.screen_radius * z * r->cam.height / r->cam.fy
+                                                       : j->p.radius;
+    double q[3] = {pw.x, pw.y, pw.z}, nv[3] = {nw.x, nw.y, nw.z};
+    mr_rng rng;
+    mr_rng_seed(&rng, j->p.seed * 0x9E3779B97F4A7C15ull + i);
+    return (float)visibility(j->g, q, nv, R, j->p.rays, &rng);
 }
 
 bool mr_eval_ao_groundtruth(const mr_eval_gt *g, const mr_view *view, const mr_image *depth, const mr_image *normal,
@@ -211,27 +245,9 @@ bool mr_eval_ao_groundtruth(const mr_eval_gt *g, const mr_view *view, const mr_i
     if (!(p.radius > 0) || !isfinite(p.radius)) p.radius = 0.02 * g->diag;
     if (!(p.screen_radius > 0) || !isfinite(p.screen_radius)) p.screen_radius = 0.05;
     if (!mr_image_alloc(out, depth->width, depth->height, 1, MR_PIX_F32, err)) return false;
-    gt_job j;
-    memset(&j, 0, sizeof j);
-    j.g = g;
-    j.depth = depth;
-    j.normal = normal;
-    j.out = out;
-    j.cam = mr_camera_resized(&view->camera, depth->width, depth->height);
-    j.p = p;
-    mr_dmat4 shift = mr_m4_translate(-g->origin[0], -g->origin[1], -g->origin[2]);
-    j.rel_from_camera = mr_m4_mul(&shift, &view->world_from_camera);
-    pthread_mutex_init(&j.lock, NULL);
-    int nt = p.threads > 0 ? p.threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
-    if (nt < 1) nt = 1;
-    if (nt > 64) nt = 64;
-    pthread_t th[64];
-    int started = 0;
-    for (int i = 1; i < nt; i++)
-        if (pthread_create(&th[started], NULL, gt_worker, &j) == 0) started++;
-    gt_worker(&j);
-    for (int i = 0; i < started; i++) pthread_join(th[i], NULL);
-    pthread_mutex_destroy(&j.lock);
+    gt_job j = {g, p};
+    gt_rows rows = {.depth = depth, .normal = normal, .out = out, .display = p.display, .pixel = ao_pixel, .ctx = &j};
+    rows_run(&rows, g, view, p.threads);
     return true;
 }
 
@@ -244,18 +260,12 @@ bool mr_eval_ao_groundtruth(const mr_eval_gt *g, const mr_view *view, const mr_i
 
 typedef struct sgt_job {
     const mr_eval_gt *g;
-    const mr_image *depth, *normal;
-    mr_image *out;
-    mr_camera cam;
-    mr_dmat4 rel_from_camera;
     mr_light light;
     double pos[3];          /* light centre in the Embree frame */
     mr_dvec3 u, v, dir;     /* the light's axes (rect, sun) and its direction */
     double hx, hy;          /* rect half sizes / sphere radius / sun tan(angle/2) */
     int grid;
     uint64_t seed;
-    int next_row;
-    pthread_mutex_t lock;
 } sgt_job;
 
 static bool occluded(const mr_eval_gt *g, const double o[3], mr_dvec3 d, double tfar) {
@@ -318,31 +328,13 @@ static double light_visibility(const sgt_job *j, const double q[3], mr_dvec3 n, 
     return (double)seen / total;
 }
 
-static void *sgt_worker(void *arg) {
-    sgt_job *j = arg;
-    int w = j->depth->width, h = j->depth->height;
-    const float *dep = j->depth->data, *nor = j->normal->data;
-    float *out = j->out->data;
-    for (;;) {
-        pthread_mutex_lock(&j->lock);
-        int y = j->next_row++;
-        pthread_mutex_unlock(&j->lock);
-        if (y >= h) break;
-        for (int x = 0; x < w; x++) {
-            size_t i = (size_t)y * w + x;
-            float z = dep[i];
-            out[i] = 1.0f;
-            if (!(z > 0) || !isfinite(z)) continue;
-            mr_dvec3 pc, nc;
-            surface_point(&j->cam, NULL, x, y, z, nor + 3 * i, &pc, &nc);
-            mr_dvec3 pw = mr_m4_point(&j->rel_from_camera, pc), nw = mr_m4_dir(&j->rel_from_camera, nc);
-            double q[3] = {pw.x, pw.y, pw.z};
-            mr_rng rng;
-            mr_rng_seed(&rng, j->seed * 0x9E3779B97F4A7C15ull + i);
-            out[i] = (float)light_visibility(j, q, nw, &rng);
-        }
-    }
-    return NULL;
+static float shadow_pixel(const gt_rows *r, size_t i, float z, mr_dvec3 pw, mr_dvec3 nw) {
+    (void)z;
+    const sgt_job *j = r->ctx;
+    double q[3] = {pw.x, pw.y, pw.z};
+    mr_rng rng;
+    mr_rng_seed(&rng, j->seed * 0x9E3779B97F4A7C15ull + i);
+    return (float)light_visibility(j, q, nw, &rng);
 }
 
 bool mr_eval_shadow_groundtruth(const mr_eval_gt *g, const mr_view *view, const mr_image *depth, const mr_image *normal,
@@ -377,26 +369,11 @@ bool mr_eval_shadow_groundtruth(const mr_eval_gt *g, const mr_view *view, const 
     for (int k = 0; k < 3; k++) j.pos[k] = light->position[k] - g->origin[k];
     if (!mr_image_alloc(out, depth->width, depth->height, 1, MR_PIX_F32, err)) return false;
     j.g = g;
-    j.depth = depth;
-    j.normal = normal;
-    j.out = out;
-    j.cam = mr_camera_resized(&view->camera, depth->width, depth->height);
     j.grid = (int)floor(sqrt((double)p.rays) + 0.5);
     if (j.grid < 1) j.grid = 1;
     j.seed = p.seed;
-    mr_dmat4 shift = mr_m4_translate(-g->origin[0], -g->origin[1], -g->origin[2]);
-    j.rel_from_camera = mr_m4_mul(&shift, &view->world_from_camera);
-    pthread_mutex_init(&j.lock, NULL);
-    int nt = p.threads > 0 ? p.threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
-    if (nt < 1) nt = 1;
-    if (nt > 64) nt = 64;
-    pthread_t th[64];
-    int started = 0;
-    for (int i = 1; i < nt; i++)
-        if (pthread_create(&th[started], NULL, sgt_worker, &j) == 0) started++;
-    sgt_worker(&j);
-    for (int i = 0; i < started; i++) pthread_join(th[i], NULL);
-    pthread_mutex_destroy(&j.lock);
+    gt_rows rows = {.depth = depth, .normal = normal, .out = out, .pixel = shadow_pixel, .ctx = &j};
+    rows_run(&rows, g, view, p.threads);
     return true;
 }
 
