@@ -1127,6 +1127,17 @@ static double directed_bound(const float *pos, const uint32_t *from, uint32_t fr
     bb_ctx x = {to, *lower, *lower, resolution, limit, accept, accept > 0 ? 0.25 : 0, 0};
     for (uint32_t t = 0; t + 2 < from_count && isfinite(x.upper); t += 3) {
         uint32_t i0 = from[t], i1 = from[t + 1], i2 = from[t + 2];
+        /* A triangle the other surface has too (the simplifier left it as
+         * it was) is at distance 0. */
+        bool shared = false;
+        if (to->vt_start)
+            for (uint32_t k = to->vt_start[i0]; k < to->vt_start[i0 + 1] && !shared; k++) {
+                const uint32_t *q = to->idx + 3 * (size_t)to->vt_items[k];
+                int hit = 0;
+                for (int j = 0; j < 3; j++) hit += q[j] == i0 || q[j] == i1 || q[j] == i2;
+                shared = hit == 3 && i0 != i1 && i1 != i2 && i0 != i2;
+            }
+        if (shared) continue;
         bound_tri(&x, vtx(pos, i0), vtx(pos, i1), vtx(pos, i2), d[i0], d[i1], d[i2], near[i0], near[i1], near[i2], i0,
                   i1, i2, 0);
     }
@@ -1457,8 +1468,13 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
          * Resolution: a small part of the level's error budget; it only
          * ever adds to the bound. */
         double res = fmax(0.05 * target, 1e-6 * scale);
+        /* Searched only out to what the level may add and still be kept
+         * (beyond: INFINITY, the level is dropped as it would be anyway),
+         * so a level that fails gives up early. */
+        double room = cap - src_err - 2 * w.slack;
+        if (!(room > 0)) break;
         double e = src_err + mr_lod_hausdorff_bound_within(w.cpos, w.ccount, src, (uint32_t)src_n, dst, (uint32_t)n,
-                                                           res, res, 2 * cap);
+                                                           res, res, room * (1 + 1e-9));
         if (!(e + 2 * w.slack <= cap)) break; /* coarser levels only get worse */
         mr_lod_level *l = &out->levels[out->level_count];
         l->indices = malloc(n * sizeof *l->indices);
