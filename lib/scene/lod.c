@@ -110,9 +110,10 @@ typedef struct tri_grid {
     int n[3];
     uint32_t *start;   /* n0*n1*n2 + 1 offsets into items */
     uint32_t *items;   /* triangle ids */
-    uint32_t *partner; /* 3 per triangle: the neighbour across each edge if
-                          both are coplanar and their union is convex, else
-                          UINT32_MAX (see convex_partners) */
+    uint32_t *partner; /* 3 per triangle: across each manifold edge the
+                          other triangle's far corner, until partner_get
+                          finds the pair not convex and flat (then, and for
+                          borders, UINT32_MAX) */
     double ptol;       /* coplanarity tolerance used for partner */
     /* Hinges: per triangle edge with a partner, the partner's opposite
      * corner rotated about the shared edge into this triangle's plane
@@ -402,28 +403,43 @@ static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
         g->nbr[3 * (size_t)e[i].tri + e[i].slot] = e[i + 1].tri;
         g->nbr[3 * (size_t)e[i + 1].tri + e[i + 1].slot] = e[i].tri;
     }
-    for (size_t i = 0; i + 1 < ne; i++) {
-        if (e[i].a != e[i + 1].a || e[i].b != e[i + 1].b) continue;
-        if (i + 2 < ne && e[i + 2].a == e[i].a && e[i + 2].b == e[i].b) continue; /* non-manifold edge */
+    /* Hinges are folded on first use (partner_get): most edges never are
+     * asked. Until then partner holds the far corner (the other
+     * triangle's opposite vertex) and hinge_s is NAN. */
+    for (size_t i = 0, j; i < ne; i = j) {
+        for (j = i + 1; j < ne && e[j].a == e[i].a && e[j].b == e[i].b;) j++;
+        if (j - i != 2) continue; /* a border, or non-manifold */
         uint32_t t1 = e[i].tri, t2 = e[i + 1].tri;
-        uint32_t c = g->idx[3 * t1 + (e[i].slot + 2) % 3], d = g->idx[3 * t2 + (e[i + 1].slot + 2) % 3];
-        dv pa = vtx(g->pos, e[i].a), pb = vtx(g->pos, e[i].b), pc = vtx(g->pos, c), pd = vtx(g->pos, d);
-        /* Each side gets the other's corner folded flat onto its own plane. */
-        for (int side = 0; side < 2; side++) {
-            dv own = side ? pd : pc, far = side ? pc : pd;
-            uint32_t t = side ? t2 : t1, q = side ? t1 : t2, slot = side ? e[i + 1].slot : e[i].slot;
-            dv f;
-            double moved;
-            if (!hinge_fold(pa, pb, own, far, &f, &moved) || !convex_pair(pa, pb, own, f, tol)) continue;
-            g->partner[3 * (size_t)t + slot] = q;
-            size_t h = 3 * (size_t)t + slot;
-            g->hinge_p[3 * h] = f.x;
-            g->hinge_p[3 * h + 1] = f.y;
-            g->hinge_p[3 * h + 2] = f.z;
-            g->hinge_s[h] = moved;
-        }
+        uint32_t c = g->idx[3 * (size_t)t1 + (e[i].slot + 2) % 3], d = g->idx[3 * (size_t)t2 + (e[i + 1].slot + 2) % 3];
+        g->partner[3 * (size_t)t1 + e[i].slot] = d;
+        g->hinge_s[3 * (size_t)t1 + e[i].slot] = NAN;
+        g->partner[3 * (size_t)t2 + e[i + 1].slot] = c;
+        g->hinge_s[3 * (size_t)t2 + e[i + 1].slot] = NAN;
     }
     free(e);
+    return true;
+}
+
+/* The hinge of edge h (triangle h / 3, edge h % 3): the other triangle's
+ * corner folded flat onto this one's plane, if the flat pair is convex
+ * (see hinge_fold, convex_pair); false if there is none. */
+static bool partner_get(const tri_grid *og, size_t h) {
+    tri_grid *g = (tri_grid *)og; /* folded lazily: scratch */
+    if (g->partner[h] == UINT32_MAX) return false;
+    if (!isnan(g->hinge_s[h])) return true;
+    size_t t = h / 3, slot = h % 3;
+    dv pa = vtx(g->pos, g->idx[3 * t + slot]), pb = vtx(g->pos, g->idx[3 * t + (slot + 1) % 3]);
+    dv own = vtx(g->pos, g->idx[3 * t + (slot + 2) % 3]), far = vtx(g->pos, g->partner[h]);
+    dv f;
+    double moved;
+    if (!hinge_fold(pa, pb, own, far, &f, &moved) || !convex_pair(pa, pb, own, f, g->ptol)) {
+        g->partner[h] = UINT32_MAX;
+        return false;
+    }
+    g->hinge_p[3 * h] = f.x;
+    g->hinge_p[3 * h + 1] = f.y;
+    g->hinge_p[3 * h + 2] = f.z;
+    g->hinge_s[h] = moved;
     return true;
 }
 
@@ -977,7 +993,7 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
             memcpy(dd, cdd[k], sizeof dd);
             for (int j = 0; j < 3; j++) {
                 size_t h = 3 * (size_t)t + (size_t)j;
-                if (o->partner[h] == UINT32_MAX) continue;
+                if (!partner_get(o, h)) continue;
                 /* The flat pair (t and the folded partner) is convex: its
                  * distance is largest at a corner; + what the fold moved,
                  * + 2 ptol: "coplanar" allows float rounding, so the flat
