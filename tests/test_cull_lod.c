@@ -609,14 +609,15 @@ static void test_100k_and_truncation(void) {
  * the other surface; the claim is proven from the patch's border edges. A
  * coarse plate (two triangles) over a fine one with a hole, a slit, a hole
  * with a separate sheet under it, and cells wound the other way: each bound
- * holds against brute force, at scales 1e-3, 1 and 1e3. Without the border
- * check the hole would be bounded by the heights alone (0). */
+ * holds against brute force, at scales 1e-3, 1 and 1e3, and at 1e3 moved
+ * 1e7 away. Without the border check the hole would be bounded by the
+ * heights alone (0). */
 static void test_lod_patch_holes(void) {
     const int n = 21;
-    const double scales[3] = {1e-3, 1, 1e3};
+    const double scales[4] = {1e-3, 1, 1e3, 1e3};
     for (int cs = 0; cs < 4; cs++)
-        for (int si = 0; si < 3; si++) {
-            double sc = scales[si];
+        for (int si = 0; si < 4; si++) {
+            double sc = scales[si], off = si == 3 ? 1e7 : 0;
             mr_mesh m = plate(n, 16);
             /* A small sheet under the hole (case 2): 4 x 4 vertices, 1 cm below. */
             uint32_t base = (uint32_t)(n * n);
@@ -627,7 +628,7 @@ static void test_lod_patch_holes(void) {
                     q[1] = -0.01f;
                     q[2] = (float)(0.1 - 0.075 + 0.05 * j);
                 }
-            for (uint32_t v = 0; v < m.vertex_count * 3; v++) m.positions[v] = (float)(m.positions[v] * sc);
+            for (uint32_t v = 0; v < m.vertex_count * 3; v++) m.positions[v] = (float)(m.positions[v] * sc + (v % 3 == 0 ? off : 0));
             uint32_t *fine = malloc(((size_t)m.index_count + 64) * 4), nf = 0;
             for (int j = 0; j + 1 < n; j++)
                 for (int i = 0; i + 1 < n; i++) {
