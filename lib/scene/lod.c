@@ -43,6 +43,12 @@
 
 typedef struct dv { double x, y, z; } dv;
 
+/* max and min without libm's calls (fmax is a call at -O2: it must treat
+ * NaN specially; every value here is finite or +-INFINITY, positions
+ * being checked finite on load). */
+static inline double dmax(double a, double b) { return a > b ? a : b; }
+static inline double dmin(double a, double b) { return a < b ? a : b; }
+
 static dv dv_sub(dv a, dv b) { return (dv){a.x - b.x, a.y - b.y, a.z - b.z}; }
 static double dv_dot(dv a, dv b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 static dv dv_mad(dv a, dv b, double s) { return (dv){a.x + b.x * s, a.y + b.y * s, a.z + b.z * s}; }
@@ -186,7 +192,7 @@ static bool grid_build(tri_grid *g, const float *pos, const uint32_t *idx, uint3
     g->pos = pos;
     g->idx = idx;
     g->tri_count = index_count / 3;
-    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    double ext = dmax(hi[0] - lo[0], dmax(hi[1] - lo[1], hi[2] - lo[2]));
     if (!(ext > 0)) ext = 1;
     /* A few cells per triangle (most are empty: surfaces are thin), at most
      * 128 per axis. */
@@ -206,8 +212,8 @@ static bool grid_build(tri_grid *g, const float *pos, const uint32_t *idx, uint3
     for (int pass = 0; pass < 2; pass++) {
         for (uint32_t t = 0; t < g->tri_count; t++) {
             dv a = vtx(pos, idx[3 * t]), b = vtx(pos, idx[3 * t + 1]), c = vtx(pos, idx[3 * t + 2]);
-            dv mn = {fmin(a.x, fmin(b.x, c.x)), fmin(a.y, fmin(b.y, c.y)), fmin(a.z, fmin(b.z, c.z))};
-            dv mx = {fmax(a.x, fmax(b.x, c.x)), fmax(a.y, fmax(b.y, c.y)), fmax(a.z, fmax(b.z, c.z))};
+            dv mn = {dmin(a.x, dmin(b.x, c.x)), dmin(a.y, dmin(b.y, c.y)), dmin(a.z, dmin(b.z, c.z))};
+            dv mx = {dmax(a.x, dmax(b.x, c.x)), dmax(a.y, dmax(b.y, c.y)), dmax(a.z, dmax(b.z, c.z))};
             int c0[3], c1[3];
             cell_of(g, mn, c0);
             cell_of(g, mx, c1);
@@ -320,11 +326,11 @@ static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
         double r = 0;
         for (int j = 0; j < 3; j++) {
             dv d = dv_sub(p[j], ctr);
-            r = fmax(r, sqrt(dv_dot(d, d)));
+            r = dmax(r, sqrt(dv_dot(d, d)));
             for (int k = 0; k < 3; k++) {
                 uint32_t v = g->idx[3 * (size_t)t + (size_t)j];
                 dv e = dv_sub(p[k], p[j]);
-                g->vrad[v] = fmax(g->vrad[v], sqrt(dv_dot(e, e)));
+                g->vrad[v] = dmax(g->vrad[v], sqrt(dv_dot(e, e)));
             }
         }
         double *sp = g->tsph + 5 * (size_t)t;
@@ -624,8 +630,8 @@ static double fan_bound(const tri_grid *o, uint32_t v, uint32_t ref, dv a, dv b,
     for (int j = 0; j < 3; j++) {
         double best = INFINITY;
         for (uint32_t k = 0; k < 16; k++)
-            if (o->fan_mask[v] & (1u << k)) best = fmin(best, dist_to_tri(o, q[j], o->vt_items[k0 + k]));
-        m = fmax(m, best);
+            if (o->fan_mask[v] & (1u << k)) best = dmin(best, dist_to_tri(o, q[j], o->vt_items[k0 + k]));
+        m = dmax(m, best);
     }
     return m + slack;
 }
@@ -683,14 +689,14 @@ static double clipped_height(const double x[3][2], const double h[3], const doub
                 xin = false;
                 break;
             }
-    if (xin) return fmax(fabs(h[0]), fmax(fabs(h[1]), fabs(h[2])));
+    if (xin) return dmax(fabs(h[0]), dmax(fabs(h[1]), fabs(h[2])));
     double ax = cross2(x[0], x[1], x[2]);
     bool pin = ax > 0;
     double hm = 0;
     for (int i = 0; i < 3 && pin; i++) {
         double w0 = cross2(x[1], x[2], p[i]), w1 = cross2(x[2], x[0], p[i]), w2 = cross2(x[0], x[1], p[i]);
         if (w0 < 0 || w1 < 0 || w2 < 0) pin = false;
-        else hm = fmax(hm, fabs((w0 * h[0] + w1 * h[1] + w2 * h[2]) / ax));
+        else hm = dmax(hm, fabs((w0 * h[0] + w1 * h[1] + w2 * h[2]) / ax));
     }
     if (pin) return hm;
     double poly[2][9][3]; /* (x, y, height) */
@@ -717,8 +723,8 @@ static double clipped_height(const double x[3][2], const double h[3], const doub
         cur = nx;
     }
     hm = 0;
-    if (n == 0) return fmax(fabs(h[0]), fmax(fabs(h[1]), fabs(h[2])));
-    for (int i = 0; i < n; i++) hm = fmax(hm, fabs(poly[cur][i][2]));
+    if (n == 0) return dmax(fabs(h[0]), dmax(fabs(h[1]), fabs(h[2])));
+    for (int i = 0; i < n; i++) hm = dmax(hm, fabs(poly[cur][i][2]));
     return hm;
 }
 
@@ -731,7 +737,11 @@ static bool seg_hits_open_tri(const double *s0, const double *s1, const double t
     return true;
 }
 
-static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *seed, int nseed, double enough) {
+/* seed: where to start (the corners' nearest triangles); more: further
+ * starts (the triangles around corners the surfaces share), taken only if
+ * nothing from seed lies under the piece. */
+static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *seed, int nseed, const uint32_t *more,
+                          int nmore, double enough) {
     tri_grid *o = (tri_grid *)og; /* the patch marks are scratch */
     if (!o->nbr) return INFINITY;
     dv e1 = dv_sub(b, a), e2 = dv_sub(c, a);
@@ -748,11 +758,11 @@ static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *
     double r = area2 / per, d = o->ptol > 0 ? o->ptol : 1e-300;
     if (!(r > 4 * d)) return INFINITY;
     const double I[2] = {(la * P[0][0] + lb * P[1][0] + lc * P[2][0]) / per, (la * P[0][1] + lb * P[1][1] + lc * P[2][1]) / per};
-    double k = (r - d) / r, dmax = 0, Q[3][2];
+    double k = (r - d) / r, dgrow = 0, Q[3][2];
     for (int i = 0; i < 3; i++) {
         Q[i][0] = I[0] + k * (P[i][0] - I[0]);
         Q[i][1] = I[1] + k * (P[i][1] - I[1]);
-        dmax = fmax(dmax, d / r * hypot(P[i][0] - I[0], P[i][1] - I[1]));
+        dgrow = dmax(dgrow, d / r * hypot(P[i][0] - I[0], P[i][1] - I[1]));
     }
     if (o->stamp >= 0x7ffffff0u) {
         memset(o->mark, 0, (size_t)o->tri_count * sizeof *o->mark);
@@ -769,7 +779,14 @@ static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *
     int nc = 0;
     for (int i = 0; i < nseed && nc < 96; i++)
         if (seed[i] != UINT32_MAX) cand[nc++] = seed[i];
-    for (int ci = 0; ci < nc; ci++) {
+    for (int ci = 0;; ci++) {
+        if (ci == nc) {
+            if (np > 0 || nmore == 0) break;
+            for (int i = 0; i < nmore && nc < 96; i++)
+                if (more[i] != UINT32_MAX) cand[nc++] = more[i];
+            nmore = 0;
+            if (ci == nc) break;
+        }
         uint32_t t = cand[ci];
         if (o->mark[t] >= seen) continue;
         o->mark[t] = seen;
@@ -787,15 +804,15 @@ static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *
         /* Only the part over P matters (the clip also keeps 9 corners at
          * most: a triangle clipped by three half-planes); no clip needed
          * where even the corners do not raise H. */
-        double hmax = fmax(fabs(hs[0]), fmax(fabs(hs[1]), fabs(hs[2])));
+        double hmax = dmax(fabs(hs[0]), dmax(fabs(hs[1]), fabs(hs[2])));
         if (hmax > H) hmax = clipped_height(x, hs, P);
         if (!(hmax <= enough)) continue;
         if (np == PATCH_MAX) return INFINITY;
         o->mark[t] = in;
         memcpy(xy[np], x, sizeof x);
         list[np++] = t;
-        H = fmax(H, hmax);
-        if (H + dmax + 2 * o->ptol > enough) return INFINITY;
+        H = dmax(H, hmax);
+        if (H + dgrow + 2 * o->ptol > enough) return INFINITY;
         for (int j = 0; j < 3; j++) {
             uint32_t nb = o->nbr[3 * (size_t)t + (size_t)j];
             if (nb != UINT32_MAX && o->mark[nb] < seen) cand[nc++] = nb;
@@ -815,7 +832,7 @@ static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *
     const double g[2] = {(Q[0][0] + Q[1][0] + Q[2][0]) / 3, (Q[0][1] + Q[1][1] + Q[2][1]) / 3};
     for (int i = 0; i < np; i++)
         if (cross2(xy[i][0], xy[i][1], g) > 0 && cross2(xy[i][1], xy[i][2], g) > 0 && cross2(xy[i][2], xy[i][0], g) > 0)
-            return H + dmax + 2 * o->ptol;
+            return H + dgrow + 2 * o->ptol;
     return INFINITY;
 }
 
@@ -858,7 +875,7 @@ static void ring_prepare(const tri_grid *o, uint32_t v) {
             uint32_t vi = o->idx[3 * t + (uint32_t)j];
             if (vi == v) iv = j;
             dv d = dv_sub(vtx(o->pos, vi), pv);
-            height = fmax(height, fabs(dv_dot(d, n)));
+            height = dmax(height, fabs(dv_dot(d, n)));
             q[j][0] = pts[np][0] = dv_dot(d, u);
             q[j][1] = pts[np][1] = dv_dot(d, w);
             np++;
@@ -907,8 +924,8 @@ static double ring_bound(const tri_grid *o, uint32_t v, dv a, dv b, dv c, double
     double m = 0;
     for (int j = 0; j < 3; j++) {
         double best = INFINITY;
-        for (uint32_t k = 0; k < nk; k++) best = fmin(best, dist2_point_tri(q[j], p[k][0], p[k][1], p[k][2]));
-        m = fmax(m, sqrt(best));
+        for (uint32_t k = 0; k < nk; k++) best = dmin(best, dist2_point_tri(q[j], p[k][0], p[k][1], p[k][2]));
+        m = dmax(m, sqrt(best));
     }
     return m + slack;
 }
@@ -929,7 +946,7 @@ static double corner_max(const tri_grid *o, dv a, dv b, dv c, uint32_t t, double
     d[0] = dist_to_tri(o, a, t);
     d[1] = dist_to_tri(o, b, t);
     d[2] = dist_to_tri(o, c, t);
-    return fmax(d[0], fmax(d[1], d[2]));
+    return dmax(d[0], dmax(d[1], d[2]));
 }
 
 /* Largest distance of the piece's corners from the plane of triangle t: a
@@ -942,7 +959,7 @@ static double plane_gap(const tri_grid *o, uint32_t t, dv a, dv b, dv c) {
     dv n = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
     double nl = sqrt(dv_dot(n, n));
     if (!(nl > 0)) return 0;
-    double g = fmax(fabs(dv_dot(dv_sub(a, r0), n)), fmax(fabs(dv_dot(dv_sub(b, r0), n)), fabs(dv_dot(dv_sub(c, r0), n))));
+    double g = dmax(fabs(dv_dot(dv_sub(a, r0), n)), dmax(fabs(dv_dot(dv_sub(b, r0), n)), fabs(dv_dot(dv_sub(c, r0), n))));
     /* Slightly under the exact value, so float rounding never skips a
      * bound that would have held (skipping only costs time anyway). */
     return 0.999 * g / nl;
@@ -962,7 +979,7 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
         }
         /* Enough: within what is asked (accept), or within resolution of
          * the largest distance known to be real (lower). */
-        double enough = fmax(x->accept, x->lower * (1 + x->rel) + x->resolution);
+        double enough = dmax(x->accept, x->lower * (1 + x->rel) + x->resolution);
         double ub = INFINITY, dd[3], cdd[3][3];
         const uint32_t cand[3] = {ta, tb, tc}, vid[3] = {va, vb, vc};
         const dv q[3] = {a, b, c};
@@ -971,8 +988,8 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
          * covering radius (at most the longest edge / sqrt 3) of a corner. */
         dv ab = dv_sub(b, a), bc = dv_sub(c, b), ca = dv_sub(a, c);
         double lab = dv_dot(ab, ab), lbc = dv_dot(bc, bc), lca = dv_dot(ca, ca);
-        double longest = sqrt(fmax(lab, fmax(lbc, lca)));
-        double lip = fmax(da, fmax(db, dc)) + longest / sqrt(3.0);
+        double longest = sqrt(dmax(lab, dmax(lbc, lca)));
+        double lip = dmax(da, dmax(db, dc)) + longest / sqrt(3.0);
         if (lip <= enough) {
             if (lip > x->upper) x->upper = lip;
             return;
@@ -1002,22 +1019,21 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
                 dv f = {o->hinge_p[3 * h], o->hinge_p[3 * h + 1], o->hinge_p[3 * h + 2]};
                 double slack = o->hinge_s[h] + 2 * o->ptol;
                 if (slack >= ub) continue;
-                double mq = fmax(fmin(dd[0], sqrt(dist2_point_tri(a, e1, e0, f))),
-                                 fmax(fmin(dd[1], sqrt(dist2_point_tri(b, e1, e0, f))),
-                                      fmin(dd[2], sqrt(dist2_point_tri(c, e1, e0, f))))) + slack;
+                double mq = dmax(dmin(dd[0], sqrt(dist2_point_tri(a, e1, e0, f))),
+                                 dmax(dmin(dd[1], sqrt(dist2_point_tri(b, e1, e0, f))),
+                                      dmin(dd[2], sqrt(dist2_point_tri(c, e1, e0, f))))) + slack;
                 if (mq < ub) ub = mq;
             }
         }
         /* A projected patch of the other surface (see patch_bound). */
         if (ub > enough) {
-            uint32_t seed[3 + 3 * 24];
+            uint32_t more[3 * 24];
             int ns = 0;
-            for (int k = 0; k < 3; k++) seed[ns++] = cand[k];
             for (int k = 0; k < 3 && o->vt_start; k++)
                 if (vid[k] != UINT32_MAX)
                     for (uint32_t j = o->vt_start[vid[k]], m = 0; j < o->vt_start[vid[k] + 1] && m < 24; j++, m++)
-                        seed[ns++] = o->vt_items[j];
-            double pb = patch_bound(o, a, b, c, seed, ns, enough);
+                        more[ns++] = o->vt_items[j];
+            double pb = patch_bound(o, a, b, c, cand, 3, more, ns, enough);
             if (pb < ub) ub = pb;
         }
         /* Curved fans around the candidates' vertices and the shared
@@ -1074,7 +1090,7 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
             uint32_t tab, tbc, tca;
             double dab = grid_nearest(x->other, mab, x->limit, &tab), dbc = grid_nearest(x->other, mbc, x->limit, &tbc),
                    dca = grid_nearest(x->other, mca, x->limit, &tca);
-            x->lower = fmax(x->lower, fmax(dab, fmax(dbc, dca)));
+            x->lower = dmax(x->lower, dmax(dab, dmax(dbc, dca)));
             bound_tri(x, a, mab, mca, da, dab, dca, ta, tab, tca, va, UINT32_MAX, UINT32_MAX, depth + 1);
             bound_tri(x, mab, b, mbc, dab, db, dbc, tab, tb, tbc, UINT32_MAX, vb, UINT32_MAX, depth + 1);
             bound_tri(x, mca, mbc, c, dca, dbc, dc, tca, tbc, tc, UINT32_MAX, UINT32_MAX, vc, depth + 1);
@@ -1180,13 +1196,13 @@ static double hausdorff(const float *positions, uint32_t vertex_count, const uin
             if (p < lo[k]) lo[k] = p;
             if (p > hi[k]) hi[k] = p;
         }
-    if (!(resolution > 0)) resolution = 1e-6 * fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    if (!(resolution > 0)) resolution = 1e-6 * dmax(hi[0] - lo[0], dmax(hi[1] - lo[1], hi[2] - lo[2]));
     if (!(resolution > 0)) resolution = 1e-12;
     if (!(limit > 0)) limit = INFINITY;
     if (!(accept > 0)) accept = 0;
     tri_grid ga, gb;
     /* Positions are float: a few ulps of the extent. */
-    double ptol = 1e-6 * fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    double ptol = 1e-6 * dmax(hi[0] - lo[0], dmax(hi[1] - lo[1], hi[2] - lo[2]));
     bool ok = grid_build(&ga, positions, a, a_count, lo, hi) && grid_build(&gb, positions, b, b_count, lo, hi);
     double *da = malloc((size_t)vertex_count * sizeof *da), *db = malloc((size_t)vertex_count * sizeof *db);
     uint32_t *na = malloc((size_t)vertex_count * sizeof *na), *nb = malloc((size_t)vertex_count * sizeof *nb);
@@ -1200,7 +1216,7 @@ static double hausdorff(const float *positions, uint32_t vertex_count, const uin
             double ab = directed_bound(positions, a, a_count, &gb, da, na, &lower, resolution, accept, limit);
             double ba = isfinite(ab) ? directed_bound(positions, b, b_count, &ga, db, nb, &lower, resolution, accept, limit)
                                      : INFINITY;
-            r = fmax(ab, ba);
+            r = dmax(ab, ba);
 
         }
     }
@@ -1341,7 +1357,7 @@ static bool weld_build(const mr_mesh *m, weld *w) {
     w->slack = 0;
     for (size_t v = 0; v < nv; v++) {
         dv d = dv_sub(vtx(m->positions, (uint32_t)v), vtx(m->positions, canon[v]));
-        w->slack = fmax(w->slack, sqrt(dv_dot(d, d)));
+        w->slack = dmax(w->slack, sqrt(dv_dot(d, d)));
     }
     for (size_t v = 0; v < nv; v++) w->gstart[canon[v] + 2]++;
     for (size_t v = 0; v < nv; v++) w->gstart[v + 2] += w->gstart[v + 1];
@@ -1483,7 +1499,7 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
          * more than a quarter over the largest real distance found.
          * Resolution: a small part of the level's error budget; it only
          * ever adds to the bound. */
-        double res = fmax(0.05 * target, 1e-6 * scale);
+        double res = dmax(0.05 * target, 1e-6 * scale);
         /* Searched only out to what the level may add and still be kept
          * (beyond: INFINITY, the level is dropped as it would be anyway),
          * so a level that fails gives up early. */
@@ -1502,7 +1518,7 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
         l->index_count = (uint32_t)n;
         /* The welded surfaces differ from the mesh's own (full, and the
          * level mapped back) by at most the weld's slack each. */
-        l->error = fmax(e + 2 * w.slack, src_err + 2 * w.slack); /* kept increasing for the renderer */
+        l->error = dmax(e + 2 * w.slack, src_err + 2 * w.slack); /* kept increasing for the renderer */
         out->level_count++;
         /* This level (welded) is the next one's source. */
         si = di;
