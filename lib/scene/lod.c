@@ -995,11 +995,18 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
             return;
         }
         /* Convexity: over the triangle, distance to one triangle t is at
-         * most the largest corner distance to t. */
+         * most the largest corner distance to t. A corner whose nearest
+         * triangle is t is at its known distance from it (all three, the
+         * common case: no distance computed at all). */
+        const double dk[3] = {da, db, dc};
         for (int k = 0; k < 3; k++) {
             uint32_t t = cand[k];
             if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
-            double m = corner_max(o, a, b, c, t, cdd[k]);
+            double m = 0;
+            for (int j = 0; j < 3; j++) {
+                cdd[k][j] = cand[j] == t ? dk[j] : dist_to_tri(o, q[j], t);
+                m = dmax(m, cdd[k][j]);
+            }
             if (m < ub) ub = m;
         }
         /* The convex union with a coplanar neighbour. */
