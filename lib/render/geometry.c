@@ -51,6 +51,7 @@ typedef struct geo_mesh {
     float color[4];
     uint32_t has_tex;
     uint32_t cl_first[LEVELS], cl_count[LEVELS]; /* meshlets of each level in mr_geo.clusters */
+    bool single_sided;             /* issue 17 (lane cluster): its material's back faces are culled */
 } geo_mesh;
 
 /* One meshlet (issue 17, lane meshlet): its contiguous index range in the
@@ -63,9 +64,16 @@ typedef struct geo_cluster {
     float apex[3], axis[3], cutoff; /* back-facing cone */
 } geo_cluster;
 
+/* issue 17 (lane cluster): the face-culling class of a (node, mesh) pair:
+ * both faces drawn; single-sided; single-sided under a mirroring node (glTF:
+ * a negative determinant turns the front face clockwise). Classes are the
+ * outermost sort key, so each (class, draw group) is one contiguous run of
+ * commands, submitted with its own face-culling state. */
+enum { CLS_DOUBLE, CLS_SINGLE, CLS_MIRROR, CLS_COUNT };
+
 typedef struct geo_rec {
     int32_t node, mesh;
-    uint32_t key;                  /* rank(mesh) * LEVELS + level */
+    uint32_t key;                  /* (class * meshes + rank(mesh)) * LEVELS + level */
 } geo_rec;
 
 struct mr_geo {
@@ -105,6 +113,8 @@ struct mr_geo {
     geo_cluster *clusters;
     uint32_t cluster_count;
     size_t cmd_cap;                /* g->cmds (clusters add commands) */
+    /* issue 17 (lane cluster) */
+    uint8_t *node_mirror;          /* the node's world 3x3 has a negative determinant */
 };
 
 /* ------------------------------------------------------------- params */
@@ -158,6 +168,7 @@ void mr_geometry_free(mr_renderer *r) {
         free(g->depth);
         free(g->hz);
         free(g->clusters);
+        free(g->node_mirror);
         free(g);
         r->geo = NULL;
     }
@@ -305,9 +316,10 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     g->by_rank = calloc(nm + 1, sizeof *g->by_rank);
     g->node_scale = calloc(nn + 1, sizeof *g->node_scale);
     g->group_count = 1 + s->texture_count;
-    g->group_first = calloc((size_t)g->group_count, sizeof *g->group_first);
-    g->group_cmds = calloc((size_t)g->group_count, sizeof *g->group_cmds);
-    if (!g->meshes || !g->rank || !g->by_rank || !g->node_scale || !g->group_first || !g->group_cmds)
+    g->group_first = calloc((size_t)g->group_count * CLS_COUNT, sizeof *g->group_first);
+    g->group_cmds = calloc((size_t)g->group_count * CLS_COUNT, sizeof *g->group_cmds);
+    g->node_mirror = calloc(nn + 1, 1);
+    if (!g->meshes || !g->rank || !g->by_rank || !g->node_scale || !g->group_first || !g->group_cmds || !g->node_mirror)
         return mr_fail(err, MR_ERR_NOMEM, "out of memory uploading the scene");
 
     /* Layout, group and place of each mesh in the shared buffers. */
@@ -322,6 +334,7 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
         gm->has_tex = textured;
         static const float grey[4] = {0.7f, 0.7f, 0.7f, 1.0f};
         memcpy(gm->color, mat ? mat->base_color : grey, sizeof gm->color);
+        gm->single_sided = mat && mat->single_sided; /* issue 17 (lane cluster) */
         gm->base_vertex = (int32_t)verts[gm->pool];
         verts[gm->pool] += m->vertex_count;
         gm->level_count = 1;
@@ -338,7 +351,8 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
             gm->error[l] = ml->levels[k].error;
             indices += ml->levels[k].index_count;
         }
-        if (verts[0] > INT32_MAX || verts[1] > INT32_MAX || indices > UINT32_MAX / 4)
+        if (verts[0] > INT32_MAX || verts[1] > INT32_MAX || indices > UINT32_MAX / 4 ||
+            (nm + 1) * LEVELS * CLS_COUNT > UINT32_MAX)
             return mr_fail(err, MR_ERR_NOMEM, "scene too large for one upload (%llu vertices, %llu indices)",
                            (unsigned long long)(verts[0] + verts[1]), (unsigned long long)indices);
     }
@@ -433,6 +447,10 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     for (size_t i = 0; i < nn; i++) {
         const mr_node *n = &s->nodes[i];
         g->node_scale[i] = stretch_bound(&n->world);
+        const double *w = n->world.m; /* issue 17 (lane cluster): mirroring? */
+        double det = w[0] * (w[5] * w[10] - w[6] * w[9]) - w[1] * (w[4] * w[10] - w[6] * w[8]) +
+                     w[2] * (w[4] * w[9] - w[5] * w[8]);
+        g->node_mirror[i] = det < 0;
         double lo[3], hi[3];
         if (n->layer < MR_LAYER_COUNT && mr_scene_node_bounds(s, (int32_t)i, lo, hi)) g->drawable[n->layer]++;
         if (n->mesh_first >= 0 && n->mesh_count > 0 && n->mesh_first < s->mesh_count) {
@@ -448,7 +466,7 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     g->occ_rest = malloc((nn + 1) * sizeof *g->occ_rest);
     g->recs = malloc((recs + 1) * sizeof *g->recs);
     g->sorted = malloc((recs + 1) * sizeof *g->sorted);
-    g->key_count = malloc((nm * LEVELS + 1) * sizeof *g->key_count);
+    g->key_count = malloc((nm * LEVELS * CLS_COUNT + 1) * sizeof *g->key_count);
     g->inst = malloc((recs + 1) * sizeof *g->inst);
     g->cmds = malloc((recs + 1) * sizeof *g->cmds);
     g->cmd_cap = recs + 1;
@@ -558,7 +576,8 @@ static bool fill_instance(const mr_geo_view *vw, const mr_node *n, const mr_mesh
  * Surviving consecutive meshlets merge into one command. Returns the
  * triangles submitted. */
 static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_node *n, const mr_mesh *m,
-                              const geo_mesh *gm, int level, double scale, uint32_t inst, uint32_t *ncmd) {
+                              const geo_mesh *gm, int level, double scale, uint32_t inst, uint32_t *ncmd, int grp,
+                              bool cone) {
     struct mr_geo *g = r->geo;
     const geo_cluster *cl = g->clusters + gm->cl_first[level];
     uint32_t cnt = gm->cl_count[level]; /* emit_recs made room for cnt commands */
@@ -577,7 +596,6 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
     /* A pass with depth clamping (the shadow map) draws what lies before
      * its near plane too: there only the side planes cull. */
     double near_cut = glIsEnabled(GL_DEPTH_CLAMP) ? -INFINITY : vw->near_plane;
-    bool cone = r->draw.cluster_cone;
     if (cone) {
         double col[3][3], s2[3];
         for (int j = 0; j < 3; j++) {
@@ -625,8 +643,8 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
             g->cmds[*ncmd - 1].count += q->count;
         } else {
             g->cmds[*ncmd] = (draw_cmd){q->count, 1, q->first, gm->base_vertex, inst};
-            if (g->group_first[gm->group] < 0) g->group_first[gm->group] = (int32_t)*ncmd;
-            g->group_cmds[gm->group]++;
+            if (g->group_first[grp] < 0) g->group_first[grp] = (int32_t)*ncmd;
+            g->group_cmds[grp]++;
             (*ncmd)++;
         }
         last_end = q->first + q->count;
@@ -658,7 +676,7 @@ static size_t select_recs(mr_renderer *r, const mr_geo_view *vw, double fmax_t, 
     double tol = dp->lod_tolerance == 0 ? INFINITY : dp->lod_tolerance;
     double pix = dp->lod_pixels == 0 ? MR_DRAW_DEFAULT_LOD_PIXELS : dp->lod_pixels;
     bool use_lod = g->lod && !dp->no_lod && tol > 0;
-    size_t nkeys = (size_t)g->mesh_count * LEVELS;
+    size_t nkeys = (size_t)g->mesh_count * LEVELS * CLS_COUNT;
     memset(g->key_count, 0, (nkeys + 1) * sizeof *g->key_count);
     size_t nrec = 0;
     for (int32_t vi = 0; vi < nvis; vi++) {
@@ -671,7 +689,8 @@ static size_t select_recs(mr_renderer *r, const mr_geo_view *vw, double fmax_t, 
             const geo_mesh *gm = &g->meshes[mi];
             if (gm->count[0] == 0) continue;
             int level = use_lod && gm->level_count > 1 && isfinite(ppu) ? choose_level(gm, g->node_scale[ni], ppu, tol, pix) : 0;
-            uint32_t key = (uint32_t)g->rank[mi] * LEVELS + (uint32_t)level;
+            uint32_t cls = !gm->single_sided ? CLS_DOUBLE : g->node_mirror[ni] ? CLS_MIRROR : CLS_SINGLE;
+            uint32_t key = (cls * (uint32_t)g->mesh_count + (uint32_t)g->rank[mi]) * LEVELS + (uint32_t)level;
             g->recs[nrec++] = (geo_rec){ni, mi, key};
             g->key_count[key]++;
         }
@@ -715,8 +734,14 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     }
     uint32_t ninst = 0, ncmd = 0, last_key = UINT32_MAX, lod_inst = 0;
     uint64_t tris = 0, tri_full = 0;
-    memset(g->group_cmds, 0, (size_t)g->group_count * sizeof *g->group_cmds);
-    for (int32_t k = 0; k < g->group_count; k++) g->group_first[k] = -1;
+    int32_t ngroups = g->group_count * CLS_COUNT; /* (class, draw group) */
+    uint32_t cls_keys = (uint32_t)g->mesh_count * LEVELS;
+    memset(g->group_cmds, 0, (size_t)ngroups * sizeof *g->group_cmds);
+    for (int32_t k = 0; k < ngroups; k++) g->group_first[k] = -1;
+    /* issue 17 (lane cluster): back-facing meshlets are skipped only where
+     * this draw culls back faces (then it is exact); mirrored instances
+     * never test cones (emit_clusters: similarities of det > 0 only). */
+    bool cone_ok = !dp->no_cluster_cone && vw->cull_back;
     for (size_t i = 0; i < nrec; i++) {
         const geo_rec *rc = &sorted[i];
         const geo_mesh *gm = &g->meshes[rc->mesh];
@@ -727,10 +752,12 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
             r->stats.lod_max_error = gm->error[level] * g->node_scale[rc->node];
         tri_full += gm->count[0] / 3;
         if (!fill_instance(vw, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, rc->node, &g->inst[ninst])) continue;
+        uint32_t cls = rc->key / cls_keys;
+        int grp = (int)cls * g->group_count + gm->group;
         if (clusters && gm->cl_count[level] > 0) {
             /* issue 17 (lane meshlet): this instance's visible meshlets */
             tris += emit_clusters(r, vw, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, level, g->node_scale[rc->node],
-                                  ninst, &ncmd);
+                                  ninst, &ncmd, grp, cone_ok && cls == CLS_SINGLE);
             last_key = UINT32_MAX; /* its commands take no other instance */
             ninst++;
             continue;
@@ -743,8 +770,8 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
             g->cmds[ncmd - 1].instance_count++;
         } else {
             g->cmds[ncmd] = (draw_cmd){gm->count[level], 1, gm->first[level], gm->base_vertex, ninst};
-            if (g->group_first[gm->group] < 0) g->group_first[gm->group] = (int32_t)ncmd;
-            g->group_cmds[gm->group]++;
+            if (g->group_first[grp] < 0) g->group_first[grp] = (int32_t)ncmd;
+            g->group_cmds[grp]++;
             ncmd++;
         }
         tris += gm->count[level] / 3;
@@ -774,9 +801,24 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, g->cmd_buf);
     uint32_t calls = 0;
-    for (int32_t grp = 0; grp < g->group_count; grp++) {
-        int32_t first = g->group_first[grp], count = g->group_cmds[grp];
+    bool culling = false;
+    for (int32_t cg = 0; cg < ngroups; cg++) {
+        int32_t first = g->group_first[cg], count = g->group_cmds[cg];
         if (first < 0 || count == 0) continue;
+        int32_t grp = cg % g->group_count, cls = cg / g->group_count;
+        /* issue 17 (lane cluster): glTF's front faces are counter-clockwise
+         * in the node's frame; the camera's axes (OpenCV: y down) unflipped
+         * by the projection put them clockwise in the window, and a
+         * mirroring node turns them back. */
+        bool cull = vw->cull_back && cls != CLS_DOUBLE;
+        if (cull) {
+            if (!culling) glEnable(GL_CULL_FACE);
+            glCullFace(GL_BACK);
+            glFrontFace(cls == CLS_MIRROR ? GL_CCW : GL_CW);
+        } else if (culling) {
+            glDisable(GL_CULL_FACE);
+        }
+        culling = cull;
         glBindVertexArray(g->vao[grp > 0 ? 1 : 0]);
         if (grp > 0) glBindTextureUnit(MR_TEX_GBUFFER_BASE_COLOR, r->textures[grp - 1]);
         if (!dp->no_batch) {
@@ -796,6 +838,8 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     glBindVertexArray(0);
+    if (culling) glDisable(GL_CULL_FACE);
+    glFrontFace(GL_CCW);
     if (replicate > 1)
         for (int p = 0; p < 2; p++) glVertexArrayBindingDivisor(g->vao[p], 1, 1);
     r->stats.gl_draw_calls += calls;

@@ -853,12 +853,13 @@ typedef struct mr_draw_params {
      * takes effect at the next scene upload. */
     bool no_cluster_cull;       /* default off: clusters are culled */
     int32_t cluster_triangles;  /* 0 = MR_DRAW_DEFAULT_CLUSTER_TRIANGLES */
-    /* The back-facing cone test of meshopt's meshlet bounds. The G-buffer
-     * draws both faces of every triangle (glTF doubleSided is not kept:
-     * every material counts as double-sided), so a back-facing cluster of
-     * an open surface is visible; only for scenes of closed solids seen
-     * from outside. Default off. */
-    bool cluster_cone;
+    /* The back-facing cone test of meshopt's meshlet bounds (issue 17,
+     * lane cluster). It runs only where the draw culls back faces: the
+     * G-buffer's instances of single-sided materials (glTF doubleSided =
+     * false) under a similarity that does not mirror; there it removes
+     * only triangles the rasteriser would cull, so the image is the same.
+     * Default off: meshlets are cone-tested where valid. */
+    bool no_cluster_cone;
 } mr_draw_params;
 #define MR_DRAW_DEFAULT_LOD_PIXELS 1.0
 #define MR_DRAW_DEFAULT_CLUSTER_TRIANGLES 16384

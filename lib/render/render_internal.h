@@ -118,6 +118,10 @@ typedef struct mr_geo_view {
     GLuint program;             /* its MR_LOC_PROJECTION receives the projection */
     uint32_t layers;            /* 1 << mr_layer of the nodes drawn */
     bool shared;                /* issue 14: a rig view: draws the rig frame's shared list */
+    /* issue 17 (lane cluster): cull the back faces of single-sided
+     * materials (glTF doubleSided = false), as glTF says they look; only
+     * then may back-facing meshlets be skipped. Set by the G-buffer. */
+    bool cull_back;
 } mr_geo_view;
 /* The frame's camera with a program and layers. */
 mr_geo_view mr_frame_view(const frame *f, GLuint program, uint32_t layers);
