@@ -16,6 +16,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static mr_gpu *g_gpu;
 static mr_renderer *g_r;
@@ -421,6 +422,123 @@ static void test_threshold(void) {
     mr_scene_destroy(&s);
 }
 
+/* issue 17 (lane cluster): the meshlet cache beside the file. A first
+ * upload builds and writes it; the next reads every clustered level from
+ * it, and both draw byte-identical images with the same meshlet counts.
+ * A truncated, damaged (one flipped byte), foreign (garbage) or stale
+ * (another threshold, another geometry) file is ignored: the levels are
+ * built, the image is the same, the file is rewritten; never a crash. */
+typedef struct shot {
+    mr_frame_result res[4];
+    uint64_t drawn[4];
+} shot;
+
+static void take(mr_scene *s, const char *cache, const mr_draw_params *dp, shot *out, mr_cluster_info *ci) {
+    mr_error err = {0};
+    CHECK(mr_renderer_set_cluster_cache(g_r, cache, &err));
+    CHECK(mr_renderer_set_draw_params(g_r, dp, &err));
+    CHECK_MSG(mr_renderer_set_scene(g_r, s, &err), "%s", err.msg);
+    mr_renderer_cluster_info(g_r, ci);
+    g_rng = 0x1234567ull;
+    for (int i = 0; i < 4; i++) {
+        mr_view v = random_view(0, i != 3);
+        mr_draw_stats st;
+        memset(&out->res[i], 0, sizeof out->res[i]);
+        out->drawn[i] = frame(&v, dp, &out->res[i], &st) ? st.clusters_drawn : 0;
+    }
+    mr_renderer_set_cluster_cache(g_r, NULL, &err);
+}
+
+static void same_shots(shot *a, shot *b, const char *what) {
+    for (int i = 0; i < 4; i++) {
+        CHECK_MSG(same_depth(&a->res[i], &b->res[i]) && same_color(&a->res[i], &b->res[i]), "%s: view %d differs", what, i);
+        CHECK_MSG(a->drawn[i] == b->drawn[i] && a->drawn[i] > 0, "%s: view %d draws %llu vs %llu meshlets", what, i,
+                  (unsigned long long)a->drawn[i], (unsigned long long)b->drawn[i]);
+        mr_frame_result_free(&b->res[i]);
+    }
+}
+
+static long file_size(const char *path) {
+    FILE *f = fopen(path, "rb");
+    if (!f) return -1;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fclose(f);
+    return n;
+}
+
+static void test_cache(void) {
+    char dir[4096], path[4200];
+    if (!mr_test_fresh_dir("test_meshlet", dir, sizeof dir)) {
+        CHECK_MSG(false, "no scratch folder");
+        return;
+    }
+    snprintf(path, sizeof path, "%s/scene.glb.mrclu", dir);
+    mr_error err = {0};
+    mr_scene *s = big_scene_ex(0, true, 1, true, false);
+    mr_draw_params dp = MR_DRAW_DEFAULTS;
+    dp.occlusion_auto = false;
+    shot ref, got;
+    mr_cluster_info ci;
+    take(s, NULL, &dp, &ref, &ci); /* no cache: the reference */
+    CHECK(ci.levels_built == 0 && ci.levels_cached == 0 && !ci.cache_written);
+    take(s, path, &dp, &got, &ci);
+    CHECK_MSG(ci.levels_built == 2 && ci.levels_cached == 0 && ci.cache_written, "first upload: %llu built, %llu cached",
+              (unsigned long long)ci.levels_built, (unsigned long long)ci.levels_cached);
+    same_shots(&ref, &got, "built with a cache");
+    take(s, path, &dp, &got, &ci);
+    CHECK_MSG(ci.levels_cached == 2 && ci.levels_built == 0 && !ci.cache_written, "second upload: %llu built, %llu cached",
+              (unsigned long long)ci.levels_built, (unsigned long long)ci.levels_cached);
+    same_shots(&ref, &got, "read from the cache");
+    long size = file_size(path);
+    CHECK(size > 1000);
+    /* Damage: truncated, one byte flipped in the middle and near the end,
+     * garbage; each is ignored, rebuilt and rewritten. */
+    for (int k = 0; k < 4 && size > 1000; k++) {
+        FILE *f = fopen(path, "r+b");
+        if (!f) break;
+        if (k == 0) {
+            CHECK(ftruncate(fileno(f), size / 2) == 0);
+        } else if (k < 3) {
+            long at = k == 1 ? size / 2 : size - 3;
+            fseek(f, at, SEEK_SET);
+            int ch = fgetc(f);
+            fseek(f, at, SEEK_SET);
+            fputc(ch ^ 0x10, f);
+        } else {
+            for (long i = 0; i < size; i++) fputc((int)((i * 7919) & 0xff), f);
+        }
+        fclose(f);
+        take(s, path, &dp, &got, &ci);
+        CHECK_MSG(ci.levels_built == 2 && ci.levels_cached == 0 && ci.cache_written, "damage %d: %llu built, %llu cached", k,
+                  (unsigned long long)ci.levels_built, (unsigned long long)ci.levels_cached);
+        same_shots(&ref, &got, "rebuilt after damage");
+        CHECK(file_size(path) == size);
+    }
+    /* Stale: another threshold (a whole other cache) ... */
+    mr_draw_params dt = dp;
+    dt.cluster_triangles = 20000; /* the sheet (20k) is still clustered, the ball too */
+    take(s, path, &dt, &got, &ci);
+    CHECK(ci.levels_built == 2 && ci.levels_cached == 0);
+    same_shots(&ref, &got, "another threshold");
+    take(s, path, &dp, &got, &ci); /* back: built again (the file was for 20000) */
+    CHECK(ci.levels_built == 2 && ci.levels_cached == 0);
+    mr_frame_result_free(&got.res[0]), mr_frame_result_free(&got.res[1]), mr_frame_result_free(&got.res[2]),
+        mr_frame_result_free(&got.res[3]);
+    /* ... and another geometry: the ball's level misses, the sheet's hits. */
+    mr_renderer_set_scene(g_r, NULL, &err);
+    for (uint32_t v = 0; v < s->meshes[0].vertex_count; v += 97) s->meshes[0].positions[3 * v] *= 1.01f;
+    take(s, path, &dp, &got, &ci);
+    CHECK_MSG(ci.levels_built == 1 && ci.levels_cached == 1, "changed ball: %llu built, %llu cached",
+              (unsigned long long)ci.levels_built, (unsigned long long)ci.levels_cached);
+    for (int i = 0; i < 4; i++) mr_frame_result_free(&got.res[i]);
+    for (int i = 0; i < 4; i++) mr_frame_result_free(&ref.res[i]);
+    mr_renderer_set_scene(g_r, NULL, &err);
+    mr_renderer_set_draw_params(g_r, NULL, &err);
+    mr_scene_destroy(&s);
+    remove(path);
+}
+
 int main(void) {
     mr_error err = {0};
     g_gpu = mr_gpu_create_headless(NULL, &err);
@@ -440,6 +558,7 @@ int main(void) {
         cone_views(0, 1e3, false);
         cone_views(1e7, 1e3, false);
         cone_views(0, 1, true);
+        test_cache();
     }
     mr_renderer_destroy(&g_r);
     mr_gpu_destroy(&g_gpu);

@@ -17,6 +17,7 @@
  * of textures, not with the number of nodes, and a culled node costs nothing
  * on the GPU. */
 #include "render_internal.h"
+#include "cluster_cache.h" /* issue 17 (lane cluster) */
 
 #include <math.h>
 #include <meshoptimizer.h>
@@ -54,15 +55,8 @@ typedef struct geo_mesh {
     bool single_sided;             /* issue 17 (lane cluster): its material's back faces are culled */
 } geo_mesh;
 
-/* One meshlet (issue 17, lane meshlet): its contiguous index range in the
- * shared index buffer and meshopt's bounds, in the mesh's own (vertex)
- * coordinates: float is enough there, the instance's camera-relative
- * double transform carries them to the camera. */
-typedef struct geo_cluster {
-    uint32_t first, count;         /* index range (global offset, indices) */
-    float center[3], radius;       /* bounding sphere */
-    float apex[3], axis[3], cutoff; /* back-facing cone */
-} geo_cluster;
+/* One meshlet (issue 17, lane meshlet): geo_cluster, in cluster_cache.h
+ * (issue 17, lane cluster: the meshlets are cached beside the file). */
 
 /* issue 17 (lane cluster): the face-culling class of a (node, mesh) pair:
  * both faces drawn; single-sided; single-sided under a mirroring node (glTF:
@@ -115,6 +109,7 @@ struct mr_geo {
     size_t cmd_cap;                /* g->cmds (clusters add commands) */
     /* issue 17 (lane cluster) */
     uint8_t *node_mirror;          /* the node's world 3x3 has a negative determinant */
+    clu_cache *cc;                 /* during upload: the meshlet cache (NULL: none) */
 };
 
 /* ------------------------------------------------------------- params */
@@ -139,6 +134,25 @@ void mr_renderer_draw_stats(const mr_renderer *r, mr_draw_stats *out) {
 }
 
 void mr_geometry_begin_frame(mr_renderer *r) { memset(&r->stats, 0, sizeof r->stats); }
+
+/* issue 17 (lane cluster) */
+bool mr_renderer_set_cluster_cache(mr_renderer *r, const char *path, mr_error *err) {
+    if (!r) return mr_fail(err, MR_ERR_INVALID, "no renderer");
+    if (path && strlen(path) >= sizeof r->cluster_cache)
+        return mr_fail(err, MR_ERR_INVALID, "meshlet cache path too long");
+    snprintf(r->cluster_cache, sizeof r->cluster_cache, "%s", path ? path : "");
+    return true;
+}
+
+void mr_renderer_cluster_info(const mr_renderer *r, mr_cluster_info *out) {
+    if (!out) return;
+    if (!r) memset(out, 0, sizeof *out);
+    else *out = r->cluster_info;
+}
+
+void mr_cluster_cache_path(const char *scene_path, char *out, size_t n) {
+    if (n) snprintf(out, n, "%s.mrclu", scene_path ? scene_path : "");
+}
 
 /* ------------------------------------------------------------- upload */
 
@@ -169,6 +183,8 @@ void mr_geometry_free(mr_renderer *r) {
         free(g->hz);
         free(g->clusters);
         free(g->node_mirror);
+        if (g->cc) clu_cache_close(g->cc, false); /* a failed upload writes nothing */
+        free(g->cc);
         free(g);
         r->geo = NULL;
     }
@@ -241,9 +257,8 @@ static bool ensure_instances(struct mr_geo *g, uint32_t need) {
  * (meshopt_buildMeshlets: up to 64 vertices, 124 triangles) and its indices
  * are written meshlet by meshlet, so each meshlet is one contiguous range
  * that a draw can keep or skip (same triangles, another order). Done at
- * upload, not cached: a few hundred ms per million triangles. */
-#define CL_VERTS 64
-#define CL_TRIS 124
+ * upload: a few hundred ms per million triangles, hence (issue 17, lane
+ * cluster) taken from the cache beside the file where it has them. */
 
 static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int32_t mi, int level,
                          const uint32_t *indices, mr_error *err) {
@@ -255,6 +270,29 @@ static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int
         glNamedBufferSubData(g->ibo, (GLintptr)gm->first[level] * 4, (GLsizeiptr)n * 4, indices);
         return true;
     }
+    /* issue 17 (lane cluster): the cache's copy of this level. */
+    uint64_t key = 0;
+    if (g->cc) {
+        key = clu_level_key(m->positions, m->vertex_count, indices, (uint32_t)n, (uint32_t)thr);
+        const clu_level *hit = clu_cache_find(g->cc, mi, level, key, (uint32_t)n, m->vertex_count);
+        geo_cluster *cl = hit ? realloc(g->clusters, ((size_t)g->cluster_count + hit->cluster_count + 1) * sizeof *cl) : NULL;
+        if (hit && cl && clu_cache_add(g->cc, hit)) {
+            g->clusters = cl;
+            gm->cl_first[level] = g->cluster_count;
+            gm->cl_count[level] = hit->cluster_count;
+            for (uint32_t c = 0; c < hit->cluster_count; c++) {
+                cl[g->cluster_count + c] = hit->clusters[c];
+                cl[g->cluster_count + c].first += gm->first[level];
+            }
+            g->cluster_count += hit->cluster_count;
+            gm->count[level] = hit->out_count;
+            glNamedBufferSubData(g->ibo, (GLintptr)gm->first[level] * 4, (GLsizeiptr)hit->out_count * 4, hit->indices);
+            g->cc->hits++;
+            return true;
+        }
+        if (hit && cl) g->clusters = cl;
+    }
+    double t_build = mr_time_now();
     size_t maxm = meshopt_buildMeshletsBound(n, CL_VERTS, CL_TRIS);
     struct meshopt_Meshlet *ml = malloc(maxm * sizeof *ml);
     unsigned int *mv = malloc(maxm * CL_VERTS * sizeof *mv);
@@ -296,6 +334,23 @@ static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int
      * whatever it wrote is what the level draws. */
     gm->count[level] = (uint32_t)w;
     glNamedBufferSubData(g->ibo, (GLintptr)gm->first[level] * 4, (GLsizeiptr)w * 4, out);
+    if (g->cc) {
+        /* issue 17 (lane cluster): into the cache, firsts relative to the level */
+        geo_cluster *copy = malloc((cnt + 1) * sizeof *copy);
+        for (size_t c = 0; copy && c < cnt; c++) {
+            copy[c] = g->clusters[gm->cl_first[level] + c];
+            copy[c].first -= gm->first[level];
+        }
+        clu_level lv = {mi, level, key, (uint32_t)n, m->vertex_count, (uint32_t)w, (uint32_t)cnt, copy, out, true};
+        if (!copy || !clu_cache_add(g->cc, &lv)) {
+            free(copy);
+            g->cc->path[0] = 0; /* incomplete: not written */
+        } else {
+            out = NULL; /* the cache owns it now */
+        }
+        g->cc->built++;
+        g->cc->build_s += mr_time_now() - t_build;
+    }
     free(out);
     return true;
 }
@@ -307,6 +362,13 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     if (!g) return mr_fail(err, MR_ERR_NOMEM, "out of memory uploading the scene");
     r->geo = g;
     g->lod = lod;
+    /* issue 17 (lane cluster): the meshlet cache beside the file */
+    memset(&r->cluster_info, 0, sizeof r->cluster_info);
+    if (r->cluster_cache[0] && !r->draw.no_cluster_cull) {
+        g->cc = calloc(1, sizeof *g->cc);
+        int32_t thr = r->draw.cluster_triangles > 0 ? r->draw.cluster_triangles : MR_DRAW_DEFAULT_CLUSTER_TRIANGLES;
+        if (g->cc) clu_cache_open(g->cc, r->cluster_cache, (uint32_t)thr);
+    }
     g->occ_auto_on = true; /* the first frames measure */
     g->occ_rb_ms = -1;
     size_t nm = (size_t)s->mesh_count, nn = (size_t)s->node_count;
@@ -474,6 +536,18 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
         return mr_fail(err, MR_ERR_NOMEM, "out of memory for %zu mesh instances", recs);
     glCreateBuffers(1, &g->cmd_buf);
     ensure_instances(g, 1024);
+    if (g->cc) { /* issue 17 (lane cluster) */
+        r->cluster_info.levels_cached = g->cc->hits;
+        r->cluster_info.levels_built = g->cc->built;
+        r->cluster_info.build_s = g->cc->build_s;
+        r->cluster_info.cache_written = clu_cache_close(g->cc, true);
+        free(g->cc);
+        g->cc = NULL;
+        if (r->cluster_info.levels_built || r->cluster_info.levels_cached)
+            mr_log(MR_LOG_INFO, "meshlets: %llu levels read from the cache, %llu built in %.2f s%s",
+                   (unsigned long long)r->cluster_info.levels_cached, (unsigned long long)r->cluster_info.levels_built,
+                   r->cluster_info.build_s, r->cluster_info.cache_written ? " (cache written)" : "");
+    }
     r->scene = s;
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x while uploading the scene", e);

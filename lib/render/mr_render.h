@@ -904,6 +904,25 @@ void mr_renderer_draw_stats(const mr_renderer *r, mr_draw_stats *out);
  * scene's geometry; setting another scene drops the levels. */
 bool mr_renderer_set_lod(mr_renderer *r, const mr_lod *lod, mr_error *err);
 
+/* issue 17 (lane cluster): the meshlets of big meshes cached beside the
+ * scene file. From the next upload (set_scene / set_lod) on, each level's
+ * meshlets are read from `path` where it holds them for exactly this input
+ * (keyed by the level's indices and the mesh's positions, the threshold,
+ * the meshlet limits and meshoptimizer's version; checked by a checksum
+ * and ranges: a stale or damaged file is ignored with a warning), else
+ * built, and the file is rewritten atomically. NULL or "": no cache. */
+bool mr_renderer_set_cluster_cache(mr_renderer *r, const char *path, mr_error *err);
+typedef struct mr_cluster_info {
+    uint64_t levels_cached;  /* clustered levels read from the cache */
+    uint64_t levels_built;   /* clustered levels built (meshopt) */
+    double build_s;          /* seconds building them */
+    bool cache_written;
+} mr_cluster_info;
+/* What the last upload took from the cache. */
+void mr_renderer_cluster_info(const mr_renderer *r, mr_cluster_info *out);
+/* The default cache path next to a scene file: "<scene>.mrclu". */
+void mr_cluster_cache_path(const char *scene_path, char *out, size_t n);
+
 #ifdef __cplusplus
 }
 #endif

@@ -77,6 +77,10 @@ struct mr_renderer {
     struct mr_ao_state *ao_hidden; /* the same for the ghosting's hidden layer D */
     struct mr_ghost_state *ghost;  /* pass_ghost.c: targets, programs, caches */
     struct mr_shadow_state *shadow; /* pass_shadow.c: maps, visibility, the fitted light */
+    /* issue 17 (lane cluster): the meshlet cache file ("" = none) and what
+     * the last upload took from it (geometry.c, cluster_cache.c). */
+    char cluster_cache[4096];
+    mr_cluster_info cluster_info;
 };
 
 typedef struct frame {
