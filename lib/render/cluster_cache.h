@@ -55,8 +55,6 @@ typedef struct clu_cache {
     clu_level *cur;         /* levels of this upload */
     size_t cur_count, cur_cap;
     bool dirty;             /* a level was built: rewrite at close */
-    uint64_t hits, built;
-    double build_s;
 } clu_cache;
 
 /* Key of one level's meshlets. */

@@ -287,7 +287,7 @@ static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int
             g->cluster_count += hit->cluster_count;
             gm->count[level] = hit->out_count;
             glNamedBufferSubData(g->ibo, (GLintptr)gm->first[level] * 4, (GLsizeiptr)hit->out_count * 4, hit->indices);
-            g->cc->hits++;
+            r->cluster_info.levels_cached++;
             return true;
         }
         if (hit && cl) g->clusters = cl;
@@ -348,9 +348,9 @@ static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int
         } else {
             out = NULL; /* the cache owns it now */
         }
-        g->cc->built++;
-        g->cc->build_s += mr_time_now() - t_build;
     }
+    r->cluster_info.levels_built++;
+    r->cluster_info.build_s += mr_time_now() - t_build;
     free(out);
     return true;
 }
@@ -537,16 +537,14 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     glCreateBuffers(1, &g->cmd_buf);
     ensure_instances(g, 1024);
     if (g->cc) { /* issue 17 (lane cluster) */
-        r->cluster_info.levels_cached = g->cc->hits;
-        r->cluster_info.levels_built = g->cc->built;
-        r->cluster_info.build_s = g->cc->build_s;
         r->cluster_info.cache_written = clu_cache_close(g->cc, true);
         free(g->cc);
         g->cc = NULL;
-        if (r->cluster_info.levels_built || r->cluster_info.levels_cached)
-            mr_log(MR_LOG_INFO, "meshlets: %llu levels read from the cache, %llu built in %.2f s%s",
-                   (unsigned long long)r->cluster_info.levels_cached, (unsigned long long)r->cluster_info.levels_built,
-                   r->cluster_info.build_s, r->cluster_info.cache_written ? " (cache written)" : "");
+    }
+    if (r->cluster_info.levels_built || r->cluster_info.levels_cached) {
+        mr_log(MR_LOG_INFO, "meshlets: %llu levels read from the cache, %llu built in %.2f s%s",
+               (unsigned long long)r->cluster_info.levels_cached, (unsigned long long)r->cluster_info.levels_built,
+               r->cluster_info.build_s, r->cluster_info.cache_written ? " (cache written)" : "");
     }
     r->scene = s;
     GLenum e = glGetError();
