@@ -193,8 +193,9 @@ int cmd_render(int argc, char **argv) {
                     (unsigned long long)ds.triangles_full, ds.cull_ms, mr_peak_rss_bytes() / 1048576.0);
             /* issue 17 (lane meshlet) */
             if (ds.clusters_tested)
-                fprintf(stderr, "mrcheck: render: clusters: %llu of %llu meshlets drawn\n",
-                        (unsigned long long)ds.clusters_drawn, (unsigned long long)ds.clusters_tested);
+                fprintf(stderr, "mrcheck: render: clusters: %llu of %llu meshlets drawn (%llu occluded)\n",
+                        (unsigned long long)ds.clusters_drawn, (unsigned long long)ds.clusters_tested,
+                        (unsigned long long)ds.clusters_occluded);
             /* issue 17 (lane cluster) */
             mr_cluster_info ci;
             mr_renderer_cluster_info(gfx.renderer, &ci);

@@ -539,6 +539,88 @@ static void test_cache(void) {
     remove(path);
 }
 
+/* issue 17 (lane cluster): meshlets of the nodes that pass the occlusion
+ * test are tested against the same depth pyramid. A wall hides part of a
+ * grid of 96 balls (small on screen, so they are tested, not occluders),
+ * some before it;
+ * over 12 views the image with meshlet occlusion is byte-identical to the
+ * one without and to the one without any occlusion culling, also at a
+ * 1e7 offset, and meshlets of partly hidden balls are skipped. */
+static void test_cluster_occlusion(double ox) {
+    mr_error err = {0};
+    mr_scene *s = mr_scene_create();
+    mr_material mat = {"ball", {0.8f, 0.6f, 0.3f, 1}, -1, true};
+    int32_t mt = mr_scene_add_material(s, &mat);
+    mr_mesh ball = sphere(0.35, 48, 24); /* 2304 triangles: clustered with the threshold below */
+    ball.material = mt;
+    int32_t mb = mr_scene_add_mesh(s, &ball, &err);
+    mr_mesh wall = sheet(1.0, 4);        /* 32 triangles, a unit square */
+    int32_t mw = mr_scene_add_mesh(s, &wall, &err);
+    CHECK_MSG(mb >= 0 && mw >= 0, "%s", err.msg);
+    for (int k = 0; k < 96; k++) {
+        mr_node n;
+        memset(&n, 0, sizeof n);
+        snprintf(n.name, sizeof n.name, "Ball_%d", k);
+        n.parent = -1;
+        n.world = mr_m4_translate(ox + (k % 12) - 5.5, (k / 12) * 0.8 - 2.8, 4.4 + 0.6 * (k % 5)); /* before and behind the wall */
+        n.mesh_first = mb;
+        n.mesh_count = 1;
+        mr_scene_add_node(s, &n);
+    }
+    mr_node n;
+    memset(&n, 0, sizeof n);
+    snprintf(n.name, sizeof n.name, "Wall");
+    n.parent = -1;
+    /* the sheet lies in y = 0: stand it up (normal towards -z, the camera) */
+    mr_dmat4 T = mr_m4_translate(ox - 3.3, 0, 5.4), R = mr_m4_rotate_axis(mr_v3(1, 0, 0), 1.5707963267948966),
+             S = mr_m4_scale(7, 1, 9), TR = mr_m4_mul(&T, &R);
+    n.world = mr_m4_mul(&TR, &S);
+    n.mesh_first = mw;
+    n.mesh_count = 1;
+    mr_scene_add_node(s, &n);
+    mr_scene_update_bounds(s);
+    mr_draw_params on = MR_DRAW_DEFAULTS;
+    on.occlusion = true;
+    on.cluster_triangles = 2000;
+    mr_draw_params off = on, none = on;
+    off.no_cluster_occlusion = true;
+    none.occlusion = false;
+    none.occlusion_auto = false;
+    CHECK(mr_renderer_set_draw_params(g_r, &on, &err));
+    CHECK_MSG(mr_renderer_set_scene(g_r, s, &err), "%s", err.msg);
+    uint64_t occl = 0, fewer = 0;
+    g_rng = 0x5eed5eedull; /* the same views whatever ran before */
+    for (int i = 0; i < 12; i++) {
+        mr_dvec3 eye = mr_v3(ox + 0.6 * (rnd() - 0.5), 0.6 * (rnd() - 0.5), -4 - 2 * rnd());
+        mr_dvec3 at = mr_v3(ox + 0.5 * (rnd() - 0.5), 0.5 * (rnd() - 0.5), 6);
+        mr_view v = {{320, 240, 220, 220, 159.5, 119.5, {0}}, mr_m4_look_at_cv(eye, at, mr_v3(0, 1, 0))};
+        mr_frame_result a, b, c;
+        mr_draw_stats sa, sb, sc;
+        if (!frame(&v, &on, &a, &sa)) break;
+        if (!frame(&v, &off, &b, &sb)) {
+            mr_frame_result_free(&a);
+            break;
+        }
+        if (frame(&v, &none, &c, &sc)) {
+            CHECK_MSG(same_depth(&a, &c) && same_color(&a, &c), "offset %g view %d: occlusion changes the image", ox, i);
+            mr_frame_result_free(&c);
+        }
+        CHECK_MSG(same_depth(&a, &b) && same_color(&a, &b), "offset %g view %d: meshlet occlusion changes the image", ox, i);
+        CHECK(sa.occlusion_frames > 0 && sb.clusters_occluded == 0 && sa.triangles <= sb.triangles);
+        occl += sa.clusters_occluded;
+        fewer += sa.triangles < sb.triangles;
+        mr_frame_result_free(&a);
+        mr_frame_result_free(&b);
+    }
+    CHECK_MSG(occl > 0 && fewer >= 5, "offset %g: meshlet occlusion skipped %llu meshlets, fewer triangles in %llu of 12 views",
+              ox, (unsigned long long)occl, (unsigned long long)fewer);
+    printf("offset %g: meshlet occlusion skipped %llu meshlets over 12 views (fewer triangles in %llu)\n", ox,
+           (unsigned long long)occl, (unsigned long long)fewer);
+    mr_renderer_set_scene(g_r, NULL, &err);
+    mr_renderer_set_draw_params(g_r, NULL, &err);
+    mr_scene_destroy(&s);
+}
+
 int main(void) {
     mr_error err = {0};
     g_gpu = mr_gpu_create_headless(NULL, &err);
@@ -559,6 +641,8 @@ int main(void) {
         cone_views(1e7, 1e3, false);
         cone_views(0, 1, true);
         test_cache();
+        test_cluster_occlusion(0);
+        test_cluster_occlusion(1e7);
     }
     mr_renderer_destroy(&g_r);
     mr_gpu_destroy(&g_gpu);

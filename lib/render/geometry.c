@@ -110,6 +110,10 @@ struct mr_geo {
     /* issue 17 (lane cluster) */
     uint8_t *node_mirror;          /* the node's world 3x3 has a negative determinant */
     clu_cache *cc;                 /* during upload: the meshlet cache (NULL: none) */
+    int occ_levels;                /* > 0 while the occluded-tested nodes are drawn: meshlets test the pyramid too */
+    int occ_w, occ_h;
+    uint64_t occ_cl_tris;          /* triangles of the meshlets it skipped this frame */
+    double occ_cl_ms;              /* and what testing them cost */
 };
 
 /* ------------------------------------------------------------- params */
@@ -647,6 +651,26 @@ static bool fill_instance(const mr_geo_view *vw, const mr_node *n, const mr_mesh
  * only under a similarity, so it runs only for those (mirrors excluded).
  * Surviving consecutive meshlets merge into one command. Returns the
  * triangles submitted. */
+static bool occluded(const struct mr_geo *g, int levels, const double rect[4], double near_depth, int w, int h);
+
+/* issue 17 (lane cluster): a meshlet's sphere (camera space p, radius rad)
+ * wholly behind the occluders' depth pyramid. Its projection lies within
+ * that of the cube around it, whose nearest point is at depth p.z - rad. */
+static bool sphere_occluded(const struct mr_geo *g, const mr_geo_view *vw, const double p[3], double rad) {
+    double z0 = p[2] - rad;
+    if (!(z0 > vw->near_plane)) return false; /* reaches the camera: cannot be tested */
+    double rect[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+    for (int c = 0; c < 8; c++) {
+        double x = p[0] + ((c & 1) ? rad : -rad), y = p[1] + ((c & 2) ? rad : -rad), z = p[2] + ((c & 4) ? rad : -rad);
+        double u = vw->cam.fx * x / z + vw->cam.cx, v = vw->cam.fy * y / z + vw->cam.cy;
+        rect[0] = fmin(rect[0], u);
+        rect[1] = fmin(rect[1], v);
+        rect[2] = fmax(rect[2], u);
+        rect[3] = fmax(rect[3], v);
+    }
+    return occluded(g, g->occ_levels, rect, vw->near_plane / z0, g->occ_w, g->occ_h);
+}
+
 static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_node *n, const mr_mesh *m,
                               const geo_mesh *gm, int level, double scale, uint32_t inst, uint32_t *ncmd, int grp,
                               bool cone) {
@@ -684,8 +708,10 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
         }
         if (!(det > 0)) cone = false;
     }
-    uint64_t tris = 0, drawn = 0;
+    uint64_t tris = 0, drawn = 0, occl = 0;
     uint32_t last_end = UINT32_MAX;
+    bool occ = g->occ_levels > 0 && !r->draw.no_cluster_occlusion;
+    double t_occ = occ ? mr_time_now() : 0;
     for (uint32_t k = 0; k < cnt; k++) {
         const geo_cluster *q = &cl[k];
         double p[3];
@@ -708,6 +734,11 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
             }
             if (la > 0 && lx > 0 && d / sqrt(la * lx) >= (double)q->cutoff + 1e-3) keep = false;
         }
+        if (keep && occ && sphere_occluded(g, vw, p, rad)) { /* issue 17 (lane cluster) */
+            keep = false;
+            occl++;
+            g->occ_cl_tris += q->count / 3;
+        }
         if (!keep) continue;
         drawn++;
         tris += q->count / 3;
@@ -723,6 +754,8 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
     }
     r->stats.clusters_tested += cnt;
     r->stats.clusters_drawn += drawn;
+    r->stats.clusters_occluded += occl;
+    if (occ) g->occ_cl_ms += (mr_time_now() - t_occ) * 1e3;
     return tris;
 }
 
@@ -1023,6 +1056,7 @@ static int build_pyramid(struct mr_geo *g, const float *depth, int w, int h) {
 }
 
 static bool occluded(const struct mr_geo *g, int levels, const double rect[4], double near_depth, int w, int h) {
+    if (!(rect[0] > -1e9 && rect[1] > -1e9 && rect[2] < 1e9 && rect[3] < 1e9)) return false; /* not finite: keep */
     /* Pixels the projection can touch (pixel centres at integers), widened
      * by a pixel for rasterisation rounding. */
     double x0 = floor(rect[0] - 1), y0 = floor(rect[1] - 1), x1 = ceil(rect[2] + 1), y1 = ceil(rect[3] + 1);
@@ -1275,13 +1309,24 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     r->stats.nodes_occluded += (uint32_t)(nrest - nkeep);
     double t_end = mr_time_now();
     r->stats.cull_ms += (t_end - t0) * 1e3;
+    /* issue 17 (lane cluster): the surviving nodes' meshlets are tested
+     * against the same pyramid (emit_clusters); what they skip and cost
+     * counts in the same decision. */
+    g->occ_levels = levels;
+    g->occ_w = w;
+    g->occ_h = h;
+    g->occ_cl_tris = 0;
+    g->occ_cl_ms = 0;
+    submit_nodes(r, vw, out, rest, nkeep);
+    g->occ_levels = 0;
     if (learn) {
         /* Skipped triangles at the occluders' LOD ratio (full-detail counts
-         * would overstate the gain where LOD engages). */
+         * would overstate the gain where LOD engages); skipped meshlets are
+         * counted at the level drawn. */
         double ratio = occluder_full > 0 ? (double)occluder_tris / (double)occluder_full : 1;
-        occlusion_learn(g, (t_sync - t0) * 1e3, (t_end - t_sync) * 1e3, occluder_tris, (uint64_t)(skipped_full * ratio));
+        occlusion_learn(g, (t_sync - t0) * 1e3, (t_end - t_sync) * 1e3 + g->occ_cl_ms, occluder_tris,
+                        (uint64_t)(skipped_full * ratio) + g->occ_cl_tris);
     }
-    submit_nodes(r, vw, out, rest, nkeep);
 }
 
 bool mr_geometry_draw_replicated(mr_renderer *r, const mr_geo_view *vw, int replicate) {

@@ -860,6 +860,11 @@ typedef struct mr_draw_params {
      * only triangles the rasteriser would cull, so the image is the same.
      * Default off: meshlets are cone-tested where valid. */
     bool no_cluster_cone;
+    /* issue 17 (lane cluster): where a frame runs occlusion culling (on,
+     * or automatic and paying), the meshlets of the nodes that pass it are
+     * tested against the same depth pyramid (exact: the same image).
+     * Default off: they are. */
+    bool no_cluster_occlusion;
 } mr_draw_params;
 #define MR_DRAW_DEFAULT_LOD_PIXELS 1.0
 #define MR_DRAW_DEFAULT_CLUSTER_TRIANGLES 16384
@@ -894,6 +899,10 @@ typedef struct mr_draw_stats {
     /* issue 17 (lane meshlet): meshlets of big meshes tested and drawn */
     uint64_t clusters_tested;
     uint64_t clusters_drawn;
+    /* issue 17 (lane cluster): meshlets of the nodes that passed the
+     * occlusion test, themselves skipped by it (their bounding spheres lie
+     * behind the occluders' depth) */
+    uint64_t clusters_occluded;
 } mr_draw_stats;
 
 /* Sets how geometry is submitted from the next frame on (NULL: defaults). */

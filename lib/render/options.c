@@ -154,6 +154,10 @@ const mr_opt mr_draw_opts[] = {
     {"cluster-cone", MR_OPT_BOOL, DR(no_cluster_cone), 0, 1, 1, NULL,
      "also cull back-facing meshlets of single-sided materials (exact: their back faces are culled)",
      MR_OPT_NEGATE | MR_OPT_ONOFF},
+    /* issue 17 (lane cluster) */
+    {"cluster-occlusion", MR_OPT_BOOL, DR(no_cluster_occlusion), 0, 1, 1, NULL,
+     "also test meshlets against the occlusion pyramid where a frame culls by occlusion (exact)",
+     MR_OPT_NEGATE | MR_OPT_ONOFF},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef DR
