@@ -57,7 +57,7 @@ int cmd_render(int argc, char **argv) {
         {"hidden", "GLOB", "extra node-name glob for the hidden layer", NULL},
         APP_DRAW_OPTS,
         APP_RIG_OPTS,
-        {"lod-cache", "on|off", "read/write LOD levels in <scene>.mrlod (default on)", NULL},
+        {"lod-cache", "on|off", "read/write LOD levels in <scene>.mrlod and meshlets in <scene>.mrclu (default on)", NULL},
         {"verbose", NULL, "print the passes that ran and more", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -148,8 +148,16 @@ int cmd_render(int argc, char **argv) {
     if (!app_gfx_open(&gfx, &err)) {
         rc = mr_cli_error(cmd, &err);
     } else {
-        if (!mr_renderer_set_draw_params(gfx.renderer, &dp, &err) || !mr_renderer_set_scene(gfx.renderer, scene, &err) ||
-            !mr_renderer_set_lod(gfx.renderer, lod, &err)) {
+        /* issue 17 (lane cluster): meshlets cached beside the file too */
+        char clu[4096] = "";
+        if ((!lod_cache || strcmp(lod_cache, "on") == 0) && scene->source[0])
+            mr_cluster_cache_path(scene->source, clu, sizeof clu);
+        double t_up = mr_time_now();
+        bool set = mr_renderer_set_cluster_cache(gfx.renderer, clu, &err) && mr_renderer_set_draw_params(gfx.renderer, &dp, &err) &&
+                   mr_renderer_set_scene(gfx.renderer, scene, &err) &&
+                   (!lod || mr_renderer_set_lod(gfx.renderer, lod, &err)); /* no levels: set_scene's upload is it */
+        double t_upload = mr_time_now() - t_up;
+        if (!set) {
             rc = mr_cli_error(cmd, &err);
         } else if (multiview) {
             mr_quilt_layout ql;
@@ -185,8 +193,15 @@ int cmd_render(int argc, char **argv) {
                     (unsigned long long)ds.triangles_full, ds.cull_ms, mr_peak_rss_bytes() / 1048576.0);
             /* issue 17 (lane meshlet) */
             if (ds.clusters_tested)
-                fprintf(stderr, "mrcheck: render: clusters: %llu of %llu meshlets drawn\n",
-                        (unsigned long long)ds.clusters_drawn, (unsigned long long)ds.clusters_tested);
+                fprintf(stderr, "mrcheck: render: clusters: %llu of %llu meshlets drawn (%llu occluded)\n",
+                        (unsigned long long)ds.clusters_drawn, (unsigned long long)ds.clusters_tested,
+                        (unsigned long long)ds.clusters_occluded);
+            /* issue 17 (lane cluster) */
+            mr_cluster_info ci;
+            mr_renderer_cluster_info(gfx.renderer, &ci);
+            fprintf(stderr, "mrcheck: render: upload %.2f s; meshlets: %llu levels from the cache, %llu built in %.2f s%s\n",
+                    t_upload, (unsigned long long)ci.levels_cached, (unsigned long long)ci.levels_built, ci.build_s,
+                    ci.cache_written ? " (cache written)" : "");
         }
         mr_frame_result_free(&res);
         app_gfx_close(&gfx);

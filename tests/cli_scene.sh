@@ -67,6 +67,21 @@ if "$mr" factory --unique --unit 1000 --triangles 40k --out "$tmp/cad/c.glb" --v
 else
   bad "factory --unique failed: $(cat "$tmp/cad.log")"
 fi
+# issue 17 (lane cluster): the meshlets cached beside the file; a damaged
+# cache is ignored with a warning (same image, exit 0) and rewritten.
+if [ -s "$tmp/cad/c.glb" ]; then
+  rc_() { "$mr" render --scene "$tmp/cad/c.glb" --view "$tmp/cadviews/view_floor.json" --size 160x120 --lod off --verbose "$@"; }
+  rc_ --out "$tmp/cad/a.png" 2>"$tmp/cad/a.err" && grep -q "0 levels from the cache, 2 built.*(cache written)" "$tmp/cad/a.err" &&
+    [ -s "$tmp/cad/c.glb.mrclu" ] && ok || bad "first render: no meshlet cache written: $(cat "$tmp/cad/a.err")"
+  rc_ --out "$tmp/cad/b.png" 2>"$tmp/cad/b.err" && grep -q "2 levels from the cache, 0 built" "$tmp/cad/b.err" &&
+    cmp -s "$tmp/cad/a.png" "$tmp/cad/b.png" && ok || bad "second render: meshlets not from the cache: $(cat "$tmp/cad/b.err")"
+  head -c 1000 "$tmp/cad/c.glb.mrclu" >"$tmp/cad/short" && mv "$tmp/cad/short" "$tmp/cad/c.glb.mrclu"
+  rc_ --out "$tmp/cad/c.png" 2>"$tmp/cad/c.err" && grep -q "c.glb.mrclu: ignored (truncated" "$tmp/cad/c.err" &&
+    grep -q "2 built.*(cache written)" "$tmp/cad/c.err" && cmp -s "$tmp/cad/a.png" "$tmp/cad/c.png" && ok ||
+    bad "truncated meshlet cache: $(cat "$tmp/cad/c.err")"
+  rc_ --out "$tmp/cad/d.png" --lod-cache off 2>"$tmp/cad/d.err" && grep -q "0 levels from the cache, 2 built" "$tmp/cad/d.err" &&
+    ! grep -q "cache written" "$tmp/cad/d.err" && ok || bad "--lod-cache off: $(cat "$tmp/cad/d.err")"
+fi
 expect_fail factory_bad_unit "$tmp/cad/bad.glb" -- "$mr" factory --unique --unit 0 --out "$tmp/cad/bad.glb"
 expect_fail factory_unit_alone "$tmp/cad/bad.glb" -- "$mr" factory --unit 1000 --out "$tmp/cad/bad.glb"
 expect_fail factory_unique_halls "$tmp/cad/bad.glb" -- "$mr" factory --unique --halls 2 --out "$tmp/cad/bad.glb"

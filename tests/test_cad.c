@@ -13,6 +13,7 @@
 #include "mr_test.h"
 #include "mr_test_lod.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -318,9 +319,112 @@ static void test_units_same_choice(mr_renderer *r) {
     }
 }
 
+/* issue 17 (lane cluster): the CAD factory's materials are single-sided,
+ * which is right only if every mesh is a closed surface wound outwards.
+ * Positions welded on a fine grid (the seams repeat them, up to rounding):
+ * every directed edge of a non-degenerate triangle has its reverse as
+ * often (closed, consistently oriented), and the signed volume of each
+ * connected piece (plate, body, rim, bolts) is positive (outwards). */
+typedef struct wkey {
+    int64_t q[3];
+    uint32_t v;
+} wkey;
+static int wkey_cmp(const void *a, const void *b) {
+    const wkey *x = a, *y = b;
+    for (int k = 0; k < 3; k++)
+        if (x->q[k] != y->q[k]) return x->q[k] < y->q[k] ? -1 : 1;
+    return 0;
+}
+static int edge_cmp(const void *a, const void *b) {
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+static uint32_t uf_find(uint32_t *p, uint32_t x) {
+    while (p[x] != x) x = p[x] = p[p[x]];
+    return x;
+}
+static bool closed_outward(const mr_mesh *m, double cell, double *volume) {
+    wkey *k = malloc((size_t)m->vertex_count * sizeof *k);
+    uint32_t *weld = malloc((size_t)m->vertex_count * sizeof *weld);
+    uint64_t *fw = malloc((size_t)m->index_count * sizeof *fw), *bw = malloc((size_t)m->index_count * sizeof *bw);
+    bool ok = k && weld && fw && bw;
+    for (uint32_t v = 0; ok && v < m->vertex_count; v++) {
+        for (int c = 0; c < 3; c++) k[v].q[c] = (int64_t)llround(m->positions[3 * v + c] / cell);
+        k[v].v = v;
+    }
+    if (ok) qsort(k, m->vertex_count, sizeof *k, wkey_cmp);
+    uint32_t id = 0;
+    for (uint32_t v = 0; ok && v < m->vertex_count; v++) {
+        if (v > 0 && wkey_cmp(&k[v], &k[v - 1]) != 0) id++;
+        weld[k[v].v] = id;
+    }
+    size_t ne = 0;
+    double vol = 0;
+    uint32_t *uf = ok ? malloc(((size_t)id + 1) * sizeof *uf) : NULL;
+    double *pvol = ok ? calloc((size_t)id + 1, sizeof *pvol) : NULL;
+    ok = ok && uf && pvol;
+    for (uint32_t v = 0; ok && v <= id; v++) uf[v] = v;
+    for (uint32_t t = 0; ok && t + 2 < m->index_count; t += 3) {
+        uint32_t a = weld[m->indices[t]], b = weld[m->indices[t + 1]], c = weld[m->indices[t + 2]];
+        uf[uf_find(uf, a)] = uf_find(uf, b);
+        uf[uf_find(uf, b)] = uf_find(uf, c);
+    }
+    for (uint32_t t = 0; ok && t + 2 < m->index_count; t += 3) {
+        uint32_t a = weld[m->indices[t]], b = weld[m->indices[t + 1]], c = weld[m->indices[t + 2]];
+        const float *p0 = m->positions + 3 * (size_t)m->indices[t], *p1 = m->positions + 3 * (size_t)m->indices[t + 1],
+                    *p2 = m->positions + 3 * (size_t)m->indices[t + 2];
+        double tv = (p0[0] * ((double)p1[1] * p2[2] - (double)p1[2] * p2[1]) -
+                     p0[1] * ((double)p1[0] * p2[2] - (double)p1[2] * p2[0]) +
+                     p0[2] * ((double)p1[0] * p2[1] - (double)p1[1] * p2[0])) / 6;
+        vol += tv;
+        pvol[uf_find(uf, a)] += tv;
+        if (a == b || b == c || c == a) continue;
+        const uint32_t e[3][2] = {{a, b}, {b, c}, {c, a}};
+        for (int j = 0; j < 3; j++) {
+            fw[ne] = (uint64_t)e[j][0] << 32 | e[j][1];
+            bw[ne++] = (uint64_t)e[j][1] << 32 | e[j][0];
+        }
+    }
+    if (ok) {
+        qsort(fw, ne, sizeof *fw, edge_cmp);
+        qsort(bw, ne, sizeof *bw, edge_cmp);
+        ok = memcmp(fw, bw, ne * sizeof *fw) == 0;
+        for (uint32_t v = 0; ok && v <= id; v++)
+            if (uf_find(uf, v) == v && pvol[v] < 0) ok = false; /* a piece wound inwards */
+    }
+    free(uf);
+    free(pvol);
+    *volume = vol;
+    free(k);
+    free(weld);
+    free(fw);
+    free(bw);
+    return ok && vol > 0;
+}
+
+static void test_closed_outward(void) {
+    const double units[2] = {1, 1000};
+    for (int u = 0; u < 2; u++) {
+        mr_scene *s = cad(units[u], 12, 3000);
+        if (!s) return;
+        int good = 0;
+        for (int32_t i = 0; i < s->mesh_count; i++) {
+            const mr_mesh *m = &s->meshes[i];
+            double vol = 0;
+            bool ok = closed_outward(m, 1e-5 * units[u], &vol);
+            CHECK_MSG(ok, "unit %g mesh %s: not a closed outward surface (signed volume %g)", units[u], m->name, vol);
+            good += ok;
+            CHECK(m->material >= 0 && s->materials[m->material].single_sided);
+        }
+        CHECK(good == s->mesh_count && s->mesh_count == 13);
+        mr_scene_destroy(&s);
+    }
+}
+
 int main(void) {
     double t = mr_time_now();
 #define RUN(f) f; printf("%s: %.2f s\n", #f, mr_time_now() - t); t = mr_time_now()
+    RUN(test_closed_outward()); /* issue 17 (lane cluster) */
     RUN(test_split_cylinder());
     RUN(test_cad_levels());
     RUN(test_seam_normals());

@@ -553,7 +553,7 @@ static void test_unified_sign(void) {
  * and (optionally) a hidden box far off to the side, out of view. */
 static mr_scene *wall_scene_scaled(bool bar_in_view, double k, bool round_occluder) {
     mr_scene *s = mr_scene_create();
-    mr_material a = {"wall", {0.5f, 0.5f, 0.45f, 1}, -1}, b = {"pipe", {0.7f, 0.05f, 0.05f, 1}, -1};
+    mr_material a = {"wall", {0.5f, 0.5f, 0.45f, 1}, -1, false}, b = {"pipe", {0.7f, 0.05f, 0.05f, 1}, -1, false};
     int32_t ma = mr_scene_add_material(s, &a), mb = mr_scene_add_material(s, &b);
     if (round_occluder) {
         /* A smooth sphere: all its importance comes from mesh curvature. */
@@ -590,7 +590,7 @@ static bool render(const mr_scene *s, const mr_frame_params *p, mr_frame_result 
  * ghosting is off. */
 static void test_hidden_layer_left_to_ghosting(void) {
     mr_scene *s = mr_scene_create();
-    mr_material a = {"wall", {0.8f, 0.8f, 0.8f, 1}, -1}, b = {"pipe", {0.9f, 0.1f, 0.1f, 1}, -1};
+    mr_material a = {"wall", {0.8f, 0.8f, 0.8f, 1}, -1, false}, b = {"pipe", {0.9f, 0.1f, 0.1f, 1}, -1, false};
     int32_t ma = mr_scene_add_material(s, &a), mb = mr_scene_add_material(s, &b);
     /* 96x72, fx 80: the wall spans columns 32..64, the pipe 8..88. */
     mr_test_add_node(s, "Wall", mr_m4_translate(0, 0, 5), mr_test_add_box(s, 2, 2, 0.1, ma), MR_LAYER_VISIBLE);
@@ -695,7 +695,7 @@ done:
  * flat rest lets the bar through. */
 static void test_frame_video(void) {
     mr_scene *s = mr_scene_create();
-    mr_material b = {"pipe", {0.7f, 0.05f, 0.05f, 1}, -1};
+    mr_material b = {"pipe", {0.7f, 0.05f, 0.05f, 1}, -1, false};
     int32_t mb = mr_scene_add_material(s, &b);
     mr_test_add_node(s, "Pipe", mr_m4_translate(0, 0, 6), mr_test_add_box(s, 3, 0.6, 0.4, mb), MR_LAYER_HIDDEN);
     mr_scene_update_bounds(s);
@@ -782,7 +782,7 @@ static void test_frame_importance(void) {
  * D there) gets darker with AO, while the flat wall in front does not. */
 static void test_frame_hidden_ao(void) {
     mr_scene *s = mr_scene_create();
-    mr_material a = {"wall", {0.5f, 0.5f, 0.45f, 1}, -1}, b = {"pipe", {0.8f, 0.8f, 0.8f, 1}, -1};
+    mr_material a = {"wall", {0.5f, 0.5f, 0.45f, 1}, -1, false}, b = {"pipe", {0.8f, 0.8f, 0.8f, 1}, -1, false};
     int32_t ma = mr_scene_add_material(s, &a), mb = mr_scene_add_material(s, &b);
     mr_test_add_node(s, "Wall", mr_m4_translate(0, 0, 5), mr_test_add_box(s, 6, 4, 0.1, ma), MR_LAYER_VISIBLE);
     mr_test_add_node(s, "Back", mr_m4_translate(0, 0, 7.05), mr_test_add_box(s, 4, 3, 0.1, mb), MR_LAYER_HIDDEN);

@@ -61,8 +61,8 @@ static void count_objects(int out[KIND_COUNT]) {
 }
 
 static void build_scene(mr_scene *s) {
-    mr_material wall = {"wall", {0.6f, 0.5f, 0.4f, 1}, -1};
-    mr_material pipe = {"pipe", {0.2f, 0.4f, 0.8f, 1}, -1};
+    mr_material wall = {"wall", {0.6f, 0.5f, 0.4f, 1}, -1, false};
+    mr_material pipe = {"pipe", {0.2f, 0.4f, 0.8f, 1}, -1, false};
     int32_t mw = mr_scene_add_material(s, &wall), mp = mr_scene_add_material(s, &pipe);
     /* A 4x4 checker texture on a quad, so the textured draw group and the
      * scene's texture upload are exercised too. */
@@ -76,7 +76,7 @@ static void build_scene(mr_scene *s) {
         px[4 * i + 3] = 255;
     }
     int32_t ti = mr_scene_add_texture(s, &t);
-    mr_material tex = {"plate", {1, 1, 1, 1}, ti};
+    mr_material tex = {"plate", {1, 1, 1, 1}, ti, false};
     int32_t mt = mr_scene_add_material(s, &tex);
     /* Camera axes: z forward. A wall with a box on it (corners for the
      * mask), a hidden pipe behind the wall (ghosting), a textured plate. */

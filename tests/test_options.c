@@ -402,7 +402,8 @@ static void test_tables(void) {
         /* issue 17 (lane meshlet) */
         N(mr_draw_params, "cluster-cull", no_cluster_cull, 0, 1),
         N(mr_draw_params, "cluster-triangles", cluster_triangles, 64, 1 << 30),
-        N(mr_draw_params, "cluster-cone", cluster_cone, 0, 1),
+        N(mr_draw_params, "cluster-cone", no_cluster_cone, 0, 1), /* issue 17 (lane cluster): default on */
+        N(mr_draw_params, "cluster-occlusion", no_cluster_occlusion, 0, 1), /* issue 17 (lane cluster) */
     };
     const expect ex_mp[] = {
         N(mr_map_params, "tag-size", tag_size, 1e-9, 1e9),

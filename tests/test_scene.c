@@ -280,6 +280,7 @@ static mr_scene *build_rich_scene(void) {
     mr_scene_add_texture(s, &tex);
     mr_material red = {.name = "red", .base_color = {0.8f, 0.2f, 0.1f, 1.0f}, .base_color_texture = 0};
     mr_material blue = {.name = "blue", .base_color = {0.1f, 0.2f, 0.9f, 0.5f}, .base_color_texture = -1};
+    blue.single_sided = true; /* issue 17 (lane cluster): doubleSided survives the round trip */
     mr_scene_add_material(s, &red);
     mr_scene_add_material(s, &blue);
 
@@ -373,6 +374,7 @@ static void compare_scenes(const mr_scene *a, const mr_scene *b) {
     for (int i = 0; i < a->material_count && i < b->material_count; i++) {
         CHECK(strcmp(a->materials[i].name, b->materials[i].name) == 0);
         CHECK(a->materials[i].base_color_texture == b->materials[i].base_color_texture);
+        CHECK(a->materials[i].single_sided == b->materials[i].single_sided); /* issue 17 (lane cluster) */
         for (int c = 0; c < 4; c++) CHECK_NEAR(b->materials[i].base_color[c], a->materials[i].base_color[c], 1e-7);
     }
     CHECK(b->texture_count == a->texture_count);

@@ -43,7 +43,7 @@ int main(void) {
     CHECK_MSG(r != NULL, "%s", err.msg);
     if (r) {
         mr_scene *s = mr_scene_create();
-        mr_material m = {"wall", {0.5f, 0.5f, 0.5f, 1}, -1};
+        mr_material m = {"wall", {0.5f, 0.5f, 0.5f, 1}, -1, false};
         int32_t mi = mr_scene_add_material(s, &m);
         /* A wall across the view at z = 5 (camera axes: z forward), its
          * front face towards the camera. */

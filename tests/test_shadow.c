@@ -44,7 +44,7 @@ static void add_box(mr_scene *s, const world *w, const char *name, double sx, do
 
 static mr_scene *base_scene(const world *w, double floor_size) {
     mr_scene *s = mr_scene_create();
-    mr_material m = {"grey", {0.7f, 0.7f, 0.7f, 1}, -1};
+    mr_material m = {"grey", {0.7f, 0.7f, 0.7f, 1}, -1, false};
     int32_t mi = mr_scene_add_material(s, &m);
     add_box(s, w, "Floor", floor_size, 0.02, floor_size, 0, -0.01, 0, mi);
     return s;

@@ -17,6 +17,7 @@
  * of textures, not with the number of nodes, and a culled node costs nothing
  * on the GPU. */
 #include "render_internal.h"
+#include "cluster_cache.h" /* issue 17 (lane cluster) */
 
 #include <math.h>
 #include <meshoptimizer.h>
@@ -51,21 +52,22 @@ typedef struct geo_mesh {
     float color[4];
     uint32_t has_tex;
     uint32_t cl_first[LEVELS], cl_count[LEVELS]; /* meshlets of each level in mr_geo.clusters */
+    bool single_sided;             /* issue 17 (lane cluster): its material's back faces are culled */
 } geo_mesh;
 
-/* One meshlet (issue 17, lane meshlet): its contiguous index range in the
- * shared index buffer and meshopt's bounds, in the mesh's own (vertex)
- * coordinates: float is enough there, the instance's camera-relative
- * double transform carries them to the camera. */
-typedef struct geo_cluster {
-    uint32_t first, count;         /* index range (global offset, indices) */
-    float center[3], radius;       /* bounding sphere */
-    float apex[3], axis[3], cutoff; /* back-facing cone */
-} geo_cluster;
+/* One meshlet (issue 17, lane meshlet): geo_cluster, in cluster_cache.h
+ * (issue 17, lane cluster: the meshlets are cached beside the file). */
+
+/* issue 17 (lane cluster): the face-culling class of a (node, mesh) pair:
+ * both faces drawn; single-sided; single-sided under a mirroring node (glTF:
+ * a negative determinant turns the front face clockwise). Classes are the
+ * outermost sort key, so each (class, draw group) is one contiguous run of
+ * commands, submitted with its own face-culling state. */
+enum { CLS_DOUBLE, CLS_SINGLE, CLS_MIRROR, CLS_COUNT };
 
 typedef struct geo_rec {
     int32_t node, mesh;
-    uint32_t key;                  /* rank(mesh) * LEVELS + level */
+    uint32_t key;                  /* (class * meshes + rank(mesh)) * LEVELS + level */
 } geo_rec;
 
 struct mr_geo {
@@ -105,6 +107,13 @@ struct mr_geo {
     geo_cluster *clusters;
     uint32_t cluster_count;
     size_t cmd_cap;                /* g->cmds (clusters add commands) */
+    /* issue 17 (lane cluster) */
+    uint8_t *node_mirror;          /* the node's world 3x3 has a negative determinant */
+    clu_cache *cc;                 /* during upload: the meshlet cache (NULL: none) */
+    int occ_levels;                /* > 0 while the occluded-tested nodes are drawn: meshlets test the pyramid too */
+    int occ_w, occ_h;
+    uint64_t occ_cl_tris;          /* triangles of the meshlets it skipped this frame */
+    double occ_cl_ms;              /* and what testing them cost */
 };
 
 /* ------------------------------------------------------------- params */
@@ -129,6 +138,25 @@ void mr_renderer_draw_stats(const mr_renderer *r, mr_draw_stats *out) {
 }
 
 void mr_geometry_begin_frame(mr_renderer *r) { memset(&r->stats, 0, sizeof r->stats); }
+
+/* issue 17 (lane cluster) */
+bool mr_renderer_set_cluster_cache(mr_renderer *r, const char *path, mr_error *err) {
+    if (!r) return mr_fail(err, MR_ERR_INVALID, "no renderer");
+    if (path && strlen(path) >= sizeof r->cluster_cache)
+        return mr_fail(err, MR_ERR_INVALID, "meshlet cache path too long");
+    snprintf(r->cluster_cache, sizeof r->cluster_cache, "%s", path ? path : "");
+    return true;
+}
+
+void mr_renderer_cluster_info(const mr_renderer *r, mr_cluster_info *out) {
+    if (!out) return;
+    if (!r) memset(out, 0, sizeof *out);
+    else *out = r->cluster_info;
+}
+
+void mr_cluster_cache_path(const char *scene_path, char *out, size_t n) {
+    if (n) snprintf(out, n, "%s.mrclu", scene_path ? scene_path : "");
+}
 
 /* ------------------------------------------------------------- upload */
 
@@ -158,6 +186,9 @@ void mr_geometry_free(mr_renderer *r) {
         free(g->depth);
         free(g->hz);
         free(g->clusters);
+        free(g->node_mirror);
+        if (g->cc) clu_cache_close(g->cc, false); /* a failed upload writes nothing */
+        free(g->cc);
         free(g);
         r->geo = NULL;
     }
@@ -230,9 +261,8 @@ static bool ensure_instances(struct mr_geo *g, uint32_t need) {
  * (meshopt_buildMeshlets: up to 64 vertices, 124 triangles) and its indices
  * are written meshlet by meshlet, so each meshlet is one contiguous range
  * that a draw can keep or skip (same triangles, another order). Done at
- * upload, not cached: a few hundred ms per million triangles. */
-#define CL_VERTS 64
-#define CL_TRIS 124
+ * upload: a few hundred ms per million triangles, hence (issue 17, lane
+ * cluster) taken from the cache beside the file where it has them. */
 
 static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int32_t mi, int level,
                          const uint32_t *indices, mr_error *err) {
@@ -244,6 +274,29 @@ static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int
         glNamedBufferSubData(g->ibo, (GLintptr)gm->first[level] * 4, (GLsizeiptr)n * 4, indices);
         return true;
     }
+    /* issue 17 (lane cluster): the cache's copy of this level. */
+    uint64_t key = 0;
+    if (g->cc) {
+        key = clu_level_key(m->positions, m->vertex_count, indices, (uint32_t)n, (uint32_t)thr);
+        const clu_level *hit = clu_cache_find(g->cc, mi, level, key, (uint32_t)n, m->vertex_count);
+        geo_cluster *cl = hit ? realloc(g->clusters, ((size_t)g->cluster_count + hit->cluster_count + 1) * sizeof *cl) : NULL;
+        if (hit && cl && clu_cache_add(g->cc, hit)) {
+            g->clusters = cl;
+            gm->cl_first[level] = g->cluster_count;
+            gm->cl_count[level] = hit->cluster_count;
+            for (uint32_t c = 0; c < hit->cluster_count; c++) {
+                cl[g->cluster_count + c] = hit->clusters[c];
+                cl[g->cluster_count + c].first += gm->first[level];
+            }
+            g->cluster_count += hit->cluster_count;
+            gm->count[level] = hit->out_count;
+            glNamedBufferSubData(g->ibo, (GLintptr)gm->first[level] * 4, (GLsizeiptr)hit->out_count * 4, hit->indices);
+            r->cluster_info.levels_cached++;
+            return true;
+        }
+        if (hit && cl) g->clusters = cl;
+    }
+    double t_build = mr_time_now();
     size_t maxm = meshopt_buildMeshletsBound(n, CL_VERTS, CL_TRIS);
     struct meshopt_Meshlet *ml = malloc(maxm * sizeof *ml);
     unsigned int *mv = malloc(maxm * CL_VERTS * sizeof *mv);
@@ -285,6 +338,23 @@ static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int
      * whatever it wrote is what the level draws. */
     gm->count[level] = (uint32_t)w;
     glNamedBufferSubData(g->ibo, (GLintptr)gm->first[level] * 4, (GLsizeiptr)w * 4, out);
+    if (g->cc) {
+        /* issue 17 (lane cluster): into the cache, firsts relative to the level */
+        geo_cluster *copy = malloc((cnt + 1) * sizeof *copy);
+        for (size_t c = 0; copy && c < cnt; c++) {
+            copy[c] = g->clusters[gm->cl_first[level] + c];
+            copy[c].first -= gm->first[level];
+        }
+        clu_level lv = {mi, level, key, (uint32_t)n, m->vertex_count, (uint32_t)w, (uint32_t)cnt, copy, out, true};
+        if (!copy || !clu_cache_add(g->cc, &lv)) {
+            free(copy);
+            g->cc->path[0] = 0; /* incomplete: not written */
+        } else {
+            out = NULL; /* the cache owns it now */
+        }
+    }
+    r->cluster_info.levels_built++;
+    r->cluster_info.build_s += mr_time_now() - t_build;
     free(out);
     return true;
 }
@@ -296,6 +366,13 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     if (!g) return mr_fail(err, MR_ERR_NOMEM, "out of memory uploading the scene");
     r->geo = g;
     g->lod = lod;
+    /* issue 17 (lane cluster): the meshlet cache beside the file */
+    memset(&r->cluster_info, 0, sizeof r->cluster_info);
+    if (r->cluster_cache[0] && !r->draw.no_cluster_cull) {
+        g->cc = calloc(1, sizeof *g->cc);
+        int32_t thr = r->draw.cluster_triangles > 0 ? r->draw.cluster_triangles : MR_DRAW_DEFAULT_CLUSTER_TRIANGLES;
+        if (g->cc) clu_cache_open(g->cc, r->cluster_cache, (uint32_t)thr);
+    }
     g->occ_auto_on = true; /* the first frames measure */
     g->occ_rb_ms = -1;
     size_t nm = (size_t)s->mesh_count, nn = (size_t)s->node_count;
@@ -305,9 +382,10 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     g->by_rank = calloc(nm + 1, sizeof *g->by_rank);
     g->node_scale = calloc(nn + 1, sizeof *g->node_scale);
     g->group_count = 1 + s->texture_count;
-    g->group_first = calloc((size_t)g->group_count, sizeof *g->group_first);
-    g->group_cmds = calloc((size_t)g->group_count, sizeof *g->group_cmds);
-    if (!g->meshes || !g->rank || !g->by_rank || !g->node_scale || !g->group_first || !g->group_cmds)
+    g->group_first = calloc((size_t)g->group_count * CLS_COUNT, sizeof *g->group_first);
+    g->group_cmds = calloc((size_t)g->group_count * CLS_COUNT, sizeof *g->group_cmds);
+    g->node_mirror = calloc(nn + 1, 1);
+    if (!g->meshes || !g->rank || !g->by_rank || !g->node_scale || !g->group_first || !g->group_cmds || !g->node_mirror)
         return mr_fail(err, MR_ERR_NOMEM, "out of memory uploading the scene");
 
     /* Layout, group and place of each mesh in the shared buffers. */
@@ -322,6 +400,7 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
         gm->has_tex = textured;
         static const float grey[4] = {0.7f, 0.7f, 0.7f, 1.0f};
         memcpy(gm->color, mat ? mat->base_color : grey, sizeof gm->color);
+        gm->single_sided = mat && mat->single_sided; /* issue 17 (lane cluster) */
         gm->base_vertex = (int32_t)verts[gm->pool];
         verts[gm->pool] += m->vertex_count;
         gm->level_count = 1;
@@ -338,7 +417,8 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
             gm->error[l] = ml->levels[k].error;
             indices += ml->levels[k].index_count;
         }
-        if (verts[0] > INT32_MAX || verts[1] > INT32_MAX || indices > UINT32_MAX / 4)
+        if (verts[0] > INT32_MAX || verts[1] > INT32_MAX || indices > UINT32_MAX / 4 ||
+            (nm + 1) * LEVELS * CLS_COUNT > UINT32_MAX)
             return mr_fail(err, MR_ERR_NOMEM, "scene too large for one upload (%llu vertices, %llu indices)",
                            (unsigned long long)(verts[0] + verts[1]), (unsigned long long)indices);
     }
@@ -433,6 +513,10 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     for (size_t i = 0; i < nn; i++) {
         const mr_node *n = &s->nodes[i];
         g->node_scale[i] = stretch_bound(&n->world);
+        const double *w = n->world.m; /* issue 17 (lane cluster): mirroring? */
+        double det = w[0] * (w[5] * w[10] - w[6] * w[9]) - w[1] * (w[4] * w[10] - w[6] * w[8]) +
+                     w[2] * (w[4] * w[9] - w[5] * w[8]);
+        g->node_mirror[i] = det < 0;
         double lo[3], hi[3];
         if (n->layer < MR_LAYER_COUNT && mr_scene_node_bounds(s, (int32_t)i, lo, hi)) g->drawable[n->layer]++;
         if (n->mesh_first >= 0 && n->mesh_count > 0 && n->mesh_first < s->mesh_count) {
@@ -448,7 +532,7 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     g->occ_rest = malloc((nn + 1) * sizeof *g->occ_rest);
     g->recs = malloc((recs + 1) * sizeof *g->recs);
     g->sorted = malloc((recs + 1) * sizeof *g->sorted);
-    g->key_count = malloc((nm * LEVELS + 1) * sizeof *g->key_count);
+    g->key_count = malloc((nm * LEVELS * CLS_COUNT + 1) * sizeof *g->key_count);
     g->inst = malloc((recs + 1) * sizeof *g->inst);
     g->cmds = malloc((recs + 1) * sizeof *g->cmds);
     g->cmd_cap = recs + 1;
@@ -456,6 +540,16 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
         return mr_fail(err, MR_ERR_NOMEM, "out of memory for %zu mesh instances", recs);
     glCreateBuffers(1, &g->cmd_buf);
     ensure_instances(g, 1024);
+    if (g->cc) { /* issue 17 (lane cluster) */
+        r->cluster_info.cache_written = clu_cache_close(g->cc, true);
+        free(g->cc);
+        g->cc = NULL;
+    }
+    if (r->cluster_info.levels_built || r->cluster_info.levels_cached) {
+        mr_log(MR_LOG_INFO, "meshlets: %llu levels read from the cache, %llu built in %.2f s%s",
+               (unsigned long long)r->cluster_info.levels_cached, (unsigned long long)r->cluster_info.levels_built,
+               r->cluster_info.build_s, r->cluster_info.cache_written ? " (cache written)" : "");
+    }
     r->scene = s;
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x while uploading the scene", e);
@@ -557,8 +651,29 @@ static bool fill_instance(const mr_geo_view *vw, const mr_node *n, const mr_mesh
  * only under a similarity, so it runs only for those (mirrors excluded).
  * Surviving consecutive meshlets merge into one command. Returns the
  * triangles submitted. */
+static bool occluded(const struct mr_geo *g, int levels, const double rect[4], double near_depth, int w, int h);
+
+/* issue 17 (lane cluster): a meshlet's sphere (camera space p, radius rad)
+ * wholly behind the occluders' depth pyramid. Its projection lies within
+ * that of the cube around it, whose nearest point is at depth p.z - rad. */
+static bool sphere_occluded(const struct mr_geo *g, const mr_geo_view *vw, const double p[3], double rad) {
+    double z0 = p[2] - rad;
+    if (!(z0 > vw->near_plane)) return false; /* reaches the camera: cannot be tested */
+    double rect[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+    for (int c = 0; c < 8; c++) {
+        double x = p[0] + ((c & 1) ? rad : -rad), y = p[1] + ((c & 2) ? rad : -rad), z = p[2] + ((c & 4) ? rad : -rad);
+        double u = vw->cam.fx * x / z + vw->cam.cx, v = vw->cam.fy * y / z + vw->cam.cy;
+        rect[0] = fmin(rect[0], u);
+        rect[1] = fmin(rect[1], v);
+        rect[2] = fmax(rect[2], u);
+        rect[3] = fmax(rect[3], v);
+    }
+    return occluded(g, g->occ_levels, rect, vw->near_plane / z0, g->occ_w, g->occ_h);
+}
+
 static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_node *n, const mr_mesh *m,
-                              const geo_mesh *gm, int level, double scale, uint32_t inst, uint32_t *ncmd) {
+                              const geo_mesh *gm, int level, double scale, uint32_t inst, uint32_t *ncmd, int grp,
+                              bool cone) {
     struct mr_geo *g = r->geo;
     const geo_cluster *cl = g->clusters + gm->cl_first[level];
     uint32_t cnt = gm->cl_count[level]; /* emit_recs made room for cnt commands */
@@ -577,7 +692,6 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
     /* A pass with depth clamping (the shadow map) draws what lies before
      * its near plane too: there only the side planes cull. */
     double near_cut = glIsEnabled(GL_DEPTH_CLAMP) ? -INFINITY : vw->near_plane;
-    bool cone = r->draw.cluster_cone;
     if (cone) {
         double col[3][3], s2[3];
         for (int j = 0; j < 3; j++) {
@@ -594,8 +708,10 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
         }
         if (!(det > 0)) cone = false;
     }
-    uint64_t tris = 0, drawn = 0;
+    uint64_t tris = 0, drawn = 0, occl = 0;
     uint32_t last_end = UINT32_MAX;
+    bool occ = g->occ_levels > 0 && !r->draw.no_cluster_occlusion;
+    double t_occ = occ ? mr_time_now() : 0;
     for (uint32_t k = 0; k < cnt; k++) {
         const geo_cluster *q = &cl[k];
         double p[3];
@@ -618,6 +734,11 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
             }
             if (la > 0 && lx > 0 && d / sqrt(la * lx) >= (double)q->cutoff + 1e-3) keep = false;
         }
+        if (keep && occ && sphere_occluded(g, vw, p, rad)) { /* issue 17 (lane cluster) */
+            keep = false;
+            occl++;
+            g->occ_cl_tris += q->count / 3;
+        }
         if (!keep) continue;
         drawn++;
         tris += q->count / 3;
@@ -625,14 +746,16 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
             g->cmds[*ncmd - 1].count += q->count;
         } else {
             g->cmds[*ncmd] = (draw_cmd){q->count, 1, q->first, gm->base_vertex, inst};
-            if (g->group_first[gm->group] < 0) g->group_first[gm->group] = (int32_t)*ncmd;
-            g->group_cmds[gm->group]++;
+            if (g->group_first[grp] < 0) g->group_first[grp] = (int32_t)*ncmd;
+            g->group_cmds[grp]++;
             (*ncmd)++;
         }
         last_end = q->first + q->count;
     }
     r->stats.clusters_tested += cnt;
     r->stats.clusters_drawn += drawn;
+    r->stats.clusters_occluded += occl;
+    if (occ) g->occ_cl_ms += (mr_time_now() - t_occ) * 1e3;
     return tris;
 }
 
@@ -658,7 +781,7 @@ static size_t select_recs(mr_renderer *r, const mr_geo_view *vw, double fmax_t, 
     double tol = dp->lod_tolerance == 0 ? INFINITY : dp->lod_tolerance;
     double pix = dp->lod_pixels == 0 ? MR_DRAW_DEFAULT_LOD_PIXELS : dp->lod_pixels;
     bool use_lod = g->lod && !dp->no_lod && tol > 0;
-    size_t nkeys = (size_t)g->mesh_count * LEVELS;
+    size_t nkeys = (size_t)g->mesh_count * LEVELS * CLS_COUNT;
     memset(g->key_count, 0, (nkeys + 1) * sizeof *g->key_count);
     size_t nrec = 0;
     for (int32_t vi = 0; vi < nvis; vi++) {
@@ -671,7 +794,8 @@ static size_t select_recs(mr_renderer *r, const mr_geo_view *vw, double fmax_t, 
             const geo_mesh *gm = &g->meshes[mi];
             if (gm->count[0] == 0) continue;
             int level = use_lod && gm->level_count > 1 && isfinite(ppu) ? choose_level(gm, g->node_scale[ni], ppu, tol, pix) : 0;
-            uint32_t key = (uint32_t)g->rank[mi] * LEVELS + (uint32_t)level;
+            uint32_t cls = !gm->single_sided ? CLS_DOUBLE : g->node_mirror[ni] ? CLS_MIRROR : CLS_SINGLE;
+            uint32_t key = (cls * (uint32_t)g->mesh_count + (uint32_t)g->rank[mi]) * LEVELS + (uint32_t)level;
             g->recs[nrec++] = (geo_rec){ni, mi, key};
             g->key_count[key]++;
         }
@@ -715,8 +839,14 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     }
     uint32_t ninst = 0, ncmd = 0, last_key = UINT32_MAX, lod_inst = 0;
     uint64_t tris = 0, tri_full = 0;
-    memset(g->group_cmds, 0, (size_t)g->group_count * sizeof *g->group_cmds);
-    for (int32_t k = 0; k < g->group_count; k++) g->group_first[k] = -1;
+    int32_t ngroups = g->group_count * CLS_COUNT; /* (class, draw group) */
+    uint32_t cls_keys = (uint32_t)g->mesh_count * LEVELS;
+    memset(g->group_cmds, 0, (size_t)ngroups * sizeof *g->group_cmds);
+    for (int32_t k = 0; k < ngroups; k++) g->group_first[k] = -1;
+    /* issue 17 (lane cluster): back-facing meshlets are skipped only where
+     * this draw culls back faces (then it is exact); mirrored instances
+     * never test cones (emit_clusters: similarities of det > 0 only). */
+    bool cone_ok = !dp->no_cluster_cone && vw->cull_back;
     for (size_t i = 0; i < nrec; i++) {
         const geo_rec *rc = &sorted[i];
         const geo_mesh *gm = &g->meshes[rc->mesh];
@@ -727,10 +857,12 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
             r->stats.lod_max_error = gm->error[level] * g->node_scale[rc->node];
         tri_full += gm->count[0] / 3;
         if (!fill_instance(vw, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, rc->node, &g->inst[ninst])) continue;
+        uint32_t cls = rc->key / cls_keys;
+        int grp = (int)cls * g->group_count + gm->group;
         if (clusters && gm->cl_count[level] > 0) {
             /* issue 17 (lane meshlet): this instance's visible meshlets */
             tris += emit_clusters(r, vw, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, level, g->node_scale[rc->node],
-                                  ninst, &ncmd);
+                                  ninst, &ncmd, grp, cone_ok && cls == CLS_SINGLE);
             last_key = UINT32_MAX; /* its commands take no other instance */
             ninst++;
             continue;
@@ -743,8 +875,8 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
             g->cmds[ncmd - 1].instance_count++;
         } else {
             g->cmds[ncmd] = (draw_cmd){gm->count[level], 1, gm->first[level], gm->base_vertex, ninst};
-            if (g->group_first[gm->group] < 0) g->group_first[gm->group] = (int32_t)ncmd;
-            g->group_cmds[gm->group]++;
+            if (g->group_first[grp] < 0) g->group_first[grp] = (int32_t)ncmd;
+            g->group_cmds[grp]++;
             ncmd++;
         }
         tris += gm->count[level] / 3;
@@ -774,9 +906,24 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, g->cmd_buf);
     uint32_t calls = 0;
-    for (int32_t grp = 0; grp < g->group_count; grp++) {
-        int32_t first = g->group_first[grp], count = g->group_cmds[grp];
+    bool culling = false;
+    for (int32_t cg = 0; cg < ngroups; cg++) {
+        int32_t first = g->group_first[cg], count = g->group_cmds[cg];
         if (first < 0 || count == 0) continue;
+        int32_t grp = cg % g->group_count, cls = cg / g->group_count;
+        /* issue 17 (lane cluster): glTF's front faces are counter-clockwise
+         * in the node's frame; the camera's axes (OpenCV: y down) unflipped
+         * by the projection put them clockwise in the window, and a
+         * mirroring node turns them back. */
+        bool cull = vw->cull_back && cls != CLS_DOUBLE;
+        if (cull) {
+            if (!culling) glEnable(GL_CULL_FACE);
+            glCullFace(GL_BACK);
+            glFrontFace(cls == CLS_MIRROR ? GL_CCW : GL_CW);
+        } else if (culling) {
+            glDisable(GL_CULL_FACE);
+        }
+        culling = cull;
         glBindVertexArray(g->vao[grp > 0 ? 1 : 0]);
         if (grp > 0) glBindTextureUnit(MR_TEX_GBUFFER_BASE_COLOR, r->textures[grp - 1]);
         if (!dp->no_batch) {
@@ -796,6 +943,8 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     glBindVertexArray(0);
+    if (culling) glDisable(GL_CULL_FACE);
+    glFrontFace(GL_CCW);
     if (replicate > 1)
         for (int p = 0; p < 2; p++) glVertexArrayBindingDivisor(g->vao[p], 1, 1);
     r->stats.gl_draw_calls += calls;
@@ -907,6 +1056,7 @@ static int build_pyramid(struct mr_geo *g, const float *depth, int w, int h) {
 }
 
 static bool occluded(const struct mr_geo *g, int levels, const double rect[4], double near_depth, int w, int h) {
+    if (!(rect[0] > -1e9 && rect[1] > -1e9 && rect[2] < 1e9 && rect[3] < 1e9)) return false; /* not finite: keep */
     /* Pixels the projection can touch (pixel centres at integers), widened
      * by a pixel for rasterisation rounding. */
     double x0 = floor(rect[0] - 1), y0 = floor(rect[1] - 1), x1 = ceil(rect[2] + 1), y1 = ceil(rect[3] + 1);
@@ -1159,13 +1309,24 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     r->stats.nodes_occluded += (uint32_t)(nrest - nkeep);
     double t_end = mr_time_now();
     r->stats.cull_ms += (t_end - t0) * 1e3;
+    /* issue 17 (lane cluster): the surviving nodes' meshlets are tested
+     * against the same pyramid (emit_clusters); what they skip and cost
+     * counts in the same decision. */
+    g->occ_levels = levels;
+    g->occ_w = w;
+    g->occ_h = h;
+    g->occ_cl_tris = 0;
+    g->occ_cl_ms = 0;
+    submit_nodes(r, vw, out, rest, nkeep);
+    g->occ_levels = 0;
     if (learn) {
         /* Skipped triangles at the occluders' LOD ratio (full-detail counts
-         * would overstate the gain where LOD engages). */
+         * would overstate the gain where LOD engages); skipped meshlets are
+         * counted at the level drawn. */
         double ratio = occluder_full > 0 ? (double)occluder_tris / (double)occluder_full : 1;
-        occlusion_learn(g, (t_sync - t0) * 1e3, (t_end - t_sync) * 1e3, occluder_tris, (uint64_t)(skipped_full * ratio));
+        occlusion_learn(g, (t_sync - t0) * 1e3, (t_end - t_sync) * 1e3 + g->occ_cl_ms, occluder_tris,
+                        (uint64_t)(skipped_full * ratio) + g->occ_cl_tris);
     }
-    submit_nodes(r, vw, out, rest, nkeep);
 }
 
 bool mr_geometry_draw_replicated(mr_renderer *r, const mr_geo_view *vw, int replicate) {

@@ -853,12 +853,18 @@ typedef struct mr_draw_params {
      * takes effect at the next scene upload. */
     bool no_cluster_cull;       /* default off: clusters are culled */
     int32_t cluster_triangles;  /* 0 = MR_DRAW_DEFAULT_CLUSTER_TRIANGLES */
-    /* The back-facing cone test of meshopt's meshlet bounds. The G-buffer
-     * draws both faces of every triangle (glTF doubleSided is not kept:
-     * every material counts as double-sided), so a back-facing cluster of
-     * an open surface is visible; only for scenes of closed solids seen
-     * from outside. Default off. */
-    bool cluster_cone;
+    /* The back-facing cone test of meshopt's meshlet bounds (issue 17,
+     * lane cluster). It runs only where the draw culls back faces: the
+     * G-buffer's instances of single-sided materials (glTF doubleSided =
+     * false) under a similarity that does not mirror; there it removes
+     * only triangles the rasteriser would cull, so the image is the same.
+     * Default off: meshlets are cone-tested where valid. */
+    bool no_cluster_cone;
+    /* issue 17 (lane cluster): where a frame runs occlusion culling (on,
+     * or automatic and paying), the meshlets of the nodes that pass it are
+     * tested against the same depth pyramid (exact: the same image).
+     * Default off: they are. */
+    bool no_cluster_occlusion;
 } mr_draw_params;
 #define MR_DRAW_DEFAULT_LOD_PIXELS 1.0
 #define MR_DRAW_DEFAULT_CLUSTER_TRIANGLES 16384
@@ -893,6 +899,10 @@ typedef struct mr_draw_stats {
     /* issue 17 (lane meshlet): meshlets of big meshes tested and drawn */
     uint64_t clusters_tested;
     uint64_t clusters_drawn;
+    /* issue 17 (lane cluster): meshlets of the nodes that passed the
+     * occlusion test, themselves skipped by it (their bounding spheres lie
+     * behind the occluders' depth) */
+    uint64_t clusters_occluded;
 } mr_draw_stats;
 
 /* Sets how geometry is submitted from the next frame on (NULL: defaults). */
@@ -902,6 +912,25 @@ void mr_renderer_draw_stats(const mr_renderer *r, mr_draw_stats *out);
  * must stay alive while set; NULL: full detail only). Re-uploads the
  * scene's geometry; setting another scene drops the levels. */
 bool mr_renderer_set_lod(mr_renderer *r, const mr_lod *lod, mr_error *err);
+
+/* issue 17 (lane cluster): the meshlets of big meshes cached beside the
+ * scene file. From the next upload (set_scene / set_lod) on, each level's
+ * meshlets are read from `path` where it holds them for exactly this input
+ * (keyed by the level's indices and the mesh's positions, the threshold,
+ * the meshlet limits and meshoptimizer's version; checked by a checksum
+ * and ranges: a stale or damaged file is ignored with a warning), else
+ * built, and the file is rewritten atomically. NULL or "": no cache. */
+bool mr_renderer_set_cluster_cache(mr_renderer *r, const char *path, mr_error *err);
+typedef struct mr_cluster_info {
+    uint64_t levels_cached;  /* clustered levels read from the cache */
+    uint64_t levels_built;   /* clustered levels built (meshopt) */
+    double build_s;          /* seconds building them */
+    bool cache_written;
+} mr_cluster_info;
+/* What the last upload took from the cache. */
+void mr_renderer_cluster_info(const mr_renderer *r, mr_cluster_info *out);
+/* The default cache path next to a scene file: "<scene>.mrclu". */
+void mr_cluster_cache_path(const char *scene_path, char *out, size_t n);
 
 #ifdef __cplusplus
 }

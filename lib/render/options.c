@@ -151,8 +151,13 @@ const mr_opt mr_draw_opts[] = {
      "frustum culling of the meshlets of big meshes", MR_OPT_NEGATE | MR_OPT_ONOFF},
     {"cluster-triangles", MR_OPT_INT, DR(cluster_triangles), 64, 1 << 30, MR_DRAW_DEFAULT_CLUSTER_TRIANGLES, NULL,
      "triangles from which a mesh level is split into meshlets (at upload)", MR_OPT_ZERO_DEFAULT},
-    {"cluster-cone", MR_OPT_BOOL, DR(cluster_cone), 0, 1, 0, NULL,
-     "also cull back-facing meshlets (closed solids only: both faces are drawn)", MR_OPT_ONOFF},
+    {"cluster-cone", MR_OPT_BOOL, DR(no_cluster_cone), 0, 1, 1, NULL,
+     "also cull back-facing meshlets of single-sided materials (exact: their back faces are culled)",
+     MR_OPT_NEGATE | MR_OPT_ONOFF},
+    /* issue 17 (lane cluster) */
+    {"cluster-occlusion", MR_OPT_BOOL, DR(no_cluster_occlusion), 0, 1, 1, NULL,
+     "also test meshlets against the occlusion pyramid where a frame culls by occlusion (exact)",
+     MR_OPT_NEGATE | MR_OPT_ONOFF},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef DR

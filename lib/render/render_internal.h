@@ -77,6 +77,10 @@ struct mr_renderer {
     struct mr_ao_state *ao_hidden; /* the same for the ghosting's hidden layer D */
     struct mr_ghost_state *ghost;  /* pass_ghost.c: targets, programs, caches */
     struct mr_shadow_state *shadow; /* pass_shadow.c: maps, visibility, the fitted light */
+    /* issue 17 (lane cluster): the meshlet cache file ("" = none) and what
+     * the last upload took from it (geometry.c, cluster_cache.c). */
+    char cluster_cache[4096];
+    mr_cluster_info cluster_info;
 };
 
 typedef struct frame {
@@ -118,6 +122,10 @@ typedef struct mr_geo_view {
     GLuint program;             /* its MR_LOC_PROJECTION receives the projection */
     uint32_t layers;            /* 1 << mr_layer of the nodes drawn */
     bool shared;                /* issue 14: a rig view: draws the rig frame's shared list */
+    /* issue 17 (lane cluster): cull the back faces of single-sided
+     * materials (glTF doubleSided = false), as glTF says they look; only
+     * then may back-facing meshlets be skipped. Set by the G-buffer. */
+    bool cull_back;
 } mr_geo_view;
 /* The frame's camera with a program and layers. */
 mr_geo_view mr_frame_view(const frame *f, GLuint program, uint32_t layers);

@@ -1015,6 +1015,8 @@ struct Loader {
             }
             mat.base_color_texture = texture(gm.pbrMetallicRoughness.baseColorTexture.index);
             uv_xform.push_back(texture_transform(gm.pbrMetallicRoughness.baseColorTexture, gm.name));
+            // issue 17 (lane cluster): glTF's default is single-sided.
+            mat.single_sided = !gm.doubleSided;
             if (mr_scene_add_material(s, &mat) < 0) throw std::bad_alloc();
         }
     }
@@ -1821,6 +1823,7 @@ struct Writer {
             if (mat.base_color_texture >= 0 && mat.base_color_texture < s->texture_count)
                 gm.pbrMetallicRoughness.baseColorTexture.index = mat.base_color_texture;
             gm.pbrMetallicRoughness.metallicFactor = 0.0;  // plain albedo for other viewers
+            gm.doubleSided = !mat.single_sided;             // issue 17 (lane cluster)
             m.materials.push_back(gm);
         }
         std::map<std::pair<int32_t, int32_t>, int> mesh_of;  // instancing survives the round trip

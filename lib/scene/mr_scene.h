@@ -40,6 +40,12 @@ typedef struct mr_material {
     char name[64];
     float base_color[4];         /* linear RGBA factor, default 1 1 1 1 */
     int32_t base_color_texture;  /* index into textures, or -1 */
+    /* issue 17 (lane cluster): glTF's doubleSided = false. Zero (the
+     * default of a material built in memory) is double-sided: both faces
+     * drawn, as before. A single-sided material's back faces are culled in
+     * the G-buffer (and its meshlets' back-facing cones with them); a
+     * primitive without material is drawn double-sided. */
+    bool single_sided;
 } mr_material;
 
 typedef struct mr_texture {

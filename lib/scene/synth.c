@@ -490,6 +490,12 @@ mr_scene *mr_synth_cad_build(const mr_synth_cad_params *params, mr_error *err) {
         memcpy(m.base_color, cols_rgb[i], sizeof cols_rgb[i]);
         m.base_color[3] = 1;
         m.base_color_texture = -1;
+        /* issue 17 (lane cluster): every part and the floor are closed
+         * solids wound outwards (test_cad checks it), as a CAD export's
+         * are: single-sided, so back faces and back-facing meshlets are
+         * culled. (The instanced factory has open pipes and flanges and
+         * the demo hall open tag quads: those stay double-sided.) */
+        m.single_sided = true;
         c.mat[i] = mr_scene_add_material(c.s, &m);
     }
     mr_rng rng;
