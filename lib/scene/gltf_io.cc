@@ -413,7 +413,14 @@ bool top_level(const char *s, size_t n, std::map<std::string, Span> *out) {
 // required extension we do not read is refused here, by name, before any
 // buffer error can hide it. Only the members changed are re-printed and
 // spliced into the text. Returns the JSON to parse.
-std::string take_buffers(const char *json, size_t len, const Glb *glb, const char *base_dir, Source *src) {
+//
+// only_tinygltf: tinygltf keeps the buffers; only what it cannot read at
+// all changes (meshopt fallback buffers, draco's indices without a
+// bufferView) and nothing is refused (mr_gltf_parse_only). *changed: the
+// text was changed.
+std::string take_buffers(const char *json, size_t len, const Glb *glb, const char *base_dir, Source *src,
+                         bool only_tinygltf = false, bool *changed_out = nullptr) {
+    if (changed_out) *changed_out = false;
     std::map<std::string, Span> top;
     if (!top_level(json, len, &top)) return std::string(json, len);  // tinygltf says what is wrong
     auto member = [&](const char *key) -> cJSON * {
@@ -428,7 +435,7 @@ std::string take_buffers(const char *json, size_t len, const Glb *glb, const cha
         splice[sp.b] = std::make_pair(sp, std::string(t));
         cJSON_free(t);
     };
-    {
+    if (!only_tinygltf) {
         JsonGuard req{member("extensionsRequired")};
         const cJSON *r;
         cJSON_ArrayForEach(r, req.j) {
@@ -485,6 +492,19 @@ std::string take_buffers(const char *json, size_t len, const Glb *glb, const cha
         const char *u = cJSON_IsString(uri) ? uri->valuestring : "";
         const cJSON *mx = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(b, "extensions"),
                                                            "EXT_meshopt_compression");
+        if (only_tinygltf) {
+            // tinygltf takes a GLB's buffer without a uri for its BIN chunk,
+            // and then refuses it as longer than the chunk: gltfpack -c's
+            // fallback buffer gets one byte of its own instead.
+            if (!u[0] && cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(mx, "fallback"))) {
+                cJSON_DeleteItemFromObjectCaseSensitive(b, "byteLength");
+                cJSON_AddStringToObject(b, "uri", "data:application/octet-stream;base64,AA==");
+                cJSON_AddNumberToObject(b, "byteLength", 1);
+                changed = true;
+            }
+            i++;
+            continue;
+        }
         if (std::strncmp(u, "data:", 5) == 0) {
             ref.data_uri = true;
             src->bufs.push_back(ref);
@@ -526,6 +546,7 @@ std::string take_buffers(const char *json, size_t len, const Glb *glb, const cha
     }
     if (changed) replace("buffers", bufs.j);
     if (splice.empty()) return std::string(json, len);
+    if (changed_out) *changed_out = true;
     std::string out;
     out.reserve(len + 256);
     size_t at = 0;
@@ -2175,12 +2196,44 @@ bool mr_gltf_parse_only(const void *data, size_t size, mr_error *err) {
         tinygltf::Model model;
         std::string terr, twarn;
         const unsigned char *bytes = static_cast<const unsigned char *>(data);
-        bool ok = std::memcmp(bytes, "glTF", 4) == 0
-                      ? gltf.LoadBinaryFromMemory(&model, &terr, &twarn, bytes, (unsigned)size, "")
-                      : gltf.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char *>(bytes),
-                                                 (unsigned)size, "");
+        const bool binary = std::memcmp(bytes, "glTF", 4) == 0;
+        // What tinygltf cannot read at all (gltfpack -c's fallback buffer,
+        // draco indices) is changed as the loader changes it; the rest is
+        // tinygltf's own parse, buffers copied as it copies them.
+        Source src;
+        bool changed = false;
+        std::string json, glb2;
+        if (binary) {
+            Glb glb = glb_split(bytes, size);
+            json = take_buffers(glb.json, glb.json_len, &glb, nullptr, &src, true, &changed);
+            if (changed) {
+                // The same GLB with the new JSON chunk (padded to 4 bytes)
+                // and every chunk after it as it was.
+                while (json.size() % 4) json += ' ';
+                const size_t rest = 20 + glb.json_len, total = 20 + json.size() + (size - rest);
+                if (total > UINT_MAX) return mr_fail(err, MR_ERR_PARSE, "glTF data too large");
+                glb2.reserve(total);
+                uint32_t h[5] = {0x46546C67u, 2, (uint32_t)total, (uint32_t)json.size(), 0x4E4F534Au};
+                glb2.append(reinterpret_cast<const char *>(h), sizeof h);
+                glb2 += json;
+                glb2.append(reinterpret_cast<const char *>(bytes) + rest, size - rest);
+                bytes = reinterpret_cast<const unsigned char *>(glb2.data());
+                size = glb2.size();
+            }
+        } else {
+            json = take_buffers(reinterpret_cast<const char *>(bytes), size, nullptr, nullptr, &src, true, &changed);
+            if (changed) {
+                bytes = reinterpret_cast<const unsigned char *>(json.data());
+                size = json.size();
+            }
+        }
+        bool ok = binary ? gltf.LoadBinaryFromMemory(&model, &terr, &twarn, bytes, (unsigned)size, "")
+                         : gltf.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char *>(bytes),
+                                                    (unsigned)size, "");
         if (!ok) return mr_fail(err, MR_ERR_PARSE, "invalid glTF: %s", one_line(terr).c_str());
         return true;
+    } catch (const Fail &f) {
+        return mr_fail(err, f.code, "%s", f.msg.c_str());
     } catch (const std::bad_alloc &) {
         return mr_fail(err, MR_ERR_NOMEM, "out of memory parsing glTF");
     } catch (...) {
