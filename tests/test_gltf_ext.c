@@ -357,7 +357,8 @@ static void test_meshopt_shared(void) {
     uint32_t idx2[108];
     grid(pos, idx);
     for (int i = 0; i < 48; i++) pos[48 + i] = pos[i] + (i % 3 == 0 ? 5.0f : 0.0f); /* grid B: 5 to the right */
-    for (int i = 0; i < 108; i++) idx2[i] = idx[i % 54];
+    /* Tile B lists the grid's triangles in reverse order. */
+    for (int i = 0; i < 54; i++) idx2[i] = idx[i], idx2[54 + i] = idx[(17 - i / 3) * 3 + i % 3];
     for (int i = 0; i < 96; i++) nrm[i] = i % 3 == 2 ? 1.0f : 0.0f;
     unsigned char vb[2048], nb[2048], ib[1024];
     size_t vn = meshopt_encodeVertexBuffer(vb, sizeof vb, pos, 32, 12);
@@ -371,10 +372,12 @@ static void test_meshopt_shared(void) {
     memcpy(bin + vp, nb, nn);
     memcpy(bin + vp + np, ib, in);
     size_t bn = vp + np + in;
-    for (int variant = 0; variant < 3; variant++) {
+    for (int variant = 0; variant < 4; variant++) {
         /* 0: two primitives in two tiles of each view; 1: and a second mesh
          * reading mesh 0's first accessors again; 2: the second normal
-         * accessor is 15 long for 16 vertices. */
+         * accessor is 15 long for 16 vertices; 3: 32-bit indices, whose
+         * view (decoded last) becomes the first mesh's index array. */
+        const int is = variant == 3 ? 4 : 2;
         char json[8192];
         snprintf(json, sizeof json,
                  "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0%s]}],\"scene\":0,"
@@ -385,19 +388,19 @@ static void test_meshopt_shared(void) {
                  "\"buffers\":[{\"byteLength\":%zu},{\"byteLength\":1000,\"extensions\":{\"EXT_meshopt_compression\":{\"fallback\":true}}}],"
                  "\"bufferViews\":[{\"buffer\":1,\"byteLength\":384,\"byteStride\":12,\"extensions\":{\"EXT_meshopt_compression\":"
                  "{\"buffer\":0,\"byteLength\":%zu,\"byteStride\":12,\"count\":32,\"mode\":\"ATTRIBUTES\"}}},"
-                 "{\"buffer\":1,\"byteOffset\":384,\"byteLength\":216,\"extensions\":{\"EXT_meshopt_compression\":"
-                 "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":2,\"count\":108,\"mode\":\"TRIANGLES\"}}},"
+                 "{\"buffer\":1,\"byteOffset\":384,\"byteLength\":%d,\"extensions\":{\"EXT_meshopt_compression\":"
+                 "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":%d,\"count\":108,\"mode\":\"TRIANGLES\"}}},"
                  "{\"buffer\":1,\"byteOffset\":600,\"byteLength\":384,\"byteStride\":12,\"extensions\":{\"EXT_meshopt_compression\":"
                  "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":12,\"count\":32,\"mode\":\"ATTRIBUTES\"}}}],"
                  "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":16,\"type\":\"VEC3\"},"
                  "{\"bufferView\":0,\"byteOffset\":192,\"componentType\":5126,\"count\":16,\"type\":\"VEC3\"},"
-                 "{\"bufferView\":1,\"componentType\":5123,\"count\":54,\"type\":\"SCALAR\"},"
-                 "{\"bufferView\":1,\"byteOffset\":108,\"componentType\":5123,\"count\":54,\"type\":\"SCALAR\"},"
+                 "{\"bufferView\":1,\"componentType\":%d,\"count\":54,\"type\":\"SCALAR\"},"
+                 "{\"bufferView\":1,\"byteOffset\":%d,\"componentType\":%d,\"count\":54,\"type\":\"SCALAR\"},"
                  "{\"bufferView\":2,\"componentType\":5126,\"count\":16,\"type\":\"VEC3\"},"
                  "{\"bufferView\":2,\"byteOffset\":192,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\"}]}",
                  variant == 1 ? ",1" : "", variant == 1 ? ",{\"name\":\"M\",\"mesh\":1}" : "",
-                 variant == 1 ? ",{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":4},\"indices\":2}]}" : "", bn, vn, vp + np,
-                 in, vp, nn, variant == 2 ? 15 : 16);
+                 variant == 1 ? ",{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":4},\"indices\":2}]}" : "", bn, vn, 108 * is, vp + np,
+                 in, is, vp, nn, is == 4 ? 5125 : 5123, 54 * is, is == 4 ? 5125 : 5123, variant == 2 ? 15 : 16);
         mr_error err = {0};
         mr_scene *s = load_glb(json, bin, bn, &err);
         CHECK_MSG(s != NULL, "variant %d: %s", variant, err.msg);
@@ -413,8 +416,9 @@ static void test_meshopt_shared(void) {
                       "variant %d mesh %d: %u vertices, %u indices, off by %g", variant, (int)k, m->vertex_count,
                       m->index_count, worst);
             bool same = m->index_count == 54; /* the codec may rotate a triangle's corners */
+            const uint32_t *want_idx = idx2 + (k == 1 ? 54 : 0);
             for (int t = 0; same && t < 54; t += 3) {
-                const uint32_t *a = m->indices + t, *b = idx + t;
+                const uint32_t *a = m->indices + t, *b = want_idx + t;
                 same = (a[0] == b[0] && a[1] == b[1] && a[2] == b[2]) || (a[0] == b[1] && a[1] == b[2] && a[2] == b[0]) ||
                        (a[0] == b[2] && a[1] == b[0] && a[2] == b[1]);
             }

@@ -661,8 +661,13 @@ struct Loader {
     std::vector<char> view_pre;
     std::vector<std::vector<int>> view_readers;  // pre views -> their accessors
     std::map<int, void *> ready;                 // accessor -> malloc'd float or uint32 array
-    std::unique_ptr<unsigned char[]> scratch;
+    // The last pre view to decode hands the scratch itself to its 32-bit
+    // index accessor at offset 0 (already its final array: pages not
+    // faulted twice), so the scratch is malloc'd.
+    unsigned char *scratch = nullptr;
     size_t scratch_n = 0, scratch_need = 0;
+    std::vector<char> view_decoded;
+    size_t pre_left = 0;  // pre views with readers not yet decoded
     std::vector<const char *> globs;
     std::vector<std::pair<int32_t, int32_t>> mesh_map;  // glTF mesh -> (first, count); first -2: not yet
     std::vector<int32_t> tex_map;                        // glTF texture -> scene texture; -2: not yet
@@ -674,6 +679,7 @@ struct Loader {
     Loader(const tinygltf::Model &model, mr_scene *scene, Source &source) : m(model), s(scene), src(source) {}
     ~Loader() {
         for (auto &kv : ready) std::free(kv.second);
+        std::free(scratch);
     }
     Loader(const Loader &) = delete;
     Loader &operator=(const Loader &) = delete;
@@ -727,13 +733,14 @@ struct Loader {
         const bool pre = (size_t)bvi < view_pre.size() && view_pre[(size_t)bvi];
         std::unique_ptr<unsigned char[]> own;
         if (pre && (scratch_n < out_n || !scratch)) {
-            scratch.reset();
+            std::free(scratch);
+            scratch = nullptr;
             scratch_n = std::max(std::max(out_n, scratch_need), (size_t)1);
-            scratch.reset(new unsigned char[scratch_n]);
+            scratch = xmalloc<unsigned char>(scratch_n);
         } else if (!pre) {
             own.reset(new unsigned char[out_n ? out_n : 1]);
         }
-        unsigned char *out = pre ? scratch.get() : own.get();
+        unsigned char *out = pre ? scratch : own.get();
         const unsigned char *in = b.p + o;
         int rc;
         if (mode == "ATTRIBUTES") {
@@ -851,11 +858,14 @@ struct Loader {
             else view_readers[(size_t)bv].push_back((int)ai);
         }
         scratch_need = 0;
+        pre_left = 0;
+        view_decoded.assign(m.bufferViews.size(), 0);
         for (size_t bi = 0; bi < m.bufferViews.size(); bi++) {
             if (!view_pre[bi]) {
                 view_readers[bi].clear();
                 continue;
             }
+            if (!view_readers[bi].empty()) pre_left++;
             // The largest decoded size of these views: the scratch is
             // allocated once. Checked in meshopt_view; a lie only grows this
             // up to its stream's 64:1.
@@ -889,36 +899,69 @@ struct Loader {
     // read it in; any that primitive() would refuse or warn about is left to
     // it (read again from a fresh decode, to fail or warn as it does).
     void preconvert(int bvi, const unsigned char *p, size_t len) {
-        for (int a : view_readers[(size_t)bvi]) {
-            if (acc_state[(size_t)a] != 0) continue;
-            acc_state[(size_t)a] = 2;
-            View v;
-            if (!window(a, p, len, &v) || v.count > UINT32_MAX) continue;
-            const int role = acc_role[(size_t)a];
-            int n = 0;
-            if (role == k_role_position && position_ok(v)) n = 3;
-            else if (role == k_role_normal && normal_ok(v)) n = 3;
-            else if (role == k_role_uv && uv_ok(v)) n = 2;
-            else if (role == k_role_index && v.ncomp == 1 &&
-                     (v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ||
-                      v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
-                n = 1;
-            if (n == 0) continue;
-            void *out;
-            if (role == k_role_index) {
-                uint32_t *q = xmalloc<uint32_t>(v.count);
-                out = q;
-                ready[a] = out;  // owned before read can throw (it cannot here: no sparse)
-                read(v, 1, q, "index", "");
-            } else {
-                float *q = xmalloc<float>(v.count * (size_t)n);
-                out = q;
-                ready[a] = out;
-                read(v, n, q, "attribute", "");
-            }
-            src.consumed(v.count * v.stride);
-            acc_state[(size_t)a] = 1;
+        bool last = false;
+        if (!view_decoded[(size_t)bvi] && !view_readers[(size_t)bvi].empty()) {
+            view_decoded[(size_t)bvi] = 1;
+            last = --pre_left == 0;
         }
+        int handoff = -1;  // the accessor that may keep the scratch (see scratch)
+        for (int a : view_readers[(size_t)bvi]) {
+            View v;
+            if (last && handoff < 0 && p == scratch && acc_state[(size_t)a] == 0 && acc_role[(size_t)a] == k_role_index &&
+                m.accessors[(size_t)a].byteOffset == 0 && window(a, p, len, &v) &&
+                v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT && v.ncomp == 1 && v.stride == 4 && v.count <= UINT32_MAX)
+                handoff = a;
+        }
+        bool all = true;
+        for (int a : view_readers[(size_t)bvi])
+            if (a != handoff) all = convert_one(a, p, len) && all;
+        if (handoff < 0) return;
+        if (!all) {
+            // Some accessor is left to read(), which reads this view's
+            // bytes after us: the scratch stays.
+            convert_one(handoff, p, len);
+            return;
+        }
+        const size_t n = m.accessors[(size_t)handoff].count;
+        void *&slot = ready[handoff];
+        void *q = std::realloc(scratch, n * 4);  // shrinks in place; on failure the block stays as it was
+        slot = q ? q : scratch;
+        scratch = nullptr;
+        scratch_n = 0;
+        src.consumed(n * 4);
+        acc_state[(size_t)handoff] = 1;
+    }
+
+    // One accessor of a pre view into its final array (ready); false if it
+    // is left to read() (acc_state 2).
+    bool convert_one(int a, const unsigned char *p, size_t len) {
+        if (acc_state[(size_t)a] != 0) return acc_state[(size_t)a] == 1;
+        acc_state[(size_t)a] = 2;
+        View v;
+        if (!window(a, p, len, &v) || v.count > UINT32_MAX) return false;
+        const int role = acc_role[(size_t)a];
+        int n = 0;
+        if (role == k_role_position && position_ok(v)) n = 3;
+        else if (role == k_role_normal && normal_ok(v)) n = 3;
+        else if (role == k_role_uv && uv_ok(v)) n = 2;
+        else if (role == k_role_index && v.ncomp == 1 &&
+                 (v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ||
+                  v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+            n = 1;
+        if (n == 0) return false;
+        void *&slot = ready[a];  // owned here before anything can throw
+        if (role == k_role_index) {
+            uint32_t *q = xmalloc<uint32_t>(v.count);
+            slot = q;
+            read(v, 1, q, "index", "");  // no sparse: cannot fail
+        } else {
+            float *q = xmalloc<float>(v.count * (size_t)n);
+            slot = q;
+            read(v, n, q, "attribute", "");
+        }
+        src.consumed(v.count * v.stride);
+        acc_state[(size_t)a] = 1;
+        return true;
     }
 
     // The converted array of accessor a, now the caller's; NULL if none.
@@ -996,19 +1039,21 @@ struct Loader {
             for (size_t i = 0; i < v.count; i++, p += v.stride) {
                 C c[N];
                 std::memcpy(c, p, sizeof c);
-                for (int k = 0; k < N; k++) out[i * N + (size_t)k] = (T)c[k];
+                T *q = out + i * N;
+                q[0] = (T)c[0];
+                if (N > 1) q[N > 1 ? 1 : 0] = (T)c[N > 1 ? 1 : 0];  // unrolled: N is a constant
+                if (N > 2) q[N > 2 ? 2 : 0] = (T)c[N > 2 ? 2 : 0];
             }
             return;
         }
-        const double inv = 1.0 / norm_max;
+        const double inv = 1.0 / norm_max, lo = std::is_signed<C>::value ? -1.0 : 0.0;
         for (size_t i = 0; i < v.count; i++, p += v.stride) {
             C c[N];
             std::memcpy(c, p, sizeof c);
-            for (int k = 0; k < N; k++) {
-                double d = (double)c[k] * inv;
-                if (std::is_signed<C>::value) d = std::max(d, -1.0);
-                out[i * N + (size_t)k] = (T)d;
-            }
+            T *q = out + i * N;
+            q[0] = (T)std::max((double)c[0] * inv, lo);
+            if (N > 1) q[N > 1 ? 1 : 0] = (T)std::max((double)c[N > 1 ? 1 : 0] * inv, lo);
+            if (N > 2) q[N > 2 ? 2 : 0] = (T)std::max((double)c[N > 2 ? 2 : 0] * inv, lo);
         }
     }
 
