@@ -434,6 +434,66 @@ static void test_meshopt_shared(void) {
     }
 }
 
+/* A meshopt view big enough (over 8 MB decoded) to be converted on two
+ * threads, each primitive's elements split in halves: every vertex exact
+ * (the codec is lossless), in both primitives. */
+static void test_meshopt_big(void) {
+    const size_t nv = 400000, n = 2 * nv; /* two primitives of 400k vertices: 9.6 MB of floats */
+    float *pos = malloc(n * 12);
+    size_t cap = meshopt_encodeVertexBufferBound(n, 12);
+    unsigned char *bin = malloc(cap + 64);
+    CHECK(pos && bin);
+    if (!pos || !bin) {
+        free(pos);
+        free(bin);
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        pos[3 * i + 0] = (float)(i % 1000) * 0.01f;
+        pos[3 * i + 1] = (float)(i / 1000) * 0.01f;
+        pos[3 * i + 2] = (float)((i * 7) % 13) * 0.1f;
+    }
+    size_t vn = meshopt_encodeVertexBuffer(bin, cap, pos, n, 12);
+    CHECK(vn > 0);
+    size_t vp = (vn + 3) & ~(size_t)3;
+    uint32_t tri[3] = {0, 1, 2};
+    unsigned char ib[64];
+    size_t in = meshopt_encodeIndexBuffer(ib, sizeof ib, tri, 3);
+    memset(bin + vn, 0, vp - vn);
+    memcpy(bin + vp, ib, in);
+    size_t bn = vp + in;
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{%s\"extensionsUsed\":[\"EXT_meshopt_compression\"],\"extensionsRequired\":[\"EXT_meshopt_compression\"],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":2},{\"attributes\":{\"POSITION\":1},\"indices\":3}]}],"
+             "\"buffers\":[{\"byteLength\":%zu},{\"byteLength\":%zu,\"extensions\":{\"EXT_meshopt_compression\":{\"fallback\":true}}}],"
+             "\"bufferViews\":[{\"buffer\":1,\"byteLength\":%zu,\"byteStride\":12,\"extensions\":{\"EXT_meshopt_compression\":"
+             "{\"buffer\":0,\"byteLength\":%zu,\"byteStride\":12,\"count\":%zu,\"mode\":\"ATTRIBUTES\"}}},"
+             "{\"buffer\":1,\"byteOffset\":%zu,\"byteLength\":6,\"extensions\":{\"EXT_meshopt_compression\":"
+             "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":2,\"count\":3,\"mode\":\"TRIANGLES\"}}}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\"},"
+             "{\"bufferView\":0,\"byteOffset\":%zu,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\"},"
+             "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"},"
+             "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
+             k_head, bn, n * 12 + 12, n * 12, vn, n, n * 12, vp, in, nv, nv * 12, nv);
+    mr_error err = {0};
+    mr_scene *s = load_glb(json, bin, bn, &err);
+    CHECK_MSG(s != NULL, "big meshopt view: %s", err.msg);
+    for (int32_t k = 0; s && k < 2 && k < s->mesh_count; k++) {
+        const mr_mesh *m = &s->meshes[k];
+        size_t bad = 0;
+        for (size_t i = 0; i < nv * 3 && m->vertex_count == nv; i++)
+            bad += (double)m->positions[i] + m->origin[i % 3] != (double)pos[(k ? nv * 3 : 0) + i] &&
+                   fabs((double)m->positions[i] + m->origin[i % 3] - pos[(k ? nv * 3 : 0) + i]) > 1e-5;
+        CHECK_MSG(m->vertex_count == nv && bad == 0, "big meshopt view, mesh %d: %u vertices, %zu values off", (int)k,
+                  m->vertex_count, bad);
+    }
+    CHECK(s && s->mesh_count == 2);
+    mr_scene_destroy(&s);
+    free(pos);
+    free(bin);
+}
+
 /* KHR_draco_mesh_compression on real draco data; then damaged data. */
 static void test_draco(void) {
     float pos[48];
@@ -588,6 +648,7 @@ int main(void) {
     test_glb_lies();
     test_meshopt();
     test_meshopt_shared();
+    test_meshopt_big();
     test_draco();
     test_texture_transform();
     test_big_files();

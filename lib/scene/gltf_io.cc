@@ -31,6 +31,8 @@
 #include <new>
 #include <sstream>
 #include <string>
+#include <system_error>
+#include <thread>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -912,14 +914,37 @@ struct Loader {
                 v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT && v.ncomp == 1 && v.stride == 4 && v.count <= UINT32_MAX)
                 handoff = a;
         }
+        // Every array is allocated here, then filled on both cores when
+        // there is enough to fill (the views of a compressed file are whole
+        // meshes' worth: this is where its load has parallel work).
+        std::vector<Job> jobs;
         bool all = true;
+        size_t bytes = 0;
         for (int a : view_readers[(size_t)bvi])
-            if (a != handoff) all = convert_one(a, p, len) && all;
+            if (a != handoff) {
+                Job j;
+                if (plan_one(a, p, len, &j)) {
+                    jobs.push_back(j);
+                    bytes += j.v.count * (size_t)j.n * 4;
+                } else {
+                    all = all && acc_state[(size_t)a] == 1;
+                }
+            }
+        run_jobs(jobs, bytes);
+        for (const Job &j : jobs) {
+            src.consumed(j.v.count * j.v.stride);
+            acc_state[(size_t)j.v.index] = 1;
+        }
         if (handoff < 0) return;
         if (!all) {
             // Some accessor is left to read(), which reads this view's
             // bytes after us: the scratch stays.
-            convert_one(handoff, p, len);
+            Job j;
+            if (plan_one(handoff, p, len, &j)) {
+                run_jobs(std::vector<Job>(1, j), 0);
+                src.consumed(j.v.count * j.v.stride);
+                acc_state[(size_t)handoff] = 1;
+            }
             return;
         }
         const size_t n = m.accessors[(size_t)handoff].count;
@@ -932,10 +957,16 @@ struct Loader {
         acc_state[(size_t)handoff] = 1;
     }
 
-    // One accessor of a pre view into its final array (ready); false if it
-    // is left to read() (acc_state 2).
-    bool convert_one(int a, const unsigned char *p, size_t len) {
-        if (acc_state[(size_t)a] != 0) return acc_state[(size_t)a] == 1;
+    // One accessor of a pre view to convert: its window, its component count
+    // and its array (allocated, in ready); false if it is left to read()
+    // (acc_state 2) or already done.
+    struct Job {
+        View v;
+        int n;
+        void *out;
+    };
+    bool plan_one(int a, const unsigned char *p, size_t len, Job *j) {
+        if (acc_state[(size_t)a] != 0) return false;
         acc_state[(size_t)a] = 2;
         View v;
         if (!window(a, p, len, &v) || v.count > UINT32_MAX) return false;
@@ -950,18 +981,37 @@ struct Loader {
             n = 1;
         if (n == 0) return false;
         void *&slot = ready[a];  // owned here before anything can throw
-        if (role == k_role_index) {
-            uint32_t *q = xmalloc<uint32_t>(v.count);
-            slot = q;
-            read(v, 1, q, "index", "");  // no sparse: cannot fail
-        } else {
-            float *q = xmalloc<float>(v.count * (size_t)n);
-            slot = q;
-            read(v, n, q, "attribute", "");
-        }
-        src.consumed(v.count * v.stride);
-        acc_state[(size_t)a] = 1;
+        if (role == k_role_index) slot = xmalloc<uint32_t>(v.count);
+        else slot = xmalloc<float>(v.count * (size_t)n);
+        *j = Job{v, n, slot};
         return true;
+    }
+
+    // Fills the jobs' arrays (read() cannot fail on them: no sparse), the
+    // elements split in two halves on a second thread when there are
+    // bytes enough to pay for it and a second core.
+    void run_jobs(const std::vector<Job> &jobs, size_t bytes) const {
+        auto fill = [this](const Job &j, size_t first, size_t count) {
+            View v = j.v;
+            v.base += first * v.stride;
+            v.count = count;
+            if (j.n == 1) read_plain(v, 1, static_cast<uint32_t *>(j.out) + first);
+            else read_plain(v, j.n, static_cast<float *>(j.out) + first * (size_t)j.n);
+        };
+        const bool two = bytes >= ((size_t)8 << 20) && std::thread::hardware_concurrency() > 1;
+        if (two) {
+            try {
+                std::thread t([&] {
+                    for (const Job &j : jobs) fill(j, j.v.count / 2, j.v.count - j.v.count / 2);
+                });
+                for (const Job &j : jobs) fill(j, 0, j.v.count / 2);
+                t.join();
+                return;
+            } catch (const std::system_error &) {
+                // no second thread (nothing was filled yet): all on this one
+            }
+        }
+        for (const Job &j : jobs) fill(j, 0, j.v.count);
     }
 
     // The converted array of accessor a, now the caller's; NULL if none.
@@ -1069,7 +1119,14 @@ struct Loader {
     // 0), converting any component type, then applies sparse substitution.
     template <typename T>
     void read(const View &v, int n, T *out, const char *what, const char *mesh) {
-        const int k_n = std::min(n, v.ncomp), cs = component_size(v.comp);
+        read_plain(v, n, out);
+        read_sparse(v, n, out, what, mesh);
+    }
+
+    // read's element loops: no sparse values, nothing that can fail.
+    template <typename T>
+    static void read_plain(const View &v, int n, T *out) {
+        const int k_n = std::min(n, v.ncomp);
         if (!v.base) {
             std::fill(out, out + v.count * (size_t)n, T(0));
         } else if (k_n == n && ((v.comp == TINYGLTF_COMPONENT_TYPE_FLOAT && std::is_same<T, float>::value) ||
@@ -1090,6 +1147,11 @@ struct Loader {
             default: convert_any<float>(v, n, k_n, out, 0); break;
             }
         }
+    }
+
+    template <typename T>
+    void read_sparse(const View &v, int n, T *out, const char *what, const char *mesh) {
+        const int k_n = std::min(n, v.ncomp), cs = component_size(v.comp);
         const tinygltf::Accessor &a = m.accessors[(size_t)v.index];
         if (!a.sparse.isSparse) return;
         // Sparse: count (index, value) pairs replace elements.
