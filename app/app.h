@@ -124,4 +124,7 @@ int bench_scene(int argc, char **argv);
 /* mrcheck bench map (bench_map.c). */
 int bench_map(int argc, char **argv);
 
+/* mrcheck bench load (bench_load.c; issue 17, lane gltf). */
+int bench_load(int argc, char **argv);
+
 #endif

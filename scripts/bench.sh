@@ -3,7 +3,7 @@
 # docs/bench/ (ao, ghost, tracking, scene, multiview, map), each stamped with
 # the commit it was made at and the exact command.
 #
-#   scripts/bench.sh [ao|ghost|tracking|scene|multiview|map|shadows ...]   (default: all but shadows)
+#   scripts/bench.sh [ao|ghost|tracking|scene|multiview|map|shadows|load ...]   (default: all but shadows and load)
 #
 # Commit first, then run: the stamp names HEAD and says "dirty" when the
 # working tree differs from it (tables of uncommitted code). Sizes are
@@ -121,7 +121,12 @@ for b in "${benches[@]}"; do
         else run bench_scene_unique docs/bench/scene_unique $mr bench scene --unique --sizes 100k,200k --frames 3 --out docs/bench/scene_unique --quiet; fi
         find docs/bench/scene_unique -type f ! -name '*.csv' ! -name '*.md' ! -name '*.svg' ! -name '*.log' -delete
         find docs/bench/scene_unique -mindepth 1 -type d -empty -delete ;;
-    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, scene-unique, multiview, map, shadows)" >&2; exit 2 ;;
+    load)
+        # issue 17 (lane gltf): first loads of the factories and their
+        # gltfpack files, CPU only, about 30 s; not in the default list.
+        run bench_load docs/bench/load $mr bench load --runs 15 --out docs/bench/load
+        find docs/bench/load -type f -name '*.glb' -delete ;;
+    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, scene-unique, multiview, map, shadows, load)" >&2; exit 2 ;;
     esac
 done
 echo "bench.sh: wrote docs/bench/ at commit $commit ($dirty)" >&2

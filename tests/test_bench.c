@@ -325,6 +325,53 @@ static void test_map_runner(const char *tmp) {
     read_svg(path, "bench_map.svg");
 }
 
+/* bench load at its smallest (one hall, one part, one round): the
+ * documented columns, a row per scene and file, the packed files' triangles
+ * alike, every time measured. */
+static void test_load_runner(const char *tmp) {
+    char out[4096], path[4096];
+    mr_path_join(tmp, "load", out, sizeof out);
+    mr_bench_load_params p = {MR_BENCH_LOAD_DEFAULTS};
+    p.out_dir = out;
+    p.runs = 1;
+    p.triangles = 1e5;
+    p.unique_triangles = 2e4;
+    mr_error err = {0};
+    CHECK_MSG(mr_bench_load(&p, &err), "mr_bench_load: %s", err.msg);
+    mr_path_join(out, "bench_load.csv", path, sizeof path);
+    size_t n = 0;
+    const char *csv = slurp(path, &n);
+    const char *cols = "scene,variant,file_mb,runs,cpu_s,wall_s,mb_s,peak_rss_mb,base_rss_mb,triangles,nodes\n";
+    const char *body = csv ? strchr(csv, '\n') : NULL; /* after the comment line */
+    CHECK_MSG(body && strncmp(body + 1, cols, strlen(cols)) == 0, "bench_load.csv must have the documented header");
+    CHECK(csv && count(csv, "\n") == 10 && count(csv, ",") == 10 * 9);
+    const char *names[] = {"\"unpacked\"", "\"gltfpack\"", "\"gltfpack -c\"", "\"gltfpack -cc\""};
+    for (int si = 0; si < 2 && csv; si++) {
+        long long tri[4] = {0, 0, 0, 0};
+        for (int v = 0; v < 4; v++) {
+            char key[64];
+            snprintf(key, sizeof key, "\n%s,%s,", si ? "unique" : "instanced", names[v]);
+            const char *row = strstr(csv, key);
+            CHECK_MSG(row != NULL, "bench_load.csv lacks %s", key + 1);
+            if (!row) continue;
+            double f[10];
+            const char *q = row + strlen(key);
+            for (int k = 0; k < 9; k++) {
+                f[k] = atof(q);
+                q = strchr(q, ',');
+                if (!q) break;
+                q++;
+            }
+            CHECK_MSG(f[0] > 0 && f[2] > 0 && f[3] > 0 && f[5] > 0, "%s: file MB, CPU, wall and RSS must be measured", key + 1);
+            tri[v] = (long long)f[7];
+        }
+        CHECK_MSG(tri[0] > 0 && tri[1] > 0 && tri[1] == tri[2] && tri[2] == tri[3], "triangles %lld %lld %lld %lld", tri[0],
+                  tri[1], tri[2], tri[3]);
+    }
+    mr_path_join(out, "bench_load.svg", path, sizeof path);
+    read_svg(path, "bench_load.svg");
+}
+
 int main(void) {
     const char *tmp = getenv("MR_TEST_TMP");
     char dir[4096];
@@ -339,5 +386,6 @@ int main(void) {
     test_plot(dir);
     test_runner(dir);
     test_map_runner(dir);
+    test_load_runner(dir);
     return mr_test_finish("test_bench");
 }

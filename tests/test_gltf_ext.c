@@ -305,6 +305,12 @@ static void test_meshopt(void) {
         CHECK(same);
     }
     mr_scene_destroy(&s);
+    /* tinygltf's reference parse (bench scene's raw_parse_s) reads it too:
+     * it took the fallback buffer for the GLB's BIN chunk. */
+    size_t gn = 0;
+    unsigned char *g = make_glb(json, bin, bn, &gn);
+    CHECK_MSG(mr_gltf_parse_only(g, gn, &err), "parse only, meshopt fallback buffer: %s", err.msg);
+    free(g);
     /* Lies and damage: counts of 2^31, streams cut short, garbage. */
     snprintf(json, sizeof json, fmt, k_head, bn, vn, "2147483648", vp, in, "TRIANGLES");
     expect_refused(json, bin, bn, "meshopt", __LINE__);
@@ -338,6 +344,154 @@ static void test_meshopt(void) {
              "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}",
              k_head);
     expect_refused(nofb, "abcd", 4, "fallback", __LINE__);
+}
+
+/* gltfpack's layout: one meshopt view holds the vertices (and one the
+ * indices) of several primitives, each an accessor at its own offset;
+ * these are converted straight into the meshes' arrays. An accessor read by
+ * two primitives, and a NORMAL that does not fit its primitive, take the
+ * general path. Every mesh must be exactly its own grid. */
+static void test_meshopt_shared(void) {
+    float pos[96], nrm[96];
+    uint32_t idx[54];
+    uint32_t idx2[108];
+    grid(pos, idx);
+    for (int i = 0; i < 48; i++) pos[48 + i] = pos[i] + (i % 3 == 0 ? 5.0f : 0.0f); /* grid B: 5 to the right */
+    /* Tile B lists the grid's triangles in reverse order. */
+    for (int i = 0; i < 54; i++) idx2[i] = idx[i], idx2[54 + i] = idx[(17 - i / 3) * 3 + i % 3];
+    for (int i = 0; i < 96; i++) nrm[i] = i % 3 == 2 ? 1.0f : 0.0f;
+    unsigned char vb[2048], nb[2048], ib[1024];
+    size_t vn = meshopt_encodeVertexBuffer(vb, sizeof vb, pos, 32, 12);
+    size_t nn = meshopt_encodeVertexBuffer(nb, sizeof nb, nrm, 32, 12);
+    size_t in = meshopt_encodeIndexBuffer(ib, sizeof ib, idx2, 108);
+    CHECK(vn > 0 && nn > 0 && in > 0);
+    size_t vp = (vn + 3) & ~(size_t)3, np = (nn + 3) & ~(size_t)3;
+    unsigned char bin[8192];
+    memset(bin, 0, sizeof bin);
+    memcpy(bin, vb, vn);
+    memcpy(bin + vp, nb, nn);
+    memcpy(bin + vp + np, ib, in);
+    size_t bn = vp + np + in;
+    for (int variant = 0; variant < 4; variant++) {
+        /* 0: two primitives in two tiles of each view; 1: and a second mesh
+         * reading mesh 0's first accessors again; 2: the second normal
+         * accessor is 15 long for 16 vertices; 3: 32-bit indices, whose
+         * view (decoded last) becomes the first mesh's index array. */
+        const int is = variant == 3 ? 4 : 2;
+        char json[8192];
+        snprintf(json, sizeof json,
+                 "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0%s]}],\"scene\":0,"
+                 "\"nodes\":[{\"name\":\"N\",\"mesh\":0}%s],"
+                 "\"extensionsUsed\":[\"EXT_meshopt_compression\"],\"extensionsRequired\":[\"EXT_meshopt_compression\"],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":4},\"indices\":2},"
+                 "{\"attributes\":{\"POSITION\":1,\"NORMAL\":5},\"indices\":3}]}%s],"
+                 "\"buffers\":[{\"byteLength\":%zu},{\"byteLength\":1000,\"extensions\":{\"EXT_meshopt_compression\":{\"fallback\":true}}}],"
+                 "\"bufferViews\":[{\"buffer\":1,\"byteLength\":384,\"byteStride\":12,\"extensions\":{\"EXT_meshopt_compression\":"
+                 "{\"buffer\":0,\"byteLength\":%zu,\"byteStride\":12,\"count\":32,\"mode\":\"ATTRIBUTES\"}}},"
+                 "{\"buffer\":1,\"byteOffset\":384,\"byteLength\":%d,\"extensions\":{\"EXT_meshopt_compression\":"
+                 "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":%d,\"count\":108,\"mode\":\"TRIANGLES\"}}},"
+                 "{\"buffer\":1,\"byteOffset\":600,\"byteLength\":384,\"byteStride\":12,\"extensions\":{\"EXT_meshopt_compression\":"
+                 "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":12,\"count\":32,\"mode\":\"ATTRIBUTES\"}}}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":16,\"type\":\"VEC3\"},"
+                 "{\"bufferView\":0,\"byteOffset\":192,\"componentType\":5126,\"count\":16,\"type\":\"VEC3\"},"
+                 "{\"bufferView\":1,\"componentType\":%d,\"count\":54,\"type\":\"SCALAR\"},"
+                 "{\"bufferView\":1,\"byteOffset\":%d,\"componentType\":%d,\"count\":54,\"type\":\"SCALAR\"},"
+                 "{\"bufferView\":2,\"componentType\":5126,\"count\":16,\"type\":\"VEC3\"},"
+                 "{\"bufferView\":2,\"byteOffset\":192,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\"}]}",
+                 variant == 1 ? ",1" : "", variant == 1 ? ",{\"name\":\"M\",\"mesh\":1}" : "",
+                 variant == 1 ? ",{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":4},\"indices\":2}]}" : "", bn, vn, 108 * is, vp + np,
+                 in, is, vp, nn, is == 4 ? 5125 : 5123, 54 * is, is == 4 ? 5125 : 5123, variant == 2 ? 15 : 16);
+        mr_error err = {0};
+        mr_scene *s = load_glb(json, bin, bn, &err);
+        CHECK_MSG(s != NULL, "variant %d: %s", variant, err.msg);
+        if (!s) continue;
+        CHECK_MSG(s->mesh_count == (variant == 1 ? 3 : 2), "variant %d: %d meshes", variant, (int)s->mesh_count);
+        for (int32_t k = 0; k < s->mesh_count; k++) {
+            const mr_mesh *m = &s->meshes[k];
+            const float *want = pos + (k == 1 ? 48 : 0); /* mesh 1's second primitive is grid B */
+            double worst = 0;
+            for (int i = 0; i < 48 && m->vertex_count == 16; i++)
+                worst = fmax(worst, fabs(m->positions[i] + m->origin[i % 3] - want[i]));
+            CHECK_MSG(m->vertex_count == 16 && m->index_count == 54 && worst < 1e-6,
+                      "variant %d mesh %d: %u vertices, %u indices, off by %g", variant, (int)k, m->vertex_count,
+                      m->index_count, worst);
+            bool same = m->index_count == 54; /* the codec may rotate a triangle's corners */
+            const uint32_t *want_idx = idx2 + (k == 1 ? 54 : 0);
+            for (int t = 0; same && t < 54; t += 3) {
+                const uint32_t *a = m->indices + t, *b = want_idx + t;
+                same = (a[0] == b[0] && a[1] == b[1] && a[2] == b[2]) || (a[0] == b[1] && a[1] == b[2] && a[2] == b[0]) ||
+                       (a[0] == b[2] && a[1] == b[0] && a[2] == b[1]);
+            }
+            CHECK_MSG(same, "variant %d mesh %d: indices differ", variant, (int)k);
+            double nz = 0;
+            for (uint32_t v = 0; v < m->vertex_count; v++) nz += m->normals[3 * v + 2];
+            /* The file's normals (0,0,1); variant 2's second mesh makes its own
+             * from the grid (whose z rises with x*y: not all (0,0,1)). */
+            if (!(variant == 2 && k == 1)) CHECK_MSG(nz == 16.0, "variant %d mesh %d: normals not the file's", variant, (int)k);
+            else CHECK_MSG(nz < 15.99, "variant %d: the short NORMAL was used", variant);
+        }
+        mr_scene_destroy(&s);
+    }
+}
+
+/* A meshopt view big enough (over 8 MB decoded) to be converted on two
+ * threads, each primitive's elements split in halves: every vertex exact
+ * (the codec is lossless), in both primitives. */
+static void test_meshopt_big(void) {
+    const size_t nv = 400000, n = 2 * nv; /* two primitives of 400k vertices: 9.6 MB of floats */
+    float *pos = malloc(n * 12);
+    size_t cap = meshopt_encodeVertexBufferBound(n, 12);
+    unsigned char *bin = malloc(cap + 64);
+    CHECK(pos && bin);
+    if (!pos || !bin) {
+        free(pos);
+        free(bin);
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        pos[3 * i + 0] = (float)(i % 1000) * 0.01f;
+        pos[3 * i + 1] = (float)(i / 1000) * 0.01f;
+        pos[3 * i + 2] = (float)((i * 7) % 13) * 0.1f;
+    }
+    size_t vn = meshopt_encodeVertexBuffer(bin, cap, pos, n, 12);
+    CHECK(vn > 0);
+    size_t vp = (vn + 3) & ~(size_t)3;
+    uint32_t tri[3] = {0, 1, 2};
+    unsigned char ib[64];
+    size_t in = meshopt_encodeIndexBuffer(ib, sizeof ib, tri, 3);
+    memset(bin + vn, 0, vp - vn);
+    memcpy(bin + vp, ib, in);
+    size_t bn = vp + in;
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{%s\"extensionsUsed\":[\"EXT_meshopt_compression\"],\"extensionsRequired\":[\"EXT_meshopt_compression\"],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":2},{\"attributes\":{\"POSITION\":1},\"indices\":3}]}],"
+             "\"buffers\":[{\"byteLength\":%zu},{\"byteLength\":%zu,\"extensions\":{\"EXT_meshopt_compression\":{\"fallback\":true}}}],"
+             "\"bufferViews\":[{\"buffer\":1,\"byteLength\":%zu,\"byteStride\":12,\"extensions\":{\"EXT_meshopt_compression\":"
+             "{\"buffer\":0,\"byteLength\":%zu,\"byteStride\":12,\"count\":%zu,\"mode\":\"ATTRIBUTES\"}}},"
+             "{\"buffer\":1,\"byteOffset\":%zu,\"byteLength\":6,\"extensions\":{\"EXT_meshopt_compression\":"
+             "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":2,\"count\":3,\"mode\":\"TRIANGLES\"}}}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\"},"
+             "{\"bufferView\":0,\"byteOffset\":%zu,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\"},"
+             "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"},"
+             "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
+             k_head, bn, n * 12 + 12, n * 12, vn, n, n * 12, vp, in, nv, nv * 12, nv);
+    mr_error err = {0};
+    mr_scene *s = load_glb(json, bin, bn, &err);
+    CHECK_MSG(s != NULL, "big meshopt view: %s", err.msg);
+    for (int32_t k = 0; s && k < 2 && k < s->mesh_count; k++) {
+        const mr_mesh *m = &s->meshes[k];
+        size_t bad = 0;
+        for (size_t i = 0; i < nv * 3 && m->vertex_count == nv; i++)
+            bad += (double)m->positions[i] + m->origin[i % 3] != (double)pos[(k ? nv * 3 : 0) + i] &&
+                   fabs((double)m->positions[i] + m->origin[i % 3] - pos[(k ? nv * 3 : 0) + i]) > 1e-5;
+        CHECK_MSG(m->vertex_count == nv && bad == 0, "big meshopt view, mesh %d: %u vertices, %zu values off", (int)k,
+                  m->vertex_count, bad);
+    }
+    CHECK(s && s->mesh_count == 2);
+    mr_scene_destroy(&s);
+    free(pos);
+    free(bin);
 }
 
 /* KHR_draco_mesh_compression on real draco data; then damaged data. */
@@ -381,6 +535,11 @@ static void test_draco(void) {
         CHECK_MSG(worst <= tol, "draco vertex off by %g (tolerance %g)", worst, tol);
     }
     mr_scene_destroy(&s);
+    /* tinygltf alone refuses draco's index accessor without a bufferView. */
+    size_t gn = 0;
+    unsigned char *g = make_glb(json, d, dn, &gn);
+    CHECK_MSG(mr_gltf_parse_only(g, gn, &err), "parse only, draco: %s", err.msg);
+    free(g);
     /* Damage: cut short, garbage, random flips. */
     expect_refused(json, d, dn / 2, NULL, __LINE__);
     unsigned char *junk = malloc(dn);
@@ -488,6 +647,8 @@ int main(void) {
     test_sparse_and_zeros();
     test_glb_lies();
     test_meshopt();
+    test_meshopt_shared();
+    test_meshopt_big();
     test_draco();
     test_texture_transform();
     test_big_files();

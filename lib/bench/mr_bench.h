@@ -188,6 +188,23 @@ typedef struct mr_bench_map_params {
 bool mr_bench_map(const mr_bench_map_params *params, mr_error *err);
 extern const mr_opt mr_bench_map_opts[]; /* seeds, max-photos, noise, misdetect */
 
+/* bench load (load.c, issue 17 item 7): the instanced factory
+ * (mr_synth_build, `triangles` drawn) and the unique one (mr_synth_cad_build,
+ * `unique_triangles`) as .glb and packed by gltfpack (default, -c, -cc);
+ * each file loaded by mr_scene_load in a fresh child process per load, in
+ * turn, `runs` rounds: median CPU s (user + system), wall s, MB/s and peak
+ * RSS per file (bench_load.csv, bench_load.svg). Needs gltfpack. */
+typedef struct mr_bench_load_params {
+    const char *out_dir;       /* default "bench-out" */
+    int runs;                  /* rounds, default 5 */
+    double triangles;          /* instanced factory, drawn; default 4e6 */
+    double unique_triangles;   /* unique factory, stored; default 2e6 */
+    FILE *out;                 /* the table; NULL: silent */
+} mr_bench_load_params;
+#define MR_BENCH_LOAD_DEFAULTS .out_dir = "bench-out", .runs = 5, .triangles = 4e6, .unique_triangles = 2e6
+bool mr_bench_load(const mr_bench_load_params *params, mr_error *err);
+extern const mr_opt mr_bench_load_opts[]; /* runs, triangles, unique-triangles */
+
 /* ------------------------------------------------------ synthetic data */
 
 /* A synthetic recording of the demo hall (as built) along a walking path

@@ -88,6 +88,17 @@ const mr_opt mr_bench_map_opts[] = {
 };
 #undef MP
 
+/* bench load (issue 17, lane gltf) */
+#define LD(f) offsetof(mr_bench_load_params, f)
+const mr_opt mr_bench_load_opts[] = {
+    {"runs", MR_OPT_INT, LD(runs), 1, 99, 5, NULL, "rounds over all files (each a fresh process per file); medians reported", 0},
+    {"triangles", MR_OPT_DOUBLE, LD(triangles), 1e5, 1e8, 4e6, NULL, "drawn triangles of the instanced factory", 0},
+    {"unique-triangles", MR_OPT_DOUBLE, LD(unique_triangles), 2e4, 5e7, 2e6, NULL,
+     "stored triangles of the unique factory", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef LD
+
 #define SR(f) offsetof(mr_synth_recording_params, f)
 const mr_opt mr_synth_recording_opts[] = {
     {"frames", MR_OPT_INT, SR(frames), 1, 100000, 0, NULL, "frames spread over the walking path (auto: one per path step, 217)",

@@ -31,6 +31,8 @@
 #include <new>
 #include <sstream>
 #include <string>
+#include <system_error>
+#include <thread>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -413,7 +415,14 @@ bool top_level(const char *s, size_t n, std::map<std::string, Span> *out) {
 // required extension we do not read is refused here, by name, before any
 // buffer error can hide it. Only the members changed are re-printed and
 // spliced into the text. Returns the JSON to parse.
-std::string take_buffers(const char *json, size_t len, const Glb *glb, const char *base_dir, Source *src) {
+//
+// only_tinygltf: tinygltf keeps the buffers; only what it cannot read at
+// all changes (meshopt fallback buffers, draco's indices without a
+// bufferView) and nothing is refused (mr_gltf_parse_only). *changed: the
+// text was changed.
+std::string take_buffers(const char *json, size_t len, const Glb *glb, const char *base_dir, Source *src,
+                         bool only_tinygltf = false, bool *changed_out = nullptr) {
+    if (changed_out) *changed_out = false;
     std::map<std::string, Span> top;
     if (!top_level(json, len, &top)) return std::string(json, len);  // tinygltf says what is wrong
     auto member = [&](const char *key) -> cJSON * {
@@ -428,7 +437,7 @@ std::string take_buffers(const char *json, size_t len, const Glb *glb, const cha
         splice[sp.b] = std::make_pair(sp, std::string(t));
         cJSON_free(t);
     };
-    {
+    if (!only_tinygltf) {
         JsonGuard req{member("extensionsRequired")};
         const cJSON *r;
         cJSON_ArrayForEach(r, req.j) {
@@ -485,6 +494,19 @@ std::string take_buffers(const char *json, size_t len, const Glb *glb, const cha
         const char *u = cJSON_IsString(uri) ? uri->valuestring : "";
         const cJSON *mx = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(b, "extensions"),
                                                            "EXT_meshopt_compression");
+        if (only_tinygltf) {
+            // tinygltf takes a GLB's buffer without a uri for its BIN chunk,
+            // and then refuses it as longer than the chunk: gltfpack -c's
+            // fallback buffer gets one byte of its own instead.
+            if (!u[0] && cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(mx, "fallback"))) {
+                cJSON_DeleteItemFromObjectCaseSensitive(b, "byteLength");
+                cJSON_AddStringToObject(b, "uri", "data:application/octet-stream;base64,AA==");
+                cJSON_AddNumberToObject(b, "byteLength", 1);
+                changed = true;
+            }
+            i++;
+            continue;
+        }
         if (std::strncmp(u, "data:", 5) == 0) {
             ref.data_uri = true;
             src->bufs.push_back(ref);
@@ -526,6 +548,7 @@ std::string take_buffers(const char *json, size_t len, const Glb *glb, const cha
     }
     if (changed) replace("buffers", bufs.j);
     if (splice.empty()) return std::string(json, len);
+    if (changed_out) *changed_out = true;
     std::string out;
     out.reserve(len + 256);
     size_t at = 0;
@@ -609,7 +632,11 @@ struct View {
     int comp, ncomp;
     bool normalized;
     int index;
+    bool ready;  // its final array is already converted (Loader::ready): base is not to be read
 };
+
+// What a primitive reads an accessor as (Loader::preconvert).
+enum Role { k_role_none = -1, k_role_position, k_role_normal, k_role_uv, k_role_index, k_role_mixed };
 
 // -------------------------------------------------------------- loader
 
@@ -624,6 +651,25 @@ struct Loader {
     // that is decoded again.
     std::map<int, std::unique_ptr<unsigned char[]>> meshopt;
     std::vector<int> view_uses;
+    // Compressed files must load at least as fast as plain ones (issue 17,
+    // item 7), and a decoded view's fresh pages cost as much as decoding
+    // it. So a meshopt view whose every reader is a primitive attribute or
+    // index list read once (view_pre) is decoded into one scratch buffer,
+    // reused by all such views and sized for the largest (scratch_need), and
+    // every accessor in it is converted to its final mesh array at once
+    // (ready, owned here until the primitive takes it): no view is kept,
+    // copied, or decoded twice. Anything else keeps the path above.
+    std::vector<int> acc_role, acc_uses, acc_state;  // per accessor; state 0 not yet, 1 converted, 2 left to read()
+    std::vector<char> view_pre;
+    std::vector<std::vector<int>> view_readers;  // pre views -> their accessors
+    std::map<int, void *> ready;                 // accessor -> malloc'd float or uint32 array
+    // The last pre view to decode hands the scratch itself to its 32-bit
+    // index accessor at offset 0 (already its final array: pages not
+    // faulted twice), so the scratch is malloc'd.
+    unsigned char *scratch = nullptr;
+    size_t scratch_n = 0, scratch_need = 0;
+    std::vector<char> view_decoded;
+    size_t pre_left = 0;  // pre views with readers not yet decoded
     std::vector<const char *> globs;
     std::vector<std::pair<int32_t, int32_t>> mesh_map;  // glTF mesh -> (first, count); first -2: not yet
     std::vector<int32_t> tex_map;                        // glTF texture -> scene texture; -2: not yet
@@ -633,6 +679,12 @@ struct Loader {
     void *progress_user = nullptr;
 
     Loader(const tinygltf::Model &model, mr_scene *scene, Source &source) : m(model), s(scene), src(source) {}
+    ~Loader() {
+        for (auto &kv : ready) std::free(kv.second);
+        std::free(scratch);
+    }
+    Loader(const Loader &) = delete;
+    Loader &operator=(const Loader &) = delete;
 
     // ------------------------------------------------ bytes of bufferViews
 
@@ -680,20 +732,30 @@ struct Loader {
             fail(MR_ERR_PARSE, "bufferView %d: byteLength %zu is more than its meshopt data decodes to (%zu)", bvi,
                  bv.byteLength, out_n);
         // Not zeroed: the decoder writes every byte, or fails.
-        std::unique_ptr<unsigned char[]> out(new unsigned char[out_n ? out_n : 1]);
+        const bool pre = (size_t)bvi < view_pre.size() && view_pre[(size_t)bvi];
+        std::unique_ptr<unsigned char[]> own;
+        if (pre && (scratch_n < out_n || !scratch)) {
+            std::free(scratch);
+            scratch = nullptr;
+            scratch_n = std::max(std::max(out_n, scratch_need), (size_t)1);
+            scratch = xmalloc<unsigned char>(scratch_n);
+        } else if (!pre) {
+            own.reset(new unsigned char[out_n ? out_n : 1]);
+        }
+        unsigned char *out = pre ? scratch : own.get();
         const unsigned char *in = b.p + o;
         int rc;
         if (mode == "ATTRIBUTES") {
             if (st % 4 != 0) fail(MR_ERR_PARSE, "bufferView %d: meshopt ATTRIBUTES stride %zu is not a multiple of 4", bvi, st);
-            rc = meshopt_decodeVertexBuffer(out.get(), cnt, st, in, n);
+            rc = meshopt_decodeVertexBuffer(out, cnt, st, in, n);
             if (rc == 0 && filter == "OCTAHEDRAL") {
                 if (st != 4 && st != 8) fail(MR_ERR_PARSE, "bufferView %d: OCTAHEDRAL filter needs stride 4 or 8", bvi);
-                meshopt_decodeFilterOct(out.get(), cnt, st);
+                meshopt_decodeFilterOct(out, cnt, st);
             } else if (rc == 0 && filter == "QUATERNION") {
                 if (st != 8) fail(MR_ERR_PARSE, "bufferView %d: QUATERNION filter needs stride 8", bvi);
-                meshopt_decodeFilterQuat(out.get(), cnt, st);
+                meshopt_decodeFilterQuat(out, cnt, st);
             } else if (rc == 0 && filter == "EXPONENTIAL") {
-                meshopt_decodeFilterExp(out.get(), cnt, st);
+                meshopt_decodeFilterExp(out, cnt, st);
             } else if (filter != "NONE") {
                 fail(MR_ERR_UNSUPPORTED, "bufferView %d: meshopt filter %s (not supported)", bvi, filter.c_str());
             }
@@ -701,14 +763,18 @@ struct Loader {
             if (st != 2 && st != 4) fail(MR_ERR_PARSE, "bufferView %d: meshopt %s stride must be 2 or 4", bvi, mode.c_str());
             if (mode == "TRIANGLES" && cnt % 3 != 0)
                 fail(MR_ERR_PARSE, "bufferView %d: meshopt TRIANGLES count %zu is not a multiple of 3", bvi, cnt);
-            rc = mode == "TRIANGLES" ? meshopt_decodeIndexBuffer(out.get(), cnt, st, in, n)
-                                     : meshopt_decodeIndexSequence(out.get(), cnt, st, in, n);
+            rc = mode == "TRIANGLES" ? meshopt_decodeIndexBuffer(out, cnt, st, in, n)
+                                     : meshopt_decodeIndexSequence(out, cnt, st, in, n);
         } else {
             fail(MR_ERR_UNSUPPORTED, "bufferView %d: meshopt mode %s (not supported)", bvi, mode.c_str());
         }
         if (rc != 0) fail(MR_ERR_PARSE, "bufferView %d: malformed meshopt %s stream (decoder error %d)", bvi, mode.c_str(), rc);
         src.consumed(n);
-        return meshopt.emplace(bvi, std::move(out)).first->second.get();
+        if (pre) {
+            preconvert(bvi, out, bv.byteLength);
+            return out;
+        }
+        return meshopt.emplace(bvi, std::move(own)).first->second.get();
     }
 
     // The bytes of bufferView bvi, bounds-checked; *len gets its byteLength.
@@ -742,21 +808,220 @@ struct Loader {
 
     void count_view_uses() {
         view_uses.assign(m.bufferViews.size(), 0);
-        auto use = [&](int a) {
+        acc_role.assign(m.accessors.size(), k_role_none);
+        acc_uses.assign(m.accessors.size(), 0);
+        acc_state.assign(m.accessors.size(), 0);
+        auto use = [&](int a, int role) {
             if (a < 0 || (size_t)a >= m.accessors.size()) return;
+            int &r = acc_role[(size_t)a];
+            r = r == k_role_none || r == role ? role : k_role_mixed;
+            acc_uses[(size_t)a]++;
             int bv = m.accessors[(size_t)a].bufferView;
             if (bv >= 0 && (size_t)bv < view_uses.size()) view_uses[(size_t)bv]++;
+        };
+        std::vector<char> other(m.bufferViews.size(), 0);  // read by something else too
+        auto mark = [&](int bv) {
+            if (bv >= 0 && (size_t)bv < other.size()) other[(size_t)bv] = 1;
         };
         for (size_t mi = 0; mi < m.meshes.size(); mi++)
             for (size_t pi = 0; pi < m.meshes[mi].primitives.size(); pi++) {
                 const tinygltf::Primitive &p = m.meshes[mi].primitives[pi];
+                const int roles[3] = {k_role_position, k_role_normal, k_role_uv};
+                int ri = 0;
                 for (const char *k : {"POSITION", "NORMAL", "TEXCOORD_0"}) {
                     auto it = p.attributes.find(k);
-                    if (it != p.attributes.end()) use(it->second);
+                    if (it != p.attributes.end()) use(it->second, roles[ri]);
+                    ri++;
                 }
                 auto moved = src.moved_indices.find(std::make_pair((int)mi, (int)pi));
-                use(moved != src.moved_indices.end() ? moved->second : p.indices);
+                use(moved != src.moved_indices.end() ? moved->second : p.indices, k_role_index);
+                auto dx = p.extensions.find("KHR_draco_mesh_compression");
+                if (dx != p.extensions.end() && dx->second.IsObject() && dx->second.Has("bufferView") &&
+                    dx->second.Get("bufferView").IsNumber())
+                    mark(dx->second.Get("bufferView").GetNumberAsInt());
             }
+        for (const tinygltf::Image &im : m.images) mark(im.bufferView);
+        for (const tinygltf::Accessor &a : m.accessors)
+            if (a.sparse.isSparse) {
+                mark(a.bufferView);
+                mark(a.sparse.indices.bufferView);
+                mark(a.sparse.values.bufferView);
+            }
+        view_pre.assign(m.bufferViews.size(), 0);
+        view_readers.assign(m.bufferViews.size(), std::vector<int>());
+        for (size_t bi = 0; bi < m.bufferViews.size(); bi++) {
+            auto x = m.bufferViews[bi].extensions.find("EXT_meshopt_compression");
+            view_pre[bi] = x != m.bufferViews[bi].extensions.end() && !other[bi];
+        }
+        for (size_t ai = 0; ai < m.accessors.size(); ai++) {
+            int bv = m.accessors[ai].bufferView;
+            if (bv < 0 || (size_t)bv >= view_pre.size() || !view_pre[(size_t)bv] || acc_uses[ai] == 0) continue;
+            if (acc_uses[ai] != 1 || acc_role[ai] == k_role_mixed) view_pre[(size_t)bv] = 0;  // shared: read() copies
+            else view_readers[(size_t)bv].push_back((int)ai);
+        }
+        scratch_need = 0;
+        pre_left = 0;
+        view_decoded.assign(m.bufferViews.size(), 0);
+        for (size_t bi = 0; bi < m.bufferViews.size(); bi++) {
+            if (!view_pre[bi]) {
+                view_readers[bi].clear();
+                continue;
+            }
+            if (!view_readers[bi].empty()) pre_left++;
+            // The largest decoded size of these views: the scratch is
+            // allocated once. Checked in meshopt_view; a lie only grows this
+            // up to its stream's 64:1.
+            const tinygltf::Value &x = m.bufferViews[bi].extensions.find("EXT_meshopt_compression")->second;
+            double cnt = 0, st = 0, len = 0;
+            if (x.IsObject() && ext_num(x, "count", &cnt) && ext_num(x, "byteStride", &st) && ext_num(x, "byteLength", &len) &&
+                cnt >= 0 && st >= 1 && st <= 256 && len >= 0 && cnt * st <= 64 * len + 65536 && cnt * st < 4.0e9)
+                scratch_need = std::max(scratch_need, (size_t)(cnt * st));
+        }
+    }
+
+    // Byte window of accessor a in a view of len bytes at p, as
+    // accessor_view checks it; false where it would fail (read() then says
+    // why, in the primitive that reads it).
+    bool window(int a, const unsigned char *p, size_t len, View *out) const {
+        const tinygltf::Accessor &acc = m.accessors[(size_t)a];
+        int csize = component_size(acc.componentType), ncomp = type_components(acc.type);
+        if (csize == 0 || ncomp == 0 || acc.count == 0 || acc.sparse.isSparse) return false;
+        size_t elem = (size_t)csize * (size_t)ncomp;
+        const tinygltf::BufferView &bv = m.bufferViews[(size_t)acc.bufferView];
+        size_t stride = bv.byteStride ? bv.byteStride : elem;
+        if (stride < elem || acc.byteOffset > len || elem > len - acc.byteOffset ||
+            (acc.count - 1) > (len - acc.byteOffset - elem) / stride)
+            return false;
+        *out = View{p + acc.byteOffset, stride, acc.count, acc.componentType, ncomp, acc.normalized, a, false};
+        return true;
+    }
+
+    // A pre view was just decoded at p: each of its accessors becomes the
+    // array its primitive takes (take), in the layout primitive() would
+    // read it in; any that primitive() would refuse or warn about is left to
+    // it (read again from a fresh decode, to fail or warn as it does).
+    void preconvert(int bvi, const unsigned char *p, size_t len) {
+        bool last = false;
+        if (!view_decoded[(size_t)bvi] && !view_readers[(size_t)bvi].empty()) {
+            view_decoded[(size_t)bvi] = 1;
+            last = --pre_left == 0;
+        }
+        int handoff = -1;  // the accessor that may keep the scratch (see scratch)
+        for (int a : view_readers[(size_t)bvi]) {
+            View v;
+            if (last && handoff < 0 && p == scratch && acc_state[(size_t)a] == 0 && acc_role[(size_t)a] == k_role_index &&
+                m.accessors[(size_t)a].byteOffset == 0 && window(a, p, len, &v) &&
+                v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT && v.ncomp == 1 && v.stride == 4 && v.count <= UINT32_MAX)
+                handoff = a;
+        }
+        // Every array is allocated here, then filled on both cores when
+        // there is enough to fill (the views of a compressed file are whole
+        // meshes' worth: this is where its load has parallel work).
+        std::vector<Job> jobs;
+        bool all = true;
+        size_t bytes = 0;
+        for (int a : view_readers[(size_t)bvi])
+            if (a != handoff) {
+                Job j;
+                if (plan_one(a, p, len, &j)) {
+                    jobs.push_back(j);
+                    bytes += j.v.count * (size_t)j.n * 4;
+                } else {
+                    all = all && acc_state[(size_t)a] == 1;
+                }
+            }
+        run_jobs(jobs, bytes);
+        for (const Job &j : jobs) {
+            src.consumed(j.v.count * j.v.stride);
+            acc_state[(size_t)j.v.index] = 1;
+        }
+        if (handoff < 0) return;
+        if (!all) {
+            // Some accessor is left to read(), which reads this view's
+            // bytes after us: the scratch stays.
+            Job j;
+            if (plan_one(handoff, p, len, &j)) {
+                run_jobs(std::vector<Job>(1, j), 0);
+                src.consumed(j.v.count * j.v.stride);
+                acc_state[(size_t)handoff] = 1;
+            }
+            return;
+        }
+        const size_t n = m.accessors[(size_t)handoff].count;
+        void *&slot = ready[handoff];
+        void *q = std::realloc(scratch, n * 4);  // shrinks in place; on failure the block stays as it was
+        slot = q ? q : scratch;
+        scratch = nullptr;
+        scratch_n = 0;
+        src.consumed(n * 4);
+        acc_state[(size_t)handoff] = 1;
+    }
+
+    // One accessor of a pre view to convert: its window, its component count
+    // and its array (allocated, in ready); false if it is left to read()
+    // (acc_state 2) or already done.
+    struct Job {
+        View v;
+        int n;
+        void *out;
+    };
+    bool plan_one(int a, const unsigned char *p, size_t len, Job *j) {
+        if (acc_state[(size_t)a] != 0) return false;
+        acc_state[(size_t)a] = 2;
+        View v;
+        if (!window(a, p, len, &v) || v.count > UINT32_MAX) return false;
+        const int role = acc_role[(size_t)a];
+        int n = 0;
+        if (role == k_role_position && position_ok(v)) n = 3;
+        else if (role == k_role_normal && normal_ok(v)) n = 3;
+        else if (role == k_role_uv && uv_ok(v)) n = 2;
+        else if (role == k_role_index && v.ncomp == 1 &&
+                 (v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ||
+                  v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+            n = 1;
+        if (n == 0) return false;
+        void *&slot = ready[a];  // owned here before anything can throw
+        if (role == k_role_index) slot = xmalloc<uint32_t>(v.count);
+        else slot = xmalloc<float>(v.count * (size_t)n);
+        *j = Job{v, n, slot};
+        return true;
+    }
+
+    // Fills the jobs' arrays (read() cannot fail on them: no sparse), the
+    // elements split in two halves on a second thread when there are
+    // bytes enough to pay for it and a second core.
+    void run_jobs(const std::vector<Job> &jobs, size_t bytes) const {
+        auto fill = [this](const Job &j, size_t first, size_t count) {
+            View v = j.v;
+            v.base += first * v.stride;
+            v.count = count;
+            if (j.n == 1) read_plain(v, 1, static_cast<uint32_t *>(j.out) + first);
+            else read_plain(v, j.n, static_cast<float *>(j.out) + first * (size_t)j.n);
+        };
+        const bool two = bytes >= ((size_t)8 << 20) && std::thread::hardware_concurrency() > 1;
+        if (two) {
+            try {
+                std::thread t([&] {
+                    for (const Job &j : jobs) fill(j, j.v.count / 2, j.v.count - j.v.count / 2);
+                });
+                for (const Job &j : jobs) fill(j, 0, j.v.count / 2);
+                t.join();
+                return;
+            } catch (const std::system_error &) {
+                // no second thread (nothing was filled yet): all on this one
+            }
+        }
+        for (const Job &j : jobs) fill(j, 0, j.v.count);
+    }
+
+    // The converted array of accessor a, now the caller's; NULL if none.
+    template <typename T>
+    T *take(int a) {
+        auto it = ready.find(a);
+        if (it == ready.end()) return nullptr;
+        T *p = static_cast<T *>(it->second);
+        ready.erase(it);
+        return p;
     }
 
     View accessor_view(int idx, const char *what, const char *mesh) {
@@ -774,10 +1039,13 @@ struct Loader {
             if (a.count > src.input_bytes)
                 fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d claims %zu elements without a bufferView, more than the file's %zu bytes could describe",
                      mesh, what, idx, a.count, src.input_bytes);
-            return View{nullptr, elem, a.count, a.componentType, ncomp, a.normalized, idx};
+            return View{nullptr, elem, a.count, a.componentType, ncomp, a.normalized, idx, false};
         }
+        if (ready.count(idx)) return View{nullptr, elem, a.count, a.componentType, ncomp, a.normalized, idx, true};
         size_t len = 0;
         const unsigned char *p = view_bytes(a.bufferView, &len);
+        // Decoding the view may just have converted this accessor (preconvert).
+        if (ready.count(idx)) return View{nullptr, elem, a.count, a.componentType, ncomp, a.normalized, idx, true};
         const tinygltf::BufferView &bv = m.bufferViews[(size_t)a.bufferView];
         size_t stride = bv.byteStride ? bv.byteStride : elem;
         if (stride < elem)
@@ -788,7 +1056,7 @@ struct Loader {
             fail(MR_ERR_PARSE, "mesh '%s': %s accessor %d (%zu elements) runs past the end of bufferView %d", mesh,
                  what, idx, a.count, a.bufferView);
         src.consumed(a.count * stride);
-        return View{p + a.byteOffset, stride, a.count, a.componentType, ncomp, a.normalized, idx};
+        return View{p + a.byteOffset, stride, a.count, a.componentType, ncomp, a.normalized, idx, false};
     }
 
     // Element loop for component type C; norm_max > 0: normalised by the
@@ -811,28 +1079,79 @@ struct Loader {
         }
     }
 
+    // convert for N components of N: a loop the compiler unrolls (the
+    // quantised attributes and 16-bit indices of gltfpack files). Same
+    // values: integers convert exactly, normalised ones as above.
+    template <typename C, typename T, int N>
+    static void convert_n(const View &v, T *out, double norm_max) {
+        const unsigned char *p = v.base;
+        if (!(v.normalized && norm_max > 0)) {
+            for (size_t i = 0; i < v.count; i++, p += v.stride) {
+                C c[N];
+                std::memcpy(c, p, sizeof c);
+                T *q = out + i * N;
+                q[0] = (T)c[0];
+                if (N > 1) q[N > 1 ? 1 : 0] = (T)c[N > 1 ? 1 : 0];  // unrolled: N is a constant
+                if (N > 2) q[N > 2 ? 2 : 0] = (T)c[N > 2 ? 2 : 0];
+            }
+            return;
+        }
+        const double inv = 1.0 / norm_max, lo = std::is_signed<C>::value ? -1.0 : 0.0;
+        for (size_t i = 0; i < v.count; i++, p += v.stride) {
+            C c[N];
+            std::memcpy(c, p, sizeof c);
+            T *q = out + i * N;
+            q[0] = (T)std::max((double)c[0] * inv, lo);
+            if (N > 1) q[N > 1 ? 1 : 0] = (T)std::max((double)c[N > 1 ? 1 : 0] * inv, lo);
+            if (N > 2) q[N > 2 ? 2 : 0] = (T)std::max((double)c[N > 2 ? 2 : 0] * inv, lo);
+        }
+    }
+
+    template <typename C, typename T>
+    static void convert_any(const View &v, int n, int k_n, T *out, double norm_max) {
+        if (k_n == n && n == 1) convert_n<C, T, 1>(v, out, norm_max);
+        else if (k_n == n && n == 2) convert_n<C, T, 2>(v, out, norm_max);
+        else if (k_n == n && n == 3) convert_n<C, T, 3>(v, out, norm_max);
+        else convert<C>(v, n, k_n, out, norm_max);
+    }
+
     // Reads n components per element into out[count*n] (missing components
     // 0), converting any component type, then applies sparse substitution.
     template <typename T>
     void read(const View &v, int n, T *out, const char *what, const char *mesh) {
-        const int k_n = std::min(n, v.ncomp), cs = component_size(v.comp);
+        read_plain(v, n, out);
+        read_sparse(v, n, out, what, mesh);
+    }
+
+    // read's element loops: no sparse values, nothing that can fail.
+    template <typename T>
+    static void read_plain(const View &v, int n, T *out) {
+        const int k_n = std::min(n, v.ncomp);
         if (!v.base) {
             std::fill(out, out + v.count * (size_t)n, T(0));
-        } else if (v.comp == TINYGLTF_COMPONENT_TYPE_FLOAT && std::is_same<T, float>::value && k_n == n) {
-            for (size_t i = 0; i < v.count; i++) std::memcpy(out + i * (size_t)n, v.base + i * v.stride, 4 * (size_t)n);
+        } else if (k_n == n && ((v.comp == TINYGLTF_COMPONENT_TYPE_FLOAT && std::is_same<T, float>::value) ||
+                                (v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT && std::is_same<T, uint32_t>::value))) {
+            if (v.stride == 4 * (size_t)n) std::memcpy(out, v.base, v.count * v.stride);  // tightly packed
+            else
+                for (size_t i = 0; i < v.count; i++) std::memcpy(out + i * (size_t)n, v.base + i * v.stride, 4 * (size_t)n);
         } else {
             // One loop per component type: quantised files (gltfpack) must
             // load at least as fast as float ones.
             switch (v.comp) {
-            case TINYGLTF_COMPONENT_TYPE_BYTE: convert<int8_t>(v, n, k_n, out, 127.0); break;
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: convert<uint8_t>(v, n, k_n, out, 255.0); break;
-            case TINYGLTF_COMPONENT_TYPE_SHORT: convert<int16_t>(v, n, k_n, out, 32767.0); break;
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: convert<uint16_t>(v, n, k_n, out, 65535.0); break;
-            case TINYGLTF_COMPONENT_TYPE_INT: convert<int32_t>(v, n, k_n, out, 0); break;
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: convert<uint32_t>(v, n, k_n, out, 0); break;
-            default: convert<float>(v, n, k_n, out, 0); break;
+            case TINYGLTF_COMPONENT_TYPE_BYTE: convert_any<int8_t>(v, n, k_n, out, 127.0); break;
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: convert_any<uint8_t>(v, n, k_n, out, 255.0); break;
+            case TINYGLTF_COMPONENT_TYPE_SHORT: convert_any<int16_t>(v, n, k_n, out, 32767.0); break;
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: convert_any<uint16_t>(v, n, k_n, out, 65535.0); break;
+            case TINYGLTF_COMPONENT_TYPE_INT: convert_any<int32_t>(v, n, k_n, out, 0); break;
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: convert_any<uint32_t>(v, n, k_n, out, 0); break;
+            default: convert_any<float>(v, n, k_n, out, 0); break;
             }
         }
+    }
+
+    template <typename T>
+    void read_sparse(const View &v, int n, T *out, const char *what, const char *mesh) {
+        const int k_n = std::min(n, v.ncomp), cs = component_size(v.comp);
         const tinygltf::Accessor &a = m.accessors[(size_t)v.index];
         if (!a.sparse.isSparse) return;
         // Sparse: count (index, value) pairs replace elements.
@@ -1188,7 +1507,7 @@ struct Loader {
         }
         MeshGuard g;
         std::vector<uint32_t> order;
-        bool have_order = false;
+        bool have_order = false, float_positions = true;
         if (dx != p.extensions.end()) {
             draco_primitive(p, dx->second, name, g, order);
             have_order = true;
@@ -1200,19 +1519,29 @@ struct Loader {
             if (pv.count > UINT32_MAX) fail(MR_ERR_UNSUPPORTED, "mesh '%s': too many vertices", name);
             uint32_t nv = (uint32_t)pv.count;
             g.m.vertex_count = nv;
-            g.m.positions = xmalloc<float>((size_t)nv * 3);
-            read(pv, 3, g.m.positions, "POSITION", name);
+            // Each array is read once, into the mesh's own (or taken
+            // converted from a decoded meshopt view): no copies.
+            if (!(g.m.positions = take<float>(pos_it->second))) {
+                g.m.positions = xmalloc<float>((size_t)nv * 3);
+                read(pv, 3, g.m.positions, "POSITION", name);
+            }
+            float_positions = pv.comp == TINYGLTF_COMPONENT_TYPE_FLOAT;
             done(pos_it->second);
 
             auto nrm_it = p.attributes.find("NORMAL");
             if (nrm_it != p.attributes.end()) {
                 View nview = accessor_view(nrm_it->second, "NORMAL", name);
                 if (!normal_ok(nview) || nview.count != nv) {
+                    std::free(take<float>(nrm_it->second));
                     warning(std::string("mesh '") + name + "': NORMAL has an unsupported layout; regenerated");
                 } else {
-                    g.m.normals = xmalloc<float>((size_t)nv * 3);
-                    read(nview, 3, g.m.normals, "NORMAL", name);
-                    check_normals(g, name, nview.comp != TINYGLTF_COMPONENT_TYPE_FLOAT);
+                    if (!(g.m.normals = take<float>(nrm_it->second))) {
+                        g.m.normals = xmalloc<float>((size_t)nv * 3);
+                        read(nview, 3, g.m.normals, "NORMAL", name);
+                    }
+                    // Integer normals are finite, and mr_scene_add_mesh
+                    // makes every normal unit length: only floats are checked.
+                    if (nview.comp == TINYGLTF_COMPONENT_TYPE_FLOAT) check_normals(g, name, false);
                 }
                 done(nrm_it->second);
             }
@@ -1220,10 +1549,13 @@ struct Loader {
             if (uv_it != p.attributes.end()) {
                 View uview = accessor_view(uv_it->second, "TEXCOORD_0", name);
                 if (!uv_ok(uview) || uview.count != nv) {
+                    std::free(take<float>(uv_it->second));
                     warning(std::string("mesh '") + name + "': TEXCOORD_0 has an unsupported layout; ignored");
                 } else {
-                    g.m.uvs = xmalloc<float>((size_t)nv * 2);
-                    read(uview, 2, g.m.uvs, "TEXCOORD_0", name);
+                    if (!(g.m.uvs = take<float>(uv_it->second))) {
+                        g.m.uvs = xmalloc<float>((size_t)nv * 2);
+                        read(uview, 2, g.m.uvs, "TEXCOORD_0", name);
+                    }
                 }
                 done(uv_it->second);
             }
@@ -1235,30 +1567,56 @@ struct Loader {
                                       iv.comp != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
                                       iv.comp != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
                     fail(MR_ERR_PARSE, "mesh '%s': indices must be unsigned byte/short/int scalars", name);
-                order.resize(iv.count);
-                read(iv, 1, order.data(), "index", name);
+                if (iv.count > UINT32_MAX) fail(MR_ERR_UNSUPPORTED, "mesh '%s': too many indices", name);
+                // A triangle list is the mesh's index array as it is read.
+                uint32_t *q = take<uint32_t>(indices);
+                if (mode == TINYGLTF_MODE_TRIANGLES) {
+                    g.m.indices = q ? q : xmalloc<uint32_t>(iv.count);
+                    g.m.index_count = (uint32_t)iv.count;
+                    if (!q) read(iv, 1, g.m.indices, "index", name);
+                } else if (q) {
+                    order.assign(q, q + iv.count);
+                    std::free(q);
+                } else {
+                    order.resize(iv.count);
+                    read(iv, 1, order.data(), "index", name);
+                }
                 done(indices);
                 have_order = true;
             }
         }
         const uint32_t nv = g.m.vertex_count;
-        for (size_t i = 0; i < (size_t)nv * 3; i++)
-            if (!std::isfinite(g.m.positions[i])) fail(MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
-        if (have_order) {
-            for (size_t i = 0; i < order.size(); i++)
-                if (order[i] >= nv)
-                    fail(MR_ERR_INVALID, "mesh '%s': index %u at position %zu is out of range (%u vertices)", name,
-                         order[i], i, nv);
+        if (float_positions)  // integers are finite (mr_scene_add_mesh checks again anyway)
+            for (size_t i = 0; i < (size_t)nv * 3; i++)
+                if (!std::isfinite(g.m.positions[i])) fail(MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
+        if (g.m.indices) {
+            const uint32_t *q = g.m.indices;
+            const size_t n = g.m.index_count;
+            uint32_t worst = 0;  // branch-free scan; the error path finds the first
+            for (size_t i = 0; i < n; i++) worst = std::max(worst, q[i]);
+            if (n && worst >= nv)
+                for (size_t i = 0; i < n; i++)
+                    if (q[i] >= nv)
+                        fail(MR_ERR_INVALID, "mesh '%s': index %u at position %zu is out of range (%u vertices)", name,
+                             q[i], i, nv);
+            if (n % 3 != 0) fail(MR_ERR_INVALID, "mesh '%s': %zu indices is not a multiple of 3", name, n);
         } else {
-            order.resize(nv);
-            for (uint32_t i = 0; i < nv; i++) order[i] = i;
+            if (have_order) {
+                for (size_t i = 0; i < order.size(); i++)
+                    if (order[i] >= nv)
+                        fail(MR_ERR_INVALID, "mesh '%s': index %u at position %zu is out of range (%u vertices)", name,
+                             order[i], i, nv);
+            } else {
+                order.resize(nv);
+                for (uint32_t i = 0; i < nv; i++) order[i] = i;
+            }
+            std::vector<uint32_t> tris = triangulate(std::move(order), mode, name);
+            if (tris.size() > UINT32_MAX) fail(MR_ERR_UNSUPPORTED, "mesh '%s': too many indices", name);
+            g.m.index_count = (uint32_t)tris.size();
+            g.m.indices = xmalloc<uint32_t>(tris.size());
+            if (!tris.empty()) std::memcpy(g.m.indices, tris.data(), tris.size() * sizeof(uint32_t));
+            std::vector<uint32_t>().swap(tris);
         }
-        std::vector<uint32_t> tris = triangulate(std::move(order), mode, name);
-        if (tris.size() > UINT32_MAX) fail(MR_ERR_UNSUPPORTED, "mesh '%s': too many indices", name);
-        g.m.index_count = (uint32_t)tris.size();
-        g.m.indices = xmalloc<uint32_t>(tris.size());
-        if (!tris.empty()) std::memcpy(g.m.indices, tris.data(), tris.size() * sizeof(uint32_t));
-        std::vector<uint32_t>().swap(tris);
 
         g.m.material = -1;
         if (p.material >= 0) {
@@ -1948,12 +2306,44 @@ bool mr_gltf_parse_only(const void *data, size_t size, mr_error *err) {
         tinygltf::Model model;
         std::string terr, twarn;
         const unsigned char *bytes = static_cast<const unsigned char *>(data);
-        bool ok = std::memcmp(bytes, "glTF", 4) == 0
-                      ? gltf.LoadBinaryFromMemory(&model, &terr, &twarn, bytes, (unsigned)size, "")
-                      : gltf.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char *>(bytes),
-                                                 (unsigned)size, "");
+        const bool binary = std::memcmp(bytes, "glTF", 4) == 0;
+        // What tinygltf cannot read at all (gltfpack -c's fallback buffer,
+        // draco indices) is changed as the loader changes it; the rest is
+        // tinygltf's own parse, buffers copied as it copies them.
+        Source src;
+        bool changed = false;
+        std::string json, glb2;
+        if (binary) {
+            Glb glb = glb_split(bytes, size);
+            json = take_buffers(glb.json, glb.json_len, &glb, nullptr, &src, true, &changed);
+            if (changed) {
+                // The same GLB with the new JSON chunk (padded to 4 bytes)
+                // and every chunk after it as it was.
+                while (json.size() % 4) json += ' ';
+                const size_t rest = 20 + glb.json_len, total = 20 + json.size() + (size - rest);
+                if (total > UINT_MAX) return mr_fail(err, MR_ERR_PARSE, "glTF data too large");
+                glb2.reserve(total);
+                uint32_t h[5] = {0x46546C67u, 2, (uint32_t)total, (uint32_t)json.size(), 0x4E4F534Au};
+                glb2.append(reinterpret_cast<const char *>(h), sizeof h);
+                glb2 += json;
+                glb2.append(reinterpret_cast<const char *>(bytes) + rest, size - rest);
+                bytes = reinterpret_cast<const unsigned char *>(glb2.data());
+                size = glb2.size();
+            }
+        } else {
+            json = take_buffers(reinterpret_cast<const char *>(bytes), size, nullptr, nullptr, &src, true, &changed);
+            if (changed) {
+                bytes = reinterpret_cast<const unsigned char *>(json.data());
+                size = json.size();
+            }
+        }
+        bool ok = binary ? gltf.LoadBinaryFromMemory(&model, &terr, &twarn, bytes, (unsigned)size, "")
+                         : gltf.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char *>(bytes),
+                                                    (unsigned)size, "");
         if (!ok) return mr_fail(err, MR_ERR_PARSE, "invalid glTF: %s", one_line(terr).c_str());
         return true;
+    } catch (const Fail &f) {
+        return mr_fail(err, f.code, "%s", f.msg.c_str());
     } catch (const std::bad_alloc &) {
         return mr_fail(err, MR_ERR_NOMEM, "out of memory parsing glTF");
     } catch (...) {
