@@ -102,6 +102,27 @@ void mr_rng_seed(mr_rng *r, uint64_t seed) {
     for (int i = 0; i < 4; i++) r->s[i] = splitmix64(&seed);
 }
 
+uint64_t mr_hash64_mix(uint64_t h, uint64_t w) {
+    w *= 0x9E3779B97F4A7C15ull;
+    w ^= w >> 29;
+    h ^= w;
+    h *= 0xBF58476D1CE4E5B9ull;
+    return h ^ (h >> 32);
+}
+
+uint64_t mr_hash64(uint64_t h, const void *data, size_t n) {
+    const unsigned char *p = data;
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        uint64_t w;
+        memcpy(&w, p + i, 8);
+        h = mr_hash64_mix(h, w);
+    }
+    uint64_t t = 0;
+    for (size_t k = 0; i + k < n; k++) t |= (uint64_t)p[i + k] << (8 * k);
+    return mr_hash64_mix(mr_hash64_mix(h, t), (uint64_t)n);
+}
+
 static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
 
 uint64_t mr_rng_u64(mr_rng *r) {

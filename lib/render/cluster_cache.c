@@ -14,36 +14,13 @@
 #define CLU_ENTRY 40
 static const char k_magic[8] = {'M', 'R', 'C', 'L', 'U', '\r', '\n', 0x1a};
 
-/* A 64-bit hash of 8-byte words (multiply-xorshift): a few GB/s, so keying
- * a level costs a small part of building its meshlets. */
-static uint64_t mix(uint64_t h, uint64_t w) {
-    w *= 0x9E3779B97F4A7C15ull;
-    w ^= w >> 29;
-    h ^= w;
-    h *= 0xBF58476D1CE4E5B9ull;
-    return h ^ (h >> 32);
-}
-
-static uint64_t hash_bytes(uint64_t h, const void *data, size_t n) {
-    const unsigned char *p = data;
-    size_t i = 0;
-    for (; i + 8 <= n; i += 8) {
-        uint64_t w;
-        memcpy(&w, p + i, 8);
-        h = mix(h, w);
-    }
-    uint64_t t = 0;
-    for (size_t k = 0; i + k < n; k++) t |= (uint64_t)p[i + k] << (8 * k);
-    return mix(mix(h, t), (uint64_t)n);
-}
-
 uint64_t clu_level_key(const float *positions, uint32_t vertex_count, const uint32_t *indices, uint32_t count,
                        uint32_t threshold) {
-    uint64_t h = mix(0x6d72636c75ull, ((uint64_t)CLU_VERSION << 32) | threshold);
-    h = mix(h, ((uint64_t)CL_VERTS << 32) | CL_TRIS);
-    h = mix(h, MESHOPTIMIZER_VERSION);
-    h = hash_bytes(h, positions, (size_t)vertex_count * 12);
-    return hash_bytes(h, indices, (size_t)count * 4);
+    uint64_t h = mr_hash64_mix(0x6d72636c75ull, ((uint64_t)CLU_VERSION << 32) | threshold);
+    h = mr_hash64_mix(h, ((uint64_t)CL_VERTS << 32) | CL_TRIS);
+    h = mr_hash64_mix(h, MESHOPTIMIZER_VERSION);
+    h = mr_hash64(h, positions, (size_t)vertex_count * 12);
+    return mr_hash64(h, indices, (size_t)count * 4);
 }
 
 static void put32(uint8_t *p, uint32_t v) { memcpy(p, &v, 4); }
@@ -95,7 +72,7 @@ static const char *parse(clu_cache *c, size_t size) {
     uint32_t n = get32(d + 28);
     uint64_t payload = get64(d + 32);
     if (payload != size - CLU_HEADER) return "truncated or too long";
-    if (get64(d + 40) != hash_bytes(0x636c75, d + CLU_HEADER, (size_t)payload)) return "checksum mismatch (damaged)";
+    if (get64(d + 40) != mr_hash64(0x636c75, d + CLU_HEADER, (size_t)payload)) return "checksum mismatch (damaged)";
     if (n > payload / CLU_ENTRY) return "entry count out of range";
     c->old = calloc((size_t)n + 1, sizeof *c->old);
     if (!c->old) return "out of memory";
@@ -224,7 +201,7 @@ static bool write_file(clu_cache *c) {
         put32(buf + 24, MESHOPTIMIZER_VERSION);
         put32(buf + 28, (uint32_t)n);
         put64(buf + 32, total - CLU_HEADER);
-        put64(buf + 40, hash_bytes(0x636c75, buf + CLU_HEADER, total - CLU_HEADER));
+        put64(buf + 40, mr_hash64(0x636c75, buf + CLU_HEADER, total - CLU_HEADER));
         mr_error e = {0};
         ok = mr_file_write_atomic(c->path, buf, total, &e);
         if (!ok) mr_log(MR_LOG_WARN, "meshlet cache not written: %s", e.msg);

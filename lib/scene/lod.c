@@ -1259,31 +1259,17 @@ void mr_lod_destroy(mr_lod **lp) {
     *lp = NULL;
 }
 
-/* 64-bit hash (FNV-1a over 8-byte words, then a final mix): fast enough
- * for hundreds of MB, and any change of geometry changes it. */
-static uint64_t hash_bytes(uint64_t h, const void *data, size_t n) {
-    const unsigned char *p = data;
-    size_t i = 0;
-    for (; i + 8 <= n; i += 8) {
-        uint64_t w;
-        memcpy(&w, p + i, 8);
-        h = (h ^ w) * 0x100000001b3ull;
-        h ^= h >> 29;
-    }
-    for (; i < n; i++) h = (h ^ p[i]) * 0x100000001b3ull;
-    return h;
-}
 
 uint64_t mr_lod_scene_hash(const mr_scene *s) {
     uint64_t h = 0xcbf29ce484222325ull;
     if (!s) return h;
-    h = hash_bytes(h, &s->mesh_count, sizeof s->mesh_count);
+    h = mr_hash64(h, &s->mesh_count, sizeof s->mesh_count);
     for (int32_t i = 0; i < s->mesh_count; i++) {
         const mr_mesh *m = &s->meshes[i];
-        h = hash_bytes(h, &m->vertex_count, sizeof m->vertex_count);
-        h = hash_bytes(h, &m->index_count, sizeof m->index_count);
-        h = hash_bytes(h, m->positions, (size_t)m->vertex_count * 12);
-        h = hash_bytes(h, m->indices, (size_t)m->index_count * 4);
+        h = mr_hash64(h, &m->vertex_count, sizeof m->vertex_count);
+        h = mr_hash64(h, &m->index_count, sizeof m->index_count);
+        h = mr_hash64(h, m->positions, (size_t)m->vertex_count * 12);
+        h = mr_hash64(h, m->indices, (size_t)m->index_count * 4);
     }
     h ^= h >> 33;
     h *= 0xff51afd7ed558ccdull;
@@ -1640,7 +1626,7 @@ mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *e
 /* -------------------------------------------------------------- cache */
 
 #define CACHE_MAGIC "MRLOD\r\n\x1a"
-#define CACHE_VERSION 4u /* bump whenever simplification or certification changes */
+#define CACHE_VERSION 5u /* bump whenever simplification or certification changes */
 
 void mr_lod_cache_path(const char *scene_path, char *out, size_t n) {
     snprintf(out, n, "%s.mrlod", scene_path ? scene_path : "scene");
@@ -1686,7 +1672,7 @@ static bool cache_write(const mr_lod *l, const mr_lod_params *p, const char *pat
             put(&b, lv->indices, (size_t)lv->index_count * 4);
         }
     }
-    uint64_t sum = b.oom ? 0 : hash_bytes(0x9e3779b97f4a7c15ull, b.p, b.n);
+    uint64_t sum = b.oom ? 0 : mr_hash64(0x9e3779b97f4a7c15ull, b.p, b.n);
     put(&b, &sum, 8);
     bool ok = !b.oom && mr_file_write_atomic(path, b.p, b.n, err);
     if (b.oom) mr_fail(err, MR_ERR_NOMEM, "out of memory writing %s", path);
@@ -1726,7 +1712,7 @@ static mr_lod *cache_read(const mr_scene *s, const mr_lod_params *p, const char 
     if (size < 8 + 8 || !get(&r, magic, 8) || memcmp(magic, CACHE_MAGIC, 8) != 0) goto out;
     memcpy(&sum, data + size - 8, 8);
     *why = "checksum mismatch (truncated or damaged)";
-    if (hash_bytes(0x9e3779b97f4a7c15ull, data, size - 8) != sum) goto out;
+    if (mr_hash64(0x9e3779b97f4a7c15ull, data, size - 8) != sum) goto out;
     r.n = size - 8;
     *why = "written for another scene or other settings";
     if (!get(&r, &ver, 4) || ver != CACHE_VERSION || !get(&r, &mc, 4) || mc != (uint32_t)s->mesh_count ||
