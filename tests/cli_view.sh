@@ -153,9 +153,12 @@ else bad "tracking-lost run failed: $(tail -3 "$tmp/lost.err")"; fi
 
 # 1b. The shipped demo recording (recordings/demo, lib/session's format):
 #     recorded poses, play advances, the seek bar and step move the frame.
+#     `frame 4` waits (up to 60 s) until play has reached frame 4 before the
+#     pause: a loaded machine plays slowly, and the check is that play
+#     advances, not how fast.
 rec=$(cd "$(dirname "$0")/.." && pwd)/recordings/demo
 if [ -f "$rec/meta.json" ]; then
-  printf '%s\n' "0.3 state $tmp/r0.json" "0.4 key space" "1.5 key space" "1.7 state $tmp/r1.json" \
+  printf '%s\n' "0.3 state $tmp/r0.json" "0.4 key space" "0.5 frame 4" "1.5 key space" "1.7 state $tmp/r1.json" \
     "1.8 drag @seek 0.2 0.9" "2.6 state $tmp/r2.json" "2.7 key ," "3.3 state $tmp/r3.json" "3.4 quit" >"$tmp/rec.script"
   if timeout 120 "$mr" view --scene "$d/scene_planned.json" --replay "$rec" --out "$tmp/recsession" --config "$tmp/cfgr.json" \
        --size 480x360 --paused --script "$tmp/rec.script" >/dev/null 2>"$tmp/rec.err"; then

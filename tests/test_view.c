@@ -968,6 +968,30 @@ static void test_script(void) {
     CHECK_MSG(t_state >= 0.3 && t_quit >= 0.5 && t_quit > t_state, "script commands ran early or out of order "
               "(state at %.3f s, quit at %.3f s)", t_state, t_quit);
     mr_viewer_destroy(&r.v);
+    /* `frame N`: what follows waits until frame N is shown, however late
+     * (a loaded machine plays slowly); a frame already past goes on at once. */
+    write_text(sp, "0.1 frame 7\n0.2 quit\n");
+    s = mr_view_script_load(sp, &err);
+    CHECK_MSG(s != NULL, "script with frame: %s", err.msg);
+    if (s && rig_open(&r, NULL, 96 / 25.4, &err)) {
+        mr_viewer_set_script(r.v, &s);
+        double t_q = -1;
+        for (int i = 0; i < 2000 && t_q < 0; i++) {
+            if (i == 600) r.f.index = 6;  /* 10 s in: still short of 7 */
+            if (i == 1200) r.f.index = 9; /* 20 s in: past 7 */
+            step(&r);
+            if (count(&r, MR_VA_QUIT, NULL)) t_q = r.t;
+        }
+        CHECK_MSG(t_q > 20, "script `frame 7` did not wait for frame 7 (quit at %.2f s)", t_q);
+        CHECK_MSG(t_q > 0 && t_q < 21, "script `frame 7` went on late or never (quit at %.2f s)", t_q);
+        mr_viewer_destroy(&r.v);
+    }
+    mr_view_script_destroy(&s);
+    write_text(sp, "0.1 frame\n");
+    memset(&err, 0, sizeof err);
+    s = mr_view_script_load(sp, &err);
+    CHECK_MSG(s == NULL && err.code == MR_ERR_PARSE, "`frame` without N was taken");
+    mr_view_script_destroy(&s);
     /* A bad line names the file and line. */
     write_text(sp, "0.1 tap @video\n0.2 fly 1 2\n");
     memset(&err, 0, sizeof err);

@@ -297,6 +297,9 @@ void mr_viewer_measure_distance(mr_viewer *v, mr_dvec3 planned, double dist_m, d
  *   drag @slider F0 F1         (fractions of the slider's width)
  *   key K                      (a character, or esc enter left right up down home end f1 f11 space tab)
  *   resize W H | shot OUT.png | state OUT.json | quit
+ *   frame N                    (the commands after it wait, up to 60 s, until
+ *                               frame N or a later one is shown: play tests
+ *                               that do not depend on the machine's speed)
  * Input enters the controller's queue, the path real input takes. */
 typedef struct mr_view_script mr_view_script;
 /* NULL + err (MR_ERR_IO, or MR_ERR_PARSE naming the line) on a bad file. */
