@@ -364,6 +364,23 @@ bool mr_snapshot_write(const char *session_dir, const char *stem, const mr_snaps
  * whose <stem>.json no earlier session wrote, into stem: never overwrite. */
 void mr_snapshot_next_stem(const char *session_dir, const char *prefix, int *counter, char *stem, size_t n);
 
+/* ----------------------------------------------- the view's marks (mark.c) */
+
+/* A deep copy of src (its image too) into dst, whose image is freed first;
+ * false + err (dst without an image) when out of memory. */
+bool mr_capture_frame_copy(mr_capture_frame *dst, const mr_capture_frame *src, mr_error *err);
+/* A "discrepancy" annotation of a mark made on frame f with note: the
+ * frame's index, time and pose; the rest zero (node_index -1) for the
+ * caller to fill (pixel, pick, uncertainty, measurement). */
+void mr_annotation_from_frame(mr_annotation *m, const mr_capture_frame *f, const char *note, double time_unix);
+/* A finished mark's files: the snapshot (sn) as session_dir/snapshots/<stem>_*
+ * and line, with the snapshot's paths under "snapshot", appended to
+ * session_dir/annotations.jsonl. The line is written even when the snapshot
+ * fails (*snapshot_ok false, snapshot_err says why): the mark matters more.
+ * False + err when the line could not be saved. */
+bool mr_mark_save(const char *session_dir, const char *stem, cJSON *line, const mr_snapshot *sn, bool *snapshot_ok,
+                  mr_error *snapshot_err, mr_error *err);
+
 #ifdef __cplusplus
 }
 #endif

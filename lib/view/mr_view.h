@@ -288,6 +288,47 @@ bool mr_viewer_measurement(const mr_viewer *v, mr_measurement *out);
  * shown to the planner and kept in the measurement. */
 void mr_viewer_measure_distance(mr_viewer *v, mr_dvec3 planned, double dist_m, double sigma_m, const char *node);
 
+/* ----------------------------------------- marking and rendering (mark.c) */
+
+/* A window position (framebuffer px) in the picture shown at image_rect,
+ * rendered at rw x rh: the rendered image's pixel (OpenCV convention);
+ * false outside the picture. */
+bool mr_view_window_to_image(mr_ui_rect image_rect, int rw, int rh, double x, double y, double *u, double *v);
+/* That pixel in the camera's own resolution (ideal pinhole), as marks store it. */
+void mr_view_image_to_camera(const mr_camera *cam, int rw, int rh, double u, double v, double *px, double *py);
+
+/* The planned surface's point nearest to a measurement (lib/eval's
+ * mr_nearest_hit, as plain data). */
+typedef struct mr_view_planned {
+    bool found;
+    mr_dvec3 point;            /* world, scene units */
+    int node;                  /* -1: none */
+    int layer;                 /* that node's layer */
+} mr_view_planned;
+/* Where the mark of a finished measurement goes. */
+typedef struct mr_view_mark_at {
+    double px, py;             /* the measured point in the frame (ideal pinhole; the centre if behind) */
+    mr_pick pick;              /* the planned point, when found; else no hit, node -1 */
+    float note_u, note_v;      /* for mr_viewer_note_open: fractions of the picture */
+} mr_view_mark_at;
+/* cam: the camera (resized here to the frame's image_w x image_h). */
+void mr_view_measure_mark(const mr_camera *cam, int image_w, int image_h, const mr_dmat4 *world_from_camera,
+                          mr_dvec3 measured, const mr_view_planned *planned, mr_view_mark_at *out);
+
+/* The shadow method of a frame: the C key's once it changed the saved
+ * setting (start), else --shadows (given, flag), else the scene config's
+ * ("" none; an unknown name: off), else the saved setting. */
+typedef struct mr_view_shadow_choice {
+    mr_shadow_method start;    /* the saved setting at start */
+    bool keyed;                /* the C key changed it (set by mr_view_shadow_choose) */
+    bool given;                /* --shadows */
+    mr_shadow_method flag;
+} mr_view_shadow_choice;
+mr_shadow_method mr_view_shadow_choose(mr_view_shadow_choice *c, mr_shadow_method setting, const char *scene_method);
+/* What the settings set in a frame's parameters: the hidden layer, the AO
+ * method, the ghosting mode, and the shadow method given. */
+void mr_view_frame_params(const mr_view_settings *s, mr_shadow_method shadows, mr_frame_params *fp);
+
 /* ---------------------------------------------------------------- script */
 
 /* A script of timed input: one command per line, `T COMMAND ARGS`, T in
