@@ -136,23 +136,6 @@ typedef struct run_app {
     int stored;
 } run_app;
 
-static int load_images(run_app *a, const char *cmd) {
-    int t = a->plan.set.method_count, S = a->plan.set.stimulus_count;
-    a->images = calloc((size_t)t * S, sizeof *a->images);
-    if (!a->images) return mr_cli_errorf(cmd, "out of memory");
-    for (int m = 0; m < t; m++)
-        for (int s = 0; s < S; s++) {
-            char path[8192];
-            mr_error err = {0};
-            mr_study_plan_image(&a->plan, s, m, path, sizeof path);
-            if (!mr_image_load(path, 3, &a->images[m * S + s], &err)) return mr_cli_error(cmd, &err);
-            if (a->images[m * S + s].width != a->images[0].width || a->images[m * S + s].height != a->images[0].height)
-                return mr_cli_errorf(cmd, "%s: all stimuli must have one size (%dx%d)", path, a->images[0].width,
-                                  a->images[0].height);
-        }
-    return 0;
-}
-
 static void run_frame(run_app *a, bool *quit) {
     mr_event e;
     while (mr_window_next_event(a->win, &e)) {
@@ -257,7 +240,10 @@ static int study_run(int argc, char **argv) {
         rc = mr_cli_error(cmd, &err);
         goto done;
     }
-    if ((rc = load_images(a, cmd)) != 0) goto done;
+    if (!mr_study_images_load(&a->plan, &a->images, &err)) {
+        rc = mr_cli_error(cmd, &err);
+        goto done;
+    }
     /* A torn last line (a kill mid-write) is ended, so our first vote
      * starts a line of its own; nothing written is changed. */
     if (votes.torn_tail && !mr_study_votes_seal(out, &err)) {
@@ -318,9 +304,7 @@ done:
     free(a->tex);
     mr_draw2d_destroy(&a->d2);
     mr_window_destroy(&a->win);
-    if (a->images)
-        for (int i = 0; i < a->plan.set.method_count * a->plan.set.stimulus_count; i++) mr_image_free(&a->images[i]);
-    free(a->images);
+    mr_study_images_free(&a->plan, &a->images);
     free(answered);
     mr_study_votes_free(&votes);
     mr_study_plan_free(&a->plan);

@@ -143,6 +143,11 @@ bool mr_study_plan_load(const char *path, mr_study_plan *plan, mr_error *err);
 void mr_study_plan_free(mr_study_plan *plan);
 /* DIR/<method>/<stimulus>.png of a trial's method m. */
 void mr_study_plan_image(const mr_study_plan *plan, int stimulus, int method, char *out, size_t n);
+/* Every stimulus image of the plan (method x stimulus, index
+ * method * stimulus_count + stimulus), RGB; false + err (nothing kept) when
+ * one cannot be read or differs in size from the first (images.c). */
+bool mr_study_images_load(const mr_study_plan *plan, mr_image **out, mr_error *err);
+void mr_study_images_free(const mr_study_plan *plan, mr_image **images); /* NULLs *images */
 
 /* --------------------------------------------------------------- votes */
 
