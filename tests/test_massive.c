@@ -5,6 +5,7 @@
  * device exists. */
 #include "mr_render.h"
 #include "mr_test.h"
+#include "mr_test_scene.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -264,31 +265,7 @@ static void test_far_plant(void) {
     mr_scene_destroy(&b);
 }
 
-static mr_mesh sphere(double r, int nu, int nv) {
-    mr_mesh m;
-    memset(&m, 0, sizeof m);
-    m.vertex_count = (uint32_t)((nu + 1) * (nv + 1));
-    m.index_count = (uint32_t)(nu * nv * 6);
-    m.positions = malloc((size_t)m.vertex_count * 12);
-    m.indices = malloc((size_t)m.index_count * 4);
-    uint32_t ni = 0;
-    for (int i = 0; i <= nu; i++)
-        for (int j = 0; j <= nv; j++) {
-            double th = 3.14159265358979 * j / nv, ph = 2 * 3.14159265358979 * (i % nu) / nu;
-            float *p = m.positions + 3 * (size_t)(i * (nv + 1) + j);
-            p[0] = (float)(r * sin(th) * cos(ph));
-            p[1] = (float)(r * cos(th));
-            p[2] = (float)(r * sin(th) * sin(ph));
-        }
-    for (int i = 0; i < nu; i++)
-        for (int j = 0; j < nv; j++) {
-            uint32_t a = (uint32_t)(i * (nv + 1) + j), b = a + (uint32_t)(nv + 1);
-            uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
-            for (int k = 0; k < 6; k++) m.indices[ni++] = q[k];
-        }
-    m.material = -1;
-    return m;
-}
+static mr_mesh sphere(double r, int nu, int nv) { return mr_test_sphere_mesh("", r, nu, nv, 0, 0, 0); }
 
 static void test_lod_tolerance(void) {
     mr_scene *s = mr_scene_create();

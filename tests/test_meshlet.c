@@ -10,10 +10,14 @@
  * outside. Skips (77) where no EGL device exists. */
 #include "mr_render.h"
 #include "mr_test.h"
+#include "mr_test_scene.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* A closed sphere of nu * nv * 2 triangles, bumps so clusters differ. */
+static mr_mesh big_sphere(double r, int nu, int nv) { return mr_test_sphere_mesh("big_sphere", r, nu, nv, 0.03, 7, 5); }
 
 static mr_gpu *g_gpu;
 static mr_renderer *g_r;
@@ -22,35 +26,6 @@ static uint64_t g_rng = 0x9e3779b97f4a7c15ull;
 static double rnd(void) { /* uniform [0, 1) */
     g_rng = g_rng * 6364136223846793005ull + 1442695040888963407ull;
     return (double)(g_rng >> 11) / 9007199254740992.0;
-}
-
-/* A closed sphere of nu * nv * 2 triangles, bumps so clusters differ. */
-static mr_mesh sphere(double r, int nu, int nv) {
-    mr_mesh m;
-    memset(&m, 0, sizeof m);
-    snprintf(m.name, sizeof m.name, "big_sphere");
-    m.vertex_count = (uint32_t)((nu + 1) * (nv + 1));
-    m.index_count = (uint32_t)(nu * nv * 6);
-    m.positions = malloc((size_t)m.vertex_count * 12);
-    m.indices = malloc((size_t)m.index_count * 4);
-    for (int i = 0; i <= nu; i++)
-        for (int j = 0; j <= nv; j++) {
-            double th = 3.14159265358979 * j / nv, ph = 2 * 3.14159265358979 * (i % nu) / nu;
-            double rr = r * (1 + 0.03 * sin(7 * ph) * sin(5 * th));
-            float *p = m.positions + 3 * (size_t)(i * (nv + 1) + j);
-            p[0] = (float)(rr * sin(th) * cos(ph));
-            p[1] = (float)(rr * cos(th));
-            p[2] = (float)(rr * sin(th) * sin(ph));
-        }
-    uint32_t ni = 0;
-    for (int i = 0; i < nu; i++)
-        for (int j = 0; j < nv; j++) {
-            uint32_t a = (uint32_t)(i * (nv + 1) + j), b = a + (uint32_t)(nv + 1);
-            uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
-            for (int k = 0; k < 6; k++) m.indices[ni++] = q[k];
-        }
-    m.material = -1;
-    return m;
 }
 
 /* An open, wavy sheet (both faces visible: the cone test must not run). */
@@ -84,7 +59,7 @@ static mr_mesh sheet(double size, int n) {
 static mr_scene *big_scene(double ox, bool with_sheet) {
     mr_error err = {0};
     mr_scene *s = mr_scene_create();
-    mr_mesh a = sphere(2.0, 160, 80); /* 25.6k triangles */
+    mr_mesh a = big_sphere(2.0, 160, 80); /* 25.6k triangles */
     int32_t ma = mr_scene_add_mesh(s, &a, &err);
     int32_t mb = -1;
     if (with_sheet) {
@@ -108,7 +83,7 @@ static mr_scene *big_scene(double ox, bool with_sheet) {
     }
     /* Small balls after the big meshes: their commands follow the
      * meshlets' (a per-node submission must find room for both). */
-    mr_mesh c = sphere(0.2, 8, 4);
+    mr_mesh c = big_sphere(0.2, 8, 4);
     int32_t mc = mr_scene_add_mesh(s, &c, &err);
     for (int k = 0; k < 40 && mc >= 0; k++) {
         mr_node n;
