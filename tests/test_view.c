@@ -1004,6 +1004,33 @@ static void test_script(void) {
     CHECK(!mr_view_key_parse("nokey", &k));
 }
 
+/* The frame's shadow method (mark.c): the scene config's over the saved
+ * setting, --shadows over both, the C key over all once it changed the
+ * setting; an unknown scene name is off. And a tap's picture pixel. */
+static void test_shadow_choice_and_taps(void) {
+    mr_view_shadow_choice c = {.start = MR_SHADOW_OFF};
+    CHECK(mr_view_shadow_choose(&c, MR_SHADOW_OFF, NULL) == MR_SHADOW_OFF);
+    CHECK(mr_view_shadow_choose(&c, MR_SHADOW_OFF, "pcss") == MR_SHADOW_PCSS);
+    CHECK(mr_view_shadow_choose(&c, MR_SHADOW_OFF, "soft") == MR_SHADOW_OFF);
+    c.given = true;
+    c.flag = MR_SHADOW_HARD;
+    CHECK(mr_view_shadow_choose(&c, MR_SHADOW_OFF, "pcss") == MR_SHADOW_HARD);
+    CHECK(!c.keyed);
+    CHECK(mr_view_shadow_choose(&c, MR_SHADOW_PCF, "pcss") == MR_SHADOW_PCF && c.keyed);
+    /* keyed stays: back to the start value is still the key's choice */
+    CHECK(mr_view_shadow_choose(&c, MR_SHADOW_OFF, "pcss") == MR_SHADOW_OFF);
+    double u = 0, v = 0, px = 0, py = 0;
+    mr_ui_rect r = mr_ui_rect_make(100, 50, 320, 240);
+    CHECK(!mr_view_window_to_image(r, 160, 120, 99, 60, &u, &v));
+    CHECK(mr_view_window_to_image(r, 160, 120, 260, 170, &u, &v));
+    CHECK_NEAR(u, 79.5, 1e-12);
+    CHECK_NEAR(v, 59.5, 1e-12);
+    mr_camera cam = {640, 480, 500, 500, 319.5, 239.5, {0}};
+    mr_view_image_to_camera(&cam, 160, 120, u, v, &px, &py);
+    CHECK_NEAR(px, 319.5, 1e-12);
+    CHECK_NEAR(py, 239.5, 1e-12);
+}
+
 int main(void) {
     const char *t = getenv("MR_TEST_TMP");
     snprintf(g_tmp, sizeof g_tmp, "%s/test_view", t && t[0] ? t : "/tmp");
@@ -1011,6 +1038,7 @@ int main(void) {
     CHECK_MSG(mr_mkdirs(g_tmp, &err), "%s", err.msg);
     test_tracking_lost();
     test_settings();
+    test_shadow_choice_and_taps();
     char font[1024];
     if (!mr_ui_font_find(font, sizeof font, &err)) {
         printf("test_view: SKIPPED the controller tests (no font): %s\n", err.msg);
