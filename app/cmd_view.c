@@ -301,34 +301,18 @@ static void render_3d(view_app *a) {
     if (a->res.ao_reused) strncat(a->passes, " (ao reused)", sizeof a->passes - strlen(a->passes) - 1);
 }
 
-static const char *source_state_name(mr_capture_status st) {
-    return st == MR_CAPTURE_RUNNING ? "running" : st == MR_CAPTURE_NO_CAMERA ? "no_camera" : st == MR_CAPTURE_ENDED ? "ended" : "starting";
-}
-
 /* `state` in a script: what a test needs to check, as JSON: the
- * controller's part, and what only the window knows. The distances of the
- * shown picture to the model-only and video-only renderings say which way
- * the slider moved the image. */
+ * controller's part, and what only the window knows (lib/view). The
+ * distances of the shown picture to the model-only and video-only
+ * renderings say which way the slider moved the image. */
 static void write_state(view_app *a, const mr_image *screen) {
     cJSON *j = mr_viewer_state_json(a->vc);
     const mr_view_settings *s = mr_viewer_settings(a->vc);
-    cJSON_AddNumberToObject(j, "marks", a->mark_count);
-    cJSON_AddNumberToObject(j, "snapshots", a->snap_count);
     char msg[512] = "";
     mr_capture_status st = a->cap ? mr_capture_state(a->cap, msg, sizeof msg) : MR_CAPTURE_STARTING;
-    cJSON_AddStringToObject(j, "source_state", source_state_name(st));
-    cJSON_AddStringToObject(j, "source_message", msg);
-    cJSON_AddStringToObject(j, "scene_message", a->scene_msg);
-    if (screen && screen->data) {
-        /* Spread of the screen's pixel values: a blank window has none. */
-        double mean, std;
-        mr_image_u8_stats(screen, &mean, &std);
-        cJSON_AddNumberToObject(j, "screen_mean", mean);
-        cJSON_AddNumberToObject(j, "screen_std", std);
-    }
+    mr_view_window_state ws = {a->mark_count, a->snap_count, mr_capture_status_name(st), msg, a->scene_msg, screen,
+                               false, 0, 0, -1, -1};
     if (a->have_res && a->have_frame && a->frame.have_pose) {
-        cJSON_AddNumberToObject(j, "render_width", a->rw);
-        cJSON_AddNumberToObject(j, "render_height", a->rh);
         mr_view view;
         view.camera = mr_camera_resized(&a->camera, a->frame.image.width, a->frame.image.height);
         view.world_from_camera = a->frame.pose;
@@ -347,10 +331,14 @@ static void write_state(view_app *a, const mr_image *screen) {
                 mr_frame_result_free(&r);
             }
         }
-        cJSON_AddNumberToObject(j, "diff_to_model", d[0]);
-        cJSON_AddNumberToObject(j, "diff_to_video", d[1]);
+        ws.have_render = true;
+        ws.render_w = a->rw;
+        ws.render_h = a->rh;
+        ws.diff_to_model = d[0];
+        ws.diff_to_video = d[1];
         a->need_render = true; /* the renderer's last frame is now another one */
     }
+    mr_view_state_add_window(j, &ws);
     mr_error err = {0};
     if (!mr_json_save(a->state_path, j, &err)) mr_log(MR_LOG_ERROR, "view: %s", err.msg);
     cJSON_Delete(j);

@@ -41,3 +41,7 @@ bool mr_mark_save(const char *session_dir, const char *stem, cJSON *line, const 
     /* The line goes out even if the snapshot failed: the mark matters more. */
     return mr_mkdirs(session_dir, err) && mr_annotation_append(path, line, err);
 }
+
+const char *mr_capture_status_name(mr_capture_status st) {
+    return st == MR_CAPTURE_RUNNING ? "running" : st == MR_CAPTURE_NO_CAMERA ? "no_camera" : st == MR_CAPTURE_ENDED ? "ended" : "starting";
+}

@@ -329,6 +329,8 @@ void mr_capture_stop(mr_capture **c);
 bool mr_capture_latest(mr_capture *c, mr_capture_frame *f);
 void mr_capture_frame_free(mr_capture_frame *f);
 mr_capture_status mr_capture_state(mr_capture *c, char *msg, size_t n);
+/* "starting", "running", "no_camera", "ended" (the view's state snapshot). */
+const char *mr_capture_status_name(mr_capture_status st);
 bool mr_capture_seekable(mr_capture *c);   /* replay: seek, step, rate */
 /* Replay controls (ignored for live input). */
 void mr_capture_play(mr_capture *c, bool playing);

@@ -54,3 +54,23 @@ void mr_view_frame_params(const mr_view_settings *s, mr_shadow_method shadows, m
     fp->ghost.mode = s->ghost;
     fp->shadow.method = shadows;
 }
+
+void mr_view_state_add_window(cJSON *j, const mr_view_window_state *w) {
+    cJSON_AddNumberToObject(j, "marks", w->marks);
+    cJSON_AddNumberToObject(j, "snapshots", w->snapshots);
+    cJSON_AddStringToObject(j, "source_state", w->source_state ? w->source_state : "");
+    cJSON_AddStringToObject(j, "source_message", w->source_message ? w->source_message : "");
+    cJSON_AddStringToObject(j, "scene_message", w->scene_message ? w->scene_message : "");
+    if (w->screen && w->screen->data) {
+        double mean, std;
+        mr_image_u8_stats(w->screen, &mean, &std);
+        cJSON_AddNumberToObject(j, "screen_mean", mean);
+        cJSON_AddNumberToObject(j, "screen_std", std);
+    }
+    if (w->have_render) {
+        cJSON_AddNumberToObject(j, "render_width", w->render_w);
+        cJSON_AddNumberToObject(j, "render_height", w->render_h);
+        cJSON_AddNumberToObject(j, "diff_to_model", w->diff_to_model);
+        cJSON_AddNumberToObject(j, "diff_to_video", w->diff_to_video);
+    }
+}

@@ -329,6 +329,23 @@ mr_shadow_method mr_view_shadow_choose(mr_view_shadow_choice *c, mr_shadow_metho
  * method, the ghosting mode, and the shadow method given. */
 void mr_view_frame_params(const mr_view_settings *s, mr_shadow_method shadows, mr_frame_params *fp);
 
+/* What only the window knows, for a `state` snapshot. */
+typedef struct mr_view_window_state {
+    int marks, snapshots;
+    const char *source_state, *source_message, *scene_message;
+    const mr_image *screen;    /* the screen as read back, or NULL */
+    bool have_render;          /* a rendered picture with a pose: the fields below */
+    int render_w, render_h;
+    double diff_to_model, diff_to_video; /* mean |difference| of the picture to the
+                                            alpha 0 and alpha 1 renderings (-1: failed) */
+} mr_view_window_state;
+/* Adds it to j (mr_viewer_state_json's object): "marks", "snapshots",
+ * "source_state", "source_message", "scene_message", the screen's
+ * "screen_mean" and "screen_std" (a blank window has no spread), and with a
+ * render "render_width", "render_height", "diff_to_model", "diff_to_video"
+ * (which way the slider moved the picture). */
+void mr_view_state_add_window(cJSON *j, const mr_view_window_state *w);
+
 /* ---------------------------------------------------------------- script */
 
 /* A script of timed input: one command per line, `T COMMAND ARGS`, T in
