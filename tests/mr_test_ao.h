@@ -7,6 +7,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "mr_eval.h"
@@ -96,6 +97,40 @@ static inline double mr_test_ao_wall_rmse(const mr_view *v, const mr_frame_resul
         }
     if (count) *count = n;
     return n ? sqrt(se / n) : 1e9;
+}
+
+/* The slice methods' wall setting (test_ao's closed-form check, issue 18):
+ * radius 0.6 (view) or 0.1 (screen), 64 samples unblurred, a thick wall;
+ * scheer-gt and scheer-bm with c = 0 (and scheer-gt bias 0) reduce to the
+ * closed form of GTAO and the bitmask. */
+static inline mr_ao_params mr_test_ao_wall_params(mr_ao_method m, bool view_radius) {
+    mr_ao_params ao = MR_AO_DEFAULTS;
+    ao.method = m;
+    ao.radius_mode = view_radius ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
+    ao.radius = 0.6;
+    ao.screen_radius = 0.1;
+    ao.samples = 64;
+    ao.thickness = 2.0f; /* the wall is thick */
+    ao.blur_radius = 0;  /* the bilateral blur mixes the wall's AO into the floor's */
+    if (m == MR_AO_SCHEER_GT) ao.c = 0, ao.bias = 0;
+    if (m == MR_AO_SCHEER_BM) ao.c = 0;
+    return ao;
+}
+
+/* One frame with ao beside the wall: > 100 floor pixels in front of it,
+ * within 0.025 RMSE of the closed form, no value outside [0, 1]. */
+static inline void mr_test_ao_wall_check(mr_renderer *r, const mr_scene *s, const mr_view *v, const mr_ao_params *ao,
+                                         const char *what) {
+    mr_frame_result res;
+    if (!mr_test_render_ao(r, s, v, ao, &res)) return;
+    int n = 0;
+    bool view = ao->radius_mode == MR_AO_RADIUS_VIEW;
+    double e = mr_test_ao_wall_rmse(v, &res, &res.ao, ao->radius, view ? 0 : ao->screen_radius, &n);
+    if (getenv("MR_TEST_VERBOSE")) printf("wall %s: RMSE %.4f over %d pixels\n", what, e, n);
+    CHECK_MSG(n > 100, "only %d floor pixels in front of the wall", n);
+    CHECK_MSG(e < 0.025, "%s beside a wall: RMSE %.4f against the closed form", what, e);
+    CHECK(mr_test_ao_count_bad(&res.ao) == 0);
+    mr_frame_result_free(&res);
 }
 
 #endif

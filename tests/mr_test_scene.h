@@ -110,4 +110,21 @@ static inline mr_mesh mr_test_sphere_mesh(const char *name, double r, int nu, in
     return m;
 }
 
+/* count root nodes "part_<i>" on a 400 x 5 x ... grid 0.5 apart, drawing
+ * meshes 0 .. meshes-1 in turn, every 50th on the hidden layer: a big
+ * assembly's node list. */
+static inline void mr_test_add_grid_nodes(mr_scene *s, int count, int meshes) {
+    for (int i = 0; i < count; i++) {
+        mr_node n;
+        memset(&n, 0, sizeof n);
+        snprintf(n.name, sizeof n.name, "part_%d", i);
+        n.parent = -1;
+        n.world = mr_m4_translate((i % 400) * 0.5, (i / 400 % 5) * 0.5, (i / 2000) * 0.5);
+        n.mesh_first = i % meshes;
+        n.mesh_count = 1;
+        n.layer = i % 50 == 0 ? MR_LAYER_HIDDEN : MR_LAYER_VISIBLE;
+        mr_scene_add_node(s, &n);
+    }
+}
+
 #endif

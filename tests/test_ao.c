@@ -1136,29 +1136,12 @@ static void test_slice_wall(void) {
     for (int mi = 0; mi < 4; mi++)
         for (int mode = 0; mode < 4; mode++) {
             bool mips = mode >= 2;
-            mr_ao_params ao = MR_AO_DEFAULTS;
-            ao.method = ms[mi];
-            ao.radius_mode = mode % 2 ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
-            ao.radius = 0.6;
-            ao.screen_radius = 0.1;
-            ao.samples = 64;
+            mr_ao_params ao = mr_test_ao_wall_params(ms[mi], mode % 2);
             ao.mips = mips;
-            ao.thickness = 2.0f; /* the wall is thick */
-            ao.blur_radius = 0;  /* the bilateral blur mixes the wall's AO into the floor's */
-            if (ms[mi] == MR_AO_SCHEER_GT) ao.c = 0, ao.bias = 0;
-            if (ms[mi] == MR_AO_SCHEER_BM) ao.c = 0;
-            mr_frame_result res;
-            if (!mr_test_render_ao(g_r, s, &v, &ao, &res)) continue;
-            int n = 0;
-            double e = mr_test_ao_wall_rmse(&v, &res, &res.ao, ao.radius, mode % 2 ? 0 : ao.screen_radius, &n);
-            const char *mn = mode % 2 ? (mips ? "view mips" : "view") : (mips ? "screen mips" : "screen");
-            if (getenv("MR_TEST_VERBOSE"))
-                printf("wall %s %s: RMSE %.4f over %d pixels\n", mr_ao_method_name(ao.method), mn, e, n);
-            CHECK_MSG(n > 100, "only %d floor pixels in front of the wall", n);
-            CHECK_MSG(e < 0.025, "%s %s radius beside a wall: RMSE %.4f against the closed form", mr_ao_method_name(ao.method),
-                      mn, e);
-            CHECK(mr_test_ao_count_bad(&res.ao) == 0);
-            mr_frame_result_free(&res);
+            char what[96];
+            snprintf(what, sizeof what, "%s %s radius", mr_ao_method_name(ao.method),
+                     mode % 2 ? (mips ? "view mips" : "view") : (mips ? "screen mips" : "screen"));
+            mr_test_ao_wall_check(g_r, s, &v, &ao, what);
         }
     mr_scene_destroy(&s);
     mr_renderer_set_scene(g_r, NULL, NULL);

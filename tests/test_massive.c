@@ -387,17 +387,7 @@ static void test_100k_nodes_frame(void) {
         mr_mesh m = sphere(0.1 + 0.02 * k, 6 + 2 * k, 4 + k);
         mr_scene_add_mesh(s, &m, &err);
     }
-    for (int i = 0; i < 100000; i++) {
-        mr_node n;
-        memset(&n, 0, sizeof n);
-        snprintf(n.name, sizeof n.name, "part_%d", i);
-        n.parent = -1;
-        n.world = mr_m4_translate((i % 400) * 0.5, (i / 400 % 5) * 0.5, (i / 2000) * 0.5);
-        n.mesh_first = i % 4;
-        n.mesh_count = 1;
-        n.layer = i % 50 == 0 ? MR_LAYER_HIDDEN : MR_LAYER_VISIBLE;
-        mr_scene_add_node(s, &n);
-    }
+    mr_test_add_grid_nodes(s, 100000, 4);
     char path[1024];
     snprintf(path, sizeof path, "%s/massive100k.glb", tmp_dir());
     CHECK_MSG(mr_scene_save_glb(s, path, &err), "%s", err.msg);
