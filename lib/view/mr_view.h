@@ -13,7 +13,9 @@
  * names (mr_event, MR_KEY_*, mr_ao_method, mr_ghost_mode,
  * mr_ao_method_name/parse, the option tables' enum names): no GL or GLFW call. One way only: nothing
  * below lib/view includes this header.
- */
+ * mark.c (the marking and render decisions moved out of app/cmd_view.c)
+ * adds lib/track's mr_project_point and lib/render's plain mr_pick,
+ * mr_frame_params and mr_shadow_method_parse. */
 #ifndef MR_VIEW_CTL_H
 #define MR_VIEW_CTL_H
 
