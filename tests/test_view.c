@@ -1029,6 +1029,20 @@ static void test_shadow_choice_and_taps(void) {
     mr_view_image_to_camera(&cam, 160, 120, u, v, &px, &py);
     CHECK_NEAR(px, 319.5, 1e-12);
     CHECK_NEAR(py, 239.5, 1e-12);
+    /* A finished measurement's mark: at the measured point's pixel (the
+     * centre when it is behind the camera), its point the planned one. */
+    mr_dmat4 pose = mr_m4_identity();
+    mr_view_planned planned = {true, mr_v3(0.1, 0, 2), 3, MR_LAYER_HIDDEN};
+    mr_view_mark_at at;
+    mr_view_measure_mark(&cam, 640, 480, &pose, mr_v3(0.2, -0.1, 2), &planned, &at);
+    CHECK_NEAR(at.px, 319.5 + 500 * 0.1, 1e-9);
+    CHECK_NEAR(at.py, 239.5 - 500 * 0.05, 1e-9);
+    CHECK_NEAR(at.note_u, (at.px + 0.5) / 640, 1e-6);
+    CHECK(at.pick.hit && at.pick.node == 3 && at.pick.layer == MR_LAYER_HIDDEN);
+    CHECK_NEAR(at.pick.depth, 2, 1e-12);
+    planned.found = false;
+    mr_view_measure_mark(&cam, 640, 480, &pose, mr_v3(0, 0, -1), &planned, &at);
+    CHECK(!at.pick.hit && at.pick.node == -1 && at.px == 319.5 && at.py == 239.5);
 }
 
 int main(void) {
