@@ -32,9 +32,6 @@ bool app_ao_check(const char *cmd, const mr_cli_table *t, bool *groundtruth, mr_
 #define APP_SHADOW_TABLE(p) {.prefix = "shadows", .table = mr_shadow_opts, .params = (p)}
 bool app_shadow_scene_default(const char *cmd, const mr_cli_table *t, const mr_scene *s, mr_shadow_params *p);
 
-/* Writes what --aux asks for: depth.pfm, normal.pfm, ao.pfm (and
- * shadow.pfm) into dir. */
-bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err);
 
 
 

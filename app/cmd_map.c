@@ -11,69 +11,9 @@ static void progress(void *user, const char *stage, double f) {
     fprintf(stderr, "\rmap: %s %3.0f%%   ", stage, 100 * f);
 }
 
-/* "id=size,id=size" into arrays (malloc'd). */
-static bool parse_sizes(const char *s, int **ids, double **sizes, int *n) {
-    int cap = 1;
-    for (const char *c = s; *c; c++) cap += *c == ',';
-    *ids = calloc((size_t)cap, sizeof **ids);
-    *sizes = calloc((size_t)cap, sizeof **sizes);
-    *n = 0;
-    if (!*ids || !*sizes) return false;
-    const char *c = s;
-    while (*c) {
-        char *e;
-        long id = strtol(c, &e, 10);
-        if (e == c || *e != '=' || id < 0) return false;
-        c = e + 1;
-        double v = strtod(c, &e);
-        if (e == c || !isfinite(v) || !(v > 0)) return false;
-        (*ids)[*n] = (int)id;
-        (*sizes)[(*n)++] = v;
-        c = e;
-        if (*c == ',') c++;
-        else if (*c) return false;
-    }
-    return *n > 0;
-}
-
-/* The photos' detections as mr_map_build takes them, gathered by
- * mr_detect_each (lib/track). */
-typedef struct photo_set {
-    mr_camera *cam;
-    mr_detection **dets;
-    mr_map_photo *photos;
-    char (*names)[256];
-    int n, cap;
-    bool tty;
-} photo_set;
-
-static bool take_photo(void *user, const mr_frame *f, const mr_detection *d, int k, mr_error *err) {
-    photo_set *ps = user;
-    if (ps->n == ps->cap) {
-        ps->cap = ps->cap ? 2 * ps->cap : 64;
-        mr_detection **nd = realloc(ps->dets, (size_t)ps->cap * sizeof *nd);
-        if (nd) ps->dets = nd;
-        mr_map_photo *np = realloc(ps->photos, (size_t)ps->cap * sizeof *np);
-        if (np) ps->photos = np;
-        char(*nn)[256] = realloc(ps->names, (size_t)ps->cap * sizeof *nn);
-        if (nn) ps->names = nn;
-        if (!nd || !np || !nn) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    }
-    /* Intrinsics are for the camera's size: photos of another size get them
-     * rescaled (the same lens at another resolution; mr_detect_each keeps
-     * the first photo's size for all). */
-    if (ps->n == 0 && (f->image.width != ps->cam->width || f->image.height != ps->cam->height))
-        *ps->cam = mr_camera_resized(ps->cam, f->image.width, f->image.height);
-    int i = ps->n;
-    ps->dets[i] = k ? malloc((size_t)k * sizeof **ps->dets) : NULL;
-    if (k && !ps->dets[i]) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    if (k) memcpy(ps->dets[i], d, (size_t)k * sizeof *d);
-    snprintf(ps->names[i], sizeof ps->names[i], "%s", f->name[0] ? f->name : "frame");
-    ps->photos[i] = (mr_map_photo){ps->dets[i], k, ps->names[i]};
-    ps->n++;
-    if (ps->tty) fprintf(stderr, "\rmap: detecting, photo %d   ", ps->n);
-    mr_log(MR_LOG_INFO, "%s: %d tags", ps->names[i], k);
-    return true;
+static void photo_progress(void *user, int n) {
+    (void)user;
+    fprintf(stderr, "\rmap: detecting, photo %d   ", n);
 }
 
 int cmd_map(int argc, char **argv) {
@@ -120,7 +60,7 @@ int cmd_map(int argc, char **argv) {
 
     int *size_ids = NULL;
     double *sizes = NULL;
-    if (mr_cli_get(opts, "tag-sizes") && !parse_sizes(mr_cli_get(opts, "tag-sizes"), &size_ids, &sizes, &mp.size_count)) {
+    if (mr_cli_get(opts, "tag-sizes") && !mr_map_tag_sizes_parse(mr_cli_get(opts, "tag-sizes"), &size_ids, &sizes, &mp.size_count)) {
         free(size_ids);
         free(sizes);
         return mr_cli_errorf(cmd, "--tag-sizes: expected ID=SIZE,... with sizes > 0, got '%s'", mr_cli_get(opts, "tag-sizes")), 2;
@@ -132,10 +72,7 @@ int cmd_map(int argc, char **argv) {
     mr_camera cam;
     mr_dmat4 fix_pose;
     mr_map_control *ctl = NULL;
-    mr_detection **dets = NULL;
-    mr_map_photo *photos = NULL;
-    char (*names)[256] = NULL;
-    int n = 0;
+    mr_map_photo_set ps = {0};
     int rc = 1;
     mr_map_result res = {0};
     mr_marker_map mm = {0};
@@ -148,16 +85,7 @@ int cmd_map(int argc, char **argv) {
         }
         mp.fix_id = (int)id;
         if (mr_cli_get(opts, "fix-pose")) {
-            cJSON *j = mr_json_load(mr_cli_get(opts, "fix-pose"), &err);
-            if (!j) goto fail; /* the loader's message names the file */
-            bool ok = mr_json_dmat4(j, "world_from_tag", &fix_pose, &err);
-            cJSON_Delete(j);
-            if (ok && !mr_m4_is_rigid(&fix_pose, 1e-4))
-                ok = mr_fail(&err, MR_ERR_INVALID, "world_from_tag is not a rigid transform");
-            if (!ok) {
-                mr_error_prefix(&err, "%s", mr_cli_get(opts, "fix-pose"));
-                goto fail;
-            }
+            if (!mr_map_fix_pose_load(mr_cli_get(opts, "fix-pose"), &fix_pose, &err)) goto fail;
             mp.fix_pose = &fix_pose;
         }
     } else {
@@ -165,19 +93,13 @@ int cmd_map(int argc, char **argv) {
         mp.controls = ctl;
     }
 
-    photo_set ps = {&cam, NULL, NULL, NULL, 0, 0, isatty(2) && mr_log_get_level() >= MR_LOG_WARN};
-    bool tty = ps.tty;
-    bool detected = mr_detect_each(in, family, cmd, take_photo, &ps, NULL, &err);
-    dets = ps.dets;
-    photos = ps.photos;
-    names = ps.names;
-    n = ps.n;
-    if (!detected) goto fail;
+    bool tty = isatty(2) && mr_log_get_level() >= MR_LOG_WARN;
+    if (!mr_map_photos_detect(in, family, cmd, &cam, tty ? photo_progress : NULL, NULL, &ps, &err)) goto fail;
     if (tty) {
         fprintf(stderr, "\n");
         mp.progress = progress;
     }
-    if (!mr_map_build(&cam, photos, n, &mp, &res, &err)) {
+    if (!mr_map_build(&cam, ps.photos, ps.n, &mp, &res, &err)) {
         if (tty) fprintf(stderr, "\n");
         goto fail;
     }
@@ -193,10 +115,7 @@ int cmd_map(int argc, char **argv) {
 fail:
     rc = mr_cli_error(cmd, &err);
 out:
-    for (int i = 0; i < n; i++) free(dets[i]);
-    free(dets);
-    free(photos);
-    free(names);
+    mr_map_photo_set_free(&ps);
     free(size_ids);
     free(sizes);
     free(ctl);

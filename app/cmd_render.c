@@ -23,28 +23,6 @@ void app_gfx_close(app_gfx *g) {
     mr_gpu_destroy(&g->gpu);
 }
 
-bool app_write_aux(const char *dir, const mr_frame_result *res, mr_error *err) {
-    char path[4096];
-    if (!mr_mkdirs(dir, err)) return false;
-    if (res->depth.data) {
-        mr_path_join(dir, "depth.pfm", path, sizeof path);
-        if (!mr_image_save_pfm(path, &res->depth, err)) return false;
-    }
-    if (res->normal.data) {
-        mr_path_join(dir, "normal.pfm", path, sizeof path);
-        if (!mr_image_save_pfm(path, &res->normal, err)) return false;
-    }
-    if (res->ao.data) {
-        mr_path_join(dir, "ao.pfm", path, sizeof path);
-        if (!mr_image_save_pfm(path, &res->ao, err)) return false;
-    }
-    if (res->shadow.data) {
-        mr_path_join(dir, "shadow.pfm", path, sizeof path);
-        if (!mr_image_save_pfm(path, &res->shadow, err)) return false;
-    }
-    return true;
-}
-
 int cmd_render(int argc, char **argv) {
     static const char *cmd = "render";
     mr_cli_opt opts[] = {
@@ -178,7 +156,7 @@ int cmd_render(int argc, char **argv) {
         } else if (!mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||
                    (groundtruth && !mr_eval_render_groundtruth_ao(gfx.renderer, scene, &view, &fp, &gtp, &res, &err)))
             rc = mr_cli_error(cmd, &err);
-        else if (!mr_image_save_png(out, &res.color, &err) || (aux && !app_write_aux(aux, &res, &err)))
+        else if (!mr_image_save_png(out, &res.color, &err) || (aux && !mr_frame_result_save_aux(aux, &res, &err)))
             rc = mr_cli_error(cmd, &err);
         if (rc == 0 && !multiview && mr_cli_flag(opts, "verbose")) {
             char passes[256];

@@ -136,23 +136,6 @@ typedef struct run_app {
     int stored;
 } run_app;
 
-static int load_images(run_app *a, const char *cmd) {
-    int t = a->plan.set.method_count, S = a->plan.set.stimulus_count;
-    a->images = calloc((size_t)t * S, sizeof *a->images);
-    if (!a->images) return mr_cli_errorf(cmd, "out of memory");
-    for (int m = 0; m < t; m++)
-        for (int s = 0; s < S; s++) {
-            char path[8192];
-            mr_error err = {0};
-            mr_study_plan_image(&a->plan, s, m, path, sizeof path);
-            if (!mr_image_load(path, 3, &a->images[m * S + s], &err)) return mr_cli_error(cmd, &err);
-            if (a->images[m * S + s].width != a->images[0].width || a->images[m * S + s].height != a->images[0].height)
-                return mr_cli_errorf(cmd, "%s: all stimuli must have one size (%dx%d)", path, a->images[0].width,
-                                  a->images[0].height);
-        }
-    return 0;
-}
-
 static void run_frame(run_app *a, bool *quit) {
     mr_event e;
     while (mr_window_next_event(a->win, &e)) {
@@ -236,19 +219,14 @@ static int study_run(int argc, char **argv) {
     if (!a) return mr_cli_errorf(cmd, "out of memory");
     a->votes_path = out;
     mr_error err = {0};
-    mr_study_votes votes = {0};
+    mr_study_resume_point at = {0};
     mr_study_script *script = NULL;
-    bool *answered = NULL;
     int rc = 0, first = 0;
-    if (!mr_study_plan_load(pos[0], &a->plan, &err) || !mr_study_votes_read(out, true, &votes, &err)) {
+    if (!mr_study_plan_load(pos[0], &a->plan, &err) || !mr_study_resume_open(&a->plan, out, who, &at, &err)) {
         rc = mr_cli_error(cmd, &err);
         goto done;
     }
-    answered = calloc((size_t)a->plan.trial_count, sizeof *answered);
-    if (!answered || (first = mr_study_resume(&a->plan, &votes, who, answered, &err)) < 0) {
-        rc = answered ? mr_cli_error(cmd, &err) : mr_cli_errorf(cmd, "out of memory");
-        goto done;
-    }
+    first = at.first;
     if (first >= a->plan.trial_count) {
         printf("study run: participant %s has answered all %d trials of plan %s\n", who, a->plan.trial_count, a->plan.id);
         goto done;
@@ -257,15 +235,17 @@ static int study_run(int argc, char **argv) {
         rc = mr_cli_error(cmd, &err);
         goto done;
     }
-    if ((rc = load_images(a, cmd)) != 0) goto done;
-    /* A torn last line (a kill mid-write) is ended, so our first vote
-     * starts a line of its own; nothing written is changed. */
-    if (votes.torn_tail && !mr_study_votes_seal(out, &err)) {
+    if (!mr_study_images_load(&a->plan, &a->images, &err)) {
         rc = mr_cli_error(cmd, &err);
         goto done;
     }
-    int done_before = 0;
-    for (int k = 0; k < a->plan.trial_count; k++) done_before += answered[k];
+    /* A torn last line (a kill mid-write) is ended, so our first vote
+     * starts a line of its own; nothing written is changed. */
+    if (at.torn_tail && !mr_study_votes_seal(out, &err)) {
+        rc = mr_cli_error(cmd, &err);
+        goto done;
+    }
+    int done_before = at.answered_count;
     printf("study run: participant %s, plan %s: %s at trial %d of %d (%d answered)\n", who, a->plan.id,
            done_before ? "resuming" : "starting", first + 1, a->plan.trial_count, done_before);
     fflush(stdout);
@@ -289,7 +269,7 @@ static int study_run(int argc, char **argv) {
     rp.plan = &a->plan;
     rp.participant = who;
     rp.first_trial = first;
-    rp.answered = answered;
+    rp.answered = at.answered;
     rp.slider = mr_cli_flag(opts, "slider");
     rp.px_per_mm = mr_window_px_per_mm(a->win) * ui_scale;
     rp.image_w = a->images[0].width;
@@ -318,11 +298,8 @@ done:
     free(a->tex);
     mr_draw2d_destroy(&a->d2);
     mr_window_destroy(&a->win);
-    if (a->images)
-        for (int i = 0; i < a->plan.set.method_count * a->plan.set.stimulus_count; i++) mr_image_free(&a->images[i]);
-    free(a->images);
-    free(answered);
-    mr_study_votes_free(&votes);
+    mr_study_images_free(&a->plan, &a->images);
+    mr_study_resume_point_free(&at);
     mr_study_plan_free(&a->plan);
     free(a);
     return rc;

@@ -59,13 +59,8 @@ typedef struct view_app {
     mr_image mark_screen;
     bool mark_grab_screen, snap_request;
     char session_dir[4096];
-    /* --shadows (else the scene config's "shadows", else off) */
-    mr_shadow_method shadows;
-    bool shadows_given;
-    /* The saved shadows setting at start; once the C key changes it, the
-     * setting wins over --shadows and the scene config's. */
-    mr_shadow_method shadows_start;
-    bool shadows_keyed;
+    /* --shadows, the scene config's, the saved setting, the C key (lib/view) */
+    mr_view_shadow_choice shadows;
     int snap_count, mark_count;
     char shot_path[1024], state_path[1024];
     /* the rendered frame */
@@ -112,20 +107,11 @@ static void do_snapshot(view_app *a, const mr_image *screen) {
     else mr_viewer_toast(a->vc, "snapshot failed: %s", err.msg);
 }
 
-/* Maps a window position to the rendered image; false outside it. */
-static bool window_to_image(const view_app *a, double x, double y, double *u, double *v) {
-    mr_ui_rect r = a->image_rect;
-    if (!a->have_res || !mr_ui_rect_contains(r, (float)x, (float)y)) return false;
-    *u = (x - r.x) * a->rw / r.w - 0.5;
-    *v = (y - r.y) * a->rh / r.h - 0.5;
-    return true;
-}
-
 /* A tap in mark mode: what is under it, and the screen as it is now. */
 static void begin_mark(view_app *a, double x, double y) {
     a->mark_measured = false; /* a mark of Mark, not of Measure */
     double u, v;
-    if (!window_to_image(a, x, y, &u, &v)) {
+    if (!a->have_res || !mr_view_window_to_image(a->image_rect, a->rw, a->rh, x, y, &u, &v)) {
         mr_viewer_toast(a->vc, "tap on the picture to mark");
         return;
     }
@@ -134,15 +120,8 @@ static void begin_mark(view_app *a, double x, double y) {
         mr_viewer_toast(a->vc, "cannot mark: %s", err.msg);
         return;
     }
-    /* Store the pixel in the camera's own resolution (ideal pinhole). */
-    a->mark_px = (u + 0.5) * a->camera.width / a->rw - 0.5;
-    a->mark_py = (v + 0.5) * a->camera.height / a->rh - 0.5;
-    mr_capture_frame_free(&a->mark_frame);
-    a->mark_frame = a->frame;
-    memset(&a->mark_frame.image, 0, sizeof a->mark_frame.image);
-    if (a->frame.image.data && mr_image_alloc(&a->mark_frame.image, a->frame.image.width, a->frame.image.height,
-                                              a->frame.image.channels, MR_PIX_U8, &err))
-        memcpy(a->mark_frame.image.data, a->frame.image.data, mr_image_bytes(&a->frame.image));
+    mr_view_image_to_camera(&a->camera, a->rw, a->rh, u, v, &a->mark_px, &a->mark_py);
+    mr_capture_frame_copy(&a->mark_frame, &a->frame, &err);
     a->mark_grab_screen = true;
     mr_viewer_note_open(a->vc, (float)((a->mark_px + 0.5) / a->camera.width),
                         (float)((a->mark_py + 0.5) / a->camera.height));
@@ -151,12 +130,7 @@ static void begin_mark(view_app *a, double x, double y) {
 /* The annotation line of a finished mark (the format is lib/session's). */
 static cJSON *mark_line(view_app *a, int note) {
     mr_annotation m;
-    memset(&m, 0, sizeof m);
-    snprintf(m.type, sizeof m.type, "discrepancy");
-    m.time_unix = (double)time(NULL);
-    m.frame_index = a->mark_frame.index;
-    m.timestamp = a->mark_frame.timestamp;
-    snprintf(m.note, sizeof m.note, "%s", mr_view_notes[note]);
+    mr_annotation_from_frame(&m, &a->mark_frame, mr_view_notes[note], (double)time(NULL));
     m.has_pixel = true;
     m.pixel[0] = a->mark_px;
     m.pixel[1] = a->mark_py;
@@ -166,17 +140,11 @@ static cJSON *mark_line(view_app *a, int note) {
     m.world[2] = a->mark_pick.world.z;
     m.depth = a->mark_pick.depth;
     const mr_scene *sc = a->scene;
-    m.node_index = -1;
     if (a->mark_pick.node >= 0 && sc && a->mark_pick.node < sc->node_count) {
         m.node_index = a->mark_pick.node;
         snprintf(m.node, sizeof m.node, "%s", sc->nodes[a->mark_pick.node].name);
         snprintf(m.layer, sizeof m.layer, "%s", a->mark_pick.layer == MR_LAYER_HIDDEN ? "hidden" : "visible");
     }
-    m.has_pose = true;
-    m.pose_valid = a->mark_frame.pose_valid;
-    m.world_from_camera = a->mark_frame.pose;
-    m.pose_tags_seen = a->mark_frame.tags_seen;
-    m.pose_rms_px = a->mark_frame.rms_px;
     /* issue 15: the registration's σ at the marked point (absent when the
      * pose has no covariance, e.g. an older recording, or nothing was hit) */
     mr_viewer_frame sf = {.have_pose = a->mark_frame.have_pose, .world_from_camera = a->mark_frame.pose,
@@ -201,16 +169,11 @@ static void finish_mark(view_app *a, int note) {
     a->mark_count++;
     snprintf(stem, sizeof stem, "mark_%ld_%04d", (long)time(NULL), a->mark_count);
     cJSON *line = mark_line(a, note);
-    cJSON *snap = cJSON_CreateObject();
     mr_snapshot sn = snapshot_of(a, &a->mark_screen, &a->mark_frame);
-    bool ok = mr_snapshot_write(a->session_dir, stem, &sn, snap, &err);
-    cJSON_AddItemToObject(line, "snapshot", snap);
-    char path[8192];
-    mr_path_join(a->session_dir, "annotations.jsonl", path, sizeof path);
-    /* The line goes out even if the snapshot failed: the mark matters more. */
+    bool ok;
     mr_error aerr = {0};
     const mr_scene *sc = a->scene;
-    if (!mr_mkdirs(a->session_dir, &aerr) || !mr_annotation_append(path, line, &aerr))
+    if (!mr_mark_save(a->session_dir, stem, line, &sn, &ok, &err, &aerr))
         mr_viewer_toast(a->vc, "MARK NOT SAVED: %s", aerr.msg);
     else if (!ok) mr_viewer_toast(a->vc, "mark %d saved (snapshot failed: %s)", a->mark_count, err.msg);
     else
@@ -243,29 +206,17 @@ static void measure_done(view_app *a) {
     if (!a->have_frame) return;
     mr_viewer_measurement(a->vc, &a->mark_measure);
     a->mark_measured = true; /* the mark opened below carries it */
-    memset(&a->mark_pick, 0, sizeof a->mark_pick);
-    a->mark_pick.node = -1;
-    /* The mark's point: where the model is nearest to what was built. */
-    mr_view view = {mr_camera_resized(&a->camera, a->frame.image.width, a->frame.image.height), a->frame.pose};
-    mr_camera pin = view.camera;
-    memset(pin.dist, 0, sizeof pin.dist);
-    double u = pin.cx, v = pin.cy;
-    if (!mr_project_point(&pin, &view.world_from_camera, m.tri.point, &u, &v)) u = pin.cx, v = pin.cy;
-    if (h.found) {
-        mr_dmat4 cfw = mr_m4_invert_rigid(&a->frame.pose);
-        a->mark_pick = (mr_pick){true, h.point, mr_m4_point(&cfw, h.point).z, h.node,
-                                 h.node >= 0 ? a->scene->nodes[h.node].layer : 0};
-    }
-    a->mark_px = u;
-    a->mark_py = v;
-    mr_capture_frame_free(&a->mark_frame);
-    a->mark_frame = a->frame;
-    memset(&a->mark_frame.image, 0, sizeof a->mark_frame.image);
-    if (a->frame.image.data && mr_image_alloc(&a->mark_frame.image, a->frame.image.width, a->frame.image.height,
-                                              a->frame.image.channels, MR_PIX_U8, &err))
-        memcpy(a->mark_frame.image.data, a->frame.image.data, mr_image_bytes(&a->frame.image));
+    mr_view_planned planned = {h.found, h.point, h.node, 0};
+    if (h.found && h.node >= 0) planned.layer = a->scene->nodes[h.node].layer;
+    mr_view_mark_at at;
+    mr_view_measure_mark(&a->camera, a->frame.image.width, a->frame.image.height, &a->frame.pose, m.tri.point,
+                         &planned, &at);
+    a->mark_pick = at.pick;
+    a->mark_px = at.px;
+    a->mark_py = at.py;
+    mr_capture_frame_copy(&a->mark_frame, &a->frame, &err);
     a->mark_grab_screen = true;
-    mr_viewer_note_open(a->vc, (float)((u + 0.5) / pin.width), (float)((v + 0.5) / pin.height));
+    mr_viewer_note_open(a->vc, at.note_u, at.note_v);
 }
 
 static void set_frozen(view_app *a, bool on) {
@@ -298,18 +249,11 @@ static void carry_out(view_app *a, const mr_view_actions *acts) {
     }
 }
 
-/* Renders the 3D frame when something it depends on changed. */
-/* The shadow method of a frame: the C key's once pressed, else --shadows,
- * else the scene config's, else the saved setting. */
 static mr_shadow_method view_shadows(view_app *a) {
-    mr_shadow_method m = mr_viewer_settings(a->vc)->shadows;
-    if (m != a->shadows_start) a->shadows_keyed = true;
-    if (a->shadows_keyed) return m;
-    if (a->shadows_given) return a->shadows;
-    if (a->scene && a->scene->shadow_method[0] && !mr_shadow_method_parse(a->scene->shadow_method, &m)) m = MR_SHADOW_OFF;
-    return m;
+    return mr_view_shadow_choose(&a->shadows, mr_viewer_settings(a->vc)->shadows, a->scene ? a->scene->shadow_method : NULL);
 }
 
+/* Renders the 3D frame when something it depends on changed. */
 static void render_3d(view_app *a) {
     if (!a->have_frame || !a->need_render) return;
     a->need_render = false;
@@ -325,13 +269,10 @@ static void render_3d(view_app *a) {
     fp.width = rw;
     fp.height = rh;
     fp.video = s->show_video ? &a->frame.image : NULL;
-    fp.hide_hidden_layer = s->hide_hidden;
-    fp.ao.method = s->ao;
+    mr_view_frame_params(s, view_shadows(a), &fp);
     fp.ao.temporal = a->ao_temporal;
     fp.ao.temporal_reset = !a->ao_had_pose; /* tracking (re)acquired: no history across the gap */
     a->ao_had_pose = a->frame.have_pose && a->frame.pose_valid;
-    fp.ghost.mode = s->ghost;
-    fp.shadow.method = view_shadows(a);
     mr_view_render_choice c =
         mr_view_render_policy(s, a->frame.have_pose, a->frame.pose_valid, mr_viewer_frozen(a->vc));
     fp.alpha = c.alpha;
@@ -360,34 +301,18 @@ static void render_3d(view_app *a) {
     if (a->res.ao_reused) strncat(a->passes, " (ao reused)", sizeof a->passes - strlen(a->passes) - 1);
 }
 
-static const char *source_state_name(mr_capture_status st) {
-    return st == MR_CAPTURE_RUNNING ? "running" : st == MR_CAPTURE_NO_CAMERA ? "no_camera" : st == MR_CAPTURE_ENDED ? "ended" : "starting";
-}
-
 /* `state` in a script: what a test needs to check, as JSON: the
- * controller's part, and what only the window knows. The distances of the
- * shown picture to the model-only and video-only renderings say which way
- * the slider moved the image. */
+ * controller's part, and what only the window knows (lib/view). The
+ * distances of the shown picture to the model-only and video-only
+ * renderings say which way the slider moved the image. */
 static void write_state(view_app *a, const mr_image *screen) {
     cJSON *j = mr_viewer_state_json(a->vc);
     const mr_view_settings *s = mr_viewer_settings(a->vc);
-    cJSON_AddNumberToObject(j, "marks", a->mark_count);
-    cJSON_AddNumberToObject(j, "snapshots", a->snap_count);
     char msg[512] = "";
     mr_capture_status st = a->cap ? mr_capture_state(a->cap, msg, sizeof msg) : MR_CAPTURE_STARTING;
-    cJSON_AddStringToObject(j, "source_state", source_state_name(st));
-    cJSON_AddStringToObject(j, "source_message", msg);
-    cJSON_AddStringToObject(j, "scene_message", a->scene_msg);
-    if (screen && screen->data) {
-        /* Spread of the screen's pixel values: a blank window has none. */
-        double mean, std;
-        mr_image_u8_stats(screen, &mean, &std);
-        cJSON_AddNumberToObject(j, "screen_mean", mean);
-        cJSON_AddNumberToObject(j, "screen_std", std);
-    }
+    mr_view_window_state ws = {a->mark_count, a->snap_count, mr_capture_status_name(st), msg, a->scene_msg, screen,
+                               false, 0, 0, -1, -1};
     if (a->have_res && a->have_frame && a->frame.have_pose) {
-        cJSON_AddNumberToObject(j, "render_width", a->rw);
-        cJSON_AddNumberToObject(j, "render_height", a->rh);
         mr_view view;
         view.camera = mr_camera_resized(&a->camera, a->frame.image.width, a->frame.image.height);
         view.world_from_camera = a->frame.pose;
@@ -398,10 +323,7 @@ static void write_state(view_app *a, const mr_image *screen) {
             fp.height = a->rh;
             fp.video = &a->frame.image;
             fp.alpha = (float)k;
-            fp.hide_hidden_layer = s->hide_hidden;
-            fp.ao.method = s->ao;
-            fp.ghost.mode = s->ghost;
-            fp.shadow.method = view_shadows(a);
+            mr_view_frame_params(s, view_shadows(a), &fp);
             mr_frame_result r;
             mr_error err = {0};
             if (mr_render_frame(a->rend, &view, &fp, &r, &err)) {
@@ -409,10 +331,14 @@ static void write_state(view_app *a, const mr_image *screen) {
                 mr_frame_result_free(&r);
             }
         }
-        cJSON_AddNumberToObject(j, "diff_to_model", d[0]);
-        cJSON_AddNumberToObject(j, "diff_to_video", d[1]);
+        ws.have_render = true;
+        ws.render_w = a->rw;
+        ws.render_h = a->rh;
+        ws.diff_to_model = d[0];
+        ws.diff_to_video = d[1];
         a->need_render = true; /* the renderer's last frame is now another one */
     }
+    mr_view_state_add_window(j, &ws);
     mr_error err = {0};
     if (!mr_json_save(a->state_path, j, &err)) mr_log(MR_LOG_ERROR, "view: %s", err.msg);
     cJSON_Delete(j);
@@ -668,7 +594,7 @@ static int open_window(view_app *a, const mr_cli_opt *opts, int ww, int wh, int 
     if (ao >= 0) s.ao = (mr_ao_method)ao;
     if (ghost >= 0) s.ghost = (mr_ghost_mode)ghost;
     mr_viewer_set_settings(a->vc, &s);
-    a->shadows_start = s.shadows;
+    a->shadows.start = s.shadows;
     if (*script) mr_viewer_set_script(a->vc, script);
     return 0;
 }
@@ -763,12 +689,12 @@ int cmd_view(int argc, char **argv) {
     else snprintf(a->session_dir, sizeof a->session_dir, "mrcheck-session");
     if ((rc = parse_start_modes(opts, &ao, &ghost)) != 0) goto done;
     if (mr_cli_get(opts, "shadows")) {
-        if (!mr_shadow_method_parse(mr_cli_get(opts, "shadows"), &a->shadows)) {
+        if (!mr_shadow_method_parse(mr_cli_get(opts, "shadows"), &a->shadows.flag)) {
             mr_cli_errorf(k_cmd, "--shadows must be off, hard, pcf, pcss, bp or groundtruth, not '%s'", mr_cli_get(opts, "shadows"));
             rc = 2;
             goto done;
         }
-        a->shadows_given = true;
+        a->shadows.given = true;
     }
 
     /* A scene that fails to load is shown as a message; the window still

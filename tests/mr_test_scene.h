@@ -3,6 +3,7 @@
 #ifndef MR_TEST_SCENE_H
 #define MR_TEST_SCENE_H
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -76,6 +77,54 @@ static inline void mr_test_add_node(mr_scene *s, const char *name, mr_dmat4 worl
     n.mesh_count = 1;
     n.layer = layer;
     mr_scene_add_node(s, &n);
+}
+
+/* A closed UV sphere of nu * nv * 2 triangles, radius r * (1 + bump *
+ * sin(fu * phi) * sin(fv * theta)) (bump 0: a plain sphere; bumps make
+ * every cluster and LOD level differ), named name ("" none). */
+static inline mr_mesh mr_test_sphere_mesh(const char *name, double r, int nu, int nv, double bump, int fu, int fv) {
+    mr_mesh m;
+    memset(&m, 0, sizeof m);
+    snprintf(m.name, sizeof m.name, "%s", name);
+    m.vertex_count = (uint32_t)((nu + 1) * (nv + 1));
+    m.index_count = (uint32_t)(nu * nv * 6);
+    m.positions = malloc((size_t)m.vertex_count * 12);
+    m.indices = malloc((size_t)m.index_count * 4);
+    for (int i = 0; i <= nu; i++)
+        for (int j = 0; j <= nv; j++) {
+            double th = 3.14159265358979 * j / nv, ph = 2 * 3.14159265358979 * (i % nu) / nu;
+            double rr = r * (1 + bump * sin(fu * ph) * sin(fv * th));
+            float *p = m.positions + 3 * (size_t)(i * (nv + 1) + j);
+            p[0] = (float)(rr * sin(th) * cos(ph));
+            p[1] = (float)(rr * cos(th));
+            p[2] = (float)(rr * sin(th) * sin(ph));
+        }
+    uint32_t ni = 0;
+    for (int i = 0; i < nu; i++)
+        for (int j = 0; j < nv; j++) {
+            uint32_t a = (uint32_t)(i * (nv + 1) + j), b = a + (uint32_t)(nv + 1);
+            uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
+            for (int k = 0; k < 6; k++) m.indices[ni++] = q[k];
+        }
+    m.material = -1;
+    return m;
+}
+
+/* count root nodes "part_<i>" on a 400 x 5 x ... grid 0.5 apart, drawing
+ * meshes 0 .. meshes-1 in turn, every 50th on the hidden layer: a big
+ * assembly's node list. */
+static inline void mr_test_add_grid_nodes(mr_scene *s, int count, int meshes) {
+    for (int i = 0; i < count; i++) {
+        mr_node n;
+        memset(&n, 0, sizeof n);
+        snprintf(n.name, sizeof n.name, "part_%d", i);
+        n.parent = -1;
+        n.world = mr_m4_translate((i % 400) * 0.5, (i / 400 % 5) * 0.5, (i / 2000) * 0.5);
+        n.mesh_first = i % meshes;
+        n.mesh_count = 1;
+        n.layer = i % 50 == 0 ? MR_LAYER_HIDDEN : MR_LAYER_VISIBLE;
+        mr_scene_add_node(s, &n);
+    }
 }
 
 #endif

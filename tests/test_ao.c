@@ -15,56 +15,14 @@
 #include "mr_render.h"
 #include "mr_test.h"
 #include "mr_test_scene.h"
+#include "mr_test_ao.h"
 
 #include <stdlib.h>
 #include <string.h>
 
 /* --------------------------------------------------------- scene helpers */
 
-
-static void add_node(mr_scene *s, mr_dmat4 world, int32_t mesh) {
-    mr_node n;
-    memset(&n, 0, sizeof n);
-    snprintf(n.name, sizeof n.name, "n%d", (int)s->node_count);
-    n.parent = -1;
-    n.world = world;
-    n.mesh_first = mesh;
-    n.mesh_count = 1;
-    mr_scene_add_node(s, &n);
-}
-
-static void place(mr_scene *s, int32_t mesh, double k, mr_dvec3 off, double x, double y, double z) {
-    add_node(s, mr_m4_translate(off.x + x * k, off.y + y * k, off.z + z * k), mesh);
-}
-
-/* Floor (top at y = 0), a wall whose face is the plane z = 2.9 standing on
- * it (a concave corner), and a cube; all lengths times k, moved by off. */
-static mr_scene *corner_scene(double k, mr_dvec3 off, bool with_wall) {
-    mr_scene *s = mr_scene_create();
-    place(s, mr_test_add_box(s, 20 * k, 0.2 * k, 20 * k, -1), k, off, 0, -0.1, 0);
-    if (with_wall) {
-        place(s, mr_test_add_box(s, 20 * k, 6 * k, 0.2 * k, -1), k, off, 0, 3, 3.0);
-        place(s, mr_test_add_box(s, 1 * k, 1 * k, 1 * k, -1), k, off, -1.5, 0.5, 1.0);
-    }
-    mr_scene_update_bounds(s);
-    return s;
-}
-
-static mr_view corner_view(double k, mr_dvec3 off, int w, int h) {
-    mr_view v;
-    mr_camera c = {w, h, 0.8 * w, 0.8 * w, (w - 1) / 2.0, (h - 1) / 2.0, {0, 0, 0, 0, 0}};
-    v.camera = c;
-    v.world_from_camera = mr_m4_look_at_cv(mr_v3(off.x + 0.7 * k, off.y + 2.2 * k, off.z - 2.5 * k),
-                                           mr_v3(off.x + 0.2 * k, off.y + 0.2 * k, off.z + 2.5 * k), mr_v3(0, 1, 0));
-    return v;
-}
-
-/* World point of pixel i of a rendered frame (depth > 0). */
-static mr_dvec3 pixel_world(const mr_view *v, const mr_image *depth, int x, int y) {
-    mr_camera c = mr_camera_resized(&v->camera, depth->width, depth->height);
-    double z = ((const float *)depth->data)[(size_t)y * depth->width + x];
-    return mr_m4_point(&v->world_from_camera, mr_v3((x - c.cx) / c.fx * z, (y - c.cy) / c.fy * z, z));
-}
+/* The corner, its view and the AO measures are mr_test_ao.h's. */
 
 /* ------------------------------------------------------------ CPU tests */
 
@@ -139,8 +97,8 @@ static void test_groundtruth_wall(void) {
     for (int far = 0; far < 2; far++) {
         double off = far ? 1e7 : 0;
         mr_scene *s = mr_scene_create();
-        add_node(s, mr_m4_translate(off, -0.5, off), mr_test_add_box(s, 400, 1, 400, -1));
-        add_node(s, mr_m4_translate(off + 0.5, 0, off), mr_test_add_box(s, 1, 400, 400, -1));
+        mr_test_ao_place(s, mr_test_add_box(s, 400, 1, 400, -1), 1, mr_v3(off, -0.5, off), 0, 0, 0);
+        mr_test_ao_place(s, mr_test_add_box(s, 1, 400, 400, -1), 1, mr_v3(off + 0.5, 0, off), 0, 0, 0);
         mr_scene_update_bounds(s);
         mr_error err = {0};
         mr_eval_gt *gt = mr_eval_gt_create(s, false, &err);
@@ -194,34 +152,16 @@ static void test_metrics(void) {
 static mr_gpu *g_gpu;
 static mr_renderer *g_r;
 
-static bool render_ao(const mr_scene *s, const mr_view *v, const mr_ao_params *ao, mr_frame_result *res) {
-    mr_frame_params p = MR_FRAME_DEFAULTS;
-    p.ao = *ao;
-    p.ao.want_ao = true;
-    p.want_depth = p.want_normals = true;
-    mr_error err = {0};
-    bool ok = mr_renderer_set_scene(g_r, s, &err) && mr_render_frame(g_r, v, &p, res, &err);
-    CHECK_MSG(ok, "%s", err.msg);
-    return ok;
-}
-
-static int count_bad(const mr_image *ao) {
-    int bad = 0;
-    const float *a = ao->data;
-    for (int i = 0; i < ao->width * ao->height; i++) bad += !(a[i] >= 0 && a[i] <= 1);
-    return bad;
-}
-
 static void test_flat_plane(void) {
-    mr_scene *s = corner_scene(1, mr_v3(0, 0, 0), false);
-    mr_view v = corner_view(1, mr_v3(0, 0, 0), 128, 96);
+    mr_scene *s = mr_test_ao_corner_scene(1, mr_v3(0, 0, 0), false);
+    mr_view v = mr_test_ao_corner_view(1, mr_v3(0, 0, 0), 128, 96);
     for (int mode = 0; mode < 2; mode++) {
         mr_ao_params ao = MR_AO_DEFAULTS;
         ao.method = MR_AO_SCHEER;
         ao.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
         ao.radius = 0.5;
         mr_frame_result res;
-        if (!render_ao(s, &v, &ao, &res)) continue;
+        if (!mr_test_render_ao(g_r, s, &v, &ao, &res)) continue;
         const float *a = res.ao.data, *d = res.depth.data;
         double sum = 0;
         int n = 0;
@@ -229,7 +169,7 @@ static void test_flat_plane(void) {
             if (d[i] > 0) { sum += a[i]; n++; }
         CHECK(n > 1000);
         CHECK_MSG(n && sum / n >= 0.98, "flat plane, %s radius: mean AO %.4f < 0.98", mode ? "view" : "screen", n ? sum / n : 0);
-        CHECK(count_bad(&res.ao) == 0);
+        CHECK(mr_test_ao_count_bad(&res.ao) == 0);
         mr_frame_result_free(&res);
     }
     mr_scene_destroy(&s);
@@ -245,7 +185,7 @@ static double floor_band(const mr_view *v, const mr_frame_result *res, const mr_
         for (int x = 0; x < res->depth.width; x++) {
             size_t i = (size_t)y * res->depth.width + x;
             if (!(d[i] > 0)) continue;
-            mr_dvec3 p = pixel_world(v, &res->depth, x, y);
+            mr_dvec3 p = mr_test_pixel_world(v, &res->depth, x, y);
             double py = (p.y - off.y) / k, dist = 2.9 - (p.z - off.z) / k, px = (p.x - off.x) / k;
             if (fabs(py) > 0.01 || dist < d0 || dist >= d1 || px < -0.5 || px > 5) continue;
             sum += a[i];
@@ -257,8 +197,8 @@ static double floor_band(const mr_view *v, const mr_frame_result *res, const mr_
 
 static void test_corner_all_methods(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
-    mr_view v = corner_view(1, o, 128, 96);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 128, 96);
     for (int m = MR_AO_SCHEER; m < MR_AO_METHOD_COUNT; m++) {
         for (int mode = 0; mode < 2; mode++) {
             mr_ao_params ao = MR_AO_DEFAULTS;
@@ -266,7 +206,7 @@ static void test_corner_all_methods(void) {
             ao.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
             ao.radius = 0.5;
             mr_frame_result res;
-            if (!render_ao(s, &v, &ao, &res)) continue;
+            if (!mr_test_render_ao(g_r, s, &v, &ao, &res)) continue;
             int nc = 0, no = 0;
             double corner = floor_band(&v, &res, &res.ao, 0.0, 0.12, 1, o, &nc);
             double open = floor_band(&v, &res, &res.ao, 1.5, 2.5, 1, o, &no);
@@ -277,7 +217,7 @@ static void test_corner_all_methods(void) {
                 printf("%s %s: corner %.3f open %.3f\n", mr_ao_method_name(ao.method), mode ? "view" : "screen", corner, open);
             CHECK_MSG(corner < open - margin, "%s %s: corner %.3f not darker than open floor %.3f", mr_ao_method_name(ao.method),
                       mode ? "view" : "screen", corner, open);
-            CHECK(count_bad(&res.ao) == 0);
+            CHECK(mr_test_ao_count_bad(&res.ao) == 0);
             mr_frame_result_free(&res);
         }
     }
@@ -288,11 +228,11 @@ static void test_corner_all_methods(void) {
  * closed form for floor pixels in front of the wall (away from its ends). */
 static void test_groundtruth_pixels(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
-    mr_view v = corner_view(1, o, 96, 72);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 96, 72);
     mr_ao_params none = MR_AO_DEFAULTS;
     mr_frame_result res;
-    if (render_ao(s, &v, &none, &res)) {
+    if (mr_test_render_ao(g_r, s, &v, &none, &res)) {
         mr_error err = {0};
         mr_eval_gt *gt = mr_eval_gt_create(s, false, &err);
         mr_gt_params gp = MR_GT_DEFAULTS;
@@ -301,7 +241,7 @@ static void test_groundtruth_pixels(void) {
         mr_image ao = {0};
         CHECK_MSG(gt && mr_eval_ao_groundtruth(gt, &v, &res.depth, &res.normal, &gp, &ao, &err), "%s", err.msg);
         if (ao.data) {
-            CHECK(count_bad(&ao) == 0);
+            CHECK(mr_test_ao_count_bad(&ao) == 0);
             double se = 0;
             int n = 0;
             const float *a = ao.data, *d = res.depth.data;
@@ -309,7 +249,7 @@ static void test_groundtruth_pixels(void) {
                 for (int x = 0; x < 96; x++) {
                     size_t i = (size_t)y * 96 + x;
                     if (!(d[i] > 0)) continue;
-                    mr_dvec3 p = pixel_world(&v, &res.depth, x, y);
+                    mr_dvec3 p = mr_test_pixel_world(&v, &res.depth, x, y);
                     double dist = 2.9 - p.z;
                     /* Floor, in front of the wall, away from the cube (x < -0.9). */
                     if (fabs(p.y) > 0.01 || dist < 0 || dist > 1.0 || p.x < -0.5 || p.x > 5) continue;
@@ -338,7 +278,7 @@ static void test_groundtruth_pixels(void) {
                 for (int x = 0; x < 96; x++) {
                     size_t i = (size_t)y * 96 + x;
                     if (!(d[i] > 0)) continue;
-                    mr_dvec3 p = pixel_world(&v, &res.depth, x, y);
+                    mr_dvec3 p = mr_test_pixel_world(&v, &res.depth, x, y);
                     double dist = 2.9 - p.z, R = gp.screen_radius * d[i] * c.height / c.fy;
                     if (fabs(p.y) > 0.01 || dist < 0 || dist > 1.0 || p.x < -0.5 || p.x > 5) continue;
                     double e = a[i] - mr_eval_ao_wall_analytic(dist, R);
@@ -356,7 +296,7 @@ static void test_groundtruth_pixels(void) {
             sp.radius = 0.6;
             sp.screen_radius = 0.1;
             mr_frame_result rs;
-            if (!render_ao(s, &v, &sp, &rs)) continue;
+            if (!mr_test_render_ao(g_r, s, &v, &sp, &rs)) continue;
             mr_image ones = {0};
             mr_image_alloc(&ones, 96, 72, 1, MR_PIX_F32, NULL);
             for (int i = 0; i < 96 * 72; i++) ((float *)ones.data)[i] = 1.0f;
@@ -382,14 +322,14 @@ static double rmse(const mr_image *a, const mr_image *b);
  * resolution, and does not smear AO across the cube's silhouette. */
 static void test_half_res(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
-    mr_view v = corner_view(1, o, 128, 96);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 128, 96);
     mr_ao_params ao = MR_AO_DEFAULTS;
     ao.method = MR_AO_SCHEER;
     mr_frame_result full, half;
-    if (render_ao(s, &v, &ao, &full)) {
+    if (mr_test_render_ao(g_r, s, &v, &ao, &full)) {
         ao.half_res = true;
-        if (render_ao(s, &v, &ao, &half)) {
+        if (mr_test_render_ao(g_r, s, &v, &ao, &half)) {
             double e = rmse(&half.ao, &full.ao);
             if (getenv("MR_TEST_VERBOSE")) printf("half vs full resolution: RMSE %.4f\n", e);
             CHECK_MSG(e < 0.05, "half vs full resolution: RMSE %.4f", e);
@@ -422,16 +362,16 @@ static void test_scale_invariance(void) {
     for (int half = 0; half < 2; half++) {
         mr_image ref = {0};
         for (int i = 0; i < 4; i++) {
-            mr_scene *s = corner_scene(scales[i], offs[i], true);
-            mr_view v = corner_view(scales[i], offs[i], 128, 96);
+            mr_scene *s = mr_test_ao_corner_scene(scales[i], offs[i], true);
+            mr_view v = mr_test_ao_corner_view(scales[i], offs[i], 128, 96);
             mr_ao_params ao = MR_AO_DEFAULTS;
             ao.method = methods[mi];
             ao.half_res = half;
             ao.mips = mips;
             ao.screen_radius = mips ? 0.15 : ao.screen_radius; /* 19 px at 128x96: levels 1 and 2 are read */
             mr_frame_result res;
-            if (render_ao(s, &v, &ao, &res)) {
-                CHECK(count_bad(&res.ao) == 0);
+            if (mr_test_render_ao(g_r, s, &v, &ao, &res)) {
+                CHECK(mr_test_ao_count_bad(&res.ao) == 0);
                 if (i == 0) {
                     ref = res.ao;
                     res.ao.data = NULL;
@@ -454,11 +394,11 @@ static void test_scale_invariance(void) {
 /* Extreme inputs: every method and option stays finite and in [0,1]. */
 static void test_finite(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
     /* Zero-length normals on the cube (the G-buffer must cope). */
     memset(s->meshes[2].normals, 0, s->meshes[2].vertex_count * 3 * sizeof(float));
     mr_view views[3];
-    views[0] = corner_view(1, o, 96, 72);
+    views[0] = mr_test_ao_corner_view(1, o, 96, 72);
     /* Half the image is sky. */
     views[1] = views[0];
     views[1].world_from_camera = mr_m4_look_at_cv(mr_v3(0, 0.5, -2), mr_v3(0, 0.6, -30), mr_v3(0, 1, 0));
@@ -480,8 +420,8 @@ static void test_finite(void) {
                 ao.radius_mode = variant == 2 ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
                 ao.samples = 8;
                 mr_frame_result res;
-                if (!render_ao(s, &views[vi], &ao, &res)) continue;
-                int bad = count_bad(&res.ao);
+                if (!mr_test_render_ao(g_r, s, &views[vi], &ao, &res)) continue;
+                int bad = mr_test_ao_count_bad(&res.ao);
                 const unsigned char *c = res.color.data;
                 (void)c;
                 CHECK_MSG(bad == 0, "view %d %s variant %d: %d non-finite or out-of-range AO values", vi,
@@ -503,8 +443,8 @@ static void passes_of(const mr_frame_result *r, char *buf, size_t n) { mr_frame_
 
 static void test_pass_list(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
-    mr_view v = corner_view(1, o, 96, 72);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 96, 72);
     mr_error err = {0};
     CHECK(mr_renderer_set_scene(g_r, s, &err));
     mr_frame_params p = MR_FRAME_DEFAULTS;
@@ -597,15 +537,15 @@ static void test_pass_list(void) {
  * then exactly 1; the standalone mask darkens the corner by itself. */
 static void test_mask(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
-    mr_view v = corner_view(1, o, 128, 96);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 128, 96);
     for (int mm = MR_AO_MASK_ON; mm <= MR_AO_MASK_STANDALONE; mm++) {
         mr_ao_params ao = MR_AO_DEFAULTS;
         ao.method = MR_AO_SCHEER;
         ao.mask = (mr_ao_mask)mm;
         ao.blur_radius = 0;
         mr_frame_result res;
-        if (!render_ao(s, &v, &ao, &res)) continue;
+        if (!mr_test_render_ao(g_r, s, &v, &ao, &res)) continue;
         int nc = 0, no = 0;
         double corner = floor_band(&v, &res, &res.ao, 0.0, 0.1, 1, o, &nc);
         double open = floor_band(&v, &res, &res.ao, 2.0, 2.5, 1, o, &no);
@@ -616,7 +556,6 @@ static void test_mask(void) {
     }
     mr_scene_destroy(&s);
 }
-
 
 /* ------------------------------------------- pinned against the reference */
 
@@ -684,8 +623,8 @@ static bool pin_view_make(int which, pin_view *pv) {
     memset(pv, 0, sizeof *pv);
     mr_dvec3 o = mr_v3(0, 0, 0);
     if (which == PIN_PLANE || which == PIN_CORNER) {
-        pv->scene = corner_scene(1, o, which == PIN_CORNER);
-        pv->view = corner_view(1, o, 96, 72);
+        pv->scene = mr_test_ao_corner_scene(1, o, which == PIN_CORNER);
+        pv->view = mr_test_ao_corner_view(1, o, 96, 72);
         return pv->scene != NULL;
     }
     mr_error err = {0};
@@ -722,7 +661,7 @@ static void test_pinned_reference(void) {
         if (!pin_view_make(vi, &pv)) continue;
         mr_ao_params none = MR_AO_DEFAULTS;
         mr_frame_result g;
-        if (!render_ao(pv.scene, &pv.view, &none, &g)) {
+        if (!mr_test_render_ao(g_r, pv.scene, &pv.view, &none, &g)) {
             pin_view_free(&pv);
             continue;
         }
@@ -751,7 +690,7 @@ static void test_pinned_reference(void) {
                 ao.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
                 ao.radius = 0.5;
                 mr_frame_result res;
-                if (!render_ao(pv.scene, &pv.view, &ao, &res)) continue;
+                if (!mr_test_render_ao(g_r, pv.scene, &pv.view, &ao, &res)) continue;
                 ao_err e = ao_error(&res.ao, &ref[mode], &g.depth);
                 const double *k = k_pinned[vi][m][mode];
                 const char *what = mode ? "view" : "screen";
@@ -830,8 +769,8 @@ static void test_golden(void) {
         {"scheer_bm_screen", MR_AO_SCHEER_BM, MR_AO_RADIUS_SCREEN, 0, false, 1, MR_AO_MASK_OFF, false},
     };
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
-    mr_view v = corner_view(1, o, 96, 72);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 96, 72);
     bool update = getenv("MR_UPDATE_GOLDEN") != NULL;
     for (size_t ci = 0; ci < sizeof cases / sizeof cases[0]; ci++) {
         const golden_case *gc = &cases[ci];
@@ -848,7 +787,7 @@ static void test_golden(void) {
             ao.r_min = 0;
         }
         mr_frame_result res;
-        if (!render_ao(s, &v, &ao, &res)) continue;
+        if (!mr_test_render_ao(g_r, s, &v, &ao, &res)) continue;
         char path[1024];
         snprintf(path, sizeof path, "%s/golden/ao_%s.png", data, gc->name);
         mr_error err = {0};
@@ -892,7 +831,6 @@ static void test_golden(void) {
     mr_scene_destroy(&s);
     mr_renderer_set_scene(g_r, NULL, NULL);
 }
-
 
 /* ------------------------------------------------- corner mask, analytic */
 
@@ -947,8 +885,8 @@ static bool window_is(const mr_image *cnt, const mr_image *depth, int x, int y, 
  * checked against the analytic count of grown boxes (view radius). */
 static void test_mask_count(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
-    mr_view v = corner_view(1, o, 96, 72);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 96, 72);
     for (int mode = 0; mode < 2; mode++)
         for (int blur = 0; blur <= 2; blur += 2) {
             const char *what = mode ? "view" : "screen";
@@ -959,10 +897,10 @@ static void test_mask_count(void) {
             ao.screen_radius = 0.1;
             ao.blur_radius = blur;
             mr_frame_result off, on;
-            if (!render_ao(s, &v, &ao, &off)) continue;
+            if (!mr_test_render_ao(g_r, s, &v, &ao, &off)) continue;
             ao.mask = MR_AO_MASK_ON;
             ao.want_mask = true;
-            if (!render_ao(s, &v, &ao, &on)) {
+            if (!mr_test_render_ao(g_r, s, &v, &ao, &on)) {
                 mr_frame_result_free(&off);
                 continue;
             }
@@ -1013,7 +951,7 @@ static void test_mask_count(void) {
                         size_t i = (size_t)y * 96 + x;
                         if (!(d[i] > 0)) continue;
                         double margin;
-                        mr_dvec3 p = pixel_world(&v, &off.depth, x, y);
+                        mr_dvec3 p = mr_test_pixel_world(&v, &off.depth, x, y);
                         int want = analytic_count(p, a, &margin);
                         if (margin < 0.03) continue;
                         checked++;
@@ -1049,8 +987,8 @@ static void test_mask_count(void) {
  * inside the mask the AO is exactly 1 - s, where it is outside exactly 1. */
 static void test_mask_standalone(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
-    mr_view v = corner_view(1, o, 96, 72);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 96, 72);
     const mr_ao_method methods[3] = {MR_AO_SCHEER, MR_AO_CRYTEK, MR_AO_HBAO};
     const float strengths[3] = {0.0f, 1.0f, 7.0f}; /* the method's strength plays no part */
     for (int blur = 0; blur <= 2; blur += 2) {
@@ -1067,7 +1005,7 @@ static void test_mask_standalone(void) {
             ao.mask_strength = 0.6f;
             ao.want_mask = true;
             mr_frame_result res;
-            if (!render_ao(s, &v, &ao, &res)) continue;
+            if (!mr_test_render_ao(g_r, s, &v, &ao, &res)) continue;
             const float *a = res.ao.data, *cnt = res.ao_mask.data, *d = res.depth.data;
             CHECK_MSG(cnt != NULL, "standalone mask: no outline counts returned");
             int out_of_range = 0, wrong = 0, inside = 0;
@@ -1107,7 +1045,7 @@ static void test_mask_standalone(void) {
             ao.mask = MR_AO_MASK_STANDALONE;
             ao.mask_strength = ms[k];
             mr_frame_result res;
-            if (!render_ao(s, &v, &ao, &res)) continue;
+            if (!mr_test_render_ao(g_r, s, &v, &ao, &res)) continue;
             const float *a = res.ao.data, *f6 = first.data;
             if (k == 0) {
                 unit = res.ao;
@@ -1141,8 +1079,8 @@ static void test_mask_standalone(void) {
  * more are clamped to 5. */
 static void test_radii(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
-    mr_view v = corner_view(1, o, 96, 72);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 96, 72);
     for (int mode = 0; mode < 2; mode++) {
         mr_image img[3] = {{0}, {0}, {0}};
         const int ks[3] = {4, 5, 6};
@@ -1155,7 +1093,7 @@ static void test_radii(void) {
             ao.blur_radius = 0;
             ao.radii = ks[k];
             mr_frame_result res;
-            if (!render_ao(s, &v, &ao, &res)) continue;
+            if (!mr_test_render_ao(g_r, s, &v, &ao, &res)) continue;
             img[k] = res.ao;
             res.ao.data = NULL;
             mr_frame_result_free(&res);
@@ -1182,29 +1120,6 @@ static void test_radii(void) {
 
 /* ------------------------------------------------ issue 18: slice methods */
 
-/* RMSE of an AO image against the closed form beside the wall, over floor
- * pixels in front of it (dist < 1, away from the cube and the image's
- * ends), for the view radius R or the depth-scaled one (screen > 0). */
-static double wall_rmse(const mr_view *v, const mr_frame_result *g, const mr_image *ao, double R, double screen, int *count) {
-    mr_camera c = mr_camera_resized(&v->camera, g->depth.width, g->depth.height);
-    double se = 0;
-    int n = 0;
-    const float *a = ao->data, *d = g->depth.data;
-    for (int y = 0; y < g->depth.height; y++)
-        for (int x = 0; x < g->depth.width; x++) {
-            size_t i = (size_t)y * g->depth.width + x;
-            if (!(d[i] > 0)) continue;
-            mr_dvec3 p = pixel_world(v, &g->depth, x, y);
-            double dist = 2.9 - p.z, r = screen > 0 ? screen * d[i] * c.height / c.fy : R;
-            if (fabs(p.y) > 0.01 || dist < 0 || dist > 1.0 || p.x < -0.5 || p.x > 5) continue;
-            double e = a[i] - mr_eval_ao_wall_analytic(dist, r);
-            se += e * e;
-            n++;
-        }
-    if (count) *count = n;
-    return n ? sqrt(se / n) : 1e9;
-}
-
 /* GTAO, the bitmask and scheer-gt (c = 0, bias 0: its horizon is GTAO's
  * without the falloff, so the same closed form) beside a wall: V = 1 -
  * (acos a - a sqrt(1 - a^2)) / pi, a = d / R, within 0.025 RMSE with 64
@@ -1212,8 +1127,8 @@ static double wall_rmse(const mr_view *v, const mr_frame_result *g, const mr_ima
  * the depth-scaled radius. */
 static void test_slice_wall(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
-    mr_view v = corner_view(1, o, 160, 120);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 160, 120);
     /* issue 18 (lane ao): scheer-bm with c = 0 (the bitmask's closed form),
      * and every method again with the depth mip chain (12 px of radius:
      * the samples beyond 8 px read level 1) */
@@ -1221,29 +1136,12 @@ static void test_slice_wall(void) {
     for (int mi = 0; mi < 4; mi++)
         for (int mode = 0; mode < 4; mode++) {
             bool mips = mode >= 2;
-            mr_ao_params ao = MR_AO_DEFAULTS;
-            ao.method = ms[mi];
-            ao.radius_mode = mode % 2 ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
-            ao.radius = 0.6;
-            ao.screen_radius = 0.1;
-            ao.samples = 64;
+            mr_ao_params ao = mr_test_ao_wall_params(ms[mi], mode % 2);
             ao.mips = mips;
-            ao.thickness = 2.0f; /* the wall is thick */
-            ao.blur_radius = 0;  /* the bilateral blur mixes the wall's AO into the floor's */
-            if (ms[mi] == MR_AO_SCHEER_GT) ao.c = 0, ao.bias = 0;
-            if (ms[mi] == MR_AO_SCHEER_BM) ao.c = 0;
-            mr_frame_result res;
-            if (!render_ao(s, &v, &ao, &res)) continue;
-            int n = 0;
-            double e = wall_rmse(&v, &res, &res.ao, ao.radius, mode % 2 ? 0 : ao.screen_radius, &n);
-            const char *mn = mode % 2 ? (mips ? "view mips" : "view") : (mips ? "screen mips" : "screen");
-            if (getenv("MR_TEST_VERBOSE"))
-                printf("wall %s %s: RMSE %.4f over %d pixels\n", mr_ao_method_name(ao.method), mn, e, n);
-            CHECK_MSG(n > 100, "only %d floor pixels in front of the wall", n);
-            CHECK_MSG(e < 0.025, "%s %s radius beside a wall: RMSE %.4f against the closed form", mr_ao_method_name(ao.method),
-                      mn, e);
-            CHECK(count_bad(&res.ao) == 0);
-            mr_frame_result_free(&res);
+            char what[96];
+            snprintf(what, sizeof what, "%s %s radius", mr_ao_method_name(ao.method),
+                     mode % 2 ? (mips ? "view mips" : "view") : (mips ? "screen mips" : "screen"));
+            mr_test_ao_wall_check(g_r, s, &v, &ao, what);
         }
     mr_scene_destroy(&s);
     mr_renderer_set_scene(g_r, NULL, NULL);
@@ -1264,8 +1162,8 @@ static double mean_geo(const mr_image *ao, const mr_image *depth) {
 
 static void test_scheer_bm(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
-    mr_view v = corner_view(1, o, 128, 96);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 128, 96);
     const float cs[3] = {0.0f, 1.0f, 4.0f};
     mr_frame_result bm, r[3];
     memset(&bm, 0, sizeof bm);
@@ -1273,11 +1171,11 @@ static void test_scheer_bm(void) {
     ao.method = MR_AO_BITMASK;
     ao.blur_radius = 0; /* per pixel */
     ao.screen_radius = 0.15;
-    bool ok = render_ao(s, &v, &ao, &bm);
+    bool ok = mr_test_render_ao(g_r, s, &v, &ao, &bm);
     for (int k = 0; k < 3 && ok; k++) {
         ao.method = MR_AO_SCHEER_BM;
         ao.c = cs[k];
-        ok = render_ao(s, &v, &ao, &r[k]);
+        ok = mr_test_render_ao(g_r, s, &v, &ao, &r[k]);
         if (!ok) {
             for (int j = 0; j < k; j++) mr_frame_result_free(&r[j]);
         }
@@ -1299,7 +1197,7 @@ static void test_scheer_bm(void) {
         CHECK_MSG(m1 > m0 + 0.002 && m4 > m1 + 0.002, "scheer-bm mean AO c=0 %.4f, c=1 %.4f, c=4 %.4f: not lighter with c", m0,
                   m1, m4);
         for (int k = 0; k < 3; k++) {
-            CHECK(count_bad(&r[k].ao) == 0);
+            CHECK(mr_test_ao_count_bad(&r[k].ao) == 0);
             mr_frame_result_free(&r[k]);
         }
     }
@@ -1318,8 +1216,8 @@ static void test_scheer_bm(void) {
  * bound 0.04). */
 static void test_mips(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
-    mr_view v = corner_view(1, o, 128, 96);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 128, 96);
     const mr_ao_method ms[4] = {MR_AO_GTAO, MR_AO_BITMASK, MR_AO_SCHEER_GT, MR_AO_SCHEER_BM};
     for (int mi = 0; mi < 4; mi++)
         for (int far = 0; far < 2; far++) {
@@ -1328,9 +1226,9 @@ static void test_mips(void) {
             ao.blur_radius = 0;
             ao.screen_radius = far ? 0.3 : 0.05;
             mr_frame_result a, b;
-            if (!render_ao(s, &v, &ao, &a)) continue;
+            if (!mr_test_render_ao(g_r, s, &v, &ao, &a)) continue;
             ao.mips = true;
-            if (!render_ao(s, &v, &ao, &b)) {
+            if (!mr_test_render_ao(g_r, s, &v, &ao, &b)) {
                 mr_frame_result_free(&a);
                 continue;
             }
@@ -1345,7 +1243,7 @@ static void test_mips(void) {
                 CHECK_MSG(maxd > 1e-4, "%s: far samples do not read the mip chain (max |d| %.3g)", mr_ao_method_name(ao.method), maxd);
                 CHECK_MSG(e < 0.04, "%s: the mip chain moved the AO by RMSE %.4f", mr_ao_method_name(ao.method), e);
             }
-            CHECK(count_bad(&b.ao) == 0);
+            CHECK(mr_test_ao_count_bad(&b.ao) == 0);
             mr_frame_result_free(&a);
             mr_frame_result_free(&b);
         }
@@ -1376,7 +1274,7 @@ static void render_ao_fp(const mr_scene *s, const mr_view *v, const mr_ao_params
 }
 
 static mr_view moved_view(double t, int w, int h) {
-    mr_view v = corner_view(1, mr_v3(0, 0, 0), w, h);
+    mr_view v = mr_test_ao_corner_view(1, mr_v3(0, 0, 0), w, h);
     v.world_from_camera = mr_m4_look_at_cv(mr_v3(0.7 + 0.3 * t, 2.2, -2.5 + 0.2 * t), mr_v3(0.2 + 0.2 * t, 0.2, 2.5),
                                            mr_v3(0, 1, 0));
     return v;
@@ -1384,7 +1282,7 @@ static mr_view moved_view(double t, int w, int h) {
 
 static void test_temporal(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o, true);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
     const int w = 128, h = 96;
     const mr_ao_method ms[2] = {MR_AO_SCHEER, MR_AO_GTAO};
     mr_error serr = {0};
@@ -1421,14 +1319,14 @@ static void test_temporal(void) {
             double bound = moving ? 0.75 : 0.6;
             CHECK_MSG(ea < bound * e1, "temporal %s %s camera: accumulated RMSE %.4f not below %.2f x one frame's %.4f", name,
                       moving ? "moving" : "static", ea, bound, e1);
-            CHECK(count_bad(&acc) == 0);
+            CHECK(mr_test_ao_count_bad(&acc) == 0);
         }
         /* A step of 0.4 units towards the wall after 16 still frames: every
          * pixel's depth changes, so only a correct reprojection finds the
          * history (at the same pixel the depth test rejects it: the frame
          * would be a single frame's). */
         {
-            mr_view a = corner_view(1, o, w, h), a2 = a;
+            mr_view a = mr_test_ao_corner_view(1, o, w, h), a2 = a;
             a2.world_from_camera = mr_m4_look_at_cv(mr_v3(0.7, 2.1, -2.1), mr_v3(0.2, 0.2, 2.5), mr_v3(0, 1, 0));
             ao.temporal = false;
             ao.samples = 64;
@@ -1454,7 +1352,7 @@ static void test_temporal(void) {
          * noise, so not equal to it), where a kept history would be the
          * other view's AO. */
         for (int reset = 1; reset >= 0; reset--) {
-            mr_view a = corner_view(1, o, w, h), b = a;
+            mr_view a = mr_test_ao_corner_view(1, o, w, h), b = a;
             b.world_from_camera = reset ? mr_m4_look_at_cv(mr_v3(-3, 1.5, 0.5), mr_v3(2, 0.2, 2.8), mr_v3(0, 1, 0))
                                         : mr_m4_look_at_cv(mr_v3(1, 2, 8), mr_v3(0.5, 0.5, 3.2), mr_v3(0, 1, 0));
             ao.temporal = true;
@@ -1490,9 +1388,9 @@ static void test_temporal(void) {
     /* Off, single frames do not accumulate: the pass list has no ao_temporal. */
     mr_ao_params off = MR_AO_DEFAULTS;
     off.method = MR_AO_SCHEER;
-    mr_view v = corner_view(1, o, w, h);
+    mr_view v = mr_test_ao_corner_view(1, o, w, h);
     mr_frame_result res;
-    if (render_ao(s, &v, &off, &res)) {
+    if (mr_test_render_ao(g_r, s, &v, &off, &res)) {
         char buf[512];
         mr_frame_result_passes(&res, buf, sizeof buf);
         CHECK_MSG(strstr(buf, "ao_temporal") == NULL, "temporal accumulation ran while off: %s", buf);

@@ -10,61 +10,13 @@
 #include "mr_render.h"
 #include "mr_test.h"
 #include "mr_test_scene.h"
+#include "mr_test_ao.h"
 
 #include <stdlib.h>
 #include <string.h>
 
 static mr_gpu *g_gpu;
 static mr_renderer *g_r;
-
-static void place(mr_scene *s, int32_t mesh, double k, mr_dvec3 off, double x, double y, double z) {
-    mr_node n;
-    memset(&n, 0, sizeof n);
-    snprintf(n.name, sizeof n.name, "n%d", (int)s->node_count);
-    n.parent = -1;
-    n.world = mr_m4_translate(off.x + x * k, off.y + y * k, off.z + z * k);
-    n.mesh_first = mesh;
-    n.mesh_count = 1;
-    mr_scene_add_node(s, &n);
-}
-
-/* test_ao's corner: floor (top y = 0), a wall with its face at z = 2.9,
- * a cube; lengths times k, moved by off. */
-static mr_scene *corner_scene(double k, mr_dvec3 off) {
-    mr_scene *s = mr_scene_create();
-    place(s, mr_test_add_box(s, 20 * k, 0.2 * k, 20 * k, -1), k, off, 0, -0.1, 0);
-    place(s, mr_test_add_box(s, 20 * k, 6 * k, 0.2 * k, -1), k, off, 0, 3, 3.0);
-    place(s, mr_test_add_box(s, 1 * k, 1 * k, 1 * k, -1), k, off, -1.5, 0.5, 1.0);
-    mr_scene_update_bounds(s);
-    return s;
-}
-
-static mr_view corner_view(double k, mr_dvec3 off, int w, int h) {
-    mr_view v;
-    mr_camera c = {w, h, 0.8 * w, 0.8 * w, (w - 1) / 2.0, (h - 1) / 2.0, {0, 0, 0, 0, 0}};
-    v.camera = c;
-    v.world_from_camera = mr_m4_look_at_cv(mr_v3(off.x + 0.7 * k, off.y + 2.2 * k, off.z - 2.5 * k),
-                                           mr_v3(off.x + 0.2 * k, off.y + 0.2 * k, off.z + 2.5 * k), mr_v3(0, 1, 0));
-    return v;
-}
-
-static bool render_ao(const mr_scene *s, const mr_view *v, const mr_ao_params *ao, mr_frame_result *res) {
-    mr_frame_params p = MR_FRAME_DEFAULTS;
-    p.ao = *ao;
-    p.ao.want_ao = true;
-    p.want_depth = p.want_normals = true;
-    mr_error err = {0};
-    bool ok = mr_renderer_set_scene(g_r, s, &err) && mr_render_frame(g_r, v, &p, res, &err);
-    CHECK_MSG(ok, "%s", err.msg);
-    return ok;
-}
-
-static int count_bad(const mr_image *ao) {
-    int bad = 0;
-    const float *a = ao->data;
-    for (int i = 0; i < ao->width * ao->height; i++) bad += !(a[i] >= 0 && a[i] <= 1);
-    return bad;
-}
 
 /* RMSE over geometry pixels (depth > 0). */
 static double rmse_geo(const mr_image *a, const mr_image *b, const mr_image *depth) {
@@ -76,45 +28,17 @@ static double rmse_geo(const mr_image *a, const mr_image *b, const mr_image *dep
     return n ? sqrt(se / n) : 1e9;
 }
 
-static mr_dvec3 pixel_world(const mr_view *v, const mr_image *depth, int x, int y) {
-    mr_camera c = mr_camera_resized(&v->camera, depth->width, depth->height);
-    double z = ((const float *)depth->data)[(size_t)y * depth->width + x];
-    return mr_m4_point(&v->world_from_camera, mr_v3((x - c.cx) / c.fx * z, (y - c.cy) / c.fy * z, z));
-}
-
-/* test_ao's wall_rmse: floor pixels in front of the wall (dist < 1, away
- * from the cube and the image's ends) against the closed form. */
-static double wall_rmse(const mr_view *v, const mr_frame_result *g, double R, double screen, int *count) {
-    mr_camera c = mr_camera_resized(&v->camera, g->depth.width, g->depth.height);
-    double se = 0;
-    int n = 0;
-    const float *a = g->ao.data, *d = g->depth.data;
-    for (int y = 0; y < g->depth.height; y++)
-        for (int x = 0; x < g->depth.width; x++) {
-            size_t i = (size_t)y * g->depth.width + x;
-            if (!(d[i] > 0)) continue;
-            mr_dvec3 p = pixel_world(v, &g->depth, x, y);
-            double dist = 2.9 - p.z, r = screen > 0 ? screen * d[i] * c.height / c.fy : R;
-            if (fabs(p.y) > 0.01 || dist < 0 || dist > 1.0 || p.x < -0.5 || p.x > 5) continue;
-            double e = a[i] - mr_eval_ao_wall_analytic(dist, r);
-            se += e * e;
-            n++;
-        }
-    *count = n;
-    return n ? sqrt(se / n) : 1e9;
-}
-
 static void test_pass_list(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o);
-    mr_view v = corner_view(1, o, 96, 72);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 96, 72);
     mr_ao_params ao = MR_AO_DEFAULTS;
     ao.method = MR_AO_SCHEER;
     mr_frame_result r;
     char buf[256];
     for (int on = 0; on < 2; on++) {
         ao.deinterleave = on;
-        if (!render_ao(s, &v, &ao, &r)) continue;
+        if (!mr_test_render_ao(g_r, s, &v, &ao, &r)) continue;
         mr_frame_result_passes(&r, buf, sizeof buf);
         const char *want = on ? "gbuffer ao_deint_split ao ao_deint_merge ao_blur shade" : "gbuffer ao ao_blur shade";
         CHECK_MSG(strcmp(buf, want) == 0, "deinterleave %s: passes %s", on ? "on" : "off", buf);
@@ -122,7 +46,7 @@ static void test_pass_list(void) {
     }
     /* The positions path is not split: the option is ignored there. */
     ao.positions = true;
-    if (render_ao(s, &v, &ao, &r)) {
+    if (mr_test_render_ao(g_r, s, &v, &ao, &r)) {
         mr_frame_result_passes(&r, buf, sizeof buf);
         CHECK_MSG(strstr(buf, "deint") == NULL, "deinterleave with positions: passes %s", buf);
         mr_frame_result_free(&r);
@@ -136,33 +60,16 @@ static void test_pass_list(void) {
  * depth-scaled and the fixed radius, at full and half resolution. */
 static void test_wall(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o);
-    mr_view v = corner_view(1, o, 160, 120);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 160, 120);
     const mr_ao_method ms[4] = {MR_AO_GTAO, MR_AO_BITMASK, MR_AO_SCHEER_GT, MR_AO_SCHEER_BM};
     for (int mi = 0; mi < 4; mi++)
         for (int mode = 0; mode < 2; mode++) {
-            mr_ao_params ao = MR_AO_DEFAULTS;
-            ao.method = ms[mi];
-            ao.radius_mode = mode ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
-            ao.radius = 0.6;
-            ao.screen_radius = 0.1;
-            ao.samples = 64;
-            ao.thickness = 2.0f;
-            ao.blur_radius = 0;
+            mr_ao_params ao = mr_test_ao_wall_params(ms[mi], mode);
             ao.deinterleave = true;
-            if (ms[mi] == MR_AO_SCHEER_GT) ao.c = 0, ao.bias = 0;
-            if (ms[mi] == MR_AO_SCHEER_BM) ao.c = 0;
-            mr_frame_result res;
-            if (!render_ao(s, &v, &ao, &res)) continue;
-            int n = 0;
-            double e = wall_rmse(&v, &res, ao.radius, mode ? 0 : ao.screen_radius, &n);
-            if (getenv("MR_TEST_VERBOSE"))
-                printf("deint wall %s %s: RMSE %.4f over %d pixels\n", mr_ao_method_name(ao.method), mode ? "view" : "screen", e, n);
-            CHECK_MSG(n > 100, "only %d floor pixels in front of the wall", n);
-            CHECK_MSG(e < 0.025, "deinterleaved %s %s radius beside a wall: RMSE %.4f against the closed form",
-                      mr_ao_method_name(ao.method), mode ? "view" : "screen", e);
-            CHECK(count_bad(&res.ao) == 0);
-            mr_frame_result_free(&res);
+            char what[96];
+            snprintf(what, sizeof what, "deinterleaved %s %s radius", mr_ao_method_name(ao.method), mode ? "view" : "screen");
+            mr_test_ao_wall_check(g_r, s, &v, &ao, what);
         }
     mr_scene_destroy(&s);
     mr_renderer_set_scene(g_r, NULL, NULL);
@@ -182,8 +89,8 @@ static void test_wall(void) {
  * checks the layers' padding: sky stays exactly 1. */
 static void test_noise(void) {
     mr_dvec3 o = mr_v3(0, 0, 0);
-    mr_scene *s = corner_scene(1, o);
-    mr_view v = corner_view(1, o, 126, 94);
+    mr_scene *s = mr_test_ao_corner_scene(1, o, true);
+    mr_view v = mr_test_ao_corner_view(1, o, 126, 94);
     const mr_ao_method ms[3] = {MR_AO_SCHEER, MR_AO_GTAO, MR_AO_HBAO};
     for (int mi = 0; mi < 3; mi++)
         for (int half = 0; half < 2; half++) {
@@ -192,16 +99,16 @@ static void test_noise(void) {
             ao.half_res = half;
             ao.screen_radius = 0.2; /* 19 px: the samples beyond 8 px (16 at half) read the layers */
             mr_frame_result a, b, c;
-            if (!render_ao(s, &v, &ao, &a)) continue;
+            if (!mr_test_render_ao(g_r, s, &v, &ao, &a)) continue;
             ao.noise = MR_AO_NOISE_WORLD;
             ao.noise_cell = 1e-4; /* pixels are ~0.03 apart: a cell per pixel */
-            if (!render_ao(s, &v, &ao, &b)) {
+            if (!mr_test_render_ao(g_r, s, &v, &ao, &b)) {
                 mr_frame_result_free(&a);
                 continue;
             }
             ao.noise = MR_AO_NOISE_PIXEL;
             ao.deinterleave = true;
-            if (render_ao(s, &v, &ao, &c)) {
+            if (mr_test_render_ao(g_r, s, &v, &ao, &c)) {
                 double e_ii = rmse_geo(&a.ao, &b.ao, &a.depth), e_di = rmse_geo(&c.ao, &a.ao, &a.depth);
                 double ma = 0, mc = 0;
                 int n = 0, sky = 0;
@@ -220,7 +127,7 @@ static void test_noise(void) {
                 CHECK_MSG(fabs(mc - ma) < 0.01, "%s%s: mean AO deinterleaved %.4f vs interleaved %.4f",
                           mr_ao_method_name(ao.method), half ? " half" : "", mc, ma);
                 CHECK_MSG(sky == 0, "%s%s: %d sky pixels not 1", mr_ao_method_name(ao.method), half ? " half" : "", sky);
-                CHECK(count_bad(&c.ao) == 0);
+                CHECK(mr_test_ao_count_bad(&c.ao) == 0);
                 mr_frame_result_free(&c);
             }
             mr_frame_result_free(&a);
@@ -240,15 +147,15 @@ static void test_scale_invariance(void) {
         for (int half = 0; half < 2; half++) {
             mr_image ref = {0};
             for (int i = 0; i < 4; i++) {
-                mr_scene *s = corner_scene(scales[i], offs[i]);
-                mr_view v = corner_view(scales[i], offs[i], 128, 96);
+                mr_scene *s = mr_test_ao_corner_scene(scales[i], offs[i], true);
+                mr_view v = mr_test_ao_corner_view(scales[i], offs[i], 128, 96);
                 mr_ao_params ao = MR_AO_DEFAULTS;
                 ao.method = methods[mi];
                 ao.half_res = half;
                 ao.deinterleave = true;
                 mr_frame_result res;
-                if (render_ao(s, &v, &ao, &res)) {
-                    CHECK(count_bad(&res.ao) == 0);
+                if (mr_test_render_ao(g_r, s, &v, &ao, &res)) {
+                    CHECK(mr_test_ao_count_bad(&res.ao) == 0);
                     if (i == 0) {
                         ref = res.ao;
                         res.ao.data = NULL;

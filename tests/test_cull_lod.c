@@ -9,6 +9,7 @@
 #include "mr_scene.h"
 #include "mr_test.h"
 #include "mr_test_lod.h"
+#include "mr_test_scene.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -159,33 +160,7 @@ static void test_far_cull(void) {
 
 /* A bumpy sphere (radius ~r): curved everywhere, so every level has a real
  * error. */
-static mr_mesh bumpy_sphere(double r, int nu, int nv) {
-    mr_mesh m;
-    memset(&m, 0, sizeof m);
-    snprintf(m.name, sizeof m.name, "bumpy");
-    m.vertex_count = (uint32_t)((nu + 1) * (nv + 1));
-    m.index_count = (uint32_t)(nu * nv * 6);
-    m.positions = malloc((size_t)m.vertex_count * 12);
-    m.indices = malloc((size_t)m.index_count * 4);
-    uint32_t ni = 0;
-    for (int i = 0; i <= nu; i++)
-        for (int j = 0; j <= nv; j++) {
-            double th = 3.14159265358979 * j / nv, ph = 2 * 3.14159265358979 * (i % nu) / nu;
-            double rr = r * (1 + 0.08 * sin(3 * ph) * sin(2 * th));
-            float *p = m.positions + 3 * (size_t)(i * (nv + 1) + j);
-            p[0] = (float)(rr * sin(th) * cos(ph));
-            p[1] = (float)(rr * cos(th));
-            p[2] = (float)(rr * sin(th) * sin(ph));
-        }
-    for (int i = 0; i < nu; i++)
-        for (int j = 0; j < nv; j++) {
-            uint32_t a = (uint32_t)(i * (nv + 1) + j), b = a + (uint32_t)(nv + 1);
-            uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
-            for (int k = 0; k < 6; k++) m.indices[ni++] = q[k];
-        }
-    m.material = -1;
-    return m;
-}
+static mr_mesh bumpy_sphere(double r, int nu, int nv) { return mr_test_sphere_mesh("bumpy", r, nu, nv, 0.08, 3, 2); }
 
 /* A capped cylinder along y (planar strips, planar fans at the caps):
  * exercises the convex-pair and planar-fan bounds. */
@@ -525,17 +500,7 @@ static void test_100k_and_truncation(void) {
         mr_mesh m = bumpy_sphere(0.05 + 0.01 * k, 6 + 2 * k, 4 + k);
         CHECK(mr_scene_add_mesh(s, &m, &err) == k);
     }
-    for (int i = 0; i < 100000; i++) {
-        mr_node n;
-        memset(&n, 0, sizeof n);
-        snprintf(n.name, sizeof n.name, "part_%d", i);
-        n.parent = -1;
-        n.world = mr_m4_translate((i % 400) * 0.5, (i / 400 % 5) * 0.5, (i / 2000) * 0.5);
-        n.mesh_first = i % 4;
-        n.mesh_count = 1;
-        n.layer = i % 50 == 0 ? MR_LAYER_HIDDEN : MR_LAYER_VISIBLE;
-        mr_scene_add_node(s, &n);
-    }
+    mr_test_add_grid_nodes(s, 100000, 4);
     mr_scene_update_bounds(s);
     CHECK(s->node_count == 100000);
     char path[1024];

@@ -18,6 +18,22 @@ static void photos_of(const mr_synth_map *s, mr_map_photo *ph) {
     for (int j = 0; j < s->photo_count; j++) ph[j] = (mr_map_photo){s->dets[j], s->counts[j], NULL};
 }
 
+/* The room's parameters with tags and photos; the set made from them and
+ * its photos as mr_map_build takes them. */
+static mr_synth_map_params room_params(int tags, int photos) {
+    mr_synth_map_params sp = {MR_SYNTH_MAP_DEFAULTS};
+    room(&sp);
+    sp.tags = tags;
+    sp.photos = photos;
+    return sp;
+}
+
+static bool room_make(const mr_synth_map_params *sp, mr_synth_map *s, mr_map_photo *ph, mr_error *err) {
+    if (!mr_synth_map_make(sp, s, err)) return false;
+    photos_of(s, ph);
+    return true;
+}
+
 /* Position error of the mapped tags against the truth, metres: RMS and max;
  * also the RMS of error / predicted sigma (the sigma's calibration). */
 static void map_error(const mr_map_result *r, const mr_marker_map *truth, double *rms, double *max, double *deg,
@@ -44,15 +60,11 @@ static void map_error(const mr_map_result *r, const mr_marker_map *truth, double
 }
 
 static void test_fixed_gauge_and_chaining(void) {
-    mr_synth_map_params sp = {MR_SYNTH_MAP_DEFAULTS};
-    room(&sp);
-    sp.tags = 12;
-    sp.photos = 40;
+    mr_synth_map_params sp = room_params(12, 40);
     mr_synth_map s;
     mr_error err = {0};
-    CHECK(mr_synth_map_make(&sp, &s, &err));
     mr_map_photo ph[128];
-    photos_of(&s, ph);
+    CHECK(room_make(&sp, &s, ph, &err));
     mr_map_params mp = MR_MAP_DEFAULTS;
     mp.tag_size = sp.tag_size;
     mp.fix_id = 0;
@@ -106,19 +118,15 @@ static void test_fixed_gauge_and_chaining(void) {
 }
 
 static void test_disconnected_mixed_misdetect(void) {
-    mr_synth_map_params sp = {MR_SYNTH_MAP_DEFAULTS};
-    room(&sp);
-    sp.tags = 12;
-    sp.photos = 40;
+    mr_synth_map_params sp = room_params(12, 40);
     sp.isolated = 2;
     sp.mixed_sizes = true;
     sp.misdetect = getenv("NOMIS") ? 0 : 0.2;
     sp.seed = 7;
     mr_synth_map s;
     mr_error err = {0};
-    CHECK(mr_synth_map_make(&sp, &s, &err));
     mr_map_photo ph[128];
-    photos_of(&s, ph);
+    CHECK(room_make(&sp, &s, ph, &err));
     int ids[16];
     double sizes[16];
     int ns = 0;
@@ -187,17 +195,13 @@ static void test_disconnected_mixed_misdetect(void) {
 }
 
 static void test_control_points(void) {
-    mr_synth_map_params sp = {MR_SYNTH_MAP_DEFAULTS};
-    room(&sp);
-    sp.tags = 10;
-    sp.photos = 40;
+    mr_synth_map_params sp = room_params(10, 40);
     sp.seed = 3;
     sp.offset = 0;
     mr_synth_map s;
     mr_error err = {0};
-    CHECK(mr_synth_map_make(&sp, &s, &err));
     mr_map_photo ph[128];
-    photos_of(&s, ph);
+    CHECK(room_make(&sp, &s, ph, &err));
     mr_rng rng;
     mr_rng_seed(&rng, 11);
     mr_map_control ctl[5];
@@ -305,15 +309,11 @@ static void test_control_points(void) {
  * length lands near the truth and the map error and the reprojection RMS
  * drop. */
 static void test_refine_intrinsics(void) {
-    mr_synth_map_params sp = {MR_SYNTH_MAP_DEFAULTS};
-    room(&sp);
-    sp.tags = 12;
-    sp.photos = 40;
+    mr_synth_map_params sp = room_params(12, 40);
     mr_synth_map s;
     mr_error err = {0};
-    CHECK(mr_synth_map_make(&sp, &s, &err));
     mr_map_photo ph[128];
-    photos_of(&s, ph);
+    CHECK(room_make(&sp, &s, ph, &err));
     const double factors[2] = {1.04, 0.97};
     for (int k = 0; k < 2; k++) {
         mr_camera wrong = s.camera;

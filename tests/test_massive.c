@@ -5,6 +5,7 @@
  * device exists. */
 #include "mr_render.h"
 #include "mr_test.h"
+#include "mr_test_scene.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -264,31 +265,7 @@ static void test_far_plant(void) {
     mr_scene_destroy(&b);
 }
 
-static mr_mesh sphere(double r, int nu, int nv) {
-    mr_mesh m;
-    memset(&m, 0, sizeof m);
-    m.vertex_count = (uint32_t)((nu + 1) * (nv + 1));
-    m.index_count = (uint32_t)(nu * nv * 6);
-    m.positions = malloc((size_t)m.vertex_count * 12);
-    m.indices = malloc((size_t)m.index_count * 4);
-    uint32_t ni = 0;
-    for (int i = 0; i <= nu; i++)
-        for (int j = 0; j <= nv; j++) {
-            double th = 3.14159265358979 * j / nv, ph = 2 * 3.14159265358979 * (i % nu) / nu;
-            float *p = m.positions + 3 * (size_t)(i * (nv + 1) + j);
-            p[0] = (float)(r * sin(th) * cos(ph));
-            p[1] = (float)(r * cos(th));
-            p[2] = (float)(r * sin(th) * sin(ph));
-        }
-    for (int i = 0; i < nu; i++)
-        for (int j = 0; j < nv; j++) {
-            uint32_t a = (uint32_t)(i * (nv + 1) + j), b = a + (uint32_t)(nv + 1);
-            uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
-            for (int k = 0; k < 6; k++) m.indices[ni++] = q[k];
-        }
-    m.material = -1;
-    return m;
-}
+static mr_mesh sphere(double r, int nu, int nv) { return mr_test_sphere_mesh("", r, nu, nv, 0, 0, 0); }
 
 static void test_lod_tolerance(void) {
     mr_scene *s = mr_scene_create();
@@ -410,17 +387,7 @@ static void test_100k_nodes_frame(void) {
         mr_mesh m = sphere(0.1 + 0.02 * k, 6 + 2 * k, 4 + k);
         mr_scene_add_mesh(s, &m, &err);
     }
-    for (int i = 0; i < 100000; i++) {
-        mr_node n;
-        memset(&n, 0, sizeof n);
-        snprintf(n.name, sizeof n.name, "part_%d", i);
-        n.parent = -1;
-        n.world = mr_m4_translate((i % 400) * 0.5, (i / 400 % 5) * 0.5, (i / 2000) * 0.5);
-        n.mesh_first = i % 4;
-        n.mesh_count = 1;
-        n.layer = i % 50 == 0 ? MR_LAYER_HIDDEN : MR_LAYER_VISIBLE;
-        mr_scene_add_node(s, &n);
-    }
+    mr_test_add_grid_nodes(s, 100000, 4);
     char path[1024];
     snprintf(path, sizeof path, "%s/massive100k.glb", tmp_dir());
     CHECK_MSG(mr_scene_save_glb(s, path, &err), "%s", err.msg);

@@ -12,11 +12,15 @@
  * Skips (77) where no EGL device exists. */
 #include "mr_render.h"
 #include "mr_test.h"
+#include "mr_test_scene.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+
+/* A closed sphere of nu * nv * 2 triangles, bumps so clusters differ. */
+static mr_mesh big_sphere(double r, int nu, int nv) { return mr_test_sphere_mesh("big_sphere", r, nu, nv, 0.03, 7, 5); }
 
 static mr_gpu *g_gpu;
 static mr_renderer *g_r;
@@ -25,35 +29,6 @@ static uint64_t g_rng = 0x9e3779b97f4a7c15ull;
 static double rnd(void) { /* uniform [0, 1) */
     g_rng = g_rng * 6364136223846793005ull + 1442695040888963407ull;
     return (double)(g_rng >> 11) / 9007199254740992.0;
-}
-
-/* A closed sphere of nu * nv * 2 triangles, bumps so clusters differ. */
-static mr_mesh sphere(double r, int nu, int nv) {
-    mr_mesh m;
-    memset(&m, 0, sizeof m);
-    snprintf(m.name, sizeof m.name, "big_sphere");
-    m.vertex_count = (uint32_t)((nu + 1) * (nv + 1));
-    m.index_count = (uint32_t)(nu * nv * 6);
-    m.positions = malloc((size_t)m.vertex_count * 12);
-    m.indices = malloc((size_t)m.index_count * 4);
-    for (int i = 0; i <= nu; i++)
-        for (int j = 0; j <= nv; j++) {
-            double th = 3.14159265358979 * j / nv, ph = 2 * 3.14159265358979 * (i % nu) / nu;
-            double rr = r * (1 + 0.03 * sin(7 * ph) * sin(5 * th));
-            float *p = m.positions + 3 * (size_t)(i * (nv + 1) + j);
-            p[0] = (float)(rr * sin(th) * cos(ph));
-            p[1] = (float)(rr * cos(th));
-            p[2] = (float)(rr * sin(th) * sin(ph));
-        }
-    uint32_t ni = 0;
-    for (int i = 0; i < nu; i++)
-        for (int j = 0; j < nv; j++) {
-            uint32_t a = (uint32_t)(i * (nv + 1) + j), b = a + (uint32_t)(nv + 1);
-            uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
-            for (int k = 0; k < 6; k++) m.indices[ni++] = q[k];
-        }
-    m.material = -1;
-    return m;
 }
 
 /* An open, wavy sheet (both faces visible: the cone test must not run). */
@@ -92,7 +67,7 @@ static mr_scene *big_scene_ex(double ox, bool with_sheet, double sc, bool single
     mr_scene *s = mr_scene_create();
     mr_material mat = {"ball", {0.8f, 0.6f, 0.3f, 1}, -1, single};
     int32_t mt = mr_scene_add_material(s, &mat);
-    mr_mesh a = sphere(2.0 * sc, 160, 80); /* 25.6k triangles */
+    mr_mesh a = big_sphere(2.0 * sc, 160, 80); /* 25.6k triangles */
     a.material = mt;
     int32_t ma = mr_scene_add_mesh(s, &a, &err);
     int32_t mb = -1;
@@ -118,7 +93,7 @@ static mr_scene *big_scene_ex(double ox, bool with_sheet, double sc, bool single
     }
     /* Small balls after the big meshes: their commands follow the
      * meshlets' (a per-node submission must find room for both). */
-    mr_mesh c = sphere(0.2 * sc, 8, 4);
+    mr_mesh c = big_sphere(0.2 * sc, 8, 4);
     int32_t mc = mr_scene_add_mesh(s, &c, &err);
     for (int k = 0; k < 40 && mc >= 0; k++) {
         mr_node n;
@@ -551,7 +526,7 @@ static void test_cluster_occlusion(double ox) {
     mr_scene *s = mr_scene_create();
     mr_material mat = {"ball", {0.8f, 0.6f, 0.3f, 1}, -1, true};
     int32_t mt = mr_scene_add_material(s, &mat);
-    mr_mesh ball = sphere(0.35, 48, 24); /* 2304 triangles: clustered with the threshold below */
+    mr_mesh ball = big_sphere(0.35, 48, 24); /* 2304 triangles: clustered with the threshold below */
     ball.material = mt;
     int32_t mb = mr_scene_add_mesh(s, &ball, &err);
     mr_mesh wall = sheet(1.0, 4);        /* 32 triangles, a unit square */

@@ -658,6 +658,50 @@ static void test_annotation_round_trip(void) {
     }
 }
 
+/* The view's marks as session data (mark.c): a frame copy owns its own
+ * image; the annotation takes the frame's index, time and pose; a mark's
+ * line is written even when its snapshot cannot be, and reads back. */
+static void test_mark_files(void) {
+    mr_capture_frame src = {0}, dst = {0};
+    mr_error err = {0};
+    CHECK(mr_image_alloc(&src.image, 4, 2, 3, MR_PIX_U8, &err));
+    memset(src.image.data, 7, mr_image_bytes(&src.image));
+    src.index = 42;
+    src.timestamp = 4.2;
+    src.pose_valid = src.have_pose = true;
+    src.pose = mr_m4_translate(1, 2, 3);
+    src.tags_seen = 3;
+    src.rms_px = 0.5;
+    CHECK(mr_capture_frame_copy(&dst, &src, &err));
+    CHECK(dst.image.data && dst.image.data != src.image.data && dst.index == 42);
+    ((unsigned char *)src.image.data)[0] = 9;
+    CHECK(dst.image.data && ((unsigned char *)dst.image.data)[0] == 7);
+    mr_annotation m;
+    mr_annotation_from_frame(&m, &src, "extra", 1000);
+    CHECK(!strcmp(m.type, "discrepancy") && !strcmp(m.note, "extra") && m.frame_index == 42 && m.timestamp == 4.2);
+    CHECK(m.has_pose && m.pose_valid && m.world_from_camera.m[3] == 1 && m.pose_tags_seen == 3 && m.node_index == -1);
+    char dir[1200];
+    tmp_path("marks", dir, sizeof dir);
+    mr_camera cam = {4, 2, 4, 4, 1.5, 0.5, {0}};
+    mr_image none = {0};
+    mr_snapshot sn = {&none, &dst, &cam, 0.5, "gbuffer"};
+    cJSON *line = mr_annotation_to_json(&m);
+    bool snap_ok = true;
+    mr_error serr = {0};
+    CHECK_MSG(mr_mark_save(dir, "mark_1", line, &sn, &snap_ok, &serr, &err), "%s", err.msg);
+    CHECK_MSG(!snap_ok && serr.msg[0], "a snapshot without a screen was written");
+    cJSON_Delete(line);
+    char path[1300];
+    snprintf(path, sizeof path, "%s/annotations.jsonl", dir);
+    mr_annotations a = {0};
+    CHECK(mr_annotations_load(path, &a, &err));
+    CHECK_MSG(a.count == 1 && a.items[0].frame_index == 42 && !strcmp(a.items[0].note, "extra"),
+              "mark line: %d read back", a.count);
+    mr_annotations_free(&a);
+    mr_capture_frame_free(&src);
+    mr_capture_frame_free(&dst);
+}
+
 int main(void) {
     if (!mr_test_fresh_dir("test_session", g_tmp, sizeof g_tmp)) return 1;
     test_round_trip();
@@ -668,5 +712,6 @@ int main(void) {
     test_annotations_reader();
     test_annotation_uncertainty();
     test_annotation_round_trip();
+    test_mark_files();
     return mr_test_finish("test_session");
 }

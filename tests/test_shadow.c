@@ -842,6 +842,44 @@ static void catcher(mr_renderer *r) {
     mr_scene_destroy(&s);
 }
 
+/* The map reuse key includes hide_hidden_layer: an occluder on the hidden
+ * layer casts while that layer is drawn and not when it is left out, so a
+ * frozen camera that toggles it must redraw the map each time (a kept map
+ * would show the other setting's shadow). */
+static void hidden_layer_key(mr_renderer *r) {
+    world w = {1, {0, 0, 0}};
+    mr_scene *s = square_scene(&w);
+    s->nodes[1].layer = MR_LAYER_HIDDEN; /* the occluder */
+    mr_view v = look(&w, mr_v3(2.6, 0.7, 0.4), mr_v3(0.2, 0, 0), mr_v3(0, 1, 0));
+    mr_error err = {0};
+    CHECK_MSG(mr_renderer_set_scene(r, s, &err), "%s", err.msg);
+    static const bool hide[4] = {false, true, false, true};
+    for (int i = 0; i < 4; i++) {
+        mr_frame_params p = MR_FRAME_DEFAULTS;
+        p.shadow.method = MR_SHADOW_HARD;
+        p.shadow.want_shadow = true;
+        p.hide_hidden_layer = hide[i];
+        p.want_depth = true;
+        mr_frame_result res;
+        if (!mr_render_frame(r, &v, &p, &res, &err)) {
+            CHECK_MSG(false, "hidden layer key: %s", err.msg);
+            continue;
+        }
+        char passes[256];
+        mr_frame_result_passes(&res, passes, sizeof passes);
+        double in = res.shadow.data && res.depth.data ? vis_at(&w, &v, &res.shadow, 0.3, 0.2) : -1;
+        printf("  hidden occluder, hide_hidden_layer %d: V(0.3, 0.2) = %.2f, reused %d\n", (int)hide[i], in,
+               (int)res.shadow_reused);
+        CHECK_MSG(!res.shadow_reused && strstr(passes, "shadow_map"), "frame %d reused the other setting's map: %s", i,
+                  passes);
+        if (hide[i]) CHECK_MSG(in > 0.99, "hidden layer left out, yet it casts: V = %.2f", in);
+        else CHECK_MSG(in >= 0 && in < 0.01, "hidden layer drawn, yet no shadow: V = %.2f", in);
+        mr_frame_result_free(&res);
+    }
+    mr_renderer_set_scene(r, NULL, NULL);
+    mr_scene_destroy(&s);
+}
+
 /* The bench at a tiny size: its files, its header, one row per setting;
  * and the suite's cases all build with a casting light. */
 static void bench_and_suite(mr_gpu *gpu, mr_renderer *r) {
@@ -907,6 +945,7 @@ int main(void) {
         scales(r);
         cascades(r);
         catcher(r);
+        hidden_layer_key(r);
         bench_and_suite(gpu, r);
     }
     mr_renderer_destroy(&r);

@@ -968,6 +968,30 @@ static void test_script(void) {
     CHECK_MSG(t_state >= 0.3 && t_quit >= 0.5 && t_quit > t_state, "script commands ran early or out of order "
               "(state at %.3f s, quit at %.3f s)", t_state, t_quit);
     mr_viewer_destroy(&r.v);
+    /* `frame N`: what follows waits until frame N is shown, however late
+     * (a loaded machine plays slowly); a frame already past goes on at once. */
+    write_text(sp, "0.1 frame 7\n0.2 quit\n");
+    s = mr_view_script_load(sp, &err);
+    CHECK_MSG(s != NULL, "script with frame: %s", err.msg);
+    if (s && rig_open(&r, NULL, 96 / 25.4, &err)) {
+        mr_viewer_set_script(r.v, &s);
+        double t_q = -1;
+        for (int i = 0; i < 2000 && t_q < 0; i++) {
+            if (i == 600) r.f.index = 6;  /* 10 s in: still short of 7 */
+            if (i == 1200) r.f.index = 9; /* 20 s in: past 7 */
+            step(&r);
+            if (count(&r, MR_VA_QUIT, NULL)) t_q = r.t;
+        }
+        CHECK_MSG(t_q > 20, "script `frame 7` did not wait for frame 7 (quit at %.2f s)", t_q);
+        CHECK_MSG(t_q > 0 && t_q < 21, "script `frame 7` went on late or never (quit at %.2f s)", t_q);
+        mr_viewer_destroy(&r.v);
+    }
+    mr_view_script_destroy(&s);
+    write_text(sp, "0.1 frame\n");
+    memset(&err, 0, sizeof err);
+    s = mr_view_script_load(sp, &err);
+    CHECK_MSG(s == NULL && err.code == MR_ERR_PARSE, "`frame` without N was taken");
+    mr_view_script_destroy(&s);
     /* A bad line names the file and line. */
     write_text(sp, "0.1 tap @video\n0.2 fly 1 2\n");
     memset(&err, 0, sizeof err);
@@ -980,6 +1004,47 @@ static void test_script(void) {
     CHECK(!mr_view_key_parse("nokey", &k));
 }
 
+/* The frame's shadow method (mark.c): the scene config's over the saved
+ * setting, --shadows over both, the C key over all once it changed the
+ * setting; an unknown scene name is off. And a tap's picture pixel. */
+static void test_shadow_choice_and_taps(void) {
+    mr_view_shadow_choice c = {.start = MR_SHADOW_OFF};
+    CHECK(mr_view_shadow_choose(&c, MR_SHADOW_OFF, NULL) == MR_SHADOW_OFF);
+    CHECK(mr_view_shadow_choose(&c, MR_SHADOW_OFF, "pcss") == MR_SHADOW_PCSS);
+    CHECK(mr_view_shadow_choose(&c, MR_SHADOW_OFF, "soft") == MR_SHADOW_OFF);
+    c.given = true;
+    c.flag = MR_SHADOW_HARD;
+    CHECK(mr_view_shadow_choose(&c, MR_SHADOW_OFF, "pcss") == MR_SHADOW_HARD);
+    CHECK(!c.keyed);
+    CHECK(mr_view_shadow_choose(&c, MR_SHADOW_PCF, "pcss") == MR_SHADOW_PCF && c.keyed);
+    /* keyed stays: back to the start value is still the key's choice */
+    CHECK(mr_view_shadow_choose(&c, MR_SHADOW_OFF, "pcss") == MR_SHADOW_OFF);
+    double u = 0, v = 0, px = 0, py = 0;
+    mr_ui_rect r = mr_ui_rect_make(100, 50, 320, 240);
+    CHECK(!mr_view_window_to_image(r, 160, 120, 99, 60, &u, &v));
+    CHECK(mr_view_window_to_image(r, 160, 120, 260, 170, &u, &v));
+    CHECK_NEAR(u, 79.5, 1e-12);
+    CHECK_NEAR(v, 59.5, 1e-12);
+    mr_camera cam = {640, 480, 500, 500, 319.5, 239.5, {0}};
+    mr_view_image_to_camera(&cam, 160, 120, u, v, &px, &py);
+    CHECK_NEAR(px, 319.5, 1e-12);
+    CHECK_NEAR(py, 239.5, 1e-12);
+    /* A finished measurement's mark: at the measured point's pixel (the
+     * centre when it is behind the camera), its point the planned one. */
+    mr_dmat4 pose = mr_m4_identity();
+    mr_view_planned planned = {true, mr_v3(0.1, 0, 2), 3, MR_LAYER_HIDDEN};
+    mr_view_mark_at at;
+    mr_view_measure_mark(&cam, 640, 480, &pose, mr_v3(0.2, -0.1, 2), &planned, &at);
+    CHECK_NEAR(at.px, 319.5 + 500 * 0.1, 1e-9);
+    CHECK_NEAR(at.py, 239.5 - 500 * 0.05, 1e-9);
+    CHECK_NEAR(at.note_u, (at.px + 0.5) / 640, 1e-6);
+    CHECK(at.pick.hit && at.pick.node == 3 && at.pick.layer == MR_LAYER_HIDDEN);
+    CHECK_NEAR(at.pick.depth, 2, 1e-12);
+    planned.found = false;
+    mr_view_measure_mark(&cam, 640, 480, &pose, mr_v3(0, 0, -1), &planned, &at);
+    CHECK(!at.pick.hit && at.pick.node == -1 && at.px == 319.5 && at.py == 239.5);
+}
+
 int main(void) {
     const char *t = getenv("MR_TEST_TMP");
     snprintf(g_tmp, sizeof g_tmp, "%s/test_view", t && t[0] ? t : "/tmp");
@@ -987,6 +1052,7 @@ int main(void) {
     CHECK_MSG(mr_mkdirs(g_tmp, &err), "%s", err.msg);
     test_tracking_lost();
     test_settings();
+    test_shadow_choice_and_taps();
     char font[1024];
     if (!mr_ui_font_find(font, sizeof font, &err)) {
         printf("test_view: SKIPPED the controller tests (no font): %s\n", err.msg);

@@ -249,6 +249,18 @@ extern const mr_opt mr_synth_recording_opts[];
 bool mr_demo_marks(const char *dir, const mr_bench_gpu *g, const mr_scene *built, const mr_scene *planned,
                    mr_error *err);
 bool mr_synth_calibration(const char *dir, int images, mr_error *err);
+/* The first parts of `mrcheck demo` (demo_files.c). Files: dir/ and its
+ * frames/ overlay/ virtual/ views/ folders, both halls as .glb with
+ * scene_planned.json and scene_built.json, markers.json, discrepancies.json,
+ * camera.json and views/view_NNN.json; views (MR_DEMO_VIEWS) and the count
+ * of known discrepancies out. */
+bool mr_demo_write_files(const char *dir, mr_view *views, int *discrepancy_count, mr_error *err);
+/* Frames: per view, the hall as built rendered wide and made a camera frame
+ * (frames/frame_NNN.png), the planned model over it at alpha 0.5
+ * (overlay/overlay_NNN.png) and alone (virtual/virtual_NNN.png). Leaves the
+ * planned scene set on g's renderer. */
+bool mr_demo_render_frames(const char *dir, const mr_bench_gpu *g, const mr_scene *built, const mr_scene *planned,
+                           const mr_view *views, mr_error *err);
 
 /* ------------------------------------------------------------ multiview */
 

@@ -472,6 +472,10 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
 void mr_frame_result_free(mr_frame_result *res);
 /* "gbuffer shade overlay" — the pass list as one line. */
 void mr_frame_result_passes(const mr_frame_result *res, char *buf, size_t n);
+/* The frame's auxiliary buffers, those it has, into dir (created):
+ * depth.pfm (linear view depth), normal.pfm, ao.pfm (1 = unoccluded),
+ * shadow.pfm (frame_files.c). */
+bool mr_frame_result_save_aux(const char *dir, const mr_frame_result *res, mr_error *err);
 
 /* ------------------------------------------------------- multi-view rigs
  * Views for 3D displays (lib/render/multiview.c; pure functions, no GL).

@@ -95,6 +95,7 @@ typedef struct map_key {
     int cascades;
     int rig_views;         /* issue 14: a rig frame's maps, fitted to all its views */
     mr_dmat4 rig_outer;    /* its last view (with world_from_camera: the first) */
+    bool hide_hidden;      /* the hidden layer casts only while it is drawn */
 } map_key;
 
 struct mr_shadow_state {
@@ -163,6 +164,7 @@ static void make_key(const frame *f, map_key *k) {
     k->map_size = map_size(&f->p->shadow);
     k->light_scale = light_scale(&f->p->shadow);
     k->cascades = f->p->shadow.cascades;
+    k->hide_hidden = f->p->hide_hidden_layer;
 }
 
 static bool reusable(const frame *f) {

@@ -329,6 +329,8 @@ void mr_capture_stop(mr_capture **c);
 bool mr_capture_latest(mr_capture *c, mr_capture_frame *f);
 void mr_capture_frame_free(mr_capture_frame *f);
 mr_capture_status mr_capture_state(mr_capture *c, char *msg, size_t n);
+/* "starting", "running", "no_camera", "ended" (the view's state snapshot). */
+const char *mr_capture_status_name(mr_capture_status st);
 bool mr_capture_seekable(mr_capture *c);   /* replay: seek, step, rate */
 /* Replay controls (ignored for live input). */
 void mr_capture_play(mr_capture *c, bool playing);
@@ -363,6 +365,23 @@ bool mr_snapshot_write(const char *session_dir, const char *stem, const mr_snaps
 /* The next "<prefix>_NNNN" (counting on from *counter, which it advances)
  * whose <stem>.json no earlier session wrote, into stem: never overwrite. */
 void mr_snapshot_next_stem(const char *session_dir, const char *prefix, int *counter, char *stem, size_t n);
+
+/* ----------------------------------------------- the view's marks (mark.c) */
+
+/* A deep copy of src (its image too) into dst, whose image is freed first;
+ * false + err (dst without an image) when out of memory. */
+bool mr_capture_frame_copy(mr_capture_frame *dst, const mr_capture_frame *src, mr_error *err);
+/* A "discrepancy" annotation of a mark made on frame f with note: the
+ * frame's index, time and pose; the rest zero (node_index -1) for the
+ * caller to fill (pixel, pick, uncertainty, measurement). */
+void mr_annotation_from_frame(mr_annotation *m, const mr_capture_frame *f, const char *note, double time_unix);
+/* A finished mark's files: the snapshot (sn) as session_dir/snapshots/<stem>_*
+ * and line, with the snapshot's paths under "snapshot", appended to
+ * session_dir/annotations.jsonl. The line is written even when the snapshot
+ * fails (*snapshot_ok false, snapshot_err says why): the mark matters more.
+ * False + err when the line could not be saved. */
+bool mr_mark_save(const char *session_dir, const char *stem, cJSON *line, const mr_snapshot *sn, bool *snapshot_ok,
+                  mr_error *snapshot_err, mr_error *err);
 
 #ifdef __cplusplus
 }

@@ -143,6 +143,11 @@ bool mr_study_plan_load(const char *path, mr_study_plan *plan, mr_error *err);
 void mr_study_plan_free(mr_study_plan *plan);
 /* DIR/<method>/<stimulus>.png of a trial's method m. */
 void mr_study_plan_image(const mr_study_plan *plan, int stimulus, int method, char *out, size_t n);
+/* Every stimulus image of the plan (method x stimulus, index
+ * method * stimulus_count + stimulus), RGB; false + err (nothing kept) when
+ * one cannot be read or differs in size from the first (images.c). */
+bool mr_study_images_load(const mr_study_plan *plan, mr_image **out, mr_error *err);
+void mr_study_images_free(const mr_study_plan *plan, mr_image **images); /* NULLs *images */
 
 /* --------------------------------------------------------------- votes */
 
@@ -193,6 +198,18 @@ bool mr_study_votes_seal(const char *path, mr_error *err);
  * or votes that do not match the plan's trials. */
 int mr_study_resume(const mr_study_plan *plan, const mr_study_votes *votes, const char *participant, bool *answered,
                     mr_error *err);
+/* The same from the votes file (a missing one: nothing answered), with the
+ * count answered and whether the file ends in a torn line (seal it with
+ * mr_study_votes_seal before the first append) (resume.c). */
+typedef struct mr_study_resume_point {
+    bool *answered;           /* plan->trial_count entries, owned */
+    int first;                /* the first unanswered trial; trial_count when done */
+    int answered_count;
+    bool torn_tail;
+} mr_study_resume_point;
+bool mr_study_resume_open(const mr_study_plan *plan, const char *votes_path, const char *participant,
+                          mr_study_resume_point *out, mr_error *err);
+void mr_study_resume_point_free(mr_study_resume_point *p);
 
 /* ---------------------------------------------------------- statistics */
 

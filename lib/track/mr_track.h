@@ -252,6 +252,26 @@ void mr_map_result_report(const mr_map_result *r, const mr_map_params *params, c
 bool mr_map_controls_parse(const char *text, size_t size, mr_map_control **out, int *count, mr_error *err);
 bool mr_map_controls_load(const char *path, mr_map_control **out, int *count, mr_error *err);
 
+/* What `mrcheck map` gathers for mr_map_build (map_photos.c). */
+/* "id=size,id=size" (ids >= 0, sizes > 0) into malloc'd arrays; false on a
+ * bad list (the arrays may still be allocated: the caller frees them). */
+bool mr_map_tag_sizes_parse(const char *s, int **ids, double **sizes, int *n);
+/* {"world_from_tag": [16]}, rigid; false + err naming the file. */
+bool mr_map_fix_pose_load(const char *path, mr_dmat4 *out, mr_error *err);
+/* Every photo's detections (mr_detect_each over input), as mr_map_build
+ * takes them; the first photo's size rescales *cam's intrinsics. on_photo
+ * (may be NULL) is told the count after each photo. The set is filled as
+ * far as it got even on failure: free it with mr_map_photo_set_free. */
+typedef struct mr_map_photo_set {
+    mr_detection **dets;
+    mr_map_photo *photos;
+    char (*names)[256];
+    int n;
+} mr_map_photo_set;
+bool mr_map_photos_detect(const char *input, const char *family, const char *who, mr_camera *cam,
+                          void (*on_photo)(void *user, int n), void *user, mr_map_photo_set *out, mr_error *err);
+void mr_map_photo_set_free(mr_map_photo_set *ps);
+
 /* ------------------------------------------------------------------ pose */
 
 typedef struct mr_pose_params {

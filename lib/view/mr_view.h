@@ -13,7 +13,9 @@
  * names (mr_event, MR_KEY_*, mr_ao_method, mr_ghost_mode,
  * mr_ao_method_name/parse, the option tables' enum names): no GL or GLFW call. One way only: nothing
  * below lib/view includes this header.
- */
+ * mark.c (the marking and render decisions moved out of app/cmd_view.c)
+ * adds lib/track's mr_project_point and lib/render's plain mr_pick,
+ * mr_frame_params and mr_shadow_method_parse. */
 #ifndef MR_VIEW_CTL_H
 #define MR_VIEW_CTL_H
 
@@ -288,6 +290,64 @@ bool mr_viewer_measurement(const mr_viewer *v, mr_measurement *out);
  * shown to the planner and kept in the measurement. */
 void mr_viewer_measure_distance(mr_viewer *v, mr_dvec3 planned, double dist_m, double sigma_m, const char *node);
 
+/* ----------------------------------------- marking and rendering (mark.c) */
+
+/* A window position (framebuffer px) in the picture shown at image_rect,
+ * rendered at rw x rh: the rendered image's pixel (OpenCV convention);
+ * false outside the picture. */
+bool mr_view_window_to_image(mr_ui_rect image_rect, int rw, int rh, double x, double y, double *u, double *v);
+/* That pixel in the camera's own resolution (ideal pinhole), as marks store it. */
+void mr_view_image_to_camera(const mr_camera *cam, int rw, int rh, double u, double v, double *px, double *py);
+
+/* The planned surface's point nearest to a measurement (lib/eval's
+ * mr_nearest_hit, as plain data). */
+typedef struct mr_view_planned {
+    bool found;
+    mr_dvec3 point;            /* world, scene units */
+    int node;                  /* -1: none */
+    int layer;                 /* that node's layer */
+} mr_view_planned;
+/* Where the mark of a finished measurement goes. */
+typedef struct mr_view_mark_at {
+    double px, py;             /* the measured point in the frame (ideal pinhole; the centre if behind) */
+    mr_pick pick;              /* the planned point, when found; else no hit, node -1 */
+    float note_u, note_v;      /* for mr_viewer_note_open: fractions of the picture */
+} mr_view_mark_at;
+/* cam: the camera (resized here to the frame's image_w x image_h). */
+void mr_view_measure_mark(const mr_camera *cam, int image_w, int image_h, const mr_dmat4 *world_from_camera,
+                          mr_dvec3 measured, const mr_view_planned *planned, mr_view_mark_at *out);
+
+/* The shadow method of a frame: the C key's once it changed the saved
+ * setting (start), else --shadows (given, flag), else the scene config's
+ * ("" none; an unknown name: off), else the saved setting. */
+typedef struct mr_view_shadow_choice {
+    mr_shadow_method start;    /* the saved setting at start */
+    bool keyed;                /* the C key changed it (set by mr_view_shadow_choose) */
+    bool given;                /* --shadows */
+    mr_shadow_method flag;
+} mr_view_shadow_choice;
+mr_shadow_method mr_view_shadow_choose(mr_view_shadow_choice *c, mr_shadow_method setting, const char *scene_method);
+/* What the settings set in a frame's parameters: the hidden layer, the AO
+ * method, the ghosting mode, and the shadow method given. */
+void mr_view_frame_params(const mr_view_settings *s, mr_shadow_method shadows, mr_frame_params *fp);
+
+/* What only the window knows, for a `state` snapshot. */
+typedef struct mr_view_window_state {
+    int marks, snapshots;
+    const char *source_state, *source_message, *scene_message;
+    const mr_image *screen;    /* the screen as read back, or NULL */
+    bool have_render;          /* a rendered picture with a pose: the fields below */
+    int render_w, render_h;
+    double diff_to_model, diff_to_video; /* mean |difference| of the picture to the
+                                            alpha 0 and alpha 1 renderings (-1: failed) */
+} mr_view_window_state;
+/* Adds it to j (mr_viewer_state_json's object): "marks", "snapshots",
+ * "source_state", "source_message", "scene_message", the screen's
+ * "screen_mean" and "screen_std" (a blank window has no spread), and with a
+ * render "render_width", "render_height", "diff_to_model", "diff_to_video"
+ * (which way the slider moved the picture). */
+void mr_view_state_add_window(cJSON *j, const mr_view_window_state *w);
+
 /* ---------------------------------------------------------------- script */
 
 /* A script of timed input: one command per line, `T COMMAND ARGS`, T in
@@ -297,6 +357,9 @@ void mr_viewer_measure_distance(mr_viewer *v, mr_dvec3 planned, double dist_m, d
  *   drag @slider F0 F1         (fractions of the slider's width)
  *   key K                      (a character, or esc enter left right up down home end f1 f11 space tab)
  *   resize W H | shot OUT.png | state OUT.json | quit
+ *   frame N                    (the commands after it wait, up to 60 s, until
+ *                               frame N or a later one is shown: play tests
+ *                               that do not depend on the machine's speed)
  * Input enters the controller's queue, the path real input takes. */
 typedef struct mr_view_script mr_view_script;
 /* NULL + err (MR_ERR_IO, or MR_ERR_PARSE naming the line) on a bad file. */

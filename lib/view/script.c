@@ -53,6 +53,7 @@ static bool parse_line(const char *path, int line_no, char *line, script_cmd *c,
     else if (!strcmp(op, "shot")) c->op = S_SHOT, ok = na >= 1;
     else if (!strcmp(op, "state")) c->op = S_STATE, ok = na >= 1;
     else if (!strcmp(op, "quit")) c->op = S_QUIT, ok = true;
+    else if (!strcmp(op, "frame")) c->op = S_FRAME, ok = na >= 1 && !target && c->a >= 0;
     else ok = false;
     if ((c->op == S_SHOT || c->op == S_STATE) && na >= 1) snprintf(c->path, sizeof c->path, "%s", arg[0]);
     if (!ok) return mr_fail(err, MR_ERR_PARSE, "%s:%d: bad command '%s'", path, line_no, op);
@@ -112,6 +113,9 @@ static void push(mr_viewer *v, mr_event_type t, double x, double y) {
 
 /* How long a command naming a widget waits for it to be shown. */
 #define MR_VIEW_SCRIPT_WIDGET_WAIT_S 10.0
+/* How long `frame N` waits for the picture to reach frame N: generous, as
+ * a loaded machine may play a recording far slower than its rate. */
+#define MR_VIEW_SCRIPT_FRAME_WAIT_S 60.0
 
 void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out) {
     if (!v->script || v->script_next >= v->script->count) return;
@@ -139,6 +143,10 @@ void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out) {
          * machine: wait for it, for a while. */
         if (id < 0 && v->now - v->script_t0 - c->t < MR_VIEW_SCRIPT_WIDGET_WAIT_S) return;
     }
+    /* `frame N`: the commands after it wait until frame N (or later) is
+     * shown, so a test of play does not depend on how fast the machine is. */
+    bool frame_reached = v->f.have_frame && v->f.index >= (int64_t)c->a;
+    if (c->op == S_FRAME && !frame_reached && v->now - v->script_t0 - c->t < MR_VIEW_SCRIPT_FRAME_WAIT_S) return;
     v->script_next++;
     v->script_frame = v->frames;
     if (c->target[0]) {
@@ -184,5 +192,8 @@ void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out) {
     case S_SHOT: vw_emit(out, MR_VA_SHOT)->path = c->path; break;
     case S_STATE: vw_emit(out, MR_VA_STATE)->path = c->path; break;
     case S_QUIT: vw_emit(out, MR_VA_QUIT); break;
+    case S_FRAME:
+        if (!frame_reached) mr_log(MR_LOG_WARN, "view: script: frame %.0f not shown in %.0f s", c->a, MR_VIEW_SCRIPT_FRAME_WAIT_S);
+        break;
     }
 }

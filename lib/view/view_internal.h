@@ -6,7 +6,7 @@
 #include "mr_view.h"
 #include "mr_track.h"
 
-typedef enum script_op { S_TAP, S_DOWN, S_UP, S_MOVE, S_DRAG, S_KEY, S_RESIZE, S_SHOT, S_STATE, S_QUIT } script_op;
+typedef enum script_op { S_TAP, S_DOWN, S_UP, S_MOVE, S_DRAG, S_KEY, S_RESIZE, S_SHOT, S_STATE, S_QUIT, S_FRAME } script_op;
 
 typedef struct script_cmd {
     double t;

@@ -1,0 +1,76 @@
+/* The view's marking and render decisions as plain data (no GL, no
+ * window): where a tap lands in the picture and the camera image, where a
+ * finished measurement's mark goes, which shadow method a frame uses and
+ * the frame parameters the settings give. app/cmd_view.c carries them out. */
+#include "view_internal.h"
+
+#include <string.h>
+
+bool mr_view_window_to_image(mr_ui_rect image_rect, int rw, int rh, double x, double y, double *u, double *v) {
+    mr_ui_rect r = image_rect;
+    if (!mr_ui_rect_contains(r, (float)x, (float)y)) return false;
+    *u = (x - r.x) * rw / r.w - 0.5;
+    *v = (y - r.y) * rh / r.h - 0.5;
+    return true;
+}
+
+void mr_view_image_to_camera(const mr_camera *cam, int rw, int rh, double u, double v, double *px, double *py) {
+    *px = (u + 0.5) * cam->width / rw - 0.5;
+    *py = (v + 0.5) * cam->height / rh - 0.5;
+}
+
+void mr_view_measure_mark(const mr_camera *cam, int image_w, int image_h, const mr_dmat4 *world_from_camera,
+                          mr_dvec3 measured, const mr_view_planned *planned, mr_view_mark_at *out) {
+    /* The picture is shown undistorted: project with the pinhole. */
+    mr_camera pin = mr_camera_resized(cam, image_w, image_h);
+    memset(pin.dist, 0, sizeof pin.dist);
+    double u = pin.cx, v = pin.cy;
+    if (!mr_project_point(&pin, world_from_camera, measured, &u, &v)) u = pin.cx, v = pin.cy;
+    memset(&out->pick, 0, sizeof out->pick);
+    out->pick.node = -1;
+    if (planned && planned->found) {
+        /* The mark's point: where the model is nearest to what was built. */
+        mr_dmat4 cfw = mr_m4_invert_rigid(world_from_camera);
+        out->pick = (mr_pick){true, planned->point, mr_m4_point(&cfw, planned->point).z, planned->node, planned->layer};
+    }
+    out->px = u;
+    out->py = v;
+    out->note_u = (float)((u + 0.5) / pin.width);
+    out->note_v = (float)((v + 0.5) / pin.height);
+}
+
+mr_shadow_method mr_view_shadow_choose(mr_view_shadow_choice *c, mr_shadow_method setting, const char *scene_method) {
+    mr_shadow_method m = setting;
+    if (m != c->start) c->keyed = true;
+    if (c->keyed) return m;
+    if (c->given) return c->flag;
+    if (scene_method && scene_method[0] && !mr_shadow_method_parse(scene_method, &m)) m = MR_SHADOW_OFF;
+    return m;
+}
+
+void mr_view_frame_params(const mr_view_settings *s, mr_shadow_method shadows, mr_frame_params *fp) {
+    fp->hide_hidden_layer = s->hide_hidden;
+    fp->ao.method = s->ao;
+    fp->ghost.mode = s->ghost;
+    fp->shadow.method = shadows;
+}
+
+void mr_view_state_add_window(cJSON *j, const mr_view_window_state *w) {
+    cJSON_AddNumberToObject(j, "marks", w->marks);
+    cJSON_AddNumberToObject(j, "snapshots", w->snapshots);
+    cJSON_AddStringToObject(j, "source_state", w->source_state ? w->source_state : "");
+    cJSON_AddStringToObject(j, "source_message", w->source_message ? w->source_message : "");
+    cJSON_AddStringToObject(j, "scene_message", w->scene_message ? w->scene_message : "");
+    if (w->screen && w->screen->data) {
+        double mean, std;
+        mr_image_u8_stats(w->screen, &mean, &std);
+        cJSON_AddNumberToObject(j, "screen_mean", mean);
+        cJSON_AddNumberToObject(j, "screen_std", std);
+    }
+    if (w->have_render) {
+        cJSON_AddNumberToObject(j, "render_width", w->render_w);
+        cJSON_AddNumberToObject(j, "render_height", w->render_h);
+        cJSON_AddNumberToObject(j, "diff_to_model", w->diff_to_model);
+        cJSON_AddNumberToObject(j, "diff_to_video", w->diff_to_video);
+    }
+}
