@@ -605,6 +605,64 @@ static void test_100k_and_truncation(void) {
     mr_scene_destroy(&s);
 }
 
+/* The projected-patch bound (lod.c, patch_bound) claims a piece lies over
+ * the other surface; the claim is proven from the patch's border edges. A
+ * coarse plate (two triangles) over a fine one with a hole, a slit, a hole
+ * with a separate sheet under it, and cells wound the other way: each bound
+ * holds against brute force, at scales 1e-3, 1 and 1e3. Without the border
+ * check the hole would be bounded by the heights alone (0). */
+static void test_lod_patch_holes(void) {
+    const int n = 21;
+    const double scales[3] = {1e-3, 1, 1e3};
+    for (int cs = 0; cs < 4; cs++)
+        for (int si = 0; si < 3; si++) {
+            double sc = scales[si];
+            mr_mesh m = plate(n, 16);
+            /* A small sheet under the hole (case 2): 4 x 4 vertices, 1 cm below. */
+            uint32_t base = (uint32_t)(n * n);
+            for (int j = 0; j < 4; j++)
+                for (int i = 0; i < 4; i++) {
+                    float *q = m.positions + 3 * (size_t)(base + (uint32_t)(j * 4 + i));
+                    q[0] = (float)(-0.15 - 0.075 + 0.05 * i);
+                    q[1] = -0.01f;
+                    q[2] = (float)(0.1 - 0.075 + 0.05 * j);
+                }
+            for (uint32_t v = 0; v < m.vertex_count * 3; v++) m.positions[v] = (float)(m.positions[v] * sc);
+            uint32_t *fine = malloc(((size_t)m.index_count + 64) * 4), nf = 0;
+            for (int j = 0; j + 1 < n; j++)
+                for (int i = 0; i + 1 < n; i++) {
+                    const uint32_t *c6 = m.indices + 6 * (size_t)(j * (n - 1) + i);
+                    /* Centred at (-0.15, 0.1): not a dyadic point, so no
+                     * midpoint the bound queries lands on it by luck. */
+                    bool hole = (cs == 0 || cs == 2) && i >= 6 && i <= 7 && j >= 11 && j <= 12;
+                    bool slit = cs == 1 && i == 10;
+                    if (hole || slit) continue;
+                    bool flip = cs == 3 && i >= 8 && i <= 11 && j >= 8 && j <= 11;
+                    for (int k = 0; k < 6; k++) fine[nf++] = c6[flip ? (k / 3) * 3 + 2 - k % 3 : k];
+                }
+            if (cs == 2)
+                for (int j = 0; j < 3; j++)
+                    for (int i = 0; i < 3; i++) {
+                        uint32_t a = base + (uint32_t)(j * 4 + i), b = a + 1, c = a + 4, d = c + 1;
+                        const uint32_t q6[6] = {a, c, b, b, c, d};
+                        for (int k = 0; k < 6; k++) fine[nf++] = q6[k];
+                    }
+            const uint32_t c00 = 0, c10 = (uint32_t)(n - 1), c01 = (uint32_t)(n * (n - 1)), c11 = (uint32_t)(n * n - 1);
+            const uint32_t coarse[6] = {c00, c01, c10, c10, c01, c11};
+            double res = 1e-4 * sc;
+            double e = mr_lod_hausdorff_bound(m.positions, m.vertex_count, coarse, 6, fine, nf, res, 10 * sc);
+            double brute = mr_test_sampled_distance(m.positions, coarse, 6, fine, nf, 40);
+            const double truth[4] = {0.05, 0.025, 0.01, 0};
+            CHECK_MSG(brute >= 0.9 * truth[cs] * sc, "patch case %d scale %g: sampled %g, expected about %g", cs, sc, brute,
+                      truth[cs] * sc);
+            CHECK_MSG(e >= brute - 1e-9 * sc, "patch case %d scale %g: bound %g below sampled %g", cs, sc, e, brute);
+            CHECK_MSG(e <= 1.2 * brute + 4 * res, "patch case %d scale %g: bound %g, sampled %g", cs, sc, e, brute);
+            free(fine);
+            free(m.positions);
+            free(m.indices);
+        }
+}
+
 int main(void) {
     mr_error err;
     mr_mkdirs(tmp_dir(), &err);
@@ -614,6 +672,7 @@ int main(void) {
     RUN(test_far_cull);
     RUN(test_lod_bound);
     RUN(test_lod_lost_protrusion);
+    RUN(test_lod_patch_holes);
     RUN(test_lod_cache);
     RUN(test_synth_roundtrip);
     RUN(test_100k_and_truncation);

@@ -17,7 +17,11 @@
  *    neighbour folded flat about the shared edge (hinge), a planar fan, the
  *    1-ring of a vertex projected onto its plane (curved surfaces). The
  *    smallest of these over a few candidates (the corners' nearest
- *    triangles) bounds T. Only where it exceeds what is enough (the level's
+ *    triangles) bounds T; so does a projected patch (the other surface's
+ *    triangles under T, projected onto T's plane, proven to cover T from
+ *    their border edges: the distance is at most their height over T),
+ *    the bound that handles chords of curved surfaces and re-triangulated
+ *    regions in one piece. Only where it exceeds what is enough (the level's
  *    error budget, or L + a quarter) is T split (in four if thin, else
  *    across its longest edge) and the pieces bounded again.
  *
@@ -119,6 +123,25 @@ typedef struct tri_grid {
      * NAN: not prepared yet). */
     double *ring_n, *ring_s;
     uint32_t *vt_start, *vt_items; /* triangles around each vertex (CSR) */
+    /* Cheap lower bounds that let a bound which cannot hold be skipped
+     * before its point-triangle distances are computed: vrad, per vertex,
+     * the largest distance from it to a corner of a triangle around it (the
+     * fan and 1-ring lie within that ball); tsph, per triangle, a centre
+     * and radius of a ball holding it. */
+    double *vrad, *tsph;
+    /* Planar fans (fan_bound), the last one per vertex: fan_ref the
+     * triangle whose plane chose it (UINT32_MAX: none yet), fan_mask which
+     * of the vertex's triangles (vt_items order) lie in that plane,
+     * fan_slack its slack (INFINITY: no claim). */
+    uint32_t *fan_ref;
+    uint16_t *fan_mask;
+    double *fan_slack;
+    /* Projected patches (patch_bound): nbr, 3 per triangle, the triangle
+     * across each edge where exactly two share it and run it in opposite
+     * directions (else UINT32_MAX: the edge is a border); mark, per
+     * triangle, 2 * stamp (+1 if in the patch) of the last patch that
+     * looked at it. */
+    uint32_t *nbr, *mark, stamp;
 } tri_grid;
 
 static dv vtx(const float *pos, uint32_t i) {
@@ -143,6 +166,13 @@ static void grid_free(tri_grid *g) {
     free(g->ring_s);
     free(g->vt_start);
     free(g->vt_items);
+    free(g->vrad);
+    free(g->tsph);
+    free(g->fan_ref);
+    free(g->fan_mask);
+    free(g->fan_slack);
+    free(g->nbr);
+    free(g->mark);
     memset(g, 0, sizeof *g);
 }
 
@@ -262,17 +292,54 @@ static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
     g->vt_items = malloc(((size_t)g->tri_count * 3 + 1) * sizeof *g->vt_items);
     g->ring_n = malloc(((size_t)vertex_count * 3 + 1) * sizeof *g->ring_n);
     g->ring_s = malloc(((size_t)vertex_count + 1) * sizeof *g->ring_s);
-    if (!g->vt_start || !g->vt_items || !g->ring_n || !g->ring_s) return false;
-    for (uint32_t v = 0; v < vertex_count; v++) g->ring_s[v] = NAN;
+    g->vrad = calloc((size_t)vertex_count + 1, sizeof *g->vrad);
+    g->tsph = malloc(((size_t)g->tri_count * 4 + 1) * sizeof *g->tsph);
+    g->fan_ref = malloc(((size_t)vertex_count + 1) * sizeof *g->fan_ref);
+    g->fan_mask = malloc(((size_t)vertex_count + 1) * sizeof *g->fan_mask);
+    g->fan_slack = malloc(((size_t)vertex_count + 1) * sizeof *g->fan_slack);
+    if (!g->vt_start || !g->vt_items || !g->ring_n || !g->ring_s || !g->vrad || !g->tsph || !g->fan_ref ||
+        !g->fan_mask || !g->fan_slack)
+        return false;
+    for (uint32_t v = 0; v < vertex_count; v++) {
+        g->ring_s[v] = NAN;
+        g->fan_ref[v] = UINT32_MAX;
+    }
     for (size_t i = 0; i < (size_t)g->tri_count * 3; i++) g->vt_start[g->idx[i] + 2]++;
     for (uint32_t v = 0; v < vertex_count; v++) g->vt_start[v + 2] += g->vt_start[v + 1];
     for (size_t i = 0; i < (size_t)g->tri_count * 3; i++) g->vt_items[g->vt_start[g->idx[i] + 1]++] = (uint32_t)(i / 3);
+    for (uint32_t t = 0; t < g->tri_count; t++) {
+        dv p[3];
+        for (int j = 0; j < 3; j++) p[j] = vtx(g->pos, g->idx[3 * (size_t)t + (size_t)j]);
+        /* Centroid ball; 1 + 1e-9 and + ptol so rounding never makes it
+         * smaller than the triangle (it only ever skips a bound that would
+         * have failed). */
+        dv ctr = {(p[0].x + p[1].x + p[2].x) / 3, (p[0].y + p[1].y + p[2].y) / 3, (p[0].z + p[1].z + p[2].z) / 3};
+        double r = 0;
+        for (int j = 0; j < 3; j++) {
+            dv d = dv_sub(p[j], ctr);
+            r = fmax(r, sqrt(dv_dot(d, d)));
+            for (int k = 0; k < 3; k++) {
+                uint32_t v = g->idx[3 * (size_t)t + (size_t)j];
+                dv e = dv_sub(p[k], p[j]);
+                g->vrad[v] = fmax(g->vrad[v], sqrt(dv_dot(e, e)));
+            }
+        }
+        double *sp = g->tsph + 4 * (size_t)t;
+        sp[0] = ctr.x;
+        sp[1] = ctr.y;
+        sp[2] = ctr.z;
+        sp[3] = r * (1 + 1e-9) + tol;
+    }
+    for (uint32_t v = 0; v < vertex_count; v++) g->vrad[v] = g->vrad[v] * (1 + 1e-9) + tol;
     size_t ne = (size_t)g->tri_count * 3;
     g->partner = malloc((ne + 1) * sizeof *g->partner);
+    g->nbr = malloc((ne + 1) * sizeof *g->nbr);
+    g->mark = calloc((size_t)g->tri_count + 1, sizeof *g->mark);
+    g->stamp = 0;
     g->hinge_p = malloc((ne * 3 + 1) * sizeof *g->hinge_p);
     g->hinge_s = malloc((ne + 1) * sizeof *g->hinge_s);
     edge_rec *e = malloc((ne + 1) * sizeof *e);
-    if (!g->partner || !g->hinge_p || !g->hinge_s || !e) {
+    if (!g->partner || !g->hinge_p || !g->hinge_s || !e || !g->nbr || !g->mark) {
         free(e);
         return false;
     }
@@ -281,8 +348,18 @@ static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
         uint32_t a = g->idx[3 * t + k], b = g->idx[3 * t + (k + 1) % 3];
         e[i] = (edge_rec){a < b ? a : b, a < b ? b : a, t, k};
         g->partner[i] = UINT32_MAX;
+        g->nbr[i] = UINT32_MAX;
     }
     qsort(e, ne, sizeof *e, cmp_edge);
+    for (size_t i = 0, j; i < ne; i = j) {
+        for (j = i + 1; j < ne && e[j].a == e[i].a && e[j].b == e[i].b;) j++;
+        if (j - i != 2) continue; /* a border, or non-manifold */
+        bool fwd0 = g->idx[3 * (size_t)e[i].tri + e[i].slot] == e[i].a;
+        bool fwd1 = g->idx[3 * (size_t)e[i + 1].tri + e[i + 1].slot] == e[i + 1].a;
+        if (fwd0 == fwd1 || e[i].tri == e[i + 1].tri) continue; /* inconsistently oriented: a border too */
+        g->nbr[3 * (size_t)e[i].tri + e[i].slot] = e[i + 1].tri;
+        g->nbr[3 * (size_t)e[i + 1].tri + e[i + 1].slot] = e[i].tri;
+    }
     for (size_t i = 0; i + 1 < ne; i++) {
         if (e[i].a != e[i + 1].a || e[i].b != e[i + 1].b) continue;
         if (i + 2 < ne && e[i + 2].a == e[i].a && e[i + 2].b == e[i].b) continue; /* non-manifold edge */
@@ -406,7 +483,22 @@ static void hull_area2(double (*pts)[2], int np, double *area, double *perim) {
  * regions split into many triangles (cylinder strips, box faces, caps)
  * then need no subdivision around their vertices. INFINITY if it does not
  * apply. */
-static double fan_bound(const tri_grid *o, uint32_t v, uint32_t ref, dv a, dv b, dv c) {
+/* Largest distance of the corners q from a ball (centre c, radius r): a
+ * lower bound of the largest corner distance to anything inside the ball,
+ * so a bound from a region there that cannot reach `enough` is skipped. */
+static bool ball_misses(const dv q[3], dv c, double r, double enough) {
+    double lim = r + enough;
+    for (int j = 0; j < 3; j++) {
+        dv d = dv_sub(q[j], c);
+        if (dv_dot(d, d) > lim * lim) return true;
+    }
+    return false;
+}
+
+/* The planar fan of vertex v in the plane of `ref`: which of v's
+ * triangles it holds (*mask) and its slack (INFINITY: no claim). */
+static double fan_prepare(const tri_grid *o, uint32_t v, uint32_t ref, uint16_t *mask) {
+    *mask = 0;
     dv r0 = vtx(o->pos, o->idx[3 * ref]), r1 = vtx(o->pos, o->idx[3 * ref + 1]), r2 = vtx(o->pos, o->idx[3 * ref + 2]);
     dv e1 = dv_sub(r1, r0), e2 = dv_sub(r2, r0);
     dv n = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
@@ -417,12 +509,13 @@ static double fan_bound(const tri_grid *o, uint32_t v, uint32_t ref, dv a, dv b,
     double ul = sqrt(dv_dot(u, u));
     u = (dv){u.x / ul, u.y / ul, u.z / ul};
     dv w = {n.y * u.z - n.z * u.y, n.z * u.x - n.x * u.z, n.x * u.y - n.y * u.x};
-    uint32_t fan[16];
     int nf = 0;
     double area = 0, angle = 0;
     double pts[48][2];
     int np = 0;
-    for (uint32_t k = o->vt_start[v]; k < o->vt_start[v + 1]; k++) {
+    uint32_t k0 = o->vt_start[v], k1 = o->vt_start[v + 1];
+    if (k1 - k0 > 16) return INFINITY; /* (then more than 16 in the plane too, in practice: no claim) */
+    for (uint32_t k = k0; k < k1; k++) {
         uint32_t t = o->vt_items[k];
         dv p[3];
         bool in_plane = true;
@@ -434,8 +527,8 @@ static double fan_bound(const tri_grid *o, uint32_t v, uint32_t ref, dv a, dv b,
         dv f1 = dv_sub(p[1], p[0]), f2 = dv_sub(p[2], p[0]);
         dv fn = {f1.y * f2.z - f1.z * f2.y, f1.z * f2.x - f1.x * f2.z, f1.x * f2.y - f1.y * f2.x};
         if (!(dv_dot(fn, n) > 0)) return INFINITY; /* flipped or degenerate: no claim */
-        if (nf == 16) return INFINITY;
-        fan[nf++] = t;
+        *mask |= (uint16_t)(1u << (k - k0));
+        nf++;
         area += 0.5 * sqrt(dv_dot(fn, fn));
         /* angle at v */
         int iv = o->idx[3 * t] == v ? 0 : o->idx[3 * t + 1] == v ? 1 : 2;
@@ -455,15 +548,198 @@ static double fan_bound(const tri_grid *o, uint32_t v, uint32_t ref, dv a, dv b,
     if (!(harea > 0) || !(fabs(harea - area) <= 1e-6 * harea)) return INFINITY;
     /* What float rounding may leave uncovered: a sliver of the area
      * mismatch is at most 2 * area / perimeter wide; plus the plane slack. */
-    double slack = 2 * fabs(harea - area) / perim + 2 * o->ptol;
-    double m = 0;
+    return 2 * fabs(harea - area) / perim + 2 * o->ptol;
+}
+
+static double fan_bound(const tri_grid *o, uint32_t v, uint32_t ref, dv a, dv b, dv c, double enough) {
     const dv q[3] = {a, b, c};
+    /* The fan lies within v's ball. */
+    if (ball_misses(q, vtx(o->pos, v), o->vrad[v], enough)) return INFINITY;
+    if (o->fan_ref[v] != ref) {
+        o->fan_slack[v] = fan_prepare(o, v, ref, &o->fan_mask[v]);
+        o->fan_ref[v] = ref;
+    }
+    double slack = o->fan_slack[v];
+    if (!(slack < enough)) return INFINITY;
+    uint32_t k0 = o->vt_start[v];
+    double m = 0;
     for (int j = 0; j < 3; j++) {
         double best = INFINITY;
-        for (int k = 0; k < nf; k++) best = fmin(best, dist_to_tri(o, q[j], fan[k]));
+        for (uint32_t k = 0; k < 16; k++)
+            if (o->fan_mask[v] & (1u << k)) best = fmin(best, dist_to_tri(o, q[j], o->vt_items[k0 + k]));
         m = fmax(m, best);
     }
     return m + slack;
+}
+
+/* A projected patch: the bound that makes big pieces cheap. Project the
+ * other surface's triangles near the piece P orthogonally onto P's plane.
+ * If P lies inside the projection U of some of them, every point p of P is
+ * the projection of a point s of the surface, and |p - s| is s's height
+ * above the plane: the distance from P to the surface is at most the
+ * largest height H of those triangles' corners (heights are affine over a
+ * triangle). No corner distances, no convexity: a chord of a curved
+ * surface, a re-triangulated planar region, a fine strip under a coarse
+ * one are each bounded in one piece.
+ *
+ * Coverage is proven, not assumed: the patch is grown from the corners'
+ * nearest triangles across edges (each shared by exactly two triangles
+ * running it in opposite directions), keeping triangles that face the
+ * plane (projected orientation positive, at least 5 % of their area),
+ * touch P's projection and are within `enough` of the plane. Across an
+ * interior edge the two projected triangles then lie on opposite sides, and
+ * around an interior vertex they wind around it, so the boundary of U lies
+ * on the projected border edges of the patch. If no border edge meets the
+ * open triangle P_d (P shrunk by d = ptol about its incentre) and P_d's
+ * centroid lies in U, the connected P_d lies in U; every point of P is
+ * within d' (d / inradius times the corners' distance to the incentre) of
+ * P_d. Bound: H + d' + 2 ptol (rounding of positions). INFINITY where any
+ * step fails: only the cost of trying is lost. */
+#define PATCH_MAX 384
+
+/* Closed triangles (both counter-clockwise) overlap: no edge of either
+ * separates them. */
+static bool tri2_overlap(const double x[3][2], const double y[3][2]) {
+    for (int i = 0; i < 3; i++) {
+        const double *p = x[i], *q = x[(i + 1) % 3];
+        if (cross2(p, q, y[0]) < 0 && cross2(p, q, y[1]) < 0 && cross2(p, q, y[2]) < 0) return false;
+        p = y[i], q = y[(i + 1) % 3];
+        if (cross2(p, q, x[0]) < 0 && cross2(p, q, x[1]) < 0 && cross2(p, q, x[2]) < 0) return false;
+    }
+    return true;
+}
+
+/* The largest |height| over the part of triangle x (counter-clockwise,
+ * signed heights h at its corners, affine in between) that projects into
+ * the triangle p: the corners of x clipped by p's three half-planes
+ * (Sutherland-Hodgman). If rounding leaves nothing (they only touch), the
+ * corners' largest. */
+static double clipped_height(const double x[3][2], const double h[3], const double p[3][2]) {
+    double poly[2][9][3]; /* (x, y, height) */
+    int n = 3, cur = 0;
+    for (int i = 0; i < 3; i++) {
+        poly[0][i][0] = x[i][0];
+        poly[0][i][1] = x[i][1];
+        poly[0][i][2] = h[i];
+    }
+    for (int e = 0; e < 3 && n > 0; e++) {
+        const double *p0 = p[e], *p1 = p[(e + 1) % 3];
+        int m = 0, nx = 1 - cur;
+        for (int i = 0; i < n; i++) {
+            const double *A = poly[cur][i], *B = poly[cur][(i + 1) % n];
+            double sa = cross2(p0, p1, A), sb = cross2(p0, p1, B);
+            if (sa >= 0) memcpy(poly[nx][m++], A, sizeof poly[0][0]);
+            if ((sa >= 0) != (sb >= 0)) {
+                double t = sa / (sa - sb);
+                for (int k = 0; k < 3; k++) poly[nx][m][k] = A[k] + t * (B[k] - A[k]);
+                m++;
+            }
+        }
+        n = m;
+        cur = nx;
+    }
+    double hm = 0;
+    if (n == 0) return fmax(fabs(h[0]), fmax(fabs(h[1]), fabs(h[2])));
+    for (int i = 0; i < n; i++) hm = fmax(hm, fabs(poly[cur][i][2]));
+    return hm;
+}
+
+/* Segment s0 s1 meets the open counter-clockwise triangle t. */
+static bool seg_hits_open_tri(const double *s0, const double *s1, const double t[3][2]) {
+    for (int i = 0; i < 3; i++)
+        if (cross2(t[i], t[(i + 1) % 3], s0) <= 0 && cross2(t[i], t[(i + 1) % 3], s1) <= 0) return false;
+    double c0 = cross2(s0, s1, t[0]), c1 = cross2(s0, s1, t[1]), c2 = cross2(s0, s1, t[2]);
+    if ((c0 >= 0 && c1 >= 0 && c2 >= 0) || (c0 <= 0 && c1 <= 0 && c2 <= 0)) return false;
+    return true;
+}
+
+static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *seed, int nseed, double enough) {
+    tri_grid *o = (tri_grid *)og; /* the patch marks are scratch */
+    if (!o->nbr) return INFINITY;
+    dv e1 = dv_sub(b, a), e2 = dv_sub(c, a);
+    dv n = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
+    double nl = sqrt(dv_dot(n, n)), l1 = sqrt(dv_dot(e1, e1));
+    if (!(nl > 0) || !(l1 > 0)) return INFINITY;
+    n = (dv){n.x / nl, n.y / nl, n.z / nl};
+    dv u = {e1.x / l1, e1.y / l1, e1.z / l1};
+    dv w = {n.y * u.z - n.z * u.y, n.z * u.x - n.x * u.z, n.x * u.y - n.y * u.x};
+    const double P[3][2] = {{0, 0}, {l1, 0}, {dv_dot(e2, u), dv_dot(e2, w)}};
+    /* The shrunk triangle: a homothety about the incentre. */
+    double la = hypot(P[2][0] - P[1][0], P[2][1] - P[1][1]), lb = hypot(P[2][0], P[2][1]), lc = l1;
+    double per = la + lb + lc, area2 = cross2(P[0], P[1], P[2]);
+    double r = area2 / per, d = o->ptol > 0 ? o->ptol : 1e-300;
+    if (!(r > 4 * d)) return INFINITY;
+    const double I[2] = {(la * P[0][0] + lb * P[1][0] + lc * P[2][0]) / per, (la * P[0][1] + lb * P[1][1] + lc * P[2][1]) / per};
+    double k = (r - d) / r, dmax = 0, Q[3][2];
+    for (int i = 0; i < 3; i++) {
+        Q[i][0] = I[0] + k * (P[i][0] - I[0]);
+        Q[i][1] = I[1] + k * (P[i][1] - I[1]);
+        dmax = fmax(dmax, d / r * hypot(P[i][0] - I[0], P[i][1] - I[1]));
+    }
+    if (o->stamp >= 0x7ffffff0u) {
+        memset(o->mark, 0, (size_t)o->tri_count * sizeof *o->mark);
+        o->stamp = 0;
+    }
+    uint32_t st = ++o->stamp, in = 2 * st + 1, seen = 2 * st;
+    uint32_t list[PATCH_MAX];
+    double xy[PATCH_MAX][3][2];
+    int np = 0;
+    double H = 0;
+    /* Breadth first: candidates come from the seeds, then from the border
+     * edges of what is in. */
+    uint32_t cand[PATCH_MAX * 3 + 96];
+    int nc = 0;
+    for (int i = 0; i < nseed && nc < 96; i++)
+        if (seed[i] != UINT32_MAX) cand[nc++] = seed[i];
+    for (int ci = 0; ci < nc; ci++) {
+        uint32_t t = cand[ci];
+        if (o->mark[t] >= seen) continue;
+        o->mark[t] = seen;
+        double x[3][2], hs[3];
+        for (int j = 0; j < 3; j++) {
+            dv dp = dv_sub(vtx(o->pos, o->idx[3 * (size_t)t + (size_t)j]), a);
+            hs[j] = dv_dot(dp, n);
+            x[j][0] = dv_dot(dp, u);
+            x[j][1] = dv_dot(dp, w);
+        }
+        /* Facing the plane, by at least 5 % of its area. */
+        dv t0 = vtx(o->pos, o->idx[3 * (size_t)t]);
+        dv f1 = dv_sub(vtx(o->pos, o->idx[3 * (size_t)t + 1]), t0), f2 = dv_sub(vtx(o->pos, o->idx[3 * (size_t)t + 2]), t0);
+        dv fn = {f1.y * f2.z - f1.z * f2.y, f1.z * f2.x - f1.x * f2.z, f1.x * f2.y - f1.y * f2.x};
+        double a2 = cross2(x[0], x[1], x[2]);
+        if (!(a2 > 0.05 * sqrt(dv_dot(fn, fn)))) continue;
+        if (!tri2_overlap(P, x)) continue;
+        /* Only the part over P matters (the clip also keeps 9 corners at
+         * most: a triangle clipped by three half-planes). */
+        double hmax = clipped_height(x, hs, P);
+        if (!(hmax <= enough)) continue;
+        if (np == PATCH_MAX) return INFINITY;
+        o->mark[t] = in;
+        memcpy(xy[np], x, sizeof x);
+        list[np++] = t;
+        H = fmax(H, hmax);
+        if (H + dmax + 2 * o->ptol > enough) return INFINITY;
+        for (int j = 0; j < 3; j++) {
+            uint32_t nb = o->nbr[3 * (size_t)t + (size_t)j];
+            if (nb != UINT32_MAX && o->mark[nb] < seen) cand[nc++] = nb;
+        }
+    }
+    if (np == 0) return INFINITY;
+    /* Border edges must stay off the open shrunk triangle. */
+    for (int i = 0; i < np; i++) {
+        uint32_t t = list[i];
+        for (int j = 0; j < 3; j++) {
+            uint32_t nb = o->nbr[3 * (size_t)t + (size_t)j];
+            if (nb != UINT32_MAX && o->mark[nb] == in) continue;
+            if (seg_hits_open_tri(xy[i][j], xy[i][(j + 1) % 3], Q)) return INFINITY;
+        }
+    }
+    /* ... and the shrunk triangle's centroid must be covered. */
+    const double g[2] = {(Q[0][0] + Q[1][0] + Q[2][0]) / 3, (Q[0][1] + Q[1][1] + Q[2][1]) / 3};
+    for (int i = 0; i < np; i++)
+        if (cross2(xy[i][0], xy[i][1], g) > 0 && cross2(xy[i][1], xy[i][2], g) > 0 && cross2(xy[i][2], xy[i][0], g) > 0)
+            return H + dmax + 2 * o->ptol;
+    return INFINITY;
 }
 
 /* The whole fan of triangles around vertex v, projected orthogonally onto
@@ -539,18 +815,22 @@ static double ring_bound(const tri_grid *o, uint32_t v, dv a, dv b, dv c, double
      * bound of its distance to it. */
     for (int j = 0; j < 3; j++)
         if (fabs(dv_dot(dv_sub(q[j], pv), n)) + slack > enough) return INFINITY;
+    /* The projected ring lies within v's ball (projection only shortens
+     * distances to v, which is in the plane). */
+    if (ball_misses(q, pv, o->vrad[v], enough - slack)) return INFINITY;
+    dv p[16][3];
+    uint32_t k0 = o->vt_start[v], nk = o->vt_start[v + 1] - k0; /* <= 16 (ring_prepare) */
+    for (uint32_t k = 0; k < nk; k++) {
+        uint32_t t = o->vt_items[k0 + k];
+        for (int i = 0; i < 3; i++) {
+            dv x = vtx(o->pos, o->idx[3 * t + (uint32_t)i]);
+            p[k][i] = dv_mad(x, n, -dv_dot(dv_sub(x, pv), n));
+        }
+    }
     double m = 0;
     for (int j = 0; j < 3; j++) {
         double best = INFINITY;
-        for (uint32_t k = o->vt_start[v]; k < o->vt_start[v + 1]; k++) {
-            uint32_t t = o->vt_items[k];
-            dv p[3];
-            for (int i = 0; i < 3; i++) {
-                dv x = vtx(o->pos, o->idx[3 * t + (uint32_t)i]);
-                p[i] = dv_mad(x, n, -dv_dot(dv_sub(x, pv), n));
-            }
-            best = fmin(best, dist2_point_tri(q[j], p[0], p[1], p[2]));
-        }
+        for (uint32_t k = 0; k < nk; k++) best = fmin(best, dist2_point_tri(q[j], p[k][0], p[k][1], p[k][2]));
         m = fmax(m, sqrt(best));
     }
     return m + slack;
@@ -606,15 +886,26 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
         /* Enough: within what is asked (accept), or within resolution of
          * the largest distance known to be real (lower). */
         double enough = fmax(x->accept, x->lower * (1 + x->rel) + x->resolution);
+        double ub = INFINITY, dd[3], cdd[3][3];
+        const uint32_t cand[3] = {ta, tb, tc}, vid[3] = {va, vb, vc};
+        const dv q[3] = {a, b, c};
+        const tri_grid *o = x->other;
+        /* Lipschitz, first because it is free: every point is within the
+         * covering radius (at most the longest edge / sqrt 3) of a corner. */
+        dv ab = dv_sub(b, a), bc = dv_sub(c, b), ca = dv_sub(a, c);
+        double lab = dv_dot(ab, ab), lbc = dv_dot(bc, bc), lca = dv_dot(ca, ca);
+        double longest = sqrt(fmax(lab, fmax(lbc, lca)));
+        double lip = fmax(da, fmax(db, dc)) + longest / sqrt(3.0);
+        if (lip <= enough) {
+            if (lip > x->upper) x->upper = lip;
+            return;
+        }
         /* Convexity: over the triangle, distance to one triangle t is at
          * most the largest corner distance to t. */
-        double ub = INFINITY, dd[3];
-        const uint32_t cand[3] = {ta, tb, tc}, vid[3] = {va, vb, vc};
-        const tri_grid *o = x->other;
         for (int k = 0; k < 3; k++) {
             uint32_t t = cand[k];
             if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
-            double m = corner_max(o, a, b, c, t, dd);
+            double m = corner_max(o, a, b, c, t, cdd[k]);
             if (m < ub) ub = m;
         }
         /* The convex union with a coplanar neighbour. */
@@ -622,7 +913,7 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
             uint32_t t = cand[k];
             if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
             if (plane_gap(o, t, a, b, c) > enough) continue;
-            corner_max(o, a, b, c, t, dd);
+            memcpy(dd, cdd[k], sizeof dd);
             for (int j = 0; j < 3; j++) {
                 size_t h = 3 * (size_t)t + (size_t)j;
                 if (o->partner[h] == UINT32_MAX) continue;
@@ -639,6 +930,18 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
                                       fmin(dd[2], sqrt(dist2_point_tri(c, e1, e0, f))))) + slack;
                 if (mq < ub) ub = mq;
             }
+        }
+        /* A projected patch of the other surface (see patch_bound). */
+        if (ub > enough) {
+            uint32_t seed[3 + 3 * 24];
+            int ns = 0;
+            for (int k = 0; k < 3; k++) seed[ns++] = cand[k];
+            for (int k = 0; k < 3 && o->vt_start; k++)
+                if (vid[k] != UINT32_MAX)
+                    for (uint32_t j = o->vt_start[vid[k]], m = 0; j < o->vt_start[vid[k] + 1] && m < 24; j++, m++)
+                        seed[ns++] = o->vt_items[j];
+            double pb = patch_bound(o, a, b, c, seed, ns, enough);
+            if (pb < ub) ub = pb;
         }
         /* Curved fans around the candidates' vertices and the shared
          * corners. */
@@ -660,6 +963,8 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
             uint32_t v = vid[k];
             if (v == UINT32_MAX) continue;
             for (uint32_t j = o->vt_start[v], n = 0; j < o->vt_start[v + 1] && n < 24 && ub > enough; j++, n++) {
+                const double *sp = o->tsph + 4 * (size_t)o->vt_items[j];
+                if (ball_misses(q, (dv){sp[0], sp[1], sp[2]}, sp[3], enough)) continue;
                 if (plane_gap(o, o->vt_items[j], a, b, c) > enough) continue;
                 double m = corner_max(o, a, b, c, o->vt_items[j], dd);
                 if (m < ub) ub = m;
@@ -671,17 +976,11 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
             if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
             if (plane_gap(o, t, a, b, c) > enough) continue;
             for (int j = 0; j < 3 && ub > enough; j++) {
-                double fb = fan_bound(o, o->idx[3 * t + (uint32_t)j], t, a, b, c);
+                double fb = fan_bound(o, o->idx[3 * t + (uint32_t)j], t, a, b, c, enough);
                 if (fb < ub) ub = fb;
             }
         }
-        /* Lipschitz: every point is within the covering radius (at most the
-         * longest edge / sqrt 3) of a corner. */
-        dv ab = dv_sub(b, a), bc = dv_sub(c, b), ca = dv_sub(a, c);
-        double lab = dv_dot(ab, ab), lbc = dv_dot(bc, bc), lca = dv_dot(ca, ca);
-        double longest = sqrt(fmax(lab, fmax(lbc, lca)));
-        double lip = fmax(da, fmax(db, dc)) + longest / sqrt(3.0);
-        if (lip < ub) ub = lip;
+        if (lip < ub) ub = lip; /* (computed above) */
         /* Past the work cap a piece keeps the bound it has: still a bound,
          * only looser, so a pathological mesh costs seconds, not hours. */
         if (ub <= enough || depth >= 40 || longest <= x->resolution || x->work > 4000000ull) {
@@ -814,6 +1113,7 @@ static double hausdorff(const float *positions, uint32_t vertex_count, const uin
             double ba = isfinite(ab) ? directed_bound(positions, b, b_count, &ga, db, nb, &lower, resolution, accept, limit)
                                      : INFINITY;
             r = fmax(ab, ba);
+
         }
     }
     free(da);
@@ -1224,7 +1524,7 @@ mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *e
 /* -------------------------------------------------------------- cache */
 
 #define CACHE_MAGIC "MRLOD\r\n\x1a"
-#define CACHE_VERSION 3u /* bump whenever simplification or certification changes */
+#define CACHE_VERSION 4u /* bump whenever simplification or certification changes */
 
 void mr_lod_cache_path(const char *scene_path, char *out, size_t n) {
     snprintf(out, n, "%s.mrlod", scene_path ? scene_path : "scene");
