@@ -203,8 +203,9 @@ static mr_scene *load_scene(const char *path, load_info *li, mr_error *err) {
  * issue 17 (lane bench): every case starts from the automatic occlusion's
  * initial state; with `cap`, the untimed warm-up frame also reads back
  * depth and its colour and depth are kept there (it draws the same levels
- * as the timed frames; after the reset it always runs the occlusion test,
- * so its image includes what occlusion culling removes). */
+ * as the timed frames; after the reset, automatic occlusion tests on it
+ * wherever it may run at all (64 visible nodes or more), so its image
+ * includes what occlusion culling removes). */
 static bool time_case(const mr_bench_gpu *g, const mr_view *view, const mr_draw_params *dp, int w, int h, long frames,
                       double *ft, double *ct, double *gt, double *pt, row *r, mr_draw_stats *st, mr_frame_result *cap,
                       mr_error *err) {
