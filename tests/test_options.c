@@ -455,7 +455,9 @@ static void test_tables(void) {
                              N(mr_bench_frame_params, "no-video", no_video, 0, 1)};
     const expect ex_bgh[] = {N(mr_bench_ghost_params, "frames", frames, 1, 100000),
                              N(mr_bench_ghost_params, "view", view, 0, MR_DEMO_VIEWS - 1)};
-    const expect ex_bsc[] = {N(mr_bench_scene_params, "frames", frames, 1, 1000)};
+    const expect ex_bsc[] = {N(mr_bench_scene_params, "frames", frames, 1, 1000),
+                             /* issue 17 (lane bench) */
+                             N(mr_bench_scene_params, "full-detail-frames", full_frames, 0, 1000)};
     const expect ex_btr[] = {
         N(mr_bench_tracking_params, "frames", max_frames, 1, 1 << 30),
         N(mr_bench_tracking_params, "quick", quick, 0, 1),

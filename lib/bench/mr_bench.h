@@ -143,10 +143,13 @@ typedef struct mr_bench_scene_params {
      * LOD's first build and its cached load timed apart. */
     bool unique;
     double unit;            /* scene units per metre of the unique factory; 0 = 1 */
+    /* issue 17 (lane bench): timed frames of the full-detail configurations
+     * (no-lod, none), which cost seconds a frame at 20M; 0: frames. */
+    int full_frames;
 } mr_bench_scene_params;
 #define MR_BENCH_SCENE_DEFAULTS .out_dir = "bench-out", .width = 1024, .height = 768, .frames = 3
 bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err);
-extern const mr_opt mr_bench_scene_opts[]; /* frames */
+extern const mr_opt mr_bench_scene_opts[]; /* frames, full-detail-frames */
 
 /* ------------------------------------------------------------- tracking */
 

@@ -37,6 +37,9 @@ const mr_opt mr_bench_ghost_opts[] = {
 const mr_opt mr_bench_scene_opts[] = {
     {"frames", MR_OPT_INT, offsetof(mr_bench_scene_params, frames), 1, 1000, 3, NULL,
      "timed frames per case after one warm-up", 0},
+    /* issue 17 (lane bench) */
+    {"full-detail-frames", MR_OPT_INT, offsetof(mr_bench_scene_params, full_frames), 0, 1000, 0, NULL,
+     "timed frames of the full-detail cases (no-lod, none; auto: --frames)", MR_OPT_ZERO_AUTO},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 

@@ -6,12 +6,22 @@
  * and its parts (CPU culling, GPU geometry pass), triangles submitted, draw
  * calls and visible nodes, with culling, batching and LOD each switched
  * off in turn, and occlusion culling switched on. CSV + an SVG plot of frame time against scene size. Never
- * pass/fail. */
+ * pass/fail.
+ *
+ * issue 17 (lane bench), with --unique: each configuration's image against
+ * the full-detail one ("none": no LOD, no culling) off depth edges
+ * (mr_image_diff_depth), the whole open of the file with and without the
+ * LOD cache, and the issue's Goals (frame ratios 20M / 2M, image difference)
+ * as lines of the log and notes at the end of the CSV. Every (view,
+ * configuration) case starts from the same automatic-occlusion state
+ * (mr_renderer_reset_occlusion), so no case inherits what the one before it
+ * learnt. */
 #include "bench_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 typedef struct bench_config {
     const char *name;
@@ -34,6 +44,8 @@ static const bench_config k_configs[] = {
     {"no-cluster", false, false, false, false, false, false, true},
 };
 #define N_CONFIGS (int)(sizeof k_configs / sizeof k_configs[0])
+/* issue 17 (lane bench): the defaults and the full-detail reference */
+enum { k_all = 0, k_none = 4 };
 
 static const char *const k_view_names[MR_SYNTH_VIEW_COUNT] = {"floor", "aisle", "overview"};
 
@@ -41,7 +53,23 @@ typedef struct row {
     double tri_scene;
     int view, config;
     double frame_ms, cull_ms, gpu_ms;
+    /* issue 17 (lane bench) */
+    int size;             /* index into the sizes */
+    int frames;           /* timed frames */
+    double rss_mb;        /* peak RSS when the case was measured */
+    mr_draw_stats st;     /* of the last timed frame */
+    mr_image_diff diff;   /* against the view's "none" image (unique only) */
+    double cpu_ms;        /* median process CPU time of a frame (all threads) */
 } row;
+
+/* issue 17 (lane bench): the process's CPU time (all threads, llvmpipe's
+ * rasteriser threads included). On the shared machine a frame's wall time
+ * grows with the other users' load, its CPU time much less: the work. */
+static double process_cpu_s(void) {
+    struct timespec ts;
+    if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0) return 0;
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 /* Frame time (floor view solid, overview dashed) against drawn scene
  * triangles, log-log, one colour per configuration. */
@@ -79,6 +107,79 @@ static bool write_plot(const char *path, const row *rows, int n, mr_error *err) 
     return ok;
 }
 
+/* issue 17 (lane bench): the issue's Goals from the measured rows, as lines
+ * of the log and notes at the end of the CSV (scripts/bench.sh puts them
+ * under the Markdown table). The frame ratio of a size is its "all" frame
+ * over the first size's from the same view; the Goals name 20M / 2M (floor
+ * <= 2, overview <= 3), reported when both sizes ran. The image Goal: the
+ * "all" image against "none", off depth edges, under 0.5 % per view. */
+static const row *find_row(const row *rows, int n, int size, int view, int config) {
+    for (int i = 0; i < n; i++)
+        if (rows[i].size == size && rows[i].view == view && rows[i].config == config) return &rows[i];
+    return NULL;
+}
+
+/* "2M", "10M", "200k" */
+static const char *size_label(double v, char *buf, size_t n) {
+    if (v >= 1e6) snprintf(buf, n, "%gM", v / 1e6);
+    else snprintf(buf, n, "%gk", v / 1e3);
+    return buf;
+}
+
+static void goal_line(FILE *out, mr_csv *csv, const char *line) {
+    BENCH_PRINT(out, "%s\n", line);
+    mr_csv_comment(csv, line);
+}
+
+static void report_goals(FILE *out, mr_csv *csv, const double *sizes, int nsizes, const row *rows, int n) {
+    char line[512], la[32], lb[32];
+    const mr_image_diff_params idp = MR_IMAGE_DIFF_DEFAULTS;
+    int s2 = -1, s20 = -1;
+    for (int i = 0; i < nsizes; i++) {
+        if (sizes[i] == 2e6) s2 = i;
+        if (sizes[i] == 20e6) s20 = i;
+    }
+    for (int v = 0; v < MR_SYNTH_VIEW_COUNT; v++)
+        for (int si = 1; si < nsizes; si++) {
+            const row *a = find_row(rows, n, si, v, k_all), *b = find_row(rows, n, 0, v, k_all);
+            if (!a || !b) continue;
+            snprintf(line, sizeof line,
+                     "frame ratio %s: frame_ms(%s, all) / frame_ms(%s, all) = %.1f / %.1f = %.2f; CPU ms %.1f / %.1f = %.2f",
+                     k_view_names[v], size_label(sizes[si], la, sizeof la), size_label(sizes[0], lb, sizeof lb),
+                     a->frame_ms, b->frame_ms, a->frame_ms / b->frame_ms, a->cpu_ms, b->cpu_ms, a->cpu_ms / b->cpu_ms);
+            goal_line(out, csv, line);
+        }
+    static const struct {
+        int view;
+        double limit;
+    } goals[] = {{MR_SYNTH_VIEW_FLOOR, 2}, {MR_SYNTH_VIEW_OVERVIEW, 3}};
+    for (int k = 0; k < 2; k++) {
+        int v = goals[k].view;
+        const row *a = s20 >= 0 ? find_row(rows, n, s20, v, k_all) : NULL, *b = s2 >= 0 ? find_row(rows, n, s2, v, k_all) : NULL;
+        if (a && b)
+            snprintf(line, sizeof line,
+                     "Goal %s: frame_ms(20M, all) / frame_ms(2M, all) = %.2f (goal <= %g: %s); in frame CPU time %.2f (%s)",
+                     k_view_names[v], a->frame_ms / b->frame_ms, goals[k].limit,
+                     a->frame_ms / b->frame_ms <= goals[k].limit ? "met" : "not met", a->cpu_ms / b->cpu_ms,
+                     a->cpu_ms / b->cpu_ms <= goals[k].limit ? "met" : "not met");
+        else
+            snprintf(line, sizeof line, "Goal %s: frame_ms(20M, all) / frame_ms(2M, all) <= %g: not measured (needs --sizes with 2M and 20M)",
+                     k_view_names[v], goals[k].limit);
+        goal_line(out, csv, line);
+    }
+    for (int si = 0; si < nsizes; si++)
+        for (int v = 0; v < MR_SYNTH_VIEW_COUNT; v++) {
+            const row *a = find_row(rows, n, si, v, k_all);
+            if (!a) continue;
+            snprintf(line, sizeof line,
+                     "Goal image %s %s: all differs from none in %.3f %% of pixels (by more than %.0f/255 on a channel, "
+                     "off depth edges: %.1f %% of pixels are edges) (goal < 0.5 %%: %s)",
+                     size_label(sizes[si], la, sizeof la), k_view_names[v], a->diff.differ_pct, idp.tolerance * 255,
+                     a->diff.edge_pct, a->diff.differ_pct < 0.5 ? "met" : "not met");
+            goal_line(out, csv, line);
+        }
+}
+
 /* A scene loaded as any user's would be, with the wall-clock time and the
  * drawn (instances counted each time) and stored triangle counts. */
 typedef struct load_info {
@@ -98,20 +199,36 @@ static mr_scene *load_scene(const char *path, load_info *li, mr_error *err) {
 }
 
 /* One case's timing: the median of `frames` frames after one warm-up of
- * the whole frame (wall ms), the CPU culling and the G-buffer pass (GPU). */
+ * the whole frame (wall ms), the CPU culling and the G-buffer pass (GPU).
+ * issue 17 (lane bench): every case starts from the automatic occlusion's
+ * initial state; with `cap`, the untimed warm-up frame also reads back
+ * depth and its colour and depth are kept there (it draws the same levels
+ * as the timed frames; after the reset, automatic occlusion tests on it
+ * wherever it may run at all (64 visible nodes or more), so its image
+ * includes what occlusion culling removes). */
 static bool time_case(const mr_bench_gpu *g, const mr_view *view, const mr_draw_params *dp, int w, int h, long frames,
-                      double *ft, double *ct, double *gt, row *r, mr_draw_stats *st, mr_error *err) {
+                      double *ft, double *ct, double *gt, double *pt, row *r, mr_draw_stats *st, mr_frame_result *cap,
+                      mr_error *err) {
     mr_frame_params fp = MR_FRAME_DEFAULTS;
     fp.width = w;
     fp.height = h;
     fp.timing = true;
     memset(st, 0, sizeof *st);
     bool ok = mr_renderer_set_draw_params(g->renderer, dp, err);
+    mr_renderer_reset_occlusion(g->renderer); /* issue 17 (lane bench) */
     for (long f = -1; ok && f < frames; f++) {
         mr_frame_result res;
-        double ts = mr_time_now();
+        fp.want_depth = cap && f < 0;
+        double ts = mr_time_now(), tc = process_cpu_s();
         ok = mr_render_frame(g->renderer, view, &fp, &res, err);
         if (!ok) break;
+        if (f >= 0) pt[f] = (process_cpu_s() - tc) * 1e3; /* issue 17 (lane bench) */
+        if (cap && f < 0) { /* issue 17 (lane bench): keep the images */
+            cap->color = res.color;
+            cap->depth = res.depth;
+            memset(&res.color, 0, sizeof res.color);
+            memset(&res.depth, 0, sizeof res.depth);
+        }
         if (f >= 0) {
             ft[f] = (mr_time_now() - ts) * 1e3;
             mr_renderer_draw_stats(g->renderer, st);
@@ -126,6 +243,7 @@ static bool time_case(const mr_bench_gpu *g, const mr_view *view, const mr_draw_
     r->frame_ms = mr_median(ft, (int)frames);
     r->cull_ms = mr_median(ct, (int)frames);
     r->gpu_ms = mr_median(gt, (int)frames);
+    r->cpu_ms = mr_median(pt, (int)frames);
     return true;
 }
 
@@ -137,15 +255,21 @@ typedef struct size_info {
     bool from_cache;
     bool unique;
     double lod_cached_s, unit;
+    /* issue 17 (lane bench): the whole open of the file as mrcheck render
+     * does it (scene load + LOD levels + upload with them), first without
+     * the LOD cache, then with it */
+    double open_first_s, open_cached_s;
 } size_info;
 
 /* One case: its line of the table and its CSV row. */
 static void report_row(FILE *out, mr_csv *csv, const size_info *z, int v, int c, const row *r, const mr_draw_stats *st) {
-    double rss = mr_peak_rss_bytes() / 1048576.0;
-    BENCH_PRINT(out, "%10llu %8d %9.1f %6.2f %6.2f %7.2f %8.0f %-9s %-9s %9.1f %8.2f %8.1f %11llu %6u %7u %7u\n",
+    double rss = r->rss_mb;
+    BENCH_PRINT(out, "%10llu %8d %9.1f %6.2f %6.2f %7.2f %8.0f %-9s %-9s %9.1f %8.2f %8.1f %11llu %6u %7u %7u",
            (unsigned long long)z->li.triangles, z->nodes, z->mb, z->parse_s, z->li.load_s, z->upload_s, rss,
            k_view_names[v], k_configs[c].name, r->frame_ms, r->cull_ms, r->gpu_ms,
            (unsigned long long)st->triangles, st->gl_draw_calls, st->nodes_visible, st->nodes_occluded);
+    if (z->unique) BENCH_PRINT(out, " %7.3f %8.1f", r->diff.differ_pct, r->cpu_ms); /* issue 17 (lane bench) */
+    BENCH_PRINT(out, "\n");
     if (out) fflush(out);
     mr_csv_int(csv, (long long)z->li.triangles);
     mr_csv_int(csv, (long long)z->li.unique_triangles);
@@ -170,6 +294,13 @@ static void report_row(FILE *out, mr_csv *csv, const size_info *z, int v, int c,
     if (z->unique) {
         mr_csv_num(csv, "%.3f", z->lod_cached_s);
         mr_csv_num(csv, "%g", z->unit);
+        /* issue 17 (lane bench) */
+        mr_csv_num(csv, "%.4f", r->diff.differ_pct);
+        mr_csv_num(csv, "%.4f", r->diff.edge_pct);
+        mr_csv_num(csv, "%.3f", z->open_first_s);
+        mr_csv_num(csv, "%.3f", z->open_cached_s);
+        mr_csv_int(csv, r->frames);
+        mr_csv_num(csv, "%.3f", r->cpu_ms);
     }
     mr_csv_end_row(csv);
 }
@@ -186,6 +317,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
     for (int i = 0; i < nsizes; i++) sizes[i] = p.size_count > 0 ? p.sizes[i] : (const double[]){1e6, 5e6, 20e6}[i];
     const int w = p.width, h = p.height;
     const long frames = p.frames;
+    const long full_frames = p.full_frames > 0 ? p.full_frames : p.frames; /* issue 17 (lane bench) */
     FILE *out = p.out;
     if (!mr_mkdirs(out_dir, err)) return false;
     const mr_bench_gpu gfx = p.gfx;
@@ -193,10 +325,12 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
 
     mr_csv *csv = mr_csv_create(err);
     row *rows = calloc((size_t)nsizes * MR_SYNTH_VIEW_COUNT * N_CONFIGS + 1, sizeof *rows);
-    double *ft = calloc((size_t)frames, sizeof *ft), *ct = calloc((size_t)frames, sizeof *ct), *gt = calloc((size_t)frames, sizeof *gt);
+    const long max_frames = frames > full_frames ? frames : full_frames;
+    double *ft = calloc((size_t)max_frames, sizeof *ft), *ct = calloc((size_t)max_frames, sizeof *ct),
+           *gt = calloc((size_t)max_frames, sizeof *gt), *pt = calloc((size_t)max_frames, sizeof *pt);
     int nrows = 0;
     bool failed = false;
-    if (!csv || !rows || !ft || !ct || !gt) {
+    if (!csv || !rows || !ft || !ct || !gt || !pt) {
         failed = !mr_fail(err, MR_ERR_NOMEM, "out of memory");
         goto done;
     }
@@ -204,12 +338,16 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
     snprintf(header, sizeof header, "scene_triangles,stored_triangles,nodes,file_mb,raw_parse_s,load_s,upload_s,load_upload_mb_s,"
                        "raw_parse_mb_s,lod_s,lod_from_cache,peak_rss_mb,view,config,frame_ms,cull_ms,gpu_geometry_ms,"
                        "triangles_submitted,draw_calls,commands,nodes_visible,nodes_drawable,nodes_occluded,lod_instances%s",
-             p.unique ? ",lod_cached_s,unit" : "");
+             p.unique ? ",lod_cached_s,unit,image_diff_pct,image_edge_pct,open_first_s,open_cached_s,timed_frames,frame_cpu_ms" : "");
     mr_csv_header(csv, header);
-    BENCH_PRINT(out, "bench scene: %s, %dx%d, median of %ld frames\n", mr_gpu_description(gfx.gpu), w, h, frames);
-    BENCH_PRINT(out, "%10s %8s %9s %6s %6s %7s %8s %-9s %-9s %9s %8s %8s %11s %6s %7s %7s\n", "triangles", "nodes", "file MB", "parse",
+    BENCH_PRINT(out, "bench scene: %s, %dx%d, median of %ld frames", mr_gpu_description(gfx.gpu), w, h, frames);
+    if (full_frames != frames) BENCH_PRINT(out, " (no-lod and none: %ld)", full_frames); /* issue 17 (lane bench) */
+    BENCH_PRINT(out, "\n");
+    BENCH_PRINT(out, "%10s %8s %9s %6s %6s %7s %8s %-9s %-9s %9s %8s %8s %11s %6s %7s %7s", "triangles", "nodes", "file MB", "parse",
            "load", "upload", "RSS MB", "view", "config", "frame ms", "cull ms", "GPU ms", "submitted", "calls", "visible",
            "occl");
+    if (p.unique) BENCH_PRINT(out, " %7s %8s", "diff %", "CPU ms"); /* issue 17 (lane bench): image against none, frame CPU */
+    BENCH_PRINT(out, "\n");
     char lod_cache[4096];
     mr_path_join(out_dir, "synth.glb.mrlod", lod_cache, sizeof lod_cache); /* same parts at every size */
     for (int si = 0; si < nsizes; si++) {
@@ -274,10 +412,15 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                 mr_lod_destroy(&lod);
                 lod = again;
             } else {
+                /* issue 17 (lane bench): the second time was no cached load */
+                BENCH_PRINT(out, "  warning: the LOD cache %s was not used on the second load (%s)\n", lod_cache,
+                            again ? "levels rebuilt" : err->msg);
                 mr_lod_destroy(&again);
             }
         }
+        t0 = mr_time_now();
         ok = lod && mr_renderer_set_lod(gfx.renderer, lod, err);
+        double lod_upload_s = mr_time_now() - t0; /* issue 17 (lane bench) */
         if (!ok) {
             failed = true;
             mr_lod_destroy(&lod);
@@ -285,11 +428,20 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
             goto done;
         }
         double mb = fsize / 1e6;
+        /* issue 17 (lane bench): the open as a user's: load, levels, upload with them */
+        const size_info z = {li, (int)s->node_count, mb, parse_s, upload_s, lod_s, linfo.from_cache, p.unique,
+                             lod_cached_s, cp.unit, li.load_s + lod_s + lod_upload_s,
+                             li.load_s + lod_cached_s + lod_upload_s};
         for (int v = 0; v < MR_SYNTH_VIEW_COUNT && ok; v++) {
             mr_view view;
             view.camera = mr_demo_camera();
             memset(view.camera.dist, 0, sizeof view.camera.dist);
             view.world_from_camera = p.unique ? mr_synth_cad_viewpoint(&cp, v) : mr_synth_viewpoint(&sp, v);
+            /* issue 17 (lane bench): all configurations of the view first,
+             * then their rows, each image against the "none" one. */
+            mr_frame_result caps[N_CONFIGS];
+            memset(caps, 0, sizeof caps);
+            int first = nrows;
             for (int c = 0; c < N_CONFIGS && ok; c++) {
                 mr_draw_params dp = MR_DRAW_DEFAULTS;
                 dp.no_cull = k_configs[c].no_cull;
@@ -303,13 +455,19 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                 r->tri_scene = (double)li.triangles;
                 r->view = v;
                 r->config = c;
-                mr_draw_stats st;
-                if (!(ok = time_case(&gfx, &view, &dp, w, h, frames, ft, ct, gt, r, &st, err))) break;
+                r->size = si;
+                r->frames = (int)(k_configs[c].no_lod ? full_frames : frames);
+                if (!(ok = time_case(&gfx, &view, &dp, w, h, r->frames, ft, ct, gt, pt, r, &r->st, p.unique ? &caps[c] : NULL,
+                                     err)))
+                    break;
+                r->rss_mb = mr_peak_rss_bytes() / 1048576.0;
                 nrows++;
-                const size_info z = {li, (int)s->node_count, mb, parse_s, upload_s, lod_s, linfo.from_cache,
-                                     p.unique, lod_cached_s, cp.unit};
-                report_row(out, csv, &z, v, c, r, &st);
             }
+            for (int i = first; ok && p.unique && i < nrows; i++)
+                ok = mr_image_diff_depth(&caps[rows[i].config].color, &caps[rows[i].config].depth, &caps[k_none].color,
+                                         &caps[k_none].depth, NULL, &rows[i].diff, err);
+            for (int i = first; ok && i < nrows; i++) report_row(out, csv, &z, v, rows[i].config, &rows[i], &rows[i].st);
+            for (int c = 0; c < N_CONFIGS; c++) mr_frame_result_free(&caps[c]);
         }
         BENCH_PRINT(out, "  load %.2f s + upload %.2f s = %.0f MB/s; tinygltf raw parse %.2f s = %.0f MB/s; LOD %.2f s (%s)\n",
                li.load_s, upload_s, mb / (li.load_s + upload_s), parse_s, mb / parse_s, lod_s,
@@ -317,6 +475,9 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
         if (p.unique)
             BENCH_PRINT(out, "  LOD first build %.2f s = %.0f input triangles/s; from the cache %.3f s\n", lod_s,
                         li.unique_triangles / lod_s, lod_cached_s);
+        if (p.unique) /* issue 17 (lane bench) */
+            BENCH_PRINT(out, "  open (load + LOD + upload with levels): first %.2f s, with the LOD cache %.2f s\n",
+                        z.open_first_s, z.open_cached_s);
         mr_renderer_set_scene(gfx.renderer, NULL, err);
         mr_lod_destroy(&lod);
         mr_scene_destroy(&s);
@@ -325,6 +486,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
             goto done;
         }
     }
+    if (p.unique) report_goals(out, csv, sizes, nsizes, rows, nrows); /* issue 17 (lane bench) */
     {
         char path[4096];
         const char *stem = p.unique ? "bench_scene_unique" : "bench_scene";
@@ -344,6 +506,7 @@ done:
     free(ft);
     free(ct);
     free(gt);
+    free(pt);
     mr_renderer_set_scene(gfx.renderer, NULL, NULL);
     return !failed;
 }

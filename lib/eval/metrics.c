@@ -98,6 +98,86 @@ bool mr_image_compare(const mr_image *a, const mr_image *ref, const mr_image *ma
     return true;
 }
 
+/* ---------------------------------------- issue 17 (lane bench): image
+ * difference off depth edges (definition at mr_image_diff_depth). */
+
+static bool has_surface(float z) { return isfinite(z) && z > 0; }
+
+/* Inverse depth, affine in the pixel coordinates on any plane. */
+static double inv_depth(const float *z, int w, int x, int y) { return 1.0 / (double)z[(size_t)y * w + x]; }
+
+/* A depth-edge pixel (see mr_image_diff_depth): coverage differs within
+ * its 3x3 neighbourhood, or along one of the 4 directions through it the
+ * inverse depth bends by more than rel of its own (second difference; a
+ * plane has none, however grazing, while a step between two surfaces gives
+ * the step on both sides of it). On the image border, where a direction has
+ * one neighbour, the second difference of p and the next two pixels inwards
+ * stands in. */
+static bool depth_edge(const float *z, int w, int h, int x, int y, double rel) {
+    bool sc = has_surface(z[(size_t)y * w + x]);
+    for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+            int xx = x + dx, yy = y + dy;
+            if (xx >= 0 && yy >= 0 && xx < w && yy < h && has_surface(z[(size_t)yy * w + xx]) != sc) return true;
+        }
+    if (!sc) return false;
+    static const int dirs[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
+    double wc = inv_depth(z, w, x, y);
+    for (int k = 0; k < 4; k++) {
+        int ddx = dirs[k][0], ddy = dirs[k][1];
+        for (int side = 0; side < 3; side++) {
+            /* centred, else one-sided from p towards the inside */
+            int s0 = side == 0 ? -1 : side == 1 ? 0 : -2, xs = x + s0 * ddx, ys = y + s0 * ddy;
+            int xe = xs + 2 * ddx, ye = ys + 2 * ddy;
+            if (xs < 0 || ys < 0 || xs >= w || ys >= h || xe < 0 || ye < 0 || xe >= w || ye >= h) continue;
+            /* (the 3x3 pixels have surfaces here; a pixel two away without
+             * one is the edge of that pixel's neighbours, not p's) */
+            if (!has_surface(z[(size_t)ys * w + xs]) || !has_surface(z[(size_t)ye * w + xe])) continue;
+            double bend = inv_depth(z, w, xs, ys) - 2 * inv_depth(z, w, xs + ddx, ys + ddy) + inv_depth(z, w, xe, ye);
+            if (fabs(bend) > rel * wc) return true;
+            break; /* the first triple that fits decides */
+        }
+    }
+    return false;
+}
+
+bool mr_image_diff_depth(const mr_image *a, const mr_image *depth_a, const mr_image *b, const mr_image *depth_b,
+                         const mr_image_diff_params *params, mr_image_diff *out, mr_error *err) {
+    const mr_image_diff_params dflt = MR_IMAGE_DIFF_DEFAULTS;
+    mr_image_diff_params p = params ? *params : dflt;
+    memset(out, 0, sizeof *out);
+    if (!is_u8x3(a) || !is_u8x3(b) || !is_f32x1(depth_a) || !is_f32x1(depth_b))
+        return mr_fail(err, MR_ERR_INVALID, "image difference needs RGB8 colour and F32x1 depth images");
+    int w = a->width, h = a->height;
+    if (b->width != w || b->height != h || depth_a->width != w || depth_a->height != h || depth_b->width != w ||
+        depth_b->height != h)
+        return mr_fail(err, MR_ERR_INVALID, "image difference needs images of one size");
+    if (!(p.tolerance >= 0) || !(p.depth_rel >= 0))
+        return mr_fail(err, MR_ERR_INVALID, "image difference: tolerance and depth step must be >= 0");
+    /* Differences of 8-bit values: above tolerance * 255 (rounded down, so
+     * 8/255 means "more than 8"). */
+    int tol = (int)floor(p.tolerance * 255.0 + 1e-9);
+    const unsigned char *pa = a->data, *pb = b->data;
+    const float *za = depth_a->data, *zb = depth_b->data;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            size_t i = (size_t)y * w + x;
+            if (depth_edge(za, w, h, x, y, p.depth_rel) || depth_edge(zb, w, h, x, y, p.depth_rel)) {
+                out->edge++;
+                continue;
+            }
+            for (int c = 0; c < 3; c++)
+                if (abs((int)pa[3 * i + c] - (int)pb[3 * i + c]) > tol) {
+                    out->differ++;
+                    break;
+                }
+        }
+    out->pixels = (long long)w * h;
+    out->differ_pct = out->pixels ? 100.0 * (double)out->differ / (double)out->pixels : 0;
+    out->edge_pct = out->pixels ? 100.0 * (double)out->edge / (double)out->pixels : 0;
+    return true;
+}
+
 bool mr_montage_png(const char *path, const mr_image *const *images, int count, int cols, int tile_w, int tile_h,
                     mr_error *err) {
     if (count <= 0 || cols <= 0 || tile_w <= 0 || tile_h <= 0) return mr_fail(err, MR_ERR_INVALID, "empty montage");

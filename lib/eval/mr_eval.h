@@ -107,6 +107,39 @@ typedef struct mr_image_metrics {
 bool mr_image_compare(const mr_image *a, const mr_image *ref, const mr_image *mask, mr_image_metrics *out,
                       mr_error *err);
 
+/* issue 17 (lane bench): how much an approximated image (LOD, culling)
+ * differs from the full-detail one, silhouettes aside. A pixel counts as
+ * differing when one of its colour channels differs by more than
+ * `tolerance` (0..1 of the 8-bit range) and it is not a depth-edge pixel of
+ * either image. A depth-edge pixel lies next to a depth discontinuity: in
+ * its 3x3 neighbourhood one pixel shows a surface and another nothing
+ * (depth 0 or not finite), or along one of the 4 directions through it
+ * (horizontal, vertical, the diagonals) the inverse depth 1/z bends by more
+ * than `depth_rel` of its own value (|w(p-d) - 2 w(p) + w(p+d)| > depth_rel
+ * w(p); 1/z is affine on a plane, so a floor seen at a grazing angle has no
+ * edges, while a step between two surfaces marks the pixels on both sides
+ * of it; on the image border a one-sided second difference stands in). So a
+ * silhouette that moves by one pixel (what a 1 px LOD error may do) is not
+ * counted, while a missing, added or moved surface is, inside and on flat
+ * ground alike. The share is of all pixels of the image. */
+typedef struct mr_image_diff_params {
+    double tolerance; /* per channel, of 1 (the 8-bit range); default 8/255 */
+    double depth_rel; /* bend of 1/z at a discontinuity, of 1/z; default 0.02 */
+} mr_image_diff_params;
+#define MR_IMAGE_DIFF_DEFAULTS {.tolerance = 8.0 / 255.0, .depth_rel = 0.02}
+
+typedef struct mr_image_diff {
+    long long pixels; /* all pixels */
+    long long differ; /* beyond the tolerance, off depth edges */
+    long long edge;   /* depth-edge pixels of either image (not compared) */
+    double differ_pct, edge_pct; /* 100 * differ / pixels, 100 * edge / pixels */
+} mr_image_diff;
+
+/* a, b: RGB8 colour images of one size; depth_a, depth_b: F32x1 linear view
+ * depths of the same size (0 where nothing), as mr_frame_result gives. */
+bool mr_image_diff_depth(const mr_image *a, const mr_image *depth_a, const mr_image *b, const mr_image *depth_b,
+                         const mr_image_diff_params *params, mr_image_diff *out, mr_error *err);
+
 /* ------------------------------------------------ ghosting legibility
  * Measured from the hidden layer D alone, never from the ghosting's own
  * target C_desired (see lib/eval/legibility.c for the full definition). */

@@ -1179,6 +1179,16 @@ static void occlusion_learn(struct mr_geo *g, double sync_ms, double cpu_ms, uin
     }
 }
 
+/* issue 17 (lane bench): the learnt state back to the upload's (see
+ * upload): the next frame tests and measures. */
+void mr_renderer_reset_occlusion(mr_renderer *r) {
+    struct mr_geo *g = r ? r->geo : NULL;
+    if (!g) return;
+    g->occ_auto_on = true;
+    g->occ_probe = 0;
+    g->occ_gain_ms = 0;
+}
+
 void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *out) {
     uint32_t layer_mask = vw->layers;
     const mr_scene *s = r->scene;

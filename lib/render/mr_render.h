@@ -912,6 +912,12 @@ typedef struct mr_draw_stats {
 /* Sets how geometry is submitted from the next frame on (NULL: defaults). */
 bool mr_renderer_set_draw_params(mr_renderer *r, const mr_draw_params *params, mr_error *err);
 void mr_renderer_draw_stats(const mr_renderer *r, mr_draw_stats *out);
+/* issue 17 (lane bench): forgets what automatic occlusion culling learnt
+ * from the frames drawn so far (on or off, the smoothed gain, the next
+ * trial), as a scene upload does, so that the next frame measures afresh;
+ * the read-back cost of the frame size is kept (a cost of the size, not of
+ * the view). For comparable measurements from different views. */
+void mr_renderer_reset_occlusion(mr_renderer *r);
 /* Draws simplified levels from `lod` (built for the scene that is set; it
  * must stay alive while set; NULL: full detail only). Re-uploads the
  * scene's geometry; setting another scene drops the levels. */
