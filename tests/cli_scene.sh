@@ -103,6 +103,16 @@ if bu >"$tmp/bu1.log" 2>&1 && bu --full-detail-frames 2 >"$tmp/bu.log" 2>&1; the
 else
   bad "bench scene --unique failed: $(cat "$tmp/bu1.log" "$tmp/bu.log")"
 fi
+# Two sizes of parts big enough for meshlets (20k triangles): each size
+# uploads with the default draw parameters, and its second open reads the
+# meshlets back from their cache (the last case of the first size once left
+# cluster culling off for the second size's uploads).
+if "$mr" bench scene --unique --sizes 20k,40k --frames 1 --full-detail-frames 1 --size 64x48 --out "$tmp/bm" >"$tmp/bm.log" 2>&1; then
+  ! grep -q 'was not used' "$tmp/bm.log" && [ -s "$tmp/bm/cad_2parts.glb.mrclu" ] && ok ||
+    bad "bench scene --unique: a cache not used: $(grep -i 'cache' "$tmp/bm.log")"
+else
+  bad "bench scene --unique at 20k,40k failed: $(cat "$tmp/bm.log")"
+fi
 [ ! -e "$tmp/x.png" ] && [ ! -e "$tmp/y.glb" ] && ok || bad "output left behind"
 
 cli_finish cli_scene

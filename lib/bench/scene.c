@@ -394,8 +394,13 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
             failed = true;
             goto done;
         }
+        /* Each size uploads with the defaults and no meshlet cache (the
+         * last case of the previous size left its own draw parameters,
+         * e.g. no cluster culling, and its cache path). */
+        const mr_draw_params dp0 = MR_DRAW_DEFAULTS;
+        ok = mr_renderer_set_draw_params(gfx.renderer, &dp0, err) && mr_renderer_set_cluster_cache(gfx.renderer, "", err);
         t0 = mr_time_now();
-        ok = mr_renderer_set_scene(gfx.renderer, s, err);
+        ok = ok && mr_renderer_set_scene(gfx.renderer, s, err);
         double upload_s = mr_time_now() - t0;
         mr_lod_params lp = MR_LOD_DEFAULTS;
         mr_lod_info linfo;
