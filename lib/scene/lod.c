@@ -578,7 +578,7 @@ static double fan_prepare(const tri_grid *o, uint32_t v, uint32_t ref, uint16_t 
     double pts[48][2];
     int np = 0;
     uint32_t k0 = o->vt_start[v], k1 = o->vt_start[v + 1];
-    if (k1 - k0 > 16) return INFINITY; /* (then more than 16 in the plane too, in practice: no claim) */
+    if (k1 - k0 > 16) return INFINITY; /* the mask holds 16: a vertex with more makes no claim (looser, not wrong) */
     for (uint32_t k = k0; k < k1; k++) {
         uint32_t t = o->vt_items[k];
         dv p[3];
