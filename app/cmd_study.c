@@ -166,9 +166,7 @@ static void run_frame(run_app *a, bool *quit) {
         if (!mr_draw2d_image_draw(a->d2, a->tex[f.image_method[i] * S + tr->stimulus], r.x, r.y, r.w, r.h, &err))
             mr_log(MR_LOG_ERROR, "study run: %s", err.msg);
     }
-    mr_draw2d_list l = {(const mr_draw2d_vertex *)dl->vertices, dl->vertex_count, dl->indices, dl->index_count,
-                        dl->atlas, dl->atlas_w, dl->atlas_h, dl->atlas_version};
-    if (!mr_draw2d_list_draw(a->d2, &l, &err)) mr_log(MR_LOG_ERROR, "study run: %s", err.msg);
+    app_draw_ui(a->d2, dl, "study run");
     if (f.shot_path[0] || f.state_path[0]) {
         mr_image screen = {0};
         if (f.shot_path[0] && mr_draw2d_read(a->d2, &screen, &err) && !mr_image_save_png(f.shot_path, &screen, &err))

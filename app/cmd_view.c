@@ -127,35 +127,6 @@ static void begin_mark(view_app *a, double x, double y) {
                         (float)((a->mark_py + 0.5) / a->camera.height));
 }
 
-/* The annotation line of a finished mark (the format is lib/session's). */
-static cJSON *mark_line(view_app *a, int note) {
-    mr_annotation m;
-    mr_annotation_from_frame(&m, &a->mark_frame, mr_view_notes[note], (double)time(NULL));
-    m.has_pixel = true;
-    m.pixel[0] = a->mark_px;
-    m.pixel[1] = a->mark_py;
-    m.hit = a->mark_pick.hit;
-    m.world[0] = a->mark_pick.world.x;
-    m.world[1] = a->mark_pick.world.y;
-    m.world[2] = a->mark_pick.world.z;
-    m.depth = a->mark_pick.depth;
-    const mr_scene *sc = a->scene;
-    if (a->mark_pick.node >= 0 && sc && a->mark_pick.node < sc->node_count) {
-        m.node_index = a->mark_pick.node;
-        snprintf(m.node, sizeof m.node, "%s", sc->nodes[a->mark_pick.node].name);
-        snprintf(m.layer, sizeof m.layer, "%s", a->mark_pick.layer == MR_LAYER_HIDDEN ? "hidden" : "visible");
-    }
-    /* issue 15: the registration's σ at the marked point (absent when the
-     * pose has no covariance, e.g. an older recording, or nothing was hit) */
-    mr_viewer_frame sf = {.have_pose = a->mark_frame.have_pose, .world_from_camera = a->mark_frame.pose,
-                          .pose_cov = a->mark_frame.cov, .corner_sigma_px = a->mark_frame.corner_sigma_px,
-                          .have_point = a->mark_pick.hit, .point = a->mark_pick.world};
-    m.has_uncertainty = mr_view_sigma_here(&sf, &m.uncertainty_m);
-    m.has_measurement = a->mark_measured; /* issue 15: a mark made by Measure */
-    m.measurement = a->mark_measure;
-    return mr_annotation_to_json(&m);
-}
-
 static void finish_mark(view_app *a, int note) {
     if (note < 0 || note >= MR_VIEW_NOTE_COUNT) {
         mr_viewer_toast(a->vc, "mark cancelled");
@@ -168,7 +139,8 @@ static void finish_mark(view_app *a, int note) {
     char stem[64];
     a->mark_count++;
     snprintf(stem, sizeof stem, "mark_%ld_%04d", (long)time(NULL), a->mark_count);
-    cJSON *line = mark_line(a, note);
+    cJSON *line = mr_view_mark_line(&a->mark_frame, mr_view_notes[note], a->mark_px, a->mark_py, &a->mark_pick, a->scene,
+                                    a->mark_measured ? &a->mark_measure : NULL);
     mr_snapshot sn = snapshot_of(a, &a->mark_screen, &a->mark_frame);
     bool ok;
     mr_error aerr = {0};
@@ -261,23 +233,13 @@ static void render_3d(view_app *a) {
     mr_ui_rect fit = mr_ui_fit(area, a->frame.image.width, a->frame.image.height);
     int rw = (int)lround(fit.w), rh = (int)lround(fit.h);
     if (rw < 16 || rh < 16) return;
-    const mr_view_settings *s = mr_viewer_settings(a->vc);
     mr_view view;
-    view.camera = mr_camera_resized(&a->camera, a->frame.image.width, a->frame.image.height);
-    view.world_from_camera = a->frame.pose;
-    mr_frame_params fp = MR_FRAME_DEFAULTS;
-    fp.width = rw;
-    fp.height = rh;
-    fp.video = s->show_video ? &a->frame.image : NULL;
-    mr_view_frame_params(s, view_shadows(a), &fp);
-    fp.ao.temporal = a->ao_temporal;
-    fp.ao.temporal_reset = !a->ao_had_pose; /* tracking (re)acquired: no history across the gap */
+    mr_frame_params fp;
+    mr_view_render_choice c;
+    mr_view_render_setup(mr_viewer_settings(a->vc), &a->camera, &a->frame, mr_viewer_frozen(a->vc), view_shadows(a),
+                         a->ao_temporal, a->ao_had_pose, rw, rh, &view, &fp, &c);
     a->ao_had_pose = a->frame.have_pose && a->frame.pose_valid;
-    mr_view_render_choice c =
-        mr_view_render_policy(s, a->frame.have_pose, a->frame.pose_valid, mr_viewer_frozen(a->vc));
-    fp.alpha = c.alpha;
     a->dimmed = c.dimmed;
-    if (!c.use_pose) view.world_from_camera = mr_m4_look_at_cv(mr_v3(0, 0, 0), mr_v3(0, 0, 1), mr_v3(0, -1, 0));
     double t0 = mr_time_now();
     mr_frame_result_free(&a->res);
     mr_error err = {0};
@@ -316,21 +278,13 @@ static void write_state(view_app *a, const mr_image *screen) {
         mr_view view;
         view.camera = mr_camera_resized(&a->camera, a->frame.image.width, a->frame.image.height);
         view.world_from_camera = a->frame.pose;
-        double d[2] = {-1, -1};
-        for (int k = 0; k < 2; k++) {
-            mr_frame_params fp = MR_FRAME_DEFAULTS;
-            fp.width = a->rw;
-            fp.height = a->rh;
-            fp.video = &a->frame.image;
-            fp.alpha = (float)k;
-            mr_view_frame_params(s, view_shadows(a), &fp);
-            mr_frame_result r;
-            mr_error err = {0};
-            if (mr_render_frame(a->rend, &view, &fp, &r, &err)) {
-                d[k] = mr_image_u8_mean_abs_diff(&a->res.color, &r.color);
-                mr_frame_result_free(&r);
-            }
-        }
+        mr_frame_params fp = MR_FRAME_DEFAULTS;
+        fp.width = a->rw;
+        fp.height = a->rh;
+        fp.video = &a->frame.image;
+        mr_view_frame_params(s, view_shadows(a), &fp);
+        double d[2];
+        mr_render_alpha_distances(a->rend, &view, &fp, &a->res.color, d);
         ws.have_render = true;
         ws.render_w = a->rw;
         ws.render_h = a->rh;
@@ -375,13 +329,7 @@ static mr_viewer_frame frame_info(view_app *a, char *state_msg, size_t n) {
     f.fb_w = (float)a->fb_w;
     f.fb_h = (float)a->fb_h;
     f.px_per_mm = mr_window_px_per_mm(a->win) * a->ui_scale;
-    f.have_frame = a->have_frame;
-    f.have_pose = a->frame.have_pose;
-    f.pose_valid = a->frame.pose_valid;
-    f.index = a->frame.index;
-    f.count = a->frame.count;
-    f.tags_seen = a->frame.tags_seen;
-    f.rms_px = a->frame.rms_px;
+    mr_view_frame_from_capture(&f, &a->frame, a->have_frame, &a->camera, &a->picture_cam);
     f.seekable = a->cap && mr_capture_seekable(a->cap);
     f.playing = f.seekable && mr_capture_playing(a->cap);
     f.source_desc = a->source_desc;
@@ -393,19 +341,11 @@ static mr_viewer_frame frame_info(view_app *a, char *state_msg, size_t n) {
     f.dimmed = a->dimmed;
     f.passes = a->passes;
     f.fps = a->fps;
-    /* issue 15: the pose's covariance, told at the point being marked while
-     * the note chooser is open, else at the model under the centre */
-    f.world_from_camera = a->frame.pose;
-    f.pose_cov = a->frame.cov;
-    f.corner_sigma_px = a->frame.corner_sigma_px;
+    /* issue 15: the pose's covariance is told at the point being marked
+     * while the note chooser is open, else at the model under the centre */
     bool marking = mr_viewer_note_is_open(a->vc);
     f.have_point = marking ? a->mark_pick.hit : a->centre_hit;
     f.point = marking ? a->mark_pick.world : a->centre_world;
-    /* issue 15, Measure: taps are made on the undistorted picture */
-    if (a->have_frame && a->frame.image.width > 0) {
-        a->picture_cam = mr_camera_resized(&a->camera, a->frame.image.width, a->frame.image.height);
-        f.camera = &a->picture_cam;
-    }
     return f;
 }
 
@@ -449,9 +389,7 @@ static void frame_tick(view_app *a) {
     carry_out(a, &acts);
     a->sum_ui_cpu_ms += mr_ui_last_cpu_s(mr_viewer_ui_ctx(a->vc)) * 1e3;
     double t3 = mr_time_now();
-    mr_draw2d_list l = {(const mr_draw2d_vertex *)dl->vertices, dl->vertex_count, dl->indices, dl->index_count,
-                        dl->atlas, dl->atlas_w, dl->atlas_h, dl->atlas_version};
-    if (!mr_draw2d_list_draw(a->d2, &l, &err)) mr_log(MR_LOG_ERROR, "view: %s", err.msg);
+    app_draw_ui(a->d2, dl, "view");
     a->sum_ui_draw_ms += (mr_time_now() - t3) * 1e3;
     read_screen(a);
     mr_window_swap(a->win);

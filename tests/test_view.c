@@ -1045,6 +1045,63 @@ static void test_shadow_choice_and_taps(void) {
     CHECK(!at.pick.hit && at.pick.node == -1 && at.px == 319.5 && at.py == 239.5);
 }
 
+/* A mark's annotation line and a frame's render setup (lib/view/mark.c,
+ * out of app/cmd_view.c): the picked node's name and layer, the pixel,
+ * the measurement only on a Measure mark; no pose: the neutral view, and
+ * temporal AO reset after a render without one. */
+static void test_mark_line_and_setup(void) {
+    mr_scene *s = mr_scene_create();
+    mr_node n;
+    memset(&n, 0, sizeof n);
+    snprintf(n.name, sizeof n.name, "Pipe_1");
+    n.parent = -1;
+    n.mesh_first = -1;
+    n.layer = MR_LAYER_HIDDEN;
+    n.world = mr_m4_identity();
+    CHECK(mr_scene_add_node(s, &n) == 0);
+    mr_capture_frame f;
+    memset(&f, 0, sizeof f);
+    f.have_pose = f.pose_valid = true;
+    f.pose = mr_m4_identity();
+    f.index = 7;
+    f.image.width = 64;
+    f.image.height = 48;
+    mr_pick pick = {true, mr_v3(1, 2, 3), 3, 0, MR_LAYER_HIDDEN};
+    cJSON *line = mr_view_mark_line(&f, "missing", 10.5, 20.25, &pick, s, NULL);
+    CHECK(line != NULL);
+    if (line) {
+        const cJSON *node = cJSON_GetObjectItem(line, "node"), *layer = cJSON_GetObjectItem(line, "layer");
+        const cJSON *px = cJSON_GetObjectItem(line, "pixel");
+        CHECK(cJSON_IsString(node) && strcmp(node->valuestring, "Pipe_1") == 0);
+        CHECK(cJSON_IsString(layer) && strcmp(layer->valuestring, "hidden") == 0);
+        CHECK(cJSON_GetArraySize(px) == 2 && cJSON_GetArrayItem(px, 1)->valuedouble == 20.25);
+        CHECK(!cJSON_GetObjectItem(line, "measured_point"));
+        cJSON_Delete(line);
+    }
+    mr_measurement m;
+    memset(&m, 0, sizeof m);
+    m.tri.point = mr_v3(1, 2, 3);
+    line = mr_view_mark_line(&f, "moved", 1, 2, &pick, s, &m);
+    CHECK(line && cJSON_GetObjectItem(line, "measured_point"));
+    cJSON_Delete(line);
+    mr_view_settings vs = MR_VIEW_SETTINGS_DEFAULTS;
+    mr_camera cam = mr_demo_camera();
+    mr_view view;
+    mr_frame_params fp;
+    mr_view_render_choice c;
+    f.have_pose = f.pose_valid = false;
+    mr_view_render_setup(&vs, &cam, &f, false, MR_SHADOW_OFF, true, false, 32, 24, &view, &fp, &c);
+    CHECK(fp.width == 32 && fp.height == 24 && fp.video == &f.image && fp.ao.temporal && fp.ao.temporal_reset);
+    CHECK(!c.use_pose && fp.alpha == c.alpha && view.camera.width == 64);
+    mr_dmat4 neutral = mr_m4_look_at_cv(mr_v3(0, 0, 0), mr_v3(0, 0, 1), mr_v3(0, -1, 0));
+    CHECK(memcmp(&view.world_from_camera, &neutral, sizeof neutral) == 0);
+    f.have_pose = f.pose_valid = true;
+    f.pose.m[3] = 5;
+    mr_view_render_setup(&vs, &cam, &f, false, MR_SHADOW_OFF, true, true, 32, 24, &view, &fp, &c);
+    CHECK(c.use_pose && !fp.ao.temporal_reset && view.world_from_camera.m[3] == 5);
+    mr_scene_destroy(&s);
+}
+
 int main(void) {
     const char *t = getenv("MR_TEST_TMP");
     snprintf(g_tmp, sizeof g_tmp, "%s/test_view", t && t[0] ? t : "/tmp");
@@ -1053,6 +1110,7 @@ int main(void) {
     test_tracking_lost();
     test_settings();
     test_shadow_choice_and_taps();
+    test_mark_line_and_setup();
     char font[1024];
     if (!mr_ui_font_find(font, sizeof font, &err)) {
         printf("test_view: SKIPPED the controller tests (no font): %s\n", err.msg);

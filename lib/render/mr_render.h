@@ -469,6 +469,14 @@ typedef struct mr_frame_result {
 /* Renders one frame of the current scene seen through `view`. */
 bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params *params,
                      mr_frame_result *out, mr_error *err);
+
+/* How far `shown` is from the same view drawn as the model only (d[0],
+ * alpha 0) and as the video only (d[1], alpha 1): mean absolute 8-bit
+ * difference, -1 where a render fails. Says which way a transparency
+ * slider moved a picture (the view's `state`). The renderer's last frame
+ * is one of these afterwards. */
+void mr_render_alpha_distances(mr_renderer *r, const mr_view *view, const mr_frame_params *params, const mr_image *shown,
+                               double d[2]);
 void mr_frame_result_free(mr_frame_result *res);
 /* "gbuffer shade overlay" — the pass list as one line. */
 void mr_frame_result_passes(const mr_frame_result *res, char *buf, size_t n);

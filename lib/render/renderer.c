@@ -347,3 +347,18 @@ void mr_frame_result_passes(const mr_frame_result *res, char *buf, size_t n) {
         len += (size_t)snprintf(buf + len, n - len, "%s%s", i ? " " : "", res->passes[i]);
 }
 
+
+void mr_render_alpha_distances(mr_renderer *r, const mr_view *view, const mr_frame_params *params, const mr_image *shown,
+                               double d[2]) {
+    for (int k = 0; k < 2; k++) {
+        mr_frame_params fp = *params;
+        fp.alpha = (float)k;
+        mr_frame_result res;
+        mr_error err = {0};
+        d[k] = -1;
+        if (mr_render_frame(r, view, &fp, &res, &err)) {
+            d[k] = mr_image_u8_mean_abs_diff(shown, &res.color);
+            mr_frame_result_free(&res);
+        }
+    }
+}

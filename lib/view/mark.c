@@ -4,7 +4,9 @@
  * the frame parameters the settings give. app/cmd_view.c carries them out. */
 #include "view_internal.h"
 
+#include <stdio.h>
 #include <string.h>
+#include <time.h>
 
 bool mr_view_window_to_image(mr_ui_rect image_rect, int rw, int rh, double x, double y, double *u, double *v) {
     mr_ui_rect r = image_rect;
@@ -72,5 +74,70 @@ void mr_view_state_add_window(cJSON *j, const mr_view_window_state *w) {
         cJSON_AddNumberToObject(j, "render_height", w->render_h);
         cJSON_AddNumberToObject(j, "diff_to_model", w->diff_to_model);
         cJSON_AddNumberToObject(j, "diff_to_video", w->diff_to_video);
+    }
+}
+
+void mr_view_render_setup(const mr_view_settings *s, const mr_camera *cam, const mr_capture_frame *f, bool frozen,
+                          mr_shadow_method shadows, bool ao_temporal, bool had_pose, int rw, int rh, mr_view *view,
+                          mr_frame_params *fp, mr_view_render_choice *c) {
+    view->camera = mr_camera_resized(cam, f->image.width, f->image.height);
+    view->world_from_camera = f->pose;
+    *fp = (mr_frame_params)MR_FRAME_DEFAULTS;
+    fp->width = rw;
+    fp->height = rh;
+    fp->video = s->show_video ? &f->image : NULL;
+    mr_view_frame_params(s, shadows, fp);
+    fp->ao.temporal = ao_temporal;
+    fp->ao.temporal_reset = !had_pose; /* tracking (re)acquired: no history across the gap */
+    *c = mr_view_render_policy(s, f->have_pose, f->pose_valid, frozen);
+    fp->alpha = c->alpha;
+    if (!c->use_pose) view->world_from_camera = mr_m4_look_at_cv(mr_v3(0, 0, 0), mr_v3(0, 0, 1), mr_v3(0, -1, 0));
+}
+
+cJSON *mr_view_mark_line(const mr_capture_frame *f, const char *note, double px, double py, const mr_pick *pick,
+                         const mr_scene *scene, const mr_measurement *measured) {
+    mr_annotation m;
+    mr_annotation_from_frame(&m, f, note, (double)time(NULL));
+    m.has_pixel = true;
+    m.pixel[0] = px;
+    m.pixel[1] = py;
+    m.hit = pick->hit;
+    m.world[0] = pick->world.x;
+    m.world[1] = pick->world.y;
+    m.world[2] = pick->world.z;
+    m.depth = pick->depth;
+    if (pick->node >= 0 && scene && pick->node < scene->node_count) {
+        m.node_index = pick->node;
+        snprintf(m.node, sizeof m.node, "%s", scene->nodes[pick->node].name);
+        snprintf(m.layer, sizeof m.layer, "%s", pick->layer == MR_LAYER_HIDDEN ? "hidden" : "visible");
+    }
+    /* issue 15: the registration's sigma at the marked point (absent when
+     * the pose has no covariance, e.g. an older recording, or nothing was
+     * hit) */
+    mr_viewer_frame sf = {.have_pose = f->have_pose, .world_from_camera = f->pose, .pose_cov = f->cov,
+                          .corner_sigma_px = f->corner_sigma_px, .have_point = pick->hit, .point = pick->world};
+    m.has_uncertainty = mr_view_sigma_here(&sf, &m.uncertainty_m);
+    m.has_measurement = measured != NULL; /* issue 15: a mark made by Measure */
+    if (measured) m.measurement = *measured;
+    return mr_annotation_to_json(&m);
+}
+
+void mr_view_frame_from_capture(mr_viewer_frame *vf, const mr_capture_frame *f, bool have_frame, const mr_camera *cam,
+                                mr_camera *picture_cam) {
+    vf->have_frame = have_frame;
+    vf->have_pose = f->have_pose;
+    vf->pose_valid = f->pose_valid;
+    vf->index = f->index;
+    vf->count = f->count;
+    vf->tags_seen = f->tags_seen;
+    vf->rms_px = f->rms_px;
+    /* issue 15: the pose's covariance */
+    vf->world_from_camera = f->pose;
+    vf->pose_cov = f->cov;
+    vf->corner_sigma_px = f->corner_sigma_px;
+    /* issue 15, Measure: taps are made on the undistorted picture */
+    if (have_frame && f->image.width > 0) {
+        *picture_cam = mr_camera_resized(cam, f->image.width, f->image.height);
+        vf->camera = picture_cam;
     }
 }

@@ -15,12 +15,15 @@
  * below lib/view includes this header.
  * mark.c (the marking and render decisions moved out of app/cmd_view.c)
  * adds lib/track's mr_project_point and lib/render's plain mr_pick,
- * mr_frame_params and mr_shadow_method_parse. */
+ * mr_frame_params and mr_shadow_method_parse, and lib/session's plain
+ * types (mr_capture_frame, mr_annotation: a mark's line and the frame's
+ * render setup, DESIGN.md's view -> session). */
 #ifndef MR_VIEW_CTL_H
 #define MR_VIEW_CTL_H
 
 #include "mr_core.h"
 #include "mr_render.h"
+#include "mr_session.h"
 #include "mr_ui.h"
 
 #ifdef __cplusplus
@@ -330,6 +333,28 @@ mr_shadow_method mr_view_shadow_choose(mr_view_shadow_choice *c, mr_shadow_metho
 /* What the settings set in a frame's parameters: the hidden layer, the AO
  * method, the ghosting mode, and the shadow method given. */
 void mr_view_frame_params(const mr_view_settings *s, mr_shadow_method shadows, mr_frame_params *fp);
+
+/* What the window renders for capture frame f at rw x rh: the view (the
+ * frame's pose, or a neutral one where the render policy says not to use
+ * it) and the frame parameters (size, video, the policy's alpha, the
+ * settings' passes, temporal AO reset when the pose comes back after a gap:
+ * had_pose is whether the last render had one). *c gets the policy. */
+void mr_view_render_setup(const mr_view_settings *s, const mr_camera *cam, const mr_capture_frame *f, bool frozen,
+                          mr_shadow_method shadows, bool ao_temporal, bool had_pose, int rw, int rh, mr_view *view,
+                          mr_frame_params *fp, mr_view_render_choice *c);
+
+/* The annotation line (lib/session's format) of a mark made on frame f:
+ * the note, the tapped camera pixel, what was picked there (its node's name
+ * and layer from scene), the registration's sigma at the picked point, and
+ * the measurement of a Measure mark (NULL for a plain mark). */
+cJSON *mr_view_mark_line(const mr_capture_frame *f, const char *note, double px, double py, const mr_pick *pick,
+                         const mr_scene *scene, const mr_measurement *measured);
+
+/* The capture frame's part of what the controller is told each frame
+ * (pose, its covariance, tracking counts, the picture's undistorted camera
+ * in *picture_cam, which vf->camera then points to). */
+void mr_view_frame_from_capture(mr_viewer_frame *vf, const mr_capture_frame *f, bool have_frame, const mr_camera *cam,
+                                mr_camera *picture_cam);
 
 /* What only the window knows, for a `state` snapshot. */
 typedef struct mr_view_window_state {
