@@ -10,12 +10,9 @@ static int parse_sizes(const char *spec, double *out, int max) {
     int n = 0;
     const char *p = spec;
     while (*p && n < max) {
-        char *end;
-        double v = strtod(p, &end);
-        if (end == p) return -1;
-        if (*end == 'M' || *end == 'm') { v *= 1e6; end++; }
-        else if (*end == 'k' || *end == 'K') { v *= 1e3; end++; }
-        if (!(v >= 1e4 && v <= 1e9)) return -1;
+        const char *end;
+        double v;
+        if (!mr_cli_count_prefix(p, &v, &end) || !(v >= 1e4 && v <= 1e9)) return -1;
         out[n++] = v;
         if (*end == ',') end++;
         else if (*end) return -1;

@@ -7,12 +7,9 @@
 
 /* "5M", "200k", "1e6" or a plain number of triangles. */
 static bool parse_count(const char *s, uint64_t *out) {
-    char *end = NULL;
-    double v = strtod(s, &end);
-    if (end == s) return false;
-    if (*end == 'k' || *end == 'K') { v *= 1e3; end++; }
-    else if (*end == 'm' || *end == 'M') { v *= 1e6; end++; }
-    if (*end || !(v >= 1 && v <= 1e11)) return false;
+    const char *end;
+    double v;
+    if (!mr_cli_count_prefix(s, &v, &end) || *end || !(v >= 1 && v <= 1e11)) return false;
     *out = (uint64_t)v;
     return true;
 }

@@ -614,7 +614,19 @@ static void test_facility(void) {
     cJSON_Delete(j);
 }
 
+/* Counts with k / M (factory --triangles, bench scene --sizes). */
+static void test_count_prefix(void) {
+    double v = 0;
+    const char *end = NULL;
+    CHECK(mr_cli_count_prefix("5M,200k", &v, &end) && v == 5e6 && *end == ',');
+    CHECK(mr_cli_count_prefix(end + 1, &v, &end) && v == 2e5 && *end == 0);
+    CHECK(mr_cli_count_prefix("1e6", &v, &end) && v == 1e6 && *end == 0);
+    CHECK(mr_cli_count_prefix("12x", &v, &end) && v == 12 && *end == 'x');
+    CHECK(!mr_cli_count_prefix("M5", &v, &end));
+}
+
 int main(void) {
+    test_count_prefix();
     test_facility();
     test_tables();
     return mr_test_finish("test_options");

@@ -227,3 +227,19 @@ void mr_cli_log_level(const mr_cli_opt *opts) {
     if (mr_cli_get(opts, "quiet")) mr_log_set_level(MR_LOG_ERROR);
     else if (mr_cli_get(opts, "verbose")) mr_log_set_level(MR_LOG_INFO);
 }
+
+bool mr_cli_count_prefix(const char *s, double *out, const char **end) {
+    char *e = NULL;
+    double v = strtod(s, &e);
+    if (e == s) return false;
+    if (*e == 'k' || *e == 'K') {
+        v *= 1e3;
+        e++;
+    } else if (*e == 'm' || *e == 'M') {
+        v *= 1e6;
+        e++;
+    }
+    *out = v;
+    *end = e;
+    return true;
+}

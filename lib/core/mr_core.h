@@ -360,6 +360,10 @@ bool mr_cli_flag(const mr_cli_opt *opts, const char *name);
 bool mr_cli_double(const char *opt, const char *s, double lo, double hi, double *out);
 bool mr_cli_int(const char *opt, const char *s, long lo, long hi, long *out);
 bool mr_cli_size(const char *opt, const char *s, int *w, int *h);
+/* A count at the start of s: a number with an optional k (1e3) or M (1e6),
+ * like "5M", "200k", "1e6"; *end is where it stops. false if s does not
+ * start with a number. */
+bool mr_cli_count_prefix(const char *s, double *out, const char **end);
 /* Exit status of a command that found no GPU device, GL context or display
  * (MR_ERR_NODEVICE): EX_UNAVAILABLE of sysexits.h. Tests skip on this status
  * only, never on the text of a message. */
