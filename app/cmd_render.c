@@ -139,8 +139,7 @@ int cmd_render(int argc, char **argv) {
             mr_cluster_cache_path(scene->source, clu, sizeof clu);
         double t_up = mr_time_now();
         bool set = mr_renderer_set_cluster_cache(gfx.renderer, clu, &err) && mr_renderer_set_draw_params(gfx.renderer, &dp, &err) &&
-                   mr_renderer_set_scene(gfx.renderer, scene, &err) &&
-                   (!lod || mr_renderer_set_lod(gfx.renderer, lod, &err)); /* no levels: set_scene's upload is it */
+                   mr_renderer_set_scene_lod(gfx.renderer, scene, lod, &err); /* one upload, levels included */
         double t_upload = mr_time_now() - t_up;
         if (!set) {
             rc = mr_cli_error(cmd, &err);

@@ -556,8 +556,10 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     return true;
 }
 
-bool mr_geometry_upload(mr_renderer *r, const mr_scene *s, mr_error *err) {
-    if (!upload(r, s, NULL, err)) {
+bool mr_geometry_upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_error *err) {
+    if (lod && lod->mesh_count != s->mesh_count)
+        return mr_fail(err, MR_ERR_INVALID, "LOD levels are for %d meshes, the scene has %d", lod->mesh_count, s->mesh_count);
+    if (!upload(r, s, lod, err)) {
         mr_geometry_free(r);
         return false;
     }

@@ -930,6 +930,9 @@ void mr_renderer_reset_occlusion(mr_renderer *r);
  * must stay alive while set; NULL: full detail only). Re-uploads the
  * scene's geometry; setting another scene drops the levels. */
 bool mr_renderer_set_lod(mr_renderer *r, const mr_lod *lod, mr_error *err);
+/* mr_renderer_set_scene and mr_renderer_set_lod in one upload (a big
+ * scene's upload, meshlets included, costs seconds: not twice). */
+bool mr_renderer_set_scene_lod(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_error *err);
 
 /* issue 17 (lane cluster): the meshlets of big meshes cached beside the
  * scene file. From the next upload (set_scene / set_lod) on, each level's

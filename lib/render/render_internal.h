@@ -138,7 +138,7 @@ void mr_gl_target_free(target *t);
 void mr_gl_projection(const mr_camera *c, double near_plane, float out[16]);
 
 /* Geometry (geometry.c). */
-bool mr_geometry_upload(mr_renderer *r, const mr_scene *s, mr_error *err);
+bool mr_geometry_upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_error *err);
 void mr_geometry_free(mr_renderer *r);
 /* Draws the view's layers with its program into the bound framebuffer
  * (culling, LOD, instancing), counting triangles and draw calls into out

@@ -148,11 +148,15 @@ void mr_renderer_destroy(mr_renderer **rp) {
 
 
 bool mr_renderer_set_scene(mr_renderer *r, const mr_scene *s, mr_error *err) {
+    return mr_renderer_set_scene_lod(r, s, NULL, err);
+}
+
+bool mr_renderer_set_scene_lod(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_error *err) {
     for (size_t i = 0; i < PASS_COUNT; i++)
         if (k_passes[i]->scene_changed) k_passes[i]->scene_changed(r);
     mr_geometry_free(r);
     if (!s) return true;
-    return mr_geometry_upload(r, s, err);
+    return mr_geometry_upload(r, s, lod, err);
 }
 
 /* Near plane: half the distance to the scene's bounding box, but never below
