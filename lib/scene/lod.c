@@ -150,13 +150,21 @@ typedef struct tri_grid {
      * triangle, 2 * stamp (+1 if in the patch) of the last patch that
      * looked at it. */
     uint32_t *nbr, *mark, stamp;
+    /* Nearest queries (grid_nearest): qmark, per triangle, the last query
+     * that computed its distance (a long triangle sits in many cells). */
+    uint32_t *qmark, qstamp;
+    /* tpl, per triangle, its unit normal and offset (n.a): the distance to
+     * the plane is a lower bound of the distance to the triangle, so most
+     * of a cell's triangles are passed over without the full distance. */
+    double *tpl;
+    double mag; /* largest |coordinate| of the grid's box */
 } tri_grid;
 
 static dv vtx(const float *pos, uint32_t i) {
     return (dv){pos[3 * (size_t)i], pos[3 * (size_t)i + 1], pos[3 * (size_t)i + 2]};
 }
 
-static void cell_of(const tri_grid *g, dv p, int c[3]) {
+static inline void cell_of(const tri_grid *g, dv p, int c[3]) {
     const double q[3] = {p.x, p.y, p.z};
     for (int k = 0; k < 3; k++) {
         double f = floor((q[k] - g->lo[k]) / g->cell);
@@ -181,6 +189,8 @@ static void grid_free(tri_grid *g) {
     free(g->fan_slack);
     free(g->nbr);
     free(g->mark);
+    free(g->qmark);
+    free(g->tpl);
     memset(g, 0, sizeof *g);
 }
 
@@ -196,18 +206,20 @@ static bool grid_build(tri_grid *g, const float *pos, const uint32_t *idx, uint3
     if (!(ext > 0)) ext = 1;
     /* A few cells per triangle (most are empty: surfaces are thin), at most
      * 128 per axis. */
-    double per_axis = cbrt((double)g->tri_count + 1) * 2.5;
+    double per_axis = cbrt((double)g->tri_count + 1) * 1.6;
     if (per_axis > 128) per_axis = 128;
     if (per_axis < 1) per_axis = 1;
     g->cell = ext / per_axis * 1.0000001;
     for (int k = 0; k < 3; k++) {
+        g->mag = dmax(g->mag, dmax(fabs(lo[k]), fabs(hi[k])));
         g->lo[k] = lo[k];
         g->n[k] = (int)ceil((hi[k] - lo[k]) / g->cell);
         if (g->n[k] < 1) g->n[k] = 1;
     }
     size_t cells = (size_t)g->n[0] * g->n[1] * g->n[2];
     g->start = calloc(cells + 1, sizeof *g->start);
-    if (!g->start) return false;
+    g->qmark = calloc((size_t)g->tri_count + 1, sizeof *g->qmark);
+    if (!g->start || !g->qmark) return false;
     /* Two passes: count, then fill (triangle AABB against cells). */
     for (int pass = 0; pass < 2; pass++) {
         for (uint32_t t = 0; t < g->tri_count; t++) {
@@ -303,10 +315,11 @@ static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
     g->ring_s = malloc(((size_t)vertex_count + 1) * sizeof *g->ring_s);
     g->vrad = calloc((size_t)vertex_count + 1, sizeof *g->vrad);
     g->tsph = malloc(((size_t)g->tri_count * 5 + 1) * sizeof *g->tsph);
+    g->tpl = malloc(((size_t)g->tri_count * 4 + 1) * sizeof *g->tpl);
     g->fan_ref = malloc(((size_t)vertex_count + 1) * sizeof *g->fan_ref);
     g->fan_mask = malloc(((size_t)vertex_count + 1) * sizeof *g->fan_mask);
     g->fan_slack = malloc(((size_t)vertex_count + 1) * sizeof *g->fan_slack);
-    if (!g->vt_start || !g->vt_items || !g->ring_n || !g->ring_s || !g->vrad || !g->tsph || !g->fan_ref ||
+    if (!g->vt_start || !g->vt_items || !g->ring_n || !g->ring_s || !g->vrad || !g->tsph || !g->tpl || !g->fan_ref ||
         !g->fan_mask || !g->fan_slack)
         return false;
     for (uint32_t v = 0; v < vertex_count; v++) {
@@ -341,6 +354,15 @@ static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
         dv f1 = dv_sub(p[1], p[0]), f2 = dv_sub(p[2], p[0]);
         dv fn = {f1.y * f2.z - f1.z * f2.y, f1.z * f2.x - f1.x * f2.z, f1.x * f2.y - f1.y * f2.x};
         sp[4] = sqrt(dv_dot(fn, fn));
+        double *pl = g->tpl + 4 * (size_t)t;
+        if (sp[4] > 0 && isfinite(1 / sp[4])) {
+            pl[0] = fn.x / sp[4];
+            pl[1] = fn.y / sp[4];
+            pl[2] = fn.z / sp[4];
+            pl[3] = pl[0] * p[0].x + pl[1] * p[0].y + pl[2] * p[0].z;
+        } else {
+            pl[0] = pl[1] = pl[2] = pl[3] = 0; /* degenerate: never passed over */
+        }
     }
     for (uint32_t v = 0; v < vertex_count; v++) g->vrad[v] = g->vrad[v] * (1 + 1e-9) + tol;
     size_t ne = (size_t)g->tri_count * 3;
@@ -451,15 +473,32 @@ static bool partner_get(const tri_grid *og, size_t h) {
 
 /* Distance from p to the surface, searched out to `limit` (beyond it:
  * INFINITY); *tri gets the nearest triangle (or UINT32_MAX). */
-static double grid_nearest(const tri_grid *g, dv p, double limit, uint32_t *tri) {
+static double grid_nearest(const tri_grid *og, dv p, double limit, uint32_t *tri) {
+    tri_grid *g = (tri_grid *)og; /* the query marks are scratch */
     int c[3];
     cell_of(g, p, c);
-    double best2 = INFINITY;
+    if (g->qstamp == UINT32_MAX) {
+        memset(g->qmark, 0, (size_t)g->tri_count * sizeof *g->qmark);
+        g->qstamp = 0;
+    }
+    uint32_t qs = ++g->qstamp;
+    double best2 = INFINITY, best = INFINITY;
+    /* Rounding of a plane distance (n.p - n.a, both of the size of the
+     * coordinates): far below this, so a triangle passed over is never
+     * nearer. */
+    const double htol = 1e-3 * g->ptol + 1e-13 * (fabs(p.x) + fabs(p.y) + fabs(p.z) + g->mag);
     uint32_t bt = UINT32_MAX;
     int maxr = g->n[0] + g->n[1] + g->n[2];
+    const double q[3] = {p.x, p.y, p.z};
+    /* How far p lies inside its cell from each side: ring r (r >= 1) is at
+     * least r - 1 cells plus the nearest of these away. */
+    double wall = INFINITY;
+    for (int k = 0; k < 3; k++) {
+        double lo = g->lo[k] + c[k] * g->cell;
+        wall = dmin(wall, dmax(0, dmin(q[k] - lo, lo + g->cell - q[k])));
+    }
     for (int r = 0; r <= maxr; r++) {
-        /* Every cell of ring r+1 and beyond is at least r cells away. */
-        double ring_min = (r - 1) * g->cell;
+        double ring_min = (r - 1) * g->cell + wall;
         if (r > 0 && ring_min * ring_min > best2) break;
         if (r > 0 && ring_min > limit) break;
         for (int z = c[2] - r; z <= c[2] + r; z++) {
@@ -473,7 +512,6 @@ static double grid_nearest(const tri_grid *g, dv p, double limit, uint32_t *tri)
                     if (g->start[ci] == g->start[ci + 1]) continue;
                     /* Skip cells whose box is farther than the best so far. */
                     const int cc[3] = {x, y, z};
-                    const double q[3] = {p.x, p.y, p.z};
                     double box2 = 0;
                     for (int k = 0; k < 3; k++) {
                         double lo = g->lo[k] + cc[k] * g->cell, hi = lo + g->cell;
@@ -483,10 +521,17 @@ static double grid_nearest(const tri_grid *g, dv p, double limit, uint32_t *tri)
                     if (box2 >= best2) continue;
                     for (uint32_t k = g->start[ci]; k < g->start[ci + 1]; k++) {
                         uint32_t t = g->items[k];
+                        if (g->qmark[t] == qs) continue;
+                        g->qmark[t] = qs;
+                        if (g->tpl) {
+                            const double *pl = g->tpl + 4 * (size_t)t;
+                            if (fabs(pl[0] * p.x + pl[1] * p.y + pl[2] * p.z - pl[3]) - htol > best) continue;
+                        }
                         double d2 = dist2_point_tri(p, vtx(g->pos, g->idx[3 * t]), vtx(g->pos, g->idx[3 * t + 1]),
                                                     vtx(g->pos, g->idx[3 * t + 2]));
                         if (d2 < best2) {
                             best2 = d2;
+                            best = sqrt(d2);
                             bt = t;
                         }
                     }
@@ -800,7 +845,7 @@ static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *
         /* Facing the plane, by at least 5 % of its area. */
         double a2 = cross2(x[0], x[1], x[2]);
         if (!(a2 > 0.05 * o->tsph[5 * (size_t)t + 4])) continue;
-        if (!tri2_overlap(P, x)) continue;
+        if (!tri2_overlap(Q, x)) continue;
         /* Only the part over P matters (the clip also keeps 9 corners at
          * most: a triangle clipped by three half-planes); no clip needed
          * where even the corners do not raise H. */
@@ -1626,7 +1671,7 @@ mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *e
 /* -------------------------------------------------------------- cache */
 
 #define CACHE_MAGIC "MRLOD\r\n\x1a"
-#define CACHE_VERSION 5u /* bump whenever simplification or certification changes */
+#define CACHE_VERSION 6u /* bump whenever simplification or certification changes */
 
 void mr_lod_cache_path(const char *scene_path, char *out, size_t n) {
     snprintf(out, n, "%s.mrlod", scene_path ? scene_path : "scene");
