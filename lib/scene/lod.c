@@ -1044,7 +1044,11 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
          * triangle is t is at its known distance from it (all three, the
          * common case: no distance computed at all). */
         const double dk[3] = {da, db, dc};
-        for (int k = 0; k < 3; k++) {
+        /* (Each stage stops at the first bound that is enough: a tighter
+         * one would not change what is kept, only cost more distances.
+         * cdd of candidates not reached is not read: the flat pairs below
+         * run only while ub is over enough.) */
+        for (int k = 0; k < 3 && ub > enough; k++) {
             uint32_t t = cand[k];
             if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
             double m = 0;
@@ -1060,7 +1064,7 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
             if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
             if (plane_gap(o, t, a, b, c) > enough) continue;
             memcpy(dd, cdd[k], sizeof dd);
-            for (int j = 0; j < 3; j++) {
+            for (int j = 0; j < 3 && ub > enough; j++) {
                 size_t h = 3 * (size_t)t + (size_t)j;
                 if (!partner_get(o, h)) continue;
                 /* The flat pair (t and the folded partner) is convex: its
