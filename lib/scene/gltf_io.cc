@@ -103,12 +103,26 @@ struct MeshGuard {
     MeshGuard &operator=(const MeshGuard &) = delete;
 };
 
+// A big array's pages are first touched while it is filled, one fault
+// (and one zeroed 4 KiB page) at a time: for a large mesh that is a third
+// of its load (measured on the 2M-triangle unique factory packed with
+// gltfpack -c). Where the kernel gives transparent huge pages on request
+// (the Debian default, "madvise"), such arrays ask for them: 512 times fewer
+// faults. Still plain malloc memory, freed with free().
+void want_huge_pages(void *p, size_t bytes) {
+    const size_t huge = (size_t)2 << 20;
+    if (bytes < 2 * huge) return;
+    uintptr_t a = ((uintptr_t)p + huge - 1) & ~(uintptr_t)(huge - 1), e = ((uintptr_t)p + bytes) & ~(uintptr_t)(huge - 1);
+    if (e > a) (void)madvise(reinterpret_cast<void *>(a), e - a, MADV_HUGEPAGE);  // a hint: failure changes nothing
+}
+
 template <typename T>
 T *xmalloc(size_t n) {
     if (n == 0) n = 1;
     if (n > SIZE_MAX / sizeof(T)) throw std::bad_alloc();
     T *p = static_cast<T *>(std::malloc(n * sizeof(T)));
     if (!p) throw std::bad_alloc();
+    want_huge_pages(p, n * sizeof(T));
     return p;
 }
 
