@@ -198,6 +198,82 @@ static void check_packed(mr_renderer *r, const char *name, const mr_scene *src, 
     for (int i = 0; i < k_variants; i++) mr_scene_destroy(&b[i]);
 }
 
+/* A file whose meshopt views decode to more than a few MB decodes them on
+ * both cores (gltf_io.cc, batch_decode): its meshes must be bit for bit
+ * those of gltfpack's uncompressed file (the same quantised values; the
+ * vertex and index codecs are lossless). A file whose every stream is
+ * broken fails in one line, from that path too. */
+static void check_batch(void) {
+    mr_synth_cad_params cp = MR_SYNTH_CAD_DEFAULTS;
+    cp.parts = 16;
+    cp.part_triangles = 40000;
+    mr_error err = {0};
+    mr_scene *cad = mr_synth_cad_build(&cp, &err);
+    CHECK_MSG(cad != NULL, "%s", err.msg);
+    if (!cad) return;
+    char path[1200], plain[1200], packed[1200], broken[1200];
+    snprintf(path, sizeof path, "%s/batch.glb", g_tmp);
+    snprintf(plain, sizeof plain, "%s/batch_plain.glb", g_tmp);
+    snprintf(packed, sizeof packed, "%s/batch_c.glb", g_tmp);
+    snprintf(broken, sizeof broken, "%s/batch_broken.glb", g_tmp);
+    CHECK_MSG(mr_scene_save_glb(cad, path, &err), "%s", err.msg);
+    mr_scene_destroy(&cad);
+    if (!pack(path, plain, "") || !pack(path, packed, "-c")) return;
+    mr_scene *a = mr_scene_load(plain, NULL, &err);
+    CHECK_MSG(a != NULL, "%s: %s", plain, err.msg);
+    mr_scene *b = mr_scene_load(packed, NULL, &err);
+    CHECK_MSG(b != NULL, "%s: %s", packed, err.msg);
+    if (a && b) {
+        uint64_t decoded = 0;
+        for (int32_t i = 0; i < b->mesh_count; i++)
+            decoded += (uint64_t)b->meshes[i].vertex_count * 6 + (uint64_t)b->meshes[i].index_count * 4;
+        CHECK_MSG(decoded > (6u << 20), "the packed file decodes to only %llu bytes: too little for both cores",
+                  (unsigned long long)decoded);
+        CHECK_MSG(a->mesh_count == b->mesh_count, "meshes: %d plain, %d with -c", (int)a->mesh_count, (int)b->mesh_count);
+        int differ = 0;
+        for (int32_t i = 0; i < a->mesh_count && i < b->mesh_count; i++) {
+            const mr_mesh *x = &a->meshes[i], *y = &b->meshes[i];
+            bool same = x->vertex_count == y->vertex_count && x->index_count == y->index_count &&
+                        !memcmp(x->positions, y->positions, (size_t)x->vertex_count * 12) &&
+                        (x->normals == NULL) == (y->normals == NULL) &&
+                        (!x->normals || !memcmp(x->normals, y->normals, (size_t)x->vertex_count * 12));
+            /* The index codec keeps each triangle and its winding, not
+             * always its first corner. */
+            for (uint32_t t = 0; same && t + 2 < x->index_count; t += 3) {
+                const uint32_t *p = x->indices + t, *q = y->indices + t;
+                same = (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) || (p[0] == q[1] && p[1] == q[2] && p[2] == q[0]) ||
+                       (p[0] == q[2] && p[1] == q[0] && p[2] == q[1]);
+            }
+            differ += !same;
+        }
+        CHECK_MSG(differ == 0, "%d of %d meshes differ between gltfpack and gltfpack -c", differ, (int)a->mesh_count);
+    }
+    mr_scene_destroy(&a);
+    mr_scene_destroy(&b);
+    /* Every byte of the BIN chunk zeroed: no stream has its header. */
+    size_t n = 0;
+    unsigned char *g = mr_file_read(packed, &n, 0, &err);
+    CHECK_MSG(g && n > 28, "%s: %s", packed, err.msg);
+    if (!g || n <= 28) {
+        free(g);
+        return;
+    }
+    uint32_t jlen;
+    memcpy(&jlen, g + 12, 4);
+    size_t bin = 20 + (size_t)jlen + 8;
+    CHECK_MSG(bin < n, "%s: no BIN chunk", packed);
+    if (bin < n) {
+        memset(g + bin, 0, n - bin);
+        CHECK_MSG(mr_file_write_atomic(broken, g, n, &err), "%s", err.msg);
+        mr_error e = {0};
+        mr_scene *c = mr_scene_load(broken, NULL, &e);
+        CHECK_MSG(c == NULL, "a file with every meshopt stream zeroed loaded");
+        CHECK_MSG(strstr(e.msg, "meshopt") && !strchr(e.msg, '\n'), "error: '%s'", e.msg);
+        mr_scene_destroy(&c);
+    }
+    free(g);
+}
+
 int main(void) {
     const char *tmp = getenv("MR_TEST_TMP");
     snprintf(g_tmp, sizeof g_tmp, "%s/gltfpack", tmp && tmp[0] ? tmp : "/tmp/mrcheck_test");
@@ -240,6 +316,7 @@ int main(void) {
         check_packed(r, "cad", cad, &v);
     }
     mr_scene_destroy(&cad);
+    check_batch();
     mr_renderer_destroy(&r);
     mr_gpu_destroy(&gpu);
     if (no_gpu) return mr_test_no_gpu("test_gltfpack", &gpu_err);
