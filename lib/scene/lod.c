@@ -1233,6 +1233,64 @@ static double directed_bound(const float *pos, const uint32_t *from, uint32_t fr
     return x.upper;
 }
 
+/* The box of all vertices (both surfaces use the same array) and the
+ * coplanarity tolerance: positions are float, a few ulps of the extent. */
+static void vertex_box(const float *positions, uint32_t vertex_count, double lo[3], double hi[3], double *ptol) {
+    for (int k = 0; k < 3; k++) {
+        lo[k] = INFINITY;
+        hi[k] = -INFINITY;
+    }
+    for (uint32_t v = 0; v < vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            double p = positions[3 * (size_t)v + (size_t)k];
+            if (p < lo[k]) lo[k] = p;
+            if (p > hi[k]) hi[k] = p;
+        }
+    *ptol = 1e-6 * dmax(hi[0] - lo[0], dmax(hi[1] - lo[1], hi[2] - lo[2]));
+}
+
+/* One surface ready to be measured against: its grid, neighbours, hinges
+ * and fans. All of it (and what the bounds prepare lazily in it) belongs to
+ * the surface alone, so a level's grid serves again when it is the next
+ * level's source. false if out of memory (g still freeable). */
+static bool surface_prepare(tri_grid *g, const float *positions, uint32_t vertex_count, const uint32_t *idx,
+                            uint32_t count, const double lo[3], const double hi[3], double ptol) {
+    return grid_build(g, positions, idx, count, lo, hi) && convex_partners(g, ptol, vertex_count);
+}
+
+static bool indices_ok(const uint32_t *idx, uint32_t count, uint32_t vertex_count) {
+    for (uint32_t i = 0; i < count; i++)
+        if (idx[i] >= vertex_count) return false;
+    return true;
+}
+
+/* The two-sided bound between prepared surfaces ga (of a) and gb (of b). */
+static double hausdorff_prepared(const float *positions, uint32_t vertex_count, const uint32_t *a, uint32_t a_count,
+                                 const uint32_t *b, uint32_t b_count, const tri_grid *ga, const tri_grid *gb,
+                                 double resolution, double accept, double limit) {
+    if (!(limit > 0)) limit = INFINITY;
+    if (!(accept > 0)) accept = 0;
+    double *da = malloc((size_t)vertex_count * sizeof *da), *db = malloc((size_t)vertex_count * sizeof *db);
+    uint32_t *na = malloc((size_t)vertex_count * sizeof *na), *nb = malloc((size_t)vertex_count * sizeof *nb);
+    double r = INFINITY;
+    if (da && db && na && nb) {
+        double lower = 0;
+        vertex_distances(positions, vertex_count, a, a_count, gb, limit, da, na, &lower);
+        vertex_distances(positions, vertex_count, b, b_count, ga, limit, db, nb, &lower);
+        if (isfinite(lower)) {
+            double ab = directed_bound(positions, a, a_count, gb, da, na, &lower, resolution, accept, limit);
+            double ba = isfinite(ab) ? directed_bound(positions, b, b_count, ga, db, nb, &lower, resolution, accept, limit)
+                                     : INFINITY;
+            r = dmax(ab, ba);
+        }
+    }
+    free(da);
+    free(db);
+    free(na);
+    free(nb);
+    return r;
+}
+
 /* The two-sided bound. Vertex distances of both directions come first, so
  * that the largest real distance (lower) is known before any triangle is
  * bounded: no piece is refined below what the Hausdorff distance already is
@@ -1241,45 +1299,18 @@ static double directed_bound(const float *pos, const uint32_t *from, uint32_t fr
 static double hausdorff(const float *positions, uint32_t vertex_count, const uint32_t *a, uint32_t a_count,
                         const uint32_t *b, uint32_t b_count, double resolution, double accept, double limit) {
     if (!positions || vertex_count == 0 || !a || !b || a_count < 3 || b_count < 3) return INFINITY;
-    for (uint32_t i = 0; i < a_count; i++)
-        if (a[i] >= vertex_count) return INFINITY;
-    for (uint32_t i = 0; i < b_count; i++)
-        if (b[i] >= vertex_count) return INFINITY;
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (uint32_t v = 0; v < vertex_count; v++)
-        for (int k = 0; k < 3; k++) {
-            double p = positions[3 * (size_t)v + (size_t)k];
-            if (p < lo[k]) lo[k] = p;
-            if (p > hi[k]) hi[k] = p;
-        }
-    if (!(resolution > 0)) resolution = 1e-6 * dmax(hi[0] - lo[0], dmax(hi[1] - lo[1], hi[2] - lo[2]));
+    if (!indices_ok(a, a_count, vertex_count) || !indices_ok(b, b_count, vertex_count)) return INFINITY;
+    double lo[3], hi[3], ptol;
+    vertex_box(positions, vertex_count, lo, hi, &ptol);
+    if (!(resolution > 0)) resolution = ptol;
     if (!(resolution > 0)) resolution = 1e-12;
-    if (!(limit > 0)) limit = INFINITY;
-    if (!(accept > 0)) accept = 0;
     tri_grid ga, gb;
-    /* Positions are float: a few ulps of the extent. */
-    double ptol = 1e-6 * dmax(hi[0] - lo[0], dmax(hi[1] - lo[1], hi[2] - lo[2]));
-    bool ok = grid_build(&ga, positions, a, a_count, lo, hi) && grid_build(&gb, positions, b, b_count, lo, hi);
-    double *da = malloc((size_t)vertex_count * sizeof *da), *db = malloc((size_t)vertex_count * sizeof *db);
-    uint32_t *na = malloc((size_t)vertex_count * sizeof *na), *nb = malloc((size_t)vertex_count * sizeof *nb);
+    memset(&ga, 0, sizeof ga);
+    memset(&gb, 0, sizeof gb);
     double r = INFINITY;
-    if (ok && da && db && na && nb && convex_partners(&ga, ptol, vertex_count) &&
-        convex_partners(&gb, ptol, vertex_count)) {
-        double lower = 0;
-        vertex_distances(positions, vertex_count, a, a_count, &gb, limit, da, na, &lower);
-        vertex_distances(positions, vertex_count, b, b_count, &ga, limit, db, nb, &lower);
-        if (isfinite(lower)) {
-            double ab = directed_bound(positions, a, a_count, &gb, da, na, &lower, resolution, accept, limit);
-            double ba = isfinite(ab) ? directed_bound(positions, b, b_count, &ga, db, nb, &lower, resolution, accept, limit)
-                                     : INFINITY;
-            r = dmax(ab, ba);
-
-        }
-    }
-    free(da);
-    free(db);
-    free(na);
-    free(nb);
+    if (surface_prepare(&ga, positions, vertex_count, a, a_count, lo, hi, ptol) &&
+        surface_prepare(&gb, positions, vertex_count, b, b_count, lo, hi, ptol))
+        r = hausdorff_prepared(positions, vertex_count, a, a_count, b, b_count, &ga, &gb, resolution, accept, limit);
     grid_free(&ga);
     grid_free(&gb);
     return r;
@@ -1507,6 +1538,11 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
         return true;
     }
     bool ok = true;
+    double lo[3], hi[3], ptol;
+    vertex_box(w.cpos, w.ccount, lo, hi, &ptol);
+    tri_grid gsrc;
+    memset(&gsrc, 0, sizeof gsrc);
+    bool gsrc_ready = false;
     for (int k = MR_LOD_MAX_LEVELS - 1; k >= 0 && out->level_count < MR_LOD_MAX_LEVELS; k--) {
         double target = cap / (double)(1u << k);
         double step = target - src_err;
@@ -1551,9 +1587,24 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
          * so a level that fails gives up early. */
         double room = cap - src_err - 2 * w.slack;
         if (!(room > 0)) break;
-        double e = src_err + mr_lod_hausdorff_bound_within(w.cpos, w.ccount, src, (uint32_t)src_n, dst, (uint32_t)n,
-                                                           res, res, room * (1 + 1e-9));
-        if (!(e + 2 * w.slack <= cap)) break; /* coarser levels only get worse */
+        /* The source's grid is the last kept level's (prepared once). */
+        tri_grid gdst;
+        memset(&gdst, 0, sizeof gdst);
+        if ((!gsrc_ready && !surface_prepare(&gsrc, w.cpos, w.ccount, src, (uint32_t)src_n, lo, hi, ptol)) ||
+            !surface_prepare(&gdst, w.cpos, w.ccount, dst, (uint32_t)n, lo, hi, ptol)) {
+            grid_free(&gdst);
+            ok = false;
+            break;
+        }
+        gsrc_ready = true;
+        double e = src_err + hausdorff_prepared(w.cpos, w.ccount, src, (uint32_t)src_n, dst, (uint32_t)n, &gsrc, &gdst,
+                                                res, res, room * (1 + 1e-9));
+        if (!(e + 2 * w.slack <= cap)) {
+            grid_free(&gdst);
+            break; /* coarser levels only get worse */
+        }
+        grid_free(&gsrc);
+        gsrc = gdst; /* this level is the next one's source (its idx is dst, kept as buf[di]) */
         mr_lod_level *l = &out->levels[out->level_count];
         l->indices = malloc(n * sizeof *l->indices);
         if (!l->indices) {
@@ -1571,6 +1622,7 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
         src_n = n;
         src_err = e;
     }
+    grid_free(&gsrc);
     free(buf[0]);
     free(buf[1]);
     free(buf[2]);
