@@ -3,7 +3,8 @@
 # docs/bench/ (ao, ghost, tracking, scene, multiview, map), each stamped with
 # the commit it was made at and the exact command.
 #
-#   scripts/bench.sh [ao|ghost|tracking|scene|multiview|map|shadows|load ...]   (default: all but shadows and load)
+#   scripts/bench.sh [ao|ghost|tracking|scene|scene-unique|scene-instanced|multiview|map|shadows|load ...]
+#   (default: ao ghost tracking scene multiview map)
 #
 # Commit first, then run: the stamp names HEAD and says "dirty" when the
 # working tree differs from it (tables of uncommitted code). Sizes are
@@ -123,12 +124,19 @@ for b in "${benches[@]}"; do
         else run bench_scene_unique docs/bench/scene_unique $mr bench scene --unique --sizes 100k,200k --frames 3 --out docs/bench/scene_unique --quiet; fi
         find docs/bench/scene_unique -type f ! -name '*.csv' ! -name '*.md' ! -name '*.svg' ! -name '*.log' -delete
         find docs/bench/scene_unique -mindepth 1 -type d -empty -delete ;;
+    scene-instanced)
+        # issue 17: the instanced factory at scene-unique's full sizes and
+        # image size, for the two tables side by side; about 10 minutes
+        # here, not in the default list.
+        run bench_scene_instanced docs/bench/scene_instanced $mr bench scene --sizes 2M,10M,20M --frames 3 --full-detail-frames 1 --size 320x240 --out docs/bench/scene_instanced --quiet
+        find docs/bench/scene_instanced -type f ! -name '*.csv' ! -name '*.md' ! -name '*.svg' ! -name '*.log' -delete
+        find docs/bench/scene_instanced -mindepth 1 -type d -empty -delete ;;
     load)
         # issue 17 (lane gltf): first loads of the factories and their
         # gltfpack files, CPU only, about 30 s; not in the default list.
         run bench_load docs/bench/load $mr bench load --runs 15 --out docs/bench/load
         find docs/bench/load -type f -name '*.glb' -delete ;;
-    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, scene-unique, multiview, map, shadows, load)" >&2; exit 2 ;;
+    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, scene-unique, scene-instanced, multiview, map, shadows, load)" >&2; exit 2 ;;
     esac
 done
 echo "bench.sh: wrote docs/bench/ at commit $commit ($dirty)" >&2
