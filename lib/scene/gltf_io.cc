@@ -22,6 +22,7 @@
 #include <cctype>
 #include <cerrno>
 #include <climits>
+#include <condition_variable>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -29,6 +30,7 @@
 #include <exception>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <sstream>
 #include <string>
@@ -857,25 +859,35 @@ struct Loader {
             }
         } guard{batch};
         for (Decode &d : batch) d.out = xmalloc<unsigned char>(d.out_n ? d.out_n : 1);
-        // The largest views (about half the bytes, at least one) decode on a
-        // second thread while this one decodes the others and converts each
-        // at once; then the second thread's are converted. (All decoded
-        // first and then converted took as long as one after the other:
-        // the largest view alone decodes as long as the rest.)
+        // A second thread decodes the views, smallest first, while this one
+        // converts each as soon as it is decoded (the largest, usually an
+        // index list, last). Measured on the 2M-triangle unique factory
+        // (gltfpack -c): decoding all first, then converting, took as long
+        // as decoding one view after the other on one thread; the largest
+        // views on a second thread while this one decoded and converted
+        // the rest left that thread waiting on its own decoding.
         std::vector<size_t> order(batch.size());
         for (size_t k = 0; k < order.size(); k++) order[k] = k;
-        std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return batch[a].out_n > batch[b].out_n; });
-        size_t split = 0, half = 0;
-        while (split < order.size() - 1 && (split == 0 || 2 * (half + batch[order[split]].out_n) <= bytes))
-            half += batch[order[split++]].out_n;
-        auto far_side = [&] {
-            for (size_t k = 0; k < split; k++) batch[order[k]].rc = decode_run(batch[order[k]], batch[order[k]].out);
+        std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return batch[a].out_n < batch[b].out_n; });
+        std::mutex mu;
+        std::condition_variable cv;
+        size_t decoded = 0;  // under mu: order[0 .. decoded) are decoded
+        auto produce = [&] {
+            for (size_t k = 0; k < order.size(); k++) {
+                Decode &d = batch[order[k]];
+                d.rc = decode_run(d, d.out);
+                {
+                    std::lock_guard<std::mutex> l(mu);
+                    decoded = k + 1;
+                }
+                cv.notify_one();
+            }
         };
         std::thread t;
         try {
-            t = std::thread(far_side);
+            t = std::thread(produce);
         } catch (const std::system_error &) {
-            far_side();  // no second thread: here, first
+            produce();  // no second thread: all here, first
         }
         struct Join {
             std::thread &t;
@@ -883,25 +895,23 @@ struct Loader {
                 if (t.joinable()) t.join();
             }
         } join{t};
-        auto finish = [&](Decode &d) {
+        for (size_t k = 0; k < order.size(); k++) {
+            {
+                std::unique_lock<std::mutex> l(mu);
+                cv.wait(l, [&] { return decoded > k; });
+            }
+            Decode &d = batch[order[k]];
             if (d.rc != 0) {
                 if (d.bvi == bvi) decode_check(d);  // the one asked for: its error now
                 std::free(d.out);
                 d.out = nullptr;  // the others fail when asked for, decoded again
-                return;
+                continue;
             }
             src.consumed(d.n);
             preconvert(d.bvi, d.out, m.bufferViews[(size_t)d.bvi].byteLength, &d.out);
             std::free(d.out);  // unless its index list took it
             d.out = nullptr;
-        };
-        for (size_t k = split; k < order.size(); k++) {
-            Decode &d = batch[order[k]];
-            d.rc = decode_run(d, d.out);
-            finish(d);
         }
-        if (t.joinable()) t.join();
-        for (size_t k = 0; k < split; k++) finish(batch[order[k]]);
         return true;
     }
 
