@@ -21,9 +21,11 @@
 
 #include <math.h>
 #include <meshoptimizer.h>
+#include <pthread.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #define LEVELS (MR_LOD_MAX_LEVELS + 1) /* full detail + simplified levels */
 
@@ -264,8 +266,66 @@ static bool ensure_instances(struct mr_geo *g, uint32_t need) {
  * upload: a few hundred ms per million triangles, hence (issue 17, lane
  * cluster) taken from the cache beside the file where it has them. */
 
+/* The meshlets of one level, without GL: clusters (firsts relative to the
+ * level) and the indices meshlet by meshlet. Thread-safe: the upload builds
+ * the levels on both cores (level_jobs). false if out of memory. */
+typedef struct level_build {
+    geo_cluster *clusters;
+    uint32_t *out;
+    size_t cnt, w;
+} level_build;
+
+static bool build_meshlets(const mr_mesh *m, const uint32_t *indices, size_t n, level_build *b) {
+    memset(b, 0, sizeof *b);
+    size_t maxm = meshopt_buildMeshletsBound(n, CL_VERTS, CL_TRIS);
+    struct meshopt_Meshlet *ml = malloc(maxm * sizeof *ml);
+    unsigned int *mv = malloc(maxm * CL_VERTS * sizeof *mv);
+    unsigned char *mt = malloc(maxm * CL_TRIS * 3);
+    b->out = malloc((n + 1) * sizeof *b->out);
+    bool ok = ml && mv && mt && b->out;
+    b->cnt = ok ? meshopt_buildMeshlets(ml, mv, mt, indices, n, m->positions, m->vertex_count, 12, CL_VERTS, CL_TRIS, 0.0f) : 0;
+    b->clusters = ok ? malloc((b->cnt + 1) * sizeof *b->clusters) : NULL;
+    ok = ok && b->clusters;
+    for (size_t c = 0; ok && c < b->cnt; c++) {
+        const struct meshopt_Meshlet *me = &ml[c];
+        geo_cluster *gc = &b->clusters[c];
+        gc->first = (uint32_t)b->w;
+        gc->count = me->triangle_count * 3;
+        for (size_t t = 0; t < (size_t)me->triangle_count * 3; t++) b->out[b->w++] = mv[me->vertex_offset + mt[me->triangle_offset + t]];
+        struct meshopt_Bounds bd = meshopt_computeMeshletBounds(mv + me->vertex_offset, mt + me->triangle_offset,
+                                                                me->triangle_count, m->positions, m->vertex_count, 12);
+        memcpy(gc->center, bd.center, sizeof gc->center);
+        gc->radius = bd.radius;
+        memcpy(gc->apex, bd.cone_apex, sizeof gc->apex);
+        memcpy(gc->axis, bd.cone_axis, sizeof gc->axis);
+        gc->cutoff = bd.cone_cutoff;
+    }
+    free(ml);
+    free(mv);
+    free(mt);
+    if (!ok) {
+        free(b->out);
+        free(b->clusters);
+        memset(b, 0, sizeof *b);
+    }
+    return ok;
+}
+
+/* A level to split into meshlets, looked up in the cache and, if not there,
+ * built ahead of the upload on both cores (upload_level takes the result). */
+typedef struct level_job {
+    const mr_mesh *m;
+    const uint32_t *indices;
+    size_t n;
+    int32_t mesh, level;
+    uint64_t key;
+    const clu_level *hit;
+    level_build built;
+    bool ok; /* built (or hit) */
+} level_job;
+
 static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int32_t mi, int level,
-                         const uint32_t *indices, mr_error *err) {
+                         const uint32_t *indices, level_job *job, mr_error *err) {
     geo_mesh *gm = &g->meshes[mi];
     size_t n = gm->count[level];
     int32_t thr = r->draw.cluster_triangles > 0 ? r->draw.cluster_triangles : MR_DRAW_DEFAULT_CLUSTER_TRIANGLES;
@@ -277,8 +337,8 @@ static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int
     /* issue 17 (lane cluster): the cache's copy of this level. */
     uint64_t key = 0;
     if (g->cc) {
-        key = clu_level_key(m->positions, m->vertex_count, indices, (uint32_t)n, (uint32_t)thr);
-        const clu_level *hit = clu_cache_find(g->cc, mi, level, key, (uint32_t)n, m->vertex_count);
+        key = job ? job->key : clu_level_key(m->positions, m->vertex_count, indices, (uint32_t)n, (uint32_t)thr);
+        const clu_level *hit = job ? job->hit : clu_cache_find(g->cc, mi, level, key, (uint32_t)n, m->vertex_count);
         geo_cluster *cl = hit ? realloc(g->clusters, ((size_t)g->cluster_count + hit->cluster_count + 1) * sizeof *cl) : NULL;
         if (hit && cl && clu_cache_add(g->cc, hit)) {
             g->clusters = cl;
@@ -297,66 +357,135 @@ static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int
         if (hit && cl) g->clusters = cl;
     }
     double t_build = mr_time_now();
-    size_t maxm = meshopt_buildMeshletsBound(n, CL_VERTS, CL_TRIS);
-    struct meshopt_Meshlet *ml = malloc(maxm * sizeof *ml);
-    unsigned int *mv = malloc(maxm * CL_VERTS * sizeof *mv);
-    unsigned char *mt = malloc(maxm * CL_TRIS * 3);
-    uint32_t *out = malloc(n * sizeof *out);
-    bool ok = ml && mv && mt && out;
-    size_t cnt = ok ? meshopt_buildMeshlets(ml, mv, mt, indices, n, m->positions, m->vertex_count, 12, CL_VERTS, CL_TRIS, 0.0f) : 0;
-    geo_cluster *cl = ok ? realloc(g->clusters, ((size_t)g->cluster_count + cnt + 1) * sizeof *cl) : NULL;
+    level_build b;
+    bool ok;
+    if (job && job->ok && !job->hit) {
+        b = job->built; /* built ahead on both cores */
+        memset(&job->built, 0, sizeof job->built);
+        ok = true;
+    } else {
+        ok = build_meshlets(m, indices, n, &b);
+    }
+    geo_cluster *cl = ok ? realloc(g->clusters, ((size_t)g->cluster_count + b.cnt + 1) * sizeof *cl) : NULL;
     if (!cl) {
-        free(ml);
-        free(mv);
-        free(mt);
-        free(out);
+        free(b.out);
+        free(b.clusters);
         return mr_fail(err, MR_ERR_NOMEM, "out of memory building the meshlets of mesh '%s'", m->name);
     }
     g->clusters = cl;
     gm->cl_first[level] = g->cluster_count;
-    gm->cl_count[level] = (uint32_t)cnt;
-    size_t w = 0;
-    for (size_t c = 0; c < cnt; c++) {
-        const struct meshopt_Meshlet *me = &ml[c];
-        geo_cluster *gc = &cl[g->cluster_count + c];
-        gc->first = gm->first[level] + (uint32_t)w;
-        gc->count = me->triangle_count * 3;
-        for (size_t t = 0; t < (size_t)me->triangle_count * 3; t++) out[w++] = mv[me->vertex_offset + mt[me->triangle_offset + t]];
-        struct meshopt_Bounds b = meshopt_computeMeshletBounds(mv + me->vertex_offset, mt + me->triangle_offset, me->triangle_count,
-                                                        m->positions, m->vertex_count, 12);
-        memcpy(gc->center, b.center, sizeof gc->center);
-        gc->radius = b.radius;
-        memcpy(gc->apex, b.cone_apex, sizeof gc->apex);
-        memcpy(gc->axis, b.cone_axis, sizeof gc->axis);
-        gc->cutoff = b.cone_cutoff;
+    gm->cl_count[level] = (uint32_t)b.cnt;
+    for (size_t c = 0; c < b.cnt; c++) {
+        cl[g->cluster_count + c] = b.clusters[c];
+        cl[g->cluster_count + c].first += gm->first[level];
     }
-    g->cluster_count += (uint32_t)cnt;
-    free(ml);
-    free(mv);
-    free(mt);
+    g->cluster_count += (uint32_t)b.cnt;
+    size_t cnt = b.cnt, w = b.w;
+    uint32_t *out = b.out;
+    geo_cluster *rel = b.clusters; /* firsts relative to the level: the cache's form */
     /* meshopt drops degenerate triangles only if they repeat an index;
      * whatever it wrote is what the level draws. */
     gm->count[level] = (uint32_t)w;
     glNamedBufferSubData(g->ibo, (GLintptr)gm->first[level] * 4, (GLsizeiptr)w * 4, out);
     if (g->cc) {
         /* issue 17 (lane cluster): into the cache, firsts relative to the level */
-        geo_cluster *copy = malloc((cnt + 1) * sizeof *copy);
-        for (size_t c = 0; copy && c < cnt; c++) {
-            copy[c] = g->clusters[gm->cl_first[level] + c];
-            copy[c].first -= gm->first[level];
+        clu_level lv = {mi, level, key, (uint32_t)n, m->vertex_count, (uint32_t)w, (uint32_t)cnt, rel, out, true};
+        if (!clu_cache_add(g->cc, &lv)) {
+            g->cc->path[0] = 0; /* incomplete: not written (clu_cache_add freed them) */
         }
-        clu_level lv = {mi, level, key, (uint32_t)n, m->vertex_count, (uint32_t)w, (uint32_t)cnt, copy, out, true};
-        if (!copy || !clu_cache_add(g->cc, &lv)) {
-            free(copy);
-            g->cc->path[0] = 0; /* incomplete: not written */
-        } else {
-            out = NULL; /* the cache owns it now */
-        }
+        out = NULL; /* the cache owns them now */
+        rel = NULL;
     }
     r->cluster_info.levels_built++;
     r->cluster_info.build_s += mr_time_now() - t_build;
     free(out);
+    free(rel);
     return true;
+}
+
+typedef struct level_jobs {
+    level_job *job;
+    size_t count;
+    uint32_t threshold;
+    const clu_cache *cc;
+    pthread_mutex_t lock;
+    size_t next;
+} level_jobs;
+
+static void *level_worker(void *arg) {
+    level_jobs *q = arg;
+    for (;;) {
+        pthread_mutex_lock(&q->lock);
+        size_t k = q->next++;
+        pthread_mutex_unlock(&q->lock);
+        if (k >= q->count) return NULL;
+        level_job *j = &q->job[k];
+        j->key = clu_level_key(j->m->positions, j->m->vertex_count, j->indices, (uint32_t)j->n, q->threshold);
+        j->hit = clu_cache_find(q->cc, j->mesh, j->level, j->key, (uint32_t)j->n, j->m->vertex_count);
+        j->ok = j->hit || build_meshlets(j->m, j->indices, j->n, &j->built);
+    }
+}
+
+/* The levels that get meshlets, looked up and built on both cores before
+ * the upload (which is GL, one thread): measured, building them is most of
+ * a first upload. Only with the cache: it keeps every built level until the
+ * upload ends anyway, so building them ahead costs no memory beyond it.
+ * NULL (and upload_level builds each itself) where not worth it. */
+static level_job *level_jobs_run(const mr_scene *s, const mr_lod *lod, const clu_cache *cc, uint32_t threshold,
+                                 size_t *count) {
+    *count = 0;
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    if (!cc || ncpu < 2) return NULL;
+    size_t n = 0;
+    for (int32_t i = 0; i < s->mesh_count; i++) {
+        const mr_mesh *m = &s->meshes[i];
+        if (!m->positions || m->vertex_count == 0) continue;
+        n += m->index_count / 3 >= threshold;
+        const mr_mesh_lods *ml = lod ? &lod->meshes[i] : NULL;
+        for (int32_t k = 0; ml && k < ml->level_count && k < MR_LOD_MAX_LEVELS; k++)
+            n += ml->levels[k].indices && ml->levels[k].index_count / 3 >= threshold;
+    }
+    if (n < 2) return NULL;
+    level_jobs q;
+    memset(&q, 0, sizeof q);
+    q.job = calloc(n, sizeof *q.job);
+    if (!q.job) return NULL;
+    q.threshold = threshold;
+    q.cc = cc;
+    for (int32_t i = 0; i < s->mesh_count; i++) {
+        const mr_mesh *m = &s->meshes[i];
+        if (!m->positions || m->vertex_count == 0) continue;
+        if (m->index_count / 3 >= threshold) q.job[q.count++] = (level_job){m, m->indices, m->index_count, i, 0, 0, NULL, {0}, false};
+        const mr_mesh_lods *ml = lod ? &lod->meshes[i] : NULL;
+        for (int32_t k = 0, l = 1; ml && k < ml->level_count && k < MR_LOD_MAX_LEVELS; k++) {
+            if (!ml->levels[k].indices || ml->levels[k].index_count == 0) continue;
+            if (ml->levels[k].index_count / 3 >= threshold)
+                q.job[q.count++] = (level_job){m, ml->levels[k].indices, ml->levels[k].index_count, i, l, 0, NULL, {0}, false};
+            l++;
+        }
+    }
+    pthread_mutex_init(&q.lock, NULL);
+    pthread_t t;
+    bool two = pthread_create(&t, NULL, level_worker, &q) == 0;
+    level_worker(&q);
+    if (two) pthread_join(t, NULL);
+    pthread_mutex_destroy(&q.lock);
+    *count = q.count;
+    return q.job;
+}
+
+static void level_jobs_free(level_job *job, size_t count) {
+    for (size_t k = 0; job && k < count; k++) {
+        free(job[k].built.out);
+        free(job[k].built.clusters);
+    }
+    free(job);
+}
+
+/* The job of (mesh, level) in jobs (in upload order: *cursor walks it). */
+static level_job *level_job_at(level_job *job, size_t count, size_t *cursor, int32_t mesh, int32_t level) {
+    if (*cursor < count && job[*cursor].mesh == mesh && job[*cursor].level == level) return &job[(*cursor)++];
+    return NULL;
 }
 
 static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_error *err) {
@@ -470,6 +599,13 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     for (int p = 0; p < 2; p++) glVertexArrayElementBuffer(g->vao[p], g->ibo);
     float *tmp = NULL;
     size_t tmp_cap = 0;
+    size_t njobs = 0, cursor = 0;
+    double t_jobs = mr_time_now();
+    level_job *jobs = level_jobs_run(s, lod, g->cc,
+                                     (uint32_t)(r->draw.cluster_triangles > 0 ? r->draw.cluster_triangles
+                                                                              : MR_DRAW_DEFAULT_CLUSTER_TRIANGLES),
+                                     &njobs);
+    r->cluster_info.build_s += mr_time_now() - t_jobs; /* (lookups included) */
     for (size_t i = 0; i < nm; i++) {
         const mr_mesh *m = &s->meshes[i];
         const geo_mesh *gm = &g->meshes[i];
@@ -492,21 +628,26 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
         if (m->vertex_count)
             glNamedBufferSubData(g->vbo[gm->pool], (GLintptr)gm->base_vertex * stride[gm->pool],
                                  (GLsizeiptr)(need * sizeof *tmp), tmp);
-        if (m->index_count && !upload_level(r, g, m, (int32_t)i, 0, m->indices, err)) {
+        if (m->index_count && !upload_level(r, g, m, (int32_t)i, 0, m->indices,
+                                            level_job_at(jobs, njobs, &cursor, (int32_t)i, 0), err)) {
             free(tmp);
+            level_jobs_free(jobs, njobs);
             return false;
         }
         const mr_mesh_lods *ml = lod ? &lod->meshes[i] : NULL;
         for (int32_t k = 0, l = 1; ml && k < ml->level_count && k < MR_LOD_MAX_LEVELS; k++) {
             if (!ml->levels[k].indices || ml->levels[k].index_count == 0) continue;
-            if (!upload_level(r, g, m, (int32_t)i, l, ml->levels[k].indices, err)) {
+            if (!upload_level(r, g, m, (int32_t)i, l, ml->levels[k].indices,
+                              level_job_at(jobs, njobs, &cursor, (int32_t)i, l), err)) {
                 free(tmp);
+                level_jobs_free(jobs, njobs);
                 return false;
             }
             l++;
         }
     }
     free(tmp);
+    level_jobs_free(jobs, njobs);
 
     /* Per node: stretch bound; count of (node, mesh) pairs for scratch. */
     size_t recs = 0;
