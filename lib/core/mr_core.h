@@ -397,6 +397,16 @@ double mr_rng_normal(mr_rng *r);   /* standard normal */
 uint64_t mr_hash64_mix(uint64_t h, uint64_t w);
 uint64_t mr_hash64(uint64_t h, const void *data, size_t n);
 
+/* -------------------------------------------------------------- threads */
+
+/* Calls fn(ctx, i) for every i in [0, count) on up to `threads` threads,
+ * this one included (0: one per core; never more than count or 64); items
+ * are handed out one at a time in increasing order, so the caller orders
+ * them (largest first, say) for balance. fn returning false stops the
+ * handing out (items already running finish). fn must be safe to run
+ * concurrently with itself. Returns false if fn stopped it. */
+bool mr_parallel_for(size_t count, int threads, bool (*fn)(void *ctx, size_t i), void *ctx);
+
 #ifdef __cplusplus
 }
 #endif

@@ -5,10 +5,8 @@
 #include "mr_eval.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include <embree3/rtcore.h>
 
@@ -176,51 +174,33 @@ typedef struct gt_rows {
     mr_dmat4 rel_from_camera; /* Embree frame from camera */
     float (*pixel)(const struct gt_rows *r, size_t i, float z, mr_dvec3 pw, mr_dvec3 nw);
     const void *ctx;
-    int next_row;
-    pthread_mutex_t lock;
 } gt_rows;
 
-static void *rows_worker(void *arg) {
+static bool row_run(void *arg, size_t row) {
     gt_rows *r = arg;
-    int w = r->depth->width, h = r->depth->height;
+    int w = r->depth->width, y = (int)row;
     const float *dep = r->depth->data, *nor = r->normal->data;
     float *out = r->out->data;
-    for (;;) {
-        pthread_mutex_lock(&r->lock);
-        int y = r->next_row++;
-        pthread_mutex_unlock(&r->lock);
-        if (y >= h) break;
-        for (int x = 0; x < w; x++) {
-            size_t i = (size_t)y * w + x;
-            float z = dep[i];
-            out[i] = 1.0f;
-            if (!(z > 0) || !isfinite(z)) continue;
-            mr_dvec3 pc, nc;
-            surface_point(&r->cam, r->display, x, y, z, nor + 3 * i, &pc, &nc);
-            out[i] = r->pixel(r, i, z, mr_m4_point(&r->rel_from_camera, pc), mr_m4_dir(&r->rel_from_camera, nc));
-        }
+    for (int x = 0; x < w; x++) {
+        size_t i = (size_t)y * w + x;
+        float z = dep[i];
+        out[i] = 1.0f;
+        if (!(z > 0) || !isfinite(z)) continue;
+        mr_dvec3 pc, nc;
+        surface_point(&r->cam, r->display, x, y, z, nor + 3 * i, &pc, &nc);
+        out[i] = r->pixel(r, i, z, mr_m4_point(&r->rel_from_camera, pc), mr_m4_dir(&r->rel_from_camera, nc));
     }
-    return NULL;
+    return true;
 }
 
 /* Runs `pixel` over every pixel of depth/normal into out (allocated by the
- * caller), seen from view, on `threads` threads (0: one per core). */
+ * caller), seen from view, on `threads` threads (0: one per core), a row at
+ * a time. */
 static void rows_run(gt_rows *r, const mr_eval_gt *g, const mr_view *view, int threads) {
     r->cam = mr_camera_resized(&view->camera, r->depth->width, r->depth->height);
     mr_dmat4 shift = mr_m4_translate(-g->origin[0], -g->origin[1], -g->origin[2]);
     r->rel_from_camera = mr_m4_mul(&shift, &view->world_from_camera);
-    r->next_row = 0;
-    pthread_mutex_init(&r->lock, NULL);
-    int nt = threads > 0 ? threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
-    if (nt < 1) nt = 1;
-    if (nt > 64) nt = 64;
-    pthread_t th[64];
-    int started = 0;
-    for (int i = 1; i < nt; i++)
-        if (pthread_create(&th[started], NULL, rows_worker, r) == 0) started++;
-    rows_worker(r);
-    for (int i = 0; i < started; i++) pthread_join(th[i], NULL);
-    pthread_mutex_destroy(&r->lock);
+    mr_parallel_for((size_t)r->depth->height, threads, row_run, r);
 }
 
 static float ao_pixel(const gt_rows *r, size_t i, float z, mr_dvec3 pw, mr_dvec3 nw) {

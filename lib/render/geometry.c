@@ -21,7 +21,6 @@
 
 #include <math.h>
 #include <meshoptimizer.h>
-#include <pthread.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -405,25 +404,17 @@ static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int
 
 typedef struct level_jobs {
     level_job *job;
-    size_t count;
     uint32_t threshold;
     const clu_cache *cc;
-    pthread_mutex_t lock;
-    size_t next;
 } level_jobs;
 
-static void *level_worker(void *arg) {
+static bool level_run(void *arg, size_t k) {
     level_jobs *q = arg;
-    for (;;) {
-        pthread_mutex_lock(&q->lock);
-        size_t k = q->next++;
-        pthread_mutex_unlock(&q->lock);
-        if (k >= q->count) return NULL;
-        level_job *j = &q->job[k];
-        j->key = clu_level_key(j->m->positions, j->m->vertex_count, j->indices, (uint32_t)j->n, q->threshold);
-        j->hit = clu_cache_find(q->cc, j->mesh, j->level, j->key, (uint32_t)j->n, j->m->vertex_count);
-        j->ok = j->hit || build_meshlets(j->m, j->indices, j->n, &j->built);
-    }
+    level_job *j = &q->job[k];
+    j->key = clu_level_key(j->m->positions, j->m->vertex_count, j->indices, (uint32_t)j->n, q->threshold);
+    j->hit = clu_cache_find(q->cc, j->mesh, j->level, j->key, (uint32_t)j->n, j->m->vertex_count);
+    j->ok = j->hit || build_meshlets(j->m, j->indices, j->n, &j->built);
+    return true; /* a level that failed is built again (and fails) in upload_level */
 }
 
 /* The levels that get meshlets, looked up and built on both cores before
@@ -432,8 +423,8 @@ static void *level_worker(void *arg) {
  * upload ends anyway, so building them ahead costs no memory beyond it.
  * NULL (and upload_level builds each itself) where not worth it. */
 static level_job *level_jobs_run(const mr_scene *s, const mr_lod *lod, const clu_cache *cc, uint32_t threshold,
-                                 size_t *count) {
-    *count = 0;
+                                 size_t *count_out) {
+    *count_out = 0;
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
     if (!cc || ncpu < 2) return NULL;
     size_t n = 0;
@@ -446,31 +437,23 @@ static level_job *level_jobs_run(const mr_scene *s, const mr_lod *lod, const clu
             n += ml->levels[k].indices && ml->levels[k].index_count / 3 >= threshold;
     }
     if (n < 2) return NULL;
-    level_jobs q;
-    memset(&q, 0, sizeof q);
-    q.job = calloc(n, sizeof *q.job);
+    level_jobs q = {calloc(n, sizeof(level_job)), threshold, cc};
     if (!q.job) return NULL;
-    q.threshold = threshold;
-    q.cc = cc;
+    size_t count = 0;
     for (int32_t i = 0; i < s->mesh_count; i++) {
         const mr_mesh *m = &s->meshes[i];
         if (!m->positions || m->vertex_count == 0) continue;
-        if (m->index_count / 3 >= threshold) q.job[q.count++] = (level_job){m, m->indices, m->index_count, i, 0, 0, NULL, {0}, false};
+        if (m->index_count / 3 >= threshold) q.job[count++] = (level_job){m, m->indices, m->index_count, i, 0, 0, NULL, {0}, false};
         const mr_mesh_lods *ml = lod ? &lod->meshes[i] : NULL;
         for (int32_t k = 0, l = 1; ml && k < ml->level_count && k < MR_LOD_MAX_LEVELS; k++) {
             if (!ml->levels[k].indices || ml->levels[k].index_count == 0) continue;
             if (ml->levels[k].index_count / 3 >= threshold)
-                q.job[q.count++] = (level_job){m, ml->levels[k].indices, ml->levels[k].index_count, i, l, 0, NULL, {0}, false};
+                q.job[count++] = (level_job){m, ml->levels[k].indices, ml->levels[k].index_count, i, l, 0, NULL, {0}, false};
             l++;
         }
     }
-    pthread_mutex_init(&q.lock, NULL);
-    pthread_t t;
-    bool two = pthread_create(&t, NULL, level_worker, &q) == 0;
-    level_worker(&q);
-    if (two) pthread_join(t, NULL);
-    pthread_mutex_destroy(&q.lock);
-    *count = q.count;
+    mr_parallel_for(count, 0, level_run, &q);
+    *count_out = count;
     return q.job;
 }
 

@@ -1638,35 +1638,30 @@ typedef struct build_job {
     mr_lod *l;
     const int32_t *order;
     pthread_mutex_t lock;
-    int32_t next, done;
+    int32_t done;
     uint64_t tri_total, tri_done; /* input triangles, for the progress line */
     int32_t failed;          /* mesh that ran out of memory, or -1 */
     double t0;
     bool shown;
 } build_job;
 
-static void *build_worker(void *arg) {
+static bool build_one(void *arg, size_t k) {
     build_job *j = arg;
-    for (;;) {
-        pthread_mutex_lock(&j->lock);
-        int32_t k = j->failed < 0 && j->next < j->s->mesh_count ? j->next++ : -1;
-        pthread_mutex_unlock(&j->lock);
-        if (k < 0) return NULL;
-        int32_t i = j->order[k];
-        bool ok = build_mesh(&j->s->meshes[i], j->p, &j->l->meshes[i]);
-        pthread_mutex_lock(&j->lock);
-        if (!ok && j->failed < 0) j->failed = i;
-        j->done++;
-        j->tri_done += j->s->meshes[i].index_count / 3;
-        double dt = mr_time_now() - j->t0;
-        if (j->p->progress && dt > 1.0) {
-            fprintf(stderr, "\rLOD: mesh %d of %d, %.2f of %.2f M triangles (%.0f triangles/s)   ", (int)j->done,
-                    (int)j->s->mesh_count, j->tri_done / 1e6, j->tri_total / 1e6, j->tri_done / dt);
-            fflush(stderr);
-            j->shown = true;
-        }
-        pthread_mutex_unlock(&j->lock);
+    int32_t i = j->order[k];
+    bool ok = build_mesh(&j->s->meshes[i], j->p, &j->l->meshes[i]);
+    pthread_mutex_lock(&j->lock);
+    if (!ok && j->failed < 0) j->failed = i;
+    j->done++;
+    j->tri_done += j->s->meshes[i].index_count / 3;
+    double dt = mr_time_now() - j->t0;
+    if (j->p->progress && dt > 1.0) {
+        fprintf(stderr, "\rLOD: mesh %d of %d, %.2f of %.2f M triangles (%.0f triangles/s)   ", (int)j->done,
+                (int)j->s->mesh_count, j->tri_done / 1e6, j->tri_total / 1e6, j->tri_done / dt);
+        fflush(stderr);
+        j->shown = true;
     }
+    pthread_mutex_unlock(&j->lock);
+    return ok; /* out of memory: no further mesh is started */
 }
 
 mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *err) {
@@ -1707,16 +1702,8 @@ mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *e
     j.failed = -1;
     j.t0 = mr_time_now();
     for (int32_t i = 0; i < s->mesh_count; i++) j.tri_total += s->meshes[i].index_count / 3;
-    pthread_mutex_init(&j.lock, NULL);
-    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-    int nthreads = ncpu < 1 ? 1 : ncpu > 16 ? 16 : (int)ncpu;
-    if (nthreads > s->mesh_count) nthreads = s->mesh_count > 0 ? s->mesh_count : 1;
-    pthread_t threads[16];
-    int started = 0;
-    for (int t = 1; t < nthreads; t++)
-        if (pthread_create(&threads[started], NULL, build_worker, &j) == 0) started++;
-    build_worker(&j); /* this thread works too */
-    for (int t = 0; t < started; t++) pthread_join(threads[t], NULL);
+    pthread_mutex_init(&j.lock, NULL); /* the progress line and the failure */
+    mr_parallel_for((size_t)s->mesh_count, 0, build_one, &j);
     pthread_mutex_destroy(&j.lock);
     free(order);
     if (j.shown) fprintf(stderr, "\r%80s\r", "");
