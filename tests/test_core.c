@@ -5,6 +5,7 @@
 #include "mr_test.h"
 
 #include <dirent.h>
+#include <pthread.h>
 #include <errno.h>
 #include <signal.h>
 #include <string.h>
@@ -481,6 +482,50 @@ static void test_image_stats_and_jsonl(void) {
     CHECK(l.text == NULL && l.len == 0);
 }
 
+/* mr_parallel_for: every item exactly once, on more than one thread where
+ * asked, and a false return stops the handing out. */
+typedef struct pf_ctx {
+    int hits[1000];
+    pthread_t who[1000];
+    int stop_at;
+} pf_ctx;
+
+static bool pf_item(void *arg, size_t i) {
+    pf_ctx *c = arg;
+    __atomic_fetch_add(&c->hits[i], 1, __ATOMIC_RELAXED);
+    c->who[i] = pthread_self();
+    if (i % 64 == 0) usleep(200); /* let the other thread take some */
+    if (c->stop_at >= 0 && (int)i > c->stop_at) usleep(1000); /* after the stop: slow, so few start */
+    return (int)i != c->stop_at;
+}
+
+static void test_parallel_for(void) {
+    static pf_ctx c;
+    memset(&c, 0, sizeof c);
+    c.stop_at = -1;
+    CHECK(mr_parallel_for(1000, 2, pf_item, &c));
+    int once = 0, other = 0;
+    for (int i = 0; i < 1000; i++) {
+        once += c.hits[i] == 1;
+        other += !pthread_equal(c.who[i], pthread_self());
+    }
+    CHECK_MSG(once == 1000, "%d of 1000 items ran exactly once", once);
+    CHECK_MSG(other > 0, "no item ran on a second thread");
+    memset(&c, 0, sizeof c);
+    c.stop_at = 100;
+    CHECK(!mr_parallel_for(1000, 2, pf_item, &c));
+    int ran = 0, twice = 0, upto = 0;
+    for (int i = 0; i < 1000; i++) {
+        ran += c.hits[i] > 0;
+        twice += c.hits[i] > 1;
+        upto += i <= 100 && c.hits[i] == 1;
+    }
+    /* Items up to 100 ran once; after it, only those the other thread took
+     * before it saw the stop (each then takes 1 ms: a handful at most). */
+    CHECK_MSG(upto == 101 && ran < 200 && twice == 0, "stopped at 100: %d ran (%d of 0..100), %d twice", ran, upto, twice);
+    CHECK(mr_parallel_for(0, 0, pf_item, &c)); /* nothing to do */
+}
+
 int main(void) {
     const char *tmp = getenv("MR_TEST_TMP");
     snprintf(g_tmp, sizeof g_tmp, "%s/core", tmp ? tmp : "/tmp/mrcheck-test");
@@ -497,5 +542,6 @@ int main(void) {
     test_images();
     test_rng_and_errors();
     test_image_stats_and_jsonl();
+    test_parallel_for();
     return mr_test_finish("test_core");
 }
