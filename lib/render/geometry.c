@@ -24,7 +24,6 @@
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #define LEVELS (MR_LOD_MAX_LEVELS + 1) /* full detail + simplified levels */
 
@@ -421,23 +420,13 @@ static bool level_run(void *arg, size_t k) {
  * the upload (which is GL, one thread): measured, building them is most of
  * a first upload. Only with the cache: it keeps every built level until the
  * upload ends anyway, so building them ahead costs no memory beyond it.
- * NULL (and upload_level builds each itself) where not worth it. */
+ * NULL (and upload_level builds each itself) without the cache. */
 static level_job *level_jobs_run(const mr_scene *s, const mr_lod *lod, const clu_cache *cc, uint32_t threshold,
                                  size_t *count_out) {
     *count_out = 0;
-    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-    if (!cc || ncpu < 2) return NULL;
-    size_t n = 0;
-    for (int32_t i = 0; i < s->mesh_count; i++) {
-        const mr_mesh *m = &s->meshes[i];
-        if (!m->positions || m->vertex_count == 0) continue;
-        n += m->index_count / 3 >= threshold;
-        const mr_mesh_lods *ml = lod ? &lod->meshes[i] : NULL;
-        for (int32_t k = 0; ml && k < ml->level_count && k < MR_LOD_MAX_LEVELS; k++)
-            n += ml->levels[k].indices && ml->levels[k].index_count / 3 >= threshold;
-    }
-    if (n < 2) return NULL;
-    level_jobs q = {calloc(n, sizeof(level_job)), threshold, cc};
+    if (!cc || s->mesh_count <= 0) return NULL;
+    /* At most every level of every mesh (the full one and the simplified). */
+    level_jobs q = {calloc((size_t)s->mesh_count * LEVELS, sizeof(level_job)), threshold, cc};
     if (!q.job) return NULL;
     size_t count = 0;
     for (int32_t i = 0; i < s->mesh_count; i++) {
