@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define CLU_VERSION 1u
+#define CLU_VERSION 2u /* 2: meshlets scanned in vertex-cache order */
 #define CLU_HEADER 64
 #define CLU_ENTRY 40
 static const char k_magic[8] = {'M', 'R', 'C', 'L', 'U', '\r', '\n', 0x1a};
