@@ -112,7 +112,7 @@ typedef struct tri_grid {
     const float *pos;
     const uint32_t *idx;
     uint32_t tri_count;
-    double lo[3], cell;
+    double lo[3], cell, inv_cell; /* (a product, not a quotient, per cell lookup) */
     int n[3];
     uint32_t *start;   /* n0*n1*n2 + 1 offsets into items */
     uint32_t *items;   /* triangle ids */
@@ -167,7 +167,7 @@ static dv vtx(const float *pos, uint32_t i) {
 static inline void cell_of(const tri_grid *g, dv p, int c[3]) {
     const double q[3] = {p.x, p.y, p.z};
     for (int k = 0; k < 3; k++) {
-        double f = floor((q[k] - g->lo[k]) / g->cell);
+        double f = floor((q[k] - g->lo[k]) * g->inv_cell);
         c[k] = f < 0 ? 0 : f >= g->n[k] ? g->n[k] - 1 : (int)f;
     }
 }
@@ -210,6 +210,7 @@ static bool grid_build(tri_grid *g, const float *pos, const uint32_t *idx, uint3
     if (per_axis > 128) per_axis = 128;
     if (per_axis < 1) per_axis = 1;
     g->cell = ext / per_axis * 1.0000001;
+    g->inv_cell = 1 / g->cell;
     for (int k = 0; k < 3; k++) {
         g->mag = dmax(g->mag, dmax(fabs(lo[k]), fabs(hi[k])));
         g->lo[k] = lo[k];
@@ -336,16 +337,19 @@ static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
          * smaller than the triangle (it only ever skips a bound that would
          * have failed). */
         dv ctr = {(p[0].x + p[1].x + p[2].x) / 3, (p[0].y + p[1].y + p[2].y) / 3, (p[0].z + p[1].z + p[2].z) / 3};
-        double r = 0;
+        /* (Squares here, vrad's roots below: a root per vertex, not
+         * nine per triangle.) */
+        double r2 = 0, e2[3];
         for (int j = 0; j < 3; j++) {
-            dv d = dv_sub(p[j], ctr);
-            r = dmax(r, sqrt(dv_dot(d, d)));
-            for (int k = 0; k < 3; k++) {
-                uint32_t v = g->idx[3 * (size_t)t + (size_t)j];
-                dv e = dv_sub(p[k], p[j]);
-                g->vrad[v] = dmax(g->vrad[v], sqrt(dv_dot(e, e)));
-            }
+            dv d = dv_sub(p[j], ctr), e = dv_sub(p[(j + 1) % 3], p[j]);
+            r2 = dmax(r2, dv_dot(d, d));
+            e2[j] = dv_dot(e, e); /* edge j: corners j, j + 1 */
         }
+        for (int j = 0; j < 3; j++) {
+            uint32_t v = g->idx[3 * (size_t)t + (size_t)j];
+            g->vrad[v] = dmax(g->vrad[v], dmax(e2[j], e2[(j + 2) % 3]));
+        }
+        double r = sqrt(r2);
         double *sp = g->tsph + 5 * (size_t)t;
         sp[0] = ctr.x;
         sp[1] = ctr.y;
@@ -364,7 +368,7 @@ static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
             pl[0] = pl[1] = pl[2] = pl[3] = 0; /* degenerate: never passed over */
         }
     }
-    for (uint32_t v = 0; v < vertex_count; v++) g->vrad[v] = g->vrad[v] * (1 + 1e-9) + tol;
+    for (uint32_t v = 0; v < vertex_count; v++) g->vrad[v] = sqrt(g->vrad[v]) * (1 + 1e-9) + tol;
     size_t ne = (size_t)g->tri_count * 3;
     g->partner = malloc((ne + 1) * sizeof *g->partner);
     g->nbr = malloc((ne + 1) * sizeof *g->nbr);
@@ -473,7 +477,7 @@ static bool partner_get(const tri_grid *og, size_t h) {
 
 /* Distance from p to the surface, searched out to `limit` (beyond it:
  * INFINITY); *tri gets the nearest triangle (or UINT32_MAX). */
-static double grid_nearest(const tri_grid *og, dv p, double limit, uint32_t *tri) {
+static double grid_nearest(const tri_grid *og, dv p, double limit, uint32_t *tri, uint32_t hint0, uint32_t hint1) {
     tri_grid *g = (tri_grid *)og; /* the query marks are scratch */
     int c[3];
     cell_of(g, p, c);
@@ -488,6 +492,22 @@ static double grid_nearest(const tri_grid *og, dv p, double limit, uint32_t *tri
      * nearer. */
     const double htol = 1e-3 * g->ptol + 1e-13 * (fabs(p.x) + fabs(p.y) + fabs(p.z) + g->mag);
     uint32_t bt = UINT32_MAX;
+    /* Hints (the nearest triangles of nearby points: a bisected edge's
+     * ends, the previous vertex) first: their distance lets the plane test
+     * and the cell boxes pass over most of the rest. Still the exact
+     * nearest: a hint is only a first candidate. */
+    const uint32_t hint[2] = {hint0, hint1};
+    for (int h = 0; h < 2; h++) {
+        uint32_t t = hint[h];
+        if (t >= g->tri_count || g->qmark[t] == qs) continue;
+        g->qmark[t] = qs;
+        double d2 = dist2_point_tri(p, vtx(g->pos, g->idx[3 * t]), vtx(g->pos, g->idx[3 * t + 1]), vtx(g->pos, g->idx[3 * t + 2]));
+        if (d2 < best2) {
+            best2 = d2;
+            best = sqrt(d2);
+            bt = t;
+        }
+    }
     int maxr = g->n[0] + g->n[1] + g->n[2];
     const double q[3] = {p.x, p.y, p.z};
     /* How far p lies inside its cell from each side: ring r (r >= 1) is at
@@ -548,21 +568,31 @@ static double dist_to_tri(const tri_grid *g, dv p, uint32_t t) {
     return sqrt(dist2_point_tri(p, vtx(g->pos, g->idx[3 * t]), vtx(g->pos, g->idx[3 * t + 1]), vtx(g->pos, g->idx[3 * t + 2])));
 }
 
+/* Length of a 2D vector. Not hypot: these are differences of coordinates
+ * (at most about 1e9 here, squares far from overflow), and hypot's care
+ * cost 0.8 % of a first LOD build. */
+static inline double len2d(double x, double y) { return sqrt(x * x + y * y); }
+
 /* 2D cross of (b - a) x (c - a). */
 static double cross2(const double *a, const double *b, const double *c) {
     return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
 }
 
-static int cmp_pt2(const void *x, const void *y) {
-    const double *p = x, *q = y;
-    if (p[0] != q[0]) return p[0] < q[0] ? -1 : 1;
-    return p[1] < q[1] ? -1 : p[1] > q[1];
-}
-
-/* Convex hull (monotone chain) of np <= 48 points (sorted in place): its
- * area and perimeter. */
+/* Convex hull (monotone chain) of np <= 48 points (sorted in place, by x
+ * then y: insertion sort, as the points are few; qsort and its calls
+ * through a pointer were 1.4 % of a first LOD build): its area and perimeter. */
 static void hull_area2(double (*pts)[2], int np, double *area, double *perim) {
-    qsort(pts, (size_t)np, sizeof pts[0], cmp_pt2);
+    for (int i = 1; i < np; i++) {
+        double x = pts[i][0], y = pts[i][1];
+        int k = i;
+        while (k > 0 && (pts[k - 1][0] > x || (pts[k - 1][0] == x && pts[k - 1][1] > y))) {
+            pts[k][0] = pts[k - 1][0];
+            pts[k][1] = pts[k - 1][1];
+            k--;
+        }
+        pts[k][0] = x;
+        pts[k][1] = y;
+    }
     double hull[97][2];
     int h = 0;
     for (int i = 0; i < np; i++) {
@@ -580,7 +610,7 @@ static void hull_area2(double (*pts)[2], int np, double *area, double *perim) {
     *area = *perim = 0;
     for (int i = 0; i + 1 < h; i++) {
         *area += 0.5 * (hull[i][0] * hull[i + 1][1] - hull[i + 1][0] * hull[i][1]);
-        *perim += hypot(hull[i + 1][0] - hull[i][0], hull[i + 1][1] - hull[i][1]);
+        *perim += len2d(hull[i + 1][0] - hull[i][0], hull[i + 1][1] - hull[i][1]);
     }
 }
 
@@ -798,7 +828,7 @@ static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *
     dv w = {n.y * u.z - n.z * u.y, n.z * u.x - n.x * u.z, n.x * u.y - n.y * u.x};
     const double P[3][2] = {{0, 0}, {l1, 0}, {dv_dot(e2, u), dv_dot(e2, w)}};
     /* The shrunk triangle: a homothety about the incentre. */
-    double la = hypot(P[2][0] - P[1][0], P[2][1] - P[1][1]), lb = hypot(P[2][0], P[2][1]), lc = l1;
+    double la = len2d(P[2][0] - P[1][0], P[2][1] - P[1][1]), lb = len2d(P[2][0], P[2][1]), lc = l1;
     double per = la + lb + lc, area2 = cross2(P[0], P[1], P[2]);
     double r = area2 / per, d = o->ptol > 0 ? o->ptol : 1e-300;
     if (!(r > 4 * d)) return INFINITY;
@@ -807,7 +837,7 @@ static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *
     for (int i = 0; i < 3; i++) {
         Q[i][0] = I[0] + k * (P[i][0] - I[0]);
         Q[i][1] = I[1] + k * (P[i][1] - I[1]);
-        dgrow = dmax(dgrow, d / r * hypot(P[i][0] - I[0], P[i][1] - I[1]));
+        dgrow = dmax(dgrow, d / r * len2d(P[i][0] - I[0], P[i][1] - I[1]));
     }
     if (o->stamp >= 0x7ffffff0u) {
         memset(o->mark, 0, (size_t)o->tri_count * sizeof *o->mark);
@@ -1144,8 +1174,9 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
         if (longest > 4 * alt) {
             dv mab = dv_mad(a, ab, 0.5), mbc = dv_mad(b, bc, 0.5), mca = dv_mad(c, ca, 0.5);
             uint32_t tab, tbc, tca;
-            double dab = grid_nearest(x->other, mab, x->limit, &tab), dbc = grid_nearest(x->other, mbc, x->limit, &tbc),
-                   dca = grid_nearest(x->other, mca, x->limit, &tca);
+            double dab = grid_nearest(x->other, mab, x->limit, &tab, ta, tb),
+                   dbc = grid_nearest(x->other, mbc, x->limit, &tbc, tb, tc),
+                   dca = grid_nearest(x->other, mca, x->limit, &tca, tc, ta);
             x->lower = dmax(x->lower, dmax(dab, dmax(dbc, dca)));
             bound_tri(x, a, mab, mca, da, dab, dca, ta, tab, tca, va, UINT32_MAX, UINT32_MAX, depth + 1);
             bound_tri(x, mab, b, mbc, dab, db, dbc, tab, tb, tbc, UINT32_MAX, vb, UINT32_MAX, depth + 1);
@@ -1162,19 +1193,19 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
         uint32_t tm;
         if (lab >= lbc && lab >= lca) {
             m = dv_mad(a, ab, 0.5);
-            double dm = grid_nearest(x->other, m, x->limit, &tm);
+            double dm = grid_nearest(x->other, m, x->limit, &tm, ta, tb);
             if (dm > x->lower) x->lower = dm;
             bound_tri(x, a, m, c, da, dm, dc, ta, tm, tc, va, UINT32_MAX, vc, depth + 1);
             a = m; da = dm; ta = tm; va = UINT32_MAX; /* second half: m, b, c */
         } else if (lbc >= lca) {
             m = dv_mad(b, bc, 0.5);
-            double dm = grid_nearest(x->other, m, x->limit, &tm);
+            double dm = grid_nearest(x->other, m, x->limit, &tm, tb, tc);
             if (dm > x->lower) x->lower = dm;
             bound_tri(x, a, b, m, da, db, dm, ta, tb, tm, va, vb, UINT32_MAX, depth + 1);
             b = m; db = dm; tb = tm; vb = UINT32_MAX; /* a, m, c */
         } else {
             m = dv_mad(c, ca, 0.5);
-            double dm = grid_nearest(x->other, m, x->limit, &tm);
+            double dm = grid_nearest(x->other, m, x->limit, &tm, tc, ta);
             if (dm > x->lower) x->lower = dm;
             bound_tri(x, a, b, m, da, db, dm, ta, tb, tm, va, vb, UINT32_MAX, depth + 1);
             a = m; da = dm; ta = tm; va = UINT32_MAX; /* m, b, c */
@@ -1197,7 +1228,8 @@ static bool vertex_distances(const float *pos, uint32_t nv, const uint32_t *from
             near[v] = to->vt_items[to->vt_start[v]];
             continue;
         }
-        d[v] = grid_nearest(to, vtx(pos, v), limit, &near[v]);
+        /* hint: the nearest of the triangle's previous corner */
+        d[v] = grid_nearest(to, vtx(pos, v), limit, &near[v], i % 3 ? near[from[i - 1]] : UINT32_MAX, UINT32_MAX);
         if (d[v] > *lower) *lower = d[v];
     }
     return true;
