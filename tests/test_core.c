@@ -526,6 +526,36 @@ static void test_parallel_for(void) {
     CHECK(mr_parallel_for(0, 0, pf_item, &c)); /* nothing to do */
 }
 
+/* mr_hash64 keys the LOD and meshlet caches: every byte, the seed and the
+ * length count, across the four-lane blocks (n >= 64), the 8-byte words
+ * after them and the tail; splitting a buffer differently changes nothing
+ * else (same bytes, same hash). */
+static void test_hash(void) {
+    unsigned char b[203];
+    for (int i = 0; i < (int)sizeof b; i++) b[i] = (unsigned char)(i * 37 + 11);
+    for (int n = 0; n <= (int)sizeof b; n += n < 70 ? 1 : 19) {
+        uint64_t h = mr_hash64(7, b, (size_t)n);
+        CHECK_MSG(h == mr_hash64(7, b, (size_t)n), "n %d: not deterministic", n);
+        CHECK_MSG(h != mr_hash64(8, b, (size_t)n), "n %d: the seed does not count", n);
+        if (n > 0) CHECK_MSG(h != mr_hash64(7, b, (size_t)n - 1), "n %d: the length does not count", n);
+        int same = 0;
+        for (int i = 0; i < n; i++) {
+            b[i] ^= 0x10;
+            same += mr_hash64(7, b, (size_t)n) == h;
+            b[i] ^= 0x10;
+        }
+        CHECK_MSG(same == 0, "n %d: %d flipped bytes leave the hash as it was", n, same);
+    }
+    /* Two equal words in different lanes (or places) are not the same input. */
+    uint64_t w[8] = {0};
+    uint64_t z = mr_hash64(1, w, sizeof w);
+    w[0] = 5;
+    uint64_t a = mr_hash64(1, w, sizeof w);
+    w[0] = 0;
+    w[1] = 5;
+    CHECK(a != z && a != mr_hash64(1, w, sizeof w));
+}
+
 int main(void) {
     const char *tmp = getenv("MR_TEST_TMP");
     snprintf(g_tmp, sizeof g_tmp, "%s/core", tmp ? tmp : "/tmp/mrcheck-test");
@@ -543,5 +573,6 @@ int main(void) {
     test_rng_and_errors();
     test_image_stats_and_jsonl();
     test_parallel_for();
+    test_hash();
     return mr_test_finish("test_core");
 }

@@ -391,9 +391,10 @@ double mr_rng_normal(mr_rng *r);   /* standard normal */
 
 /* ------------------------------------------------------------------ hash */
 
-/* A 64-bit hash of 8-byte words (multiply-xorshift, a few GB/s): cache keys
- * and checksums (LOD levels, meshlets). Not cryptographic. mr_hash64_mix
- * folds one word into h; mr_hash64 a byte range (its length too). */
+/* A 64-bit hash of 8-byte words (multiply-xorshift, in four lanes: 4.4 GB/s
+ * here, 2.0 in one): cache keys and checksums (LOD levels, meshlets). Not
+ * cryptographic. mr_hash64_mix folds one word into h; mr_hash64 a byte
+ * range (its length too). */
 uint64_t mr_hash64_mix(uint64_t h, uint64_t w);
 uint64_t mr_hash64(uint64_t h, const void *data, size_t n);
 
