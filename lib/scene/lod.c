@@ -1166,29 +1166,14 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
             if (ub > x->upper) x->upper = ub;
             return;
         }
-        /* A thin piece (a long strip across a curved surface's fine
-         * strips) is split in four: halving its longest edge would leave
-         * its width, and the number of strips it spans, as it was. */
-        dv cr = {ab.y * ca.z - ab.z * ca.y, ab.z * ca.x - ab.x * ca.z, ab.x * ca.y - ab.y * ca.x};
-        double alt = sqrt(dv_dot(cr, cr)) / longest; /* the smallest altitude */
-        if (longest > 4 * alt) {
-            dv mab = dv_mad(a, ab, 0.5), mbc = dv_mad(b, bc, 0.5), mca = dv_mad(c, ca, 0.5);
-            uint32_t tab, tbc, tca;
-            double dab = grid_nearest(x->other, mab, x->limit, &tab, ta, tb),
-                   dbc = grid_nearest(x->other, mbc, x->limit, &tbc, tb, tc),
-                   dca = grid_nearest(x->other, mca, x->limit, &tca, tc, ta);
-            x->lower = dmax(x->lower, dmax(dab, dmax(dbc, dca)));
-            bound_tri(x, a, mab, mca, da, dab, dca, ta, tab, tca, va, UINT32_MAX, UINT32_MAX, depth + 1);
-            bound_tri(x, mab, b, mbc, dab, db, dbc, tab, tb, tbc, UINT32_MAX, vb, UINT32_MAX, depth + 1);
-            bound_tri(x, mca, mbc, c, dca, dbc, dc, tca, tbc, tc, UINT32_MAX, UINT32_MAX, vc, depth + 1);
-            a = mab; b = mbc; c = mca;
-            da = dab; db = dbc; dc = dca;
-            ta = tab; tb = tbc; tc = tca;
-            va = vb = vc = UINT32_MAX;
-            depth++;
-            continue;
-        }
-        /* Bisect the longest edge: query the midpoint exactly. */
+        /* Bisect the longest edge: query the midpoint exactly. A thin
+         * piece too (no four-way split, which halved its width at once):
+         * bisection makes it fat within a few steps and keeps two of its
+         * corners' vertices for the shared-corner stages. Measured: 8 to
+         * 11 % less CPU on the 2M and 10M unique factories, the same number
+         * of levels (0.15 % more level triangles: each level's target
+         * follows the bound of the one before), the bounds' sum from
+         * 0.4 % tighter (10M) to 0.13 % looser (200k). */
         dv m;
         uint32_t tm;
         if (lab >= lbc && lab >= lca) {
