@@ -150,6 +150,11 @@ typedef struct tri_grid {
      * triangle, 2 * stamp (+1 if in the patch) of the last patch that
      * looked at it. */
     uint32_t *nbr, *mark, stamp;
+    /* pmark, per vertex, the stamp of the last patch that projected it,
+     * and pxy its projection there (in-plane x, y and height): a patch's
+     * triangles share their corners. */
+    uint32_t *pmark;
+    double *pxy;
     /* Nearest queries (grid_nearest): qmark, per triangle, the last query
      * that computed its distance (a long triangle sits in many cells). */
     uint32_t *qmark, qstamp;
@@ -189,6 +194,8 @@ static void grid_free(tri_grid *g) {
     free(g->fan_slack);
     free(g->nbr);
     free(g->mark);
+    free(g->pmark);
+    free(g->pxy);
     free(g->qmark);
     free(g->tpl);
     memset(g, 0, sizeof *g);
@@ -373,11 +380,13 @@ static bool convex_partners(tri_grid *g, double tol, uint32_t vertex_count) {
     g->partner = malloc((ne + 1) * sizeof *g->partner);
     g->nbr = malloc((ne + 1) * sizeof *g->nbr);
     g->mark = calloc((size_t)g->tri_count + 1, sizeof *g->mark);
+    g->pmark = calloc((size_t)vertex_count + 1, sizeof *g->pmark);
+    g->pxy = malloc(((size_t)vertex_count * 3 + 1) * sizeof *g->pxy);
     g->stamp = 0;
     g->hinge_p = malloc((ne * 3 + 1) * sizeof *g->hinge_p);
     g->hinge_s = malloc((ne + 1) * sizeof *g->hinge_s);
     edge_rec *e = malloc((ne + 1) * sizeof *e);
-    if (!g->partner || !g->hinge_p || !g->hinge_s || !e || !g->nbr || !g->mark) {
+    if (!g->partner || !g->hinge_p || !g->hinge_s || !e || !g->nbr || !g->mark || !g->pmark || !g->pxy) {
         free(e);
         return false;
     }
@@ -841,6 +850,7 @@ static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *
     }
     if (o->stamp >= 0x7ffffff0u) {
         memset(o->mark, 0, (size_t)o->tri_count * sizeof *o->mark);
+        for (uint32_t i = 0; i < o->tri_count * 3; i++) o->pmark[o->idx[i]] = 0;
         o->stamp = 0;
     }
     uint32_t st = ++o->stamp, in = 2 * st + 1, seen = 2 * st;
@@ -867,10 +877,18 @@ static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *
         o->mark[t] = seen;
         double x[3][2], hs[3];
         for (int j = 0; j < 3; j++) {
-            dv dp = dv_sub(vtx(o->pos, o->idx[3 * (size_t)t + (size_t)j]), a);
-            hs[j] = dv_dot(dp, n);
-            x[j][0] = dv_dot(dp, u);
-            x[j][1] = dv_dot(dp, w);
+            uint32_t v = o->idx[3 * (size_t)t + (size_t)j];
+            double *pv = o->pxy + 3 * (size_t)v;
+            if (o->pmark[v] != st) {
+                o->pmark[v] = st;
+                dv dp = dv_sub(vtx(o->pos, v), a);
+                pv[0] = dv_dot(dp, u);
+                pv[1] = dv_dot(dp, w);
+                pv[2] = dv_dot(dp, n);
+            }
+            x[j][0] = pv[0];
+            x[j][1] = pv[1];
+            hs[j] = pv[2];
         }
         /* Facing the plane, by at least 5 % of its area. */
         double a2 = cross2(x[0], x[1], x[2]);
