@@ -288,12 +288,13 @@ static bool build_meshlets(const mr_mesh *m, const uint32_t *indices, size_t n, 
     struct meshopt_Meshlet *ml = malloc(maxm * sizeof *ml);
     unsigned int *mv = malloc(maxm * CL_VERTS * sizeof *mv);
     unsigned char *mt = malloc(maxm * CL_TRIS * 3);
-    unsigned int *order = malloc((n + 1) * sizeof *order);
     b->out = malloc((n + 1) * sizeof *b->out);
-    bool ok = ml && mv && mt && order && b->out;
-    if (ok) meshopt_optimizeVertexCacheFifo(order, indices, n, m->vertex_count, 16);
-    b->cnt = ok ? meshopt_buildMeshletsScan(ml, mv, mt, order, n, m->vertex_count, CL_VERTS, CL_TRIS) : 0;
-    free(order);
+    bool ok = ml && mv && mt && b->out;
+    /* The vertex-cache order goes into out: the scan has read all of it
+     * before out is written meshlet by meshlet below (no second array of
+     * fresh pages). */
+    if (ok) meshopt_optimizeVertexCacheFifo(b->out, indices, n, m->vertex_count, 16);
+    b->cnt = ok ? meshopt_buildMeshletsScan(ml, mv, mt, b->out, n, m->vertex_count, CL_VERTS, CL_TRIS) : 0;
     b->clusters = ok ? malloc((b->cnt + 1) * sizeof *b->clusters) : NULL;
     ok = ok && b->clusters;
     for (size_t c = 0; ok && c < b->cnt; c++) {
