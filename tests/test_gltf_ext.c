@@ -494,6 +494,193 @@ static void test_meshopt_big(void) {
     free(bin);
 }
 
+/* The loader's pipeline (both cores): big primitives are prepared on the
+ * pool and added in file order, a node whose meshes are still pending gets
+ * them once they are in, and several meshopt views are decoded and
+ * converted as tasks. Three primitives of 60k vertices (two in mesh 0,
+ * drawn by two nodes; one in mesh 1), float positions and non-unit
+ * normals, 32-bit indices; the same file compressed (three views, 6.5 MB
+ * decoded: one batch) and plain. Then failures: the error is the one that
+ * comes first in the file even when a later one is found first, and a
+ * broken view in a batch fails the load with one line. */
+enum { k_pipe_nv = 60000, k_pipe_prims = 3, k_pipe_ni = 3 * (k_pipe_nv - 2) };
+
+typedef struct {
+    float *pos, *nrm;
+    uint32_t *idx;
+} pipe_data;
+
+static void pipe_fill(pipe_data *d) {
+    for (size_t i = 0; i < (size_t)k_pipe_prims * k_pipe_nv; i++) {
+        size_t p = i / k_pipe_nv, v = i % k_pipe_nv;
+        d->pos[3 * i + 0] = (float)(v % 300) * 0.01f + (float)p * 10.0f;
+        d->pos[3 * i + 1] = (float)(v / 300) * 0.01f;
+        d->pos[3 * i + 2] = (float)((v * 7) % 13) * 0.1f;
+        d->nrm[3 * i + 0] = 0.5f * (float)(v % 3);
+        d->nrm[3 * i + 1] = 2.0f;
+        d->nrm[3 * i + 2] = -1.0f * (float)(p + 1);
+    }
+    for (size_t p = 0; p < k_pipe_prims; p++)
+        for (size_t t = 0; t < k_pipe_ni / 3; t++)
+            for (int c = 0; c < 3; c++) d->idx[p * k_pipe_ni + 3 * t + (size_t)c] = (uint32_t)(t + (size_t)c);
+}
+
+/* The file's JSON and BIN for d: compressed (three meshopt views) or plain.
+ * tail: more nodes after the three (",{...}"), or "". */
+static unsigned char *pipe_file(const pipe_data *d, bool packed, const char *tail, char *json, size_t json_cap,
+                                size_t *bin_n, size_t view_off[3], size_t view_len[3]) {
+    const size_t nv = (size_t)k_pipe_prims * k_pipe_nv, ni = (size_t)k_pipe_prims * k_pipe_ni;
+    const size_t raw[3] = {nv * 12, nv * 12, ni * 4};
+    size_t cap = 2 * meshopt_encodeVertexBufferBound(nv, 12) + meshopt_encodeIndexSequenceBound(ni, nv) + raw[0] + raw[1] + raw[2] + 64;
+    unsigned char *bin = malloc(cap);
+    if (!bin) return NULL;
+    size_t at = 0;
+    for (int v = 0; v < 3; v++) {
+        size_t n;
+        if (!packed) {
+            memcpy(bin + at, v == 0 ? (const void *)d->pos : v == 1 ? (const void *)d->nrm : (const void *)d->idx, raw[v]);
+            n = raw[v];
+        } else if (v < 2) {
+            n = meshopt_encodeVertexBuffer(bin + at, cap - at, v == 0 ? d->pos : d->nrm, nv, 12);
+        } else {
+            n = meshopt_encodeIndexSequence(bin + at, cap - at, d->idx, ni);
+        }
+        view_off[v] = at;
+        view_len[v] = n;
+        at += n;
+        while (at % 4) bin[at++] = 0;
+    }
+    *bin_n = at;
+    char views[2048], acc[4096];
+    size_t vo = 0, ao = 0;
+    for (int v = 0; v < 3; v++) {
+        const size_t st = v < 2 ? 12 : 4;
+        if (packed)
+            vo += (size_t)snprintf(views + vo, sizeof views - vo,
+                                   "%s{\"buffer\":1,\"byteOffset\":%zu,\"byteLength\":%zu%s,\"extensions\":{\"EXT_meshopt_compression\":"
+                                   "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":%zu,\"count\":%zu,\"mode\":\"%s\"}}}",
+                                   v ? "," : "", v == 0 ? 0 : v == 1 ? raw[0] : raw[0] + raw[1], raw[v],
+                                   v < 2 ? ",\"byteStride\":12" : "", view_off[v], view_len[v], st, v < 2 ? nv : ni,
+                                   v < 2 ? "ATTRIBUTES" : "INDICES");
+        else
+            vo += (size_t)snprintf(views + vo, sizeof views - vo, "%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu%s}",
+                                   v ? "," : "", view_off[v], view_len[v], v < 2 ? ",\"byteStride\":12" : "");
+    }
+    for (int p = 0; p < k_pipe_prims; p++) /* accessors 3p: POSITION, 3p+1: NORMAL, 3p+2: indices */
+        ao += (size_t)snprintf(acc + ao, sizeof acc - ao,
+                               "%s{\"bufferView\":0,\"byteOffset\":%zu,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\"},"
+                               "{\"bufferView\":1,\"byteOffset\":%zu,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\"},"
+                               "{\"bufferView\":2,\"byteOffset\":%zu,\"componentType\":5125,\"count\":%d,\"type\":\"SCALAR\"}",
+                               p ? "," : "", (size_t)p * k_pipe_nv * 12, k_pipe_nv, (size_t)p * k_pipe_nv * 12, k_pipe_nv,
+                               (size_t)p * k_pipe_ni * 4, k_pipe_ni);
+    char fallback[160] = "";
+    if (packed)
+        snprintf(fallback, sizeof fallback, ",{\"byteLength\":%zu,\"extensions\":{\"EXT_meshopt_compression\":{\"fallback\":true}}}",
+                 raw[0] + raw[1] + raw[2]);
+    snprintf(json, json_cap,
+             "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0,1,2%s]}],\"scene\":0,"
+             "\"nodes\":[{\"name\":\"A\",\"mesh\":0},{\"name\":\"B\",\"mesh\":0,\"translation\":[0,0,5]},{\"name\":\"C\",\"mesh\":1}%s],"
+             "%s\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2},"
+             "{\"attributes\":{\"POSITION\":3,\"NORMAL\":4},\"indices\":5}]},"
+             "{\"primitives\":[{\"attributes\":{\"POSITION\":6,\"NORMAL\":7},\"indices\":8}]}],"
+             "\"buffers\":[{\"byteLength\":%zu}%s],\"bufferViews\":[%s],\"accessors\":[%s]}",
+             tail[0] ? ",3" : "", tail,
+             packed ? "\"extensionsUsed\":[\"EXT_meshopt_compression\"],\"extensionsRequired\":[\"EXT_meshopt_compression\"]," : "",
+             at, fallback, views, acc);
+    return bin;
+}
+
+static void test_pipeline(void) {
+    const size_t nv = (size_t)k_pipe_prims * k_pipe_nv, ni = (size_t)k_pipe_prims * k_pipe_ni;
+    pipe_data d = {malloc(nv * 12), malloc(nv * 12), malloc(ni * 4)};
+    char *json = malloc(16384);
+    CHECK(d.pos && d.nrm && d.idx && json);
+    if (!d.pos || !d.nrm || !d.idx || !json) goto out;
+    pipe_fill(&d);
+    for (int packed = 0; packed < 2; packed++) {
+        size_t bn, off[3], len[3];
+        unsigned char *bin = pipe_file(&d, packed, "", json, 16384, &bn, off, len);
+        CHECK(bin != NULL);
+        if (!bin) continue;
+        mr_error err = {0};
+        mr_scene *s = load_glb(json, bin, bn, &err);
+        CHECK_MSG(s != NULL, "pipeline, %s: %s", packed ? "meshopt" : "plain", err.msg);
+        if (s) {
+            CHECK_MSG(s->mesh_count == 3 && s->node_count == 3, "%s: %d meshes, %d nodes", packed ? "meshopt" : "plain",
+                      (int)s->mesh_count, (int)s->node_count);
+            for (int32_t k = 0; k < s->node_count && s->node_count == 3; k++)
+                CHECK_MSG(s->nodes[k].mesh_first == (k < 2 ? 0 : 2) && s->nodes[k].mesh_count == (k < 2 ? 2 : 1),
+                          "%s: node %d draws meshes %d+%d", packed ? "meshopt" : "plain", (int)k, (int)s->nodes[k].mesh_first,
+                          (int)s->nodes[k].mesh_count);
+            for (int32_t k = 0; k < s->mesh_count && s->mesh_count == 3; k++) {
+                const mr_mesh *m = &s->meshes[k];
+                size_t bad_pos = 0, bad_nrm = 0, bad_idx = 0;
+                const float *wp = d.pos + (size_t)k * k_pipe_nv * 3, *wn = d.nrm + (size_t)k * k_pipe_nv * 3;
+                for (size_t v = 0; v < (size_t)k_pipe_nv && m->vertex_count == k_pipe_nv; v++) {
+                    double l = sqrt((double)wn[3 * v] * wn[3 * v] + (double)wn[3 * v + 1] * wn[3 * v + 1] +
+                                    (double)wn[3 * v + 2] * wn[3 * v + 2]);
+                    for (int c = 0; c < 3; c++) {
+                        bad_pos += fabs((double)m->positions[3 * v + c] + m->origin[c] - wp[3 * v + c]) > 1e-5;
+                        bad_nrm += fabs((double)m->normals[3 * v + c] - wn[3 * v + c] / l) > 1e-6;
+                    }
+                }
+                for (size_t i = 0; i < (size_t)k_pipe_ni && m->index_count == k_pipe_ni; i++)
+                    bad_idx += m->indices[i] != d.idx[(size_t)k * k_pipe_ni + i];
+                CHECK_MSG(m->vertex_count == k_pipe_nv && m->index_count == k_pipe_ni && !bad_pos && !bad_nrm && !bad_idx,
+                          "%s mesh %d: %u vertices, %u indices; %zu positions, %zu normals, %zu indices off",
+                          packed ? "meshopt" : "plain", (int)k, m->vertex_count, m->index_count, bad_pos, bad_nrm, bad_idx);
+            }
+        }
+        mr_scene_destroy(&s);
+        free(bin);
+
+        /* Mesh 0's second primitive (prepared on the pool) has an index out
+         * of range; node D, read after it, names a mesh that does not
+         * exist: the index is the load's error. */
+        uint32_t keep = d.idx[k_pipe_ni + 7];
+        d.idx[k_pipe_ni + 7] = k_pipe_nv;
+        bin = pipe_file(&d, packed, ",{\"name\":\"D\",\"mesh\":9}", json, 16384, &bn, off, len);
+        d.idx[k_pipe_ni + 7] = keep;
+        if (bin) expect_refused(json, bin, bn, "out of range", __LINE__);
+        free(bin);
+        /* Mesh 1 has an infinite position; nothing later fails. */
+        float keep_p = d.pos[(size_t)2 * k_pipe_nv * 3 + 100];
+        d.pos[(size_t)2 * k_pipe_nv * 3 + 100] = INFINITY;
+        bin = pipe_file(&d, packed, "", json, 16384, &bn, off, len);
+        d.pos[(size_t)2 * k_pipe_nv * 3 + 100] = keep_p;
+        if (bin) expect_refused(json, bin, bn, "non-finite position", __LINE__);
+        free(bin);
+        if (!packed) continue;
+        /* A broken stream in the batch: the view asked for first
+         * (positions) and one decoded ahead of it (normals), each cut. */
+        for (int v = 0; v < 2; v++) {
+            bin = pipe_file(&d, packed, "", json, 16384, &bn, off, len);
+            if (!bin) continue;
+            memset(bin + off[v] + len[v] / 2, 0xA5, len[v] - len[v] / 2 - 1);
+            expect_refused(json, bin, bn, "malformed meshopt", __LINE__);
+            free(bin);
+        }
+        /* Random damage anywhere in the three streams: one line or a load. */
+        bin = pipe_file(&d, packed, "", json, 16384, &bn, off, len);
+        for (int trial = 0; bin && trial < 12; trial++) {
+            unsigned char *junk = malloc(bn);
+            if (!junk) break;
+            memcpy(junk, bin, bn);
+            for (int k = 0; k < 8; k++) junk[(size_t)(trial * 7919 + k * 104729) * 31 % bn] ^= (unsigned char)(1 + (trial + k) % 255);
+            mr_scene *t = load_glb(json, junk, bn, &err);
+            if (!t) CHECK_MSG(one_line(&err), "trial %d: '%s'", trial, err.msg);
+            mr_scene_destroy(&t);
+            free(junk);
+        }
+        free(bin);
+    }
+out:
+    free(d.pos);
+    free(d.nrm);
+    free(d.idx);
+    free(json);
+}
+
 /* KHR_draco_mesh_compression on real draco data; then damaged data. */
 static void test_draco(void) {
     float pos[48];
@@ -649,6 +836,7 @@ int main(void) {
     test_meshopt();
     test_meshopt_shared();
     test_meshopt_big();
+    test_pipeline();
     test_draco();
     test_texture_transform();
     test_big_files();

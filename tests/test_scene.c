@@ -242,6 +242,96 @@ static void test_builder(void) {
     mr_scene_destroy(NULL); /* NULL handle */
 }
 
+/* mr_scene_add_mesh in two steps (mr_mesh_prepare, then
+ * mr_scene_add_prepared_mesh, as the loader does on its second core): the
+ * same mesh as in one step, bit for bit; a prepare that fails changes
+ * nothing; preparing an added mesh's arrays again changes none of its
+ * normals (a saved and reloaded mesh keeps them). */
+static void test_prepare(void) {
+    enum { nv = 5000 };
+    mr_mesh a, b;
+    memset(&a, 0, sizeof a);
+    a.vertex_count = nv;
+    a.index_count = 3 * (nv - 2);
+    a.material = -1;
+    a.origin[0] = 1e7;
+    a.positions = malloc(nv * 3 * sizeof(float));
+    a.normals = malloc(nv * 3 * sizeof(float));
+    a.indices = malloc(a.index_count * sizeof(uint32_t));
+    CHECK(a.positions && a.normals && a.indices);
+    if (!a.positions || !a.normals || !a.indices) return;
+    uint32_t r = 12345;
+    for (int i = 0; i < 3 * nv; i++) {
+        r = r * 1664525u + 1013904223u;
+        a.positions[i] = (float)(r >> 8) * 1e-3f - 5000.0f;
+        /* lengths from 1e-3 to 1e3, and some exactly 0 (the fallback) */
+        a.normals[i] = i < 30 ? 0.0f : ((float)(r >> 8) / 16777216.0f - 0.5f) * powf(10.0f, (float)(i % 7) - 3.0f);
+    }
+    for (uint32_t t = 0; t < a.index_count; t++) a.indices[t] = t / 3 + t % 3;
+    b = a;
+    b.positions = malloc(nv * 3 * sizeof(float));
+    b.normals = malloc(nv * 3 * sizeof(float));
+    b.indices = malloc(a.index_count * sizeof(uint32_t));
+    CHECK(b.positions && b.normals && b.indices);
+    if (!b.positions || !b.normals || !b.indices) return;
+    memcpy(b.positions, a.positions, nv * 3 * sizeof(float));
+    memcpy(b.normals, a.normals, nv * 3 * sizeof(float));
+    memcpy(b.indices, a.indices, a.index_count * sizeof(uint32_t));
+    mr_scene *s1 = mr_scene_create(), *s2 = mr_scene_create();
+    mr_error err = {0};
+    /* A non-finite normal at the end: refused, and nothing changed. */
+    b.normals[3 * nv - 1] = INFINITY;
+    CHECK(!mr_mesh_prepare(&b, &err) && strstr(err.msg, "non-finite normal") != NULL);
+    CHECK(memcmp(b.positions, a.positions, nv * 3 * sizeof(float)) == 0 && b.origin[0] == 1e7);
+    b.normals[3 * nv - 1] = a.normals[3 * nv - 1];
+    CHECK_MSG(mr_scene_add_mesh(s1, &a, &err) == 0, "one step: %s", err.msg);
+    CHECK_MSG(mr_mesh_prepare(&b, &err), "prepare: %s", err.msg);
+    CHECK_MSG(mr_scene_add_prepared_mesh(s2, &b, &err) == 0, "prepared: %s", err.msg);
+    CHECK(a.positions == NULL && b.positions == NULL);
+    if (s1->mesh_count == 1 && s2->mesh_count == 1) {
+        const mr_mesh *m1 = &s1->meshes[0], *m2 = &s2->meshes[0];
+        CHECK(memcmp(m1->positions, m2->positions, nv * 3 * sizeof(float)) == 0);
+        CHECK(memcmp(m1->normals, m2->normals, nv * 3 * sizeof(float)) == 0);
+        CHECK(memcmp(m1->origin, m2->origin, sizeof m1->origin) == 0);
+        CHECK(memcmp(m1->bounds_min, m2->bounds_min, sizeof m1->bounds_min) == 0);
+        double worst = 0;
+        for (int v = 0; v < nv; v++) {
+            const float *n = m1->normals + 3 * v;
+            worst = fmax(worst, fabs(sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]) - 1.0));
+        }
+        CHECK_MSG(worst < 1e-6, "normals off unit length by %g", worst);
+        /* Again: the normals stay as they are. */
+        mr_mesh c = *m1;
+        c.positions = malloc(nv * 3 * sizeof(float));
+        c.normals = malloc(nv * 3 * sizeof(float));
+        c.indices = malloc(c.index_count * sizeof(uint32_t));
+        CHECK(c.positions && c.normals && c.indices);
+        if (c.positions && c.normals && c.indices) {
+            memcpy(c.positions, m1->positions, nv * 3 * sizeof(float));
+            memcpy(c.normals, m1->normals, nv * 3 * sizeof(float));
+            memcpy(c.indices, m1->indices, c.index_count * sizeof(uint32_t));
+            CHECK(mr_mesh_prepare(&c, &err));
+            CHECK_MSG(memcmp(c.normals, m1->normals, nv * 3 * sizeof(float)) == 0, "normals changed when prepared again");
+        }
+        free(c.positions);
+        free(c.normals);
+        free(c.indices);
+    }
+    CHECK(s1->mesh_count == 1 && s2->mesh_count == 1);
+    /* A prepared mesh whose material the scene lacks: refused, still the caller's. */
+    mr_mesh d;
+    memset(&d, 0, sizeof d);
+    d.vertex_count = 3;
+    d.material = 3;
+    d.positions = calloc(9, sizeof(float));
+    CHECK(d.positions && mr_mesh_prepare(&d, &err));
+    CHECK(mr_scene_add_prepared_mesh(s2, &d, &err) == -1 && strstr(err.msg, "material") != NULL && d.positions != NULL);
+    free(d.positions);
+    free(d.normals);
+    mr_scene_destroy(&s1);
+    mr_scene_destroy(&s2);
+}
+
 static void test_globs(void) {
     CHECK(mr_glob_match("Pipe*", "Pipe_12"));
     CHECK(mr_glob_match("Pipe*", "Pipe"));
@@ -886,6 +976,7 @@ int main(void) {
         return 1;
     }
     test_builder();
+    test_prepare();
     test_globs();
     test_round_trip();
     test_handwritten();

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cctype>
 #include <cerrno>
@@ -27,7 +28,9 @@
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
+#include <deque>
 #include <exception>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -655,6 +658,99 @@ struct View {
 // What a primitive reads an accessor as (Loader::preconvert).
 enum Role { k_role_none = -1, k_role_position, k_role_normal, k_role_uv, k_role_index, k_role_mixed };
 
+// A second core for a load. Tasks run on one helper thread, started with
+// the first task, and on the loading thread whenever it waits (help): so
+// both cores work while there is work, and where no second thread can be
+// had every task still runs, on the loading thread, when it is waited for.
+// A task never throws and touches only what it was given; whoever submits
+// one waits for it before what it touches goes (shutdown drops the tasks
+// not started yet and waits for the running one).
+struct Pool {
+    struct Task {
+        std::function<void()> fn;
+        bool done = false;  // under mu
+    };
+    std::mutex mu;
+    std::condition_variable work, finished;
+    std::deque<Task *> queue;
+    std::thread helper;
+    bool stop = false, tried = false;
+
+    Pool() = default;
+    Pool(const Pool &) = delete;
+    Pool &operator=(const Pool &) = delete;
+    ~Pool() { shutdown(); }
+
+    void shutdown() {
+        {
+            std::lock_guard<std::mutex> l(mu);
+            stop = true;
+            queue.clear();
+        }
+        work.notify_all();
+        if (helper.joinable()) helper.join();
+    }
+
+    // urgent: ahead of what waits (work that frees memory or that the
+    // loading thread is about to wait for).
+    void submit(Task *t, bool urgent = false) {
+        if (!tried) {
+            tried = true;
+            if (std::thread::hardware_concurrency() > 1) {
+                try {
+                    helper = std::thread([this] { loop(); });
+                } catch (const std::system_error &) {
+                    // no helper: tasks run when waited for
+                }
+            }
+        }
+        {
+            std::lock_guard<std::mutex> l(mu);
+            t->done = false;
+            if (urgent) queue.push_front(t);
+            else queue.push_back(t);
+        }
+        work.notify_one();
+    }
+
+    // Pops and runs one task; called with l locked, returns with it locked.
+    void run_one(std::unique_lock<std::mutex> &l) {
+        Task *t = queue.front();
+        queue.pop_front();
+        l.unlock();
+        t->fn();
+        l.lock();
+        t->done = true;
+        finished.notify_all();
+    }
+
+    void loop() {
+        std::unique_lock<std::mutex> l(mu);
+        for (;;) {
+            work.wait(l, [&] { return stop || !queue.empty(); });
+            if (stop) return;
+            run_one(l);
+        }
+    }
+
+    // Runs queued tasks here until pred() holds (checked under the lock).
+    template <typename P>
+    void help(P pred) {
+        std::unique_lock<std::mutex> l(mu);
+        while (!pred()) {
+            if (!queue.empty()) run_one(l);
+            else finished.wait(l);
+        }
+    }
+    void wait(Task &t) {
+        help([&] { return t.done; });
+    }
+    bool is_done(Task &t) {
+        std::lock_guard<std::mutex> l(mu);
+        return t.done;
+    }
+};
+
 // -------------------------------------------------------------- loader
 
 struct Loader {
@@ -695,8 +791,29 @@ struct Loader {
     void (*progress)(void *, const char *, double) = nullptr;
     void *progress_user = nullptr;
 
+    // Meshes read but not yet in the scene: a big one is prepared
+    // (mr_mesh_prepare: its checks, recentring and normals, a third of a
+    // plain file's load) on the pool while the next primitive is read, and
+    // all are added in file order (flush). mesh_total counts the added and
+    // the pending: the index the next mesh will get. A node whose meshes are
+    // still pending is added without them and given them once they are in
+    // (node_fix: node, first mesh, count).
+    struct Pending {
+        MeshGuard g;
+        Pool::Task task;
+        bool inline_done = false;  // prepared on the loading thread, not a task
+        bool ok = false;
+        mr_error err;
+    };
+    std::deque<std::unique_ptr<Pending>> pending;
+    int32_t mesh_total = 0;
+    std::vector<std::array<int32_t, 3>> node_fix;
+    static const uint32_t k_async_vertices = 16384;
+    Pool pool;  // after everything its tasks touch (destroyed first)
+
     Loader(const tinygltf::Model &model, mr_scene *scene, Source &source) : m(model), s(scene), src(source) {}
     ~Loader() {
+        pool.shutdown();  // first: no task runs while what they touch goes
         for (auto &kv : ready) std::free(kv.second);
         std::free(scratch);
     }
@@ -790,13 +907,23 @@ struct Loader {
     // Decodes d into out (every byte written, or an error): the decoder's
     // return code. Never throws: runs on a second thread too.
     static int decode_run(const Decode &d, unsigned char *out) {
+        int rc = decode_stream(d, out);
+        if (rc == 0) decode_filter(d, out, 0, d.cnt);
+        return rc;
+    }
+    static int decode_stream(const Decode &d, unsigned char *out) {
         if (d.mode == 1) return meshopt_decodeIndexBuffer(out, d.cnt, d.st, d.in, d.n);
         if (d.mode == 2) return meshopt_decodeIndexSequence(out, d.cnt, d.st, d.in, d.n);
-        int rc = meshopt_decodeVertexBuffer(out, d.cnt, d.st, d.in, d.n);
-        if (rc == 0 && d.filter == 1) meshopt_decodeFilterOct(out, d.cnt, d.st);
-        else if (rc == 0 && d.filter == 2) meshopt_decodeFilterQuat(out, d.cnt, d.st);
-        else if (rc == 0 && d.filter == 3) meshopt_decodeFilterExp(out, d.cnt, d.st);
-        return rc;
+        return meshopt_decodeVertexBuffer(out, d.cnt, d.st, d.in, d.n);
+    }
+    // The filter of elements [first, first + count): each element on its
+    // own, so a view's filter can be split between the cores.
+    static void decode_filter(const Decode &d, unsigned char *out, size_t first, size_t count) {
+        unsigned char *p = out + first * d.st;
+        if (d.mode != 0 || count == 0) return;
+        if (d.filter == 1) meshopt_decodeFilterOct(p, count, d.st);
+        else if (d.filter == 2) meshopt_decodeFilterQuat(p, count, d.st);
+        else if (d.filter == 3) meshopt_decodeFilterExp(p, count, d.st);
     }
 
     void decode_check(const Decode &d) const {
@@ -859,59 +986,63 @@ struct Loader {
             }
         } guard{batch};
         for (Decode &d : batch) d.out = xmalloc<unsigned char>(d.out_n ? d.out_n : 1);
-        // A second thread decodes the views, smallest first, while this one
-        // converts each as soon as it is decoded (the largest, usually an
-        // index list, last). Measured on the 2M-triangle unique factory
-        // (gltfpack -c): decoding all first, then converting, took as long
-        // as decoding one view after the other on one thread; the largest
-        // views on a second thread while this one decoded and converted
-        // the rest left that thread waiting on its own decoding.
+        // Each view is planned here (its arrays allocated: plan_convert
+        // needs only the buffer's address), then decoded and converted by
+        // one task on the pool, largest first, while this thread runs tasks
+        // too: both cores decode and convert, and nothing waits on one
+        // thread's conversions. Measured on the 2M-triangle unique factory
+        // (gltfpack -c): one thread decoding while this one converted left
+        // this one waiting on the largest view, then the helper idle.
         std::vector<size_t> order(batch.size());
         for (size_t k = 0; k < order.size(); k++) order[k] = k;
-        std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return batch[a].out_n < batch[b].out_n; });
-        std::mutex mu;
-        std::condition_variable cv;
-        size_t decoded = 0;  // under mu: order[0 .. decoded) are decoded
-        auto produce = [&] {
-            for (size_t k = 0; k < order.size(); k++) {
-                Decode &d = batch[order[k]];
-                d.rc = decode_run(d, d.out);
-                {
-                    std::lock_guard<std::mutex> l(mu);
-                    decoded = k + 1;
-                }
-                cv.notify_one();
+        std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return batch[a].out_n > batch[b].out_n; });
+        std::vector<Convert> conv(batch.size());
+        for (size_t b = 0; b < batch.size(); b++)
+            conv[b] = plan_convert(batch[b].bvi, batch[b].out, m.bufferViews[(size_t)batch[b].bvi].byteLength, &batch[b].out);
+        std::deque<Pool::Task> tasks(batch.size());
+        struct Wait {  // every task ends before batch, conv and the buffers go
+            Pool &p;
+            std::deque<Pool::Task> &t;
+            size_t n = 0;
+            ~Wait() {
+                for (size_t k = 0; k < n; k++) p.wait(t[k]);
             }
-        };
-        std::thread t;
-        try {
-            t = std::thread(produce);
-        } catch (const std::system_error &) {
-            produce();  // no second thread: all here, first
-        }
-        struct Join {
-            std::thread &t;
-            ~Join() {
-                if (t.joinable()) t.join();
-            }
-        } join{t};
+        } wait{pool, tasks};
         for (size_t k = 0; k < order.size(); k++) {
-            {
-                std::unique_lock<std::mutex> l(mu);
-                cv.wait(l, [&] { return decoded > k; });
-            }
-            Decode &d = batch[order[k]];
+            const size_t b = order[k];
+            tasks[k].fn = [&, b] {
+                Decode &d = batch[b];
+                
+                d.rc = decode_stream(d, d.out);
+                if (d.rc != 0) return;
+                // What follows the stream's decoding is per element: split
+                // in halves, the second on the pool, so that a core done
+                // with its own views helps with this one's.
+                const size_t fc = d.filter ? d.cnt : 0;
+                split([&](int h) { decode_filter(d, d.out, h ? fc / 2 : 0, h ? fc - fc / 2 : fc / 2); }, fc ? d.out_n : 0);
+                split([&](int h) {
+                    for (const Job &j : conv[b].jobs)
+                        fill_job(j, h ? j.v.count / 2 : 0, h ? j.v.count - j.v.count / 2 : j.v.count / 2);
+                }, conv[b].bytes);
+                
+            };
+            pool.submit(&tasks[k]);
+            wait.n = k + 1;
+        }
+        for (size_t k = 0; k < tasks.size(); k++) pool.wait(tasks[k]);
+        Decode *failed = nullptr;
+        for (size_t b = 0; b < batch.size(); b++) {
+            Decode &d = batch[b];
             if (d.rc != 0) {
-                if (d.bvi == bvi) decode_check(d);  // the one asked for: its error now
-                std::free(d.out);
-                d.out = nullptr;  // the others fail when asked for, decoded again
-                continue;
+                unplan_convert(conv[b]);
+                if (d.bvi == bvi) failed = &d;
+                continue;  // the others fail when asked for, decoded again
             }
             src.consumed(d.n);
-            preconvert(d.bvi, d.out, m.bufferViews[(size_t)d.bvi].byteLength, &d.out);
-            std::free(d.out);  // unless its index list took it
-            d.out = nullptr;
+            finish_convert(conv[b]);
         }
+        if (failed) decode_check(*failed);  // the one asked for: its error now
+        // Free frees each buffer, unless its index list took it.
         return true;
     }
 
@@ -1099,79 +1230,110 @@ struct Loader {
         return true;
     }
 
-    // A pre view was just decoded at p: each of its accessors becomes the
-    // array its primitive takes (take), in the layout primitive() would
-    // read it in; any that primitive() would refuse or warn about is left to
-    // it (read again from a fresh decode, to fail or warn as it does).
-    // own: the malloc'd buffer at p that its 32-bit index list at offset 0
-    // may keep as its array (then *own becomes NULL); NULL: the scratch,
-    // when this is the last pre view (see scratch).
-    void preconvert(int bvi, const unsigned char *p, size_t len, unsigned char **own) {
+    // One accessor of a pre view to convert: its window, its component count
+    // and its array (allocated, in ready; see plan_one).
+    struct Job {
+        View v;
+        int n;
+        void *out;
+    };
+
+    // A pre view decoded (or to be decoded) at p: each of its accessors
+    // becomes the array its primitive takes (take), in the layout
+    // primitive() would read it in; any that primitive() would refuse or
+    // warn about is left to it (read again from a fresh decode, to fail or
+    // warn as it does). own: the malloc'd buffer at p that its 32-bit index
+    // list at offset 0 may keep as its array (then *own becomes NULL); NULL:
+    // the scratch, when this is the last pre view (see scratch).
+    // plan_convert allocates the arrays and needs only p's address, so a
+    // view is planned before it is decoded; run_jobs fills them from the
+    // decoded bytes; finish_convert hands the buffer over.
+    struct Convert {
+        int bvi = -1;
+        std::vector<Job> jobs;
+        size_t bytes = 0;
+        int handoff = -1;  // the index accessor that keeps *own
+        unsigned char **own = nullptr;
+    };
+    Convert plan_convert(int bvi, const unsigned char *p, size_t len, unsigned char **own) {
+        Convert c;
+        c.bvi = bvi;
         bool last = false;
         if (!view_decoded[(size_t)bvi] && !view_readers[(size_t)bvi].empty()) {
             view_decoded[(size_t)bvi] = 1;
             last = --pre_left == 0;
         }
         if (!own && last && p == scratch) own = &scratch;
-        int handoff = -1;  // the accessor that may keep the buffer
         for (int a : view_readers[(size_t)bvi]) {
             View v;
-            if (own && *own == p && handoff < 0 && acc_state[(size_t)a] == 0 && acc_role[(size_t)a] == k_role_index &&
+            if (own && *own == p && c.handoff < 0 && acc_state[(size_t)a] == 0 && acc_role[(size_t)a] == k_role_index &&
                 m.accessors[(size_t)a].byteOffset == 0 && window(a, p, len, &v) &&
                 v.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT && v.ncomp == 1 && v.stride == 4 && v.count <= UINT32_MAX)
-                handoff = a;
+                c.handoff = a;
         }
-        // Every array is allocated here, then filled on both cores when
-        // there is enough to fill (the views of a compressed file are whole
-        // meshes' worth: this is where its load has parallel work).
-        std::vector<Job> jobs;
         bool all = true;
-        size_t bytes = 0;
         for (int a : view_readers[(size_t)bvi])
-            if (a != handoff) {
+            if (a != c.handoff) {
                 Job j;
                 if (plan_one(a, p, len, &j)) {
-                    jobs.push_back(j);
-                    bytes += j.v.count * (size_t)j.n * 4;
+                    c.jobs.push_back(j);
+                    c.bytes += j.v.count * (size_t)j.n * 4;
                 } else {
                     all = all && acc_state[(size_t)a] == 1;
                 }
             }
-        run_jobs(jobs, bytes);
-        for (const Job &j : jobs) {
+        if (c.handoff >= 0 && !all) {
+            // Some accessor is left to read(), which reads this view's
+            // bytes after us: the buffer stays, the index list is copied.
+            Job j;
+            if (plan_one(c.handoff, p, len, &j)) {
+                c.jobs.push_back(j);
+                c.bytes += j.v.count * 4;
+            }
+            c.handoff = -1;
+        }
+        c.own = own;
+        return c;
+    }
+
+    void finish_convert(Convert &c) {
+        for (const Job &j : c.jobs) {
             src.consumed(j.v.count * j.v.stride);
             acc_state[(size_t)j.v.index] = 1;
         }
-        if (handoff < 0) return;
-        if (!all) {
-            // Some accessor is left to read(), which reads this view's
-            // bytes after us: the buffer stays.
-            Job j;
-            if (plan_one(handoff, p, len, &j)) {
-                run_jobs(std::vector<Job>(1, j), 0);
-                src.consumed(j.v.count * j.v.stride);
-                acc_state[(size_t)handoff] = 1;
-            }
-            return;
-        }
-        const size_t n = m.accessors[(size_t)handoff].count;
-        void *&slot = ready[handoff];
+        if (c.handoff < 0) return;
+        unsigned char **own = c.own;
+        const size_t n = m.accessors[(size_t)c.handoff].count;
+        void *&slot = ready[c.handoff];
         void *q = std::realloc(*own, n * 4);  // shrinks in place; on failure the block stays as it was
         slot = q ? q : *own;
         *own = nullptr;
         if (own == &scratch) scratch_n = 0;
         src.consumed(n * 4);
-        acc_state[(size_t)handoff] = 1;
+        acc_state[(size_t)c.handoff] = 1;
     }
 
-    // One accessor of a pre view to convert: its window, its component count
-    // and its array (allocated, in ready); false if it is left to read()
-    // (acc_state 2) or already done.
-    struct Job {
-        View v;
-        int n;
-        void *out;
-    };
+    // A planned view whose decoding failed: as if never planned (decoded
+    // again, alone, when asked for, to fail there).
+    void unplan_convert(const Convert &c) {
+        for (int a : view_readers[(size_t)c.bvi]) {
+            std::free(take<void>(a));
+            acc_state[(size_t)a] = 0;
+        }
+        if (view_decoded[(size_t)c.bvi]) {
+            view_decoded[(size_t)c.bvi] = 0;
+            pre_left++;
+        }
+    }
+
+    void preconvert(int bvi, const unsigned char *p, size_t len, unsigned char **own) {
+        Convert c = plan_convert(bvi, p, len, own);
+        run_jobs(c.jobs, c.bytes);
+        finish_convert(c);
+    }
+
+    // Accessor a's Job, its array allocated (in ready); false if it is left
+    // to read() (acc_state 2) or already done.
     bool plan_one(int a, const unsigned char *p, size_t len, Job *j) {
         if (acc_state[(size_t)a] != 0) return false;
         acc_state[(size_t)a] = 2;
@@ -1197,28 +1359,35 @@ struct Loader {
     // Fills the jobs' arrays (read() cannot fail on them: no sparse), the
     // elements split in two halves on a second thread when there are
     // bytes enough to pay for it and a second core.
-    void run_jobs(const std::vector<Job> &jobs, size_t bytes) const {
-        auto fill = [this](const Job &j, size_t first, size_t count) {
-            View v = j.v;
-            v.base += first * v.stride;
-            v.count = count;
-            if (j.n == 1) read_plain(v, 1, static_cast<uint32_t *>(j.out) + first);
-            else read_plain(v, j.n, static_cast<float *>(j.out) + first * (size_t)j.n);
-        };
-        const bool two = bytes >= ((size_t)8 << 20) && std::thread::hardware_concurrency() > 1;
-        if (two) {
-            try {
-                std::thread t([&] {
-                    for (const Job &j : jobs) fill(j, j.v.count / 2, j.v.count - j.v.count / 2);
-                });
-                for (const Job &j : jobs) fill(j, 0, j.v.count / 2);
-                t.join();
-                return;
-            } catch (const std::system_error &) {
-                // no second thread (nothing was filled yet): all on this one
-            }
+    static void fill_job(const Job &j, size_t first, size_t count) {
+        View v = j.v;
+        v.base += first * v.stride;
+        v.count = count;
+        if (j.n == 1) read_plain(v, 1, static_cast<uint32_t *>(j.out) + first);
+        else read_plain(v, j.n, static_cast<float *>(j.out) + first * (size_t)j.n);
+    }
+
+    // half(0) here and half(1) on the pool (ahead of what waits there: the
+    // wait runs it here if the helper is busy), or both here when there
+    // are too few bytes to pay for a task. Safe from a task too.
+    template <typename F>
+    void split(F half, size_t bytes) {
+        if (bytes < ((size_t)1 << 20)) {
+            half(0);
+            half(1);
+            return;
         }
-        for (const Job &j : jobs) fill(j, 0, j.v.count);
+        Pool::Task t;
+        t.fn = [&] { half(1); };
+        pool.submit(&t, true);
+        half(0);
+        pool.wait(t);
+    }
+
+    void run_jobs(const std::vector<Job> &jobs, size_t bytes) {
+        split([&](int h) {
+            for (const Job &j : jobs) fill_job(j, h ? j.v.count / 2 : 0, h ? j.v.count - j.v.count / 2 : j.v.count / 2);
+        }, bytes);
     }
 
     // The converted array of accessor a, now the caller's; NULL if none.
@@ -1714,7 +1883,7 @@ struct Loader {
         }
         MeshGuard g;
         std::vector<uint32_t> order;
-        bool have_order = false, float_positions = true;
+        bool have_order = false;
         if (dx != p.extensions.end()) {
             draco_primitive(p, dx->second, name, g, order);
             have_order = true;
@@ -1732,7 +1901,6 @@ struct Loader {
                 g.m.positions = xmalloc<float>((size_t)nv * 3);
                 read(pv, 3, g.m.positions, "POSITION", name);
             }
-            float_positions = pv.comp == TINYGLTF_COMPONENT_TYPE_FLOAT;
             done(pos_it->second);
 
             auto nrm_it = p.attributes.find("NORMAL");
@@ -1793,21 +1961,9 @@ struct Loader {
             }
         }
         const uint32_t nv = g.m.vertex_count;
-        if (float_positions)  // integers are finite (mr_scene_add_mesh checks again anyway)
-            for (size_t i = 0; i < (size_t)nv * 3; i++)
-                if (!std::isfinite(g.m.positions[i])) fail(MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
-        if (g.m.indices) {
-            const uint32_t *q = g.m.indices;
-            const size_t n = g.m.index_count;
-            uint32_t worst = 0;  // branch-free scan; the error path finds the first
-            for (size_t i = 0; i < n; i++) worst = std::max(worst, q[i]);
-            if (n && worst >= nv)
-                for (size_t i = 0; i < n; i++)
-                    if (q[i] >= nv)
-                        fail(MR_ERR_INVALID, "mesh '%s': index %u at position %zu is out of range (%u vertices)", name,
-                             q[i], i, nv);
-            if (n % 3 != 0) fail(MR_ERR_INVALID, "mesh '%s': %zu indices is not a multiple of 3", name, n);
-        } else {
+        // A triangle list's indices and every position are checked by
+        // mr_mesh_prepare (add_mesh), on the pool for a big mesh: not here too.
+        if (!g.m.indices) {
             if (have_order) {
                 for (size_t i = 0; i < order.size(); i++)
                     if (order[i] >= nv)
@@ -1842,9 +1998,51 @@ struct Loader {
         }
         if (g.m.uvs) check_uvs(g, name);
         std::snprintf(g.m.name, sizeof g.m.name, "%s", name);
-        mr_error e;
-        if (mr_scene_add_mesh(s, &g.m, &e) < 0) throw Fail{e.code, e.msg};
-        // add_mesh NULLed the arrays it took; the guard frees nothing more.
+        add_mesh(&g.m);  // took the arrays: the guard frees nothing more
+    }
+
+    void add_mesh(mr_mesh *mm) {
+        std::unique_ptr<Pending> own(new Pending);
+        Pending *q = own.get();
+        q->g.m = *mm;
+        std::memset(mm, 0, sizeof *mm);
+        mesh_total++;
+        if (q->g.m.vertex_count >= k_async_vertices || q->g.m.index_count >= 3 * k_async_vertices) {
+            q->task.fn = [q] { q->ok = mr_mesh_prepare(&q->g.m, &q->err); };
+            pending.push_back(std::move(own));
+            pool.submit(&q->task);
+        } else {
+            q->ok = mr_mesh_prepare(&q->g.m, &q->err);
+            q->inline_done = true;
+            pending.push_back(std::move(own));
+        }
+        flush(false);
+    }
+
+    // Adds the pending meshes that are prepared, in order, up to the first
+    // that is not (all: waits for each). A mesh that failed fails the load
+    // here, as it did when it was read.
+    void flush(bool all) {
+        while (!pending.empty()) {
+            Pending &q = *pending.front();
+            if (!q.inline_done) {
+                if (all) pool.wait(q.task);
+                else if (!pool.is_done(q.task)) return;
+            }
+            if (!q.ok) throw Fail{q.err.code, q.err.msg};
+            mr_error e;
+            if (mr_scene_add_prepared_mesh(s, &q.g.m, &e) < 0) throw Fail{e.code, e.msg};
+            pending.pop_front();
+        }
+    }
+
+    // The load failed while meshes were pending: a pending one that failed
+    // came first in the file, so its error is the load's.
+    void earlier_failure() {
+        for (const std::unique_ptr<Pending> &q : pending) {
+            if (!q->inline_done) pool.wait(q->task);
+            if (!q->ok) throw Fail{q->err.code, q->err.msg};
+        }
     }
 
     std::pair<int32_t, int32_t> mesh(int mi) {
@@ -1853,9 +2051,9 @@ struct Loader {
         char name[64];
         if (gm.name.empty()) std::snprintf(name, sizeof name, "mesh_%d", mi);
         else std::snprintf(name, sizeof name, "%s", gm.name.c_str());
-        int32_t first = s->mesh_count;
+        int32_t first = mesh_total;
         for (size_t k = 0; k < gm.primitives.size(); k++) primitive(gm.primitives[k], name, mi, (int)k);
-        int32_t count = s->mesh_count - first;
+        int32_t count = mesh_total - first;
         progress_nodes(0);
         mesh_map[(size_t)mi] = count > 0 ? std::make_pair(first, count) : std::make_pair(-1, 0);
         return mesh_map[(size_t)mi];
@@ -1948,8 +2146,15 @@ struct Loader {
                 n.mesh_first = r.first;
                 n.mesh_count = r.second;
             }
+            const bool later = n.mesh_first >= 0 && n.mesh_first > s->mesh_count - n.mesh_count;  // still pending
+            const int32_t first = n.mesh_first, count = n.mesh_count;
+            if (later) {
+                n.mesh_first = -1;
+                n.mesh_count = 0;
+            }
             int32_t idx = mr_scene_add_node(s, &n);
             if (idx < 0) fail(MR_ERR_NOMEM, "cannot add node '%s'", n.name);
+            if (later) node_fix.push_back(std::array<int32_t, 3>{{idx, first, count}});
             for (size_t c = gn.children.size(); c-- > 0;) stack.push_back(Item{gn.children[c], idx});
         }
     }
@@ -1959,9 +2164,19 @@ struct Loader {
         mesh_map.assign(m.meshes.size(), std::make_pair(-2, 0));
         tex_map.assign(m.textures.size(), -2);
         materials();
-        nodes();
+        try {
+            nodes();
+            flush(true);
+        } catch (const Fail &) {
+            earlier_failure();
+            throw;
+        }
+        for (const std::array<int32_t, 3> &f : node_fix) {
+            s->nodes[f[0]].mesh_first = f[1];
+            s->nodes[f[0]].mesh_count = f[2];
+        }
         report("nodes", 1, 1);
-        mr_scene_update_bounds(s);
+        mr_scene_update_bounds(s); 
     }
 };
 
@@ -1997,6 +2212,7 @@ mr_scene *load_memory(const void *data, size_t size, const char *base_dir, const
         json = take_buffers(reinterpret_cast<const char *>(bytes), size, nullptr, base_dir, &src);
     }
 
+    
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(image_loader, nullptr);
     if (!base_dir) {

@@ -117,6 +117,14 @@ void mr_scene_destroy(mr_scene **scene); /* NULLs, accepts NULL */
  * normals if mesh->normals is NULL, and validates indices and finiteness.
  * Returns the new mesh index, or -1 + err. */
 int32_t mr_scene_add_mesh(mr_scene *s, mr_mesh *mesh, mr_error *err);
+/* mr_scene_add_mesh in two steps, so that a loader can prepare meshes on
+ * another thread: mr_mesh_prepare does all of it that needs no scene (the
+ * checks, the recentring, the normals; it touches only *mesh, and on failure
+ * changes nothing), mr_scene_add_prepared_mesh checks the material and takes
+ * the arrays (false/-1: the caller still owns them). Only a mesh that
+ * mr_mesh_prepare accepted, unchanged since, may be added prepared. */
+bool mr_mesh_prepare(mr_mesh *mesh, mr_error *err);
+int32_t mr_scene_add_prepared_mesh(mr_scene *s, mr_mesh *mesh, mr_error *err);
 int32_t mr_scene_add_material(mr_scene *s, const mr_material *mat);
 /* Takes ownership of tex->image.data. */
 int32_t mr_scene_add_texture(mr_scene *s, mr_texture *tex);

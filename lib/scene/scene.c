@@ -101,115 +101,113 @@ static bool all_finite(const float *v, size_t n) {
     return true;
 }
 
-/* On failure nothing is freed or changed: the caller keeps ownership of the
- * arrays in *mesh. On success the arrays belong to the scene and the pointers
- * in *mesh are set to NULL (so a caller's cleanup cannot double-free), while
- * origin, bounds and vertex data there reflect the stored mesh. */
-int32_t mr_scene_add_mesh(mr_scene *s, mr_mesh *mesh, mr_error *err) {
-    if (!s || !mesh) {
-        mr_fail(err, MR_ERR_INVALID, "mr_scene_add_mesh: NULL argument");
-        return -1;
-    }
-    char name[80];
-    snprintf(name, sizeof name, "%.*s", (int)sizeof mesh->name, mesh->name[0] ? mesh->name : "(unnamed)");
-    size_t nv = mesh->vertex_count;
-    if (nv == 0 || !mesh->positions) {
-        mr_fail(err, MR_ERR_INVALID, "mesh '%s' has no vertices", name);
-        return -1;
-    }
-    if (mesh->index_count % 3 != 0) {
-        mr_fail(err, MR_ERR_INVALID, "mesh '%s' has %u indices, not a multiple of 3", name, mesh->index_count);
-        return -1;
-    }
-    if (mesh->index_count > 0 && !mesh->indices) {
-        mr_fail(err, MR_ERR_INVALID, "mesh '%s' has an index count but no indices", name);
-        return -1;
-    }
-    for (uint32_t i = 0; i < mesh->index_count; i++) {
-        if (mesh->indices[i] >= mesh->vertex_count) {
-            mr_fail(err, MR_ERR_INVALID, "mesh '%s': index %u (at %u) is out of range (%u vertices)", name,
-                    mesh->indices[i], i, mesh->vertex_count);
-            return -1;
-        }
-    }
-    if (!all_finite(mesh->positions, 3 * nv)) {
-        mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
-        return -1;
-    }
-    if (mesh->normals && !all_finite(mesh->normals, 3 * nv)) {
-        mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite normal", name);
-        return -1;
-    }
-    if (mesh->uvs && !all_finite(mesh->uvs, 2 * nv)) {
-        mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite texture coordinate", name);
-        return -1;
-    }
+/* Finite check and double bounds of n xyz triples in one pass over them;
+ * false at the first non-finite value. (Float comparisons with a
+ * branch-free finite test measured half as fast.) */
+static bool finite_bounds(const float *v, size_t n, double lo[3], double hi[3]) {
     for (int k = 0; k < 3; k++) {
-        if (!isfinite(mesh->origin[k])) {
-            mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite origin", name);
-            return -1;
-        }
+        lo[k] = INFINITY;
+        hi[k] = -INFINITY;
     }
-    if (mesh->material < -1 || mesh->material >= s->material_count) {
-        mr_fail(err, MR_ERR_INVALID, "mesh '%s' refers to material %d (scene has %d)", name, mesh->material,
-                s->material_count);
-        return -1;
-    }
-    /* Allocate everything before changing anything, so failure leaves the
-     * caller's mesh untouched. */
-    if (!grow((void **)&s->meshes, s->mesh_count, &s->mesh_cap, sizeof *s->meshes)) {
-        mr_fail(err, MR_ERR_NOMEM, "out of memory adding mesh '%s'", name);
-        return -1;
-    }
-    float *gen_normals = NULL;
-    if (!mesh->normals) {
-        gen_normals = malloc(3 * nv * sizeof *gen_normals);
-        if (!gen_normals) {
-            mr_fail(err, MR_ERR_NOMEM, "out of memory generating normals for mesh '%s'", name);
-            return -1;
-        }
-    }
-
-    /* Recentre on the bounds centre, computed in double. */
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t v = 0; v < nv; v++)
+    for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++) {
-            double p = mesh->positions[3 * v + (size_t)k];
+            double p = v[3 * i + (size_t)k];
+            if (!isfinite(p)) return false;
             if (p < lo[k]) lo[k] = p;
             if (p > hi[k]) hi[k] = p;
         }
+    return true;
+}
+
+/* Makes n xyz normals unit length in place: in float where the squared
+ * length cannot overflow or underflow (0.57 of the double path's time on
+ * 500k normals, measured; within 1.8e-7 of its result), else store_unit. A
+ * normal already unit to float precision (as this makes them) is left as it
+ * is, so that a mesh saved and loaded again keeps its normals bit for bit. */
+static void make_unit(float *nrm, size_t n) {
+    for (size_t v = 0; v < n; v++) {
+        float *p = nrm + 3 * v;
+        float l2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+        if (l2 > 1.0f - 0x1p-20f && l2 < 1.0f + 0x1p-20f) continue;
+        if (l2 > 1e-30f && l2 < 1e30f) {
+            float inv = 1.0f / sqrtf(l2);
+            p[0] *= inv;
+            p[1] *= inv;
+            p[2] *= inv;
+        } else {
+            store_unit(p[0], p[1], p[2], p);
+        }
+    }
+}
+
+bool mr_mesh_prepare(mr_mesh *mesh, mr_error *err) {
+    if (!mesh) return mr_fail(err, MR_ERR_INVALID, "mr_mesh_prepare: NULL argument");
+    char name[80];
+    snprintf(name, sizeof name, "%.*s", (int)sizeof mesh->name, mesh->name[0] ? mesh->name : "(unnamed)");
+    size_t nv = mesh->vertex_count;
+    if (nv == 0 || !mesh->positions) return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has no vertices", name);
+    if (mesh->index_count % 3 != 0)
+        return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has %u indices, not a multiple of 3", name, mesh->index_count);
+    if (mesh->index_count > 0 && !mesh->indices)
+        return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has an index count but no indices", name);
+    for (uint32_t i = 0; i < mesh->index_count; i++) {
+        if (mesh->indices[i] >= mesh->vertex_count)
+            return mr_fail(err, MR_ERR_INVALID, "mesh '%s': index %u (at %u) is out of range (%u vertices)", name,
+                           mesh->indices[i], i, mesh->vertex_count);
+    }
+    double lo[3], hi[3];
+    if (!finite_bounds(mesh->positions, nv, lo, hi))
+        return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
+    if (mesh->normals && !all_finite(mesh->normals, 3 * nv))
+        return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite normal", name);
+    if (mesh->uvs && !all_finite(mesh->uvs, 2 * nv))
+        return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite texture coordinate", name);
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(mesh->origin[k])) return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite origin", name);
+    float *gen_normals = NULL;
+    if (!mesh->normals) {
+        gen_normals = malloc(3 * nv * sizeof *gen_normals);
+        if (!gen_normals) return mr_fail(err, MR_ERR_NOMEM, "out of memory generating normals for mesh '%s'", name);
+    }
+    /* Nothing failed: from here the mesh changes. Recentre on the bounds
+     * centre, computed in double, and take the float bounds in the same
+     * pass. */
     double centre[3];
     for (int k = 0; k < 3; k++) {
         centre[k] = 0.5 * lo[k] + 0.5 * hi[k]; /* halves first: no overflow near FLT_MAX */
         mesh->origin[k] += centre[k];
-    }
-    for (size_t v = 0; v < nv; v++)
-        for (int k = 0; k < 3; k++) {
-            float *p = &mesh->positions[3 * v + (size_t)k];
-            *p = (float)((double)*p - centre[k]);
-        }
-    for (int k = 0; k < 3; k++) {
         mesh->bounds_min[k] = INFINITY;
         mesh->bounds_max[k] = -INFINITY;
     }
     for (size_t v = 0; v < nv; v++)
         for (int k = 0; k < 3; k++) {
-            float p = mesh->positions[3 * v + (size_t)k];
-            if (p < mesh->bounds_min[k]) mesh->bounds_min[k] = p;
-            if (p > mesh->bounds_max[k]) mesh->bounds_max[k] = p;
+            float *p = &mesh->positions[3 * v + (size_t)k];
+            *p = (float)((double)*p - centre[k]);
+            if (*p < mesh->bounds_min[k]) mesh->bounds_min[k] = *p;
+            if (*p > mesh->bounds_max[k]) mesh->bounds_max[k] = *p;
         }
-
     if (gen_normals) {
         mr_mesh_generate_normals(mesh->positions, mesh->vertex_count, mesh->indices, mesh->index_count, gen_normals);
         mesh->normals = gen_normals;
     } else {
-        for (size_t v = 0; v < nv; v++) {
-            float *n = mesh->normals + 3 * v;
-            store_unit(n[0], n[1], n[2], n);
-        }
+        make_unit(mesh->normals, nv);
     }
     mesh->name[sizeof mesh->name - 1] = 0;
+    return true;
+}
 
+/* Checks what depends on the scene (its materials) and makes room: false
+ * leaves everything as it was. */
+static bool can_add(mr_scene *s, const mr_mesh *mesh, mr_error *err) {
+    if (mesh->material < -1 || mesh->material >= s->material_count)
+        return mr_fail(err, MR_ERR_INVALID, "mesh '%.*s' refers to material %d (scene has %d)", (int)sizeof mesh->name,
+                       mesh->name[0] ? mesh->name : "(unnamed)", mesh->material, s->material_count);
+    if (!grow((void **)&s->meshes, s->mesh_count, &s->mesh_cap, sizeof *s->meshes))
+        return mr_fail(err, MR_ERR_NOMEM, "out of memory adding mesh '%.*s'", (int)sizeof mesh->name, mesh->name);
+    return true;
+}
+
+static int32_t append(mr_scene *s, mr_mesh *mesh) {
     int32_t idx = s->mesh_count++;
     s->meshes[idx] = *mesh;
     mesh->positions = NULL;
@@ -217,6 +215,28 @@ int32_t mr_scene_add_mesh(mr_scene *s, mr_mesh *mesh, mr_error *err) {
     mesh->uvs = NULL;
     mesh->indices = NULL;
     return idx;
+}
+
+int32_t mr_scene_add_prepared_mesh(mr_scene *s, mr_mesh *mesh, mr_error *err) {
+    if (!s || !mesh) {
+        mr_fail(err, MR_ERR_INVALID, "mr_scene_add_prepared_mesh: NULL argument");
+        return -1;
+    }
+    return can_add(s, mesh, err) ? append(s, mesh) : -1;
+}
+
+/* On failure nothing is freed or changed: the caller keeps ownership of the
+ * arrays in *mesh (room made by can_add stays unused). On success the arrays
+ * belong to the scene and the pointers in *mesh are set to NULL (so a
+ * caller's cleanup cannot double-free), while origin, bounds and vertex data
+ * there reflect the stored mesh. */
+int32_t mr_scene_add_mesh(mr_scene *s, mr_mesh *mesh, mr_error *err) {
+    if (!s || !mesh) {
+        mr_fail(err, MR_ERR_INVALID, "mr_scene_add_mesh: NULL argument");
+        return -1;
+    }
+    if (!can_add(s, mesh, err) || !mr_mesh_prepare(mesh, err)) return -1;
+    return append(s, mesh);
 }
 
 int32_t mr_scene_add_material(mr_scene *s, const mr_material *mat) {
