@@ -7,6 +7,7 @@
 #include <tiny_gltf.h>  // never TINYGLTF_IMPLEMENTATION: we link the shared lib
 
 #include "draco_internal.h"
+#include "prepare_internal.h"
 #include <meshoptimizer.h>
 
 #include <stb_image.h>
@@ -773,6 +774,21 @@ struct Loader {
     // (ready, owned here until the primitive takes it): no view is kept,
     // copied, or decoded twice. Anything else keeps the path above.
     std::vector<int> acc_role, acc_uses, acc_state;  // per accessor; state 0 not yet, 1 converted, 2 left to read()
+    // A pre view's arrays are also prepared where they are converted (on
+    // the pool: prepare_internal.h), so that a primitive whose arrays all
+    // were is added as it is, not prepared again on one core: per
+    // accessor, what that step found (written only by the task that
+    // converts it, read after), the mesh whose name its messages give, and
+    // for an index list its primitive's vertex count.
+    struct Prep {
+        int state = 0;  // 0 not prepared, 1 prepared, 2 failed (err)
+        mr_error err;
+        double shift[3] = {0, 0, 0};  // positions: what recentring moved into the origin
+        float bmin[3], bmax[3];
+    };
+    std::vector<Prep> acc_prep;
+    std::vector<int> acc_mesh;
+    std::vector<uint32_t> acc_nv;
     std::vector<char> view_pre;
     std::vector<std::vector<int>> view_readers;  // pre views -> their accessors
     std::map<int, void *> ready;                 // accessor -> malloc'd float or uint32 array
@@ -1024,6 +1040,13 @@ struct Loader {
                     for (const Job &j : conv[b].jobs)
                         fill_job(j, h ? j.v.count / 2 : 0, h ? j.v.count - j.v.count / 2 : j.v.count / 2);
                 }, conv[b].bytes);
+                // Then each array's prepare step, the arrays shared out.
+                const std::vector<Job> &jobs = conv[b].jobs;
+                split([&](int h) {
+                    for (size_t k = (size_t)h; k < jobs.size(); k += 2) prep_array(jobs[k].v.index, jobs[k].out, jobs[k].v.count);
+                    if (h == 0 && conv[b].handoff >= 0)
+                        prep_array(conv[b].handoff, d.out, m.accessors[(size_t)conv[b].handoff].count);
+                }, jobs.size() > 1 ? conv[b].bytes : 0);
                 
             };
             pool.submit(&tasks[k]);
@@ -1118,8 +1141,15 @@ struct Loader {
         acc_role.assign(m.accessors.size(), k_role_none);
         acc_uses.assign(m.accessors.size(), 0);
         acc_state.assign(m.accessors.size(), 0);
+        acc_prep.assign(m.accessors.size(), Prep());
+        acc_mesh.assign(m.accessors.size(), -1);
+        acc_nv.assign(m.accessors.size(), 0);
+        int use_mesh = -1;
+        uint32_t use_nv = 0;
         auto use = [&](int a, int role) {
             if (a < 0 || (size_t)a >= m.accessors.size()) return;
+            acc_mesh[(size_t)a] = use_mesh;
+            if (role == k_role_index) acc_nv[(size_t)a] = use_nv;
             int &r = acc_role[(size_t)a];
             r = r == k_role_none || r == role ? role : k_role_mixed;
             acc_uses[(size_t)a]++;
@@ -1135,6 +1165,12 @@ struct Loader {
                 const tinygltf::Primitive &p = m.meshes[mi].primitives[pi];
                 const int roles[3] = {k_role_position, k_role_normal, k_role_uv};
                 int ri = 0;
+                use_mesh = (int)mi;
+                auto pit = p.attributes.find("POSITION");
+                use_nv = 0;
+                if (pit != p.attributes.end() && pit->second >= 0 && (size_t)pit->second < m.accessors.size() &&
+                    m.accessors[(size_t)pit->second].count <= UINT32_MAX)
+                    use_nv = (uint32_t)m.accessors[(size_t)pit->second].count;
                 for (const char *k : {"POSITION", "NORMAL", "TEXCOORD_0"}) {
                     auto it = p.attributes.find(k);
                     if (it != p.attributes.end()) use(it->second, roles[ri]);
@@ -1359,6 +1395,35 @@ struct Loader {
     // Fills the jobs' arrays (read() cannot fail on them: no sparse), the
     // elements split in two halves on a second thread when there are
     // bytes enough to pay for it and a second core.
+    void mesh_name(int mi, char out[64]) const {
+        if (mi < 0 || (size_t)mi >= m.meshes.size() || m.meshes[(size_t)mi].name.empty()) std::snprintf(out, 64, "mesh_%d", mi);
+        else std::snprintf(out, 64, "%s", m.meshes[(size_t)mi].name.c_str());
+    }
+
+    // The prepare step of accessor a's converted array (Prep); on the
+    // pool: touches only acc_prep[a] and the array. Non-finite normals are
+    // left to primitive(), which regenerates them with a warning.
+    void prep_array(int a, void *out, size_t count) {
+        Prep &p = acc_prep[(size_t)a];
+        if (count > UINT32_MAX) return;
+        const uint32_t n = (uint32_t)count;
+        const int role = acc_role[(size_t)a];
+        char name[64];
+        mesh_name(acc_mesh[(size_t)a], name);
+        if (role == k_role_position) {
+            p.state = mr_mesh_recentre(static_cast<float *>(out), n, p.shift, p.bmin, p.bmax, name, &p.err) ? 1 : 2;
+        } else if (role == k_role_normal) {
+            const float *f = static_cast<const float *>(out);
+            bool finite = true;
+            for (size_t i = 0; i < (size_t)n * 3; i++) finite = finite && std::isfinite(f[i]);
+            if (!finite) return;
+            mr_mesh_unit_normals(static_cast<float *>(out), n);
+            p.state = 1;
+        } else if (role == k_role_index && acc_nv[(size_t)a] > 0) {
+            p.state = mr_mesh_check_indices(static_cast<const uint32_t *>(out), n, acc_nv[(size_t)a], name, &p.err) ? 1 : 2;
+        }
+    }
+
     static void fill_job(const Job &j, size_t first, size_t count) {
         View v = j.v;
         v.base += first * v.stride;
@@ -1884,6 +1949,7 @@ struct Loader {
         MeshGuard g;
         std::vector<uint32_t> order;
         bool have_order = false;
+        int prep_pos = -1, prep_nrm = -1, prep_idx = -1;  // accessors whose arrays came prepared (Prep)
         if (dx != p.extensions.end()) {
             draco_primitive(p, dx->second, name, g, order);
             have_order = true;
@@ -1900,6 +1966,8 @@ struct Loader {
             if (!(g.m.positions = take<float>(pos_it->second))) {
                 g.m.positions = xmalloc<float>((size_t)nv * 3);
                 read(pv, 3, g.m.positions, "POSITION", name);
+            } else if (acc_prep[(size_t)pos_it->second].state) {
+                prep_pos = pos_it->second;
             }
             done(pos_it->second);
 
@@ -1913,10 +1981,12 @@ struct Loader {
                     if (!(g.m.normals = take<float>(nrm_it->second))) {
                         g.m.normals = xmalloc<float>((size_t)nv * 3);
                         read(nview, 3, g.m.normals, "NORMAL", name);
+                    } else if (acc_prep[(size_t)nrm_it->second].state) {
+                        prep_nrm = nrm_it->second;  // finite and unit already
                     }
                     // Integer normals are finite, and mr_scene_add_mesh
                     // makes every normal unit length: only floats are checked.
-                    if (nview.comp == TINYGLTF_COMPONENT_TYPE_FLOAT) check_normals(g, name, false);
+                    if (nview.comp == TINYGLTF_COMPONENT_TYPE_FLOAT && prep_nrm < 0) check_normals(g, name, false);
                 }
                 done(nrm_it->second);
             }
@@ -1945,6 +2015,7 @@ struct Loader {
                 if (iv.count > UINT32_MAX) fail(MR_ERR_UNSUPPORTED, "mesh '%s': too many indices", name);
                 // A triangle list is the mesh's index array as it is read.
                 uint32_t *q = take<uint32_t>(indices);
+                if (q && acc_prep[(size_t)indices].state) prep_idx = indices;
                 if (mode == TINYGLTF_MODE_TRIANGLES) {
                     g.m.indices = q ? q : xmalloc<uint32_t>(iv.count);
                     g.m.index_count = (uint32_t)iv.count;
@@ -1998,16 +2069,36 @@ struct Loader {
         }
         if (g.m.uvs) check_uvs(g, name);
         std::snprintf(g.m.name, sizeof g.m.name, "%s", name);
-        add_mesh(&g.m);  // took the arrays: the guard frees nothing more
+        // Arrays prepared where they were converted: their failures are
+        // this mesh's, in mr_mesh_prepare's order; recentred positions
+        // move the origin; a triangle list whose every array came prepared
+        // is added as it is.
+        for (int a : {prep_idx, prep_pos})
+            if (a >= 0 && acc_prep[(size_t)a].state == 2) throw Fail{acc_prep[(size_t)a].err.code, acc_prep[(size_t)a].err.msg};
+        if (prep_pos >= 0)
+            for (int k = 0; k < 3; k++) g.m.origin[k] += acc_prep[(size_t)prep_pos].shift[k];
+        const bool prepared = prep_pos >= 0 && prep_nrm >= 0 && g.m.normals && prep_idx >= 0 && mode == TINYGLTF_MODE_TRIANGLES &&
+                              g.m.index_count % 3 == 0 && g.m.index_count > 0;
+        if (prepared)
+            for (int k = 0; k < 3; k++) {
+                g.m.bounds_min[k] = acc_prep[(size_t)prep_pos].bmin[k];
+                g.m.bounds_max[k] = acc_prep[(size_t)prep_pos].bmax[k];
+            }
+        add_mesh(&g.m, prepared);  // took the arrays: the guard frees nothing more
     }
 
-    void add_mesh(mr_mesh *mm) {
+    // prepared: every array already went through its prepare step.
+    void add_mesh(mr_mesh *mm, bool prepared) {
         std::unique_ptr<Pending> own(new Pending);
         Pending *q = own.get();
         q->g.m = *mm;
         std::memset(mm, 0, sizeof *mm);
         mesh_total++;
-        if (q->g.m.vertex_count >= k_async_vertices || q->g.m.index_count >= 3 * k_async_vertices) {
+        if (prepared) {
+            q->g.m.name[sizeof q->g.m.name - 1] = 0;
+            q->ok = q->inline_done = true;
+            pending.push_back(std::move(own));
+        } else if (q->g.m.vertex_count >= k_async_vertices || q->g.m.index_count >= 3 * k_async_vertices) {
             q->task.fn = [q] { q->ok = mr_mesh_prepare(&q->g.m, &q->err); };
             pending.push_back(std::move(own));
             pool.submit(&q->task);
@@ -2049,8 +2140,7 @@ struct Loader {
         if (mesh_map[(size_t)mi].first != -2) return mesh_map[(size_t)mi];
         const tinygltf::Mesh &gm = m.meshes[(size_t)mi];
         char name[64];
-        if (gm.name.empty()) std::snprintf(name, sizeof name, "mesh_%d", mi);
-        else std::snprintf(name, sizeof name, "%s", gm.name.c_str());
+        mesh_name(mi, name);
         int32_t first = mesh_total;
         for (size_t k = 0; k < gm.primitives.size(); k++) primitive(gm.primitives[k], name, mi, (int)k);
         int32_t count = mesh_total - first;

@@ -1,6 +1,7 @@
 /* Scene building: meshes, materials, textures, nodes, bounds, globs.
  * glTF import/export lives in gltf_io.cc; the demo hall in demo.c. */
 #include "mr_scene.h"
+#include "prepare_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -140,6 +141,41 @@ static void make_unit(float *nrm, size_t n) {
     }
 }
 
+bool mr_mesh_check_indices(const uint32_t *idx, uint32_t count, uint32_t vertex_count, const char *name, mr_error *err) {
+    uint32_t worst = 0; /* a branch-free scan; the error path finds the first */
+    for (uint32_t i = 0; i < count; i++) worst = idx[i] > worst ? idx[i] : worst;
+    if (count == 0 || worst < vertex_count) return true;
+    for (uint32_t i = 0; i < count; i++)
+        if (idx[i] >= vertex_count)
+            return mr_fail(err, MR_ERR_INVALID, "mesh '%s': index %u (at %u) is out of range (%u vertices)", name, idx[i], i,
+                           vertex_count);
+    return true;
+}
+
+bool mr_mesh_recentre(float *pos, uint32_t n, double origin[3], float bmin[3], float bmax[3], const char *name,
+                      mr_error *err) {
+    double lo[3], hi[3];
+    if (!finite_bounds(pos, n, lo, hi)) return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
+    double centre[3];
+    for (int k = 0; k < 3; k++) {
+        centre[k] = 0.5 * lo[k] + 0.5 * hi[k]; /* halves first: no overflow near FLT_MAX */
+        origin[k] += centre[k];
+        bmin[k] = INFINITY;
+        bmax[k] = -INFINITY;
+    }
+    /* The float bounds in the same pass. */
+    for (size_t v = 0; v < n; v++)
+        for (int k = 0; k < 3; k++) {
+            float *p = &pos[3 * v + (size_t)k];
+            *p = (float)((double)*p - centre[k]);
+            if (*p < bmin[k]) bmin[k] = *p;
+            if (*p > bmax[k]) bmax[k] = *p;
+        }
+    return true;
+}
+
+void mr_mesh_unit_normals(float *nrm, uint32_t n) { make_unit(nrm, n); }
+
 bool mr_mesh_prepare(mr_mesh *mesh, mr_error *err) {
     if (!mesh) return mr_fail(err, MR_ERR_INVALID, "mr_mesh_prepare: NULL argument");
     char name[80];
@@ -150,14 +186,7 @@ bool mr_mesh_prepare(mr_mesh *mesh, mr_error *err) {
         return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has %u indices, not a multiple of 3", name, mesh->index_count);
     if (mesh->index_count > 0 && !mesh->indices)
         return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has an index count but no indices", name);
-    for (uint32_t i = 0; i < mesh->index_count; i++) {
-        if (mesh->indices[i] >= mesh->vertex_count)
-            return mr_fail(err, MR_ERR_INVALID, "mesh '%s': index %u (at %u) is out of range (%u vertices)", name,
-                           mesh->indices[i], i, mesh->vertex_count);
-    }
-    double lo[3], hi[3];
-    if (!finite_bounds(mesh->positions, nv, lo, hi))
-        return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
+    if (!mr_mesh_check_indices(mesh->indices, mesh->index_count, mesh->vertex_count, name, err)) return false;
     if (mesh->normals && !all_finite(mesh->normals, 3 * nv))
         return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite normal", name);
     if (mesh->uvs && !all_finite(mesh->uvs, 2 * nv))
@@ -169,23 +198,12 @@ bool mr_mesh_prepare(mr_mesh *mesh, mr_error *err) {
         gen_normals = malloc(3 * nv * sizeof *gen_normals);
         if (!gen_normals) return mr_fail(err, MR_ERR_NOMEM, "out of memory generating normals for mesh '%s'", name);
     }
-    /* Nothing failed: from here the mesh changes. Recentre on the bounds
-     * centre, computed in double, and take the float bounds in the same
-     * pass. */
-    double centre[3];
-    for (int k = 0; k < 3; k++) {
-        centre[k] = 0.5 * lo[k] + 0.5 * hi[k]; /* halves first: no overflow near FLT_MAX */
-        mesh->origin[k] += centre[k];
-        mesh->bounds_min[k] = INFINITY;
-        mesh->bounds_max[k] = -INFINITY;
+    /* The last check (positions) and the first change: after it nothing
+     * fails. */
+    if (!mr_mesh_recentre(mesh->positions, mesh->vertex_count, mesh->origin, mesh->bounds_min, mesh->bounds_max, name, err)) {
+        free(gen_normals);
+        return false;
     }
-    for (size_t v = 0; v < nv; v++)
-        for (int k = 0; k < 3; k++) {
-            float *p = &mesh->positions[3 * v + (size_t)k];
-            *p = (float)((double)*p - centre[k]);
-            if (*p < mesh->bounds_min[k]) mesh->bounds_min[k] = *p;
-            if (*p > mesh->bounds_max[k]) mesh->bounds_max[k] = *p;
-        }
     if (gen_normals) {
         mr_mesh_generate_normals(mesh->positions, mesh->vertex_count, mesh->indices, mesh->index_count, gen_normals);
         mesh->normals = gen_normals;

@@ -1,0 +1,35 @@
+/* prepare_internal.h — the steps of mr_mesh_prepare one array at a time
+ * (scene.c), for the glTF loader: it converts a compressed file's arrays
+ * on both cores as their views decode, prepares each array there, and adds
+ * the mesh prepared (mr_scene_add_prepared_mesh). Each step is all or
+ * nothing: false + err changes nothing. name: the mesh's, for messages.
+ * Internal to lib/scene. */
+#ifndef MR_PREPARE_INTERNAL_H
+#define MR_PREPARE_INTERNAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "mr_core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Every index below vertex_count. */
+bool mr_mesh_check_indices(const uint32_t *idx, uint32_t count, uint32_t vertex_count, const char *name, mr_error *err);
+/* n xyz positions recentred on their bounds centre (computed in double),
+ * the centre added to origin, their bounds in bmin/bmax; false if one is
+ * not finite. */
+bool mr_mesh_recentre(float *pos, uint32_t n, double origin[3], float bmin[3], float bmax[3], const char *name,
+                      mr_error *err);
+/* n xyz normals, all finite, made unit length (degenerate ones get a
+ * fallback); an already unit one stays bit for bit. */
+void mr_mesh_unit_normals(float *nrm, uint32_t n);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
