@@ -506,7 +506,7 @@ static void test_meshopt_big(void) {
 enum { k_pipe_nv = 60000, k_pipe_prims = 3, k_pipe_ni = 3 * (k_pipe_nv - 2) };
 
 typedef struct {
-    float *pos, *nrm;
+    float *pos, *nrm, *nrm4; /* nrm4: the normals unit, xyz0 (meshopt_encodeFilterOct's input) */
     uint32_t *idx;
 } pipe_data;
 
@@ -520,17 +520,25 @@ static void pipe_fill(pipe_data *d) {
         d->nrm[3 * i + 1] = 2.0f;
         d->nrm[3 * i + 2] = -1.0f * (float)(p + 1);
     }
+    for (size_t i = 0; i < (size_t)k_pipe_prims * k_pipe_nv; i++) {
+        const float *n = d->nrm + 3 * i;
+        float l = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int c = 0; c < 3; c++) d->nrm4[4 * i + (size_t)c] = n[c] / l;
+        d->nrm4[4 * i + 3] = 0.0f;
+    }
     for (size_t p = 0; p < k_pipe_prims; p++)
         for (size_t t = 0; t < k_pipe_ni / 3; t++)
             for (int c = 0; c < 3; c++) d->idx[p * k_pipe_ni + 3 * t + (size_t)c] = (uint32_t)(t + (size_t)c);
 }
 
 /* The file's JSON and BIN for d: compressed (three meshopt views) or plain.
- * tail: more nodes after the three (",{...}"), or "". */
-static unsigned char *pipe_file(const pipe_data *d, bool packed, const char *tail, char *json, size_t json_cap,
-                                size_t *bin_n, size_t view_off[3], size_t view_len[3]) {
+ * tail: more nodes after the three (",{...}"), or "". oct: 0, or the bits
+ * (8, 16) of OCTAHEDRAL-filtered normals (compressed only). */
+static unsigned char *pipe_file_oct(const pipe_data *d, bool packed, const char *tail, char *json, size_t json_cap,
+                                    size_t *bin_n, size_t view_off[3], size_t view_len[3], int oct) {
     const size_t nv = (size_t)k_pipe_prims * k_pipe_nv, ni = (size_t)k_pipe_prims * k_pipe_ni;
-    const size_t raw[3] = {nv * 12, nv * 12, ni * 4};
+    const size_t nst = oct == 8 ? 4 : oct == 16 ? 8 : 12; /* the normals' stride */
+    const size_t raw[3] = {nv * 12, nv * nst, ni * 4};
     size_t cap = 2 * meshopt_encodeVertexBufferBound(nv, 12) + meshopt_encodeIndexSequenceBound(ni, nv) + raw[0] + raw[1] + raw[2] + 64;
     unsigned char *bin = malloc(cap);
     if (!bin) return NULL;
@@ -540,6 +548,15 @@ static unsigned char *pipe_file(const pipe_data *d, bool packed, const char *tai
         if (!packed) {
             memcpy(bin + at, v == 0 ? (const void *)d->pos : v == 1 ? (const void *)d->nrm : (const void *)d->idx, raw[v]);
             n = raw[v];
+        } else if (v == 1 && oct) {
+            unsigned char *f = malloc(raw[1]);
+            if (!f) {
+                free(bin);
+                return NULL;
+            }
+            meshopt_encodeFilterOct(f, nv, nst, oct, d->nrm4);
+            n = meshopt_encodeVertexBuffer(bin + at, cap - at, f, nv, nst);
+            free(f);
         } else if (v < 2) {
             n = meshopt_encodeVertexBuffer(bin + at, cap - at, v == 0 ? d->pos : d->nrm, nv, 12);
         } else {
@@ -554,14 +571,16 @@ static unsigned char *pipe_file(const pipe_data *d, bool packed, const char *tai
     char views[2048], acc[4096];
     size_t vo = 0, ao = 0;
     for (int v = 0; v < 3; v++) {
-        const size_t st = v < 2 ? 12 : 4;
+        const size_t st = v == 0 ? 12 : v == 1 ? nst : 4;
+        char vst[32] = "";
+        if (v < 2) snprintf(vst, sizeof vst, ",\"byteStride\":%zu", st);
         if (packed)
             vo += (size_t)snprintf(views + vo, sizeof views - vo,
                                    "%s{\"buffer\":1,\"byteOffset\":%zu,\"byteLength\":%zu%s,\"extensions\":{\"EXT_meshopt_compression\":"
-                                   "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":%zu,\"count\":%zu,\"mode\":\"%s\"}}}",
-                                   v ? "," : "", v == 0 ? 0 : v == 1 ? raw[0] : raw[0] + raw[1], raw[v],
-                                   v < 2 ? ",\"byteStride\":12" : "", view_off[v], view_len[v], st, v < 2 ? nv : ni,
-                                   v < 2 ? "ATTRIBUTES" : "INDICES");
+                                   "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":%zu,\"count\":%zu,\"mode\":\"%s\"%s}}}",
+                                   v ? "," : "", v == 0 ? 0 : v == 1 ? raw[0] : raw[0] + raw[1], raw[v], vst, view_off[v],
+                                   view_len[v], st, v < 2 ? nv : ni, v < 2 ? "ATTRIBUTES" : "INDICES",
+                                   v == 1 && oct ? ",\"filter\":\"OCTAHEDRAL\"" : "");
         else
             vo += (size_t)snprintf(views + vo, sizeof views - vo, "%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu%s}",
                                    v ? "," : "", view_off[v], view_len[v], v < 2 ? ",\"byteStride\":12" : "");
@@ -569,9 +588,10 @@ static unsigned char *pipe_file(const pipe_data *d, bool packed, const char *tai
     for (int p = 0; p < k_pipe_prims; p++) /* accessors 3p: POSITION, 3p+1: NORMAL, 3p+2: indices */
         ao += (size_t)snprintf(acc + ao, sizeof acc - ao,
                                "%s{\"bufferView\":0,\"byteOffset\":%zu,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\"},"
-                               "{\"bufferView\":1,\"byteOffset\":%zu,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\"},"
+                               "{\"bufferView\":1,\"byteOffset\":%zu,\"componentType\":%d%s,\"count\":%d,\"type\":\"VEC3\"},"
                                "{\"bufferView\":2,\"byteOffset\":%zu,\"componentType\":5125,\"count\":%d,\"type\":\"SCALAR\"}",
-                               p ? "," : "", (size_t)p * k_pipe_nv * 12, k_pipe_nv, (size_t)p * k_pipe_nv * 12, k_pipe_nv,
+                               p ? "," : "", (size_t)p * k_pipe_nv * 12, k_pipe_nv, (size_t)p * k_pipe_nv * nst,
+                               oct == 8 ? 5120 : oct == 16 ? 5122 : 5126, oct ? ",\"normalized\":true" : "", k_pipe_nv,
                                (size_t)p * k_pipe_ni * 4, k_pipe_ni);
     char fallback[160] = "";
     if (packed)
@@ -585,18 +605,85 @@ static unsigned char *pipe_file(const pipe_data *d, bool packed, const char *tai
              "{\"primitives\":[{\"attributes\":{\"POSITION\":6,\"NORMAL\":7},\"indices\":8}]}],"
              "\"buffers\":[{\"byteLength\":%zu}%s],\"bufferViews\":[%s],\"accessors\":[%s]}",
              tail[0] ? ",3" : "", tail,
-             packed ? "\"extensionsUsed\":[\"EXT_meshopt_compression\"],\"extensionsRequired\":[\"EXT_meshopt_compression\"]," : "",
+             !packed ? ""
+             : oct  ? "\"extensionsUsed\":[\"EXT_meshopt_compression\",\"KHR_mesh_quantization\"],"
+                      "\"extensionsRequired\":[\"EXT_meshopt_compression\",\"KHR_mesh_quantization\"],"
+                    : "\"extensionsUsed\":[\"EXT_meshopt_compression\"],\"extensionsRequired\":[\"EXT_meshopt_compression\"],",
              at, fallback, views, acc);
     return bin;
 }
 
+static unsigned char *pipe_file(const pipe_data *d, bool packed, const char *tail, char *json, size_t json_cap,
+                                size_t *bin_n, size_t view_off[3], size_t view_len[3]) {
+    return pipe_file_oct(d, packed, tail, json, json_cap, bin_n, view_off, view_len, 0);
+}
+
+/* OCTAHEDRAL normals (8 and 16 bits, as gltfpack -cc writes them) are
+ * filtered while converted to floats: each loaded normal is unit and
+ * within the filter's rounding of what meshoptimizer's own decoder makes
+ * of the same bytes, and of the normal encoded. */
+static void test_pipeline_oct(pipe_data *d) {
+    const size_t nv = (size_t)k_pipe_prims * k_pipe_nv;
+    char *json = malloc(16384);
+    if (!json) return;
+    for (int bits = 8; bits <= 16; bits += 8) {
+        size_t bn, off[3], len[3], st = bits == 8 ? 4 : 8;
+        unsigned char *bin = pipe_file_oct(d, true, "", json, 16384, &bn, off, len, bits);
+        unsigned char *ref = malloc(nv * st);
+        CHECK(bin && ref);
+        if (!bin || !ref) {
+            free(bin);
+            free(ref);
+            continue;
+        }
+        meshopt_encodeFilterOct(ref, nv, st, bits, d->nrm4);
+        meshopt_decodeFilterOct(ref, nv, st);
+        mr_error err = {0};
+        mr_scene *s = load_glb(json, bin, bn, &err);
+        CHECK_MSG(s != NULL && s->mesh_count == 3, "oct %d: %s", bits, err.msg);
+        double worst_ref = 0, worst_dot = 1, worst_len = 0;
+        const double one = bits == 8 ? 127.0 : 32767.0;
+        for (int32_t k = 0; s && k < s->mesh_count && s->mesh_count == 3; k++) {
+            const mr_mesh *m = &s->meshes[k];
+            for (size_t v = 0; v < (size_t)k_pipe_nv; v++) {
+                const size_t g = (size_t)k * k_pipe_nv + v;
+                const float *n = m->normals + 3 * v, *w = d->nrm4 + 4 * g;
+                double r[3], rl = 0;
+                for (int c = 0; c < 3; c++) {
+                    int q = bits == 8 ? ((const int8_t *)(ref + g * st))[c] : ((const int16_t *)(ref + g * st))[c];
+                    r[c] = q / one;
+                    rl += r[c] * r[c];
+                }
+                rl = sqrt(rl);
+                double dot = 0, l = 0;
+                for (int c = 0; c < 3; c++) {
+                    worst_ref = fmax(worst_ref, fabs(n[c] - r[c] / rl));
+                    dot += n[c] * w[c];
+                    l += (double)n[c] * n[c];
+                }
+                worst_dot = fmin(worst_dot, dot);
+                worst_len = fmax(worst_len, fabs(sqrt(l) - 1.0));
+            }
+        }
+        /* meshopt rounds each component to 1/one: its normal is that far off. */
+        CHECK_MSG(worst_ref < 1.5 / one + 1e-6, "oct %d: %g from meshopt's decoder", bits, worst_ref);
+        CHECK_MSG(worst_dot > (bits == 8 ? 0.999 : 0.9999999), "oct %d: a normal %g off the encoded one (dot)", bits, worst_dot);
+        CHECK_MSG(worst_len < 1e-6, "oct %d: normals off unit length by %g", bits, worst_len);
+        mr_scene_destroy(&s);
+        free(bin);
+        free(ref);
+    }
+    free(json);
+}
+
 static void test_pipeline(void) {
     const size_t nv = (size_t)k_pipe_prims * k_pipe_nv, ni = (size_t)k_pipe_prims * k_pipe_ni;
-    pipe_data d = {malloc(nv * 12), malloc(nv * 12), malloc(ni * 4)};
+    pipe_data d = {malloc(nv * 12), malloc(nv * 12), malloc(nv * 16), malloc(ni * 4)};
     char *json = malloc(16384);
-    CHECK(d.pos && d.nrm && d.idx && json);
-    if (!d.pos || !d.nrm || !d.idx || !json) goto out;
+    CHECK(d.pos && d.nrm && d.nrm4 && d.idx && json);
+    if (!d.pos || !d.nrm || !d.nrm4 || !d.idx || !json) goto out;
     pipe_fill(&d);
+    test_pipeline_oct(&d);
     for (int packed = 0; packed < 2; packed++) {
         size_t bn, off[3], len[3];
         unsigned char *bin = pipe_file(&d, packed, "", json, 16384, &bn, off, len);
@@ -677,6 +764,7 @@ static void test_pipeline(void) {
 out:
     free(d.pos);
     free(d.nrm);
+    free(d.nrm4);
     free(d.idx);
     free(json);
 }

@@ -1013,8 +1013,22 @@ struct Loader {
         for (size_t k = 0; k < order.size(); k++) order[k] = k;
         std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return batch[a].out_n > batch[b].out_n; });
         std::vector<Convert> conv(batch.size());
-        for (size_t b = 0; b < batch.size(); b++)
+        for (size_t b = 0; b < batch.size(); b++) {
             conv[b] = plan_convert(batch[b].bvi, batch[b].out, m.bufferViews[(size_t)batch[b].bvi].byteLength, &batch[b].out);
+            // An OCTAHEDRAL view read only as normals, each element's own
+            // first three components: filtered while converted (oct_fill),
+            // one pass instead of two.
+            Decode &d = batch[b];
+            bool oct = d.filter == 1 && conv[b].handoff < 0 && conv[b].jobs.size() == view_readers[(size_t)d.bvi].size();
+            for (const Job &j : conv[b].jobs)
+                oct = oct && acc_role[(size_t)j.v.index] == k_role_normal && j.n == 3 && j.v.normalized && j.v.ncomp >= 3 &&
+                      j.v.stride == d.st && m.accessors[(size_t)j.v.index].byteOffset % d.st == 0 &&
+                      ((j.v.comp == TINYGLTF_COMPONENT_TYPE_BYTE && d.st == 4) || (j.v.comp == TINYGLTF_COMPONENT_TYPE_SHORT && d.st == 8));
+            if (oct) {
+                for (Job &j : conv[b].jobs) j.oct = true;
+                d.filter = 0;
+            }
+        }
         std::deque<Pool::Task> tasks(batch.size());
         struct Wait {  // every task ends before batch, conv and the buffers go
             Pool &p;
@@ -1272,6 +1286,7 @@ struct Loader {
         View v;
         int n;
         void *out;
+        bool oct = false;  // unfiltered OCTAHEDRAL normals: decoded straight to unit floats (oct_fill)
     };
 
     // A pre view decoded (or to be decoded) at p: each of its accessors
@@ -1424,11 +1439,42 @@ struct Loader {
         }
     }
 
+    // EXT_meshopt_compression's OCTAHEDRAL filter (as its specification
+    // gives it) and the conversion to unit floats in one pass: x and y in
+    // units of the third component ("one"), z = one - |x| - |y|, folded
+    // over for z < 0, then normalised. The filter would round the normal
+    // back to 8 or 16 bits first; this keeps it in float.
+    template <typename T>
+    static void oct_fill(const unsigned char *base, size_t stride, size_t count, float *out) {
+        for (size_t i = 0; i < count; i++) {
+            T c[3];
+            std::memcpy(c, base + i * stride, sizeof c);
+            float x = (float)c[0], y = (float)c[1];
+            float z = (float)c[2] - std::fabs(x) - std::fabs(y);
+            float t = z < 0.0f ? z : 0.0f;
+            x += x >= 0.0f ? t : -t;
+            y += y >= 0.0f ? t : -t;
+            float l2 = x * x + y * y + z * z;
+            float inv = l2 > 0.0f ? 1.0f / std::sqrt(l2) : 0.0f;
+            if (l2 > 0.0f) {
+                out[3 * i] = x * inv;
+                out[3 * i + 1] = y * inv;
+                out[3 * i + 2] = z * inv;
+            } else {  // a zero vector: left so (made the fallback normal by the prepare step)
+                out[3 * i] = out[3 * i + 1] = out[3 * i + 2] = 0.0f;
+            }
+        }
+    }
+
     static void fill_job(const Job &j, size_t first, size_t count) {
         View v = j.v;
         v.base += first * v.stride;
         v.count = count;
-        if (j.n == 1) read_plain(v, 1, static_cast<uint32_t *>(j.out) + first);
+        if (j.oct) {
+            float *o = static_cast<float *>(j.out) + first * 3;
+            if (v.comp == TINYGLTF_COMPONENT_TYPE_BYTE) oct_fill<int8_t>(v.base, v.stride, count, o);
+            else oct_fill<int16_t>(v.base, v.stride, count, o);
+        } else if (j.n == 1) read_plain(v, 1, static_cast<uint32_t *>(j.out) + first);
         else read_plain(v, j.n, static_cast<float *>(j.out) + first * (size_t)j.n);
     }
 
