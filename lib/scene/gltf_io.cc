@@ -950,12 +950,11 @@ struct Loader {
 
     // Pre views (see view_pre) decode on both cores: from the one asked
     // for on, the next ones primitives will ask for (pre_order) join a batch
-    // of up to batch_limit decoded bytes, the batch is decoded in parallel
-    // (largest first), and every view is converted as it is now (its index
-    // list, where it can, keeps the decoded buffer itself). A view whose
-    // object is wrong stays out of the batch and fails when asked for, as
-    // before. Measured on the 2M-triangle unique factory (gltfpack -c): the
-    // decoding is a sixth of its load.
+    // of up to batch_limit decoded bytes; each view of the batch is decoded,
+    // converted into its accessors' arrays and those prepared, by one task
+    // on the pool (its index list, where it can, keeps the decoded buffer
+    // itself). A view whose object is wrong stays out of the batch and fails
+    // when asked for, as before.
     std::vector<int> pre_order;  // pre views, in the order primitives first read them
     std::vector<size_t> pre_rank;  // view -> its place in pre_order
     size_t pre_pos = 0;
