@@ -133,8 +133,8 @@ for b in "${benches[@]}"; do
         find docs/bench/scene_instanced -mindepth 1 -type d -empty -delete ;;
     load)
         # issue 17 (lane gltf): first loads of the factories and their
-        # gltfpack files, CPU only, about 30 s; not in the default list.
-        run bench_load docs/bench/load $mr bench load --runs 15 --out docs/bench/load
+        # gltfpack files, CPU only, about 60 s; not in the default list.
+        run bench_load docs/bench/load $mr bench load --runs 45 --out docs/bench/load
         find docs/bench/load -type f -name '*.glb' -delete ;;
     *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, scene-unique, scene-instanced, multiview, map, shadows, load)" >&2; exit 2 ;;
     esac
