@@ -785,6 +785,12 @@ struct Loader {
         mr_error err;
         double shift[3] = {0, 0, 0};  // positions: what recentring moved into the origin
         float bmin[3], bmax[3];
+        // Filled by fill_post, each half of the array into its own slot:
+        // positions' bounds, normals already unit, an index list's largest.
+        bool chunked = false;  // set before the tasks run
+        bool bad[2] = {false, false};  // a non-finite value seen
+        double lo[2][3], hi[2][3];
+        uint32_t imax[2] = {0, 0};
     };
     std::vector<Prep> acc_prep;
     std::vector<int> acc_mesh;
@@ -1027,6 +1033,7 @@ struct Loader {
                 for (Job &j : conv[b].jobs) j.oct = true;
                 d.filter = 0;
             }
+            for (const Job &j : conv[b].jobs) acc_prep[(size_t)j.v.index].chunked = true;
         }
         std::deque<Pool::Task> tasks(batch.size());
         struct Wait {  // every task ends before batch, conv and the buffers go
@@ -1051,7 +1058,7 @@ struct Loader {
                 split([&](int h) { decode_filter(d, d.out, h ? fc / 2 : 0, h ? fc - fc / 2 : fc / 2); }, fc ? d.out_n : 0);
                 split([&](int h) {
                     for (const Job &j : conv[b].jobs)
-                        fill_job(j, h ? j.v.count / 2 : 0, h ? j.v.count - j.v.count / 2 : j.v.count / 2);
+                        fill_post(j, h ? j.v.count / 2 : 0, h ? j.v.count - j.v.count / 2 : j.v.count / 2, h);
                 }, conv[b].bytes);
                 // Then each array's prepare step, the arrays shared out.
                 const std::vector<Job> &jobs = conv[b].jobs;
@@ -1424,6 +1431,30 @@ struct Loader {
         const int role = acc_role[(size_t)a];
         char name[64];
         mesh_name(acc_mesh[(size_t)a], name);
+        if (p.chunked) {  // what fill_post found
+            if (role == k_role_position) {
+                if (p.bad[0] || p.bad[1]) {
+                    mr_fail(&p.err, MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
+                    p.state = 2;
+                    return;
+                }
+                double lo[3], hi[3];
+                for (int k = 0; k < 3; k++) {
+                    lo[k] = std::min(p.lo[0][k], p.lo[1][k]);
+                    hi[k] = std::max(p.hi[0][k], p.hi[1][k]);
+                }
+                mr_mesh_recentre_within(static_cast<float *>(out), n, lo, hi, p.shift, p.bmin, p.bmax);
+                p.state = 1;
+            } else if (role == k_role_normal) {
+                p.state = p.bad[0] || p.bad[1] ? 0 : 1;
+            } else if (role == k_role_index && acc_nv[(size_t)a] > 0) {
+                p.state = std::max(p.imax[0], p.imax[1]) < acc_nv[(size_t)a] ||
+                                  mr_mesh_check_indices(static_cast<const uint32_t *>(out), n, acc_nv[(size_t)a], name, &p.err)
+                              ? 1
+                              : 2;
+            }
+            return;
+        }
         if (role == k_role_position) {
             p.state = mr_mesh_recentre(static_cast<float *>(out), n, p.shift, p.bmin, p.bmax, name, &p.err) ? 1 : 2;
         } else if (role == k_role_normal) {
@@ -1461,6 +1492,39 @@ struct Loader {
                 out[3 * i + 2] = z * inv;
             } else {  // a zero vector: left so (made the fallback normal by the prepare step)
                 out[3 * i] = out[3 * i + 1] = out[3 * i + 2] = 0.0f;
+            }
+        }
+    }
+
+    // fill_job for elements [first, first + count) in chunks small enough
+    // to stay in cache, each then given what prep_array would do in a pass
+    // of its own over the whole array: positions' bounds and finite check,
+    // normals made unit, an index list's largest index; into half h's
+    // slots of the accessor's Prep (on the pool: halves run on both cores).
+    void fill_post(const Job &j, size_t first, size_t count, int h) {
+        Prep &p = acc_prep[(size_t)j.v.index];
+        const int role = acc_role[(size_t)j.v.index];
+        for (int k = 0; k < 3; k++) {
+            p.lo[h][k] = INFINITY;
+            p.hi[h][k] = -INFINITY;
+        }
+        const size_t chunk = 8192;
+        for (size_t c = first; c < first + count; c += chunk) {
+            const size_t cn = std::min(chunk, first + count - c);
+            fill_job(j, c, cn);
+            if (role == k_role_position && j.n == 3) {
+                if (!mr_mesh_bounds_add(static_cast<float *>(j.out) + 3 * c, cn, p.lo[h], p.hi[h])) p.bad[h] = true;
+            } else if (role == k_role_normal && j.n == 3) {
+                float *f = static_cast<float *>(j.out) + 3 * c;
+                bool finite = true;
+                for (size_t i = 0; i < 3 * cn; i++) finite = finite && std::isfinite(f[i]);
+                if (finite) mr_mesh_unit_normals(f, (uint32_t)cn);
+                else p.bad[h] = true;
+            } else if (role == k_role_index && j.n == 1) {
+                const uint32_t *q = static_cast<const uint32_t *>(j.out) + c;
+                uint32_t mx = p.imax[h];
+                for (size_t i = 0; i < cn; i++) mx = q[i] > mx ? q[i] : mx;
+                p.imax[h] = mx;
             }
         }
     }

@@ -24,6 +24,13 @@ bool mr_mesh_check_indices(const uint32_t *idx, uint32_t count, uint32_t vertex_
  * not finite. */
 bool mr_mesh_recentre(float *pos, uint32_t n, double origin[3], float bmin[3], float bmax[3], const char *name,
                       mr_error *err);
+/* lo/hi extended by n xyz positions (start them at +inf / -inf); false if
+ * one is not finite. */
+bool mr_mesh_bounds_add(const float *pos, size_t n, double lo[3], double hi[3]);
+/* mr_mesh_recentre for positions whose bounds lo/hi are known (and all
+ * finite). */
+void mr_mesh_recentre_within(float *pos, uint32_t n, const double lo[3], const double hi[3], double origin[3], float bmin[3],
+                             float bmax[3]);
 /* n xyz normals, all finite, made unit length (degenerate ones get a
  * fallback); an already unit one stays bit for bit. */
 void mr_mesh_unit_normals(float *nrm, uint32_t n);
