@@ -168,34 +168,39 @@ bool mr_bench_load(const mr_bench_load_params *params, mr_error *err) {
     static double cpu[k_files][k_max_runs], wall[k_files][k_max_runs], peak[k_files][k_max_runs], base[k_files][k_max_runs],
         cold[k_files][k_max_runs];
     child_result last[k_files];
-    BENCH_PRINT(out, "bench load: %d rounds over %d files, one fresh process per load, each file from the page cache and "
-                     "then from disk\n", p.runs, k_files);
-    /* The files in a new order each round (a fixed seed: the same run is
-     * the same order): in a fixed order each load follows the same other
-     * file's, and on this machine that alone moved a file's median by 5-10 %
-     * (measured). */
+    BENCH_PRINT(out, "bench load: %d rounds over %d files, one fresh process per load, all from the page cache, then all "
+                     "from disk\n", p.runs, k_files);
+    /* All warm loads first, then all cold ones (each after dropping its
+     * file from the page cache), the files in a new order each round (a
+     * fixed seed: the same run is the same order). Measured: in a fixed
+     * order, or with a warm load right after another file's cold one, a
+     * file's warm median moved by 5-10 %. */
     uint32_t seed = 0x9E3779B9u;
-    for (int r = 0; r < p.runs; r++) {
-        int order[k_files];
-        for (int f = 0; f < k_files; f++) order[f] = f;
-        for (int i = k_files - 1; i > 0; i--) {
-            seed = seed * 1664525u + 1013904223u;
-            int k = (int)((seed >> 8) % (uint32_t)(i + 1)), t = order[i];
-            order[i] = order[k];
-            order[k] = t;
+    for (int phase = 0; phase < 2; phase++)
+        for (int r = 0; r < p.runs; r++) {
+            int order[k_files];
+            for (int f = 0; f < k_files; f++) order[f] = f;
+            for (int i = k_files - 1; i > 0; i--) {
+                seed = seed * 1664525u + 1013904223u;
+                int k = (int)((seed >> 8) % (uint32_t)(i + 1)), t = order[i];
+                order[i] = order[k];
+                order[k] = t;
+            }
+            for (int oi = 0; oi < k_files; oi++) {
+                const int f = order[oi];
+                if (phase == 0) {
+                    if (!timed_load(path[f], &last[f], &cpu[f][r], &peak[f][r], err)) return false;
+                    wall[f][r] = last[f].wall_s;
+                    base[f][r] = last[f].base_rss_mb;
+                } else {
+                    child_result c;
+                    double c_cpu, c_peak;
+                    evict(path[f]);
+                    if (!timed_load(path[f], &c, &c_cpu, &c_peak, err)) return false;
+                    cold[f][r] = c.wall_s;
+                }
+            }
         }
-        for (int oi = 0; oi < k_files; oi++) {
-            const int f = order[oi];
-            if (!timed_load(path[f], &last[f], &cpu[f][r], &peak[f][r], err)) return false;
-            wall[f][r] = last[f].wall_s;
-            base[f][r] = last[f].base_rss_mb;
-            child_result c;
-            double c_cpu, c_peak;
-            evict(path[f]);
-            if (!timed_load(path[f], &c, &c_cpu, &c_peak, err)) return false;
-            cold[f][r] = c.wall_s;
-        }
-    }
     mr_csv *csv = mr_csv_create(err);
     if (!csv) return false;
     mr_csv_comment(csv, "bench load: each load in a fresh process; medians over the rounds");
