@@ -1048,7 +1048,6 @@ struct Loader {
             const size_t b = order[k];
             tasks[k].fn = [&, b] {
                 Decode &d = batch[b];
-                
                 d.rc = decode_stream(d, d.out);
                 if (d.rc != 0) return;
                 // What follows the stream's decoding is per element: split
@@ -1067,7 +1066,10 @@ struct Loader {
                     if (h == 0 && conv[b].handoff >= 0)
                         prep_array(conv[b].handoff, d.out, m.accessors[(size_t)conv[b].handoff].count);
                 }, jobs.size() > 1 ? conv[b].bytes : 0);
-                
+                if (conv[b].handoff < 0) {  // its bytes are all converted: gone now, not at the batch's end
+                    std::free(d.out);
+                    d.out = nullptr;
+                }
             };
             pool.submit(&tasks[k]);
             wait.n = k + 1;
