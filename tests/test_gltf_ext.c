@@ -730,6 +730,26 @@ static void test_pipeline(void) {
         d.idx[k_pipe_ni + 7] = keep;
         if (bin) expect_refused(json, bin, bn, "out of range", __LINE__);
         free(bin);
+        /* A NaN normal in mesh 1: its normals are regenerated (a warning),
+         * every one unit; the load goes on. */
+        float keep_n = d.nrm[(size_t)2 * k_pipe_nv * 3 + 50];
+        d.nrm[(size_t)2 * k_pipe_nv * 3 + 50] = NAN;
+        bin = pipe_file(&d, packed, "", json, 16384, &bn, off, len);
+        d.nrm[(size_t)2 * k_pipe_nv * 3 + 50] = keep_n;
+        s = bin ? load_glb(json, bin, bn, &err) : NULL;
+        CHECK_MSG(s != NULL && s->mesh_count == 3, "%s, NaN normal: %s", packed ? "meshopt" : "plain", err.msg);
+        if (s && s->mesh_count == 3) {
+            double worst = 0;
+            const mr_mesh *m = &s->meshes[2];
+            for (uint32_t v = 0; v < m->vertex_count; v++) {
+                const float *n = m->normals + 3 * v;
+                double l = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+                worst = isfinite(l) ? fmax(worst, fabs(l - 1.0)) : 1e9;
+            }
+            CHECK_MSG(worst < 1e-5, "%s, NaN normal: regenerated normals off unit by %g", packed ? "meshopt" : "plain", worst);
+        }
+        mr_scene_destroy(&s);
+        free(bin);
         /* Mesh 1 has an infinite position; nothing later fails. */
         float keep_p = d.pos[(size_t)2 * k_pipe_nv * 3 + 100];
         d.pos[(size_t)2 * k_pipe_nv * 3 + 100] = INFINITY;
