@@ -1423,9 +1423,11 @@ struct Loader {
         else std::snprintf(out, 64, "%s", m.meshes[(size_t)mi].name.c_str());
     }
 
-    // The prepare step of accessor a's converted array (Prep); on the
-    // pool: touches only acc_prep[a] and the array. Non-finite normals are
-    // left to primitive(), which regenerates them with a warning.
+    // The prepare step of accessor a's converted array (Prep), from what
+    // fill_post found in its chunks; on the pool: touches only acc_prep[a]
+    // and the array. An index list that kept the decoded buffer (not
+    // chunked) is checked here in full. Non-finite normals are left to
+    // primitive(), which regenerates them with a warning.
     void prep_array(int a, void *out, size_t count) {
         Prep &p = acc_prep[(size_t)a];
         if (count > UINT32_MAX) return;
@@ -1433,41 +1435,26 @@ struct Loader {
         const int role = acc_role[(size_t)a];
         char name[64];
         mesh_name(acc_mesh[(size_t)a], name);
-        if (p.chunked) {  // what fill_post found
-            if (role == k_role_position) {
-                if (p.bad[0] || p.bad[1]) {
-                    mr_fail(&p.err, MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
-                    p.state = 2;
-                    return;
-                }
-                double lo[3], hi[3];
-                for (int k = 0; k < 3; k++) {
-                    lo[k] = std::min(p.lo[0][k], p.lo[1][k]);
-                    hi[k] = std::max(p.hi[0][k], p.hi[1][k]);
-                }
-                mr_mesh_recentre_within(static_cast<float *>(out), n, lo, hi, p.shift, p.bmin, p.bmax);
-                p.state = 1;
-            } else if (role == k_role_normal) {
-                p.state = p.bad[0] || p.bad[1] ? 0 : 1;
-            } else if (role == k_role_index && acc_nv[(size_t)a] > 0) {
-                p.state = std::max(p.imax[0], p.imax[1]) < acc_nv[(size_t)a] ||
-                                  mr_mesh_check_indices(static_cast<const uint32_t *>(out), n, acc_nv[(size_t)a], name, &p.err)
-                              ? 1
-                              : 2;
+        if (role == k_role_position && p.chunked) {
+            if (p.bad[0] || p.bad[1]) {
+                mr_fail(&p.err, MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
+                p.state = 2;
+                return;
             }
-            return;
-        }
-        if (role == k_role_position) {
-            p.state = mr_mesh_recentre(static_cast<float *>(out), n, p.shift, p.bmin, p.bmax, name, &p.err) ? 1 : 2;
-        } else if (role == k_role_normal) {
-            const float *f = static_cast<const float *>(out);
-            bool finite = true;
-            for (size_t i = 0; i < (size_t)n * 3; i++) finite = finite && std::isfinite(f[i]);
-            if (!finite) return;
-            mr_mesh_unit_normals(static_cast<float *>(out), n);
+            double lo[3], hi[3];
+            for (int k = 0; k < 3; k++) {
+                lo[k] = std::min(p.lo[0][k], p.lo[1][k]);
+                hi[k] = std::max(p.hi[0][k], p.hi[1][k]);
+            }
+            mr_mesh_recentre_within(static_cast<float *>(out), n, lo, hi, p.shift, p.bmin, p.bmax);
             p.state = 1;
+        } else if (role == k_role_normal && p.chunked) {
+            p.state = p.bad[0] || p.bad[1] ? 0 : 1;
         } else if (role == k_role_index && acc_nv[(size_t)a] > 0) {
-            p.state = mr_mesh_check_indices(static_cast<const uint32_t *>(out), n, acc_nv[(size_t)a], name, &p.err) ? 1 : 2;
+            const bool in_range = p.chunked && std::max(p.imax[0], p.imax[1]) < acc_nv[(size_t)a];
+            p.state = in_range || mr_mesh_check_indices(static_cast<const uint32_t *>(out), n, acc_nv[(size_t)a], name, &p.err)
+                          ? 1
+                          : 2;
         }
     }
 

@@ -19,16 +19,12 @@ extern "C" {
 
 /* Every index below vertex_count. */
 bool mr_mesh_check_indices(const uint32_t *idx, uint32_t count, uint32_t vertex_count, const char *name, mr_error *err);
-/* n xyz positions recentred on their bounds centre (computed in double),
- * the centre added to origin, their bounds in bmin/bmax; false if one is
- * not finite. */
-bool mr_mesh_recentre(float *pos, uint32_t n, double origin[3], float bmin[3], float bmax[3], const char *name,
-                      mr_error *err);
 /* lo/hi extended by n xyz positions (start them at +inf / -inf); false if
  * one is not finite. */
 bool mr_mesh_bounds_add(const float *pos, size_t n, double lo[3], double hi[3]);
-/* mr_mesh_recentre for positions whose bounds lo/hi are known (and all
- * finite). */
+/* n xyz positions, all finite, whose bounds are lo/hi, recentred on the
+ * bounds' centre (computed in double), the centre added to origin, their
+ * float bounds in bmin/bmax. */
 void mr_mesh_recentre_within(float *pos, uint32_t n, const double lo[3], const double hi[3], double origin[3], float bmin[3],
                              float bmax[3]);
 /* n xyz normals, all finite, made unit length (degenerate ones get a

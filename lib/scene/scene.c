@@ -166,8 +166,10 @@ void mr_mesh_recentre_within(float *pos, uint32_t n, const double lo[3], const d
         }
 }
 
-bool mr_mesh_recentre(float *pos, uint32_t n, double origin[3], float bmin[3], float bmax[3], const char *name,
-                      mr_error *err) {
+/* Positions recentred (mr_mesh_recentre_within) after their finite check
+ * and bounds; false + err, nothing changed, if one is not finite. */
+static bool recentre(float *pos, uint32_t n, double origin[3], float bmin[3], float bmax[3], const char *name,
+                     mr_error *err) {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     if (!mr_mesh_bounds_add(pos, n, lo, hi)) return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite position", name);
     mr_mesh_recentre_within(pos, n, lo, hi, origin, bmin, bmax);
@@ -200,7 +202,7 @@ bool mr_mesh_prepare(mr_mesh *mesh, mr_error *err) {
     }
     /* The last check (positions) and the first change: after it nothing
      * fails. */
-    if (!mr_mesh_recentre(mesh->positions, mesh->vertex_count, mesh->origin, mesh->bounds_min, mesh->bounds_max, name, err)) {
+    if (!recentre(mesh->positions, mesh->vertex_count, mesh->origin, mesh->bounds_min, mesh->bounds_max, name, err)) {
         free(gen_normals);
         return false;
     }
