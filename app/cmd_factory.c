@@ -48,7 +48,7 @@ int cmd_factory(int argc, char **argv) {
         if (mr_cli_get(opts, "triangles") && !parse_count(mr_cli_get(opts, "triangles"), &tri))
             return mr_cli_errorf(cmd, "--triangles: '%s' is not a count like 5M", mr_cli_get(opts, "triangles")), 2;
         sp.halls = mr_synth_halls_for(tri);
-        cp.parts = (int)fmin(1e6, fmax(1, floor((double)tri / cp.part_triangles + 0.5)));
+        cp.parts = mr_synth_cad_parts_for(&cp, (double)tri);
     }
     if (mr_cli_get(opts, "seed")) {
         long seed;
@@ -85,20 +85,7 @@ int cmd_factory(int argc, char **argv) {
     bool ok = mr_mkdirs(dir, &err) && mr_scene_save_glb(s, out, &err);
     mr_scene_destroy(&s);
     const char *views = mr_cli_get(opts, "views");
-    static const char *const names[MR_SYNTH_VIEW_COUNT] = {"floor", "aisle", "overview"};
-    for (int v = 0; ok && views && v < MR_SYNTH_VIEW_COUNT; v++) {
-        char path[4096], file[64];
-        ok = mr_mkdirs(views, &err);
-        snprintf(file, sizeof file, "view_%s.json", names[v]);
-        mr_path_join(views, file, path, sizeof path);
-        mr_view view;
-        view.camera = mr_demo_camera();
-        memset(view.camera.dist, 0, sizeof view.camera.dist); /* an ideal camera for renders */
-        view.world_from_camera = unique ? mr_synth_cad_viewpoint(&cp, v) : mr_synth_viewpoint(&sp, v);
-        cJSON *j = mr_view_to_json(&view);
-        ok = ok && j && mr_json_save(path, j, &err);
-        cJSON_Delete(j);
-    }
+    if (ok && views) ok = mr_synth_save_views(views, &sp, unique ? &cp : NULL, &err);
     if (!ok) return mr_cli_error(cmd, &err);
     printf("wrote %s%s%s\n", out, views ? " and views in " : "", views ? views : "");
     return 0;

@@ -421,6 +421,46 @@ static void test_closed_outward(void) {
     }
 }
 
+/* The part count for a triangle target (mrcheck factory --unique, bench
+ * scene --unique, bench load): nearest, at least 1, at most 1e6; and a
+ * built factory of that many parts stores about the target. */
+static void test_parts_for(void) {
+    mr_synth_cad_params cp = MR_SYNTH_CAD_DEFAULTS;
+    CHECK(mr_synth_cad_parts_for(&cp, 2e6) == 100);
+    CHECK(mr_synth_cad_parts_for(&cp, 29999) == 1 && mr_synth_cad_parts_for(&cp, 30001) == 2);
+    CHECK(mr_synth_cad_parts_for(&cp, 0) == 1 && mr_synth_cad_parts_for(&cp, -5) == 1);
+    CHECK(mr_synth_cad_parts_for(&cp, 1e15) == 1000000 && mr_synth_cad_parts_for(&cp, NAN) == 1);
+    cp.part_triangles = 0; /* the default */
+    CHECK(mr_synth_cad_parts_for(&cp, 2e6) == 100);
+    cp.part_triangles = 5000;
+    cp.parts = mr_synth_cad_parts_for(&cp, 2e4);
+    CHECK(cp.parts == 4);
+    mr_error err = {0};
+    mr_scene *s = mr_synth_cad_build(&cp, &err);
+    CHECK_MSG(s != NULL, "%s", err.msg);
+    uint64_t stored = 0;
+    for (int32_t i = 0; s && i < s->mesh_count; i++) stored += s->meshes[i].index_count / 3;
+    CHECK_MSG(stored > 1e4 && stored < 4e4, "4 parts of ~5000: %llu triangles", (unsigned long long)stored);
+    mr_scene_destroy(&s);
+    /* The viewpoints as files (mrcheck factory --views): each reads back
+     * as the view it was made from; a file where the folder should be
+     * fails with one line. */
+    char dir[1024], path[1200];
+    CHECK(mr_test_fresh_dir("cad_views", dir, sizeof dir));
+    CHECK_MSG(mr_synth_save_views(dir, NULL, &cp, &err), "%s", err.msg);
+    for (int v = 0; v < MR_SYNTH_VIEW_COUNT; v++) {
+        snprintf(path, sizeof path, "%s/view_%s.json", dir, mr_synth_view_name(v));
+        mr_view got, want = mr_synth_view(NULL, &cp, v);
+        CHECK_MSG(mr_view_load(path, &got, &err), "%s: %s", path, err.msg);
+        double worst = 0;
+        for (int k = 0; k < 16; k++) worst = fmax(worst, fabs(got.world_from_camera.m[k] - want.world_from_camera.m[k]));
+        CHECK_MSG(worst < 1e-9 && got.camera.width == want.camera.width && got.camera.dist[0] == 0, "%s: pose off by %g", path,
+                  worst);
+    }
+    snprintf(path, sizeof path, "%s/view_floor.json", dir);
+    CHECK(!mr_synth_save_views(path, NULL, &cp, &err) && err.msg[0] && !strchr(err.msg, '\n'));
+}
+
 int main(void) {
     double t = mr_time_now();
 #define RUN(f) f; printf("%s: %.2f s\n", #f, mr_time_now() - t); t = mr_time_now()
@@ -428,6 +468,7 @@ int main(void) {
     RUN(test_split_cylinder());
     RUN(test_cad_levels());
     RUN(test_seam_normals());
+    RUN(test_parts_for());
     mr_error err = {0};
     mr_gpu *gpu = mr_gpu_create_headless(NULL, &err);
     if (!gpu) {

@@ -118,7 +118,7 @@ static bool make_factories(const mr_bench_load_params *p, char paths[k_scenes][4
         bool ok = s && mr_scene_save_glb(s, paths[0], &e);
         mr_scene_destroy(&s);
         mr_synth_cad_params cp = MR_SYNTH_CAD_DEFAULTS;
-        cp.parts = (int)fmax(1, floor(p->unique_triangles / (double)cp.part_triangles + 0.5));
+        cp.parts = mr_synth_cad_parts_for(&cp, p->unique_triangles);
         s = ok ? mr_synth_cad_build(&cp, &e) : NULL;
         ok = s && mr_scene_save_glb(s, paths[1], &e);
         mr_scene_destroy(&s);

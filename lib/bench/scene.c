@@ -47,7 +47,6 @@ static const bench_config k_configs[] = {
 /* issue 17 (lane bench): the defaults and the full-detail reference */
 enum { k_all = 0, k_none = 4 };
 
-static const char *const k_view_names[MR_SYNTH_VIEW_COUNT] = {"floor", "aisle", "overview"};
 
 typedef struct row {
     double tri_scene;
@@ -145,7 +144,7 @@ static void report_goals(FILE *out, mr_csv *csv, const double *sizes, int nsizes
             if (!a || !b) continue;
             snprintf(line, sizeof line,
                      "frame ratio %s: frame_ms(%s, all) / frame_ms(%s, all) = %.1f / %.1f = %.2f; CPU ms %.1f / %.1f = %.2f",
-                     k_view_names[v], size_label(sizes[si], la, sizeof la), size_label(sizes[0], lb, sizeof lb),
+                     mr_synth_view_name(v), size_label(sizes[si], la, sizeof la), size_label(sizes[0], lb, sizeof lb),
                      a->frame_ms, b->frame_ms, a->frame_ms / b->frame_ms, a->cpu_ms, b->cpu_ms, a->cpu_ms / b->cpu_ms);
             goal_line(out, csv, line);
         }
@@ -159,12 +158,12 @@ static void report_goals(FILE *out, mr_csv *csv, const double *sizes, int nsizes
         if (a && b)
             snprintf(line, sizeof line,
                      "Goal %s: frame_ms(20M, all) / frame_ms(2M, all) = %.2f (goal <= %g: %s); in frame CPU time %.2f (%s)",
-                     k_view_names[v], a->frame_ms / b->frame_ms, goals[k].limit,
+                     mr_synth_view_name(v), a->frame_ms / b->frame_ms, goals[k].limit,
                      a->frame_ms / b->frame_ms <= goals[k].limit ? "met" : "not met", a->cpu_ms / b->cpu_ms,
                      a->cpu_ms / b->cpu_ms <= goals[k].limit ? "met" : "not met");
         else
             snprintf(line, sizeof line, "Goal %s: frame_ms(20M, all) / frame_ms(2M, all) <= %g: not measured (needs --sizes with 2M and 20M)",
-                     k_view_names[v], goals[k].limit);
+                     mr_synth_view_name(v), goals[k].limit);
         goal_line(out, csv, line);
     }
     for (int si = 0; si < nsizes; si++)
@@ -174,7 +173,7 @@ static void report_goals(FILE *out, mr_csv *csv, const double *sizes, int nsizes
             snprintf(line, sizeof line,
                      "Goal image %s %s: all differs from none in %.3f %% of pixels (by more than %.0f/255 on a channel, "
                      "off depth edges: %.1f %% of pixels are edges) (goal < 0.5 %%: %s)",
-                     size_label(sizes[si], la, sizeof la), k_view_names[v], a->diff.differ_pct, idp.tolerance * 255,
+                     size_label(sizes[si], la, sizeof la), mr_synth_view_name(v), a->diff.differ_pct, idp.tolerance * 255,
                      a->diff.edge_pct, a->diff.differ_pct < 0.5 ? "met" : "not met");
             goal_line(out, csv, line);
         }
@@ -270,7 +269,7 @@ static void report_row(FILE *out, mr_csv *csv, const size_info *z, int v, int c,
     double rss = r->rss_mb;
     BENCH_PRINT(out, "%10llu %8d %9.1f %6.2f %6.2f %7.2f %8.0f %-9s %-9s %9.1f %8.2f %8.1f %11llu %6u %7u %7u",
            (unsigned long long)z->li.triangles, z->nodes, z->mb, z->parse_s, z->li.load_s, z->upload_s, rss,
-           k_view_names[v], k_configs[c].name, r->frame_ms, r->cull_ms, r->gpu_ms,
+           mr_synth_view_name(v), k_configs[c].name, r->frame_ms, r->cull_ms, r->gpu_ms,
            (unsigned long long)st->triangles, st->gl_draw_calls, st->nodes_visible, st->nodes_occluded);
     if (z->unique) BENCH_PRINT(out, " %7.3f %8.1f", r->diff.differ_pct, r->cpu_ms); /* issue 17 (lane bench) */
     BENCH_PRINT(out, "\n");
@@ -287,7 +286,7 @@ static void report_row(FILE *out, mr_csv *csv, const size_info *z, int v, int c,
     mr_csv_num(csv, "%.3f", z->lod_s);
     mr_csv_int(csv, z->from_cache);
     mr_csv_num(csv, "%.0f", rss);
-    mr_csv_text(csv, k_view_names[v]);
+    mr_csv_text(csv, mr_synth_view_name(v));
     mr_csv_text(csv, k_configs[c].name);
     mr_csv_num(csv, "%.3f", r->frame_ms);
     mr_csv_num(csv, "%.3f", r->cull_ms);
@@ -364,7 +363,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
         mr_scene *s;
         if (p.unique) {
             /* Parts of 20k triangles each, all distinct: the size is what is stored. */
-            cp.parts = (int)fmax(1, floor(sizes[si] / cp.part_triangles + 0.5));
+            cp.parts = mr_synth_cad_parts_for(&cp, sizes[si]);
             cp.unit = p.unit > 0 ? p.unit : 1;
             snprintf(name, sizeof name, "cad_%dparts.glb", cp.parts);
             mr_path_join(out_dir, name, glb, sizeof glb);
@@ -466,10 +465,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                              lod_cached_s, cp.unit, li.load_s + lod_s + lod_upload_s,
                              li.load_s + lod_cached_s + lod_upload_cached_s, ci_first.build_s};
         for (int v = 0; v < MR_SYNTH_VIEW_COUNT && ok; v++) {
-            mr_view view;
-            view.camera = mr_demo_camera();
-            memset(view.camera.dist, 0, sizeof view.camera.dist);
-            view.world_from_camera = p.unique ? mr_synth_cad_viewpoint(&cp, v) : mr_synth_viewpoint(&sp, v);
+            mr_view view = mr_synth_view(&sp, p.unique ? &cp : NULL, v);
             /* issue 17 (lane bench): all configurations of the view first,
              * then their rows, each image against the "none" one. */
             mr_frame_result caps[N_CONFIGS];

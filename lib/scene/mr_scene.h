@@ -483,6 +483,16 @@ mr_scene *mr_synth_cad_build(const mr_synth_cad_params *params, mr_error *err);
 /* The same three kinds of viewpoint as mr_synth_viewpoint (floor, aisle,
  * overview), in the factory's unit. */
 mr_dmat4 mr_synth_cad_viewpoint(const mr_synth_cad_params *params, int which);
+/* A fixed viewpoint as a view for renders: the demo camera without lens
+ * distortion at mr_synth_cad_viewpoint (cad non-NULL) or mr_synth_viewpoint.
+ * Its name: "floor", "aisle", "overview". */
+mr_view mr_synth_view(const mr_synth_params *params, const mr_synth_cad_params *cad, int which);
+const char *mr_synth_view_name(int which);
+/* The three as dir/view_<name>.json (dir made if missing). */
+bool mr_synth_save_views(const char *dir, const mr_synth_params *params, const mr_synth_cad_params *cad, mr_error *err);
+/* The part count whose stored triangles come closest to the target, for
+ * params' part_triangles (0: the default); in [1, 1e6]. */
+int mr_synth_cad_parts_for(const mr_synth_cad_params *params, double target_triangles);
 
 #ifdef __cplusplus
 }

@@ -9,6 +9,7 @@
 #include "mr_scene.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -366,6 +367,40 @@ mr_scene *mr_synth_build(const mr_synth_params *params, mr_error *err) {
     }
     mr_scene_update_bounds(c.s);
     return c.s;
+}
+
+mr_view mr_synth_view(const mr_synth_params *params, const mr_synth_cad_params *cad, int which) {
+    mr_view view;
+    view.camera = mr_demo_camera();
+    memset(view.camera.dist, 0, sizeof view.camera.dist); /* an ideal camera for renders */
+    view.world_from_camera = cad ? mr_synth_cad_viewpoint(cad, which) : mr_synth_viewpoint(params, which);
+    return view;
+}
+
+const char *mr_synth_view_name(int which) {
+    static const char *const names[MR_SYNTH_VIEW_COUNT] = {"floor", "aisle", "overview"};
+    return which >= 0 && which < MR_SYNTH_VIEW_COUNT ? names[which] : "?";
+}
+
+bool mr_synth_save_views(const char *dir, const mr_synth_params *params, const mr_synth_cad_params *cad, mr_error *err) {
+    if (!mr_mkdirs(dir, err)) return false;
+    for (int v = 0; v < MR_SYNTH_VIEW_COUNT; v++) {
+        char path[4096], file[64];
+        snprintf(file, sizeof file, "view_%s.json", mr_synth_view_name(v));
+        mr_path_join(dir, file, path, sizeof path);
+        mr_view view = mr_synth_view(params, cad, v);
+        cJSON *j = mr_view_to_json(&view);
+        bool ok = j && mr_json_save(path, j, err);
+        cJSON_Delete(j);
+        if (!ok) return j ? false : mr_fail(err, MR_ERR_NOMEM, "out of memory writing %s", path);
+    }
+    return true;
+}
+
+int mr_synth_cad_parts_for(const mr_synth_cad_params *params, double target_triangles) {
+    const double per = params && params->part_triangles ? (double)params->part_triangles : 20000.0;
+    const double n = floor(target_triangles / per + 0.5);
+    return !(n >= 1) ? 1 : n > 1e6 ? 1000000 : (int)n;
 }
 
 int mr_synth_halls_for(uint64_t target_triangles) {
