@@ -1,7 +1,7 @@
 /* Unique CAD-like geometry (issue 17): LOD without unit assumptions and
  * across normal seams.
  *  - The CAD factory's parts (split at every normal seam) get simplified
- *    levels down to about 1 % of their size, in millimetres, metres and
+ *    levels down to about 2 % of their size, in millimetres, metres and
  *    kilometres alike, and the same levels in each unit (scaled).
  *  - Every level's certified error holds against brute-force sampling of
  *    the two-sided distance, at scales 1e-3, 1 and 1e3.
@@ -70,7 +70,7 @@ static mr_mesh split_cylinder(double r, double len, int seg) {
 }
 
 /* The classic CAD case: a finely tessellated cylinder split at its rims is
- * simplified to a quarter of its triangles or less within 1 % of its size, in
+ * simplified to a quarter of its triangles or less within 2 % of its size (the default budget), in
  * any unit, and its bound holds against brute force at 1e-3, 1 and 1e3. */
 static void test_split_cylinder(void) {
     static const double units[] = {1e-3, 1, 1e3};
@@ -89,7 +89,7 @@ static void test_split_cylinder(void) {
             for (int k = 0; k < ml->level_count; k++) printf(" %u@%.3g", ml->levels[k].index_count / 3, ml->levels[k].error / size);
             printf("\n");
             /* Levels are certified in a chain (lod.c: the steps' errors add
-             * up), so the 1 % budget runs out after two or three levels. */
+             * up), so the 2 % budget runs out after two or three levels. */
             CHECK_MSG(ml->level_count >= 2, "unit %g: %d levels", units[u], ml->level_count);
             if (ml->level_count > 0)
                 CHECK_MSG(ml->levels[ml->level_count - 1].index_count * 2 <= mm->index_count,
@@ -114,7 +114,7 @@ static void test_split_cylinder(void) {
     }
 }
 
-/* Levels engage on seam-split parts, stay within 1 % of the part's size,
+/* Levels engage on seam-split parts, stay within 2 % of the part's size,
  * hold against brute force, and are the same in every unit. */
 static void test_cad_levels(void) {
     static const double units[] = {1e-3, 1, 1e3};
