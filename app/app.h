@@ -16,9 +16,6 @@ typedef struct app_gfx {
 } app_gfx;
 bool app_gfx_open(app_gfx *g, mr_error *err);
 void app_gfx_close(app_gfx *g);
-/* Draws a UI draw list (lib/ui's vertices have draw2d's layout) with the
- * window's 2D layer; errors are logged with the command's name. */
-void app_draw_ui(mr_draw2d *d2, const mr_ui_draw_list *dl, const char *cmd);
 /* The AO and ghosting tables of a command (fill .params, then parse). */
 #define APP_AO_TABLE(p) {.prefix = "ao", .table = mr_ao_opts, .params = (p), .extra = "groundtruth"}
 /* The ground truth's rays, --ao-rays (its params live in lib/eval). */

@@ -18,13 +18,6 @@ bool app_gfx_open(app_gfx *g, mr_error *err) {
     return true;
 }
 
-void app_draw_ui(mr_draw2d *d2, const mr_ui_draw_list *dl, const char *cmd) {
-    mr_draw2d_list l = {(const mr_draw2d_vertex *)dl->vertices, dl->vertex_count, dl->indices, dl->index_count,
-                        dl->atlas, dl->atlas_w, dl->atlas_h, dl->atlas_version};
-    mr_error err = {0};
-    if (!mr_draw2d_list_draw(d2, &l, &err)) mr_log(MR_LOG_ERROR, "%s: %s", cmd, err.msg);
-}
-
 void app_gfx_close(app_gfx *g) {
     mr_renderer_destroy(&g->renderer);
     mr_gpu_destroy(&g->gpu);

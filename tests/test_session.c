@@ -327,7 +327,7 @@ static void test_replay(void) {
     mr_image_free(&img);
 }
 
-/* One mark as the view writes it (app/cmd_view.c's finish_mark). */
+/* One mark as the view writes it (lib/view/run.c's finish_mark). */
 static cJSON *mark_json(int k, bool hit) {
     cJSON *o = cJSON_CreateObject();
     cJSON_AddStringToObject(o, "type", "discrepancy");

@@ -11,7 +11,7 @@
  * process). The view side is the
  * view's own capture code, lib/session/capture.c (mr_capture_*):
  * its replay reader and tracking thread run with --retrack's parameters
- * (the recording's camera and marker map, as cmd_view.c passes them), and
+ * (the recording's camera and marker map, as lib/view/run.c passes them), and
  * the test steps through the recording one frame at a time, waiting for
  * each tracked frame, so no frame is dropped (the window does the same
  * when paused and stepped). Every frame's validity, tags seen and used,

@@ -1102,6 +1102,46 @@ static void test_mark_line_and_setup(void) {
     mr_scene_destroy(&s);
 }
 
+/* The view's source (lib/view/run.c, out of app/cmd_view.c): live input
+ * needs a camera and a marker map, or a view file that gives both a camera
+ * and a fixed pose; a recording's failure names its folder; a failure
+ * leaves nothing to free. */
+static void test_source_load(void) {
+    const char *src = getenv("MR_SOURCE_DIR");
+    if (!src) {
+        printf("test_view: MR_SOURCE_DIR not set, source tests left out\n");
+        return;
+    }
+    char cam[1024], markers[1024], view[1024];
+    snprintf(cam, sizeof cam, "%s/configs/cameras/demo_640x480.json", src);
+    snprintf(markers, sizeof markers, "%s/configs/markers/demo_hall.json", src);
+    snprintf(view, sizeof view, "%s/configs/views/demo_machine.json", src);
+    mr_view_source s;
+    mr_error err = {0};
+    mr_view_source_params p = MR_VIEW_SOURCE_DEFAULTS;
+    CHECK(!mr_view_source_load(&p, &s, &err) && err.code == MR_ERR_INVALID); /* neither input nor replay */
+    p.input = "/dev/video9";
+    memset(&err, 0, sizeof err);
+    CHECK(!mr_view_source_load(&p, &s, &err) && strstr(err.msg, "--input needs --camera"));
+    p.camera_path = cam;
+    memset(&err, 0, sizeof err);
+    CHECK(!mr_view_source_load(&p, &s, &err) && strstr(err.msg, "--input needs --markers") && !s.have_markers);
+    p.markers_path = markers;
+    CHECK_MSG(mr_view_source_load(&p, &s, &err), "%s", err.msg);
+    CHECK(s.have_markers && s.markers.count > 0 && !s.have_fixed_pose && s.camera.width == 640);
+    CHECK(!strcmp(s.desc, "live /dev/video9") && s.input == p.input && !s.replay_dir);
+    mr_view_source_free(&s);
+    CHECK(s.markers.count == 0);
+    mr_view_source_params pv = {.input = "frame.png", .view_path = view};
+    CHECK_MSG(mr_view_source_load(&pv, &s, &err), "%s", err.msg);
+    CHECK(s.have_fixed_pose && !s.have_markers && s.camera.width > 0);
+    mr_view_source_free(&s);
+    mr_view_source_params pr = {.replay_dir = "/nonexistent-recording"};
+    memset(&err, 0, sizeof err);
+    CHECK(!mr_view_source_load(&pr, &s, &err) && !strncmp(err.msg, "/nonexistent-recording: ", 24));
+    mr_view_source_free(NULL);
+}
+
 int main(void) {
     const char *t = getenv("MR_TEST_TMP");
     snprintf(g_tmp, sizeof g_tmp, "%s/test_view", t && t[0] ? t : "/tmp");
@@ -1111,6 +1151,7 @@ int main(void) {
     test_settings();
     test_shadow_choice_and_taps();
     test_mark_line_and_setup();
+    test_source_load();
     char font[1024];
     if (!mr_ui_font_find(font, sizeof font, &err)) {
         printf("test_view: SKIPPED the controller tests (no font): %s\n", err.msg);

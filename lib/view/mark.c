@@ -1,7 +1,7 @@
 /* The view's marking and render decisions as plain data (no GL, no
  * window): where a tap lands in the picture and the camera image, where a
  * finished measurement's mark goes, which shadow method a frame uses and
- * the frame parameters the settings give. app/cmd_view.c carries them out. */
+ * the frame parameters the settings give. run.c carries them out. */
 #include "view_internal.h"
 
 #include <stdio.h>

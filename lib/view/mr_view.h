@@ -4,9 +4,11 @@
  *
  * Input events in (pointer in framebuffer pixels, keys), plain data about
  * the newest camera frame and the source in, actions and a draw list (lib/ui)
- * out. The caller (app/cmd_view.c) owns the window, the renderer and the
- * capture threads and carries the actions out; nothing here touches GL,
- * GLFW, files other than the settings file, or app/.
+ * out. The window loop (run.c, mr_view_run) owns the window, the renderer
+ * and the capture threads and carries the actions out, through lib/render's
+ * and lib/session's public headers; nothing here touches GL, GLFW or app/,
+ * and only run.c reads or writes files other than the settings file
+ * (inputs, snapshots, marks, script shots and states).
  *
  * Depends on: lib/core, lib/ui, lib/track's mr_pose_point_sigma (pure
  * math: the "± N mm here" of the status line), and from lib/render only plain types and
@@ -17,7 +19,11 @@
  * adds lib/track's mr_project_point and lib/render's plain mr_pick,
  * mr_frame_params and mr_shadow_method_parse, and lib/session's plain
  * types (mr_capture_frame, mr_annotation: a mark's line and the frame's
- * render setup, DESIGN.md's view -> session). */
+ * render setup, DESIGN.md's view -> session). run.c (the window loop,
+ * moved out of app/cmd_view.c) adds lib/render's window, renderer and 2D
+ * layer (opaque handles: no GL type), lib/session's capture, snapshots and
+ * marks, lib/track's camera and marker-map files, lib/scene's loader; not
+ * lib/eval (Measure's search is the caller's, mr_view_nearest_fns). */
 #ifndef MR_VIEW_CTL_H
 #define MR_VIEW_CTL_H
 
@@ -402,6 +408,91 @@ typedef struct mr_view_key_help {
 } mr_view_key_help;
 extern const mr_view_key_help mr_view_keymap[];
 extern const int mr_view_keymap_count;
+
+/* ------------------------------------------------- the window (run.c) */
+
+/* Draws a UI draw list (lib/ui's vertices have draw2d's layout) with the
+ * window's 2D layer; errors are logged with `cmd`'s name. */
+void mr_view_draw_ui(mr_draw2d *d2, const mr_ui_draw_list *dl, const char *cmd);
+
+/* Where the frames come from, and the files they are tracked with. */
+typedef struct mr_view_source_params {
+    const char *input;         /* live: /dev/videoN, a video file, an image or a folder of images */
+    const char *replay_dir;    /* a recording (exactly one of input and replay_dir) */
+    const char *camera_path;   /* camera JSON; NULL: the view file's, or the recording's */
+    const char *markers_path;  /* marker map JSON; NULL: the recording's, if any */
+    const char *view_path;     /* view file: a fixed pose instead of tracking (and its camera) */
+} mr_view_source_params;
+#define MR_VIEW_SOURCE_DEFAULTS {NULL, NULL, NULL, NULL, NULL}
+/* The source loaded: what the capture threads and the window need. */
+typedef struct mr_view_source {
+    const char *input, *replay_dir; /* borrowed from the params */
+    mr_camera camera;
+    mr_marker_map markers;
+    bool have_markers;
+    mr_dmat4 fixed_pose;       /* world_from_camera of the view file */
+    bool have_fixed_pose;
+    char desc[256];            /* "replay", "live /dev/video0" (the status line) */
+} mr_view_source;
+/* Loads the camera, the marker map and the fixed pose, a recording's
+ * meta.json filling in what the files did not give. Live input needs a
+ * camera (or a view file) and a marker map (or a view file). false + err
+ * (the message names the file or the missing flag), with nothing left to
+ * free; else free *out with mr_view_source_free. */
+bool mr_view_source_load(const mr_view_source_params *p, mr_view_source *out, mr_error *err);
+void mr_view_source_free(mr_view_source *s); /* accepts NULL and a zeroed source */
+
+/* Measure's planned surface: the nearest point of the model to a measured
+ * point. The search lives above lib/view (lib/eval), so the caller hands it
+ * in as functions; without `create` nothing is measured against the plan. */
+typedef struct mr_view_nearest_hit {
+    bool found;
+    mr_dvec3 point;            /* nearest point on the model, world, scene units */
+    double distance;           /* to it, scene units */
+    double sigma;              /* the distance's 1-sigma from the point's covariance, scene units */
+    int node;                  /* its scene node, -1 none */
+} mr_view_nearest_hit;
+typedef struct mr_view_nearest_fns {
+    /* A search over scene's triangles (built on the first measurement; the
+     * scene outlives it); NULL + err on failure. */
+    void *(*create)(void *user, const mr_scene *scene, mr_error *err);
+    /* p's nearest point; cov: p's 3x3 covariance (row-major, scene units^2).
+     * false: no answer (out->found false). */
+    bool (*query)(void *user, void *search, mr_dvec3 p, const double cov[9], mr_view_nearest_hit *out);
+    void (*destroy)(void *user, void *search);
+    void *user;
+} mr_view_nearest_fns;
+
+/* One interactive check, from the window's opening to its closing. */
+typedef struct mr_view_run_params {
+    const char *scene_path;    /* glTF/GLB or scene config JSON (required) */
+    const mr_view_source *source; /* required; borrowed */
+    const char *out_dir;       /* annotations.jsonl and snapshots/; NULL: the recording, else ./mrcheck-session */
+    const char *config_path;   /* settings file; NULL: mr_view_default_config_path */
+    int width, height;         /* window size, px; 0 = 960 x 720 */
+    bool fullscreen;           /* default false (F11 toggles) */
+    double ui_scale;           /* the UI beyond the screen's density; 0 = 1 */
+    bool paused;               /* replay: start paused */
+    bool retrack;              /* replay: track the frames again (needs a marker map) */
+    bool ao_given, ghost_given, shadows_given; /* the values below replace the saved settings for this run */
+    mr_ao_method ao;
+    mr_ghost_mode ghost;
+    mr_shadow_method shadows;  /* over the scene config's too (mr_view_shadow_choice) */
+    bool ao_temporal;          /* accumulate the AO over frames; default false */
+    mr_view_script **script;   /* handed to the controller (*script NULLed) once it exists; NULL: none */
+    FILE *stats;               /* the frame-time split is printed here on exit; NULL: not */
+    mr_view_nearest_fns nearest; /* Measure's planned surface; zero: none */
+    double start_time;         /* mr_time_now() when the command started (the stats' wall clock); 0 = now */
+} mr_view_run_params;
+#define MR_VIEW_RUN_DEFAULT_WIDTH 960
+#define MR_VIEW_RUN_DEFAULT_HEIGHT 720
+#define MR_VIEW_RUN_DEFAULTS {.width = MR_VIEW_RUN_DEFAULT_WIDTH, .height = MR_VIEW_RUN_DEFAULT_HEIGHT, .ui_scale = 1.0}
+/* Loads the scene on a thread (a scene that fails is shown as a message),
+ * opens the window, the renderer and the controller, starts capture, and
+ * runs until quit; then saves the settings. false + err when the window,
+ * the renderer, the controller or the capture cannot start (MR_ERR_NODEVICE
+ * without a display). */
+bool mr_view_run(const mr_view_run_params *p, mr_error *err);
 
 #ifdef __cplusplus
 }
