@@ -73,9 +73,8 @@ mr_lod *app_load_lod(const mr_scene *s, const char *scene_path, bool use_cache, 
  * returns false on a bad value. */
 bool app_draw_lod(const mr_cli_opt *opts, mr_draw_params *dp);
 /* --lod auto (the default): levels only for scenes that draw at least
- * APP_LOD_AUTO_TRIANGLES, where simplifying pays for its one-off cost. */
+ * MR_LOD_AUTO_TRIANGLES (lib/scene), where simplifying pays for its one-off cost. */
 bool app_lod_auto(const mr_cli_opt *opts);
-#define APP_LOD_AUTO_TRIANGLES 500000u
 /* The draw table (no prefix) and --lod auto|on|off, which decides whether
  * levels are built or read at all. */
 #define APP_DRAW_TABLE(p) {.prefix = "", .table = mr_draw_opts, .params = (p)}

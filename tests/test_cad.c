@@ -16,6 +16,8 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 
 
 static mr_scene *cad(double unit, int parts, uint32_t tris) {
@@ -461,6 +463,71 @@ static void test_parts_for(void) {
     CHECK(!mr_synth_save_views(path, NULL, &cp, &err) && err.msg[0] && !strchr(err.msg, '\n'));
 }
 
+static bool stop_at_first(void *user, double fraction) {
+    (void)fraction;
+    ++*(int *)user;
+    return false;
+}
+
+/* Levels off the caller's thread (the view builds them while it draws):
+ * the same levels as a build here; a stop from on_progress or a cancel
+ * ends the build with no levels and no cache. */
+static void test_async(void) {
+    mr_scene *s = cad(1, 4, 1500);
+    if (!s) return;
+    mr_error err = {0};
+    mr_lod *ref = mr_lod_build(s, NULL, &err);
+    CHECK_MSG(ref != NULL, "%s", err.msg);
+    mr_lod_builder *b = mr_lod_build_async(s, NULL, NULL, &err);
+    CHECK_MSG(b != NULL, "%s", err.msg);
+    double f = -1;
+    while (b && !mr_lod_builder_poll(b, &f)) {
+        CHECK(f >= 0 && f <= 1);
+        struct timespec ts = {0, 1000000};
+        nanosleep(&ts, NULL);
+    }
+    CHECK(f == 1.0);
+    mr_lod_info info;
+    mr_lod *l = b ? mr_lod_builder_finish(&b, &info, &err) : NULL;
+    CHECK_MSG(l != NULL && b == NULL, "%s", err.msg);
+    CHECK(l && !info.from_cache && info.levels > 0);
+    for (int32_t i = 0; l && ref && i < s->mesh_count; i++) {
+        CHECK(l->meshes[i].level_count == ref->meshes[i].level_count);
+        for (int k = 0; k < l->meshes[i].level_count && k < ref->meshes[i].level_count; k++)
+            CHECK(l->meshes[i].levels[k].index_count == ref->meshes[i].levels[k].index_count &&
+                  l->meshes[i].levels[k].error == ref->meshes[i].levels[k].error &&
+                  memcmp(l->meshes[i].levels[k].indices, ref->meshes[i].levels[k].indices,
+                         l->meshes[i].levels[k].index_count * sizeof(uint32_t)) == 0);
+    }
+    mr_lod_destroy(&l);
+    /* Stopped by the caller's progress hook: one call, then nothing. */
+    char cache[4096];
+    snprintf(cache, sizeof cache, "%s/mr_test_cad_async_%d.mrlod", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp", (int)getpid());
+    remove(cache);
+    int calls = 0;
+    mr_lod_params lp = MR_LOD_DEFAULTS;
+    lp.on_progress = stop_at_first;
+    lp.progress_user = &calls;
+    b = mr_lod_build_async(s, cache, &lp, &err);
+    CHECK_MSG(b != NULL, "%s", err.msg);
+    mr_error e2 = {0};
+    l = b ? mr_lod_builder_finish(&b, NULL, &e2) : NULL;
+    CHECK(l == NULL && strstr(e2.msg, "cancelled") != NULL);
+    CHECK_MSG(calls == 1, "%d progress calls, one expected (none after a stop)", calls);
+    FILE *fc = fopen(cache, "rb");
+    CHECK_MSG(fc == NULL, "a cancelled build wrote %s", cache);
+    if (fc) fclose(fc);
+    remove(cache);
+    /* Cancelled while running (or already done): no leak, no wait for all. */
+    b = mr_lod_build_async(s, NULL, NULL, &err);
+    CHECK(b != NULL);
+    mr_lod_builder_cancel(&b);
+    CHECK(b == NULL);
+    mr_lod_builder_cancel(&b); /* accepts NULL */
+    mr_lod_destroy(&ref);
+    mr_scene_destroy(&s);
+}
+
 int main(void) {
     double t = mr_time_now();
 #define RUN(f) f; printf("%s: %.2f s\n", #f, mr_time_now() - t); t = mr_time_now()
@@ -469,6 +536,7 @@ int main(void) {
     RUN(test_cad_levels());
     RUN(test_seam_normals());
     RUN(test_parts_for());
+    RUN(test_async());
     mr_error err = {0};
     mr_gpu *gpu = mr_gpu_create_headless(NULL, &err);
     if (!gpu) {

@@ -1689,6 +1689,7 @@ typedef struct build_job {
     int32_t done;
     uint64_t tri_total, tri_done; /* input triangles, for the progress line */
     int32_t failed;          /* mesh that ran out of memory, or -1 */
+    bool cancelled;          /* params' on_progress said stop */
     double t0;
     bool shown;
 } build_job;
@@ -1708,8 +1709,12 @@ static bool build_one(void *arg, size_t k) {
         fflush(stderr);
         j->shown = true;
     }
+    if (j->p->on_progress && !j->cancelled &&
+        !j->p->on_progress(j->p->progress_user, j->tri_total ? (double)j->tri_done / (double)j->tri_total : 1.0))
+        j->cancelled = true;
+    bool go = ok && !j->cancelled;
     pthread_mutex_unlock(&j->lock);
-    return ok; /* out of memory: no further mesh is started */
+    return go; /* out of memory or cancelled: no further mesh is started */
 }
 
 mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *err) {
@@ -1757,6 +1762,11 @@ mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *e
     if (j.shown) fprintf(stderr, "\r%80s\r", "");
     if (j.failed >= 0) {
         mr_fail(err, MR_ERR_NOMEM, "out of memory simplifying mesh '%s'", s->meshes[j.failed].name);
+        mr_lod_destroy(&l);
+        return NULL;
+    }
+    if (j.cancelled) {
+        mr_fail(err, MR_ERR_INVALID, "LOD build cancelled");
         mr_lod_destroy(&l);
         return NULL;
     }

@@ -397,8 +397,14 @@ typedef struct mr_lod_params {
                                  mesh's size (largest bounding-box extent);
                                  0 = 0.02 (2 %). Levels are built for the
                                  errors rel_error / 32, / 16, ... / 1 */
+    /* Called after each mesh with the fraction of input triangles done,
+     * one call at a time from any of the build's threads; returning false
+     * stops the build (no further mesh is started, mr_lod_build fails with
+     * "LOD build cancelled"). NULL: none. */
+    bool (*on_progress)(void *user, double fraction);
+    void *progress_user;
 } mr_lod_params;
-#define MR_LOD_DEFAULTS {0.0, 0, false, 0.0}
+#define MR_LOD_DEFAULTS {0.0, 0, false, 0.0, NULL, NULL}
 /* 2 %, not 1 %: a level is only drawn where its error projects under
  * --lod-pixels, so a coarser last level changes only what far parts cost.
  * Measured (bench scene --unique, 2M/10M/20M, 320x240; 1 % -> 2 % -> 4 %
@@ -432,6 +438,22 @@ uint64_t mr_lod_scene_hash(const mr_scene *s);
  * (a failed write is only a warning). cache_path NULL: no cache. */
 mr_lod *mr_lod_load_or_build(const mr_scene *s, const char *cache_path, const mr_lod_params *params,
                              mr_lod_info *info, mr_error *err);
+/* Building off the caller's thread, so a window keeps drawing (the full
+ * detail meanwhile) while levels are read from the cache or built: start,
+ * poll once per frame (non-blocking; true when done, with the fraction of
+ * input triangles done), then finish (waits; the levels or NULL + err) or
+ * cancel (stops the build after the meshes in progress, waits, frees). The
+ * scene must stay unchanged until then; params->on_progress, if set, is
+ * called too (on the builder's threads). cache_path NULL: no cache. */
+typedef struct mr_lod_builder mr_lod_builder;
+mr_lod_builder *mr_lod_build_async(const mr_scene *s, const char *cache_path, const mr_lod_params *params,
+                                   mr_error *err);
+bool mr_lod_builder_poll(mr_lod_builder *b, double *fraction);
+mr_lod *mr_lod_builder_finish(mr_lod_builder **b, mr_lod_info *info, mr_error *err); /* NULLs *b */
+void mr_lod_builder_cancel(mr_lod_builder **b); /* NULLs *b, accepts NULL */
+/* Scenes drawing at least this many triangles get levels by default (the
+ * commands' --lod auto): below it, simplifying costs more than it saves. */
+#define MR_LOD_AUTO_TRIANGLES 500000u
 /* The default cache path next to a scene file: "<scene>.mrlod". */
 void mr_lod_cache_path(const char *scene_path, char *out, size_t n);
 /* Certified upper bound of the two-sided Hausdorff distance between the

@@ -487,8 +487,10 @@ typedef struct mr_view_run_params {
 #define MR_VIEW_RUN_DEFAULT_WIDTH 960
 #define MR_VIEW_RUN_DEFAULT_HEIGHT 720
 #define MR_VIEW_RUN_DEFAULTS {.width = MR_VIEW_RUN_DEFAULT_WIDTH, .height = MR_VIEW_RUN_DEFAULT_HEIGHT, .ui_scale = 1.0}
-/* Loads the scene on a thread (a scene that fails is shown as a message),
- * opens the window, the renderer and the controller, starts capture, and
+/* Loads the scene on a thread (a scene that fails is shown as a message)
+ * and, where it draws MR_LOD_AUTO_TRIANGLES or more, its levels of detail
+ * (the cache next to it, else built on a thread while the full detail is
+ * drawn), opens the window, the renderer and the controller, starts capture, and
  * runs until quit; then saves the settings. false + err when the window,
  * the renderer, the controller or the capture cannot start (MR_ERR_NODEVICE
  * without a display). */

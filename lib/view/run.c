@@ -95,6 +95,11 @@ typedef struct view_app {
     mr_scene *scene;
     char scene_msg[600];
     mr_scene_loader *loader; /* the scene loads on a thread; the window stays live meanwhile */
+    /* Levels of detail of a big scene (MR_LOD_AUTO_TRIANGLES, as render's
+     * --lod auto), read from <scene>.mrlod or built on a thread while the
+     * full detail is drawn; the renderer holds lod until it is destroyed. */
+    mr_lod_builder *lod_builder;
+    mr_lod *lod;
     /* frames */
     mr_capture *cap;
     mr_capture_frame frame;
@@ -492,6 +497,36 @@ static void poll_scene_load(view_app *a) {
         snprintf(a->scene_msg, sizeof a->scene_msg, "scene failed to upload: %.500s", err.msg);
         mr_log(MR_LOG_ERROR, "view: %s", a->scene_msg);
         mr_scene_destroy(&a->scene);
+    } else if (mr_scene_triangle_count(a->scene) >= MR_LOD_AUTO_TRIANGLES) {
+        char cache[4096];
+        mr_lod_cache_path(a->scene->source, cache, sizeof cache);
+        mr_lod_params lp = MR_LOD_DEFAULTS;
+        a->lod_builder = mr_lod_build_async(a->scene, a->scene->source[0] ? cache : NULL, &lp, &err);
+        if (!a->lod_builder) mr_log(MR_LOG_WARN, "view: no levels of detail: %s", err.msg);
+    }
+    a->need_render = true;
+}
+
+/* Called once per loop iteration: the levels, once read or built, go to
+ * the renderer (an upload of the levels, on this, the GL thread); until
+ * then, and where they fail, the full detail is drawn. */
+static void poll_lod(view_app *a) {
+    if (!a->lod_builder || !mr_lod_builder_poll(a->lod_builder, NULL)) return;
+    mr_error err = {0};
+    mr_lod_info info;
+    a->lod = mr_lod_builder_finish(&a->lod_builder, &info, &err);
+    if (a->lod && !mr_renderer_set_lod(a->rend, a->lod, &err)) mr_lod_destroy(&a->lod);
+    if (!a->lod) {
+        mr_log(MR_LOG_WARN, "view: no levels of detail: %s", err.msg);
+        return;
+    }
+    if (info.from_cache) {
+        mr_log(MR_LOG_INFO, "view: %llu levels of detail from the cache", (unsigned long long)info.levels);
+    } else {
+        mr_log(MR_LOG_INFO, "view: %llu levels of detail built in %.2f s%s", (unsigned long long)info.levels, info.build_s,
+               info.cache_written ? " (cached)" : "");
+        mr_viewer_toast(a->vc, "levels of detail ready: %llu levels built in %.1f s", (unsigned long long)info.levels,
+                        info.build_s);
     }
     a->need_render = true;
 }
@@ -564,6 +599,7 @@ static bool start_capture(view_app *a, const mr_view_run_params *p, mr_error *er
 static void run_loop(view_app *a) {
     while (!a->quit) {
         poll_scene_load(a);
+        poll_lod(a);
         frame_tick(a);
         /* Sleep until input or a new frame arrives; a script or a pending
          * press keeps the loop going. */
@@ -604,6 +640,7 @@ bool mr_view_run(const mr_view_run_params *p, mr_error *err) {
         mr_error ignored = {0};
         a->scene = mr_scene_loader_finish(&a->loader, &ignored); /* waits for the thread */
     }
+    mr_lod_builder_cancel(&a->lod_builder); /* a build still running stops after its meshes in progress */
     mr_capture_stop(&a->cap);
     mr_capture_frame_free(&a->frame);
     mr_capture_frame_free(&a->mark_frame);
@@ -612,6 +649,7 @@ bool mr_view_run(const mr_view_run_params *p, mr_error *err) {
     mr_viewer_destroy(&a->vc);
     mr_draw2d_destroy(&a->d2);
     mr_renderer_destroy(&a->rend);
+    mr_lod_destroy(&a->lod);
     mr_window_destroy(&a->win);
     if (a->nearest && a->nearest_fns.destroy) a->nearest_fns.destroy(a->nearest_fns.user, a->nearest);
     a->nearest = NULL;
