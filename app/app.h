@@ -71,7 +71,7 @@ mr_lod *app_load_lod(const mr_scene *s, const char *scene_path, bool use_cache, 
 /* --lod: "auto" (or not given), "on" or "off" into dp->no_lod (auto: on,
  * decided by app_lod_auto once the scene is loaded); prints one line and
  * returns false on a bad value. */
-bool app_draw_lod(const mr_cli_opt *opts, mr_draw_params *dp);
+bool app_draw_lod(const char *cmd, const mr_cli_opt *opts, mr_draw_params *dp);
 /* --lod auto (the default): levels only for scenes that draw at least
  * MR_LOD_AUTO_TRIANGLES (lib/scene), where simplifying pays for its one-off cost. */
 bool app_lod_auto(const mr_cli_opt *opts);

@@ -61,7 +61,7 @@ int cmd_render(int argc, char **argv) {
     if (!scene_path || !view_path || !out) return mr_cli_errorf(cmd, "--scene, --view and --out are required"), 2;
 
     if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &fp.width, &fp.height)) return 2;
-    if (!app_draw_lod(opts, &dp)) return 2;
+    if (!app_draw_lod(cmd, opts, &dp)) return 2;
     const char *lod_cache = mr_cli_get(opts, "lod-cache");
     if (lod_cache && strcmp(lod_cache, "on") != 0 && strcmp(lod_cache, "off") != 0)
         return mr_cli_errorf(cmd, "--lod-cache must be 'on' or 'off'"), 2;

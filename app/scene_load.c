@@ -79,10 +79,10 @@ bool app_lod_auto(const mr_cli_opt *opts) {
     return !v || strcmp(v, "auto") == 0;
 }
 
-bool app_draw_lod(const mr_cli_opt *opts, mr_draw_params *dp) {
+bool app_draw_lod(const char *cmd, const mr_cli_opt *opts, mr_draw_params *dp) {
     const char *v = mr_cli_get(opts, "lod");
     if (!v || strcmp(v, "auto") == 0 || strcmp(v, "on") == 0) dp->no_lod = false;
     else if (strcmp(v, "off") == 0) dp->no_lod = true;
-    else return mr_cli_errorf("render", "--lod must be 'on' or 'off' or 'auto', not '%s'", v), false;
+    else return mr_cli_errorf(cmd, "--lod must be 'on' or 'off' or 'auto', not '%s'", v), false;
     return true;
 }

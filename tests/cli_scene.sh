@@ -2,7 +2,8 @@
 # End-to-end checks of `mrcheck factory` and the big-scene options of
 # `mrcheck render`: the synthetic factory and its views are written; culling,
 # batching, instancing and occlusion culling do not change the image; the
-# LOD cache is written next to the scene, reused, and ignored when damaged;
+# LOD cache is written next to the scene, reused, and ignored when damaged
+# (by render, and by replay for a big scene);
 # bad values give one line on stderr and a non-zero exit.
 # Usage: cli_scene.sh MRCHECK TMPDIR. Exit 77 = skipped (no GL device: mrcheck exit 69).
 set -u
@@ -52,14 +53,42 @@ rl "$tmp/lod2.png" --verbose 2>"$tmp/lod2.err" && grep -q "read from the cache" 
 printf 'x' >>"$tmp/tri.gltf.mrlod"
 rl "$tmp/lod3.png" 2>"$tmp/lod3.err" && grep -q "ignored" "$tmp/lod3.err" && cmp -s "$tmp/lod1.png" "$tmp/lod3.png" \
   && ok || bad "damaged LOD cache: $(cat "$tmp/lod3.err")"
+# replay draws levels as render does: --lod on here (the demo hall, which
+# the demo recording sees, is under --lod auto's 500k triangles), through
+# the same cache next to the scene; --lod auto leaves them out for it.
+rec="$(dirname "$0")/../recordings/demo"
+cp "$(dirname "$0")/../configs/scenes/demo_planned.json" "$tmp/hall.json"
+rp() { "$mr" replay "$rec" --scene "$tmp/hall.json" --every 60 --out "$@" --verbose; }
+simplified() { # simplified ERRFILE: the instances the replay drew at a simplified level
+  sed -n 's/.*replay: [0-9]* triangles submitted over the overlays, \([0-9]*\) instances at a simplified level.*/\1/p' "$1"
+}
+rp "$tmp/rp1" --lod on 2>"$tmp/rp1.err" && grep -q "LOD: .* built" "$tmp/rp1.err" && [ -s "$tmp/hall.json.mrlod" ] \
+  && [ "$(simplified "$tmp/rp1.err")" -gt 0 ] \
+  && ok || bad "replay --lod on built or drew no levels: $(tail -3 "$tmp/rp1.err")"
+same_overlays() { # same_overlays DIR1 DIR2: both have the same overlay PNGs, at least one
+  local f n=0
+  for f in "$1"/overlay_*.png; do
+    [ -f "$f" ] && cmp -s "$f" "$2/$(basename "$f")" || return 1
+    n=$((n + 1))
+  done
+  [ "$n" -gt 0 ]
+}
+rp "$tmp/rp2" --lod on 2>"$tmp/rp2.err" && grep -q "read from the cache" "$tmp/rp2.err" && same_overlays "$tmp/rp1" "$tmp/rp2" \
+  && [ "$(simplified "$tmp/rp2.err")" = "$(simplified "$tmp/rp1.err")" ] \
+  && ok || bad "replay did not reuse the LOD cache or drew other images: $(tail -3 "$tmp/rp2.err")"
+for mode in off auto; do
+  rp "$tmp/rp_$mode" --lod $mode 2>"$tmp/rp_$mode.err" && ! grep -q "LOD:" "$tmp/rp_$mode.err" \
+    && [ "$(simplified "$tmp/rp_$mode.err")" = 0 ] && ok || bad "replay --lod $mode: $(tail -3 "$tmp/rp_$mode.err")"
+done
+expect_fail replay_bad_lod "$tmp/rp4" -- "$mr" replay "$rec" --scene "$tmp/hall.json" --out "$tmp/rp4" --lod sometimes
 
-expect_fail bad_cull -- r --out "$tmp/x.png" --cull maybe
-expect_fail bad_tolerance -- r --out "$tmp/x.png" --lod-tolerance -1
-expect_fail bad_lod -- r --out "$tmp/x.png" --lod sometimes
-expect_fail synth_no_out -- "$mr" factory --halls 2
-expect_fail synth_bad_count -- "$mr" factory --out "$tmp/y.glb" --triangles lots
-expect_fail synth_both -- "$mr" factory --out "$tmp/y.glb" --triangles 1M --halls 3
-expect_fail bench_bad_sizes -- "$mr" bench scene --sizes 5Q --out "$tmp/b"
+expect_fail bad_cull "$tmp/x.png" -- r --out "$tmp/x.png" --cull maybe
+expect_fail bad_tolerance "$tmp/x.png" -- r --out "$tmp/x.png" --lod-tolerance -1
+expect_fail bad_lod "$tmp/x.png" -- r --out "$tmp/x.png" --lod sometimes
+expect_fail synth_no_out "" -- "$mr" factory --halls 2
+expect_fail synth_bad_count "$tmp/y.glb" -- "$mr" factory --out "$tmp/y.glb" --triangles lots
+expect_fail synth_both "$tmp/y.glb" -- "$mr" factory --out "$tmp/y.glb" --triangles 1M --halls 3
+expect_fail bench_bad_sizes "" -- "$mr" bench scene --sizes 5Q --out "$tmp/b"
 # Unique CAD-like geometry (issue 17): every part its own mesh, in millimetres.
 if "$mr" factory --unique --unit 1000 --triangles 40k --out "$tmp/cad/c.glb" --views "$tmp/cadviews" >"$tmp/cad.log" 2>&1; then
   [ -s "$tmp/cad/c.glb" ] && [ -s "$tmp/cadviews/view_overview.json" ] && ok || bad "factory --unique did not write its files"
@@ -85,7 +114,7 @@ fi
 expect_fail factory_bad_unit "$tmp/cad/bad.glb" -- "$mr" factory --unique --unit 0 --out "$tmp/cad/bad.glb"
 expect_fail factory_unit_alone "$tmp/cad/bad.glb" -- "$mr" factory --unit 1000 --out "$tmp/cad/bad.glb"
 expect_fail factory_unique_halls "$tmp/cad/bad.glb" -- "$mr" factory --unique --halls 2 --out "$tmp/cad/bad.glb"
-expect_fail bench_bad_unit -- "$mr" bench scene --unique --unit -1 --out "$tmp/b"
+expect_fail bench_bad_unit "" -- "$mr" bench scene --unique --unit -1 --out "$tmp/b"
 # issue 17 (lane bench): bench scene --unique at one part, twice into one
 # folder: the new columns at the end, each image against "none" (0 for
 # itself), the first build's rate of LOD and meshlets, the Goal lines in the log and the CSV, the LOD cache removed

@@ -62,9 +62,14 @@ demo_or_exit() {
 # status, and leave no output (nor a temporary file next to it).
 expect_fail() {
   local name=$1 out=$2
+  # A call without its OUTFILE ran the command's arguments as a command
+  # and passed on "command not found": the form is checked, and a command
+  # that did not run (126, 127) is a failure.
+  if [ "${3-}" != "--" ]; then bad "$name: expect_fail NAME OUTFILE -- command... (use \"\" for no file)"; return; fi
   shift 3
   "$@" >"$tmp/$name.out" 2>"$tmp/$name.err"
   local rc=$?
+  if [ $rc -eq 126 ] || [ $rc -eq 127 ]; then bad "$name: the command did not run: $(cat "$tmp/$name.err")"; return; fi
   local lines
   lines=$(wc -l <"$tmp/$name.err")
   if [ $rc -eq 0 ]; then bad "$name: exit 0"; return; fi

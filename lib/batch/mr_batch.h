@@ -48,6 +48,7 @@ typedef struct mr_batch_replay_params {
     bool progress;              /* "replay: frame N" on a terminal */
     mr_batch_replay_render_fn render; /* NULL: the overlay PNG (and the AVI) */
     void *render_user;
+    const mr_lod *lod;          /* the scene's levels of detail (built for it), or NULL: full detail */
 } mr_batch_replay_params;
 #define MR_BATCH_REPLAY_DEFAULT_ALPHA 0.5f
 #define MR_BATCH_REPLAY_DEFAULTS                                                                   \
@@ -58,6 +59,8 @@ extern const mr_opt mr_batch_replay_opts[];
 typedef struct mr_batch_replay_stats {
     int overlays;               /* frames rendered with the model */
     int plain;                  /* frames written without a pose (camera frame only) */
+    uint64_t triangles;         /* submitted, summed over the overlays (the last view of a rig's) */
+    uint64_t lod_instances;     /* instances drawn at a simplified level, summed likewise */
 } mr_batch_replay_stats;
 
 /* The checks that need neither the recording nor a GPU: a folder is given,

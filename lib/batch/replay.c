@@ -58,7 +58,7 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
     if (!p->recording) return mr_fail(err, MR_ERR_INVALID, "replay needs a recording");
     const int every = p->every > 0 ? p->every : 1;
     const mr_recording *rec = p->recording;
-    bool ok = mr_mkdirs(p->out_dir, err) && mr_renderer_set_scene(r, scene, err);
+    bool ok = mr_mkdirs(p->out_dir, err) && mr_renderer_set_scene_lod(r, scene, p->lod, err);
     mr_jsonl log = {0};
     mr_video_writer *vw = NULL;
     const double fps = recording_fps(rec, every);
@@ -119,6 +119,10 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
                 mr_renderer_pick(r, rw * 0.5 - 0.5, rh * 0.5 - 0.5, &cp, &(mr_error){0}) &&
                 cp.hit && mr_pose_point_sigma(&sp, cp.world, &centre_sigma, NULL))
                 have_centre_sigma = true;
+            mr_draw_stats ds;
+            mr_renderer_draw_stats(r, &ds);
+            st.triangles += ds.triangles;
+            st.lod_instances += ds.lod_instances;
             st.overlays++;
         } else {
             /* No pose: the camera frame alone keeps the sequence complete. */
