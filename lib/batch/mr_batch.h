@@ -59,7 +59,7 @@ extern const mr_opt mr_batch_replay_opts[];
 typedef struct mr_batch_replay_stats {
     int overlays;               /* frames rendered with the model */
     int plain;                  /* frames written without a pose (camera frame only) */
-    uint64_t triangles;         /* submitted, summed over the overlays (the last view of a rig's) */
+    uint64_t triangles;         /* submitted, summed over the overlays (a rig's: its last draw per frame) */
     uint64_t lod_instances;     /* instances drawn at a simplified level, summed likewise */
 } mr_batch_replay_stats;
 

@@ -50,6 +50,14 @@ static bool video_add(const mr_batch_replay_params *p, mr_video_writer **vw, con
     return *vw && mr_video_writer_add(*vw, img, err);
 }
 
+/* What the frame just drawn submitted (a rig: the draws of its last call). */
+static void replay_count_draws(const mr_renderer *r, mr_batch_replay_stats *st) {
+    mr_draw_stats ds;
+    mr_renderer_draw_stats(r, &ds);
+    st->triangles += ds.triangles;
+    st->lod_instances += ds.lod_instances;
+}
+
 bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_scene *scene,
                      mr_batch_replay_stats *stats, mr_error *err) {
     mr_batch_replay_stats st = {0};
@@ -90,6 +98,7 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
                 fp.ao.temporal_reset = ao_restart;
                 ao_restart = false;
                 ok = p->render(p->render_user, r, &view, &fp, f->index, name, sizeof name, err);
+                replay_count_draws(r, &st);
                 st.overlays++;
             } else {
                 ao_restart = true;
@@ -119,10 +128,7 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
                 mr_renderer_pick(r, rw * 0.5 - 0.5, rh * 0.5 - 0.5, &cp, &(mr_error){0}) &&
                 cp.hit && mr_pose_point_sigma(&sp, cp.world, &centre_sigma, NULL))
                 have_centre_sigma = true;
-            mr_draw_stats ds;
-            mr_renderer_draw_stats(r, &ds);
-            st.triangles += ds.triangles;
-            st.lod_instances += ds.lod_instances;
+            replay_count_draws(r, &st);
             st.overlays++;
         } else {
             /* No pose: the camera frame alone keeps the sequence complete. */
