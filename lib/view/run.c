@@ -100,6 +100,8 @@ typedef struct view_app {
      * full detail is drawn; the renderer holds lod until it is destroyed. */
     mr_lod_builder *lod_builder;
     mr_lod *lod;
+    bool upload_pending; /* the scene waits for its levels from the cache: one upload of both */
+    double pending_since;
     /* frames */
     mr_capture *cap;
     mr_capture_frame frame;
@@ -477,8 +479,23 @@ static void print_stats(view_app *a, FILE *out) {
     fprintf(out, "  whole loop                 %8.2f ms per drawn frame\n", a->sum_loop_ms / nf);
 }
 
+/* Uploads the scene with lod (NULL: full detail); a failure is shown as
+ * the scene's message and drops the scene (after any build reading it). */
+static bool upload_scene(view_app *a, const mr_lod *lod) {
+    mr_error err = {0};
+    if (mr_renderer_set_scene_lod(a->rend, a->scene, lod, &err)) return true;
+    snprintf(a->scene_msg, sizeof a->scene_msg, "scene failed to upload: %.500s", err.msg);
+    mr_log(MR_LOG_ERROR, "view: %s", a->scene_msg);
+    mr_lod_builder_cancel(&a->lod_builder);
+    mr_renderer_set_scene(a->rend, NULL, &err);
+    mr_lod_destroy(&a->lod);
+    mr_scene_destroy(&a->scene);
+    return false;
+}
+
 /* Called once per loop iteration: shows the loader's progress and, when the
- * scene is ready, uploads it (on this thread, which owns the GL context). */
+ * scene is ready, uploads it (on this thread, which owns the GL context)
+ * and starts on its levels of detail if it is big. */
 static void poll_scene_load(view_app *a) {
     if (!a->loader) return;
     const char *stage = NULL;
@@ -490,32 +507,58 @@ static void poll_scene_load(view_app *a) {
     mr_error err = {0};
     a->scene = mr_scene_loader_finish(&a->loader, &err);
     a->scene_msg[0] = 0;
+    a->need_render = true;
     if (!a->scene) {
         snprintf(a->scene_msg, sizeof a->scene_msg, "scene failed to load: %.500s", err.msg);
         mr_log(MR_LOG_ERROR, "view: %s", a->scene_msg);
-    } else if (!mr_renderer_set_scene(a->rend, a->scene, &err)) {
-        snprintf(a->scene_msg, sizeof a->scene_msg, "scene failed to upload: %.500s", err.msg);
-        mr_log(MR_LOG_ERROR, "view: %s", a->scene_msg);
-        mr_scene_destroy(&a->scene);
-    } else if (mr_scene_triangle_count(a->scene) >= MR_LOD_AUTO_TRIANGLES) {
-        char cache[4096];
-        mr_lod_cache_path(a->scene->source, cache, sizeof cache);
+        return;
+    }
+    char cache[4096];
+    mr_lod_cache_path(a->scene->source, cache, sizeof cache);
+    const bool has_file = a->scene->source[0] != 0;
+    if (mr_scene_triangle_count(a->scene) >= MR_LOD_AUTO_TRIANGLES) {
         mr_lod_params lp = MR_LOD_DEFAULTS;
-        a->lod_builder = mr_lod_build_async(a->scene, a->scene->source[0] ? cache : NULL, &lp, &err);
+        a->lod_builder = mr_lod_build_async(a->scene, has_file ? cache : NULL, &lp, &err);
         if (!a->lod_builder) mr_log(MR_LOG_WARN, "view: no levels of detail: %s", err.msg);
     }
-    a->need_render = true;
+    /* With a cache file the levels come in a fraction of the scene's load
+     * (0.3 s for 20M triangles, measured in bench scene): the scene waits
+     * for them and is uploaded once, not in full detail first and again
+     * with the levels (2.3 s each at 20M). A cache that turns out stale
+     * is rebuilt: after a second the full detail is uploaded meanwhile. */
+    FILE *f = a->lod_builder && has_file ? fopen(cache, "rb") : NULL;
+    if (f) {
+        fclose(f);
+        a->upload_pending = true;
+        a->pending_since = mr_time_now();
+        snprintf(a->scene_msg, sizeof a->scene_msg, "loading levels of detail ...");
+    } else {
+        upload_scene(a, NULL);
+    }
 }
 
 /* Called once per loop iteration: the levels, once read or built, go to
  * the renderer (an upload of the levels, on this, the GL thread); until
  * then, and where they fail, the full detail is drawn. */
 static void poll_lod(view_app *a) {
+    if (a->upload_pending && mr_time_now() - a->pending_since > 1.0) {
+        a->upload_pending = false; /* a rebuild: the full detail until it is done */
+        a->scene_msg[0] = 0;
+        a->need_render = true;
+        if (!upload_scene(a, NULL)) return;
+    }
     if (!a->lod_builder || !mr_lod_builder_poll(a->lod_builder, NULL)) return;
     mr_error err = {0};
     mr_lod_info info;
     a->lod = mr_lod_builder_finish(&a->lod_builder, &info, &err);
-    if (a->lod && !mr_renderer_set_lod(a->rend, a->lod, &err)) mr_lod_destroy(&a->lod);
+    a->need_render = true;
+    if (a->upload_pending) {
+        a->upload_pending = false;
+        a->scene_msg[0] = 0;
+        if (!upload_scene(a, a->lod)) return;
+    } else if (a->lod && !mr_renderer_set_lod(a->rend, a->lod, &err)) {
+        mr_lod_destroy(&a->lod);
+    }
     if (!a->lod) {
         mr_log(MR_LOG_WARN, "view: no levels of detail: %s", err.msg);
         return;
@@ -528,7 +571,6 @@ static void poll_lod(view_app *a) {
         mr_viewer_toast(a->vc, "levels of detail ready: %llu levels built in %.1f s", (unsigned long long)info.levels,
                         info.build_s);
     }
-    a->need_render = true;
 }
 
 /* A scene that fails to load is shown as a message; the window still
