@@ -22,7 +22,7 @@
  * render setup, DESIGN.md's view -> session). run.c (the window loop,
  * moved out of app/cmd_view.c) adds lib/render's window, renderer and 2D
  * layer (opaque handles: no GL type), lib/session's capture, snapshots and
- * marks, lib/track's camera and marker-map files, lib/scene's loader; not
+ * marks, lib/track's camera and marker-map files, lib/scene's loader and LOD builder; not
  * lib/eval (Measure's search is the caller's, mr_view_nearest_fns). */
 #ifndef MR_VIEW_CTL_H
 #define MR_VIEW_CTL_H
