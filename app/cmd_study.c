@@ -1,18 +1,12 @@
 /* mrcheck study {stimuli,plan,run,analyze}: pairwise comparison studies
- * (Hecher's design and analysis). Wiring only: lib/study does the work;
- * `run` opens the window and carries out what the runner says. */
+ * (Hecher's design and analysis). Wiring only: lib/study does the work,
+ * `run`'s window included (mr_study_window_run). */
 #include "app.h"
 
 #include "mr_study.h"
-#include "mr_ui.h"
-#include "mr_view.h"
 
-#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-
-_Static_assert(sizeof(mr_ui_vertex) == sizeof(mr_draw2d_vertex), "vertex layouts differ");
 
 static int study_stimuli(int argc, char **argv) {
     static const char *cmd = "study stimuli";
@@ -126,64 +120,6 @@ static int study_analyze(int argc, char **argv) {
 
 /* ------------------------------------------------------------------ run */
 
-typedef struct run_app {
-    mr_study_plan plan;
-    mr_image *images;          /* method x stimulus, loaded before the window opens */
-    mr_window *win;
-    mr_draw2d *d2;
-    mr_draw2d_image **tex;     /* the same, uploaded */
-    mr_study_runner *runner;
-    const char *votes_path;
-    int stored;
-} run_app;
-
-static void run_frame(run_app *a, bool *quit) {
-    mr_event e;
-    while (mr_window_next_event(a->win, &e)) {
-        if (e.type == MR_EVENT_CLOSE) *quit = true;
-        mr_study_runner_push_event(a->runner, &e);
-    }
-    int fw, fh;
-    mr_window_framebuffer_size(a->win, &fw, &fh);
-    if (fw <= 0 || fh <= 0) return;
-    mr_study_frame f;
-    mr_study_vote v;
-    const mr_ui_draw_list *dl = mr_study_runner_frame(a->runner, mr_time_now(), (float)fw, (float)fh, &f, &v);
-    if (f.vote) {
-        mr_error err = {0};
-        if (mr_study_vote_append(a->votes_path, &v, &err)) a->stored++;
-        else {
-            mr_log(MR_LOG_ERROR, "study run: vote NOT saved: %s", err.msg);
-            mr_study_runner_vote_failed(a->runner, err.msg);
-        }
-    }
-    static const float bg[3] = {0.5f, 0.5f, 0.5f};
-    mr_draw2d_begin(a->d2, fw, fh, bg);
-    mr_error err = {0};
-    int S = a->plan.set.stimulus_count;
-    const mr_study_trial *tr = f.trial >= 0 ? &a->plan.trials[f.trial] : NULL;
-    for (int i = 0; tr && i < f.image_count; i++) {
-        mr_ui_rect r = f.image_rect[i];
-        if (!mr_draw2d_image_draw(a->d2, a->tex[f.image_method[i] * S + tr->stimulus], r.x, r.y, r.w, r.h, &err))
-            mr_log(MR_LOG_ERROR, "study run: %s", err.msg);
-    }
-    mr_view_draw_ui(a->d2, dl, "study run");
-    if (f.shot_path[0] || f.state_path[0]) {
-        mr_image screen = {0};
-        if (f.shot_path[0] && mr_draw2d_read(a->d2, &screen, &err) && !mr_image_save_png(f.shot_path, &screen, &err))
-            mr_log(MR_LOG_ERROR, "study run: %s", err.msg);
-        mr_image_free(&screen);
-        if (f.state_path[0]) {
-            cJSON *j = mr_study_runner_state_json(a->runner);
-            cJSON_AddNumberToObject(j, "stored", a->stored);
-            if (!mr_json_save(f.state_path, j, &err)) mr_log(MR_LOG_ERROR, "study run: %s", err.msg);
-            cJSON_Delete(j);
-        }
-    }
-    mr_window_swap(a->win);
-    if (f.quit) *quit = true;
-}
-
 static int study_run(int argc, char **argv) {
     static const char *cmd = "study run";
     mr_cli_opt opts[] = {
@@ -210,98 +146,19 @@ static int study_run(int argc, char **argv) {
     if (npos != 1) return mr_cli_errorf(cmd, "give the plan file"), 2;
     if (!who || !who[0] || strlen(who) >= MR_STUDY_NAME_MAX) return mr_cli_errorf(cmd, "--participant ID is required (< 64 characters)"), 2;
     if (!out) return mr_cli_errorf(cmd, "--out votes.jsonl is required"), 2;
-    int ww = 1280, wh = 800;
-    double ui_scale = 1.0;
-    if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &ww, &wh)) return 2;
-    if (mr_cli_get(opts, "ui-scale") && !mr_cli_double("ui-scale", mr_cli_get(opts, "ui-scale"), 0.25, 8, &ui_scale)) return 2;
-    run_app *a = calloc(1, sizeof *a);
-    if (!a) return mr_cli_errorf(cmd, "out of memory");
-    a->votes_path = out;
-    mr_error err = {0};
-    mr_study_resume_point at = {0};
-    mr_study_script *script = NULL;
-    int rc = 0, first = 0;
-    if (!mr_study_plan_load(pos[0], &a->plan, &err) || !mr_study_resume_open(&a->plan, out, who, &at, &err)) {
-        rc = mr_cli_error(cmd, &err);
-        goto done;
-    }
-    first = at.first;
-    if (first >= a->plan.trial_count) {
-        printf("study run: participant %s has answered all %d trials of plan %s\n", who, a->plan.trial_count, a->plan.id);
-        goto done;
-    }
-    if (mr_cli_get(opts, "script") && !(script = mr_study_script_load(mr_cli_get(opts, "script"), &err))) {
-        rc = mr_cli_error(cmd, &err);
-        goto done;
-    }
-    if (!mr_study_images_load(&a->plan, &a->images, &err)) {
-        rc = mr_cli_error(cmd, &err);
-        goto done;
-    }
-    /* A torn last line (a kill mid-write) is ended, so our first vote
-     * starts a line of its own; nothing written is changed. */
-    if (at.torn_tail && !mr_study_votes_seal(out, &err)) {
-        rc = mr_cli_error(cmd, &err);
-        goto done;
-    }
-    int done_before = at.answered_count;
-    printf("study run: participant %s, plan %s: %s at trial %d of %d (%d answered)\n", who, a->plan.id,
-           done_before ? "resuming" : "starting", first + 1, a->plan.trial_count, done_before);
-    fflush(stdout);
-    mr_window_params wp = MR_WINDOW_DEFAULTS;
-    wp.width = ww;
-    wp.height = wh;
+    mr_study_window_params wp = MR_STUDY_WINDOW_DEFAULTS;
+    wp.plan_path = pos[0];
+    wp.participant = who;
+    wp.votes_path = out;
+    wp.slider = mr_cli_flag(opts, "slider");
     wp.fullscreen = mr_cli_flag(opts, "fullscreen");
-    wp.title = "mrcheck study";
-    if (!(a->win = mr_window_create(&wp, &err)) || !(a->d2 = mr_draw2d_create(mr_window_gpu(a->win), &err))) {
-        rc = mr_cli_error(cmd, &err);
-        goto done;
-    }
-    int n = a->plan.set.method_count * a->plan.set.stimulus_count;
-    a->tex = calloc((size_t)n, sizeof *a->tex);
-    for (int i = 0; a->tex && i < n; i++)
-        if (!(a->tex[i] = mr_draw2d_image_create(a->d2, &a->images[i], &err))) {
-            rc = mr_cli_error(cmd, &err);
-            goto done;
-        }
-    mr_study_run_params rp = MR_STUDY_RUN_DEFAULTS;
-    rp.plan = &a->plan;
-    rp.participant = who;
-    rp.first_trial = first;
-    rp.answered = at.answered;
-    rp.slider = mr_cli_flag(opts, "slider");
-    rp.px_per_mm = mr_window_px_per_mm(a->win) * ui_scale;
-    rp.image_w = a->images[0].width;
-    rp.image_h = a->images[0].height;
-    rp.now = mr_time_now();
-    if (!(a->runner = mr_study_runner_create(&rp, &err))) {
-        rc = mr_cli_error(cmd, &err);
-        goto done;
-    }
-    if (script) mr_study_runner_set_script(a->runner, &script);
-    for (bool quit = false; !quit;) {
-        run_frame(a, &quit);
-        bool busy = mr_study_runner_wants_input(a->runner);
-        mr_window_wait(a->win, busy ? 0.0 : 0.05);
-        if (busy) {
-            struct timespec ts = {0, 4000000};
-            nanosleep(&ts, NULL);
-        }
-    }
-    printf("study run: %d votes stored in %s\n", a->stored, out);
-done:
-    mr_study_runner_destroy(&a->runner);
-    mr_study_script_destroy(&script);
-    if (a->tex)
-        for (int i = 0; i < a->plan.set.method_count * a->plan.set.stimulus_count; i++) mr_draw2d_image_destroy(&a->tex[i]);
-    free(a->tex);
-    mr_draw2d_destroy(&a->d2);
-    mr_window_destroy(&a->win);
-    mr_study_images_free(&a->plan, &a->images);
-    mr_study_resume_point_free(&at);
-    mr_study_plan_free(&a->plan);
-    free(a);
-    return rc;
+    wp.ui_scale = 1.0;
+    wp.script_path = mr_cli_get(opts, "script");
+    wp.out = stdout;
+    if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &wp.width, &wp.height)) return 2;
+    if (mr_cli_get(opts, "ui-scale") && !mr_cli_double("ui-scale", mr_cli_get(opts, "ui-scale"), 0.25, 8, &wp.ui_scale)) return 2;
+    mr_error err = {0};
+    return mr_study_window_run(&wp, &err) ? 0 : mr_cli_error(cmd, &err);
 }
 
 int cmd_study(int argc, char **argv) {

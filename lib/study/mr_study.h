@@ -343,6 +343,28 @@ typedef struct mr_study_script mr_study_script;
 mr_study_script *mr_study_script_load(const char *path, mr_error *err);
 void mr_study_script_destroy(mr_study_script **s);
 
+/* One participant's session in a window (window.c, `mrcheck study run`):
+ * the plan and its stimuli, the vote log resumed (a torn last line ended),
+ * the window, then the runner until it or the window quits; every vote is
+ * appended and fsync'd as it is cast. */
+typedef struct mr_study_window_params {
+    const char *plan_path;        /* plan.json (required) */
+    const char *participant;      /* anonymous id (required, < MR_STUDY_NAME_MAX) */
+    const char *votes_path;       /* the vote log, appended (required) */
+    bool slider;                  /* answer with a slider; default false */
+    bool fullscreen;              /* default false */
+    int width, height;            /* window size, px; 0 = 1280 x 800 */
+    double ui_scale;              /* the UI beyond the screen's density; 0 = 1 */
+    const char *script_path;      /* timed input (tests), or NULL */
+    FILE *out;                    /* the "starting / resuming / stored" lines; NULL: none */
+} mr_study_window_params;
+#define MR_STUDY_WINDOW_DEFAULT_WIDTH 1280
+#define MR_STUDY_WINDOW_DEFAULT_HEIGHT 800
+#define MR_STUDY_WINDOW_DEFAULTS {NULL, NULL, NULL, false, false, 0, 0, 0.0, NULL, NULL}
+/* true also when every trial was answered before (said on out); false +
+ * err when the plan, the log, the stimuli, the script or the window fail. */
+bool mr_study_window_run(const mr_study_window_params *p, mr_error *err);
+
 mr_study_runner *mr_study_runner_create(const mr_study_run_params *p, mr_error *err);
 void mr_study_runner_destroy(mr_study_runner **r);
 /* The runner owns the script from then on (*s = NULL). */
