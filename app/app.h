@@ -72,9 +72,10 @@ mr_lod *app_load_lod(const mr_scene *s, const char *scene_path, bool use_cache, 
  * decided by app_lod_auto once the scene is loaded); prints one line and
  * returns false on a bad value. */
 bool app_draw_lod(const char *cmd, const mr_cli_opt *opts, mr_draw_params *dp);
-/* --lod auto (the default): levels only for scenes that draw at least
- * MR_LOD_AUTO_TRIANGLES (lib/scene), where simplifying pays for its one-off cost. */
-bool app_lod_auto(const mr_cli_opt *opts);
+/* --lod auto (the default), once the scene is loaded: no levels (dp->no_lod)
+ * for scenes that draw under MR_LOD_AUTO_TRIANGLES (lib/scene), where
+ * simplifying does not pay for its one-off cost. */
+void app_lod_auto(const mr_cli_opt *opts, const mr_scene *s, mr_draw_params *dp);
 /* The draw table (no prefix) and --lod auto|on|off, which decides whether
  * levels are built or read at all. */
 #define APP_DRAW_TABLE(p) {.prefix = "", .table = mr_draw_opts, .params = (p)}

@@ -113,7 +113,7 @@ int cmd_render(int argc, char **argv) {
         return 2;
     }
     mr_lod *lod = NULL;
-    if (app_lod_auto(opts) && mr_scene_triangle_count(scene) < MR_LOD_AUTO_TRIANGLES) dp.no_lod = true;
+    app_lod_auto(opts, scene, &dp);
     if (!dp.no_lod && !(lod = app_load_lod(scene, scene->source, !lod_cache || strcmp(lod_cache, "on") == 0, &err))) {
         mr_scene_destroy(&scene);
         mr_image_free(&video);

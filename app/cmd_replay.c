@@ -106,7 +106,7 @@ int cmd_replay(int argc, char **argv) {
      * from the cache next to the scene; where they cannot be had, the
      * frames are drawn in full detail. */
     mr_lod *lod = NULL;
-    if (scene && app_lod_auto(opts) && mr_scene_triangle_count(scene) < MR_LOD_AUTO_TRIANGLES) dp.no_lod = true;
+    if (scene) app_lod_auto(opts, scene, &dp);
     if (scene && !dp.no_lod) {
         mr_error lerr = {0};
         lod = app_load_lod(scene, scene->source, scene->source[0] != 0, &lerr);

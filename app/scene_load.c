@@ -74,9 +74,9 @@ mr_lod *app_load_lod(const mr_scene *s, const char *scene_path, bool use_cache, 
     return lod;
 }
 
-bool app_lod_auto(const mr_cli_opt *opts) {
+void app_lod_auto(const mr_cli_opt *opts, const mr_scene *s, mr_draw_params *dp) {
     const char *v = mr_cli_get(opts, "lod");
-    return !v || strcmp(v, "auto") == 0;
+    if ((!v || strcmp(v, "auto") == 0) && mr_scene_triangle_count(s) < MR_LOD_AUTO_TRIANGLES) dp->no_lod = true;
 }
 
 bool app_draw_lod(const char *cmd, const mr_cli_opt *opts, mr_draw_params *dp) {
