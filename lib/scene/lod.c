@@ -555,6 +555,12 @@ static double grid_nearest(const tri_grid *og, dv p, double limit, uint32_t *tri
                         if (g->tpl) {
                             const double *pl = g->tpl + 4 * (size_t)t;
                             if (fabs(pl[0] * p.x + pl[1] * p.y + pl[2] * p.z - pl[3]) - htol > best) continue;
+                            /* ... and the ball around it (tsph): a triangle of
+                             * the same curved sheet passes the plane test
+                             * but lies off to the side. */
+                            const double *sp = g->tsph + 5 * (size_t)t;
+                            double cx = p.x - sp[0], cy = p.y - sp[1], cz = p.z - sp[2], reach = sp[3] + best + htol;
+                            if (cx * cx + cy * cy + cz * cz > reach * reach) continue;
                         }
                         double d2 = dist2_point_tri(p, vtx(g->pos, g->idx[3 * t]), vtx(g->pos, g->idx[3 * t + 1]),
                                                     vtx(g->pos, g->idx[3 * t + 2]));
@@ -1099,19 +1105,22 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
         for (int k = 0; k < 3 && ub > enough; k++) {
             uint32_t t = cand[k];
             if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
+            /* Corners known to be near t first; past enough the rest are
+             * left unknown (-1, computed by the flat pairs if asked): this
+             * bound has failed. */
             double m = 0;
-            for (int j = 0; j < 3; j++) {
-                cdd[k][j] = cand[j] == t ? dk[j] : dist_to_tri(o, q[j], t);
-                m = dmax(m, cdd[k][j]);
-            }
-            if (m < ub) ub = m;
+            for (int j = 0; j < 3; j++) cdd[k][j] = cand[j] == t ? dk[j] : -1;
+            for (int j = 0; j < 3 && m <= enough; j++) m = dmax(m, cdd[k][j]);
+            for (int j = 0; j < 3 && m <= enough; j++)
+                if (cdd[k][j] < 0) m = dmax(m, cdd[k][j] = dist_to_tri(o, q[j], t));
+            if (m <= enough && m < ub) ub = m;
         }
         /* The convex union with a coplanar neighbour. */
         for (int k = 0; k < 3 && ub > enough && o->partner; k++) {
             uint32_t t = cand[k];
             if (t == UINT32_MAX || (k > 0 && t == cand[0]) || (k > 1 && t == cand[1])) continue;
             if (plane_gap(o, t, a, b, c) > enough) continue;
-            memcpy(dd, cdd[k], sizeof dd);
+            double *kd = cdd[k];
             for (int j = 0; j < 3 && ub > enough; j++) {
                 size_t h = 3 * (size_t)t + (size_t)j;
                 if (!partner_get(o, h)) continue;
@@ -1119,14 +1128,22 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
                  * distance is largest at a corner; + what the fold moved,
                  * + 2 ptol: "coplanar" allows float rounding, so the flat
                  * union is convex only up to that distance. */
-                dv e0 = vtx(o->pos, o->idx[3 * t + (size_t)j]), e1 = vtx(o->pos, o->idx[3 * t + (size_t)(j + 1) % 3]);
-                dv f = {o->hinge_p[3 * h], o->hinge_p[3 * h + 1], o->hinge_p[3 * h + 2]};
                 double slack = o->hinge_s[h] + 2 * o->ptol;
                 if (slack >= ub) continue;
-                double mq = dmax(dmin(dd[0], sqrt(dist2_point_tri(a, e1, e0, f))),
-                                 dmax(dmin(dd[1], sqrt(dist2_point_tri(b, e1, e0, f))),
-                                      dmin(dd[2], sqrt(dist2_point_tri(c, e1, e0, f))))) + slack;
-                if (mq < ub) ub = mq;
+                dv e0 = vtx(o->pos, o->idx[3 * t + (size_t)j]), e1 = vtx(o->pos, o->idx[3 * t + (size_t)(j + 1) % 3]);
+                dv f = {o->hinge_p[3 * h], o->hinge_p[3 * h + 1], o->hinge_p[3 * h + 2]};
+                /* A corner already within enough of t needs no distance to
+                 * the pair; the first corner past it ends this pair (its
+                 * partial maximum is no bound). */
+                double mq = 0;
+                for (int i = 0; i < 3 && mq + slack <= enough; i++) {
+                    if (kd[i] < 0) kd[i] = dist_to_tri(o, q[i], t);
+                    double v = kd[i];
+                    if (v + slack > enough) v = dmin(v, sqrt(dist2_point_tri(q[i], e1, e0, f)));
+                    mq = dmax(mq, v);
+                }
+                mq += slack;
+                if (mq <= enough && mq < ub) ub = mq;
             }
         }
         /* A projected patch of the other surface (see patch_bound). */
