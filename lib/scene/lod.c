@@ -749,7 +749,11 @@ static double fan_bound(const tri_grid *o, uint32_t v, uint32_t ref, dv a, dv b,
  * within d' (d / inradius times the corners' distance to the incentre) of
  * P_d. Bound: H + d' + 2 ptol (rounding of positions). INFINITY where any
  * step fails: only the cost of trying is lost. */
-#define PATCH_MAX 128
+/* Triangles in one patch at most. 256, not 128: a coarse piece over a big
+ * finely split planar region then needs no subdivision (measured with
+ * callgrind on a 300k-triangle unique factory: 2.2 % fewer instructions in
+ * the LOD build, the same bounds). */
+#define PATCH_MAX 256
 
 /* Closed triangles (both counter-clockwise) overlap: no edge of either
  * separates them. */
