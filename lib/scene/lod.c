@@ -722,6 +722,7 @@ static double fan_bound(const tri_grid *o, uint32_t v, uint32_t ref, dv a, dv b,
         for (uint32_t k = 0; k < 16; k++)
             if (o->fan_mask[v] & (1u << k)) best = dmin(best, dist_to_tri(o, q[j], o->vt_items[k0 + k]));
         m = dmax(m, best);
+        if (m + slack > enough) return INFINITY; /* fails: the other corners need not be measured */
     }
     return m + slack;
 }
@@ -769,57 +770,79 @@ static bool tri2_overlap(const double x[3][2], const double y[3][2]) {
 
 /* The largest |height| over the part of triangle x (counter-clockwise,
  * signed heights h at its corners, affine in between) that projects into
- * the triangle p: the corners of x clipped by p's three half-planes
- * (Sutherland-Hodgman). If rounding leaves nothing (they only touch), the
- * corners' largest. */
+ * the triangle p (counter-clockwise). Affine over a convex polygon, the
+ * height is largest at a corner of x inside p, a corner of p inside x, or
+ * where an edge of x crosses an edge of p: the side tests (signed areas)
+ * of x's corners against p's edges and of p's corners against x's edges
+ * decide all three, with no polygon clipped. Each test admits what lies
+ * within a margin of the line (1e-12 of the largest coordinate, far above
+ * the rounding of a side test), so rounding only ever adds a candidate:
+ * the result is never below the true largest height. If nothing is found
+ * (they only touch), the corners' largest. */
 static double clipped_height(const double x[3][2], const double h[3], const double p[3][2]) {
+    double S[3][3]; /* S[i][e]: x's corner i against p's edge e */
+    bool xin = true;
+    for (int i = 0; i < 3; i++)
+        for (int e = 0; e < 3; e++) {
+            S[i][e] = cross2(p[e], p[(e + 1) % 3], x[i]);
+            xin = xin && S[i][e] >= 0;
+        }
+    double hc = dmax(fabs(h[0]), dmax(fabs(h[1]), fabs(h[2])));
     /* Common cases first: x inside p (a fine triangle under a coarse
      * piece), then p inside x (a small piece over a big triangle: the
      * heights at p's corners, barycentric). */
-    bool xin = true;
-    for (int e = 0; e < 3 && xin; e++)
-        for (int i = 0; i < 3; i++)
-            if (cross2(p[e], p[(e + 1) % 3], x[i]) < 0) {
-                xin = false;
-                break;
-            }
-    if (xin) return dmax(fabs(h[0]), dmax(fabs(h[1]), fabs(h[2])));
+    if (xin) return hc;
     double ax = cross2(x[0], x[1], x[2]);
+    double W[3][3]; /* W[j][i]: p's corner j against x's edge i */
     bool pin = ax > 0;
     double hm = 0;
-    for (int i = 0; i < 3 && pin; i++) {
-        double w0 = cross2(x[1], x[2], p[i]), w1 = cross2(x[2], x[0], p[i]), w2 = cross2(x[0], x[1], p[i]);
-        if (w0 < 0 || w1 < 0 || w2 < 0) pin = false;
-        else hm = dmax(hm, fabs((w0 * h[0] + w1 * h[1] + w2 * h[2]) / ax));
-    }
-    if (pin) return hm;
-    double poly[2][9][3]; /* (x, y, height) */
-    int n = 3, cur = 0;
-    for (int i = 0; i < 3; i++) {
-        poly[0][i][0] = x[i][0];
-        poly[0][i][1] = x[i][1];
-        poly[0][i][2] = h[i];
-    }
-    for (int e = 0; e < 3 && n > 0; e++) {
-        const double *p0 = p[e], *p1 = p[(e + 1) % 3];
-        int m = 0, nx = 1 - cur;
-        for (int i = 0; i < n; i++) {
-            const double *A = poly[cur][i], *B = poly[cur][(i + 1) % n];
-            double sa = cross2(p0, p1, A), sb = cross2(p0, p1, B);
-            if (sa >= 0) memcpy(poly[nx][m++], A, sizeof poly[0][0]);
-            if ((sa >= 0) != (sb >= 0)) {
-                double t = sa / (sa - sb);
-                for (int k = 0; k < 3; k++) poly[nx][m][k] = A[k] + t * (B[k] - A[k]);
-                m++;
-            }
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++) {
+            W[j][i] = cross2(x[i], x[(i + 1) % 3], p[j]);
+            pin = pin && W[j][i] >= 0;
         }
-        n = m;
-        cur = nx;
+    if (pin) {
+        for (int j = 0; j < 3; j++) hm = dmax(hm, fabs((W[j][1] * h[0] + W[j][2] * h[1] + W[j][0] * h[2]) / ax));
+        return hm;
     }
-    hm = 0;
-    if (n == 0) return dmax(fabs(h[0]), dmax(fabs(h[1]), fabs(h[2])));
-    for (int i = 0; i < n; i++) hm = dmax(hm, fabs(poly[cur][i][2]));
-    return hm;
+    double d = 0;
+    for (int k = 0; k < 3; k++)
+        d = dmax(d, dmax(dmax(fabs(x[k][0]), fabs(x[k][1])), dmax(fabs(p[k][0]), fabs(p[k][1]))));
+    d *= 1e-12;
+    double ts[3], tw[3]; /* the margins as side-test values: d times the edges' L1 lengths */
+    for (int k = 0; k < 3; k++) {
+        ts[k] = d * (fabs(p[(k + 1) % 3][0] - p[k][0]) + fabs(p[(k + 1) % 3][1] - p[k][1]));
+        tw[k] = d * (fabs(x[(k + 1) % 3][0] - x[k][0]) + fabs(x[(k + 1) % 3][1] - x[k][1]));
+    }
+    bool found = false;
+    for (int i = 0; i < 3; i++)
+        if (S[i][0] >= -ts[0] && S[i][1] >= -ts[1] && S[i][2] >= -ts[2]) {
+            hm = dmax(hm, fabs(h[i]));
+            found = true;
+        }
+    for (int j = 0; j < 3 && ax > 0; j++)
+        if (W[j][0] >= -tw[0] && W[j][1] >= -tw[1] && W[j][2] >= -tw[2]) {
+            /* (weights clamped: admitted by the margin, the corner is taken
+             * at the nearest point of x, never extrapolated along a sliver) */
+            double w0 = dmax(W[j][1], 0), w1 = dmax(W[j][2], 0), w2 = dmax(W[j][0], 0), ws = w0 + w1 + w2;
+            hm = dmax(hm, ws > 0 ? fabs((w0 * h[0] + w1 * h[1] + w2 * h[2]) / ws) : hc);
+            found = true;
+        }
+    for (int i = 0; i < 3; i++) {
+        int i1 = (i + 1) % 3;
+        for (int e = 0; e < 3; e++) {
+            double sa = S[i][e], sb = S[i1][e];
+            if ((sa > ts[e] && sb > ts[e]) || (sa < -ts[e] && sb < -ts[e])) continue; /* edge i off p's edge e's line */
+            double wa = W[e][i], wb = W[(e + 1) % 3][i];
+            if ((wa > tw[i] && wb > tw[i]) || (wa < -tw[i] && wb < -tw[i])) continue; /* p's edge e off x's edge i's line */
+            double den = sa - sb, t = fabs(den) > ts[e] ? sa / den : 0.5;
+            if (!(fabs(den) > ts[e])) hm = dmax(hm, dmax(fabs(h[i]), fabs(h[i1]))); /* along the line: both ends */
+            t = t < 0 ? 0 : t > 1 ? 1 : t;
+            hm = dmax(hm, fabs(h[i] + t * (h[i1] - h[i])));
+            found = true;
+        }
+    }
+    return found ? hm : hc;
 }
 
 /* Segment s0 s1 meets the open counter-clockwise triangle t. */
@@ -1029,6 +1052,7 @@ static double ring_bound(const tri_grid *o, uint32_t v, dv a, dv b, dv c, double
         double best = INFINITY;
         for (uint32_t k = 0; k < nk; k++) best = dmin(best, dist2_point_tri(q[j], p[k][0], p[k][1], p[k][2]));
         m = dmax(m, sqrt(best));
+        if (m + slack > enough) return INFINITY; /* fails (as fan_bound) */
     }
     return m + slack;
 }
@@ -1043,13 +1067,13 @@ typedef struct bb_ctx {
     uint64_t work;
 } bb_ctx;
 
-/* Largest corner distance from (a, b, c) to triangle t: by convexity of the
- * distance to one triangle, its largest value over the whole piece. */
-static double corner_max(const tri_grid *o, dv a, dv b, dv c, uint32_t t, double d[3]) {
-    d[0] = dist_to_tri(o, a, t);
-    d[1] = dist_to_tri(o, b, t);
-    d[2] = dist_to_tri(o, c, t);
-    return dmax(d[0], dmax(d[1], d[2]));
+/* Largest corner distance from q to triangle t: by convexity of the
+ * distance to one triangle, its largest value over the whole piece; or
+ * INFINITY as soon as one corner is past enough (no bound then). */
+static double corner_max(const tri_grid *o, const dv q[3], uint32_t t, double enough) {
+    double m = 0;
+    for (int j = 0; j < 3 && m <= enough; j++) m = dmax(m, dist_to_tri(o, q[j], t));
+    return m <= enough ? m : INFINITY;
 }
 
 /* Largest distance of the piece's corners from the plane of triangle t: a
@@ -1083,7 +1107,7 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
         /* Enough: within what is asked (accept), or within resolution of
          * the largest distance known to be real (lower). */
         double enough = dmax(x->accept, x->lower * (1 + x->rel) + x->resolution);
-        double ub = INFINITY, dd[3], cdd[3][3];
+        double ub = INFINITY, cdd[3][3];
         const uint32_t cand[3] = {ta, tb, tc}, vid[3] = {va, vb, vc};
         const dv q[3] = {a, b, c};
         const tri_grid *o = x->other;
@@ -1184,7 +1208,7 @@ static void bound_tri(bb_ctx *x, dv a, dv b, dv c, double da, double db, double 
                 const double *sp = o->tsph + 5 * (size_t)o->vt_items[j];
                 if (ball_misses(q, (dv){sp[0], sp[1], sp[2]}, sp[3], enough)) continue;
                 if (plane_gap(o, o->vt_items[j], a, b, c) > enough) continue;
-                double m = corner_max(o, a, b, c, o->vt_items[j], dd);
+                double m = corner_max(o, q, o->vt_items[j], enough);
                 if (m < ub) ub = m;
             }
         }
