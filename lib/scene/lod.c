@@ -228,18 +228,29 @@ static bool grid_build(tri_grid *g, const float *pos, const uint32_t *idx, uint3
     g->start = calloc(cells + 1, sizeof *g->start);
     g->qmark = calloc((size_t)g->tri_count + 1, sizeof *g->qmark);
     if (!g->start || !g->qmark) return false;
-    /* Two passes: count, then fill (triangle AABB against cells). */
+    /* Two passes: count, then fill (triangle AABB against cells). The
+     * first keeps each triangle's range of cells (at most 128 per axis:
+     * bytes), so the second reads no positions. */
+    uint8_t *box = malloc((size_t)g->tri_count * 6 + 1);
+    if (!box) return false;
     for (int pass = 0; pass < 2; pass++) {
         for (uint32_t t = 0; t < g->tri_count; t++) {
-            dv a = vtx(pos, idx[3 * t]), b = vtx(pos, idx[3 * t + 1]), c = vtx(pos, idx[3 * t + 2]);
-            dv mn = {dmin(a.x, dmin(b.x, c.x)), dmin(a.y, dmin(b.y, c.y)), dmin(a.z, dmin(b.z, c.z))};
-            dv mx = {dmax(a.x, dmax(b.x, c.x)), dmax(a.y, dmax(b.y, c.y)), dmax(a.z, dmax(b.z, c.z))};
-            int c0[3], c1[3];
-            cell_of(g, mn, c0);
-            cell_of(g, mx, c1);
-            for (int z = c0[2]; z <= c1[2]; z++)
-                for (int y = c0[1]; y <= c1[1]; y++)
-                    for (int x = c0[0]; x <= c1[0]; x++) {
+            uint8_t *bx = box + 6 * (size_t)t;
+            if (pass == 0) {
+                dv a = vtx(pos, idx[3 * t]), b = vtx(pos, idx[3 * t + 1]), c = vtx(pos, idx[3 * t + 2]);
+                dv mn = {dmin(a.x, dmin(b.x, c.x)), dmin(a.y, dmin(b.y, c.y)), dmin(a.z, dmin(b.z, c.z))};
+                dv mx = {dmax(a.x, dmax(b.x, c.x)), dmax(a.y, dmax(b.y, c.y)), dmax(a.z, dmax(b.z, c.z))};
+                int c0[3], c1[3];
+                cell_of(g, mn, c0);
+                cell_of(g, mx, c1);
+                for (int k = 0; k < 3; k++) {
+                    bx[k] = (uint8_t)c0[k];
+                    bx[3 + k] = (uint8_t)c1[k];
+                }
+            }
+            for (int z = bx[2]; z <= bx[5]; z++)
+                for (int y = bx[1]; y <= bx[4]; y++)
+                    for (int x = bx[0]; x <= bx[3]; x++) {
                         size_t ci = ((size_t)z * g->n[1] + y) * g->n[0] + x;
                         if (pass == 0) g->start[ci + 1]++;
                         else g->items[g->start[ci]++] = t;
@@ -248,13 +259,17 @@ static bool grid_build(tri_grid *g, const float *pos, const uint32_t *idx, uint3
         if (pass == 0) {
             for (size_t i = 0; i < cells; i++) g->start[i + 1] += g->start[i];
             g->items = malloc(((size_t)g->start[cells] + 1) * sizeof *g->items);
-            if (!g->items) return false;
+            if (!g->items) {
+                free(box);
+                return false;
+            }
         } else {
             /* start[i] now holds the end of cell i: shift back. */
             for (size_t i = cells; i > 0; i--) g->start[i] = g->start[i - 1];
             g->start[0] = 0;
         }
     }
+    free(box);
     return true;
 }
 
