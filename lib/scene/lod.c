@@ -961,7 +961,13 @@ static double patch_bound(const tri_grid *og, dv a, dv b, dv c, const uint32_t *
         if (H + dgrow + 2 * o->ptol > enough) return INFINITY;
         for (int j = 0; j < 3; j++) {
             uint32_t nb = o->nbr[3 * (size_t)t + (size_t)j];
-            if (nb != UINT32_MAX && o->mark[nb] < seen) cand[nc++] = nb;
+            if (nb == UINT32_MAX || o->mark[nb] >= seen) continue;
+            /* Not across an edge with all of Q strictly on this side: the
+             * neighbour lies beyond it and cannot touch Q (only a skipped
+             * test: coverage is still proven below). */
+            const double *s0 = x[j], *s1 = x[(j + 1) % 3];
+            if (cross2(s0, s1, Q[0]) > 0 && cross2(s0, s1, Q[1]) > 0 && cross2(s0, s1, Q[2]) > 0) continue;
+            cand[nc++] = nb;
         }
     }
     if (np == 0) return INFINITY;
