@@ -1107,15 +1107,15 @@ static double corner_max(const tri_grid *o, const dv q[3], uint32_t t, double en
  * pair, a planar fan), so where it already exceeds what is enough, those
  * bounds need not be tried. */
 static double plane_gap(const tri_grid *o, uint32_t t, dv a, dv b, dv c) {
-    dv r0 = vtx(o->pos, o->idx[3 * t]), r1 = vtx(o->pos, o->idx[3 * t + 1]), r2 = vtx(o->pos, o->idx[3 * t + 2]);
-    dv e1 = dv_sub(r1, r0), e2 = dv_sub(r2, r0);
-    dv n = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
-    double nl = sqrt(dv_dot(n, n));
-    if (!(nl > 0)) return 0;
-    double g = dmax(fabs(dv_dot(dv_sub(a, r0), n)), dmax(fabs(dv_dot(dv_sub(b, r0), n)), fabs(dv_dot(dv_sub(c, r0), n))));
-    /* Slightly under the exact value, so float rounding never skips a
-     * bound that would have held (skipping only costs time anyway). */
-    return 0.999 * g / nl;
+    /* From the triangle's unit normal and offset (tpl), prepared once;
+     * slightly under the exact value and less the rounding of an offset
+     * (as in grid_nearest), so rounding never skips a bound that would
+     * have held (skipping would only cost time anyway). */
+    const double *pl = o->tpl + 4 * (size_t)t;
+    double g = dmax(fabs(pl[0] * a.x + pl[1] * a.y + pl[2] * a.z - pl[3]),
+                    dmax(fabs(pl[0] * b.x + pl[1] * b.y + pl[2] * b.z - pl[3]),
+                         fabs(pl[0] * c.x + pl[1] * c.y + pl[2] * c.z - pl[3])));
+    return 0.999 * g - 1e-13 * (fabs(a.x) + fabs(a.y) + fabs(a.z) + o->mag);
 }
 
 /* Bound of the distance from triangle (a, b, c) to the other surface.
