@@ -1,9 +1,7 @@
 /* Shared wiring of the tracking commands: input, tracker, line formats. */
 #include "app_track.h"
 
-#include <math.h>
 #include <signal.h>
-#include <stdlib.h>
 #include <string.h>
 
 static volatile sig_atomic_t g_interrupted = 0; /* app only: signal flag */
@@ -24,28 +22,10 @@ void app_catch_signals(void) {
 
 bool app_interrupted(void) { return g_interrupted != 0; }
 
-static mr_source *open_input(const char *uri, const mr_source_params *sp, mr_recording **rec_info, mr_error *err) {
-    if (rec_info) *rec_info = NULL;
-    if (uri && mr_is_recording(uri)) {
-        mr_recording *rec = mr_recording_open(uri, err);
-        if (!rec) return NULL;
-        if (rec_info) {
-            /* A second, read-only copy for the caller's defaults. */
-            *rec_info = mr_recording_open(uri, err);
-            if (!*rec_info) {
-                mr_recording_close(&rec);
-                return NULL;
-            }
-        }
-        return mr_recording_source(rec, sp->gray, err);
-    }
-    return mr_source_open(uri, sp, err);
-}
-
 mr_source *app_open_input(const char *uri, bool gray, mr_recording **rec_info, mr_error *err) {
     mr_source_params sp = MR_SOURCE_DEFAULTS;
     sp.gray = gray;
-    return open_input(uri, &sp, rec_info, err);
+    return mr_input_open(uri, &sp, rec_info, err);
 }
 
 bool app_open_input_opts(const char *cmd, const mr_cli_opt *opts, bool gray, mr_recording **rec_info, mr_source **src,
@@ -57,7 +37,7 @@ bool app_open_input_opts(const char *cmd, const mr_cli_opt *opts, bool gray, mr_
     if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &sp.width, &sp.height)) return false;
     if (mr_cli_get(opts, "fps") && !mr_cli_double("fps", mr_cli_get(opts, "fps"), 0.1, 1000, &sp.fps)) return false;
     sp.pixel_format = mr_cli_get(opts, "pixel-format");
-    *src = open_input(mr_cli_get(opts, "input"), &sp, rec_info, err);
+    *src = mr_input_open(mr_cli_get(opts, "input"), &sp, rec_info, err);
     return true;
 }
 
@@ -65,45 +45,19 @@ bool app_tracker_init(app_tracker *t, const char *cmd, const mr_cli_opt *opts, c
                       const mr_recording *rec) {
     memset(t, 0, sizeof *t);
     mr_error err = {0};
-    mr_camera cam;
-    mr_marker_map loaded = {0};
     mr_tracker_params tp = MR_TRACKER_DEFAULTS;
-    const char *cam_path = mr_cli_get(opts, "camera"), *mk = mr_cli_get(opts, "markers");
-    if (cam_path) {
-        if (!mr_camera_load(cam_path, &cam, &err)) return mr_cli_error(cmd, &err), false;
-        tp.camera = &cam;
-    } else if (rec) {
-        tp.camera = &rec->camera;
-    }
-    if (mk) {
-        if (!mr_marker_map_load(mk, &loaded, &err)) return mr_cli_error(cmd, &err), false;
-        tp.markers = &loaded;
-    } else if (rec && rec->has_markers) {
-        tp.markers = &rec->markers;
-    }
-    const char *family = mr_cli_get(opts, "family");
     tp.detector = *dp;
-    tp.detector.family = family;
-    bool ok = false;
+    tp.detector.family = mr_cli_get(opts, "family");
     tp.no_filter = mr_cli_flag(opts, "no-filter");
     tp.freeze_first = mr_cli_flag(opts, "freeze");
-    t->tracker = mr_tracker_create(&tp, &err);
-    if (!t->tracker) {
-        mr_cli_error(cmd, &err);
-        goto done;
-    }
+    t->tracker = mr_input_tracker_create(mr_cli_get(opts, "camera"), mr_cli_get(opts, "markers"), rec, &tp, &err);
+    if (!t->tracker) return mr_cli_error(cmd, &err), false;
     t->camera = mr_tracker_camera(t->tracker);
     t->markers = mr_tracker_markers(t->tracker);
     t->has_camera = t->camera != NULL;
     t->has_markers = t->markers != NULL;
-    if (t->markers && family && strcmp(family, t->markers->family) != 0)
-        mr_log(MR_LOG_WARN, "--family %s differs from the marker map's %s", family, t->markers->family);
-    ok = true;
-done:
-    mr_marker_map_free(&loaded); /* the tracker keeps its own copy */
-    return ok;
+    return true;
 }
-
 void app_tracker_free(app_tracker *t) {
     mr_tracker_destroy(&t->tracker);
     memset(t, 0, sizeof *t);

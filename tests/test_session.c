@@ -702,6 +702,79 @@ static void test_mark_files(void) {
     mr_capture_frame_free(&dst);
 }
 
+/* The tracking commands' input and tracker (mr_input_open,
+ * mr_input_tracker_create): a recording supplies the camera and marker
+ * map, a file given wins over it, a bad file is an error. */
+static void test_input(void) {
+    char dir[1100], cam_path[1200], bad_path[1200];
+    tmp_path("rec_input", dir, sizeof dir);
+    mr_camera cam = {64, 48, 50, 50, 31.5, 23.5, {0, 0, 0, 0, 0}};
+    mr_marker tags[2] = {{3, mr_m4_translate(0, 1, 0), 0}, {8, mr_m4_translate(1, 1, 0), 0}};
+    mr_marker_map map = {"tag36h11", 0.2, tags, 2};
+    mr_recorder_params rp = MR_RECORDER_DEFAULTS;
+    rp.camera = &cam;
+    rp.markers = &map;
+    rp.source = "test";
+    rp.frame_ext = ".png";
+    mr_error err = {0};
+    mr_image img;
+    mr_recorder *r = open_recorder(dir, &rp, &img);
+    if (!r) return;
+    for (int i = 0; i < 3; i++) {
+        mr_frame_record fr = {0};
+        fr.t = 0.1 * i;
+        CHECK(mr_recorder_append(r, &fr, &img, &err));
+    }
+    mr_recorder_close(&r);
+    mr_image_free(&img);
+
+    mr_recording *rec = NULL;
+    mr_source *src = mr_input_open(dir, NULL, &rec, &err);
+    CHECK_MSG(src != NULL && rec != NULL, "input %s: %s", dir, err.msg);
+    if (!src || !rec) {
+        mr_source_close(&src);
+        mr_recording_close(&rec);
+        return;
+    }
+    CHECK(rec->frame_count == 3 && rec->camera.fx == 50 && rec->has_markers);
+    mr_frame fr;
+    memset(&fr, 0, sizeof fr);
+    CHECK(mr_source_read(src, &fr, &err) == MR_READ_FRAME && fr.image.width == 64); /* (the image is the source's) */
+    mr_source_close(&src);
+
+    /* The recording's camera and markers by default. */
+    mr_tracker *t = mr_input_tracker_create(NULL, NULL, rec, NULL, &err);
+    CHECK_MSG(t != NULL, "%s", err.msg);
+    CHECK(t && mr_tracker_camera(t) && mr_tracker_camera(t)->fx == 50);
+    CHECK(t && mr_tracker_markers(t) && mr_tracker_markers(t)->count == 2);
+    mr_tracker_destroy(&t);
+    /* A camera file wins over the recording's; the markers still come from it. */
+    tmp_path("input_cam.json", cam_path, sizeof cam_path);
+    mr_camera other = cam;
+    other.fx = other.fy = 77;
+    cJSON *j = mr_camera_to_json(&other);
+    CHECK(j && mr_json_save(cam_path, j, &err));
+    cJSON_Delete(j);
+    t = mr_input_tracker_create(cam_path, NULL, rec, NULL, &err);
+    CHECK(t && mr_tracker_camera(t) && mr_tracker_camera(t)->fx == 77);
+    CHECK(t && mr_tracker_markers(t) && mr_tracker_markers(t)->count == 2);
+    mr_tracker_destroy(&t);
+    /* Neither: detection only. */
+    t = mr_input_tracker_create(NULL, NULL, NULL, NULL, &err);
+    CHECK(t && !mr_tracker_camera(t) && !mr_tracker_markers(t));
+    mr_tracker_destroy(&t);
+    /* A bad file is an error, not a silent fallback to the recording's. */
+    tmp_path("input_missing.json", bad_path, sizeof bad_path);
+    err.msg[0] = 0;
+    CHECK(mr_input_tracker_create(bad_path, NULL, rec, NULL, &err) == NULL && err.msg[0]);
+    err.msg[0] = 0;
+    CHECK(mr_input_tracker_create(NULL, bad_path, rec, NULL, &err) == NULL && err.msg[0]);
+    mr_recording_close(&rec);
+    /* Not a recording: mr_source_open's error. */
+    err.msg[0] = 0;
+    CHECK(mr_input_open(bad_path, NULL, &rec, &err) == NULL && rec == NULL && err.msg[0]);
+}
+
 int main(void) {
     if (!mr_test_fresh_dir("test_session", g_tmp, sizeof g_tmp)) return 1;
     test_round_trip();
@@ -713,5 +786,6 @@ int main(void) {
     test_annotation_uncertainty();
     test_annotation_round_trip();
     test_mark_files();
+    test_input();
     return mr_test_finish("test_session");
 }

@@ -147,6 +147,22 @@ mr_source *mr_recording_source(mr_recording *rec, bool gray, mr_error *err);
 /* True if dir looks like a recording (has meta.json and frames.jsonl). */
 bool mr_is_recording(const char *dir);
 
+/* ------------------------------------------------------ tracking input */
+
+/* The input of a tracking command: a recording folder (its frames as a
+ * source; *rec_info, if asked for, a second read-only copy whose camera and
+ * markers serve as defaults), else mr_source_open's (/dev/videoN, a video
+ * file, an image or a folder of images). NULL + err if it cannot be opened. */
+mr_source *mr_input_open(const char *uri, const mr_source_params *params, mr_recording **rec_info, mr_error *err);
+
+/* A tracker whose camera and marker map come from the files given
+ * (camera_path, markers_path; NULL: none), else from rec (may be NULL):
+ * a file always wins over the recording. tp's camera and markers are
+ * ignored; its other fields are used as they are. A --family that differs
+ * from the map's is warned about. NULL + err on a bad file. */
+mr_tracker *mr_input_tracker_create(const char *camera_path, const char *markers_path, const mr_recording *rec,
+                                    const mr_tracker_params *tp, mr_error *err);
+
 /* ---------------------------------------------------------- replay index */
 
 /* A recording (or a plain folder of frames) opened for random access, so a
