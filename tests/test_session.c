@@ -62,17 +62,28 @@ static mr_dmat4 pose_of(int i) {
     return mr_m4_look_at_cv(mr_v3(1.0 + 0.1 * i, 1.6, 3.0 - 0.05 * i), mr_v3(0.1 * i, 1.5, 0), mr_v3(0, 1, 0));
 }
 
+/* A 64x48 camera and a two-tag map, and recorder params that record them
+ * (PNG frames). */
+static mr_recorder_params rec_params(mr_camera *cam, mr_marker tags[2], mr_marker_map *map) {
+    *cam = (mr_camera){64, 48, 50, 50, 31.5, 23.5, {0.01, 0, 0, 0, 0}};
+    tags[0] = (mr_marker){3, mr_m4_translate(0, 1, 0), 0};
+    tags[1] = (mr_marker){8, mr_m4_translate(1, 1, 0), 0};
+    *map = (mr_marker_map){"tag36h11", 0.2, tags, 2};
+    mr_recorder_params rp = MR_RECORDER_DEFAULTS;
+    rp.camera = cam;
+    rp.markers = map;
+    rp.source = "test";
+    rp.frame_ext = ".png";
+    return rp;
+}
+
 static void test_round_trip(void) {
     char dir[1100], path[1200];
     tmp_path("rec_rt", dir, sizeof dir);
-    mr_camera cam = {64, 48, 50, 50, 31.5, 23.5, {0.01, 0, 0, 0, 0}};
-    mr_marker tags[2] = {{3, mr_m4_translate(0, 1, 0), 0}, {8, mr_m4_translate(1, 1, 0), 0}};
-    mr_marker_map map = {"tag36h11", 0.2, tags, 2};
-    mr_recorder_params rp = MR_RECORDER_DEFAULTS;
-    rp.camera = &cam;
-    rp.markers = &map;
-    rp.source = "test";
-    rp.frame_ext = ".png";
+    mr_camera cam;
+    mr_marker tags[2];
+    mr_marker_map map;
+    mr_recorder_params rp = rec_params(&cam, tags, &map);
     rp.ground_truth = true;
     mr_error err = {0};
     mr_image img;
@@ -708,14 +719,10 @@ static void test_mark_files(void) {
 static void test_input(void) {
     char dir[1100], cam_path[1200], bad_path[1200];
     tmp_path("rec_input", dir, sizeof dir);
-    mr_camera cam = {64, 48, 50, 50, 31.5, 23.5, {0, 0, 0, 0, 0}};
-    mr_marker tags[2] = {{3, mr_m4_translate(0, 1, 0), 0}, {8, mr_m4_translate(1, 1, 0), 0}};
-    mr_marker_map map = {"tag36h11", 0.2, tags, 2};
-    mr_recorder_params rp = MR_RECORDER_DEFAULTS;
-    rp.camera = &cam;
-    rp.markers = &map;
-    rp.source = "test";
-    rp.frame_ext = ".png";
+    mr_camera cam;
+    mr_marker tags[2];
+    mr_marker_map map;
+    mr_recorder_params rp = rec_params(&cam, tags, &map);
     mr_error err = {0};
     mr_image img;
     mr_recorder *r = open_recorder(dir, &rp, &img);
