@@ -68,8 +68,9 @@ mr_lod *app_load_lod(const mr_scene *s, const char *scene_path, bool use_cache, 
     if (lod && info.from_cache)
         mr_log(MR_LOG_INFO, "LOD: %llu levels read from the cache", (unsigned long long)info.levels);
     else if (lod)
-        mr_log(MR_LOG_INFO, "LOD: %llu levels built in %.2f s (%.0f input triangles/s)%s", (unsigned long long)info.levels,
-               info.build_s, info.build_s > 0 ? info.triangles / info.build_s : 0.0,
+        mr_log(MR_LOG_INFO, "LOD: %llu levels built in %.2f s (%.0f input triangles/s, %s kernel)%s",
+               (unsigned long long)info.levels, info.build_s, info.build_s > 0 ? info.triangles / info.build_s : 0.0,
+               mr_lod_kernel(&lp),
                info.cache_written ? " (cache written)" : "");
     return lod;
 }

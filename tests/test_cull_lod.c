@@ -227,6 +227,39 @@ static void check_levels(const mr_mesh *mm, const mr_mesh_lods *ml, const mr_lod
     }
 }
 
+/* The kernel this CPU gets and the portable one build the same levels
+ * (lod_v3.c is lod.c compiled for AVX2 and FMA): the same counts, errors
+ * within rounding, and the portable levels hold against brute force too. */
+static void check_kernels(mr_scene *s, const mr_lod *fast, const mr_lod_params *lp, const char *what) {
+    mr_lod_params pp = *lp;
+    pp.portable = true;
+    CHECK(strcmp(mr_lod_kernel(&pp), "portable") == 0);
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+    /* (CMakeLists.txt builds the x86-64-v3 kernel on x86-64) */
+    if (__builtin_cpu_supports("x86-64-v3"))
+        CHECK_MSG(strcmp(mr_lod_kernel(lp), "x86-64-v3") == 0, "%s: kernel %s on an x86-64-v3 CPU", what, mr_lod_kernel(lp));
+#endif
+    printf("  %s: kernel %s against portable\n", what, mr_lod_kernel(lp));
+    mr_error err = {0};
+    mr_lod *port = mr_lod_build(s, &pp, &err);
+    CHECK_MSG(port != NULL, "%s", err.msg);
+    if (!port || !fast) {
+        mr_lod_destroy(&port);
+        return;
+    }
+    for (int32_t i = 0; i < s->mesh_count; i++) {
+        const mr_mesh_lods *a = &fast->meshes[i], *b = &port->meshes[i];
+        CHECK_MSG(a->level_count == b->level_count, "%s: %d levels, portable %d", what, a->level_count, b->level_count);
+        for (int k = 0; k < a->level_count && k < b->level_count; k++)
+            CHECK_MSG(a->levels[k].index_count == b->levels[k].index_count &&
+                          fabs(a->levels[k].error - b->levels[k].error) <= 1e-9 * b->levels[k].error,
+                      "%s level %d: %u triangles, error %.17g; portable %u, %.17g", what, k, a->levels[k].index_count / 3,
+                      a->levels[k].error, b->levels[k].index_count / 3, b->levels[k].error);
+        check_levels(&s->meshes[i], b, lp, what);
+    }
+    mr_lod_destroy(&port);
+}
+
 static void test_lod_bound(void) {
     mr_scene *s = mr_scene_create();
     mr_mesh m = bumpy_sphere(0.5, 32, 16);
@@ -244,6 +277,7 @@ static void test_lod_bound(void) {
         const mr_mesh_lods *ml = &lod->meshes[0];
         CHECK_MSG(ml->level_count >= 2, "only %d levels", ml->level_count);
         check_levels(mm, ml, &lp, "bumpy sphere");
+        check_kernels(s, lod, &lp, "bumpy sphere");
     }
     mr_lod_destroy(&lod);
     mr_scene_destroy(&s);
@@ -254,6 +288,7 @@ static void test_lod_bound(void) {
     lod = mr_lod_build(s, &lp, &err);
     CHECK(lod && lod->meshes[0].level_count >= 2);
     if (lod) check_levels(&s->meshes[0], &lod->meshes[0], &lp, "cylinder");
+    check_kernels(s, lod, &lp, "cylinder");
     /* A surface shifted by exactly 1 cm: the bound finds it (a real bound
      * would report at least the shift, a loose guess might not). */
     {

@@ -31,6 +31,7 @@
  * check against dense brute-force sampling; the renderer never uses a level
  * whose bound (times the node's stretch) exceeds the tolerance. */
 #include "mr_scene.h"
+#include "lod_internal.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -1372,11 +1373,13 @@ static double *positions_double(const float *positions, uint32_t vertex_count) {
     return d;
 }
 
+#ifndef MR_LOD_KERNEL_V3 /* (what the kernel build below does not use) */
 static bool indices_ok(const uint32_t *idx, uint32_t count, uint32_t vertex_count) {
     for (uint32_t i = 0; i < count; i++)
         if (idx[i] >= vertex_count) return false;
     return true;
 }
+#endif
 
 /* The two-sided bound between prepared surfaces ga (of a) and gb (of b). */
 static double hausdorff_prepared(const double *positions, uint32_t vertex_count, const uint32_t *a, uint32_t a_count,
@@ -1405,6 +1408,7 @@ static double hausdorff_prepared(const double *positions, uint32_t vertex_count,
     return r;
 }
 
+#ifndef MR_LOD_KERNEL_V3
 /* The two-sided bound. Vertex distances of both directions come first, so
  * that the largest real distance (lower) is known before any triangle is
  * bounded: no piece is refined below what the Hausdorff distance already is
@@ -1479,6 +1483,7 @@ static void resolve(const mr_lod_params *in, mr_lod_params *p) {
     if (!(p->rel_error > 0)) p->rel_error = MR_LOD_DEFAULT_REL_ERROR;
     if (p->min_triangles == 0) p->min_triangles = 64;
 }
+#endif
 
 /* Position welding. A CAD mesh repeats a position along every normal seam
  * (each face of a box, each segment of a lathed profile has its own
@@ -1761,6 +1766,38 @@ static bool build_mesh(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *o
     return ok;
 }
 
+#ifdef MR_LOD_KERNEL_V3
+bool mr_lod_build_mesh_v3(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *out) { return build_mesh(m, p, out); }
+#else
+
+/* The kernel for this CPU: the same code compiled for x86-64-v3 (AVX2,
+ * FMA; lod_v3.c) where the CPU has it and the build made it, else the
+ * portable one. Measured on the 2M unique factory, 12 alternating pairs:
+ * median CPU 3.87 s against 4.22 s (-8 %), identical levels and errors. */
+static bool use_v3(const mr_lod_params *p) {
+#if defined(MR_LOD_HAVE_V3) && defined(__clang__) /* (no "x86-64-v3" in clang 14: its main parts) */
+    return !p->portable && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+           __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
+#elif defined(MR_LOD_HAVE_V3)
+    return !p->portable && __builtin_cpu_supports("x86-64-v3");
+#else
+    (void)p;
+    return false;
+#endif
+}
+
+const char *mr_lod_kernel(const mr_lod_params *params) {
+    mr_lod_params d = MR_LOD_DEFAULTS;
+    return use_v3(params ? params : &d) ? "x86-64-v3" : "portable";
+}
+
+static bool build_mesh_for_cpu(const mr_mesh *m, const mr_lod_params *p, mr_mesh_lods *out) {
+#ifdef MR_LOD_HAVE_V3
+    if (use_v3(p)) return mr_lod_build_mesh_v3(m, p, out);
+#endif
+    return build_mesh(m, p, out);
+}
+
 /* Meshes are independent: workers take the next mesh from a shared
  * counter, largest meshes first so the last one does not run alone. */
 typedef struct build_job {
@@ -1780,7 +1817,7 @@ typedef struct build_job {
 static bool build_one(void *arg, size_t k) {
     build_job *j = arg;
     int32_t i = j->order[k];
-    bool ok = build_mesh(&j->s->meshes[i], j->p, &j->l->meshes[i]);
+    bool ok = build_mesh_for_cpu(&j->s->meshes[i], j->p, &j->l->meshes[i]);
     pthread_mutex_lock(&j->lock);
     if (!ok && j->failed < 0) j->failed = i;
     j->done++;
@@ -2024,3 +2061,5 @@ mr_lod *mr_lod_load_or_build(const mr_scene *s, const char *cache_path, const mr
     if (info) *info = li;
     return l;
 }
+
+#endif /* MR_LOD_KERNEL_V3 */

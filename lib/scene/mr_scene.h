@@ -403,8 +403,12 @@ typedef struct mr_lod_params {
      * "LOD build cancelled"). NULL: none. */
     bool (*on_progress)(void *user, double fraction);
     void *progress_user;
+    bool portable;            /* the portable build kernel even where the CPU
+                                 has a faster one (mr_lod_kernel): the same
+                                 algorithm either way; tests compare the two.
+                                 false = the fastest this CPU runs */
 } mr_lod_params;
-#define MR_LOD_DEFAULTS {0.0, 0, false, 0.0, NULL, NULL}
+#define MR_LOD_DEFAULTS {0.0, 0, false, 0.0, NULL, NULL, false}
 /* 2 %, not 1 %: a level is only drawn where its error projects under
  * --lod-pixels, so a coarser last level changes only what far parts cost.
  * Measured (bench scene --unique, 2M/10M/20M, 320x240; 1 % -> 2 % -> 4 %
@@ -428,6 +432,10 @@ typedef struct mr_lod_info {
 
 /* Builds the levels of every mesh. */
 mr_lod *mr_lod_build(const mr_scene *s, const mr_lod_params *params, mr_error *err);
+/* The code that builds them on this CPU with these params: "x86-64-v3"
+ * (the kernel compiled for AVX2 and FMA, where the CPU has them) or
+ * "portable". */
+const char *mr_lod_kernel(const mr_lod_params *params);
 void mr_lod_destroy(mr_lod **lod); /* NULLs, accepts NULL */
 /* Hash of the scene's mesh geometry (positions, indices, origins): a cache
  * for another geometry is never used. */
