@@ -413,6 +413,23 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
         t0 = mr_time_now();
         mr_lod *lod = ok ? mr_lod_load_or_build(s, lod_cache, &lp, &linfo, err) : NULL;
         double lod_s = mr_time_now() - t0, lod_cached_s = 0;
+        int lod_runs = 1;
+        if (lod && p.unique && !linfo.from_cache) {
+            /* The first build again (no cache), up to three builds or 40 s
+             * in all: the median, as for frames (this shared machine's
+             * speed moves by 15 % between runs of the same build). */
+            double runs[3] = {lod_s}, spent = lod_s;
+            while (lod_runs < 3 && spent < 40) {
+                t0 = mr_time_now();
+                mr_lod *again = mr_lod_build(s, &lp, err);
+                double dt = mr_time_now() - t0;
+                if (!again) break;
+                mr_lod_destroy(&again);
+                runs[lod_runs++] = dt;
+                spent += dt;
+            }
+            lod_s = mr_median(runs, lod_runs);
+        }
         if (lod && p.unique) {
             /* The second load of the same file: levels from the cache. */
             mr_lod_info li2;
@@ -503,9 +520,9 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                linfo.from_cache ? "from the cache" : "built");
         if (p.unique)
             BENCH_PRINT(out,
-                        "  LOD first build %.2f s = %.0f input triangles/s (%s kernel); from the cache %.3f s; with its "
-                        "meshlets (%.2f s) %.0f input triangles/s\n",
-                        lod_s, li.unique_triangles / lod_s, mr_lod_kernel(NULL), lod_cached_s, z.cluster_build_s,
+                        "  LOD first build %.2f s (median of %d) = %.0f input triangles/s (%s kernel); from the cache "
+                        "%.3f s; with its meshlets (%.2f s) %.0f input triangles/s\n",
+                        lod_s, lod_runs, li.unique_triangles / lod_s, mr_lod_kernel(NULL), lod_cached_s, z.cluster_build_s,
                         li.unique_triangles / (lod_s + z.cluster_build_s));
         if (p.unique) /* issue 17 (lane bench) */
             BENCH_PRINT(out, "  open (load + LOD + upload with levels): first %.2f s, with the LOD cache %.2f s\n",
