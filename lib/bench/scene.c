@@ -415,9 +415,10 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
         double lod_s = mr_time_now() - t0, lod_cached_s = 0;
         int lod_runs = 1;
         if (lod && p.unique && !linfo.from_cache) {
-            /* The first build again (no cache), up to three builds or 40 s
-             * in all: the median, as for frames (this shared machine's
-             * speed moves by 15 % between runs of the same build). */
+            /* The first build again (no cache): up to three builds, another
+             * one only while less than 40 s have been spent; the median, as
+             * for frames (this shared machine's speed moves by 15 % between
+             * runs of the same build). */
             double runs[3] = {lod_s}, spent = lod_s;
             while (lod_runs < 3 && spent < 40) {
                 t0 = mr_time_now();
