@@ -110,6 +110,22 @@ static void test_split_cylinder(void) {
                 CHECK_MSG(l->error <= 2.5 * brute + 0.05 * MR_LOD_DEFAULT_REL_ERROR * size,
                           "cylinder unit %g level %d: bound %g vs sampled %g", units[u], k, l->error, brute);
             }
+            /* The portable kernel builds the same levels in every unit (the
+             * x86-64-v3 one, where this CPU takes it, is the same code
+             * compiled with FMA). */
+            mr_lod_params pp = MR_LOD_DEFAULTS;
+            pp.portable = true;
+            mr_lod *port = mr_lod_build(s, &pp, &err);
+            CHECK_MSG(port && port->meshes[0].level_count == ml->level_count, "unit %g: portable kernel: %d levels, %s %d",
+                      units[u], port ? port->meshes[0].level_count : -1, mr_lod_kernel(NULL), ml->level_count);
+            for (int k = 0; port && k < ml->level_count && k < port->meshes[0].level_count; k++) {
+                const mr_lod_level *a = &ml->levels[k], *b = &port->meshes[0].levels[k];
+                CHECK_MSG(a->index_count == b->index_count && memcmp(a->indices, b->indices, (size_t)a->index_count * 4) == 0 &&
+                              fabs(a->error - b->error) <= 1e-9 * b->error,
+                          "unit %g level %d: %s kernel %u triangles, error %.17g; portable %u, %.17g", units[u], k,
+                          mr_lod_kernel(NULL), a->index_count / 3, a->error, b->index_count / 3, b->error);
+            }
+            mr_lod_destroy(&port);
         }
         mr_lod_destroy(&lod);
         mr_scene_destroy(&s);
