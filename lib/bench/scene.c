@@ -523,7 +523,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
             BENCH_PRINT(out,
                         "  LOD first build %.2f s (median of %d) = %.0f input triangles/s (%s kernel); from the cache "
                         "%.3f s; with its meshlets (%.2f s) %.0f input triangles/s\n",
-                        lod_s, lod_runs, li.unique_triangles / lod_s, mr_lod_kernel(NULL), lod_cached_s, z.cluster_build_s,
+                        lod_s, lod_runs, li.unique_triangles / lod_s, mr_lod_kernel(&lp), lod_cached_s, z.cluster_build_s,
                         li.unique_triangles / (lod_s + z.cluster_build_s));
         if (p.unique) /* issue 17 (lane bench) */
             BENCH_PRINT(out, "  open (load + LOD + upload with levels): first %.2f s, with the LOD cache %.2f s\n",
