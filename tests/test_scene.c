@@ -2,6 +2,7 @@
  * content sniffing, scene configs, and bad input that must fail cleanly. */
 #include "mr_scene.h"
 #include "mr_test.h"
+#include "prepare_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -330,6 +331,128 @@ static void test_prepare(void) {
     free(d.normals);
     mr_scene_destroy(&s1);
     mr_scene_destroy(&s2);
+}
+
+/* ------------------------------------------- the prepare step's passes */
+
+/* The passes as first written, one element at a time: the reference the
+ * vector forms (scene.c, SSE2 on x86-64) must match. */
+static bool ref_bounds(const float *pos, size_t n, double lo[3], double hi[3]) {
+    for (size_t i = 0; i < 3 * n; i++) {
+        double p = pos[i];
+        if (!isfinite(p)) return false;
+        if (p < lo[i % 3]) lo[i % 3] = p;
+        if (p > hi[i % 3]) hi[i % 3] = p;
+    }
+    return true;
+}
+
+static void ref_unit(float *nrm, size_t n) {
+    for (size_t v = 0; v < n; v++) {
+        float *p = nrm + 3 * v;
+        float l2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+        if (l2 > 1.0f - 0x1p-20f && l2 < 1.0f + 0x1p-20f) continue;
+        if (l2 > 1e-30f && l2 < 1e30f) {
+            float inv = 1.0f / sqrtf(l2);
+            p[0] *= inv;
+            p[1] *= inv;
+            p[2] *= inv;
+        } else {
+            double x = p[0], y = p[1], z = p[2], len = sqrt(x * x + y * y + z * z);
+            if (!(len > 1e-300) || !isfinite(len)) {
+                p[0] = 0.0f, p[1] = 1.0f, p[2] = 0.0f;
+            } else {
+                p[0] = (float)(x / len), p[1] = (float)(y / len), p[2] = (float)(z / len);
+            }
+        }
+    }
+}
+
+static uint32_t g_rng = 777;
+static float rnd_unit(void) { /* [-1, 1) */
+    g_rng = g_rng * 1664525u + 1013904223u;
+    return (float)(g_rng >> 8) / 8388608.0f - 1.0f;
+}
+
+/* Every length of array (0 to 41 vertices, so each tail), values over
+ * many magnitudes, unit and degenerate normals in every lane, non-finite
+ * values and out-of-range indices at every place: the same results as the
+ * reference, bit for bit (a bound's zero may differ in sign only). */
+static void test_prepare_passes(void) {
+    enum { max_n = 41 };
+    float pos[3 * max_n], q[3 * max_n], nrm[3 * max_n], r[3 * max_n];
+    int bad_bounds = 0, bad_recentre = 0, bad_unit = 0, bad_finite = 0, bad_index = 0;
+    for (int n = 0; n <= max_n; n++)
+        for (int trial = 0; trial < 40; trial++) {
+            const float scale = powf(10.0f, (float)(trial % 11) - 3.0f), offset = trial % 3 == 0 ? 1e7f : 0.0f;
+            for (int i = 0; i < 3 * n; i++) pos[i] = offset + scale * rnd_unit();
+            if (trial == 5 && n > 0) pos[0] = -0.0f; /* signed zeros in play */
+            double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            double rlo[3] = {INFINITY, INFINITY, INFINITY}, rhi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            if (trial % 4 == 1) /* bounds carried in from an earlier chunk */
+                for (int k = 0; k < 3; k++) lo[k] = rlo[k] = offset - 0.5 * scale, hi[k] = rhi[k] = offset + 0.25 * scale;
+            bool ok = mr_mesh_bounds_add(pos, (size_t)n, lo, hi), rok = ref_bounds(pos, (size_t)n, rlo, rhi);
+            for (int k = 0; k < 3; k++) bad_bounds += ok != rok || lo[k] != rlo[k] || hi[k] != rhi[k];
+            /* recentred: the reference's arithmetic per element */
+            if (n > 0) {
+                double org[3] = {1, 2, 3}, centre[3];
+                float bmin[3], bmax[3], rmin[3] = {INFINITY, INFINITY, INFINITY}, rmax[3] = {-INFINITY, -INFINITY, -INFINITY};
+                memcpy(q, pos, sizeof(float) * 3 * (size_t)n);
+                mr_mesh_recentre_within(q, (uint32_t)n, rlo, rhi, org, bmin, bmax);
+                for (int k = 0; k < 3; k++) centre[k] = 0.5 * rlo[k] + 0.5 * rhi[k];
+                for (int i = 0; i < 3 * n; i++) {
+                    float e = (float)((double)pos[i] - centre[i % 3]);
+                    bad_recentre += memcmp(&e, &q[i], sizeof e) != 0 && !(e == 0.0f && q[i] == 0.0f);
+                    rmin[i % 3] = fminf(rmin[i % 3], e);
+                    rmax[i % 3] = fmaxf(rmax[i % 3], e);
+                }
+                for (int k = 0; k < 3; k++)
+                    bad_recentre += bmin[k] != rmin[k] || bmax[k] != rmax[k] || org[k] != 1.0 + k + centre[k];
+            }
+            /* normals: random lengths, some already unit, zero, tiny, huge */
+            for (int i = 0; i < 3 * n; i++) nrm[i] = rnd_unit() * powf(10.0f, (float)((i / 3 + trial) % 9) - 4.0f);
+            for (int v = 0; v < n; v++) {
+                int kind = (v * 7 + trial) % 9;
+                float *p = nrm + 3 * v;
+                if (kind == 0) p[0] = 0.0f, p[1] = 0.0f, p[2] = 1.0f;
+                if (kind == 1) p[0] = p[1] = p[2] = 0.0f;
+                if (kind == 2) p[0] *= 1e-17f, p[1] *= 1e-17f, p[2] *= 1e-17f;
+                if (kind == 3) p[0] = 3e19f, p[1] = -2e19f, p[2] = 1e18f;
+                if (kind == 4) p[0] = 0.6f, p[1] = -0.8f, p[2] = 0.0f; /* unit, maybe not exactly */
+            }
+            memcpy(r, nrm, sizeof(float) * 3 * (size_t)n);
+            mr_mesh_unit_normals(nrm, (uint32_t)n);
+            ref_unit(r, (size_t)n);
+            bad_unit += memcmp(nrm, r, sizeof(float) * 3 * (size_t)n) != 0;
+        }
+    /* a non-finite value at each place and component: refused */
+    for (int n = 1; n <= 13; n++)
+        for (int at = 0; at < 3 * n; at++)
+            for (int kind = 0; kind < 3; kind++) {
+                for (int i = 0; i < 3 * n; i++) pos[i] = rnd_unit();
+                pos[at] = kind == 0 ? INFINITY : kind == 1 ? -INFINITY : NAN;
+                double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+                bad_finite += mr_mesh_bounds_add(pos, (size_t)n, lo, hi);
+            }
+    /* the largest index found in every place, also past 2^31 */
+    uint32_t idx[23];
+    mr_error err = {0};
+    for (uint32_t count = 1; count <= 23; count++)
+        for (uint32_t at = 0; at < count; at++)
+            for (int big = 0; big < 3; big++) {
+                for (uint32_t i = 0; i < count; i++) idx[i] = i % 5;
+                const uint32_t nv = 10, v = big == 0 ? 10 : big == 1 ? 0x80000000u : 0xffffffffu;
+                idx[at] = v;
+                bool ok = mr_mesh_check_indices(idx, count, nv, "k", &err);
+                bad_index += ok || strstr(err.msg, "out of range") == NULL;
+                idx[at] = 9;
+                bad_index += !mr_mesh_check_indices(idx, count, nv, "k", &err);
+            }
+    CHECK_MSG(bad_bounds == 0, "bounds differ from the reference in %d cases", bad_bounds);
+    CHECK_MSG(bad_recentre == 0, "recentring differs from the reference in %d cases", bad_recentre);
+    CHECK_MSG(bad_unit == 0, "unit normals differ from the reference in %d arrays", bad_unit);
+    CHECK_MSG(bad_finite == 0, "%d non-finite positions passed the bounds", bad_finite);
+    CHECK_MSG(bad_index == 0, "index check wrong in %d cases", bad_index);
 }
 
 static void test_globs(void) {
@@ -977,6 +1100,7 @@ int main(void) {
     }
     test_builder();
     test_prepare();
+    test_prepare_passes();
     test_globs();
     test_round_trip();
     test_handwritten();
