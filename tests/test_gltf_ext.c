@@ -151,6 +151,86 @@ static void test_quantization(void) {
 }
 
 /* Accessors without a bufferView are zeros; sparse values replace elements. */
+/* Every 8- and 16-bit component type, plain and normalised, as POSITION
+ * (three per element) and TEXCOORD_0 (two), packed tightly and
+ * interleaved, 39 vertices (the vector loop's tail too): each value as the
+ * specification's conversion gives it, bit for bit; the extremes of each
+ * type among them (-128 clamps to -1). */
+static void test_quantized_values(void) {
+    enum { nv = 39 };
+    static const int types[4] = {5120, 5121, 5122, 5123};
+    uint32_t rng = 99;
+    int bad = 0, loaded = 0;
+    for (int t = 0; t < 4; t++)
+        for (int norm = 0; norm < 2; norm++)
+            for (int inter = 0; inter < 2; inter++) {
+                const int cs = types[t] <= 5121 ? 1 : 2;
+                const bool sgn = types[t] == 5120 || types[t] == 5122;
+                const double vmax = cs == 1 ? (sgn ? 127 : 255) : (sgn ? 32767 : 65535), vmin = sgn ? -vmax - 1 : 0;
+                /* interleaved: position then uv in one stride (padded to 4); else two tight views */
+                const size_t pe = 3 * (size_t)cs, ue = 2 * (size_t)cs, stride = inter ? ((pe + ue + 3) & ~(size_t)3) : 0;
+                unsigned char bin[nv * 16 + nv * 8 + 16];
+                memset(bin, 0, sizeof bin);
+                int32_t val[nv][5];
+                for (int v = 0; v < nv; v++)
+                    for (int k = 0; k < 5; k++) {
+                        rng = rng * 1664525u + 1013904223u;
+                        double x = vmin + (double)(rng >> 8) / 16777216.0 * (vmax - vmin + 1);
+                        if (v == 1) x = vmin; /* extremes in the vector loop */
+                        if (v == 2) x = vmax;
+                        if (v == nv - 1 && k == 4) x = vmin; /* and in the tail */
+                        val[v][k] = (int32_t)floor(x);
+                        size_t at = inter ? v * stride + (k < 3 ? (size_t)k * cs : pe + (size_t)(k - 3) * cs)
+                                          : (k < 3 ? v * pe + (size_t)k * cs : nv * pe + 4 + v * ue + (size_t)(k - 3) * cs);
+                        if (cs == 1) bin[at] = (unsigned char)(val[v][k] & 0xff);
+                        else {
+                            uint16_t h = (uint16_t)(val[v][k] & 0xffff);
+                            memcpy(bin + at, &h, 2);
+                        }
+                    }
+                const size_t bin_n = inter ? nv * stride : nv * pe + 4 + nv * ue;
+                char views[256], json[2048];
+                if (inter)
+                    snprintf(views, sizeof views, "{\"buffer\":0,\"byteLength\":%zu,\"byteStride\":%zu}", bin_n, stride);
+                else
+                    snprintf(views, sizeof views, "{\"buffer\":0,\"byteLength\":%zu},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}",
+                             nv * pe, nv * pe + 4, nv * ue);
+                snprintf(json, sizeof json,
+                         "{%s\"extensionsUsed\":[\"KHR_mesh_quantization\"],\"extensionsRequired\":[\"KHR_mesh_quantization\"],"
+                         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1}}]}],"
+                         "\"buffers\":[{\"byteLength\":%zu}],\"bufferViews\":[%s],"
+                         "\"accessors\":[{\"bufferView\":0,\"componentType\":%d,%s\"count\":%d,\"type\":\"VEC3\"},"
+                         "{\"bufferView\":%d,\"byteOffset\":%zu,\"componentType\":%d,%s\"count\":%d,\"type\":\"VEC2\"}]}",
+                         k_head, bin_n, views, types[t], norm ? "\"normalized\":true," : "", nv, inter ? 0 : 1,
+                         inter ? pe : 0, types[t], norm ? "\"normalized\":true," : "", nv);
+                mr_error err = {0};
+                mr_scene *s = load_glb(json, bin, bin_n, &err);
+                CHECK_MSG(s && s->mesh_count == 1, "type %d norm %d inter %d: %s", types[t], norm, inter, err.msg);
+                if (!s || s->mesh_count != 1) {
+                    mr_scene_destroy(&s);
+                    continue;
+                }
+                loaded++;
+                const mr_mesh *m = &s->meshes[0];
+                float f[nv][5];
+                double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+                for (int v = 0; v < nv; v++)
+                    for (int k = 0; k < 5; k++) {
+                        f[v][k] = norm ? (float)fmax(val[v][k] * (1.0 / vmax), sgn ? -1.0 : 0.0) : (float)val[v][k];
+                        if (k < 3) lo[k] = fmin(lo[k], f[v][k]), hi[k] = fmax(hi[k], f[v][k]);
+                    }
+                for (int v = 0; v < nv; v++)
+                    for (int k = 0; k < 5; k++) {
+                        float want = k < 3 ? (float)((double)f[v][k] - (0.5 * lo[k] + 0.5 * hi[k])) : f[v][k];
+                        float got = k < 3 ? m->positions[3 * v + k] : (m->uvs ? m->uvs[2 * v + k - 3] : NAN);
+                        bad += memcmp(&want, &got, sizeof want) != 0 && !(want == 0.0f && got == 0.0f);
+                    }
+                mr_scene_destroy(&s);
+            }
+    CHECK_MSG(loaded == 16, "%d of 16 quantised files loaded", loaded);
+    CHECK_MSG(bad == 0, "%d converted values differ from the specification's", bad);
+}
+
 static void test_sparse_and_zeros(void) {
     /* sparse indices (ushort 1, 2) and values (2 float3). */
     unsigned char bin[4 + 24];
@@ -939,6 +1019,7 @@ int main(void) {
     }
     mr_log_set_level(MR_LOG_ERROR);
     test_quantization();
+    test_quantized_values();
     test_sparse_and_zeros();
     test_glb_lies();
     test_meshopt();
