@@ -130,10 +130,24 @@ template <typename T>
 T *xmalloc(size_t n) {
     if (n == 0) n = 1;
     if (n > SIZE_MAX / sizeof(T)) throw std::bad_alloc();
-    T *p = static_cast<T *>(std::malloc(n * sizeof(T)));
-    if (!p) throw std::bad_alloc();
-    want_huge_pages(p, n * sizeof(T));
-    return p;
+    const size_t bytes = n * sizeof(T), huge = (size_t)2 << 20;
+    void *v = nullptr;
+    if (bytes >= 2 * huge && bytes <= SIZE_MAX - huge) {
+        // Whole huge pages: malloc's block starts 16 bytes into its
+        // mapping, so its first and last 2 MiB took 4 KiB faults, which
+        // cost 3.5 times as much per byte as huge ones (22 MB first
+        // touched: 15 ms in 4 KiB pages, 4.3 ms in huge ones). Measured on
+        // the 2M unique factory (forked loads, medians of 21): gltfpack
+        // 29.6 -> 22.9 ms, gltfpack -c 35.6 -> 31.2 ms.
+        const size_t whole = (bytes + huge - 1) & ~(huge - 1);
+        if (posix_memalign(&v, huge, whole) != 0) v = nullptr;
+        if (v) want_huge_pages(v, whole);
+    } else {
+        v = std::malloc(bytes);
+        if (v) want_huge_pages(v, bytes);
+    }
+    if (!v) throw std::bad_alloc();
+    return static_cast<T *>(v);
 }
 
 // ------------------------------------------------------------- images
