@@ -426,6 +426,69 @@ static void test_meshopt(void) {
     expect_refused(nofb, "abcd", 4, "fallback", __LINE__);
 }
 
+/* A 32-bit index view holding two primitives' lists stays one buffer,
+ * owned by the scene, each mesh's indices a part of it (no copy): the
+ * meshes are right, the scene frees it once; an index out of range in the
+ * second list fails the load with one line and frees nothing twice (ASan
+ * runs this too). */
+static void test_meshopt_slices(void) {
+    float pos[48];
+    uint32_t idx[54], two[108];
+    grid(pos, idx);
+    unsigned char vb[1024], ib[1024];
+    size_t vn = meshopt_encodeVertexBuffer(vb, sizeof vb, pos, 16, 12);
+    CHECK(vn > 0);
+    for (int bad = 0; bad < 2; bad++) {
+        for (int i = 0; i < 54; i++) two[i] = idx[i], two[54 + i] = idx[53 - i];
+        if (bad) two[54 + 40] = 16; /* the grid has 16 vertices */
+        size_t in = meshopt_encodeIndexBuffer(ib, sizeof ib, two, 108);
+        CHECK(in > 0);
+        size_t vp = (vn + 3) & ~(size_t)3;
+        unsigned char bin[4096];
+        memset(bin, 0, sizeof bin);
+        memcpy(bin, vb, vn);
+        memcpy(bin + vp, ib, in);
+        char json[4096];
+        snprintf(json, sizeof json,
+                 "{%s\"extensionsUsed\":[\"EXT_meshopt_compression\"],\"extensionsRequired\":[\"EXT_meshopt_compression\"],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":2},"
+                 "{\"attributes\":{\"POSITION\":1},\"indices\":3}]}],"
+                 "\"buffers\":[{\"byteLength\":%zu},{\"byteLength\":1000,\"extensions\":{\"EXT_meshopt_compression\":{\"fallback\":true}}}],"
+                 "\"bufferViews\":[{\"buffer\":1,\"byteLength\":192,\"byteStride\":12,\"extensions\":{\"EXT_meshopt_compression\":"
+                 "{\"buffer\":0,\"byteLength\":%zu,\"byteStride\":12,\"count\":16,\"mode\":\"ATTRIBUTES\"}}},"
+                 "{\"buffer\":1,\"byteOffset\":192,\"byteLength\":432,\"extensions\":{\"EXT_meshopt_compression\":"
+                 "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":4,\"count\":108,\"mode\":\"TRIANGLES\"}}}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":16,\"type\":\"VEC3\"},"
+                 "{\"bufferView\":0,\"componentType\":5126,\"count\":16,\"type\":\"VEC3\"},"
+                 "{\"bufferView\":1,\"componentType\":5125,\"count\":54,\"type\":\"SCALAR\"},"
+                 "{\"bufferView\":1,\"byteOffset\":216,\"componentType\":5125,\"count\":54,\"type\":\"SCALAR\"}]}",
+                 k_head, vp + in, vn, vp, in);
+        if (bad) {
+            expect_refused(json, bin, vp + in, "out of range", __LINE__);
+            continue;
+        }
+        mr_error err = {0};
+        mr_scene *s = load_glb(json, bin, vp + in, &err);
+        CHECK_MSG(s && s->mesh_count == 2, "slices: %s", err.msg);
+        if (!s || s->mesh_count != 2) {
+            mr_scene_destroy(&s);
+            continue;
+        }
+        CHECK_MSG(s->block_count == 1, "%d blocks: the index lists were copied", (int)s->block_count);
+        const mr_mesh *a = &s->meshes[0], *b = &s->meshes[1];
+        CHECK(a->index_count == 54 && b->index_count == 54 && b->indices == a->indices + 54);
+        bool same = a->index_count == 54 && b->index_count == 54;
+        for (int t = 0; same && t < 54; t += 3) /* the codec may rotate a triangle's corners */
+            for (int k = 0; k < 2; k++) {
+                const uint32_t *x = (k ? b : a)->indices + t, *y = two + 54 * k + t;
+                same = same && ((x[0] == y[0] && x[1] == y[1] && x[2] == y[2]) || (x[0] == y[1] && x[1] == y[2] && x[2] == y[0]) ||
+                                (x[0] == y[2] && x[1] == y[0] && x[2] == y[1]));
+            }
+        CHECK_MSG(same, "slices: indices differ");
+        mr_scene_destroy(&s);
+    }
+}
+
 /* gltfpack's layout: one meshopt view holds the vertices (and one the
  * indices) of several primitives, each an accessor at its own offset;
  * these are converted straight into the meshes' arrays. An accessor read by
@@ -1024,6 +1087,7 @@ int main(void) {
     test_glb_lies();
     test_meshopt();
     test_meshopt_shared();
+    test_meshopt_slices();
     test_meshopt_big();
     test_pipeline();
     test_draco();

@@ -12,6 +12,7 @@
 #include <stdint.h>
 
 #include "mr_core.h"
+#include "mr_scene.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -30,6 +31,13 @@ void mr_mesh_recentre_within(float *pos, uint32_t n, const double lo[3], const d
 /* n xyz normals, all finite, made unit length (degenerate ones get a
  * fallback); an already unit one stays bit for bit. */
 void mr_mesh_unit_normals(float *nrm, uint32_t n);
+
+/* Gives s the malloc'd buffer p of n bytes, whose parts are (or will be)
+ * arrays of its meshes: freed when s is, those arrays never on their own.
+ * false (p still the caller's) if out of memory. */
+bool mr_scene_adopt_block(mr_scene *s, void *p, size_t n);
+/* Whether p lies inside one of s's blocks (then it is not to be freed). */
+bool mr_scene_block_holds(mr_scene *s, const void *p);
 
 #ifdef __cplusplus
 }

@@ -14,17 +14,68 @@ mr_scene *mr_scene_create(void) {
     return s;
 }
 
-static void mesh_free(mr_mesh *m) {
-    free(m->positions);
-    free(m->normals);
-    free(m->uvs);
-    free(m->indices);
+/* Blocks: see mr_scene. Kept in address order (sorted when first looked
+ * up after an adoption), so that an array is found in log time. */
+struct mr_scene_block {
+    char *p;
+    size_t n;
+};
+
+static int block_cmp(const void *a, const void *b) {
+    uintptr_t x = (uintptr_t)((const struct mr_scene_block *)a)->p, y = (uintptr_t)((const struct mr_scene_block *)b)->p;
+    return x < y ? -1 : x > y;
+}
+
+bool mr_scene_adopt_block(mr_scene *s, void *p, size_t n) {
+    if (!s || !p) return false;
+    if (s->block_count == s->block_cap) {
+        if (s->block_cap >= INT32_MAX / 2) return false;
+        int32_t cap = s->block_cap ? 2 * s->block_cap : 8;
+        struct mr_scene_block *b = realloc(s->blocks, (size_t)cap * sizeof *b);
+        if (!b) return false;
+        s->blocks = b;
+        s->block_cap = cap;
+    }
+    s->blocks[s->block_count].p = p;
+    s->blocks[s->block_count].n = n;
+    s->block_count++;
+    s->blocks_sorted = false;
+    return true;
+}
+
+bool mr_scene_block_holds(mr_scene *s, const void *p) {
+    if (!s || !p || s->block_count == 0) return false;
+    if (!s->blocks_sorted) {
+        qsort(s->blocks, (size_t)s->block_count, sizeof *s->blocks, block_cmp);
+        s->blocks_sorted = true;
+    }
+    const uintptr_t a = (uintptr_t)p;
+    int32_t lo = 0, hi = s->block_count - 1;
+    while (lo <= hi) { /* the last block starting at or before p */
+        int32_t mid = lo + (hi - lo) / 2;
+        if ((uintptr_t)s->blocks[mid].p <= a) lo = mid + 1;
+        else hi = mid - 1;
+    }
+    return hi >= 0 && a - (uintptr_t)s->blocks[hi].p < s->blocks[hi].n;
+}
+
+static void array_free(mr_scene *s, void *p) {
+    if (!mr_scene_block_holds(s, p)) free(p);
+}
+
+static void mesh_free(mr_scene *s, mr_mesh *m) {
+    array_free(s, m->positions);
+    array_free(s, m->normals);
+    array_free(s, m->uvs);
+    array_free(s, m->indices);
 }
 
 void mr_scene_destroy(mr_scene **scene) {
     if (!scene || !*scene) return;
     mr_scene *s = *scene;
-    for (int32_t i = 0; i < s->mesh_count; i++) mesh_free(&s->meshes[i]);
+    for (int32_t i = 0; i < s->mesh_count; i++) mesh_free(s, &s->meshes[i]);
+    for (int32_t i = 0; i < s->block_count; i++) free(s->blocks[i].p);
+    free(s->blocks);
     for (int32_t i = 0; i < s->texture_count; i++) mr_image_free(&s->textures[i].image);
     free(s->meshes);
     free(s->materials);
