@@ -1063,49 +1063,70 @@ struct Loader {
             }
             for (const Job &j : conv[b].jobs) acc_prep[(size_t)j.v.index].chunked = true;
         }
-        std::deque<Pool::Task> tasks(batch.size());
+        // Three tasks a view: its stream's decoding, then the two halves of
+        // what follows it (per element: the filter's leftovers aside, its
+        // arrays filled and checked), queued behind the decodings not yet
+        // started. So a core that ends a decoding starts the next one and
+        // the halves fill the gaps: no core waits on the other's decoding
+        // while one is queued. Measured on the 2M unique factory (gltfpack
+        // -c): with each view's halves run as soon as it was decoded, a core
+        // sat idle 2.3 of 19 ms while the last one decoded. The half that
+        // ends last gives the arrays their prepare step (which needs both
+        // halves' bounds) and frees the buffer.
+        struct Stage {
+            Pool::Task decode, half[2];
+            bool queued = false;  // the halves were submitted (read after wait(decode))
+            std::atomic<int> left{2};
+        };
+        std::deque<Stage> st(batch.size());
         struct Wait {  // every task ends before batch, conv and the buffers go
             Pool &p;
-            std::deque<Pool::Task> &t;
+            std::deque<Stage> &st;
             size_t n = 0;
-            ~Wait() {
-                for (size_t k = 0; k < n; k++) p.wait(t[k]);
+            void all() {
+                for (size_t k = 0; k < n; k++) {
+                    p.wait(st[k].decode);
+                    if (st[k].queued) {
+                        p.wait(st[k].half[0]);
+                        p.wait(st[k].half[1]);
+                    }
+                }
             }
-        } wait{pool, tasks};
+            ~Wait() { all(); }
+        } wait{pool, st};
         for (size_t k = 0; k < order.size(); k++) {
             const size_t b = order[k];
-            tasks[k].fn = [&, b] {
+            Stage &g = st[k];
+            g.decode.fn = [&, b] {
                 Decode &d = batch[b];
                 d.rc = decode_stream(d, d.out);
                 if (d.rc != 0) return;
-                // What follows the stream's decoding is per element: split
-                // in halves, the second on the pool, so that a core done
-                // with its own views helps with this one's.
-                const size_t fc = d.filter ? d.cnt : 0;
-                split([&](int h) { decode_filter(d, d.out, h ? fc / 2 : 0, h ? fc - fc / 2 : fc / 2); }, fc ? d.out_n : 0);
-                split([&](int h) {
-                    for (const Job &j : conv[b].jobs)
-                        fill_post(j, h ? j.v.count / 2 : 0, h ? j.v.count - j.v.count / 2 : j.v.count / 2, h);
-                }, conv[b].bytes);
-                // Then each array's prepare step, the arrays shared out.
-                const std::vector<Job> &jobs = conv[b].jobs;
-                const std::vector<int> &slices = conv[b].slices;
-                split([&](int h) {
-                    for (size_t k = (size_t)h; k < jobs.size(); k += 2) prep_array(jobs[k].v.index, jobs[k].out, jobs[k].v.count);
+                decode_filter(d, d.out, 0, d.filter ? d.cnt : 0);  // whole: a half's arrays may read the other's elements
+                g.queued = true;
+                pool.submit(&g.half[0]);
+                pool.submit(&g.half[1]);
+            };
+            for (int h = 0; h < 2; h++)
+                g.half[h].fn = [&, b, h] {
+                    Decode &d = batch[b];
+                    const std::vector<Job> &jobs = conv[b].jobs;
+                    const std::vector<int> &slices = conv[b].slices;
+                    for (const Job &j : jobs) fill_post(j, h ? j.v.count / 2 : 0, h ? j.v.count - j.v.count / 2 : j.v.count / 2, h);
                     for (size_t k = (size_t)h; k < slices.size(); k += 2) {
                         const tinygltf::Accessor &a = m.accessors[(size_t)slices[k]];
                         prep_array(slices[k], d.out + a.byteOffset, a.count);
                     }
-                }, jobs.size() + slices.size() > 1 ? conv[b].bytes + conv[b].slice_bytes : 0);
-                if (slices.empty()) {  // its bytes are all converted: gone now, not at the batch's end
-                    std::free(d.out);
-                    d.out = nullptr;
-                }
-            };
-            pool.submit(&tasks[k]);
+                    if (--g.left != 0) return;
+                    for (const Job &j : jobs) prep_array(j.v.index, j.out, j.v.count);
+                    if (slices.empty()) {  // its bytes are all converted: gone now, not at the batch's end
+                        std::free(d.out);
+                        d.out = nullptr;
+                    }
+                };
+            pool.submit(&g.decode);
             wait.n = k + 1;
         }
-        for (size_t k = 0; k < tasks.size(); k++) pool.wait(tasks[k]);
+        wait.all();
         Decode *failed = nullptr;
         for (size_t b = 0; b < batch.size(); b++) {
             Decode &d = batch[b];
@@ -1559,8 +1580,9 @@ struct Loader {
                 if (!mr_mesh_bounds_add(static_cast<float *>(j.out) + 3 * c, cn, p.lo[h], p.hi[h])) p.bad[h] = true;
             } else if (role == k_role_normal && j.n == 3) {
                 float *f = static_cast<float *>(j.out) + 3 * c;
-                bool finite = true;
-                for (size_t i = 0; i < 3 * cn; i++) finite = finite && std::isfinite(f[i]);
+                bool finite = true;  // integers convert to finite floats: only float ones are checked
+                if (j.v.comp == TINYGLTF_COMPONENT_TYPE_FLOAT)
+                    for (size_t i = 0; i < 3 * cn; i++) finite = finite && std::isfinite(f[i]);
                 if (finite) mr_mesh_unit_normals(f, (uint32_t)cn);
                 else p.bad[h] = true;
             } else if (role == k_role_index && j.n == 1) {
