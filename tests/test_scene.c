@@ -434,6 +434,20 @@ static void test_prepare_passes(void) {
                 double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
                 bad_finite += mr_mesh_bounds_add(pos, (size_t)n, lo, hi);
             }
+    /* mr_floats_finite: every length to 150 (vector blocks and tail), a
+     * non-finite value at every place */
+    float fv[150];
+    for (int n = 0; n <= 150; n++) {
+        for (int i = 0; i < n; i++) fv[i] = rnd_unit() * 3e38f;
+        bad_finite += !mr_floats_finite(fv, (size_t)n);
+        for (int at = 0; at < n; at++)
+            for (int kind = 0; kind < 3; kind++) {
+                float keep = fv[at];
+                fv[at] = kind == 0 ? INFINITY : kind == 1 ? -INFINITY : NAN;
+                bad_finite += mr_floats_finite(fv, (size_t)n);
+                fv[at] = keep;
+            }
+    }
     /* the largest index found in every place, also past 2^31 */
     uint32_t idx[23];
     mr_error err = {0};
@@ -451,7 +465,7 @@ static void test_prepare_passes(void) {
     CHECK_MSG(bad_bounds == 0, "bounds differ from the reference in %d cases", bad_bounds);
     CHECK_MSG(bad_recentre == 0, "recentring differs from the reference in %d cases", bad_recentre);
     CHECK_MSG(bad_unit == 0, "unit normals differ from the reference in %d arrays", bad_unit);
-    CHECK_MSG(bad_finite == 0, "%d non-finite positions passed the bounds", bad_finite);
+    CHECK_MSG(bad_finite == 0, "%d non-finite values passed (bounds, finite test)", bad_finite);
     CHECK_MSG(bad_index == 0, "index check wrong in %d cases", bad_index);
 }
 

@@ -1580,9 +1580,8 @@ struct Loader {
                 if (!mr_mesh_bounds_add(static_cast<float *>(j.out) + 3 * c, cn, p.lo[h], p.hi[h])) p.bad[h] = true;
             } else if (role == k_role_normal && j.n == 3) {
                 float *f = static_cast<float *>(j.out) + 3 * c;
-                bool finite = true;  // integers convert to finite floats: only float ones are checked
-                if (j.v.comp == TINYGLTF_COMPONENT_TYPE_FLOAT)
-                    for (size_t i = 0; i < 3 * cn; i++) finite = finite && std::isfinite(f[i]);
+                // integers convert to finite floats: only float ones are checked
+                const bool finite = j.v.comp != TINYGLTF_COMPONENT_TYPE_FLOAT || mr_floats_finite(f, 3 * cn);
                 if (finite) mr_mesh_unit_normals(f, (uint32_t)cn);
                 else p.bad[h] = true;
             } else if (role == k_role_index && j.n == 1) {
@@ -2075,13 +2074,12 @@ struct Loader {
 
     void check_normals(MeshGuard &g, const char *name, bool renormalise) {
         size_t nv = g.m.vertex_count;
-        for (size_t i = 0; i < nv * 3; i++)
-            if (!std::isfinite(g.m.normals[i])) {
-                warning(std::string("mesh '") + name + "' has non-finite normals; regenerated");
-                std::free(g.m.normals);
-                g.m.normals = nullptr;
-                return;
-            }
+        if (!mr_floats_finite(g.m.normals, nv * 3)) {
+            warning(std::string("mesh '") + name + "' has non-finite normals; regenerated");
+            release(g.m.normals);
+            g.m.normals = nullptr;
+            return;
+        }
         if (!renormalise) return;
         // Quantised normals are unit only up to their rounding.
         for (size_t i = 0; i < nv; i++) {
@@ -2092,14 +2090,11 @@ struct Loader {
     }
 
     bool check_uvs(MeshGuard &g, const char *name) {
-        for (size_t i = 0; i < (size_t)g.m.vertex_count * 2; i++)
-            if (!std::isfinite(g.m.uvs[i])) {
-                warning(std::string("mesh '") + name + "' has non-finite texture coordinates; ignored");
-                std::free(g.m.uvs);
-                g.m.uvs = nullptr;
-                return false;
-            }
-        return true;
+        if (mr_floats_finite(g.m.uvs, (size_t)g.m.vertex_count * 2)) return true;
+        warning(std::string("mesh '") + name + "' has non-finite texture coordinates; ignored");
+        release(g.m.uvs);
+        g.m.uvs = nullptr;
+        return false;
     }
 
     // KHR_draco_mesh_compression: the primitive's geometry from its draco

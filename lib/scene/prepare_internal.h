@@ -28,6 +28,8 @@ bool mr_mesh_bounds_add(const float *pos, size_t n, double lo[3], double hi[3]);
  * float bounds in bmin/bmax. */
 void mr_mesh_recentre_within(float *pos, uint32_t n, const double lo[3], const double hi[3], double origin[3], float bmin[3],
                              float bmax[3]);
+/* Every one of n floats finite. */
+bool mr_floats_finite(const float *v, size_t n);
 /* n xyz normals, all finite, made unit length (degenerate ones get a
  * fallback); an already unit one stays bit for bit. */
 void mr_mesh_unit_normals(float *nrm, uint32_t n);

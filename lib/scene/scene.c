@@ -147,11 +147,6 @@ void mr_mesh_generate_normals(const float *positions, uint32_t vertex_count,
     free(acc);
 }
 
-static bool all_finite(const float *v, size_t n) {
-    for (size_t i = 0; i < n; i++)
-        if (!isfinite(v[i])) return false;
-    return true;
-}
 
 /* The prepare step's passes over whole arrays (index check, bounds,
  * recentring, unit normals) were half of a gltfpack file's load CPU on the
@@ -181,6 +176,23 @@ static __m128i nonfinite_mask(__m128 v) {
     return _mm_cmpeq_epi32(_mm_and_si128(_mm_castps_si128(v), e), e);
 }
 #endif
+
+/* A value is finite unless all its exponent bits are set: so whole
+ * vectors are tested at once (the scalar loop, a branch per value, was 5 ms
+ * of the unpacked 2M factory's 70 ms load, and ran twice on its normals). */
+bool mr_floats_finite(const float *v, size_t n) {
+    size_t i = 0;
+#if defined(__SSE2__)
+    for (; i + 64 <= n; i += 64) { /* a verdict every 64 values */
+        __m128i bad = _mm_setzero_si128();
+        for (size_t k = 0; k < 64; k += 4) bad = _mm_or_si128(bad, nonfinite_mask(_mm_loadu_ps(v + i + k)));
+        if (_mm_movemask_epi8(bad)) return false;
+    }
+#endif
+    for (; i < n; i++)
+        if (!isfinite(v[i])) return false;
+    return true;
+}
 
 static void make_unit_scalar(float *nrm, size_t n) {
     for (size_t v = 0; v < n; v++) {
@@ -374,9 +386,9 @@ bool mr_mesh_prepare(mr_mesh *mesh, mr_error *err) {
     if (mesh->index_count > 0 && !mesh->indices)
         return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has an index count but no indices", name);
     if (!mr_mesh_check_indices(mesh->indices, mesh->index_count, mesh->vertex_count, name, err)) return false;
-    if (mesh->normals && !all_finite(mesh->normals, 3 * nv))
+    if (mesh->normals && !mr_floats_finite(mesh->normals, 3 * nv))
         return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite normal", name);
-    if (mesh->uvs && !all_finite(mesh->uvs, 2 * nv))
+    if (mesh->uvs && !mr_floats_finite(mesh->uvs, 2 * nv))
         return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite texture coordinate", name);
     for (int k = 0; k < 3; k++)
         if (!isfinite(mesh->origin[k])) return mr_fail(err, MR_ERR_INVALID, "mesh '%s' has a non-finite origin", name);
