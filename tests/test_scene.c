@@ -347,24 +347,21 @@ static bool ref_bounds(const float *pos, size_t n, double lo[3], double hi[3]) {
     return true;
 }
 
+/* Written apart from scene.c's loop (a test of the same arithmetic, not a
+ * copy): |l2 - 1| is exact near 1, so it is the same band test. */
 static void ref_unit(float *nrm, size_t n) {
-    for (size_t v = 0; v < n; v++) {
-        float *p = nrm + 3 * v;
-        float l2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
-        if (l2 > 1.0f - 0x1p-20f && l2 < 1.0f + 0x1p-20f) continue;
+    for (size_t v = 0; v < 3 * n; v += 3) {
+        float *p = &nrm[v];
+        const float l2 = (p[0] * p[0] + p[1] * p[1]) + p[2] * p[2];
+        if (fabsf(l2 - 1.0f) < 0x1p-20f) continue;
         if (l2 > 1e-30f && l2 < 1e30f) {
-            float inv = 1.0f / sqrtf(l2);
-            p[0] *= inv;
-            p[1] *= inv;
-            p[2] *= inv;
-        } else {
-            double x = p[0], y = p[1], z = p[2], len = sqrt(x * x + y * y + z * z);
-            if (!(len > 1e-300) || !isfinite(len)) {
-                p[0] = 0.0f, p[1] = 1.0f, p[2] = 0.0f;
-            } else {
-                p[0] = (float)(x / len), p[1] = (float)(y / len), p[2] = (float)(z / len);
-            }
+            const float s = 1.0f / sqrtf(l2);
+            for (int k = 0; k < 3; k++) p[k] *= s;
+            continue;
         }
+        const double len = sqrt((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+        const bool ok = len > 1e-300 && isfinite(len);
+        for (int k = 0; k < 3; k++) p[k] = ok ? (float)(p[k] / len) : (k == 1 ? 1.0f : 0.0f);
     }
 }
 
