@@ -106,7 +106,7 @@ struct MeshGuard {
     MeshGuard() { std::memset(&m, 0, sizeof m); }
     ~MeshGuard() {
         for (void *p : {(void *)m.positions, (void *)m.normals, (void *)m.uvs, (void *)m.indices})
-            if (!mr_scene_block_holds(blocks, p)) std::free(p);
+            mr_scene_array_free(blocks, p);
     }
     MeshGuard(const MeshGuard &) = delete;
     MeshGuard &operator=(const MeshGuard &) = delete;
@@ -1443,9 +1443,7 @@ struct Loader {
     }
 
     // Frees an array the loader holds, unless it is part of a scene block.
-    void release(void *p) {
-        if (!mr_scene_block_holds(s, p)) std::free(p);
-    }
+    void release(void *p) { mr_scene_array_free(s, p); }
 
     // A mesh array. In a big file, one of 64 KiB to 4 MiB is carved from
     // a 32 MiB block of whole huge pages that the scene owns

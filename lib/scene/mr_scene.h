@@ -106,8 +106,9 @@ typedef struct mr_scene {
     char shadow_method[16];  /* the scene config's "shadows" (a method name the
                                 renderer parses), "" = not given: off */
     /* Internal (scene.c): buffers that each hold several meshes' arrays
-     * (a compressed glTF file's decoded index lists), freed with the scene;
-     * an array inside one is not freed on its own. */
+     * (a compressed glTF file's decoded index lists, a big file's
+     * medium-sized arrays), freed with the scene; an array inside one is
+     * not freed on its own. */
     struct mr_scene_block *blocks;
     int32_t block_count, block_cap;
     bool blocks_sorted;

@@ -40,6 +40,9 @@ void mr_mesh_unit_normals(float *nrm, uint32_t n);
 bool mr_scene_adopt_block(mr_scene *s, void *p, size_t n);
 /* Whether p lies inside one of s's blocks (then it is not to be freed). */
 bool mr_scene_block_holds(mr_scene *s, const void *p);
+/* A mesh array let go: freed, unless it lies inside one of s's blocks
+ * (s may be NULL: then always freed). */
+void mr_scene_array_free(mr_scene *s, void *p);
 
 #ifdef __cplusplus
 }

@@ -59,15 +59,15 @@ bool mr_scene_block_holds(mr_scene *s, const void *p) {
     return hi >= 0 && a - (uintptr_t)s->blocks[hi].p < s->blocks[hi].n;
 }
 
-static void array_free(mr_scene *s, void *p) {
+void mr_scene_array_free(mr_scene *s, void *p) {
     if (!mr_scene_block_holds(s, p)) free(p);
 }
 
 static void mesh_free(mr_scene *s, mr_mesh *m) {
-    array_free(s, m->positions);
-    array_free(s, m->normals);
-    array_free(s, m->uvs);
-    array_free(s, m->indices);
+    mr_scene_array_free(s, m->positions);
+    mr_scene_array_free(s, m->normals);
+    mr_scene_array_free(s, m->uvs);
+    mr_scene_array_free(s, m->indices);
 }
 
 void mr_scene_destroy(mr_scene **scene) {
@@ -156,7 +156,7 @@ void mr_mesh_generate_normals(const float *positions, uint32_t vertex_count,
  * (phases x y z x | y z x y | z x y z). The vector forms give the scalar
  * loops' values exactly: the same IEEE operations per element in the same
  * order, exact min/max and finite tests; only the sign of a zero bound may
- * differ (-0 == +0). tests/test_prepare.c holds them to that. */
+ * differ (-0 == +0). tests/test_scene.c holds them to that. */
 #if defined(__SSE2__)
 #include <emmintrin.h>
 
