@@ -27,7 +27,7 @@
 #define MR_ATTR_INSTANCE_SLOTS             9
 #define MR_ATTR_OUTLINE_DIR                1  /* ao_outline: integrated normal */
 #define MR_ATTR_CURVATURE                  3  /* ghost_curv: per-vertex curvature */
-/* The UI's 2D vertices (pass_ui.c). */
+/* The UI's 2D vertices (lib/window/draw2d.c). */
 #define MR_ATTR_UI_POS                     0
 #define MR_ATTR_UI_UV                      1
 #define MR_ATTR_UI_COLOR                   2

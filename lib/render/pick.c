@@ -35,3 +35,5 @@ bool mr_renderer_pick(mr_renderer *r, double x, double y, mr_pick *out, mr_error
     out->layer = (int)ids[1];
     return true;
 }
+
+uint32_t mr_renderer_frame_texture(const mr_renderer *r) { return r && r->last.valid ? r->last.tex : 0; }

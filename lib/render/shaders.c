@@ -135,3 +135,5 @@ GLuint mr_gl_program(const char *const *files, mr_error *err) {
     }
     return prog;
 }
+
+uint32_t mr_gpu_program(const char *const *files, mr_error *err) { return mr_gl_program(files, err); }

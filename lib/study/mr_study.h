@@ -13,7 +13,8 @@
  *
  * Depends on: lib/core; lib/session (the durable line append); lib/ui (the
  * run controller's widgets); lib/eval (CSV, SVG plots, ray-traced AO); lib/render
- * and lib/scene for the stimuli and plain types (mr_event). One way only.
+ * and lib/scene for the stimuli; lib/window for the run window, its events
+ * (mr_event) and its 2D layer. One way only.
  */
 #ifndef MR_STUDY_H
 #define MR_STUDY_H
@@ -21,6 +22,7 @@
 #include "mr_core.h"
 #include "mr_render.h"
 #include "mr_ui.h"
+#include "mr_window.h"
 
 #ifdef __cplusplus
 extern "C" {

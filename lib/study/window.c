@@ -5,7 +5,6 @@
  * that the command is only its flags. */
 #include "mr_study.h"
 
-#include "mr_view.h" /* mr_view_draw_ui: the UI's draw list through the 2D layer */
 
 #include <stdlib.h>
 #include <string.h>
@@ -52,7 +51,7 @@ static void run_frame(run_app *a, bool *quit) {
         if (!mr_draw2d_image_draw(a->d2, a->tex[f.image_method[i] * S + tr->stimulus], r.x, r.y, r.w, r.h, &err))
             mr_log(MR_LOG_ERROR, "study run: %s", err.msg);
     }
-    mr_view_draw_ui(a->d2, dl, "study run");
+    mr_draw2d_ui(a->d2, dl, "study run");
     if (f.shot_path[0] || f.state_path[0]) {
         mr_image screen = {0};
         if (f.shot_path[0] && mr_draw2d_read(a->d2, &screen, &err) && !mr_image_save_png(f.shot_path, &screen, &err))

@@ -11,8 +11,9 @@
  * (inputs, snapshots, marks, script shots and states).
  *
  * Depends on: lib/core, lib/ui, lib/track's mr_pose_point_sigma (pure
- * math: the "± N mm here" of the status line), and from lib/render only plain types and
- * names (mr_event, MR_KEY_*, mr_ao_method, mr_ghost_mode,
+ * math: the "± N mm here" of the status line), lib/window's plain events
+ * (mr_event, MR_KEY_*), and from lib/render only plain types and
+ * names (mr_ao_method, mr_ghost_mode,
  * mr_ao_method_name/parse, the option tables' enum names): no GL or GLFW call. One way only: nothing
  * below lib/view includes this header.
  * mark.c (the marking and render decisions moved out of app/cmd_view.c)
@@ -20,8 +21,8 @@
  * mr_frame_params and mr_shadow_method_parse, and lib/session's plain
  * types (mr_capture_frame, mr_annotation: a mark's line and the frame's
  * render setup, DESIGN.md's view -> session). run.c (the window loop,
- * moved out of app/cmd_view.c) adds lib/render's window, renderer and 2D
- * layer (opaque handles: no GL type), lib/session's capture, snapshots and
+ * moved out of app/cmd_view.c) adds lib/window's window and 2D layer and
+ * lib/render's renderer (opaque handles: no GL type), lib/session's capture, snapshots and
  * marks, lib/track's camera and marker-map files, lib/scene's loader and LOD builder; not
  * lib/eval (Measure's search is the caller's, mr_view_nearest_fns). */
 #ifndef MR_VIEW_CTL_H
@@ -31,6 +32,7 @@
 #include "mr_render.h"
 #include "mr_session.h"
 #include "mr_ui.h"
+#include "mr_window.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -410,10 +412,6 @@ extern const mr_view_key_help mr_view_keymap[];
 extern const int mr_view_keymap_count;
 
 /* ------------------------------------------------- the window (run.c) */
-
-/* Draws a UI draw list (lib/ui's vertices have draw2d's layout) with the
- * window's 2D layer; errors are logged with `cmd`'s name. */
-void mr_view_draw_ui(mr_draw2d *d2, const mr_ui_draw_list *dl, const char *cmd);
 
 /* Where the frames come from, and the files they are tracked with. */
 typedef struct mr_view_source_params {

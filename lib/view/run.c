@@ -3,8 +3,8 @@
  * events and carries its actions out: renders with lib/render, writes
  * snapshots and annotations. It lives here rather than in app/ so that the
  * command is only its flags; everything it touches goes through the public
- * headers of lib/render (window, renderer, 2D layer: no GL type),
- * lib/session and lib/ui. The planned surface that Measure needs comes from
+ * headers of lib/window (window, events, 2D layer), lib/render (renderer:
+ * no GL type), lib/session and lib/ui. The planned surface that Measure needs comes from
  * the caller (mr_view_nearest_fns): lib/eval is above lib/view. */
 #include "mr_view.h"
 
@@ -14,18 +14,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-
-/* The UI's vertices are handed to the renderer as they are. */
-_Static_assert(sizeof(mr_ui_vertex) == sizeof(mr_draw2d_vertex), "vertex layouts differ");
-_Static_assert(offsetof(mr_ui_vertex, u) == offsetof(mr_draw2d_vertex, u), "vertex layouts differ");
-_Static_assert(offsetof(mr_ui_vertex, rgba) == offsetof(mr_draw2d_vertex, rgba), "vertex layouts differ");
-
-void mr_view_draw_ui(mr_draw2d *d2, const mr_ui_draw_list *dl, const char *cmd) {
-    mr_draw2d_list l = {(const mr_draw2d_vertex *)dl->vertices, dl->vertex_count, dl->indices, dl->index_count,
-                        dl->atlas, dl->atlas_w, dl->atlas_h, dl->atlas_version};
-    mr_error err = {0};
-    if (!mr_draw2d_list_draw(d2, &l, &err)) mr_log(MR_LOG_ERROR, "%s: %s", cmd, err.msg);
-}
 
 /* Camera, marker map and fixed pose from the flags (or the recording). */
 static bool source_load(const mr_view_source_params *p, mr_view_source *out, mr_error *err) {
@@ -442,7 +430,7 @@ static void frame_tick(view_app *a) {
     carry_out(a, &acts);
     a->sum_ui_cpu_ms += mr_ui_last_cpu_s(mr_viewer_ui_ctx(a->vc)) * 1e3;
     double t3 = mr_time_now();
-    mr_view_draw_ui(a->d2, dl, "view");
+    mr_draw2d_ui(a->d2, dl, "view");
     a->sum_ui_draw_ms += (mr_time_now() - t3) * 1e3;
     read_screen(a);
     mr_window_swap(a->win);

@@ -1,10 +1,10 @@
-/* The GLFW window context: an OpenGL 4.5 core window whose context the
- * renderer wraps with mr_gpu_create_current. Input arrives through GLFW
- * callbacks and is queued as plain mr_event structs in framebuffer pixels
- * (HiDPI: window coordinates times the framebuffer/window ratio), so nothing
- * above lib/render sees GLFW. Touch screens reach X11/Wayland clients as an
+/* The GLFW window: an OpenGL 4.5 core window whose context the renderer
+ * wraps with mr_gpu_create_current. Input arrives through GLFW callbacks
+ * and is queued as plain mr_event structs in framebuffer pixels (HiDPI:
+ * window coordinates times the framebuffer/window ratio), so nothing
+ * outside this file sees GLFW. Touch screens reach X11/Wayland clients as an
  * emulated pointer, which is what the UI is built for. */
-#include "gpu_internal.h"
+#include "mr_window.h"
 
 #include <math.h>
 #include <stdlib.h>

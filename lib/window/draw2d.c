@@ -2,11 +2,16 @@
  * rectangle of the window, then the touch UI's draw list on top, both with
  * one small program. Vertices stream through one buffer that grows as
  * needed; the atlas is uploaded only when its version changes. */
-#include "render_internal.h"
+#include "window_internal.h"
 
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* UI vertices are drawn as they are. */
+_Static_assert(sizeof(mr_ui_vertex) == sizeof(mr_draw2d_vertex), "vertex layouts differ");
+_Static_assert(offsetof(mr_ui_vertex, u) == offsetof(mr_draw2d_vertex, u), "vertex layouts differ");
+_Static_assert(offsetof(mr_ui_vertex, rgba) == offsetof(mr_draw2d_vertex, rgba), "vertex layouts differ");
 
 struct mr_draw2d {
     mr_gpu *gpu;
@@ -17,6 +22,17 @@ struct mr_draw2d {
     int atlas_w, atlas_h;
     int fb_w, fb_h;
 };
+
+static GLuint make_tex(GLenum fmt, int w, int h, GLenum filter) {
+    GLuint t;
+    glCreateTextures(GL_TEXTURE_2D, 1, &t);
+    glTextureStorage2D(t, 1, fmt, w, h);
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, filter);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, filter);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return t;
+}
 
 mr_draw2d *mr_draw2d_create(mr_gpu *gpu, mr_error *err) {
     if (!gpu) {
@@ -30,7 +46,7 @@ mr_draw2d *mr_draw2d_create(mr_gpu *gpu, mr_error *err) {
     }
     d->gpu = gpu;
     static const char *const files[] = {"ui.vert.glsl", "ui.frag.glsl", NULL};
-    if (!(d->prog = mr_gl_program(files, err))) {
+    if (!(d->prog = mr_gpu_program(files, err))) {
         free(d);
         return NULL;
     }
@@ -127,8 +143,9 @@ static bool textured_quad(mr_draw2d *d, GLuint tex, float x, float y, float w, f
 }
 
 bool mr_draw2d_frame(mr_draw2d *d, mr_renderer *r, float x, float y, float w, float h, mr_error *err) {
-    if (!r || !r->last.valid) return mr_fail(err, MR_ERR_INVALID, "no rendered frame to show");
-    return textured_quad(d, r->last.tex, x, y, w, h, "the frame", err);
+    GLuint tex = mr_renderer_frame_texture(r);
+    if (!tex) return mr_fail(err, MR_ERR_INVALID, "no rendered frame to show");
+    return textured_quad(d, tex, x, y, w, h, "the frame", err);
 }
 
 struct mr_draw2d_image {
@@ -148,7 +165,7 @@ mr_draw2d_image *mr_draw2d_image_create(mr_draw2d *d, const mr_image *img, mr_er
     }
     /* sRGB storage: the 2D program decodes on sampling and re-encodes, so
      * the pixels reach the window as they are in the file. */
-    im->tex = mr_gl_make_tex(GL_SRGB8_ALPHA8, img->width, img->height, GL_LINEAR);
+    im->tex = make_tex(GL_SRGB8_ALPHA8, img->width, img->height, GL_LINEAR);
     static const GLenum fmts[5] = {0, GL_RED, 0, GL_RGB, GL_RGBA};
     if (img->channels == 1) {
         const GLint swz[4] = {GL_RED, GL_RED, GL_RED, GL_ONE};
@@ -183,7 +200,7 @@ bool mr_draw2d_list_draw(mr_draw2d *d, const mr_draw2d_list *l, mr_error *err) {
     if (!l->atlas || l->atlas_w <= 0 || l->atlas_h <= 0) return mr_fail(err, MR_ERR_INVALID, "2D list without an atlas");
     if (!d->atlas || d->atlas_version != l->atlas_version || d->atlas_w != l->atlas_w || d->atlas_h != l->atlas_h) {
         glDeleteTextures(1, &d->atlas);
-        d->atlas = mr_gl_make_tex(GL_R8, l->atlas_w, l->atlas_h, GL_LINEAR);
+        d->atlas = make_tex(GL_R8, l->atlas_w, l->atlas_h, GL_LINEAR);
         glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
         glTextureSubImage2D(d->atlas, 0, 0, 0, l->atlas_w, l->atlas_h, GL_RED, GL_UNSIGNED_BYTE, l->atlas);
         d->atlas_version = l->atlas_version;
@@ -227,4 +244,11 @@ bool mr_draw2d_read(mr_draw2d *d, mr_image *out, mr_error *err) {
         return mr_fail(err, MR_ERR_GL, "GL error 0x%x reading the window", e);
     }
     return true;
+}
+
+void mr_draw2d_ui(mr_draw2d *d, const mr_ui_draw_list *dl, const char *cmd) {
+    mr_draw2d_list l = {(const mr_draw2d_vertex *)dl->vertices, dl->vertex_count, dl->indices, dl->index_count,
+                        dl->atlas, dl->atlas_w, dl->atlas_h, dl->atlas_version};
+    mr_error err = {0};
+    if (!mr_draw2d_list_draw(d, &l, &err)) mr_log(MR_LOG_ERROR, "%s: %s", cmd, err.msg);
 }
