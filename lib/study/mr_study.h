@@ -295,6 +295,76 @@ bool mr_study_bt_fit(const double *w, int t, const mr_study_fit_params *p, mr_st
 bool mr_study_davidson_fit(const double *w, const double *ties, int t, const mr_study_fit_params *p,
                            mr_study_scores *out, mr_error *err);
 
+/* ------------------------------------- inferential statistics (infer.c) */
+
+/* Distributions. Regularized incomplete beta I_x(a, b); the two-sided p of
+ * Student's t; the upper tails of F and chi-square; the normal CDF. */
+double mr_stat_beta_inc(double a, double b, double x);
+double mr_stat_t_p2(double t, double df);
+double mr_stat_f_sf(double F, double d1, double d2);
+double mr_stat_chi2_sf(double x, double k);
+double mr_stat_normal_cdf(double z);
+
+/* Multiple-comparison adjustment of m p-values (out may be p). */
+typedef enum mr_study_adjust { MR_STUDY_ADJUST_NONE = 0, MR_STUDY_ADJUST_BONFERRONI, MR_STUDY_ADJUST_HOLM } mr_study_adjust;
+void mr_study_p_adjust(const double *p, int m, mr_study_adjust how, double *out);
+const char *mr_study_adjust_name(mr_study_adjust a); /* "none", "bonferroni", "holm" */
+
+/* Paired t-test of x - y (two-sided). false when n < 2. */
+typedef struct mr_study_ttest {
+    int n;
+    double mean_diff, sd_diff, t, df, p;
+} mr_study_ttest;
+bool mr_study_paired_t(const double *x, const double *y, int n, mr_study_ttest *out);
+
+/* One-way repeated-measures ANOVA of y[i*k + j] (participant i, condition
+ * j; complete cases): F on (k-1, (k-1)(n-1)) df, Mauchly's test of
+ * sphericity (W, Bartlett's chi^2 on k(k-1)/2 - 1 df, its p with
+ * Anderson's second-order term as SPSS gives it), the
+ * Greenhouse-Geisser and Huynh-Feldt epsilons (HF capped at 1) and the p
+ * of F on the corrected df. */
+#define MR_STUDY_MAX_CONDITIONS 16
+typedef struct mr_study_rm_anova_result {
+    int n, k;
+    double mean[MR_STUDY_MAX_CONDITIONS];
+    double ss_cond, ss_subj, ss_error;
+    double df1, df2, F, p, eta_p2;   /* eta_p2: partial eta squared */
+    double mauchly_w, mauchly_chi2, mauchly_df, mauchly_p; /* p NaN when n - 1 < k - 1 */
+    double eps_gg, eps_hf, eps_lb;
+    double p_gg, p_hf;
+} mr_study_rm_anova_result;
+bool mr_study_rm_anova(const double *y, int n, int k, mr_study_rm_anova_result *out, mr_error *err);
+
+/* D'Agostino-Pearson K^2 omnibus normality test (skewness after
+ * D'Agostino 1970, kurtosis after Anscombe & Glynn 1983); needs n >= 8. */
+typedef struct mr_study_normality_result {
+    int n;
+    double z_skew, z_kurt, k2, p;
+} mr_study_normality_result;
+bool mr_study_normality(const double *x, int n, mr_study_normality_result *out);
+
+/* Friedman's test of y[i*k + j] (mid-ranks within each participant, the
+ * tie correction applied): chi^2 on k - 1 df; Kendall's W = chi^2/(n(k-1)). */
+typedef struct mr_study_friedman_result {
+    int n, k;
+    double chi2, df, p, kendall_w;
+    double mean_rank[MR_STUDY_MAX_CONDITIONS];
+} mr_study_friedman_result;
+bool mr_study_friedman(const double *y, int n, int k, mr_study_friedman_result *out, mr_error *err);
+
+/* Wilcoxon's signed-rank test of x - y (two-sided): zero differences
+ * dropped (Wilcoxon's rule), mid-ranks for ties; the exact null
+ * distribution when n <= MR_STUDY_WILCOXON_EXACT_MAX and there are no ties
+ * and no zeros, else the normal approximation (tie-corrected variance,
+ * continuity correction). z is always the normal approximation's. */
+#define MR_STUDY_WILCOXON_EXACT_MAX 50
+typedef struct mr_study_wilcoxon_result {
+    int n, zeros;            /* n: non-zero differences */
+    double w_plus, w_minus, z, p;
+    bool exact;
+} mr_study_wilcoxon_result;
+bool mr_study_wilcoxon(const double *x, const double *y, int n, mr_study_wilcoxon_result *out);
+
 /* ------------------------------------------------------------ analysis */
 
 typedef struct mr_study_analyze_params {
