@@ -1,5 +1,5 @@
-/* mrcheck study {stimuli,plan,run,analyze}: pairwise comparison studies
- * (Hecher's design and analysis). Wiring only: lib/study does the work,
+/* mrcheck study {stimuli,plan,run,analyze}: the pairwise (Hecher), rating
+ * (Scheer & Keutel) and task (Kalkofen et al.) designs. Wiring only: lib/study does the work,
  * `run`'s window included (mr_study_window_run). */
 #include "app.h"
 
@@ -43,7 +43,9 @@ static int study_plan(int argc, char **argv) {
     mr_study_plan_params pp = MR_STUDY_PLAN_DEFAULTS;
     mr_cli_opt opts[] = {
         {"out", "PLAN.json", "the plan file (required)", NULL},
-        {"blocks", "I,II,III", "blocks in the plan (default I,II,III with a reference, I without); II shows the reference", NULL},
+        {"blocks", "I,II,III", "blocks in the plan (default I,II,III with a reference, I without; rating, task: I,II "
+                               "= the condition folders present); II shows the reference", NULL},
+        {"scales", "A,B,..", "rating: the scales (default Scheer & Keutel's eight depth cues)", NULL},
         {"verbose", NULL, "more log output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -53,7 +55,8 @@ static int study_plan(int argc, char **argv) {
     int npos = 0;
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, tables, 1, pos, 1, &npos,
-                          "usage: mrcheck study plan DIR --out plan.json [--seed S] [--blocks I,II,III] [--fixation-ms 2000]",
+                          "usage: mrcheck study plan DIR --out plan.json [--design pairwise|rating|task] [--participants N] "
+                          "[--seed S] [--blocks I,II,III] [--fixation-ms 2000]",
                           &help))
         return 2;
     if (help) return 0;
@@ -64,16 +67,15 @@ static int study_plan(int argc, char **argv) {
     mr_error err = {0};
     if (mr_cli_get(opts, "blocks") && !mr_study_blocks_parse(mr_cli_get(opts, "blocks"), &pp.blocks, &err))
         return mr_cli_error(cmd, &err), 2;
-    mr_study_set set;
+    pp.scales = mr_cli_get(opts, "scales");
     mr_study_plan plan;
-    if (!mr_study_scan(pos[0], &set, &err)) return mr_cli_error(cmd, &err);
-    bool ok = mr_study_plan_make(pos[0], &set, &pp, &plan, &err) && mr_study_plan_save(out, &plan, &err);
-    mr_study_set_free(&set);
+    bool ok = mr_study_plan_scan_make(pos[0], &pp, &plan, &err) && mr_study_plan_save(out, &plan, &err);
     if (!ok) return mr_cli_error(cmd, &err);
-    printf("study plan %s: %d trials (%d methods%s, %d stimuli, blocks", plan.id, plan.trial_count,
+    printf("study plan %s (%s): %d trials per participant, %d schedule%s (%d methods%s, %d stimuli, blocks", plan.id,
+           mr_study_design_names[plan.design], plan.trial_count, plan.schedule_count, plan.schedule_count > 1 ? "s" : "",
            plan.set.method_count, plan.set.reference >= 0 ? " with the reference" : "", plan.set.stimulus_count);
     for (int b = 1; b <= MR_STUDY_MAX_BLOCKS; b++)
-        if (plan.blocks & (1u << (b - 1))) printf(" %s", mr_study_block_name(b));
+        if (plan.blocks & (1u << (b - 1))) printf(" %s", mr_study_condition_name(plan.design, b));
     printf(") -> %s\n", out);
     mr_study_plan_free(&plan);
     return 0;
@@ -109,7 +111,15 @@ static int study_analyze(int argc, char **argv) {
     mr_study_votes votes = {0};
     bool ok = true;
     for (int i = 0; ok && i < npos; i++) ok = mr_study_votes_read(pos[i], false, &votes, &err);
-    ok = ok && mr_study_analyze(&votes, have_plan ? &plan : NULL, &ap, out, &err);
+    bool other = have_plan && plan.design != MR_STUDY_PAIRWISE;
+    for (int i = 0; ok && !have_plan && i < votes.count; i++)
+        if (votes.v[i].design != MR_STUDY_PAIRWISE)
+            ok = mr_fail(&err, MR_ERR_INVALID, "%s answers need their plan: give --plan plan.json",
+                         mr_study_design_names[votes.v[i].design]);
+    if (ok && other)
+        ok = plan.design == MR_STUDY_RATING ? mr_study_analyze_rating(&votes, &plan, &ap, out, &err)
+                                            : mr_study_analyze_task(&votes, &plan, &ap, out, &err);
+    else ok = ok && mr_study_analyze(&votes, have_plan ? &plan : NULL, &ap, out, &err);
     int n = votes.count;
     mr_study_votes_free(&votes);
     if (have_plan) mr_study_plan_free(&plan);
@@ -130,6 +140,7 @@ static int study_run(int argc, char **argv) {
         {"fullscreen", NULL, "start fullscreen", NULL},
         {"ui-scale", "S", "scale the UI beyond the screen's density (default 1)", NULL},
         {"script", "FILE", "timed input (tests): see lib/study/mr_study.h", NULL},
+        {"group", "A|B", "a shared pairwise plan's block III question: A looks better (default), B plausible", NULL},
         {"verbose", NULL, "more log output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -154,6 +165,9 @@ static int study_run(int argc, char **argv) {
     wp.fullscreen = mr_cli_flag(opts, "fullscreen");
     wp.ui_scale = 1.0;
     wp.script_path = mr_cli_get(opts, "script");
+    const char *g = mr_cli_get(opts, "group");
+    if (g && strcmp(g, "A") && strcmp(g, "B")) return mr_cli_errorf(cmd, "--group is A or B"), 2;
+    wp.group = !g ? 0 : !strcmp(g, "A") ? MR_STUDY_GROUP_A : MR_STUDY_GROUP_B;
     wp.out = stdout;
     if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &wp.width, &wp.height)) return 2;
     if (mr_cli_get(opts, "ui-scale") && !mr_cli_double("ui-scale", mr_cli_get(opts, "ui-scale"), 0.25, 8, &wp.ui_scale)) return 2;
@@ -168,9 +182,10 @@ int cmd_study(int argc, char **argv) {
         const char *help;
     } subs[] = {
         {"stimuli", study_stimuli, "render one image per method and stimulus: DIR/<method>/<stimulus>.png"},
-        {"plan", study_plan, "all pairs + an identical pair per stimulus, random order and sides, blocks I-III"},
+        {"plan", study_plan, "pairwise (Hecher), rating (Scheer & Keutel) or task (Kalkofen et al.) trials per participant"},
         {"run", study_run, "the study window for one participant (resumes a killed run)"},
-        {"analyze", study_analyze, "consistence, agreement, indifference, binomial tests, Bradley-Terry/Davidson scores"},
+        {"analyze", study_analyze, "pairwise: consistence, agreement, indifference, binomial tests, Davidson scores; "
+                                   "rating: RM-ANOVA, post hoc, paired t; task: scores, RM-ANOVA or Friedman + Wilcoxon"},
     };
     const char *sub = argc >= 3 ? argv[2] : NULL;
     if (!sub || !strcmp(sub, "--help") || !strcmp(sub, "-h")) {

@@ -45,7 +45,7 @@ cmp -s "$tmp/sh/hard/simple_varying_overlap_v0.png" "$tmp/sh/reference/simple_va
 # The default blocks I,II,III: block II shows the reference, so it needs one.
 "$mr" study plan "$tmp/sh" --out "$tmp/plan_sh.json" --seed 2 --fixation-ms 50 >"$tmp/psh.log" 2>&1 && ok || bad "plan of shadows: $(cat "$tmp/psh.log")"
 # 5 methods: C(5,2) = 10 pairs + 1 identical per stimulus, 3 stimuli, 3 blocks.
-grep -q "99 trials (5 methods with the reference, 3 stimuli, blocks I II III)" "$tmp/psh.log" && ok ||
+grep -q "99 trials per participant, 1 schedule (5 methods with the reference, 3 stimuli, blocks I II III)" "$tmp/psh.log" && ok ||
   bad "plan of shadows: expected blocks I,II,III with 99 trials: $(cat "$tmp/psh.log")"
 expect_fail stim_cases "" -- "$mr" study stimuli --family shadows --out "$tmp/sx" --cases 9
 

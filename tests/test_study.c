@@ -487,7 +487,7 @@ static void test_analyze(void) {
     free(text);
     snprintf(path, sizeof path, "%s/agreement.csv", out);
     text = mr_file_read(path, &size, 0, &err);
-    CHECK(text && strstr(text, "\nI,s1,1.000000,0.000000,1,0,30,4,5\n")); /* total agreement, p5 saw a difference */
+    CHECK(text && strstr(text, "\nI,s1,1.000000,0.000000,0.000000,1,0,30,4,5\n")); /* total agreement, p5 saw a difference */
     free(text);
     snprintf(path, sizeof path, "%s/participants.csv", out);
     text = mr_file_read(path, &size, 0, &err);

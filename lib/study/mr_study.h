@@ -108,46 +108,141 @@ bool mr_study_stimuli_render(mr_renderer *r, const mr_study_stimuli_params *p, c
 
 /* ---------------------------------------------------------------- plan */
 
+/* The three designs one plan, runner and vote log serve:
+ *  - pairwise (Hecher): pairs of methods, blocks I-III, DIR/<method>/<stimulus>.png;
+ *  - rating (Scheer & Keutel): one image rated 1..7 (or "X": no judgement)
+ *    on named scales; block I shows the virtual rendering, block II the
+ *    same with the camera image blended at alpha 0.5;
+ *  - task (Kalkofen et al.): one image and a question with a right answer
+ *    (which of two marked hidden objects is nearer; tap where the hidden
+ *    pipe crosses the wall); block I the conflicting-colour scenes
+ *    (Experiment 1), block II the non-conflicting ones (Experiment 2).
+ * Rating and task stimuli are DIR/<condition>/<method>/<stimulus>.png with
+ * the conditions named by mr_study_condition_name; a task condition folder
+ * also holds answers.json (see mr_study_key). */
+typedef enum mr_study_design { MR_STUDY_PAIRWISE = 0, MR_STUDY_RATING, MR_STUDY_TASK } mr_study_design;
+extern const char *const mr_study_design_names[];  /* "pairwise", "rating", "task", NULL */
+/* A block's condition: pairwise "I", "II", "III"; rating "virtual",
+ * "video"; task "conflict", "no-conflict"; "?" otherwise. */
+const char *mr_study_condition_name(mr_study_design d, int block);
+/* The category of a stimulus: its name up to the last '.' ("fence.a" ->
+ * "fence"), or the whole name without a '.'. Two stimuli of one category
+ * are its two scenes (Hecher's design alternates them between blocks). */
+void mr_study_category_of(const char *stimulus, char *out, size_t n);
+
+/* Block III's question per participant group (thesis sec. 4.3). */
+typedef enum mr_study_group { MR_STUDY_GROUP_NONE = 0, MR_STUDY_GROUP_A, MR_STUDY_GROUP_B } mr_study_group;
+const char *mr_study_group_name(mr_study_group g); /* "", "A", "B" */
+/* The question of a pairwise block: "better" (I, III group A) or
+ * "plausible" (II, III group B). */
+const char *mr_study_question_of(int block, mr_study_group g);
+
+#define MR_STUDY_MAX_SCALES 8
+/* Scheer & Keutel's depth cues, the rating design's default scales. */
+#define MR_STUDY_DEFAULT_SCALES \
+    "occlusion,contrast,light_and_shadow,relative_brightness,linear_perspective,relative_size,detail_perspective,aerial_perspective"
+
+/* The right answer of a task stimulus, from DIR/<condition>/answers.json:
+ * {"<stimulus>": {"question": "nearer", "text": "...", "labels": ["A","B"], "correct": "A"}
+ *                 | {"question": "crossing", "text": "...", "x": px, "y": px, "units_per_px": u}}
+ * (x, y in image pixels; units_per_px: scene units per pixel at the
+ * answer's depth, so a tap error converts to scene units). */
+typedef enum mr_study_question { MR_STUDY_Q_NONE = 0, MR_STUDY_Q_CHOICE, MR_STUDY_Q_TAP } mr_study_question;
+typedef struct mr_study_key {
+    mr_study_question question;
+    char text[160];
+    char labels[2][32];
+    int correct;              /* choice: 0 or 1 */
+    double x, y, units_per_px;
+} mr_study_key;
+
 typedef struct mr_study_trial {
     int block;                /* 1..3 */
     int stimulus;             /* index into the plan's stimuli */
-    int left, right;          /* method indices; equal for an identical pair */
+    int left, right;          /* pairwise: method indices, equal for an identical pair;
+                                 rating, task: left is the method, right = left */
 } mr_study_trial;
+
+/* One participant's trials (a plan made with participants > 0), or the
+ * one schedule everyone shares (id ""). */
+typedef struct mr_study_schedule {
+    char id[MR_STUDY_NAME_MAX];
+    mr_study_group group;
+    int trial_count;
+    mr_study_trial *trials;
+} mr_study_schedule;
 
 typedef struct mr_study_plan_params {
     int seed;                 /* default 1 */
     int fixation_ms;          /* fixation cross before each trial; default 2000 */
-    unsigned blocks;          /* mask (bit b-1: block b); 0 = I,II,III with a reference, I without */
+    unsigned blocks;          /* mask (bit b-1: block b); 0 = I,II,III with a reference, I without
+                                 (rating, task: every condition folder present) */
+    int design;               /* mr_study_design; default pairwise */
+    int participants;         /* > 0: one schedule per participant P01.. with its own order
+                                 (pairwise: its own scene per block and a balanced group);
+                                 0: one schedule shared by all; default 0 */
+    const char *scales;       /* rating: comma-separated scale names; NULL = MR_STUDY_DEFAULT_SCALES */
 } mr_study_plan_params;
-#define MR_STUDY_PLAN_DEFAULTS {.seed = 1, .fixation_ms = 2000, .blocks = 0}
-extern const mr_opt mr_study_plan_opts[];      /* seed, fixation-ms */
+#define MR_STUDY_PLAN_DEFAULTS {.seed = 1, .fixation_ms = 2000, .blocks = 0, .design = 0, .participants = 0, .scales = NULL}
+extern const mr_opt mr_study_plan_opts[];      /* seed, fixation-ms, design, participants */
 
 typedef struct mr_study_plan {
     char id[17];              /* 16 hex digits: FNV-1a of the plan's content */
     char dir[4096];           /* the stimulus folder (as given) */
+    mr_study_design design;
     mr_study_set set;
     int seed, fixation_ms;
     unsigned blocks;
+    int scale_count;          /* rating */
+    char scales[MR_STUDY_MAX_SCALES][MR_STUDY_NAME_MAX];
+    mr_study_key *keys;       /* task: [(block - 1) * stimulus_count + stimulus], else NULL */
+    int schedule_count;       /* >= 1 */
+    mr_study_schedule *schedules;
+    /* The selected schedule (mr_study_plan_select; the first at first). */
+    int selected;
+    mr_study_group group;
     int trial_count;
     mr_study_trial *trials;   /* in presentation order; the trial number is the index */
 } mr_study_plan;
 
-/* Per block in order I, II, III: for each stimulus all C(t,2) pairs plus
- * one identical pair of a random method, each with a random side, shuffled
- * (Fisher-Yates) — all from the one seeded RNG, so a seed gives the same
- * plan on every machine. Block II needs a reference. */
+/* Pairwise, per schedule and block in order I, II, III: for each category
+ * all C(t,2) pairs plus one identical pair of a random method, each with a
+ * random side, shuffled (Fisher-Yates). A category with two scenes shows
+ * one in block I and the other in block II (which one: random per
+ * participant and category) and in block III half of the pairs on each.
+ * Block II needs a reference. Rating and task: per block every method on
+ * every stimulus, shuffled; a task plan with participants rotates the
+ * methods over the scenes instead (participant p sees category c with
+ * method (c + p) mod t, Kalkofen's "each technique in a different scene").
+ * All from one seeded RNG: a seed gives the same plan on every machine.
+ * dir is the stimulus folder; set its scan (pairwise: of dir; rating,
+ * task: of a condition folder; mr_study_plan_scan does that). */
 bool mr_study_plan_make(const char *dir, const mr_study_set *set, const mr_study_plan_params *p, mr_study_plan *out,
                         mr_error *err);
+/* Scans what a design needs under dir (pairwise: dir itself; rating and
+ * task: each condition folder, which must hold the same methods and
+ * stimuli) and makes the plan. */
+bool mr_study_plan_scan_make(const char *dir, const mr_study_plan_params *p, mr_study_plan *out, mr_error *err);
 bool mr_study_plan_save(const char *path, const mr_study_plan *plan, mr_error *err);
 /* Checks the id against the content (an edited plan is an error) and
  * resolves dir as given, else relative to the plan file's folder. */
 bool mr_study_plan_load(const char *path, mr_study_plan *plan, mr_error *err);
 void mr_study_plan_free(mr_study_plan *plan);
-/* DIR/<method>/<stimulus>.png of a trial's method m. */
-void mr_study_plan_image(const mr_study_plan *plan, int stimulus, int method, char *out, size_t n);
-/* Every stimulus image of the plan (method x stimulus, index
- * method * stimulus_count + stimulus), RGB; false + err (nothing kept) when
- * one cannot be read or differs in size from the first (images.c). */
+/* Points trials at a participant's schedule: the shared one takes anyone;
+ * a plan with participants needs one of its ids. */
+bool mr_study_plan_select(mr_study_plan *plan, const char *participant, mr_error *err);
+/* The image of a method on a stimulus in a block: DIR/<method>/<stimulus>.png
+ * (pairwise) or DIR/<condition>/<method>/<stimulus>.png. */
+void mr_study_plan_image(const mr_study_plan *plan, int block, int stimulus, int method, char *out, size_t n);
+/* Images the plan holds: 1 block x methods x stimuli (pairwise), else 3;
+ * the index of one (mr_study_images_load's order). */
+int mr_study_plan_image_count(const mr_study_plan *plan);
+int mr_study_plan_image_index(const mr_study_plan *plan, int block, int method, int stimulus);
+/* The key of a task trial (NULL for other designs). */
+const mr_study_key *mr_study_plan_key(const mr_study_plan *plan, int block, int stimulus);
+/* Every stimulus image of the plan's blocks (mr_study_plan_image_index;
+ * blocks not in the plan stay empty), RGB; false + err (nothing kept)
+ * when one cannot be read or differs in size from the first (images.c). */
 bool mr_study_images_load(const mr_study_plan *plan, mr_image **out, mr_error *err);
 void mr_study_images_free(const mr_study_plan *plan, mr_image **images); /* NULLs *images */
 
@@ -155,18 +250,30 @@ void mr_study_images_free(const mr_study_plan *plan, mr_image **images); /* NULL
 
 typedef enum mr_study_answer { MR_STUDY_LEFT = -1, MR_STUDY_NEUTRAL = 0, MR_STUDY_RIGHT = 1 } mr_study_answer;
 
-/* One line of votes.jsonl: {"plan","participant","block":"II","trial",
- * "stimulus","left","right","answer":"left|neutral|right","slider","ms",
- * "time_unix"}. */
+/* One line of votes.jsonl, the one log of all three designs:
+ * {"plan","participant","block":"II","trial","stimulus","left","right",
+ *  "answer":"left|neutral|right","slider","ms","time_unix"} and, where
+ * they apply, "design" (absent: pairwise), "group" ("A"/"B"), "question"
+ * ("better"/"plausible"); rating: "ratings": {"<scale>": 1..7 or "X"};
+ * task: "choice": 0|1 or "tap": [x, y] (image pixels). Rating and task
+ * lines carry the method in left and right. */
+#define MR_STUDY_RATING_X 0       /* "X": no judgement on a scale */
 typedef struct mr_study_vote {
     char plan[17];
     char participant[MR_STUDY_NAME_MAX];
+    mr_study_design design;
     int block;                /* 1..3 */
     int trial;                /* index in the plan */
     char stimulus[MR_STUDY_NAME_MAX], left[MR_STUDY_NAME_MAX], right[MR_STUDY_NAME_MAX];
-    mr_study_answer answer;
-    double slider;            /* [-1, 1]: -1 left, 0 neutral, +1 right */
-    double ms;                /* response time from the pair's appearance */
+    mr_study_group group;     /* pairwise: the participant's group (block III's question) */
+    mr_study_answer answer;   /* pairwise */
+    double slider;            /* pairwise: [-1, 1]: -1 left, 0 neutral, +1 right */
+    int rating_count;         /* rating: one per scale of the plan, in its order */
+    int ratings[MR_STUDY_MAX_SCALES]; /* 1..7, or MR_STUDY_RATING_X */
+    int choice;               /* task, choice question: 0 or 1; -1 none */
+    bool has_tap;             /* task, tap question */
+    double tap_x, tap_y;      /* image pixels */
+    double ms;                /* response time from the stimulus's appearance */
     double time_unix;
 } mr_study_vote;
 
@@ -248,6 +355,13 @@ double mr_study_agreement(const double *A, int t);
  * the denominator is taken as 1 and *baseline is false. */
 double mr_study_indifference(double neutral_distinct, double n_distinct, double neutral_identical,
                              double n_identical, bool *baseline);
+/* Eq. 5.6 as printed: iota = ((1/N) sum_{i<j} A0_ij) / ((1/N0) sum_i A0_ii)
+ * with N the answers per pair (the participants, in the thesis) and N0 the
+ * identical-pair answers: not divided by C(t,2) and not clamped, so it
+ * runs to C(t,2) when every answer is "no preference". NaN without an
+ * identical-pair "no preference" (no baseline) or without answers. */
+double mr_study_indifference_eq56(double neutral_distinct, double n_per_pair, double neutral_identical,
+                                  double n_identical);
 
 /* Exact binomial test (p = 1/2): P(X >= k) for X ~ B(n, 1/2). */
 double mr_study_binom_upper_tail(int n, int k);
@@ -367,22 +481,53 @@ bool mr_study_wilcoxon(const double *x, const double *y, int n, mr_study_wilcoxo
 
 /* ------------------------------------------------------------ analysis */
 
+typedef enum mr_study_test { MR_STUDY_TEST_AUTO = 0, MR_STUDY_TEST_ANOVA, MR_STUDY_TEST_FRIEDMAN } mr_study_test;
 typedef struct mr_study_analyze_params {
-    double alpha;             /* binomial test, per tail; default 0.025 */
-    double min_consistence;   /* participants whose mean xi is below are flagged; default 0.3 */
+    double alpha;             /* pairwise: binomial test, per tail; default 0.025 */
+    double min_consistence;   /* pairwise: participants whose mean xi is below are excluded; default 0.3 */
     double pseudo;            /* see mr_study_fit_params; default 0.5 */
     double z;                 /* confidence interval theta +- z se; default 1.96 */
+    double level;             /* rating, task: significance level (Mauchly, normality, post hoc); default 0.05 */
+    int adjust;               /* rating, task: post hoc adjustment (mr_study_adjust); default bonferroni */
+    int test;                 /* task: mr_study_test; auto = RM-ANOVA when the residuals pass
+                                 D'Agostino's test, else Friedman + Wilcoxon; default auto */
+    double tap_tolerance;     /* task: a tap this near the answer (image px) is correct; default 40 */
 } mr_study_analyze_params;
-#define MR_STUDY_ANALYZE_DEFAULTS {.alpha = 0.025, .min_consistence = 0.3, .pseudo = 0.5, .z = 1.96}
-extern const mr_opt mr_study_analyze_opts[];   /* alpha, min-consistence, pseudo, z */
+#define MR_STUDY_ANALYZE_DEFAULTS {.alpha = 0.025, .min_consistence = 0.3, .pseudo = 0.5, .z = 1.96, .level = 0.05, \
+                                   .adjust = MR_STUDY_ADJUST_BONFERRONI, .test = MR_STUDY_TEST_AUTO, .tap_tolerance = 40}
+extern const mr_opt mr_study_analyze_opts[];   /* alpha, min-consistence, pseudo, z, level, adjust, test, tap-tolerance */
 
-/* Writes into out_dir: pairs.csv, scores.csv, consistence.csv,
- * participants.csv, agreement.csv, identical.csv, chart_<block>.svg and
- * summary.md. plan may be NULL (methods from the votes); when given, votes
+/* A pairwise study's analysis. Writes into out_dir: pairs.csv, scores.csv,
+ * consistence.csv, participants.csv, agreement.csv, identical.csv,
+ * chart_<block>.svg and summary.md, per block I, II, III-A, III-B and per
+ * category (a category's two scenes pooled) -- without the participants
+ * whose mean consistence is below min_consistence; the same files with
+ * everyone in out_dir/all_participants/, and the summary compares both. plan may be NULL (methods from the votes); when given, votes
  * of another plan are left out with a warning. Lines for the user (warnings,
  * the not-connected note) go to the log. */
 bool mr_study_analyze(const mr_study_votes *votes, const mr_study_plan *plan, const mr_study_analyze_params *p,
                       const char *out_dir, mr_error *err);
+/* A rating study (analyze_rt.c; the plan is required: its scales). Per
+ * participant, condition, method and scale the mean over stimuli of the
+ * ratings ("X" left out); per condition and scale a repeated-measures
+ * ANOVA over the methods of the participants with every method rated
+ * (Mauchly's test; Greenhouse-Geisser's p where sphericity is rejected),
+ * paired t post hoc (adjusted), and per method and scale a paired t-test
+ * between the conditions. Writes means.csv, anova.csv, posthoc.csv,
+ * ttest.csv, chart_<condition>.svg and summary.md (the paper's Tables 3
+ * and 4). */
+bool mr_study_analyze_rating(const mr_study_votes *votes, const mr_study_plan *plan, const mr_study_analyze_params *p,
+                             const char *out_dir, mr_error *err);
+/* A task study (analyze_rt.c; the plan is required: its answer keys).
+ * Each answer scored (choice: right or wrong; tap: error in px and scene
+ * units, right within tap_tolerance px); per participant, condition and
+ * method the share right and the mean tap error; per condition and
+ * measure an RM-ANOVA (as for ratings) where the residuals pass
+ * D'Agostino's normality test, else Friedman's test with Wilcoxon
+ * signed-rank post hoc (adjusted). Writes trials.csv, scores.csv,
+ * tests.csv, posthoc.csv, chart_<condition>.svg and summary.md. */
+bool mr_study_analyze_task(const mr_study_votes *votes, const mr_study_plan *plan, const mr_study_analyze_params *p,
+                           const char *out_dir, mr_error *err);
 
 /* ------------------------------------------------------------- run window */
 
@@ -428,11 +573,13 @@ typedef struct mr_study_window_params {
     int width, height;            /* window size, px; 0 = 1280 x 800 */
     double ui_scale;              /* the UI beyond the screen's density; 0 = 1 */
     const char *script_path;      /* timed input (tests), or NULL */
+    int group;                    /* mr_study_group for a shared pairwise plan's block III;
+                                     0 = A (a plan with participants says it) */
     FILE *out;                    /* the "starting / resuming / stored" lines; NULL: none */
 } mr_study_window_params;
 #define MR_STUDY_WINDOW_DEFAULT_WIDTH 1280
 #define MR_STUDY_WINDOW_DEFAULT_HEIGHT 800
-#define MR_STUDY_WINDOW_DEFAULTS {NULL, NULL, NULL, false, false, 0, 0, 0.0, NULL, NULL}
+#define MR_STUDY_WINDOW_DEFAULTS {NULL, NULL, NULL, false, false, 0, 0, 0.0, NULL, 0, NULL}
 /* true also when every trial was answered before (said on out); false +
  * err when the plan, the log, the stimuli, the script or the window fail. */
 bool mr_study_window_run(const mr_study_window_params *p, mr_error *err);

@@ -1,6 +1,8 @@
-/* The study window's controller: fixation cross, the pair (and the
- * reference above it in block II), touch-sized answers, one vote out per
- * answer, the scripted input of tests. No GL and no files besides the
+/* The study window's controller for all three designs: fixation cross;
+ * the pair (and the reference above it in block II), one image rated on
+ * each scale in turn, or one image with a task question (two answers, or
+ * a tap on the image and a confirm); touch-sized answers, one vote out per
+ * trial, the scripted input of tests. No GL and no files besides the
  * script: the caller draws and stores. */
 #include "mr_study.h"
 
@@ -26,8 +28,14 @@ struct mr_study_script {
     int n;
 };
 
-typedef enum widget { W_LEFT = 0, W_NEUTRAL, W_RIGHT, W_SLIDER, W_VOTE, W_COUNT } widget;
-static const char *const k_widget_names[W_COUNT] = {"left", "neutral", "right", "slider", "vote"};
+typedef enum widget {
+    W_LEFT = 0, W_NEUTRAL, W_RIGHT, W_SLIDER, W_VOTE,
+    W_R1, W_R2, W_R3, W_R4, W_R5, W_R6, W_R7, W_RX, /* rating: 1..7 and X */
+    W_CHOICE0, W_CHOICE1, W_IMAGE, W_CONFIRM,       /* task */
+    W_COUNT
+} widget;
+static const char *const k_widget_names[W_COUNT] = {"left", "neutral", "right", "slider", "vote", "r1", "r2", "r3",
+                                                    "r4", "r5", "r6", "r7", "rx", "a", "b", "image", "confirm"};
 
 static bool key_parse(const char *s, int *key) {
     static const struct { const char *n; int k; } names[] = {
@@ -67,7 +75,8 @@ mr_study_script *mr_study_script_load(const char *path, mr_error *err) {
             for (int w = 0; w < W_COUNT; w++) known |= !strcmp(c.target, k_widget_names[w]);
             good = good && known;
         }
-        if (!strcmp(op, "tap") && target) c.op = S_TAP;
+        if (!strcmp(op, "tap") && target && n >= 4) c.op = S_TAP, c.a = atof(a1), c.b = atof(a2), c.key = 1;
+        else if (!strcmp(op, "tap") && target) c.op = S_TAP;
         else if (!strcmp(op, "tap") && n >= 4) c.op = S_TAP_XY, c.a = atof(a0), c.b = atof(a1);
         else if (!strcmp(op, "drag") && target && n >= 5) c.op = S_DRAG, c.a = atof(a1), c.b = atof(a2);
         else if (!strcmp(op, "key") && n >= 3 && key_parse(a0, &c.key)) c.op = S_KEY;
@@ -117,6 +126,10 @@ struct mr_study_runner {
     double phase_t0;          /* when the fixation / the pair started */
     double now, t_start;
     float slider;
+    int scale;                /* rating: the scale asked now */
+    int ratings[MR_STUDY_MAX_SCALES];
+    bool tapped;              /* task: a tap on the image, in image pixels */
+    double tap_x, tap_y;
     int answered_here;
     int last_voted;           /* the trial of the last vote handed out, -1 */
     char msg[256];
@@ -212,6 +225,8 @@ void mr_study_runner_vote_failed(mr_study_runner *r, const char *msg) {
         r->fixation = false;
         r->phase_t0 = r->now;
         r->last_voted = -1;
+        r->scale = 0;
+        r->tapped = false;
     }
     snprintf(r->msg, sizeof r->msg, "vote NOT saved: %.200s - please answer again", msg);
 }
@@ -238,8 +253,8 @@ static void script_tick(mr_study_runner *r) {
             if (!strcmp(c->target, k_widget_names[i])) w = i;
         if (w < 0 || !r->shown[w]) return; /* wait for it (e.g. the next pair) */
         mr_ui_rect rc = r->rect[w];
-        x = rc.x + rc.w * 0.5;
-        y = rc.y + rc.h * 0.5;
+        x = rc.x + rc.w * (c->op == S_TAP && c->key ? c->a : 0.5);
+        y = rc.y + rc.h * (c->op == S_TAP && c->key ? c->b : 0.5);
         if (c->op == S_DRAG) {
             double x0 = rc.x + rc.w * c->a, x1 = rc.x + rc.w * c->b;
             push(r, MR_EVENT_POINTER_MOVE, x0, y);
@@ -294,9 +309,44 @@ static int take_input(mr_study_runner *r) {
     return key;
 }
 
-static const char *question(int block) {
-    return block == 2 ? "Which image is physically more plausible? (top: the correct simulation)"
-                      : "Which image looks better?";
+static const char *question(const mr_study_plan *plan, const mr_study_trial *t) {
+    if (plan->design == MR_STUDY_RATING) return "How well can you perceive this depth cue in the whole scene?";
+    if (plan->design == MR_STUDY_TASK) {
+        const mr_study_key *k = mr_study_plan_key(plan, t->block, t->stimulus);
+        return k ? k->text : "";
+    }
+    return !strcmp(mr_study_question_of(t->block, plan->group), "plausible")
+               ? t->block == 2 ? "Which image is physically more plausible? (top: the correct simulation)"
+                               : "Which image is physically more plausible?"
+               : "Which image looks better?";
+}
+
+/* A scale's name for people: underscores as spaces, the first letter up. */
+static void scale_label(const char *name, char *out, size_t n) {
+    snprintf(out, n, "%s", name);
+    for (char *c = out; *c; c++)
+        if (*c == '_') *c = ' ';
+    if (out[0] >= 'a' && out[0] <= 'z') out[0] = (char)(out[0] - 'a' + 'A');
+}
+
+/* The answer widgets of a rating trial: 1..7 and X for the current scale.
+ * Returns the rating given (1..7, MR_STUDY_RATING_X) or -1. */
+static int rating_row(mr_study_runner *r, mr_ui_rect bottom, float pad, int key) {
+    float bw = bottom.w / 8;
+    int got = -1;
+    for (int k = 0; k < 8; k++) {
+        mr_ui_rect b = mr_ui_rect_inset(mr_ui_rect_make(bottom.x + k * bw, bottom.y, bw, bottom.h), pad / 2);
+        int w = W_R1 + k;
+        r->shown[w] = true;
+        r->rect[w] = b;
+        char label[8];
+        snprintf(label, sizeof label, k < 7 ? "%d" : "X", k + 1);
+        if (mr_ui_button(r->ui, (uint32_t)(20 + k), b, label, k < 7 ? MR_UI_ACCENT : MR_UI_NORMAL))
+            got = k < 7 ? k + 1 : MR_STUDY_RATING_X;
+    }
+    if (key >= '1' && key <= '7') got = key - '0';
+    else if (key == 'x' || key == 'X') got = MR_STUDY_RATING_X;
+    return got;
 }
 
 const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, float fb_w, float fb_h,
@@ -321,7 +371,7 @@ const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, flo
     out->fixation = r->fixation && !out->done;
     mr_ui_rect screen = mr_ui_rect_make(0, 0, fb_w, fb_h);
     float pad = mr_ui_mm(r->ui, 4), target = mr_ui_target_px(r->ui);
-    mr_study_answer answer = MR_STUDY_NEUTRAL;
+    int answer = MR_STUDY_NEUTRAL; /* pairwise: an mr_study_answer; task: the choice */
     bool answered = false;
     double slider_value = 0;
     if (out->done) {
@@ -337,29 +387,94 @@ const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, flo
         out->trial = r->trial;
         mr_ui_rect area = mr_ui_rect_inset(screen, pad);
         char status[200];
-        snprintf(status, sizeof status, "Block %s  -  trial %d of %d", mr_study_block_name(t->block), r->trial + 1,
-                 plan->trial_count);
+        if (plan->design == MR_STUDY_PAIRWISE)
+            snprintf(status, sizeof status, "Block %s  -  trial %d of %d", mr_study_block_name(t->block), r->trial + 1,
+                     plan->trial_count);
+        else
+            snprintf(status, sizeof status, "Part %s  -  trial %d of %d", mr_study_block_name(t->block), r->trial + 1,
+                     plan->trial_count);
         mr_ui_rect top = mr_ui_cut_top(&area, mr_ui_text_px(r->ui) * 1.6f);
         mr_ui_label(r->ui, top, status, MR_UI_RGBA(255, 255, 255, 255), false);
         mr_ui_rect q = mr_ui_cut_top(&area, mr_ui_text_px(r->ui) * 1.6f);
-        mr_ui_label(r->ui, q, r->msg[0] ? r->msg : question(t->block),
+        mr_ui_label(r->ui, q, r->msg[0] ? r->msg : question(plan, t),
                     r->msg[0] ? MR_UI_RGBA(255, 200, 80, 255) : MR_UI_RGBA(255, 255, 255, 255), true);
         /* Buttons at least the touch target after their half-pad inset. */
         mr_ui_rect bottom = mr_ui_cut_bottom(&area, target * 1.2f + 1.5f * pad);
         bottom.h -= pad;
         bottom.y += pad;
         double iw = r->p.image_w > 0 ? r->p.image_w : 4, ih = r->p.image_h > 0 ? r->p.image_h : 3;
-        if (t->block == 2 && plan->set.reference >= 0) {
-            mr_ui_rect ref = mr_ui_cut_top(&area, area.h * 0.5f);
-            out->image_rect[r->image_count] = mr_ui_fit(mr_ui_rect_inset(ref, pad / 2), iw, ih);
-            out->image_method[r->image_count++] = plan->set.reference;
+        if (plan->design == MR_STUDY_PAIRWISE) {
+            if (t->block == 2 && plan->set.reference >= 0) {
+                mr_ui_rect ref = mr_ui_cut_top(&area, area.h * 0.5f);
+                out->image_rect[r->image_count] = mr_ui_fit(mr_ui_rect_inset(ref, pad / 2), iw, ih);
+                out->image_method[r->image_count++] = plan->set.reference;
+            }
+            mr_ui_rect lh = mr_ui_cut_left(&area, area.w * 0.5f), rh = area;
+            out->image_rect[r->image_count] = mr_ui_fit(mr_ui_rect_inset(lh, pad / 2), iw, ih);
+            out->image_method[r->image_count++] = t->left;
+            out->image_rect[r->image_count] = mr_ui_fit(mr_ui_rect_inset(rh, pad / 2), iw, ih);
+            out->image_method[r->image_count++] = t->right;
+        } else {
+            if (plan->design == MR_STUDY_RATING) {
+                /* The scale asked now, above its buttons. */
+                mr_ui_rect sl = mr_ui_cut_bottom(&area, mr_ui_text_px(r->ui) * 1.8f);
+                char name[MR_STUDY_NAME_MAX], text[160];
+                scale_label(plan->scales[r->scale], name, sizeof name);
+                snprintf(text, sizeof text, "%s  (%d of %d)   1 = poorly ... 7 = very well, X = cannot say", name,
+                         r->scale + 1, plan->scale_count);
+                mr_ui_label(r->ui, sl, text, MR_UI_RGBA(255, 255, 255, 255), true);
+            }
+            mr_ui_rect ir = mr_ui_fit(mr_ui_rect_inset(area, pad / 2), iw, ih);
+            out->image_rect[r->image_count] = ir;
+            out->image_method[r->image_count++] = t->left;
+            r->shown[W_IMAGE] = true;
+            r->rect[W_IMAGE] = ir;
         }
-        mr_ui_rect lh = mr_ui_cut_left(&area, area.w * 0.5f), rh = area;
-        out->image_rect[r->image_count] = mr_ui_fit(mr_ui_rect_inset(lh, pad / 2), iw, ih);
-        out->image_method[r->image_count++] = t->left;
-        out->image_rect[r->image_count] = mr_ui_fit(mr_ui_rect_inset(rh, pad / 2), iw, ih);
-        out->image_method[r->image_count++] = t->right;
-        if (!r->p.slider) {
+        if (plan->design == MR_STUDY_RATING) {
+            int got = rating_row(r, bottom, pad, key);
+            if (got >= 0) {
+                r->ratings[r->scale++] = got;
+                if (r->scale >= plan->scale_count) answered = true;
+            }
+        } else if (plan->design == MR_STUDY_TASK) {
+            const mr_study_key *k = mr_study_plan_key(plan, t->block, t->stimulus);
+            if (k && k->question == MR_STUDY_Q_CHOICE) {
+                float bw = bottom.w / 2;
+                for (int c = 0; c < 2; c++) {
+                    mr_ui_rect b = mr_ui_rect_inset(mr_ui_rect_make(bottom.x + c * bw, bottom.y, bw, bottom.h), pad / 2);
+                    char label[64];
+                    snprintf(label, sizeof label, "%s is nearer", k->labels[c]);
+                    r->shown[W_CHOICE0 + c] = true;
+                    r->rect[W_CHOICE0 + c] = b;
+                    if (mr_ui_button(r->ui, (uint32_t)(30 + c), b, label, MR_UI_ACCENT)) answered = true, answer = c;
+                }
+                if (key == MR_KEY_LEFT) answered = true, answer = 0;
+                else if (key == MR_KEY_RIGHT) answered = true, answer = 1;
+            } else {
+                /* A press on the image places the mark (again to move it);
+                 * Confirm stores it. */
+                mr_ui_rect ir = r->rect[W_IMAGE];
+                if (r->in.down && r->in.x >= ir.x && r->in.x < ir.x + ir.w && r->in.y >= ir.y && r->in.y < ir.y + ir.h) {
+                    r->tapped = true;
+                    r->tap_x = (r->in.x - ir.x) / ir.w * iw;
+                    r->tap_y = (r->in.y - ir.y) / ir.h * ih;
+                }
+                if (r->tapped) {
+                    float mx = ir.x + (float)(r->tap_x / iw) * ir.w, my = ir.y + (float)(r->tap_y / ih) * ir.h;
+                    float arm = mr_ui_mm(r->ui, 4), th = mr_ui_mm(r->ui, 0.8f);
+                    mr_ui_draw_rect(dl, mr_ui_rect_make(mx - arm, my - th / 2, 2 * arm, th), MR_UI_RGBA(255, 40, 40, 255));
+                    mr_ui_draw_rect(dl, mr_ui_rect_make(mx - th / 2, my - arm, th, 2 * arm), MR_UI_RGBA(255, 40, 40, 255));
+                }
+                mr_ui_rect b = mr_ui_rect_inset(mr_ui_cut_right(&bottom, target * 3.0f), pad / 2);
+                r->shown[W_CONFIRM] = true;
+                r->rect[W_CONFIRM] = b;
+                mr_ui_label(r->ui, bottom, r->tapped ? "Tap again to move the mark" : "Tap on the image",
+                            MR_UI_RGBA(255, 255, 255, 255), true);
+                if ((mr_ui_button(r->ui, 40, b, "Confirm", r->tapped ? MR_UI_ACCENT : MR_UI_NORMAL) ||
+                     key == MR_KEY_ENTER) && r->tapped)
+                    answered = true;
+            }
+        } else if (!r->p.slider) {
             float bw = bottom.w / 3;
             static const char *const labels[3] = {"Left is better", "No preference", "Right is better"};
             for (int w = 0; w < 3; w++) {
@@ -401,8 +516,22 @@ const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, flo
             snprintf(v->stimulus, sizeof v->stimulus, "%s", plan->set.stimuli[t->stimulus]);
             snprintf(v->left, sizeof v->left, "%s", plan->set.methods[t->left]);
             snprintf(v->right, sizeof v->right, "%s", plan->set.methods[t->right]);
-            v->answer = answer;
-            v->slider = slider_value;
+            v->design = plan->design;
+            v->choice = -1;
+            if (plan->design == MR_STUDY_PAIRWISE) {
+                v->group = plan->group;
+                v->answer = answer;
+                v->slider = slider_value;
+            } else if (plan->design == MR_STUDY_RATING) {
+                v->rating_count = plan->scale_count;
+                memcpy(v->ratings, r->ratings, sizeof v->ratings);
+            } else if (r->tapped) {
+                v->has_tap = true;
+                v->tap_x = r->tap_x;
+                v->tap_y = r->tap_y;
+            } else {
+                v->choice = (int)answer;
+            }
             v->ms = (now - r->phase_t0) * 1000.0;
             v->time_unix = (double)time(NULL);
             out->vote = true;
@@ -412,6 +541,8 @@ const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, flo
             r->msg[0] = 0;
             r->trial = next_unanswered(r, r->trial + 1);
             r->fixation = true;
+            r->scale = 0;
+            r->tapped = false;
             r->phase_t0 = now;
         }
     }
@@ -434,6 +565,9 @@ cJSON *mr_study_runner_state_json(const mr_study_runner *r) {
     cJSON_AddNumberToObject(j, "images", r->image_count);
     cJSON_AddNumberToObject(j, "answered_here", r->answered_here);
     cJSON_AddNumberToObject(j, "slider", r->slider);
+    cJSON_AddStringToObject(j, "design", mr_study_design_names[r->p.plan->design]);
+    cJSON_AddNumberToObject(j, "scale", r->scale);
+    cJSON_AddBoolToObject(j, "tapped", r->tapped);
     cJSON *w = cJSON_AddObjectToObject(j, "widgets");
     for (int i = 0; i < W_COUNT; i++)
         if (r->shown[i]) {

@@ -55,6 +55,12 @@ double mr_study_indifference(double neutral_distinct, double n_distinct, double 
     return fmin(1.0, have ? num / den : num);
 }
 
+double mr_study_indifference_eq56(double neutral_distinct, double n_per_pair, double neutral_identical,
+                                  double n_identical) {
+    if (!(n_per_pair > 0) || !(n_identical > 0) || !(neutral_identical > 0)) return NAN;
+    return (neutral_distinct / n_per_pair) / (neutral_identical / n_identical);
+}
+
 /* log C(n, k) through lgamma: exact enough for any n a study has. */
 static double log_choose(int n, int k) { return lgamma(n + 1.0) - lgamma(k + 1.0) - lgamma(n - k + 1.0); }
 

@@ -19,13 +19,30 @@ bool mr_study_vote_append(const char *path, const mr_study_vote *v, mr_error *er
     cJSON *j = cJSON_CreateObject();
     cJSON_AddStringToObject(j, "plan", v->plan);
     cJSON_AddStringToObject(j, "participant", v->participant);
+    if (v->design != MR_STUDY_PAIRWISE) cJSON_AddStringToObject(j, "design", mr_study_design_names[v->design]);
     cJSON_AddStringToObject(j, "block", mr_study_block_name(v->block));
     cJSON_AddNumberToObject(j, "trial", v->trial);
     cJSON_AddStringToObject(j, "stimulus", v->stimulus);
     cJSON_AddStringToObject(j, "left", v->left);
     cJSON_AddStringToObject(j, "right", v->right);
-    cJSON_AddStringToObject(j, "answer", answer_name(v->answer));
-    cJSON_AddNumberToObject(j, "slider", v->slider);
+    if (v->design == MR_STUDY_PAIRWISE) {
+        if (v->group) cJSON_AddStringToObject(j, "group", mr_study_group_name(v->group));
+        cJSON_AddStringToObject(j, "question", mr_study_question_of(v->block, v->group));
+        cJSON_AddStringToObject(j, "answer", answer_name(v->answer));
+        cJSON_AddNumberToObject(j, "slider", v->slider);
+    } else if (v->design == MR_STUDY_RATING) {
+        cJSON *r = cJSON_AddArrayToObject(j, "ratings");
+        for (int k = 0; k < v->rating_count; k++)
+            cJSON_AddItemToArray(r, v->ratings[k] == MR_STUDY_RATING_X ? cJSON_CreateString("X")
+                                                                       : cJSON_CreateNumber(v->ratings[k]));
+    } else {
+        if (v->choice >= 0) cJSON_AddNumberToObject(j, "choice", v->choice);
+        if (v->has_tap) {
+            cJSON *t = cJSON_AddArrayToObject(j, "tap");
+            cJSON_AddItemToArray(t, cJSON_CreateNumber(v->tap_x));
+            cJSON_AddItemToArray(t, cJSON_CreateNumber(v->tap_y));
+        }
+    }
     cJSON_AddNumberToObject(j, "ms", v->ms);
     cJSON_AddNumberToObject(j, "time_unix", v->time_unix);
     bool ok = j && mr_annotation_append(path, j, err);
@@ -42,23 +59,65 @@ static bool get_name(const cJSON *o, const char *key, char *out, size_t n) {
 
 static bool parse_vote(const cJSON *o, mr_study_vote *v) {
     memset(v, 0, sizeof *v);
-    char block[8], answer[16];
+    v->choice = -1;
+    char block[8], answer[16], design[16] = "pairwise", group[4] = "";
     const cJSON *trial = cJSON_GetObjectItemCaseSensitive(o, "trial");
     if (!cJSON_IsObject(o) || !get_name(o, "plan", v->plan, sizeof v->plan) ||
         !get_name(o, "participant", v->participant, sizeof v->participant) || !get_name(o, "block", block, sizeof block) ||
         !get_name(o, "stimulus", v->stimulus, sizeof v->stimulus) || !get_name(o, "left", v->left, sizeof v->left) ||
-        !get_name(o, "right", v->right, sizeof v->right) || !get_name(o, "answer", answer, sizeof answer) ||
-        !cJSON_IsNumber(trial) || trial->valuedouble < 0 || trial->valuedouble > 1e9)
+        !get_name(o, "right", v->right, sizeof v->right) || !cJSON_IsNumber(trial) || trial->valuedouble < 0 ||
+        trial->valuedouble > 1e9)
         return false;
+    if (cJSON_GetObjectItemCaseSensitive(o, "design") && !get_name(o, "design", design, sizeof design)) return false;
+    int d = -1;
+    for (int k = 0; mr_study_design_names[k]; k++)
+        if (!strcmp(design, mr_study_design_names[k])) d = k;
+    if (d < 0) return false;
+    v->design = (mr_study_design)d;
     v->trial = (int)trial->valuedouble;
     v->block = 0;
     for (int b = 1; b <= MR_STUDY_MAX_BLOCKS; b++)
         if (strcmp(block, mr_study_block_name(b)) == 0) v->block = b;
     if (!v->block) return false;
-    if (!strcmp(answer, "left")) v->answer = MR_STUDY_LEFT;
-    else if (!strcmp(answer, "right")) v->answer = MR_STUDY_RIGHT;
-    else if (!strcmp(answer, "neutral")) v->answer = MR_STUDY_NEUTRAL;
-    else return false;
+    if (v->design == MR_STUDY_PAIRWISE) {
+        if (!get_name(o, "answer", answer, sizeof answer)) return false;
+        if (!strcmp(answer, "left")) v->answer = MR_STUDY_LEFT;
+        else if (!strcmp(answer, "right")) v->answer = MR_STUDY_RIGHT;
+        else if (!strcmp(answer, "neutral")) v->answer = MR_STUDY_NEUTRAL;
+        else return false;
+        if (cJSON_GetObjectItemCaseSensitive(o, "group")) {
+            if (!get_name(o, "group", group, sizeof group)) return false;
+            v->group = !strcmp(group, "A") ? MR_STUDY_GROUP_A : !strcmp(group, "B") ? MR_STUDY_GROUP_B : -1;
+            if ((int)v->group < 0) return false;
+        }
+    } else if (v->design == MR_STUDY_RATING) {
+        const cJSON *r = cJSON_GetObjectItemCaseSensitive(o, "ratings");
+        int n = cJSON_IsArray(r) ? cJSON_GetArraySize(r) : 0;
+        if (n < 1 || n > MR_STUDY_MAX_SCALES) return false;
+        for (const cJSON *x = r->child; x; x = x->next) {
+            int val;
+            if (cJSON_IsString(x) && !strcmp(x->valuestring, "X")) val = MR_STUDY_RATING_X;
+            else if (cJSON_IsNumber(x) && x->valuedouble >= 1 && x->valuedouble <= 7 && x->valuedouble == (int)x->valuedouble)
+                val = (int)x->valuedouble;
+            else return false;
+            v->ratings[v->rating_count++] = val;
+        }
+    } else {
+        const cJSON *c = cJSON_GetObjectItemCaseSensitive(o, "choice"), *t = cJSON_GetObjectItemCaseSensitive(o, "tap");
+        if (c) {
+            if (!cJSON_IsNumber(c) || (c->valuedouble != 0 && c->valuedouble != 1)) return false;
+            v->choice = (int)c->valuedouble;
+        }
+        if (t) {
+            if (!cJSON_IsArray(t) || cJSON_GetArraySize(t) != 2 || !cJSON_IsNumber(t->child) ||
+                !cJSON_IsNumber(t->child->next) || !isfinite(t->child->valuedouble) || !isfinite(t->child->next->valuedouble))
+                return false;
+            v->has_tap = true;
+            v->tap_x = t->child->valuedouble;
+            v->tap_y = t->child->next->valuedouble;
+        }
+        if (v->choice < 0 && !v->has_tap) return false;
+    }
     /* Optional numbers; present ones must be finite (1e999 parses as inf). */
     const char *keys[3] = {"slider", "ms", "time_unix"};
     double *dst[3] = {&v->slider, &v->ms, &v->time_unix};
@@ -167,7 +226,7 @@ int mr_study_resume(const mr_study_plan *plan, const mr_study_votes *votes, cons
             return -1;
         }
         const mr_study_trial *t = v->trial < plan->trial_count ? &plan->trials[v->trial] : NULL;
-        if (!t || t->block != v->block || strcmp(plan->set.stimuli[t->stimulus], v->stimulus) != 0 ||
+        if (!t || v->design != plan->design || t->block != v->block || strcmp(plan->set.stimuli[t->stimulus], v->stimulus) != 0 ||
             strcmp(plan->set.methods[t->left], v->left) != 0 || strcmp(plan->set.methods[t->right], v->right) != 0) {
             mr_fail(err, MR_ERR_INVALID, "the log's vote for trial %d of participant %s does not match the plan", v->trial,
                     participant);

@@ -44,11 +44,11 @@ static void run_frame(run_app *a, bool *quit) {
     static const float bg[3] = {0.5f, 0.5f, 0.5f};
     mr_draw2d_begin(a->d2, fw, fh, bg);
     mr_error err = {0};
-    int S = a->plan.set.stimulus_count;
     const mr_study_trial *tr = f.trial >= 0 ? &a->plan.trials[f.trial] : NULL;
     for (int i = 0; tr && i < f.image_count; i++) {
         mr_ui_rect r = f.image_rect[i];
-        if (!mr_draw2d_image_draw(a->d2, a->tex[f.image_method[i] * S + tr->stimulus], r.x, r.y, r.w, r.h, &err))
+        int k = mr_study_plan_image_index(&a->plan, tr->block, f.image_method[i], tr->stimulus);
+        if (!mr_draw2d_image_draw(a->d2, a->tex[k], r.x, r.y, r.w, r.h, &err))
             mr_log(MR_LOG_ERROR, "study run: %s", err.msg);
     }
     mr_draw2d_ui(a->d2, dl, "study run");
@@ -77,10 +77,15 @@ static bool run_window(run_app *a, const mr_study_window_params *p, const mr_stu
     wp.fullscreen = p->fullscreen;
     wp.title = "mrcheck study";
     if (!(a->win = mr_window_create(&wp, err)) || !(a->d2 = mr_draw2d_create(mr_window_gpu(a->win), err))) return false;
-    int n = a->plan.set.method_count * a->plan.set.stimulus_count;
+    int n = mr_study_plan_image_count(&a->plan);
+    const mr_image *first = NULL;
     a->tex = calloc((size_t)n, sizeof *a->tex);
-    for (int i = 0; a->tex && i < n; i++)
+    for (int i = 0; a->tex && i < n; i++) {
+        if (!a->images[i].data) continue; /* a condition the plan leaves out */
+        if (!first) first = &a->images[i];
         if (!(a->tex[i] = mr_draw2d_image_create(a->d2, &a->images[i], err))) return false;
+    }
+    if (!a->tex || !first) return mr_fail(err, MR_ERR_NOMEM, "study run: no stimulus textures");
     mr_study_run_params rp = MR_STUDY_RUN_DEFAULTS;
     rp.plan = &a->plan;
     rp.participant = p->participant;
@@ -88,8 +93,8 @@ static bool run_window(run_app *a, const mr_study_window_params *p, const mr_stu
     rp.answered = at->answered;
     rp.slider = p->slider;
     rp.px_per_mm = mr_window_px_per_mm(a->win) * (p->ui_scale > 0 ? p->ui_scale : 1.0);
-    rp.image_w = a->images[0].width;
-    rp.image_h = a->images[0].height;
+    rp.image_w = first->width;
+    rp.image_h = first->height;
     rp.now = mr_time_now();
     if (!(a->runner = mr_study_runner_create(&rp, err))) return false;
     if (*script) mr_study_runner_set_script(a->runner, script);
@@ -112,9 +117,12 @@ bool mr_study_window_run(const mr_study_window_params *p, mr_error *err) {
     mr_study_resume_point at = {0};
     mr_study_script *script = NULL;
     bool ok = false;
-    if (!mr_study_plan_load(p->plan_path, &a->plan, err) ||
-        !mr_study_resume_open(&a->plan, p->votes_path, p->participant, &at, err))
+    if (!mr_study_plan_load(p->plan_path, &a->plan, err) || !mr_study_plan_select(&a->plan, p->participant, err))
         goto done;
+    /* A shared pairwise schedule: block III's group from the command line. */
+    if (a->plan.design == MR_STUDY_PAIRWISE && (a->plan.blocks & 4u) && !a->plan.group)
+        a->plan.group = p->group ? (mr_study_group)p->group : MR_STUDY_GROUP_A;
+    if (!mr_study_resume_open(&a->plan, p->votes_path, p->participant, &at, err)) goto done;
     if (at.first >= a->plan.trial_count) {
         if (p->out)
             fprintf(p->out, "study run: participant %s has answered all %d trials of plan %s\n", p->participant,
@@ -140,7 +148,7 @@ done:
     mr_study_runner_destroy(&a->runner);
     mr_study_script_destroy(&script);
     if (a->tex)
-        for (int i = 0; i < a->plan.set.method_count * a->plan.set.stimulus_count; i++) mr_draw2d_image_destroy(&a->tex[i]);
+        for (int i = 0; i < mr_study_plan_image_count(&a->plan); i++) mr_draw2d_image_destroy(&a->tex[i]);
     free(a->tex);
     mr_draw2d_destroy(&a->d2);
     mr_window_destroy(&a->win);
