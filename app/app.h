@@ -27,7 +27,7 @@ void app_gfx_close(app_gfx *g);
  * and returns false on a bad value. */
 bool app_ao_check(const char *cmd, const mr_cli_table *t, bool *groundtruth, mr_gt_params *gt);
 
-/* Shadows (issue 12): --shadows METHOD, --shadows-KEY from mr_shadow_opts;
+/* Shadows: --shadows METHOD, --shadows-KEY from mr_shadow_opts;
  * without --shadows the scene config's "shadows" names the method (one line
  * and false if it names none). In shadow_opts.c. */
 #define APP_SHADOW_TABLE(p) {.prefix = "shadows", .table = mr_shadow_opts, .params = (p)}
@@ -116,13 +116,13 @@ int bench_multiview(int argc, char **argv);
 
 int cmd_synth(int argc, char **argv);
 int cmd_factory(int argc, char **argv);
-/* issue 16: mrcheck export (cmd_export.c) */
+/* mrcheck export (cmd_export.c) */
 int cmd_export(int argc, char **argv);
 int bench_scene(int argc, char **argv);
 /* mrcheck bench map (bench_map.c). */
 int bench_map(int argc, char **argv);
 
-/* mrcheck bench load (bench_load.c; issue 17, lane gltf). */
+/* mrcheck bench load (bench_load.c). */
 int bench_load(int argc, char **argv);
 
 #endif

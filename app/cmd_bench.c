@@ -63,7 +63,7 @@ int cmd_bench(int argc, char **argv) {
     if (argc >= 3 && strcmp(argv[2], "shadows") == 0) return app_bench_shadows(argc, argv);
     if (argc >= 3 && strcmp(argv[2], "multiview") == 0) return bench_multiview(argc, argv);
     if (argc >= 3 && strcmp(argv[2], "map") == 0) return bench_map(argc, argv);
-    if (argc >= 3 && strcmp(argv[2], "load") == 0) return bench_load(argc, argv); /* issue 17, lane gltf */
+    if (argc >= 3 && strcmp(argv[2], "load") == 0) return bench_load(argc, argv);
     if (argc >= 3 && (strcmp(argv[2], "--help") == 0 || strcmp(argv[2], "-h") == 0)) {
         printf("usage: mrcheck bench {frame,ao,ghost,tracking,map,scene,shadows,multiview,load} [options]   (mrcheck bench NAME --help)\n");
         return 0;

@@ -34,7 +34,7 @@ static bool run_demo(const char *dir, mr_error *err) {
      * pictures (lib/bench). */
     mr_bench_gpu bg = {gfx.gpu, gfx.renderer};
     ok = ok && mr_demo_render_frames(dir, &bg, built, planned, views, err);
-    /* issue 16: marks at the known discrepancies, as BCF and a report */
+    /* Marks at the known discrepancies, as BCF and a report */
     ok = ok && mr_demo_marks(dir, &bg, built, planned, err);
     if (gfx.gpu) app_gfx_close(&gfx);
     uint64_t tri = planned ? mr_scene_triangle_count(planned) : 0;

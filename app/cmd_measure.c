@@ -60,7 +60,7 @@ int cmd_measure(int argc, char **argv) {
         mr_triangulation_distance(&tr, mr_v3(planned[0], planned[1], planned[2]), &dist, &dsig);
         printf("distance to the planned point: %.1f mm +- %.1f mm (1 sigma)\n", dist * 1e3, dsig * 1e3);
     }
-    /* issue 15: the nearest point of the planned surface (exact, lib/eval). */
+    /* The nearest point of the planned surface (exact, lib/eval). */
     mr_nearest_hit nh = {0};
     double nsig = NAN;
     if (near) {

@@ -70,7 +70,7 @@ int cmd_render(int argc, char **argv) {
     bool groundtruth = false;
     if (!app_ao_check(cmd, &tables[1], &groundtruth, &gtp)) return 2;
     fp.ao.want_ao = aux != NULL;
-    fp.ao.temporal = false; /* issue 18: a single frame has nothing to accumulate */
+    fp.ao.temporal = false; /* a single frame has nothing to accumulate */
     fp.shadow.want_shadow = aux != NULL;
     mr_quilt quilt = {0};
     bool have_quilt;
@@ -126,7 +126,7 @@ int cmd_render(int argc, char **argv) {
     if (!app_gfx_open(&gfx, &err)) {
         rc = mr_cli_error(cmd, &err);
     } else {
-        /* issue 17 (lane cluster): meshlets cached beside the file too */
+        /* Meshlets cached beside the file too */
         char clu[4096] = "";
         if ((!lod_cache || strcmp(lod_cache, "on") == 0) && scene->source[0])
             mr_cluster_cache_path(scene->source, clu, sizeof clu);
@@ -145,7 +145,7 @@ int cmd_render(int argc, char **argv) {
             else if (!mr_cli_flag(opts, "quiet"))
                 printf("rendered %d views of %dx%d into %s/ (quilt %dx%d, focal distance %g) in %.0f ms\n", rr.views,
                        ql.tile_w, ql.tile_h, out, ql.cols, ql.rows, focal, rr.ms_total);
-            /* issue 14: what the views shared. */
+            /* What the views shared. */
             if (rc == 0 && mr_cli_flag(opts, "verbose"))
                 fprintf(stderr, "mrcheck: render: %d views: %d frustum culls, %d shadow map passes, culling %.2f ms\n",
                         rr.views, rr.frustum_culls, rr.shadow_maps, rr.cull_ms);
@@ -168,12 +168,10 @@ int cmd_render(int argc, char **argv) {
                     "commands, %llu of %llu triangles, culling %.2f ms; peak RSS %.0f MB\n", ds.nodes_visible,
                     ds.nodes_drawable, ds.instances, ds.lod_instances, ds.commands, (unsigned long long)ds.triangles,
                     (unsigned long long)ds.triangles_full, ds.cull_ms, mr_peak_rss_bytes() / 1048576.0);
-            /* issue 17 (lane meshlet) */
             if (ds.clusters_tested)
                 fprintf(stderr, "mrcheck: render: clusters: %llu of %llu meshlets drawn (%llu occluded)\n",
                         (unsigned long long)ds.clusters_drawn, (unsigned long long)ds.clusters_tested,
                         (unsigned long long)ds.clusters_occluded);
-            /* issue 17 (lane cluster) */
             mr_cluster_info ci;
             mr_renderer_cluster_info(gfx.renderer, &ci);
             fprintf(stderr, "mrcheck: render: upload %.2f s; meshlets: %llu levels from the cache, %llu built in %.2f s%s\n",

@@ -22,7 +22,7 @@ static const struct {
     {"study", cmd_study, "pairwise comparison studies: stimuli, plan, run (window), analyze"},
     {"map", cmd_map, "the marker map from photos: bundle adjustment, per-tag sigma, control points"},
     {"measure", cmd_measure, "triangulate a feature tapped in several recorded frames; distance to the plan with sigma"},
-    /* issue 16: findings as BCF and a report */
+    /* Findings as BCF and a report */
     {"export", cmd_export, "a session's marks as BCF 2.1/3.0 topics or a self-contained HTML report"},
 };
 

@@ -19,7 +19,6 @@ bool app_rig_check(const char *cmd, const mr_cli_table *t, const mr_cli_opt *opt
     bool lf = mr_cli_get(opts, "lightfield") != NULL;
     if (rp->views == 0 && !*have_quilt && !lf && rig_opt)
         return mr_cli_errorf(cmd, "--view-cone, --view-fov and --focal-distance need --views, --quilt or --lightfield"), false;
-    /* issue 14 */
     if (rp->views == 0 && !*have_quilt && mr_cli_table_given(t, "views-per-view-work"))
         return mr_cli_errorf(cmd, "--views-per-view-work needs --views or --quilt"), false;
     if (lf && (rp->views > 0 || *have_quilt))

@@ -1,4 +1,4 @@
-// issue 18 (lane deint): AO pixel 4 t + o back from texel t of tile o of
+// AO pixel 4 t + o back from texel t of tile o of
 // the AO atlas, so the blur and upsample see an ordinary AO image.
 #include "mr_bindings.h"
 

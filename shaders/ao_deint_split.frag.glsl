@@ -1,4 +1,4 @@
-// issue 18 (lane deint): the depth atlas of deinterleaved AO. Tile (ox, oy)
+// The depth atlas of deinterleaved AO. Tile (ox, oy)
 // of the 4x4 tiles holds the AO pixels 4 t + (ox, oy): one layer's samples
 // then read a quarter-size, contiguous block (cache-coherent), which is
 // what interleaved rendering buys (Bavoil & Jansen, deinterleaved texturing).

@@ -1,4 +1,4 @@
-// issue 18: level 0 of the AO's depth mip chain, a copy of the G-buffer's
+// Level 0 of the AO's depth mip chain, a copy of the G-buffer's
 // reversed-Z depth into an R32F texture that glGenerateTextureMipmap can
 // box-filter (a depth texture cannot be copied into a colour one). The
 // box average of d = near / z is exact on a plane (1/z is affine in the

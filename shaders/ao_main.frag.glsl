@@ -25,7 +25,7 @@ layout(location = MR_LOC_AO_MASK_STRENGTH) uniform float u_mask_strength; // sta
 layout(location = MR_LOC_AO_KERNEL) uniform vec4 u_kernel[MR_AO_KERNEL_SIZE];  // xyz in the unit ball shell [r_min, r_max]
 layout(location = MR_LOC_AO_KERNEL2) uniform vec4 u_kernel2[MR_AO_KERNEL_SIZE]; // xy in the unit disk annulus [r_min, r_max]
 
-// issue 18: the slice integrators (gtao, bitmask, scheer-gt).
+// The slice integrators (gtao, bitmask, scheer-gt).
 layout(location = MR_LOC_AO_SLICES) uniform vec4 u_slices[MR_AO_SLICES_SIZE]; // xy: unit slice directions over half a turn
 layout(location = MR_LOC_AO_SLICE_COUNT) uniform int u_slice_count;  // 1..16
 layout(location = MR_LOC_AO_STEPS) uniform int u_steps;              // samples per slice side
@@ -36,7 +36,7 @@ layout(location = MR_LOC_AO_NOISE_CELL) uniform float u_noise_cell; // grid cell
 layout(location = MR_LOC_AO_NOISE_FRAME) uniform mat4 u_noise_frame; // anchor_from_camera
 
 layout(location = MR_LOC_AO_DISPLAY) uniform vec3 u_display;       // D, E, width; D = 0: pinhole
-// issue 18 (lane ao): the slice methods' depth mip chain
+// The slice methods' depth mip chain
 layout(location = MR_LOC_AO_MIPS) uniform int u_mips;              // levels above 0; 0 = off (level 0 only)
 layout(location = MR_LOC_AO_MIP_NEAR) uniform float u_mip_near;    // samples nearer than this (px) read level 0
 
@@ -45,7 +45,7 @@ layout(binding = MR_TEX_AO_NORMAL) uniform sampler2D u_normal;
 layout(binding = MR_TEX_AO_POSITIONS) uniform sampler2D u_pos;
 layout(binding = MR_TEX_AO_MASK) uniform sampler2D u_mask;
 layout(binding = MR_TEX_AO_DEPTH_MIP) uniform sampler2D u_depth_mip; // reversed-Z depth, box-filtered levels
-// issue 18 (lane deint): deinterleaved AO. The target is a 4x4 atlas of
+// Deinterleaved AO. The target is a 4x4 atlas of
 // quarter-size layers; the fragment in tile o at texel t is AO pixel
 // 4 t + o, and every depth it samples comes from its own tile (the AO
 // pixels congruent to o mod 4), so a layer's reads stay in one small block.
@@ -237,7 +237,7 @@ float occ_alchemy(vec3 P, vec3 n, float r, vec3 rnd, vec2 px) {
     return sum / float(u_samples);                   // 2 sigma / s with sigma = 0.5
 }
 
-// ------------------------------------------------------------ issue 18
+// ------------------------------------------------------ slice integrators
 // The slice integrators. A slice is the plane through the view vector V
 // (towards the camera) and a screen direction d; in it an angle t is
 // measured from V, positive towards +d. The normal projected into the
@@ -301,7 +301,7 @@ bool slice_sample(vec2 px, vec2 d, int side, int j, float jitter, float rpx, out
     if (!(uv.x > -0.5 && uv.y > -0.5 && uv.x < float(u_full.x) - 0.5 && uv.y < float(u_full.y) - 0.5)) return false;
     if (u_use_pos != 0) return fetch_pos(ivec2(floor(uv + 0.5)), S);
     float dz;
-    // issue 18: a far sample reads a coarser level of the depth chain, one
+    // A far sample reads a coarser level of the depth chain, one
     // whose texels (2^L pixels) stay below the spacing of the samples
     // around it: level L for offsets in [near 2^(L-1), near 2^L). Nearer
     // ones read the G-buffer itself, exactly as without the chain.
@@ -459,7 +459,7 @@ float occ_scheer_gt(vec3 P, vec3 n, float r, vec3 rnd, vec2 px) {
     return total > 0.0 ? occ / total : 0.0;
 }
 
-// scheer-bm (issue 18, lane ao): Scheer & Keutel's quasi-normalised
+// scheer-bm: Scheer & Keutel's quasi-normalised
 // attenuation inside the visibility bitmask's sector weights. The samples
 // of a slice side march outwards; each marks the sectors between its front
 // face and `thickness * r` behind it like the bitmask, but only the sectors

@@ -1,4 +1,4 @@
-// issue 18: the fetch floor of a full-screen AO pass. Per pixel the same
+// The fetch floor of a full-screen AO pass. Per pixel the same
 // number of R32F texel fetches as an AO method's samples, at the same
 // spread (the AO disk kernel scaled to the projected radius), and no other
 // work than clamping the address and summing (so that no fetch can be

@@ -1,4 +1,4 @@
-// issue 18: temporal accumulation of the AO. Each pixel's surface point is
+// Temporal accumulation of the AO. Each pixel's surface point is
 // carried into the previous frame's camera (camera-relative: prev_from_cur
 // is computed in double on the CPU), the history is fetched at the nearest
 // previous pixel and kept only when its stored depth and normal agree with

@@ -73,14 +73,14 @@
 #define MR_AO_KERNEL_SIZE                  64 /* = MR_AO_MAX_SAMPLES (checked in pass_ao.c) */
 #define MR_LOC_AO_KERNEL2                  (MR_LOC_AO_KERNEL + MR_AO_KERNEL_SIZE)
 #define MR_TEX_AO_MASK                     3
-/* issue 18: gtao / bitmask / scheer-gt */
+/* gtao / bitmask / scheer-gt */
 #define MR_LOC_AO_SLICES                   (MR_LOC_AO_KERNEL2 + MR_AO_KERNEL_SIZE) /* vec4[MR_AO_SLICES_SIZE]: xy slice direction */
 #define MR_AO_SLICES_SIZE                  16 /* = MR_AO_MAX_SLICES */
 #define MR_LOC_AO_SLICE_COUNT              (MR_LOC_AO_SLICES + MR_AO_SLICES_SIZE)
 #define MR_LOC_AO_STEPS                    (MR_LOC_AO_SLICE_COUNT + 1)
 #define MR_LOC_AO_THICKNESS                (MR_LOC_AO_SLICE_COUNT + 2)
 #define MR_LOC_AO_FRAME                    (MR_LOC_AO_SLICE_COUNT + 3) /* temporal: frame index, 0 = the fixed noise */
-/* ao_temporal (issue 18), besides AO_INTR / AO_FULL / AO_NEAR and the AO textures */
+/* ao_temporal, besides AO_INTR / AO_FULL / AO_NEAR and the AO textures */
 #define MR_LOC_TAA_PREV_FROM_CUR           8
 #define MR_LOC_TAA_PREV_INTR               9
 #define MR_LOC_TAA_HAVE_HISTORY            10
@@ -90,7 +90,7 @@
 #define MR_TEX_TAA_HISTORY                 5
 #define MR_TEX_TAA_HISTORY_N               6
 
-/* ao_probe (issue 18: the fetch floor) */
+/* ao_probe (the fetch floor) */
 #define MR_LOC_PROBE_FETCHES               0
 #define MR_LOC_PROBE_OFFSETS               1  /* vec4[MR_AO_KERNEL_SIZE] */
 #define MR_TEX_PROBE_SRC                   0
@@ -99,12 +99,12 @@
 #define MR_LOC_AO_NOISE_CELL               (MR_LOC_AO_NOISE + 1)
 #define MR_LOC_AO_NOISE_FRAME              (MR_LOC_AO_NOISE + 2) /* mat4: 4 locations */
 #define MR_LOC_AO_DISPLAY                  (MR_LOC_AO_NOISE + 6) /* vec3 D, E, width: light-field mapping */
-/* issue 18 (lane ao): the depth mip chain of the slice methods' far samples */
+/* The depth mip chain of the slice methods' far samples */
 #define MR_LOC_AO_MIPS                     (MR_LOC_AO_DISPLAY + 1) /* int: levels above 0 in the chain, 0 = off */
 #define MR_LOC_AO_MIP_NEAR                 (MR_LOC_AO_DISPLAY + 2) /* float: offset (px) below which level 0 is read */
 #define MR_TEX_AO_DEPTH_MIP                5  /* ao_main: reversed-Z depth, R32F, box-filtered levels */
 #define MR_TEX_AO_MIP_SRC                  0  /* ao_depth_mip: the G-buffer's depth */
-/* issue 18 (lane deint): deinterleaved AO, 4x4 quarter-size layers in a tiled atlas */
+/* Deinterleaved AO, 4x4 quarter-size layers in a tiled atlas */
 #define MR_LOC_AO_DEINT                    (MR_LOC_AO_DISPLAY + 3) /* int: 1 = the target is the layer atlas */
 #define MR_LOC_AO_DEINT_Q                  (MR_LOC_AO_DISPLAY + 4) /* ivec2: one layer's size (AO pixels / 4) */
 #define MR_LOC_AO_DEINT_NEAR               (MR_LOC_AO_DISPLAY + 5) /* float: offsets (G-buffer px) below this read the G-buffer */
@@ -318,10 +318,10 @@
 #define MR_AO_METHOD_ID_GTAO               6
 #define MR_AO_METHOD_ID_BITMASK            7
 #define MR_AO_METHOD_ID_SCHEER_GT          8
-#define MR_AO_METHOD_ID_SCHEER_BM          9 /* issue 18 (lane ao) */
+#define MR_AO_METHOD_ID_SCHEER_BM          9
 #define MR_AO_METHOD_MASK_STANDALONE       100
 
-/* issue 14: rig_layered (the layered-rendering experiment): all of a rig
+/* rig_layered (the layered-rendering experiment): all of a rig
  * frame's views in one instanced draw, gl_ViewportIndex = instance % views;
  * the projections take MR_LOC_PROJECTION .. + MR_RIG_LAYERED_MAX - 1. */
 #define MR_RIG_LAYERED_MAX                 16

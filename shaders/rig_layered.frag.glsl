@@ -1,2 +1,2 @@
-// issue 14, the layered-rendering experiment: depth only.
+// The layered-rendering experiment: depth only.
 void main() {}

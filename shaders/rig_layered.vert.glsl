@@ -1,4 +1,4 @@
-// issue 14, the layered-rendering experiment: the G-buffer pass's vertex
+// The layered-rendering experiment: the G-buffer pass's vertex
 // work for up to MR_RIG_LAYERED_MAX views of a rig in one instanced draw.
 // The instance records are the centre camera's (attribute divisor = views):
 // view v = gl_InstanceID % views only moves the point along the camera's x

@@ -117,7 +117,7 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
                  video_add(p, &vw, &res.color, fps, err);
             const int rw = ok ? res.color.width : 0, rh = ok ? res.color.height : 0;
             if (ok) mr_frame_result_free(&res);
-            /* issue 15: the registration's σ at the model under the centre,
+            /* The registration's σ at the model under the centre,
              * when the recording has the pose's covariance (one pixel read
              * back from the frame just drawn). */
             mr_pick cp = {0};

@@ -31,7 +31,7 @@
 
 #define MAX_VIEWS MR_BENCH_AO_MAX_VIEWS
 enum { MAXC = 32, MAXS = 4 };
-enum { SEQ_METHODS = 3, SEQ_CFG = 4, COST_METHODS = 3 }; /* issue 18: the moving sequence, the cost steps */
+enum { SEQ_METHODS = 3, SEQ_CFG = 4, COST_METHODS = 3 }; /* the moving sequence, the cost steps */
 
 /* The methods raced. role: Scheer & Keutel's rendering it stands for, or
  * "-". radius: TUNE_RADIUS (tuned with the rest), REF_RADIUS (the
@@ -62,7 +62,7 @@ static const contender k_contenders[] = {
     {"hbao@R", "-", MR_AO_HBAO, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
     {"alchemy", "-", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
     {"alchemy@R", "-", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
-    /* issue 18: the modern integrators, with the depth-scaled and the fixed radius */
+    /* The modern integrators, with the depth-scaled and the fixed radius */
     {"gtao", "-", MR_AO_GTAO, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
     {"gtao@R", "-", MR_AO_GTAO, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
     {"gtao-view", "-", MR_AO_GTAO, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
@@ -75,7 +75,7 @@ static const contender k_contenders[] = {
     {"scheer-gt@R", "D2", MR_AO_SCHEER_GT, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
     {"scheer-gt-view", "-", MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
     {"scheer-gt-view@R", "-", MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
-    /* issue 18 (lane ao): Scheer's attenuation in the bitmask's sector weights */
+    /* Scheer's attenuation in the bitmask's sector weights */
     {"scheer-bm", "D2", MR_AO_SCHEER_BM, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
     {"scheer-bm@R", "D2", MR_AO_SCHEER_BM, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
     {"scheer-bm-view", "-", MR_AO_SCHEER_BM, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
@@ -111,7 +111,7 @@ typedef struct ao_bench {
     view_data vd[MAX_VIEWS + 1];
     contender cs[NC];
     agg_table agg_ms, agg_rf, agg_rs, agg_sf, agg_ss, agg_bf, agg_bs, agg_mf;
-    agg_table agg_sync, agg_floor, agg_ratio; /* issue 18: glFinish-timed ms, the fetch floor, their ratio */
+    agg_table agg_sync, agg_floor, agg_ratio; /* glFinish-timed ms, the fetch floor, their ratio */
     double pv_rf[MAX_VIEWS + 1][MAXC + 1], pv_rs[MAX_VIEWS + 1][MAXC + 1]; /* per view, reported samples, full, mask off */
     double none_rf, none_rs, none_sf, none_ss, none_bf, none_bs;
     mr_image *montage[MAX_VIEWS * 10];
@@ -121,12 +121,12 @@ typedef struct ao_bench {
     uint64_t tri_count[4];
     int ntri;
     mr_image ao; /* scratch: the last AO map */
-    /* issue 18: the moving sequence (step 6b) */
+    /* The moving sequence (step 6b) */
     int seq_frames;
     char seq_name[1100];
     double seq_rmse[SEQ_METHODS][SEQ_CFG][2], seq_ms[SEQ_METHODS][SEQ_CFG]; /* {all frames, second half}, median ms */
-    /* issue 18 (lane ao): the cost steps (step 6c): [method][full, +mips, half, half+mips] */
-    /* issue 18 (lane deint): [4] full + deinterleave, [5] half + deinterleave */
+    /* The cost steps (step 6c): [method][full, +mips, half, half+mips] */
+    /* [4] full + deinterleave, [5] half + deinterleave */
     double cost_ratio[COST_METHODS][6], cost_sync[COST_METHODS][6], cost_floor[COST_METHODS][6], cost_rmse[COST_METHODS][6];
     int cost_rounds;
     char cost_view[256], loadavg[128];
@@ -141,7 +141,7 @@ static bool run_ao(mr_renderer *r, const mr_view *v, const mr_ao_params *ao, int
     fp.width = w;
     fp.height = h;
     fp.timing = frames > 0;
-    fp.timing_sync = true; /* issue 18: each pass's whole cost, glFinish before and after */
+    fp.timing_sync = true; /* each pass's whole cost, glFinish before and after */
     fp.ao = *ao;
     fp.ao.no_reuse = true;
     fp.ao.want_ao = true;
@@ -334,7 +334,7 @@ static bool ao_tune(ao_bench *b, mr_error *err) {
                  cvals[] = {1, 0.25, 4};
     const int nr = quick ? 3 : 4, ns = quick ? 2 : 9, nb = quick ? 1 : 2;
     const double qs[] = {1, 3};
-    /* issue 18: the assumed thickness of the methods that use it (the
+    /* The assumed thickness of the methods that use it (the
      * first entry is the default) */
     const double thick[] = {MR_AO_DEFAULT_THICKNESS, 0.25, 1, 2};
     const view_data *vd = &b->vd[0];
@@ -409,7 +409,7 @@ static bool ao_tune(ao_bench *b, mr_error *err) {
     return save_csv(tune, b->p.out_dir, "bench_ao_tuning.csv", err);
 }
 
-/* issue 18: the fetch floor of one row, measured right after it (the
+/* The fetch floor of one row, measured right after it (the
  * machine is shared and noisy: side by side): as many R32F fetches per AO
  * pixel as the row has samples (times its radii), over the AO target's
  * size, spread over the depth-scaled radius in pixels. */
@@ -621,7 +621,7 @@ static bool ao_plots(ao_bench *b, mr_error *err) {
         for (int c = 0; c < NC; c++)
             for (int res = 0; res < b->nres; res++) {
                 for (int si = 0; si < b->nsamp; si++) {
-                    xs[nser][si] = b->agg_sync[c][si][res][0]; /* issue 18: glFinish-timed */
+                    xs[nser][si] = b->agg_sync[c][si][res][0]; /* glFinish-timed */
                     ys[nser][si] = ref ? b->agg_rs[c][si][res][0] : b->agg_rf[c][si][res][0];
                 }
                 snprintf(names[nser], sizeof names[nser], "%s%s", b->cs[c].label, res ? " half" : "");
@@ -715,7 +715,7 @@ static double rmse_at_ms(const ao_bench *b, int c, bool screen, double ms, bool 
     return y[a] + t * (y[bb] - y[a]);
 }
 
-/* issue 18: the table at equal ms: every contender's RMSE interpolated on
+/* The table at equal ms: every contender's RMSE interpolated on
  * its error-against-ms curve at the ms of scheer (D2, tuned) at the
  * reported sample count, and at that of the fetch floor's ratio. */
 static size_t equal_ms_table(const ao_bench *b, char *md, size_t cap, size_t len) {
@@ -735,7 +735,7 @@ static size_t equal_ms_table(const ao_bench *b, char *md, size_t cap, size_t len
         len += (size_t)snprintf(md + len, cap - len, "| %s | %.4f%s | %.4f%s | %.2f | %.2f |\n", b->cs[c].label, rf,
                                 of ? "*" : "", rs, os ? "*" : "", b->agg_sync[c][s16][0][0], b->agg_ratio[c][s16][0][0]);
     }
-    /* The goal of issue 18: the best scheer-family row against the best of
+    /* The question the bench answers: the best scheer-family row against the best of
      * gtao, bitmask, hbao and filion, at this ms, per reference (rows
      * outside their curve count with their nearest end). */
     for (int ref = 1; ref >= 0; ref--) {
@@ -760,7 +760,7 @@ static size_t equal_ms_table(const ao_bench *b, char *md, size_t cap, size_t len
     return len;
 }
 
-/* Step 6b (issue 18): temporal accumulation on a moving sequence, the
+/* Step 6b: temporal accumulation on a moving sequence, the
  * poses of a recording (--sequence DIR; default the shipped
  * recordings/demo when it is there, else the step is left out) at the
  * bench's size: per frame the depth-scaled reference, and each of the
@@ -935,10 +935,10 @@ static bool ao_sequence(ao_bench *b, mr_error *err) {
     return save_csv(csv, b->p.out_dir, "bench_ao_sequence.csv", err);
 }
 
-/* Step 6c (issue 18): the cost steps towards the fetch floor. On the first
+/* Step 6c: the cost steps towards the fetch floor. On the first
  * reported view, at 16 samples, each of the slice methods (tuned, depth-
  * scaled) at full and half resolution, with and without the depth mip
- * chain, and (issue 18, lane deint) deinterleaved at full and half
+ * chain, and deinterleaved at full and half
  * resolution; every configuration timed (glFinish, median of --frames) with its
  * fetch floor right after, in `rounds` rounds that alternate the
  * configurations (the machine is shared: side by side, the median of the
@@ -962,7 +962,7 @@ static bool ao_cost(ao_bench *b, mr_error *err) {
                 p.samples = 16;
                 p.half_res = cfg == 2 || cfg == 3 || cfg == 5;
                 p.mips = cfg == 1 || cfg == 3;
-                p.deinterleave = cfg >= 4; /* issue 18 (lane deint) */
+                p.deinterleave = cfg >= 4;
                 double gms = 0, s = 0, fl = 0;
                 mr_image_metrics mt;
                 ok = run_ao(b->gfx.renderer, &vd->view, &p, b->w, b->h, b->p.frames, &gms, &s, &b->ao, NULL, err) &&

@@ -1,4 +1,4 @@
-/* bench load (issue 17, item 7): how fast gltfpack's files load against
+/* Bench load: how fast gltfpack's files load against
  * the file they were made from. The instanced factory (mr_synth_build) and
  * the unique CAD-like one (mr_synth_cad_build) are written as .glb and
  * packed with gltfpack: default (KHR_mesh_quantization), -c and -cc

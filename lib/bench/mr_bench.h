@@ -30,7 +30,7 @@ typedef struct mr_bench_gpu {
 
 /* -------------------------------------------------------------- shadows */
 
-/* Soft shadows, error against run time, on the shadow suite (issue 12):
+/* Soft shadows, error against run time, on the shadow suite:
  * every method x setting x case x view, GPU ms against RMSE, sqrt(D)/|S|
  * and SSIM over the shadow region against Embree (bench_shadows.csv,
  * bench_shadows.svg, bench_shadows_<case>.png montages: reference, hard,
@@ -73,7 +73,7 @@ typedef struct mr_bench_ao_params {
     int rays;                    /* ground-truth rays per pixel, default 256 */
     double radius;               /* the fixed reference's R in scene units; 0: 2% of the scene diagonal */
     double screen_radius;        /* the depth-scaled reference: fraction of the image height, default 0.05 */
-    const char *sequence;        /* issue 18: recording whose poses are the moving sequence;
+    const char *sequence;        /* recording whose poses are the moving sequence;
                                     NULL: recordings/demo if it is there, else none */
     bool quick;                  /* samples 8 and 32, full resolution only, 2-point tuning */
     bool verbose;                /* print the tuned parameters */
@@ -137,13 +137,13 @@ typedef struct mr_bench_scene_params {
     int width, height;      /* px, default 1024x768 */
     int frames;             /* timed frames per case after one warm-up, default 3 */
     FILE *out;              /* the table; NULL: silent */
-    /* Unique geometry (issue 17): the CAD-like factory (mr_synth_cad_build,
+    /* Unique geometry: the CAD-like factory (mr_synth_cad_build,
      * every part its own mesh of 20k triangles, split at normal seams)
      * instead of the instanced one; bench_scene_unique.csv/.svg, with the
      * LOD's first build and its cached load timed apart. */
     bool unique;
     double unit;            /* scene units per metre of the unique factory; 0 = 1 */
-    /* issue 17 (lane bench): timed frames of the full-detail configurations
+    /* Timed frames of the full-detail configurations
      * (no-lod, none), which cost seconds a frame at 20M; 0: frames. */
     int full_frames;
 } mr_bench_scene_params;
@@ -191,7 +191,7 @@ typedef struct mr_bench_map_params {
 bool mr_bench_map(const mr_bench_map_params *params, mr_error *err);
 extern const mr_opt mr_bench_map_opts[]; /* seeds, max-photos, noise, misdetect */
 
-/* bench load (load.c, issue 17 item 7): the instanced factory
+/* Bench load (load.c): the instanced factory
  * (mr_synth_build, `triangles` drawn) and the unique one (mr_synth_cad_build,
  * `unique_triangles`) as .glb and packed by gltfpack (default, -c, -cc);
  * each file loaded by mr_scene_load in a fresh child process per load, in
@@ -286,7 +286,7 @@ typedef struct mr_bench_multiview_params {
     bool quick;                 /* views 1 and 8 only */
     bool progress;              /* a line per row on stderr */
     FILE *out;                  /* the tables; NULL: silent */
-    bool shared_only;           /* issue 14: instead of the tables above, the
+    bool shared_only;           /* instead of the tables above, the
                                    shared-work table (bench_multiview_shared.*:
                                    8, 24, 48 views at view_w x view_h on the demo
                                    hall and the synthetic factory, shared vs
@@ -337,7 +337,7 @@ typedef struct mr_synth_map {
 bool mr_synth_map_make(const mr_synth_map_params *params, mr_synth_map *out, mr_error *err);
 void mr_synth_map_free(mr_synth_map *s);
 /* A rendered set on disk (`mrcheck synth --map-photos DIR`): DIR/images/
- * photo_NNN.png, the same photos as a video photos.avi (issue 15: `map
+ * photo_NNN.png, the same photos as a video photos.avi (for `map
  * --video`), camera.json, truth.json (the true marker map) and
  * control.json (four tag centres, sigma 1 mm). params NULL: a small room
  * (MR_SYNTH_MAP_SET_DEFAULTS); images/ is never overwritten. */

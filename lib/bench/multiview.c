@@ -148,7 +148,7 @@ static double diag_of(const mr_scene *s) {
     return sqrt(d2);
 }
 
-/* issue 14: the shared work. Median ms of a rig frame (all views, read
+/* The shared work. Median ms of a rig frame (all views, read
  * back) with one cull and one shadow map per frame against the old per-view
  * work, side by side in one run (alternating, so load drifts hit both), on
  * the demo hall and the synthetic factory (many nodes: culling counts). */
@@ -232,7 +232,7 @@ static bool bench_shared(const mr_bench_multiview_params *p, mr_scene *const sce
     char path[4096];
     mr_csv *csv = mr_csv_create(err);
     if (!csv) return false;
-    mr_csv_comment(csv, "mrcheck bench multiview: shared work per rig frame (issue 14), pcf shadows, no AO");
+    mr_csv_comment(csv, "mrcheck bench multiview: shared work per rig frame, pcf shadows, no AO");
     mr_csv_header(csv, "scene,views,width,height,ms_frame_per_view_work,ms_frame_shared,speedup,cull_ms_per_view_work,"
                        "cull_ms_shared,shadow_maps_per_view_work,shadow_maps_shared,frustum_culls_per_view_work,"
                        "frustum_culls_shared,gbuffer_geometry_ms_loop,gbuffer_geometry_ms_layered");
@@ -282,7 +282,7 @@ static bool bench_shared(const mr_bench_multiview_params *p, mr_scene *const sce
     char *md = malloc(cap);
     if (!md) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
 #define MD(...) do { if (len < cap) len += (size_t)snprintf(md + len, cap - len, __VA_ARGS__); } while (0)
-    MD("# mrcheck bench multiview: shared work (issue 14)\n\nGPU: %s. A rig frame of N views of %dx%d (35 degree "
+    MD("# mrcheck bench multiview: shared work\n\nGPU: %s. A rig frame of N views of %dx%d (35 degree "
        "cone, focused on the scene's centre), pcf shadows (sun, cascades as the scene needs), no AO, read back; median "
        "of %d frames, the two ways alternating. Shared: one frustum cull + LOD choice for the union of the views' "
        "frusta and one shadow map fitted to the union per frame; per-view work: each view culls and fits and draws its "
@@ -337,7 +337,7 @@ bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err) 
     mr_view centre = p.view ? *p.view : mr_demo_view(0);
     memset(centre.camera.dist, 0, sizeof centre.camera.dist);
     if (p.shared_only) {
-        /* issue 14: the shared-work table alone. */
+        /* The shared-work table alone. */
         mr_synth_params sp = MR_SYNTH_DEFAULTS;
         mr_scene *synth = mr_synth_build(&sp, err);
         bool ok = synth != NULL;

@@ -37,7 +37,6 @@ const mr_opt mr_bench_ghost_opts[] = {
 const mr_opt mr_bench_scene_opts[] = {
     {"frames", MR_OPT_INT, offsetof(mr_bench_scene_params, frames), 1, 1000, 3, NULL,
      "timed frames per case after one warm-up", 0},
-    /* issue 17 (lane bench) */
     {"full-detail-frames", MR_OPT_INT, offsetof(mr_bench_scene_params, full_frames), 0, 1000, 0, NULL,
      "timed frames of the full-detail cases (no-lod, none; auto: --frames)", MR_OPT_ZERO_AUTO},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
@@ -75,7 +74,7 @@ const mr_opt mr_bench_multiview_opts[] = {
     {"rays", MR_OPT_INT, MV(rays), 1, 1 << 16, 64, NULL, "reference rays per pixel", 0},
     {"quick", MR_OPT_BOOL, MV(quick), 0, 1, 0, NULL, "views 1 and 8 only", 0},
     {"shared-only", MR_OPT_BOOL, MV(shared_only), 0, 1, 0, NULL,
-     "instead: the shared-work table (issue 14: one cull and shadow map per rig frame vs per view, layered rendering)", 0},
+     "instead: the shared-work table (one cull and shadow map per rig frame vs per view, layered rendering)", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef MV
@@ -91,7 +90,7 @@ const mr_opt mr_bench_map_opts[] = {
 };
 #undef MP
 
-/* bench load (issue 17, lane gltf) */
+/* Bench load */
 #define LD(f) offsetof(mr_bench_load_params, f)
 const mr_opt mr_bench_load_opts[] = {
     {"runs", MR_OPT_INT, LD(runs), 1, 99, 5, NULL, "rounds over all files (each a fresh process per file); medians reported", 0},

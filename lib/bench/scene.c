@@ -8,7 +8,7 @@
  * off in turn, and occlusion culling switched on. CSV + an SVG plot of frame time against scene size. Never
  * pass/fail.
  *
- * issue 17 (lane bench), with --unique: each configuration's image against
+ * With --unique: each configuration's image against
  * the full-detail one ("none": no LOD, no culling) off depth edges
  * (mr_image_diff_depth), the whole open of the file with and without the
  * LOD cache, and the issue's Goals (frame ratios 20M / 2M, image difference)
@@ -26,11 +26,11 @@
 typedef struct bench_config {
     const char *name;
     bool no_cull, no_batch, no_instancing, no_lod, occlusion;
-    bool no_occl_auto; /* issue 17: automatic occlusion culling off */
-    bool no_cluster;   /* issue 17 (lane meshlet): cluster culling off */
+    bool no_occl_auto; /* automatic occlusion culling off */
+    bool no_cluster;   /* cluster culling off */
 } bench_config;
 
-/* "all" is the defaults, automatic occlusion culling included (issue 17);
+/* "all" is the defaults, automatic occlusion culling included;
  * "none" switches everything off; "all+occl" forces occlusion on. */
 static const bench_config k_configs[] = {
     {"all", false, false, false, false, false, false, false},
@@ -40,11 +40,11 @@ static const bench_config k_configs[] = {
     {"none", true, true, true, true, false, true, true},
     {"all+occl", false, false, false, false, true, false, false},
     {"no-occl-auto", false, false, false, false, false, true, false},
-    /* issue 17 (lane meshlet): big meshes drawn whole, no meshlet culling */
+    /* Big meshes drawn whole, no meshlet culling */
     {"no-cluster", false, false, false, false, false, false, true},
 };
 #define N_CONFIGS (int)(sizeof k_configs / sizeof k_configs[0])
-/* issue 17 (lane bench): the defaults and the full-detail reference */
+/* The defaults and the full-detail reference */
 enum { k_all = 0, k_none = 4 };
 
 
@@ -52,7 +52,6 @@ typedef struct row {
     double tri_scene;
     int view, config;
     double frame_ms, cull_ms, gpu_ms;
-    /* issue 17 (lane bench) */
     int size;             /* index into the sizes */
     int frames;           /* timed frames */
     double rss_mb;        /* peak RSS when the case was measured */
@@ -61,7 +60,7 @@ typedef struct row {
     double cpu_ms;        /* median process CPU time of a frame (all threads) */
 } row;
 
-/* issue 17 (lane bench): the process's CPU time (all threads, llvmpipe's
+/* The process's CPU time (all threads, llvmpipe's
  * rasteriser threads included). On the shared machine a frame's wall time
  * grows with the other users' load, its CPU time much less: the work. */
 static double process_cpu_s(void) {
@@ -106,7 +105,7 @@ static bool write_plot(const char *path, const row *rows, int n, mr_error *err) 
     return ok;
 }
 
-/* issue 17 (lane bench): the issue's Goals from the measured rows, as lines
+/* The issue's Goals from the measured rows, as lines
  * of the log and notes at the end of the CSV (scripts/bench.sh puts them
  * under the Markdown table). The frame ratio of a size is its "all" frame
  * over the first size's from the same view; the Goals name 20M / 2M (floor
@@ -199,7 +198,7 @@ static mr_scene *load_scene(const char *path, load_info *li, mr_error *err) {
 
 /* One case's timing: the median of `frames` frames after one warm-up of
  * the whole frame (wall ms), the CPU culling and the G-buffer pass (GPU).
- * issue 17 (lane bench): every case starts from the automatic occlusion's
+ * Every case starts from the automatic occlusion's
  * initial state; with `cap`, the untimed warm-up frame also reads back
  * depth and its colour and depth are kept there (it draws the same levels
  * as the timed frames; after the reset, automatic occlusion tests on it
@@ -214,15 +213,15 @@ static bool time_case(const mr_bench_gpu *g, const mr_view *view, const mr_draw_
     fp.timing = true;
     memset(st, 0, sizeof *st);
     bool ok = mr_renderer_set_draw_params(g->renderer, dp, err);
-    mr_renderer_reset_occlusion(g->renderer); /* issue 17 (lane bench) */
+    mr_renderer_reset_occlusion(g->renderer);
     for (long f = -1; ok && f < frames; f++) {
         mr_frame_result res;
         fp.want_depth = cap && f < 0;
         double ts = mr_time_now(), tc = process_cpu_s();
         ok = mr_render_frame(g->renderer, view, &fp, &res, err);
         if (!ok) break;
-        if (f >= 0) pt[f] = (process_cpu_s() - tc) * 1e3; /* issue 17 (lane bench) */
-        if (cap && f < 0) { /* issue 17 (lane bench): keep the images */
+        if (f >= 0) pt[f] = (process_cpu_s() - tc) * 1e3;
+        if (cap && f < 0) { /* keep the images */
             cap->color = res.color;
             cap->depth = res.depth;
             memset(&res.color, 0, sizeof res.color);
@@ -254,11 +253,11 @@ typedef struct size_info {
     bool from_cache;
     bool unique;
     double lod_cached_s, unit;
-    /* issue 17 (lane bench): the whole open of the file as mrcheck render
+    /* The whole open of the file as mrcheck render
      * does it (scene load + LOD levels + upload with them), first without
      * the LOD cache, then with it */
     double open_first_s, open_cached_s;
-    /* issue 17, item 3: the meshlets built by the first upload with the
+    /* The meshlets built by the first upload with the
      * levels (mr_cluster_info.build_s, both cores), and the first build's
      * rate: input triangles per second of LOD and meshlets together */
     double cluster_build_s;
@@ -271,7 +270,7 @@ static void report_row(FILE *out, mr_csv *csv, const size_info *z, int v, int c,
            (unsigned long long)z->li.triangles, z->nodes, z->mb, z->parse_s, z->li.load_s, z->upload_s, rss,
            mr_synth_view_name(v), k_configs[c].name, r->frame_ms, r->cull_ms, r->gpu_ms,
            (unsigned long long)st->triangles, st->gl_draw_calls, st->nodes_visible, st->nodes_occluded);
-    if (z->unique) BENCH_PRINT(out, " %7.3f %8.1f", r->diff.differ_pct, r->cpu_ms); /* issue 17 (lane bench) */
+    if (z->unique) BENCH_PRINT(out, " %7.3f %8.1f", r->diff.differ_pct, r->cpu_ms);
     BENCH_PRINT(out, "\n");
     if (out) fflush(out);
     mr_csv_int(csv, (long long)z->li.triangles);
@@ -297,7 +296,6 @@ static void report_row(FILE *out, mr_csv *csv, const size_info *z, int v, int c,
     if (z->unique) {
         mr_csv_num(csv, "%.3f", z->lod_cached_s);
         mr_csv_num(csv, "%g", z->unit);
-        /* issue 17 (lane bench) */
         mr_csv_num(csv, "%.4f", r->diff.differ_pct);
         mr_csv_num(csv, "%.4f", r->diff.edge_pct);
         mr_csv_num(csv, "%.3f", z->open_first_s);
@@ -322,7 +320,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
     for (int i = 0; i < nsizes; i++) sizes[i] = p.size_count > 0 ? p.sizes[i] : (const double[]){1e6, 5e6, 20e6}[i];
     const int w = p.width, h = p.height;
     const long frames = p.frames;
-    const long full_frames = p.full_frames > 0 ? p.full_frames : p.frames; /* issue 17 (lane bench) */
+    const long full_frames = p.full_frames > 0 ? p.full_frames : p.frames;
     FILE *out = p.out;
     if (!mr_mkdirs(out_dir, err)) return false;
     const mr_bench_gpu gfx = p.gfx;
@@ -347,12 +345,12 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                        "cluster_build_s,lod_cluster_mtris_s" : "");
     mr_csv_header(csv, header);
     BENCH_PRINT(out, "bench scene: %s, %dx%d, median of %ld frames", mr_gpu_description(gfx.gpu), w, h, frames);
-    if (full_frames != frames) BENCH_PRINT(out, " (no-lod and none: %ld)", full_frames); /* issue 17 (lane bench) */
+    if (full_frames != frames) BENCH_PRINT(out, " (no-lod and none: %ld)", full_frames);
     BENCH_PRINT(out, "\n");
     BENCH_PRINT(out, "%10s %8s %9s %6s %6s %7s %8s %-9s %-9s %9s %8s %8s %11s %6s %7s %7s", "triangles", "nodes", "file MB", "parse",
            "load", "upload", "RSS MB", "view", "config", "frame ms", "cull ms", "GPU ms", "submitted", "calls", "visible",
            "occl");
-    if (p.unique) BENCH_PRINT(out, " %7s %8s", "diff %", "CPU ms"); /* issue 17 (lane bench): image against none, frame CPU */
+    if (p.unique) BENCH_PRINT(out, " %7s %8s", "diff %", "CPU ms"); /* image against none, frame CPU */
     BENCH_PRINT(out, "\n");
     char lod_cache[4096];
     mr_path_join(out_dir, "synth.glb.mrlod", lod_cache, sizeof lod_cache); /* same parts at every size */
@@ -441,7 +439,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                 mr_lod_destroy(&lod);
                 lod = again;
             } else {
-                /* issue 17 (lane bench): the second time was no cached load */
+                /* The second time was no cached load */
                 BENCH_PRINT(out, "  warning: the LOD cache %s was not used on the second load (%s)\n", lod_cache,
                             again ? "levels rebuilt" : err->msg);
                 mr_lod_destroy(&again);
@@ -458,7 +456,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
         ok = ok && mr_renderer_set_cluster_cache(gfx.renderer, clu, err);
         t0 = mr_time_now();
         ok = ok && lod && mr_renderer_set_lod(gfx.renderer, lod, err);
-        double lod_upload_s = mr_time_now() - t0; /* issue 17 (lane bench) */
+        double lod_upload_s = mr_time_now() - t0;
         mr_cluster_info ci_first;
         mr_renderer_cluster_info(gfx.renderer, &ci_first);
         double lod_upload_cached_s = lod_upload_s;
@@ -478,13 +476,13 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
             goto done;
         }
         double mb = fsize / 1e6;
-        /* issue 17 (lane bench): the open as a user's: load, levels, upload with them */
+        /* The open as a user's: load, levels, upload with them */
         const size_info z = {li, (int)s->node_count, mb, parse_s, upload_s, lod_s, linfo.from_cache, p.unique,
                              lod_cached_s, cp.unit, li.load_s + lod_s + lod_upload_s,
                              li.load_s + lod_cached_s + lod_upload_cached_s, ci_first.build_s};
         for (int v = 0; v < MR_SYNTH_VIEW_COUNT && ok; v++) {
             mr_view view = mr_synth_view(&sp, p.unique ? &cp : NULL, v);
-            /* issue 17 (lane bench): all configurations of the view first,
+            /* All configurations of the view first,
              * then their rows, each image against the "none" one. */
             mr_frame_result caps[N_CONFIGS];
             memset(caps, 0, sizeof caps);
@@ -525,7 +523,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                         "%.3f s; with its meshlets (%.2f s) %.0f input triangles/s\n",
                         lod_s, lod_runs, li.unique_triangles / lod_s, mr_lod_kernel(&lp), lod_cached_s, z.cluster_build_s,
                         li.unique_triangles / (lod_s + z.cluster_build_s));
-        if (p.unique) /* issue 17 (lane bench) */
+        if (p.unique)
             BENCH_PRINT(out, "  open (load + LOD + upload with levels): first %.2f s, with the LOD cache %.2f s\n",
                         z.open_first_s, z.open_cached_s);
         mr_renderer_set_scene(gfx.renderer, NULL, err);
@@ -536,7 +534,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
             goto done;
         }
     }
-    if (p.unique) report_goals(out, csv, sizes, nsizes, rows, nrows); /* issue 17 (lane bench) */
+    if (p.unique) report_goals(out, csv, sizes, nsizes, rows, nrows);
     {
         char path[4096];
         const char *stem = p.unique ? "bench_scene_unique" : "bench_scene";

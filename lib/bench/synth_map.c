@@ -239,7 +239,7 @@ bool mr_synth_map_write(const char *dir, const mr_synth_map_params *params, mr_e
         mr_path_join(dir, name, path, sizeof path);
         ok = mr_image_save_png(path, &s.images[j], err);
     }
-    /* issue 15: the same photos as a video (`mrcheck map --video`). */
+    /* The same photos as a video (`mrcheck map --video`). */
     if (ok && s.photo_count > 0) {
         mr_path_join(dir, "photos.avi", path, sizeof path);
         mr_video_writer *vw = mr_video_writer_open(path, s.images[0].width, s.images[0].height, 5.0, err);

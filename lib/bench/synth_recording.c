@@ -14,7 +14,7 @@
 
 /* ------------------------------------------------------------ the path */
 
-/* Keyframes of the check walk (issue 16): eye, look-at target and how many
+/* Keyframes of the check walk: eye, look-at target and how many
  * path steps (0.1 s each at the default 10 fps) to pause there (the camera
  * is still: jitter is measured there) before walking `walk` steps to the
  * next keyframe. From the yellow lathe and the roller conveyor in the east,

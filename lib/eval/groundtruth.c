@@ -232,7 +232,7 @@ bool mr_eval_ao_groundtruth(const mr_eval_gt *g, const mr_view *view, const mr_i
 }
 
 /* ------------------------------------------------ area-light shadows
- * Visibility of a light with size (issue 12): shadow rays from each visible
+ * Visibility of a light with size: shadow rays from each visible
  * surface point to stratified points on the light (a jittered g x g grid,
  * n = g^2: the rectangle's area, the sphere's disk facing the point, the
  * sun's disk of directions), unweighted: the fraction of the light's area

@@ -98,7 +98,7 @@ bool mr_image_compare(const mr_image *a, const mr_image *ref, const mr_image *ma
     return true;
 }
 
-/* ---------------------------------------- issue 17 (lane bench): image
+/* ------------------------------------------------------------ image
  * difference off depth edges (definition at mr_image_diff_depth). */
 
 static bool has_surface(float z) { return isfinite(z) && z > 0; }

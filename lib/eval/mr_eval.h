@@ -76,7 +76,7 @@ double mr_eval_ao_point(const mr_eval_gt *gt, mr_dvec3 p, mr_dvec3 n, double rad
  * a = d / R, and V = 1 for d >= R. */
 double mr_eval_ao_wall_analytic(double d, double radius);
 
-/* Area-light shadows (issue 12): the fraction of the light's area (sun:
+/* Area-light shadows: the fraction of the light's area (sun:
  * its disk of directions) seen from each pixel's surface point, by shadow
  * rays to a jittered g x g grid of points on the light (g = round(sqrt(rays))),
  * the same light the renderer's shadows use (mr_shadow_light). 1 where depth
@@ -107,7 +107,7 @@ typedef struct mr_image_metrics {
 bool mr_image_compare(const mr_image *a, const mr_image *ref, const mr_image *mask, mr_image_metrics *out,
                       mr_error *err);
 
-/* issue 17 (lane bench): how much an approximated image (LOD, culling)
+/* How much an approximated image (LOD, culling)
  * differs from the full-detail one, silhouettes aside. A pixel counts as
  * differing when one of its colour channels differs by more than
  * `tolerance` (0..1 of the 8-bit range) and it is not a depth-edge pixel of
@@ -277,7 +277,7 @@ bool mr_montage_png(const char *path, const mr_image *const *images, int count, 
                     mr_error *err);
 
 /* ------------------------------ nearest point on the model (nearest.c) */
-/* Issue 15 (`mrcheck measure`, the view's Measure): the distance from a
+/* For `mrcheck measure` and the view's Measure: the distance from a
  * measured point to the planned surface. Embree's point query prunes with
  * its float BVH; each candidate triangle's closest point is computed in
  * double from the scene's vertices and world transforms, so the answer is

@@ -1,4 +1,4 @@
-/* The nearest point on the planned model (issue 15, `mrcheck measure`):
+/* The nearest point on the planned model (`mrcheck measure`):
  * Embree 3's point query walks its BVH (float, relative to the scene's
  * centre) and hands each candidate triangle to a callback that computes the
  * closest point exactly, in double, from the scene's own vertices and

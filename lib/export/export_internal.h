@@ -47,7 +47,7 @@ typedef struct mr_finding {
     char screen_path[4096];      /* the screen with the overlay, "" none */
     bool has_distance, has_uncertainty;
     double distance_m, uncertainty_m;
-    bool has_distance_sigma;     /* issue 15: the view's Measure (measured_sigma_m) */
+    bool has_distance_sigma;     /* the view's Measure (measured_sigma_m) */
     double distance_sigma_m;
     double depth_m;              /* camera to the mark (hit only), metres */
     char topic_guid[37], viewpoint_guid[37], comment_guid[37];

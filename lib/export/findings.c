@@ -79,7 +79,7 @@ static bool load_one(const char *dir, const mr_export_params *p, mr_finding *f, 
         f->screen_path[0] = 0;
     f->has_distance = opt_num(line, "distance_m", &f->distance_m);
     f->has_uncertainty = opt_num(line, "uncertainty_m", &f->uncertainty_m);
-    /* issue 15: a mark made by Measure carries its triangulated distance
+    /* A mark made by Measure carries its triangulated distance
      * to the plan and that distance's sigma. */
     if (!f->has_distance) f->has_distance = opt_num(line, "measured_distance_m", &f->distance_m);
     f->has_distance_sigma = f->has_distance && opt_num(line, "measured_sigma_m", &f->distance_sigma_m);

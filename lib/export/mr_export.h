@@ -12,7 +12,7 @@
  *   "distance_m"     the measured deviation from the plan, metres
  *   "uncertainty_m"  the registration uncertainty (1 sigma) at the mark, metres
  *   "measured_distance_m", "measured_sigma_m"  a mark made by the view's
- *                    Measure (issue 15): the triangulated distance to the plan
+ *                    Measure: the triangulated distance to the plan
  *                    (used when "distance_m" is absent) and its 1 sigma
  *   "snapshot": {"screen"}  the screen with the overlay (report only)
  *

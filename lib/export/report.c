@@ -128,7 +128,7 @@ static void fmt_len(bool has, double m, char *out, size_t n) {
     else snprintf(out, n, "%.3f m", m);
 }
 
-/* issue 15: "+- sigma" after a measured distance that has one. */
+/* "+- sigma" after a measured distance that has one. */
 static void dist_sigma(const mr_finding *f, char *d, size_t n) {
     if (!f->has_distance_sigma) return;
     char s[32];

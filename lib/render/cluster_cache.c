@@ -1,4 +1,4 @@
-/* Meshlet cache beside the scene file (issue 17, lane cluster); the format
+/* Meshlet cache beside the scene file; the format
  * and the rules are in cluster_cache.h. */
 #include "cluster_cache.h"
 

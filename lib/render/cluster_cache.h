@@ -1,4 +1,4 @@
-/* Meshlet cache beside the scene file (issue 17, lane cluster): the
+/* Meshlet cache beside the scene file: the
  * meshlets of every clustered mesh level (their reordered indices and
  * meshopt's bounds), so a second upload of the same file does not rebuild
  * them. Internal to lib/render (geometry.c and cluster_cache.c).

@@ -17,7 +17,7 @@
  * of textures, not with the number of nodes, and a culled node costs nothing
  * on the GPU. */
 #include "render_internal.h"
-#include "cluster_cache.h" /* issue 17 (lane cluster) */
+#include "cluster_cache.h"
 
 #include <math.h>
 #include <meshoptimizer.h>
@@ -52,13 +52,13 @@ typedef struct geo_mesh {
     float color[4];
     uint32_t has_tex;
     uint32_t cl_first[LEVELS], cl_count[LEVELS]; /* meshlets of each level in mr_geo.clusters */
-    bool single_sided;             /* issue 17 (lane cluster): its material's back faces are culled */
+    bool single_sided;             /* its material's back faces are culled */
 } geo_mesh;
 
-/* One meshlet (issue 17, lane meshlet): geo_cluster, in cluster_cache.h
- * (issue 17, lane cluster: the meshlets are cached beside the file). */
+/* One meshlet: geo_cluster, in cluster_cache.h (the meshlets are cached
+ * beside the file). */
 
-/* issue 17 (lane cluster): the face-culling class of a (node, mesh) pair:
+/* The face-culling class of a (node, mesh) pair:
  * both faces drawn; single-sided; single-sided under a mirroring node (glTF:
  * a negative determinant turns the front face clockwise). Classes are the
  * outermost sort key, so each (class, draw group) is one contiguous run of
@@ -97,17 +97,15 @@ struct mr_geo {
     float *depth, *hz;
     size_t depth_cap, hz_cap, hz_off[24];
     int hz_w[24], hz_h[24];
-    /* issue 17: the automatic decision (see occlusion_wanted) */
+    /* The automatic decision (see occlusion_wanted) */
     bool occ_auto_on;              /* test this frame */
     int occ_probe;                 /* frames until the next trial while off */
     double occ_gain_ms;            /* smoothed measured gain (saved - cost) */
     double occ_rb_ms;              /* read-back of a finished frame, ms (< 0: not measured) */
     int occ_rb_w, occ_rb_h;
-    /* issue 17 (lane meshlet) */
     geo_cluster *clusters;
     uint32_t cluster_count;
     size_t cmd_cap;                /* g->cmds (clusters add commands) */
-    /* issue 17 (lane cluster) */
     uint8_t *node_mirror;          /* the node's world 3x3 has a negative determinant */
     clu_cache *cc;                 /* during upload: the meshlet cache (NULL: none) */
     int occ_levels;                /* > 0 while the occluded-tested nodes are drawn: meshlets test the pyramid too */
@@ -139,7 +137,6 @@ void mr_renderer_draw_stats(const mr_renderer *r, mr_draw_stats *out) {
 
 void mr_geometry_begin_frame(mr_renderer *r) { memset(&r->stats, 0, sizeof r->stats); }
 
-/* issue 17 (lane cluster) */
 bool mr_renderer_set_cluster_cache(mr_renderer *r, const char *path, mr_error *err) {
     if (!r) return mr_fail(err, MR_ERR_INVALID, "no renderer");
     if (path && strlen(path) >= sizeof r->cluster_cache)
@@ -261,8 +258,8 @@ static bool ensure_instances(struct mr_geo *g, uint32_t need) {
  * (up to 64 vertices, 124 triangles; see build_meshlets) and its indices
  * are written meshlet by meshlet, so each meshlet is one contiguous range
  * that a draw can keep or skip (same triangles, another order). Done at
- * upload: about 60 ms of one core per million triangles, hence (issue 17, lane
- * cluster) taken from the cache beside the file where it has them. */
+ * upload: about 60 ms of one core per million triangles, hence taken
+ * from the cache beside the file where it has them. */
 
 /* The meshlets of one level, without GL: clusters (firsts relative to the
  * level) and the indices meshlet by meshlet. Thread-safe: the upload builds
@@ -280,8 +277,8 @@ typedef struct level_build {
  * meshes shuffled 0.15 s; the meshlets' spheres are 8 % larger but their
  * normal cones tighter (90 % instead of 77 % of the meshlets have a cone
  * that can cull, cutoff under 0.9: cone_weight 0 builds for locality
- * only). On a first load the meshlets are part of what the user waits for
- * (issue 17, item 3). */
+ * only). On a first load the meshlets are part of what the user waits
+ * for. */
 static bool build_meshlets(const mr_mesh *m, const uint32_t *indices, size_t n, level_build *b) {
     memset(b, 0, sizeof *b);
     size_t maxm = meshopt_buildMeshletsBound(n, CL_VERTS, CL_TRIS);
@@ -345,7 +342,7 @@ static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int
         glNamedBufferSubData(g->ibo, (GLintptr)gm->first[level] * 4, (GLsizeiptr)n * 4, indices);
         return true;
     }
-    /* issue 17 (lane cluster): the cache's copy of this level. */
+    /* The cache's copy of this level. */
     uint64_t key = 0;
     if (g->cc) {
         key = job ? job->key : clu_level_key(m->positions, m->vertex_count, indices, (uint32_t)n, (uint32_t)thr);
@@ -399,7 +396,7 @@ static bool upload_level(mr_renderer *r, struct mr_geo *g, const mr_mesh *m, int
     gm->count[level] = (uint32_t)w;
     glNamedBufferSubData(g->ibo, (GLintptr)gm->first[level] * 4, (GLsizeiptr)w * 4, out);
     if (g->cc) {
-        /* issue 17 (lane cluster): into the cache, firsts relative to the level */
+        /* Into the cache, firsts relative to the level */
         clu_level lv = {mi, level, key, (uint32_t)n, m->vertex_count, (uint32_t)w, (uint32_t)cnt, rel, out, true};
         if (!clu_cache_add(g->cc, &lv)) {
             g->cc->path[0] = 0; /* incomplete: not written (clu_cache_add freed them) */
@@ -480,7 +477,7 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     if (!g) return mr_fail(err, MR_ERR_NOMEM, "out of memory uploading the scene");
     r->geo = g;
     g->lod = lod;
-    /* issue 17 (lane cluster): the meshlet cache beside the file */
+    /* The meshlet cache beside the file */
     memset(&r->cluster_info, 0, sizeof r->cluster_info);
     if (r->cluster_cache[0] && !r->draw.no_cluster_cull) {
         g->cc = calloc(1, sizeof *g->cc);
@@ -514,7 +511,7 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
         gm->has_tex = textured;
         static const float grey[4] = {0.7f, 0.7f, 0.7f, 1.0f};
         memcpy(gm->color, mat ? mat->base_color : grey, sizeof gm->color);
-        gm->single_sided = mat && mat->single_sided; /* issue 17 (lane cluster) */
+        gm->single_sided = mat && mat->single_sided;
         gm->base_vertex = (int32_t)verts[gm->pool];
         verts[gm->pool] += m->vertex_count;
         gm->level_count = 1;
@@ -639,7 +636,7 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     for (size_t i = 0; i < nn; i++) {
         const mr_node *n = &s->nodes[i];
         g->node_scale[i] = stretch_bound(&n->world);
-        const double *w = n->world.m; /* issue 17 (lane cluster): mirroring? */
+        const double *w = n->world.m; /* mirroring? */
         double det = w[0] * (w[5] * w[10] - w[6] * w[9]) - w[1] * (w[4] * w[10] - w[6] * w[8]) +
                      w[2] * (w[4] * w[9] - w[5] * w[8]);
         g->node_mirror[i] = det < 0;
@@ -666,7 +663,7 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
         return mr_fail(err, MR_ERR_NOMEM, "out of memory for %zu mesh instances", recs);
     glCreateBuffers(1, &g->cmd_buf);
     ensure_instances(g, 1024);
-    if (g->cc) { /* issue 17 (lane cluster) */
+    if (g->cc) {
         r->cluster_info.cache_written = clu_cache_close(g->cc, true);
         free(g->cc);
         g->cc = NULL;
@@ -769,7 +766,7 @@ static bool fill_instance(const mr_geo_view *vw, const mr_node *n, const mr_mesh
     return true;
 }
 
-/* Meshlet culling of one instance (issue 17, lane meshlet), in camera
+/* Meshlet culling of one instance, in camera
  * space: the instance's model-view is composed in double from the
  * camera-relative transforms (fill_instance), so a plant 1e7 units away
  * tests as precisely as one at the origin. A sphere is kept unless it lies
@@ -781,7 +778,7 @@ static bool fill_instance(const mr_geo_view *vw, const mr_node *n, const mr_mesh
  * triangles submitted. */
 static bool occluded(const struct mr_geo *g, int levels, const double rect[4], double near_depth, int w, int h);
 
-/* issue 17 (lane cluster): a meshlet's sphere (camera space p, radius rad)
+/* A meshlet's sphere (camera space p, radius rad)
  * wholly behind the occluders' depth pyramid. Its projection lies within
  * that of the cube around it, whose nearest point is at depth p.z - rad. */
 static bool sphere_occluded(const struct mr_geo *g, const mr_geo_view *vw, const double p[3], double rad) {
@@ -862,7 +859,7 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
             }
             if (la > 0 && lx > 0 && d / sqrt(la * lx) >= (double)q->cutoff + 1e-3) keep = false;
         }
-        if (keep && occ && sphere_occluded(g, vw, p, rad)) { /* issue 17 (lane cluster) */
+        if (keep && occ && sphere_occluded(g, vw, p, rad)) {
             keep = false;
             occl++;
             g->occ_cl_tris += q->count / 3;
@@ -941,7 +938,7 @@ static size_t select_recs(mr_renderer *r, const mr_geo_view *vw, double fmax_t, 
 
 /* Steps 3-4 for sorted records: instance data through vw's camera,
  * commands, submission. Adds to the frame's statistics. replicate >= 1
- * (issue 14's layered experiment): every instance drawn that many times
+ * (the layered-rendering experiment): every instance drawn that many times
  * (attribute divisor = replicate), the caller sets the projections; 0: a
  * plain draw. */
 static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *out, const geo_rec *sorted, size_t nrec,
@@ -953,7 +950,7 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
 
     /* 3. Instance data and commands, one per bucket (or per instance);
      * an instance of a mesh level with meshlets can take one command per
-     * meshlet (issue 17, lane meshlet). */
+     * meshlet. */
     bool clusters = !dp->no_cluster_cull && replicate == 0 && g->cluster_count > 0;
     size_t need = nrec + 1;
     for (size_t i = 0; clusters && i < nrec; i++) need += g->meshes[sorted[i].mesh].cl_count[sorted[i].key % LEVELS];
@@ -971,7 +968,7 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     uint32_t cls_keys = (uint32_t)g->mesh_count * LEVELS;
     memset(g->group_cmds, 0, (size_t)ngroups * sizeof *g->group_cmds);
     for (int32_t k = 0; k < ngroups; k++) g->group_first[k] = -1;
-    /* issue 17 (lane cluster): back-facing meshlets are skipped only where
+    /* Back-facing meshlets are skipped only where
      * this draw culls back faces (then it is exact); mirrored instances
      * never test cones (emit_clusters: similarities of det > 0 only). */
     bool cone_ok = !dp->no_cluster_cone && vw->cull_back;
@@ -988,7 +985,7 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
         uint32_t cls = rc->key / cls_keys;
         int grp = (int)cls * g->group_count + gm->group;
         if (clusters && gm->cl_count[level] > 0) {
-            /* issue 17 (lane meshlet): this instance's visible meshlets */
+            /* This instance's visible meshlets */
             tris += emit_clusters(r, vw, &s->nodes[rc->node], &s->meshes[rc->mesh], gm, level, g->node_scale[rc->node],
                                   ninst, &ncmd, grp, cone_ok && cls == CLS_SINGLE);
             last_key = UINT32_MAX; /* its commands take no other instance */
@@ -1039,7 +1036,7 @@ static void emit_recs(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
         int32_t first = g->group_first[cg], count = g->group_cmds[cg];
         if (first < 0 || count == 0) continue;
         int32_t grp = cg % g->group_count, cls = cg / g->group_count;
-        /* issue 17 (lane cluster): glTF's front faces are counter-clockwise
+        /* glTF's front faces are counter-clockwise
          * in the node's frame; the camera's axes (OpenCV: y down) unflipped
          * by the projection put them clockwise in the window, and a
          * mirroring node turns them back. */
@@ -1209,7 +1206,7 @@ static bool occluded(const struct mr_geo *g, int levels, const double rect[4], d
     return true;
 }
 
-/* ------------------------------------------- shared culling (issue 14)
+/* ------------------------------------------- shared culling
  *
  * A multi-view rig's views differ by a translation along the camera's x
  * axis only. Between share_begin and share_end, a draw through one of them
@@ -1280,7 +1277,7 @@ static const share_list *shared_list(mr_renderer *r, uint32_t mask) {
     return l;
 }
 
-/* Automatic occlusion culling (issue 17): the test pays when the triangles
+/* Automatic occlusion culling: the test pays when the triangles
  * it skips cost more to draw than the test costs. Both are measured on the
  * frames that run it: the read-back waits for the occluders to be drawn, so
  * its time minus that of a read-back alone (measured once per size, after a
@@ -1307,7 +1304,7 @@ static void occlusion_learn(struct mr_geo *g, double sync_ms, double cpu_ms, uin
     }
 }
 
-/* issue 17 (lane bench): the learnt state back to the upload's (see
+/* The learnt state back to the upload's (see
  * upload): the next frame tests and measures. */
 void mr_renderer_reset_occlusion(mr_renderer *r) {
     struct mr_geo *g = r ? r->geo : NULL;
@@ -1447,7 +1444,7 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     r->stats.nodes_occluded += (uint32_t)(nrest - nkeep);
     double t_end = mr_time_now();
     r->stats.cull_ms += (t_end - t0) * 1e3;
-    /* issue 17 (lane cluster): the surviving nodes' meshlets are tested
+    /* The surviving nodes' meshlets are tested
      * against the same pyramid (emit_clusters); what they skip and cost
      * counts in the same decision. */
     g->occ_levels = levels;

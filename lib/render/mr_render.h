@@ -68,7 +68,7 @@ typedef enum mr_ao_method {
     MR_AO_FILION,      /* Filion & McNaughton 2008: hemisphere samples, depth-difference falloff */
     MR_AO_HBAO,        /* Bavoil et al. 2008: horizon search along image-space directions */
     MR_AO_ALCHEMY,     /* McGuire et al. 2011: obscurance estimator on a screen-space disk */
-    /* issue 18: the modern integrators (slices of the hemisphere around the
+    /* The modern integrators (slices of the hemisphere around the
      * view vector, per slice both horizons within the radius). */
     MR_AO_GTAO,        /* Jimenez et al. 2016: cosine-weighted visibility between the two
                           horizons against the normal projected into the slice */
@@ -76,7 +76,6 @@ typedef enum mr_ao_method {
                           occluded by samples assumed `thickness` deep */
     MR_AO_SCHEER_GT,   /* scheer-gt: Scheer & Keutel's quasi-normalised attenuation
                           1/(1 + c l^2) on GTAO's slices (see pass_ao.c) */
-    /* issue 18 (lane ao) */
     MR_AO_SCHEER_BM,   /* scheer-bm: the bitmask's sectors, each counted with the attenuation
                           1/(1 + c l^2) of the nearest sample that marks it (l = |v| / r),
                           depth-scaled radius; c = 0 is the bitmask (shaders/ao_main.frag.glsl) */
@@ -153,7 +152,7 @@ typedef struct mr_ao_params {
                                      (gtao, scheer-gt: the same fraction bounds how far
                                      in front of the pixel an occluder may be before the
                                      thickness heuristic fades it) */
-    bool temporal;                /* issue 18: accumulate the AO over frames (reprojected by
+    bool temporal;                /* accumulate the AO over frames (reprojected by
                                      the poses, history rejected by depth and normal; a
                                      running mean over up to MR_AO_TEMPORAL_FRAMES frames,
                                      then weight 1/MR_AO_TEMPORAL_FRAMES for the new one);
@@ -182,12 +181,10 @@ typedef struct mr_ao_params {
                                      hashed in (a multi-view rig sets its centre camera, so
                                      all views share it); used when noise_anchor_set */
     bool noise_anchor_set;        /* false: the world frame itself */
-    /* issue 18 (lane ao) */
     bool mips;                    /* gtao / bitmask / scheer-gt / scheer-bm: samples at least
                                      MR_AO_MIP_NEAR_PX from the pixel read a box-filtered
                                      depth mip chain (built only for these methods); off
                                      by default */
-    /* issue 18 (lane deint) */
     bool deinterleave;            /* the AO pass over 4x4 quarter-size layers of the depth
                                      (a tiled atlas), one kernel rotation per layer, then
                                      re-interleaved before the blur; all methods, not with
@@ -212,10 +209,10 @@ typedef struct mr_ao_params {
 #define MR_AO_TEMPORAL_DEPTH_TOL 0.02 /* temporal: relative depth difference that rejects history */
 #define MR_AO_TEMPORAL_NORMAL_COS 0.9 /* temporal: normals further apart reject history */
 #define MR_AO_MAX_SLICES 16 /* gtao / bitmask / scheer-gt: slice directions (a uniform array) */
-#define MR_AO_MIP_NEAR_PX 8.0 /* issue 18: mips: offsets below this (pixels) read level 0;
+#define MR_AO_MIP_NEAR_PX 8.0 /* mips: offsets below this (pixels) read level 0;
                                  level L for [8 * 2^(L-1), 8 * 2^L) */
-#define MR_AO_MIP_LEVELS 4    /* issue 18: mips: levels above 0 in the chain (at most) */
-#define MR_AO_DEINT_NEAR 2     /* issue 18 (lane deint): deinterleave: samples nearer than this many
+#define MR_AO_MIP_LEVELS 4    /* mips: levels above 0 in the chain (at most) */
+#define MR_AO_DEINT_NEAR 2     /* deinterleave: samples nearer than this many
                                  layer spacings (4 AO pixels each) read the G-buffer itself */
 #define MR_AO_DEFAULTS {.method = MR_AO_NONE, .radius_mode = MR_AO_RADIUS_SCREEN, \
                         .screen_radius = MR_AO_DEFAULT_SCREEN_RADIUS, .samples = MR_AO_DEFAULT_SAMPLES, \
@@ -238,7 +235,7 @@ bool mr_ao_method_parse(const char *name, mr_ao_method *out);
 /* gtao / bitmask / scheer-gt: how `samples` splits into slices and steps
  * per slice side (slices * 2 * steps <= samples where samples >= 2). */
 void mr_ao_slice_split(int samples, int *slices, int *steps);
-/* issue 18: the fetch floor of an AO pass (lib/render/probe.c): a full-
+/* The fetch floor of an AO pass (lib/render/probe.c): a full-
  * screen pass over a w x h R32F target doing `fetches` texel fetches per
  * pixel spread over radius_px pixels (the AO disk kernel) and nothing
  * else; each of `frames` draws (after one warm-up) is timed on the CPU
@@ -378,7 +375,7 @@ typedef struct mr_shadow_params {
     float light_scale;         /* multiplies the light's size (sun angle, rect, sphere); 0 = 1 */
     bool want_shadow;          /* fill mr_frame_result.shadow */
     bool no_reuse;             /* redraw the maps even when camera and light are unchanged */
-    /* Cascaded sun shadows (issue 12): 1..4 maps over slices of the camera's
+    /* Cascaded sun shadows: 1..4 maps over slices of the camera's
      * visible depth; 0 = auto by the ratio of far to near visible depth
      * (1 below 16, one more per factor 16, at most 4). Rect and sphere
      * lights always use one map. */
@@ -508,7 +505,7 @@ typedef struct mr_rig_params {
     double focal_distance;  /* D in scene units; 0 = the median depth the centre
                                view sees in its middle third (mr_rig_focal_from_depth),
                                else the scene's centre (mr_rig_auto_focal_distance) */
-    bool per_view_work;     /* issue 14: cull and fit the shadow maps per view, as
+    bool per_view_work;     /* cull and fit the shadow maps per view, as
                                before the shared work (for comparison) */
 } mr_rig_params;
 #define MR_RIG_DEFAULT_CONE 35.0
@@ -637,7 +634,7 @@ double mr_display_column_error(const mr_display_map *m, const mr_camera *cam, in
 typedef struct mr_rig_result {
     double ms_total;        /* wall-clock, all views, glFinish'ed */
     int views;
-    /* issue 14: the shared work, summed over the views */
+    /* The shared work, summed over the views */
     int frustum_culls;      /* BVH culls (G-buffer and shadow maps) */
     int shadow_maps;        /* shadow_map passes run */
     double cull_ms;         /* CPU: culling, LOD, instance data */
@@ -646,7 +643,7 @@ bool mr_render_rig(mr_renderer *r, const mr_rig *rig, const mr_view *centre, con
                    const mr_quilt_layout *layout, const char *views_dir, mr_image *quilt, mr_rig_result *res,
                    mr_error *err);
 
-/* issue 14: the work a rig frame shares. The views (width x height pixels,
+/* The work a rig frame shares. The views (width x height pixels,
  * mr_rig_view) are translated along the centre camera's x axis and share
  * its orientation, so every view's frustum lies in one convex volume: the
  * bottom/top planes (the same slopes) and the near plane (the nearest of
@@ -667,7 +664,7 @@ mr_frustum mr_rig_cull_frustum(const mr_rig *rig, const mr_view *centre, int wid
 bool mr_render_rig_begin(mr_renderer *r, const mr_rig *rig, const mr_view *centre, int width, int height,
                          mr_error *err);
 void mr_render_rig_end(mr_renderer *r);
-/* issue 14, the layered-rendering experiment: the G-buffer pass's geometry
+/* The layered-rendering experiment: the G-buffer pass's geometry
  * work (depth only, the rig frame's shared cull) for all views into one
  * quilt depth target, either as the per-view loop does it (one draw per
  * view with that view's instance matrices) or layered: one instanced draw
@@ -764,11 +761,11 @@ typedef struct mr_draw_params {
                               occluders first, then a hierarchical-Z test
                               of the rest on the CPU; exact (same image),
                               costs a depth read-back; default off */
-    /* issue 17: occlusion culling where it pays, decided per frame from its
+    /* Occlusion culling where it pays, decided per frame from its
      * measured gain (geometry.c, "auto"); ignored where occlusion is on;
      * default on. */
     bool occlusion_auto;
-    /* issue 17 (lane meshlet): cluster culling of big meshes. Levels with
+    /* Cluster culling of big meshes. Levels with
      * at least cluster_triangles triangles are split into meshlets at
      * upload (their index ranges reordered, meshlet by meshlet); each drawn
      * instance tests its meshlets' bounding spheres against the view
@@ -776,14 +773,13 @@ typedef struct mr_draw_params {
      * takes effect at the next scene upload. */
     bool no_cluster_cull;       /* default off: clusters are culled */
     int32_t cluster_triangles;  /* 0 = MR_DRAW_DEFAULT_CLUSTER_TRIANGLES */
-    /* The back-facing cone test of meshopt's meshlet bounds (issue 17,
-     * lane cluster). It runs only where the draw culls back faces: the
+    /* The back-facing cone test of meshopt's meshlet bounds. It runs only where the draw culls back faces: the
      * G-buffer's instances of single-sided materials (glTF doubleSided =
      * false) under a similarity that does not mirror; there it removes
      * only triangles the rasteriser would cull, so the image is the same.
      * Default off: meshlets are cone-tested where valid. */
     bool no_cluster_cone;
-    /* issue 17 (lane cluster): where a frame runs occlusion culling (on,
+    /* Where a frame runs occlusion culling (on,
      * or automatic and paying), the meshlets of the nodes that pass it are
      * tested against the same depth pyramid (exact: the same image).
      * Default off: they are. */
@@ -817,12 +813,12 @@ typedef struct mr_draw_stats {
     uint32_t level_instances[MR_LOD_MAX_LEVELS + 1]; /* instances drawn at
                                   each level: 0 full detail, 1 the finest
                                   simplified level, ... */
-    uint32_t frustum_culls;    /* issue 14: BVH frustum culls run (a rig
+    uint32_t frustum_culls;    /* BVH frustum culls run (a rig
                                   frame's shared list: once, in its first view) */
-    /* issue 17 (lane meshlet): meshlets of big meshes tested and drawn */
+    /* Meshlets of big meshes tested and drawn */
     uint64_t clusters_tested;
     uint64_t clusters_drawn;
-    /* issue 17 (lane cluster): meshlets of the nodes that passed the
+    /* Meshlets of the nodes that passed the
      * occlusion test, themselves skipped by it (their bounding spheres lie
      * behind the occluders' depth) */
     uint64_t clusters_occluded;
@@ -831,7 +827,7 @@ typedef struct mr_draw_stats {
 /* Sets how geometry is submitted from the next frame on (NULL: defaults). */
 bool mr_renderer_set_draw_params(mr_renderer *r, const mr_draw_params *params, mr_error *err);
 void mr_renderer_draw_stats(const mr_renderer *r, mr_draw_stats *out);
-/* issue 17 (lane bench): forgets what automatic occlusion culling learnt
+/* Forgets what automatic occlusion culling learnt
  * from the frames drawn so far (on or off, the smoothed gain, the next
  * trial), as a scene upload does, so that the next frame measures afresh;
  * the read-back cost of the frame size is kept (a cost of the size, not of
@@ -845,7 +841,7 @@ bool mr_renderer_set_lod(mr_renderer *r, const mr_lod *lod, mr_error *err);
  * scene's upload, meshlets included, costs seconds: not twice). */
 bool mr_renderer_set_scene_lod(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_error *err);
 
-/* issue 17 (lane cluster): the meshlets of big meshes cached beside the
+/* The meshlets of big meshes cached beside the
  * scene file. From the next upload (set_scene / set_lod) on, each level's
  * meshlets are read from `path` where it holds them for exactly this input
  * (keyed by the level's indices and the mesh's positions, the threshold,

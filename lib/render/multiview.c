@@ -23,7 +23,6 @@ const mr_opt mr_rig_opts[] = {
     {"focal-distance", MR_OPT_DOUBLE, RIG(focal_distance), 1e-30, 1e30, 0, NULL,
      "multi-view: distance of the focal (zero-parallax) plane in scene units (auto: the scene's centre)",
      MR_OPT_ZERO_AUTO},
-    /* issue 14 */
     {"views-per-view-work", MR_OPT_BOOL, RIG(per_view_work), 0, 1, 0, NULL,
      "multi-view: cull and fit the shadow maps per view instead of once per frame (for comparison)", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},

@@ -8,9 +8,7 @@
 
 const char *const mr_ao_method_names[MR_AO_METHOD_COUNT + 1] = {"none", "scheer", "crytek", "filion",
                                                                 "hbao", "alchemy",
-                                                                /* issue 18 */
                                                                 "gtao", "bitmask", "scheer-gt",
-                                                                /* issue 18 (lane ao) */
                                                                 "scheer-bm", NULL};
 static const char *const k_radius_mode_names[] = {"screen", "view", NULL};
 static const char *const k_kernel_names[] = {"uniform", "stratified", "latin", "poisson", NULL};
@@ -53,10 +51,8 @@ const mr_opt mr_ao_opts[] = {
      "standalone mask: AO = 1 - S in the corners before the blur", 0},
     {"noise", MR_OPT_ENUM, AO(noise), 0, 0, MR_AO_NOISE_PIXEL, k_noise_names,
      "kernel rotation from a hash of the pixel or of the world position (stays on the surface across views)", 0},
-    /* issue 18 (lane ao) */
     {"mips", MR_OPT_BOOL, AO(mips), 0, 1, 0, NULL,
      "gtao, bitmask, scheer-gt, scheer-bm: far samples read a depth mip chain", 0},
-    /* issue 18 (lane deint) */
     {"deinterleave", MR_OPT_BOOL, AO(deinterleave), 0, 1, 0, NULL,
      "AO over 4x4 deinterleaved quarter-size depth layers, one rotation per layer", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
@@ -143,10 +139,8 @@ const mr_opt mr_draw_opts[] = {
      "largest projected error of a level in pixels", MR_OPT_ZERO_DEFAULT},
     {"occlusion", MR_OPT_BOOL, DR(occlusion), 0, 1, 0, NULL, "occlusion culling (exact; costs a depth read-back)",
      MR_OPT_ONOFF},
-    /* issue 17 */
     {"occlusion-auto", MR_OPT_BOOL, DR(occlusion_auto), 0, 1, 1, NULL,
      "occlusion culling where it pays: decided per frame from its measured gain", MR_OPT_ONOFF},
-    /* issue 17 (lane meshlet) */
     {"cluster-cull", MR_OPT_BOOL, DR(no_cluster_cull), 0, 1, 1, NULL,
      "frustum culling of the meshlets of big meshes", MR_OPT_NEGATE | MR_OPT_ONOFF},
     {"cluster-triangles", MR_OPT_INT, DR(cluster_triangles), 64, 1 << 30, MR_DRAW_DEFAULT_CLUSTER_TRIANGLES, NULL,
@@ -154,7 +148,6 @@ const mr_opt mr_draw_opts[] = {
     {"cluster-cone", MR_OPT_BOOL, DR(no_cluster_cone), 0, 1, 1, NULL,
      "also cull back-facing meshlets of single-sided materials (exact: their back faces are culled)",
      MR_OPT_NEGATE | MR_OPT_ONOFF},
-    /* issue 17 (lane cluster) */
     {"cluster-occlusion", MR_OPT_BOOL, DR(no_cluster_occlusion), 0, 1, 1, NULL,
      "also test meshlets against the occlusion pyramid where a frame culls by occlusion (exact)",
      MR_OPT_NEGATE | MR_OPT_ONOFF},

@@ -52,15 +52,15 @@ struct mr_ao_state {
     float kernel3[MR_AO_MAX_SAMPLES * 4], kernel2[MR_AO_MAX_SAMPLES * 4];
     float slices[MR_AO_MAX_SLICES * 4]; /* gtao / bitmask / scheer-gt: directions over half a turn */
     GLuint linear_sampler;              /* their bilinear depth reads (texelFetch ignores it) */
-    /* issue 18 (lane ao): the depth mip chain of their far samples */
+    /* The depth mip chain of their far samples */
     GLuint prog_mip, tex_mip, fbo_mip, mip_sampler;
     int mip_w, mip_h, mip_levels;
-    /* issue 18 (lane deint): deinterleaved AO: the depth and AO atlases
+    /* Deinterleaved AO: the depth and AO atlases
      * (4x4 tiles of dq_w x dq_h) and the programs that fill and empty them */
     GLuint prog_split, prog_merge, tex_dz, fbo_dz, tex_dao, fbo_dao;
     int dq_w, dq_h;
     bool deint; /* this frame's AO goes through the atlas */
-    /* issue 18: temporal accumulation, full resolution, ping-pong */
+    /* Temporal accumulation, full resolution, ping-pong */
     GLuint prog_temporal;
     GLuint tex_hist[2], tex_hist_n[2], fbo_hist[2]; /* (AO, frames, view z), normal */
     int t_cur;                 /* which holds the latest history */
@@ -269,7 +269,7 @@ static void mr_pass_ao_scene_changed(mr_renderer *r) {
         if (!states[i]) continue;
         states[i]->scene_gen++;
         states[i]->valid = false;
-        states[i]->t_valid = false; /* issue 18: another scene's history */
+        states[i]->t_valid = false; /* another scene's history */
         states[i]->t_frame = 0;
         free_outlines(states[i]);
     }
@@ -447,7 +447,7 @@ static bool mr_pass_need_ao_blur(const frame *f) {
     mr_ao_params p = resolve(&f->p->ao, f->r->scene);
     return blur_wanted(&p);
 }
-/* issue 18 (lane deint): the atlas path, for every method but not the
+/* The atlas path, for every method but not the
  * positions path (its texture is not split) or the standalone mask (it
  * samples nothing). */
 static bool deint_wanted(const mr_ao_params *p) {
@@ -508,7 +508,7 @@ static bool prepare_state(frame *f, mr_ao_state *s, mr_error *err) {
     return true;
 }
 
-/* issue 18 (lane deint): programs and atlases for deinterleaved AO; the
+/* Programs and atlases for deinterleaved AO; the
  * atlas is 4x4 tiles of ceil(AO size / 4), so a layer's padding texel (an
  * AO size not divisible by 4) stays inside its own tile. */
 static bool ensure_deint(mr_ao_state *s, mr_error *err) {
@@ -686,7 +686,7 @@ static bool slice_method(mr_ao_method m) {
     return m == MR_AO_GTAO || m == MR_AO_BITMASK || m == MR_AO_SCHEER_GT || m == MR_AO_SCHEER_BM;
 }
 
-/* issue 18: the depth mip chain, only for a slice method with mips on and
+/* The depth mip chain, only for a slice method with mips on and
  * the positions path off (that path reads the nearest pixel's position).
  * Level 0 is a copy of the G-buffer's reversed-Z depth (ao_depth_mip), the
  * levels above it glGenerateTextureMipmap's box filter. Returns the levels
@@ -749,7 +749,7 @@ static void noise_uniforms(const frame *f, const mr_ao_params *p) {
     glUniform1f(MR_LOC_AO_NOISE_CELL, grid ? (float)p->noise_cell : (float)MR_AO_NOISE_CELL_PX);
 }
 
-/* issue 18 (lane deint): the G-buffer's depth into the 16 layers. */
+/* The G-buffer's depth into the 16 layers. */
 static void stage_split(frame *f, mr_ao_state *s, const ao_inputs *in) {
     glUseProgram(s->prog_split);
     glUniform2i(MR_LOC_AO_DEINT_SPLIT_Q, s->dq_w, s->dq_h);
@@ -829,7 +829,7 @@ static void stage_main(frame *f, mr_ao_state *s, const ao_inputs *in) {
      * per-column formula; D = 0 is the pinhole. */
     const mr_display_map *dm = f->p->display;
     glUniform3f(MR_LOC_AO_DISPLAY, dm ? (float)dm->distance : 0.0f, dm ? (float)dm->eye_half : 0.0f, (float)f->r->w);
-    /* issue 18 (lane deint): one draw over the atlas, every tile a layer */
+    /* One draw over the atlas, every tile a layer */
     bool deint = s->deint && s->tex_dz;
     glUniform1i(MR_LOC_AO_DEINT, deint ? 1 : 0);
     glUniform2i(MR_LOC_AO_DEINT_Q, s->dq_w > 0 ? s->dq_w : 1, s->dq_h > 0 ? s->dq_h : 1);
@@ -885,7 +885,6 @@ static void mr_pass_ao(frame *f) {
     frame_put(f, RES_AO, f->r->ao->result);
 }
 
-/* issue 18 (lane deint) */
 static void mr_pass_ao_deint_split(frame *f) {
     ao_inputs in = main_inputs(f);
     stage_split(f, f->r->ao, &in);
@@ -908,7 +907,7 @@ static void mr_pass_ao_upsample(frame *f) {
     frame_put(f, RES_AO, f->r->ao->result);
 }
 
-/* ------------------------------------------------ issue 18: temporal */
+/* ------------------------------------------------------------ temporal */
 
 static bool mr_pass_need_ao_temporal(const frame *f) { return runs(f) && f->p->ao.temporal; }
 
@@ -1048,7 +1047,7 @@ bool mr_ao_hidden_prepare(frame *f, mr_error *err) {
         if (!prepare_state(f, s, err)) return false;
         s->p.mask = MR_AO_MASK_OFF; /* outlines of D are not drawn */
         s->p.positions = false;     /* D has no positions attachment */
-        s->deint = deint_wanted(&s->p); /* issue 18 (lane deint) */
+        s->deint = deint_wanted(&s->p);
     }
     f->ao_hidden_plan = pl;
     return true;
@@ -1058,7 +1057,7 @@ GLuint mr_ao_hidden_run(frame *f, GLuint depth, GLuint normal) {
     mr_ao_state *s = f->r->ao_hidden;
     if (f->ao_hidden_plan == AO_PLAN_RUN) {
         ao_inputs in = {depth, normal, 0, s->tex_mask};
-        /* issue 18 (lane deint): D's own atlases */
+        /* D's own atlases */
         mr_error e = {0};
         if (s->deint && !ensure_deint(s, &e)) s->deint = false;
         if (s->deint) stage_split(f, s, &in);
@@ -1079,7 +1078,7 @@ const pass_desc mr_pass_desc_ao = {
     .name = "ao", .needed = mr_pass_need_ao, .prepare = mr_pass_prepare_ao, .run = mr_pass_ao, AO_DESTROY,
     .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_POSITIONS) | RES(RES_AO_MASK), .writes = RES(RES_AO),
     .reads_now = mr_pass_ao_reads};
-/* issue 18 (lane deint): around the AO pass, only with deinterleave on. */
+/* Around the AO pass, only with deinterleave on. */
 const pass_desc mr_pass_desc_ao_deint_split = {
     .name = "ao_deint_split", .needed = mr_pass_need_ao_deint, .prepare = mr_pass_prepare_ao_deint,
     .run = mr_pass_ao_deint_split, AO_DESTROY, .reads = RES(RES_DEPTH)};
@@ -1095,7 +1094,7 @@ const pass_desc mr_pass_desc_ao_upsample = {
 /* Not listed (no GPU work of their own): the AO of an earlier frame with the
  * same camera, size, scene and settings, or an AO image given from outside
  * (ground truth), stands in for the AO passes. */
-/* issue 18: after the AO (and its blur / upsample), before shading. */
+/* After the AO (and its blur / upsample), before shading. */
 const pass_desc mr_pass_desc_ao_temporal = {
     .name = "ao_temporal", .needed = mr_pass_need_ao_temporal, .prepare = mr_pass_prepare_ao_temporal,
     .run = mr_pass_ao_temporal, AO_DESTROY, .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_AO), .writes = RES(RES_AO)};

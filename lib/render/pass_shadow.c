@@ -1,4 +1,4 @@
-/* Soft shadows from a shadow map (issue 12; Hecher's comparison, ch. 3-5).
+/* Soft shadows from a shadow map (Hecher's comparison, ch. 3-5).
  *
  *   shadow_map   needed: a map method (hard, pcf, pcss, bp), a casting light,
  *                and the maps of the last frame cannot stand in; draws the
@@ -93,7 +93,7 @@ typedef struct map_key {
     int map_size;
     float light_scale;
     int cascades;
-    int rig_views;         /* issue 14: a rig frame's maps, fitted to all its views */
+    int rig_views;         /* a rig frame's maps, fitted to all its views */
     mr_dmat4 rig_outer;    /* its last view (with world_from_camera: the first) */
     bool hide_hidden;      /* the hidden layer casts only while it is drawn */
 } map_key;
@@ -108,7 +108,7 @@ struct mr_shadow_state {
     light_frame lf;
     bool key_valid;
     map_key key;
-    unsigned rig_serial;   /* issue 14: the rig frame whose first view drew the maps (0: none) */
+    unsigned rig_serial;   /* the rig frame whose first view drew the maps (0: none) */
     float kernel[2 * MR_SHADOW_MAX_TAPS];
     int kernel_taps;
     GLuint catcher_flags;  /* R8UI, node i at (i % ROW, i / ROW): 1 = shadow catcher */
@@ -154,7 +154,7 @@ static void make_key(const frame *f, map_key *k) {
     k->world_from_camera = f->view->world_from_camera;
     k->cam = f->cam;
     if (f->r->rig) {
-        /* issue 14: every view of a rig frame fits the same maps. */
+        /* Every view of a rig frame fits the same maps. */
         k->world_from_camera = f->r->rig->world_from_camera[0];
         k->cam = f->r->rig->cam[0];
         k->rig_views = f->r->rig->views;
@@ -171,7 +171,7 @@ static bool reusable(const frame *f) {
     const struct mr_shadow_state *s = f->r->shadow;
     if (!s || !s->key_valid || !s->map.fbo) return false;
     /* no_reuse: nothing from an earlier frame; a rig frame's views still
-     * share the maps its first view drew (issue 14). */
+     * share the maps its first view drew. */
     if (f->p->shadow.no_reuse && !(f->r->rig && s->rig_serial == f->r->rig->serial)) return false;
     map_key k;
     make_key(f, &k);
@@ -185,7 +185,7 @@ static mr_dvec3 any_orthogonal(mr_dvec3 d) {
     return mr_v3_normalize(mr_v3_sub(a, mr_v3_scale(d, mr_v3_dot(a, d))));
 }
 
-/* What the light is fitted to (issue 14): one frame's camera, or a rig
+/* What the light is fitted to: one frame's camera, or a rig
  * frame's outer views (the other views' frusta lie in their hull, slice by
  * slice) with the union volume in the centre camera's axes. */
 typedef struct fit_views {
@@ -651,7 +651,7 @@ static bool prepare_common(frame *f, mr_error *err) {
     GLint max_tex = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
     /* A reused map keeps the light it was fitted with (a rig frame's other
-     * views: issue 14). */
+     * views). */
     if (!reusable(f)) fit_light(f, max_tex, &s->lf);
     /* Cascade k is the tile ((k & 1) S, (k >> 1) S) of one atlas. */
     int aw = s->lf.ncasc > 1 ? 2 * S : S, ah = s->lf.ncasc > 2 ? 2 * S : S;

@@ -160,7 +160,7 @@ static void mr_pass_gbuffer(frame *f) {
     /* With ghosting, the hidden layer goes to its own target D (pass_ghost.c). */
     if (!f->p->hide_hidden_layer && !(f->writing & RES(RES_HIDDEN_DEPTH))) mask |= 1u << MR_LAYER_HIDDEN;
     mr_geo_view v = mr_frame_view(f, b->prog_gbuffer, mask);
-    v.cull_back = true; /* issue 17 (lane cluster): single-sided materials as glTF draws them */
+    v.cull_back = true; /* single-sided materials as glTF draws them */
     glProgramUniform3f(b->prog_gbuffer, MR_LOC_GBUFFER_POS_OFFSET, 0, 0, 0);
     if (f->p->display) {
         gbuffer_display(f, &v);

@@ -1,4 +1,4 @@
-/* issue 18: the fetch floor of a full-screen AO pass (shaders/ao_probe.
+/* The fetch floor of a full-screen AO pass (shaders/ao_probe.
  * frag.glsl): what `fetches` R32F texel fetches per pixel cost on this
  * machine with nothing else to do, so that `bench ao` can state every AO
  * pass's cost as a multiple of it. Timed on the CPU between two glFinish:

@@ -50,7 +50,7 @@ struct mr_renderer {
     mr_gpu *gpu;
     const mr_scene *scene;
     struct mr_geo *geo;    /* geometry.c: buffers, BVH, per-frame scratch */
-    /* issue 14: a multi-view rig's shared culling (geometry.c) and its
+    /* A multi-view rig's shared culling (geometry.c) and its
      * views' common fitting set (multiview.c); NULL outside a rig frame. */
     struct mr_geo_share *share;
     const struct mr_rig_share *rig;
@@ -77,7 +77,7 @@ struct mr_renderer {
     struct mr_ao_state *ao_hidden; /* the same for the ghosting's hidden layer D */
     struct mr_ghost_state *ghost;  /* pass_ghost.c: targets, programs, caches */
     struct mr_shadow_state *shadow; /* pass_shadow.c: maps, visibility, the fitted light */
-    /* issue 17 (lane cluster): the meshlet cache file ("" = none) and what
+    /* The meshlet cache file ("" = none) and what
      * the last upload took from it (geometry.c, cluster_cache.c). */
     char cluster_cache[4096];
     mr_cluster_info cluster_info;
@@ -121,8 +121,8 @@ typedef struct mr_geo_view {
     double near_plane;
     GLuint program;             /* its MR_LOC_PROJECTION receives the projection */
     uint32_t layers;            /* 1 << mr_layer of the nodes drawn */
-    bool shared;                /* issue 14: a rig view: draws the rig frame's shared list */
-    /* issue 17 (lane cluster): cull the back faces of single-sided
+    bool shared;                /* a rig view: draws the rig frame's shared list */
+    /* Cull the back faces of single-sided
      * materials (glTF doubleSided = false), as glTF says they look; only
      * then may back-facing meshlets be skipped. Set by the G-buffer. */
     bool cull_back;
@@ -147,7 +147,7 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *view, mr_frame_result *
 /* Resets the frame's draw statistics (called by mr_render_frame). */
 void mr_geometry_begin_frame(mr_renderer *r);
 
-/* issue 14: multi-view rigs. Until share_end, draws with .shared set cull
+/* Multi-view rigs. Until share_end, draws with .shared set cull
  * once per layer set against `cull` and choose LOD levels once (with the
  * depth row of cam_from_world, near_plane and fmax_t, the largest
  * mr_geometry_lod_fmax of the views), then each draws that list through
@@ -199,8 +199,8 @@ void mr_geometry_aux_draw(mr_renderer *r, const mr_geo_view *view, const mr_geo_
 extern const pass_desc mr_pass_desc_gbuffer, mr_pass_desc_shade, mr_pass_desc_overlay;         /* passes.c */
 extern const pass_desc mr_pass_desc_ao_mask, mr_pass_desc_ao, mr_pass_desc_ao_blur, mr_pass_desc_ao_upsample,
     mr_pass_desc_ao_reuse, mr_pass_desc_ao_external;
-extern const pass_desc mr_pass_desc_ao_deint_split, mr_pass_desc_ao_deint_merge; /* issue 18 (lane deint) */                                            /* pass_ao.c */
-extern const pass_desc mr_pass_desc_ao_temporal; /* pass_ao.c, issue 18 */
+extern const pass_desc mr_pass_desc_ao_deint_split, mr_pass_desc_ao_deint_merge; /* pass_ao.c */
+extern const pass_desc mr_pass_desc_ao_temporal;                                  /* pass_ao.c */
 extern const pass_desc mr_pass_desc_ghost_hidden, mr_pass_desc_ghost_curvature, mr_pass_desc_ghost_importance,
     mr_pass_desc_ghost_g0, mr_pass_desc_ghost_analysis, mr_pass_desc_ghost_emphasis;            /* pass_ghost.c */
 extern const pass_desc mr_pass_desc_shadow_map, mr_pass_desc_shadow_map_reuse, mr_pass_desc_shadow; /* pass_shadow.c */

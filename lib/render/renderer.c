@@ -66,12 +66,12 @@ const char *const mr_resource_names[RES_COUNT] = {
 static const pass_desc *const k_passes[] = {
     &mr_pass_desc_gbuffer,
     &mr_pass_desc_ao_mask,
-    &mr_pass_desc_ao_deint_split, /* issue 18 (lane deint) */
+    &mr_pass_desc_ao_deint_split,
     &mr_pass_desc_ao,
-    &mr_pass_desc_ao_deint_merge, /* issue 18 (lane deint) */
+    &mr_pass_desc_ao_deint_merge,
     &mr_pass_desc_ao_blur,
     &mr_pass_desc_ao_upsample,
-    &mr_pass_desc_ao_temporal, /* issue 18 */
+    &mr_pass_desc_ao_temporal,
     &mr_pass_desc_ao_reuse,
     &mr_pass_desc_ao_external,
     &mr_pass_desc_ghost_hidden,
@@ -102,7 +102,7 @@ mr_geo_view mr_frame_view(const frame *f, GLuint program, uint32_t layers) {
     v.near_plane = f->near_plane;
     v.program = program;
     v.layers = layers;
-    /* issue 14: a rig frame's pinhole views share one cull (the display
+    /* A rig frame's pinhole views share one cull (the display
      * mapping's bands reach past the rig's union volume). */
     v.shared = f->r->share != NULL && !f->p->display;
     return v;
@@ -138,7 +138,7 @@ void mr_renderer_destroy(mr_renderer **rp) {
     glBindVertexArray(0);
     for (size_t i = 0; i < PASS_COUNT; i++)
         if (k_passes[i]->destroy) k_passes[i]->destroy(r);
-    mr_render_rig_end(r); /* issue 14: a rig frame left open */
+    mr_render_rig_end(r); /* a rig frame left open */
     mr_geometry_free(r);
     glDeleteVertexArrays(1, &r->empty_vao);
     glDeleteQueries(MR_MAX_PASSES, r->queries);
@@ -299,7 +299,7 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
             continue;
         }
         int k = out->pass_count;
-        /* issue 18: synchronous timing; the pass's wall time between two glFinish. */
+        /* Synchronous timing; the pass's wall time between two glFinish. */
         bool sync = p->timing && p->timing_sync;
         if (sync) glFinish();
         double t0 = mr_time_now();

@@ -297,7 +297,7 @@ static void make_plan(uint64_t seed, demo_plan *plan) {
     }
 }
 
-/* Tag posts (issue 16): square pillars carrying a cluster of four tags, two
+/* Tag posts: square pillars carrying a cluster of four tags, two
  * on each of the two faces turned towards a check point of the walk, so
  * that a camera there sees 2-4 tags within a metre, not coplanar (a pose
  * from them has no mirror ambiguity). In both halls: they are surveyed,

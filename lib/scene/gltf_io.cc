@@ -215,7 +215,7 @@ bool fs_no_write(std::string *err, const std::string &, const std::vector<unsign
 
 // A read-only file mapping (the file itself, or an external .bin): big
 // files are mapped, never copied, so a load's peak memory is about what it
-// decodes, not file + copy + decoded (issue 17, item 6).
+// decodes, not file + copy + decoded.
 struct Mapping {
     void *addr = nullptr;
     size_t len = 0;
@@ -792,8 +792,8 @@ struct Loader {
     // that is decoded again.
     std::map<int, std::unique_ptr<unsigned char[]>> meshopt;
     std::vector<int> view_uses;
-    // Compressed files must load at least as fast as plain ones (issue 17,
-    // item 7), and a decoded view's fresh pages cost as much as decoding
+    // Compressed files must load at least as fast as plain ones, and a
+    // decoded view's fresh pages cost as much as decoding
     // it. So a meshopt view whose every reader is a primitive attribute or
     // index list read once (view_pre) is decoded into one scratch buffer,
     // reused by all such views and sized for the largest (scratch_need), and
@@ -2037,7 +2037,7 @@ struct Loader {
             }
             mat.base_color_texture = texture(gm.pbrMetallicRoughness.baseColorTexture.index);
             uv_xform.push_back(texture_transform(gm.pbrMetallicRoughness.baseColorTexture, gm.name));
-            // issue 17 (lane cluster): glTF's default is single-sided.
+            // glTF's default is single-sided.
             mat.single_sided = !gm.doubleSided;
             if (mr_scene_add_material(s, &mat) < 0) throw std::bad_alloc();
         }
@@ -2956,7 +2956,7 @@ struct Writer {
             if (mat.base_color_texture >= 0 && mat.base_color_texture < s->texture_count)
                 gm.pbrMetallicRoughness.baseColorTexture.index = mat.base_color_texture;
             gm.pbrMetallicRoughness.metallicFactor = 0.0;  // plain albedo for other viewers
-            gm.doubleSided = !mat.single_sided;             // issue 17 (lane cluster)
+            gm.doubleSided = !mat.single_sided;
             m.materials.push_back(gm);
         }
         std::map<std::pair<int32_t, int32_t>, int> mesh_of;  // instancing survives the round trip

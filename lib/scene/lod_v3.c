@@ -1,5 +1,5 @@
 /* lod.c's build kernel (simplification and the certified bound: the first
- * load's hot loop, issue 17 item 3) compiled again with -march=x86-64-v3
+ * load's hot loop) compiled again with -march=x86-64-v3
  * (CMakeLists.txt), exported as mr_lod_build_mesh_v3 for lod.c to call on
  * CPUs with AVX2 and FMA. Same source, so the same algorithm; the compiler
  * only has more instructions to choose from (measured: 8 % less CPU,

@@ -40,7 +40,7 @@ typedef struct mr_material {
     char name[64];
     float base_color[4];         /* linear RGBA factor, default 1 1 1 1 */
     int32_t base_color_texture;  /* index into textures, or -1 */
-    /* issue 17 (lane cluster): glTF's doubleSided = false. Zero (the
+    /* glTF's doubleSided = false. Zero (the
      * default of a material built in memory) is double-sided: both faces
      * drawn, as before. A single-sided material's back faces are culled in
      * the G-buffer (and its meshlets' back-facing cones with them); a
@@ -79,7 +79,7 @@ typedef enum mr_light_kind {
 typedef struct mr_light {
     double direction[3];
     float color[3];       /* linear, multiplies the albedo */
-    /* Shadows (issue 12); all zero = a sun of angle 0 that casts nothing. */
+    /* Shadows; all zero = a sun of angle 0 that casts nothing. */
     uint8_t kind;         /* mr_light_kind */
     bool casts;           /* casts shadows when a shadow method is on */
     double angle;         /* sun: angular diameter in degrees, [0, 90) */
@@ -238,7 +238,7 @@ bool mr_mesh_outline_dirs(const mr_mesh *m, float *out, mr_error *err);
 
 bool mr_demo_build(const mr_demo_params *params, mr_demo_hall *out, mr_error *err);
 
-/* ------------------------------------------------- shadow suite (issue 12)
+/* ------------------------------------------------- shadow suite
  * Hecher's scene categories as generated scenes (shadow_suite.c): simple
  * objects and furniture-like assemblies with constant or varying penumbra,
  * without or with overlapping penumbrae; fences and plant-like leaves
@@ -512,7 +512,7 @@ enum { MR_SYNTH_VIEW_FLOOR = 0, MR_SYNTH_VIEW_AISLE = 1, MR_SYNTH_VIEW_OVERVIEW 
  * overview from above. */
 mr_dmat4 mr_synth_viewpoint(const mr_synth_params *params, int which);
 
-/* Unique CAD-like geometry (issue 17): `parts` distinct parts, each its own
+/* Unique CAD-like geometry: `parts` distinct parts, each its own
  * mesh drawn by one node (nothing instanced), with finely tessellated
  * curved surfaces and split at every normal seam as CAD exporters write
  * them, on a floor; in metres (unit 1), millimetres (unit 1000) or any unit:

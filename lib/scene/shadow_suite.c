@@ -1,4 +1,4 @@
-/* The soft-shadow test suite (issue 12, after Hecher's scene categories):
+/* The soft-shadow test suite (after Hecher's scene categories):
  * simple regular objects and furniture-like assemblies, each with constant
  * penumbra (lifted off the floor, every part about as far from it) or
  * varying penumbra (standing on it: contact hardening), without and with

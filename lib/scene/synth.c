@@ -525,7 +525,7 @@ mr_scene *mr_synth_cad_build(const mr_synth_cad_params *params, mr_error *err) {
         memcpy(m.base_color, cols_rgb[i], sizeof cols_rgb[i]);
         m.base_color[3] = 1;
         m.base_color_texture = -1;
-        /* issue 17 (lane cluster): every part and the floor are closed
+        /* Every part and the floor are closed
          * solids wound outwards (test_cad checks it), as a CAD export's
          * are: single-sided, so back faces and back-facing meshlets are
          * culled. (The instanced factory has open pipes and flanges and

@@ -71,7 +71,7 @@ static bool get_vec(const cJSON *o, const char *key, double *out, int n, bool *h
     return true;
 }
 
-/* issue 15: the view's Measure, flat measured_* fields of the mark. */
+/* The view's Measure, flat measured_* fields of the mark. */
 static void measurement_json(cJSON *line, const mr_measurement *m) {
     const mr_triangulation *t = &m->tri;
     double pt[3] = {t->point.x, t->point.y, t->point.z};

@@ -247,7 +247,7 @@ typedef struct mr_annotation {
     bool has_uncertainty;           /* "uncertainty_m" present */
     double uncertainty_m;           /* the registration's 1-σ at world (3D,
                                        scene units taken as metres) */
-    bool has_measurement;           /* issue 15: "measured_point" present */
+    bool has_measurement;           /* "measured_point" present */
     mr_measurement measurement;     /* the view's Measure (measured_* fields) */
     cJSON *json;                    /* the whole line (owned); NULL for one
                                        not read from a file */
@@ -259,7 +259,7 @@ typedef struct mr_annotation {
  * node (null when none; then node_index and layer), pose {valid,
  * world_from_camera, tags_seen, rms_px}, uncertainty_m (only when
  * has_uncertainty; older lines have none), and with has_measurement
- * (issue 15, the view's Measure) measured_point [x,y,z], measured_covariance
+ * (the view's Measure) measured_point [x,y,z], measured_covariance
  * (9, row-major), measured_point_sigma_m, measured_angle_deg,
  * measured_rms_px, measured_frames [..], measured_pixels [[u,v]..] and,
  * when it has a distance, measured_distance_m, measured_sigma_m (the

@@ -451,7 +451,7 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
     }
     {
         /* One photo is one view: no tag pose is checked by a second one,
-         * and a map of it is what a single PnP gives (issue 15: refused). */
+         * and a map of it is what a single PnP gives: refused. */
         int seeing = 0;
         for (int j = 0; j < photo_count; j++) seeing += photos[j].count > 0;
         if (seeing < 2) {

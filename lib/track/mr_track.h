@@ -377,8 +377,8 @@ bool mr_triangulate(const mr_camera *cam, const mr_tap *taps, int n, const mr_tr
  * sqrt(trace / 3)). */
 void mr_triangulation_distance(const mr_triangulation *t, mr_dvec3 planned, double *dist, double *sigma);
 
-/* A measurement as the view's Measure keeps it and a mark carries it
- * (issue 15): the taps, the triangulated point, and its distance to the
+/* A measurement as the view's Measure keeps it and a mark carries it:
+ * the taps, the triangulated point, and its distance to the
  * plan (the nearest point of the planned model, or a picked planned point). */
 #define MR_MEASURE_MAX_TAPS 16
 typedef struct mr_measurement {
@@ -453,7 +453,7 @@ bool mr_pose_filter_last(const mr_pose_filter *f, mr_dmat4 *out);
  * timestamp going backwards (a seek) also drops it. Without it, the solver
  * takes the candidate most tags agree with, then the lowest error.
  *
- * Adaptive decimation (issue 16), when detector.decimate is left 0: the
+ * Adaptive decimation, when detector.decimate is left 0: the
  * detector's decimation for a frame is picked from the tags of the frame
  * before, by the shortest edge e (px, full resolution) of the second
  * largest tag detected (the only one's, if one): 4 for e >= 64, 3 for

@@ -36,7 +36,7 @@ const int mr_view_keymap_count = (int)(sizeof mr_view_keymap / sizeof mr_view_ke
 static const char *const k_widget_names[MR_VW_COUNT] = {
     "alpha", "play", "back", "forward", "rate", "seek", "freeze", "snapshot", "mark", "video", "hidden", "ao",
     "ghost", "help", "note1", "note2", "note3", "note4", "note5", "note6", "cancel",
-    "measure", /* issue 15 */
+    "measure",
 };
 
 const char *mr_view_widget_name(mr_view_widget_id id) {
@@ -45,7 +45,7 @@ const char *mr_view_widget_name(mr_view_widget_id id) {
 
 /* ---------------------------------------------------------------- layout */
 
-/* The column's i-th widget in priority order: Measure (issue 15) right
+/* The column's i-th widget in priority order: Measure right
  * after Mark, then the rest as they are numbered. */
 static mr_view_widget_id column_widget(int i) {
     const int after_mark = MR_VW_MARK - MR_VW_FREEZE + 1;
@@ -530,7 +530,7 @@ static void column(mr_viewer *v, mr_view_actions *out) {
         vw_measure_cancel(v);
         v->mark_mode = !v->mark_mode;
     }
-    /* issue 15: Measure (measure.c) */
+    /* Measure (measure.c) */
     if (button(v, MR_VW_MEASURE, v->measure_mode ? "Finish" : "Measure", v->measure_mode)) vw_measure_toggle(v, out);
     if (button(v, MR_VW_VIDEO, "Video", v->s.show_video)) {
         v->s.show_video = !v->s.show_video;
@@ -567,7 +567,7 @@ static void messages(mr_viewer *v, const mr_viewer_frame *f) {
         banners[nb] = "MARK: tap the discrepancy in the picture (Esc cancels)";
         colors[nb++] = MR_UI_RGBA(214, 120, 28, 230);
     }
-    if (v->measure_mode) { /* issue 15 */
+    if (v->measure_mode) {
         vw_measure_banner(v, measure_banner, sizeof measure_banner);
         banners[nb] = measure_banner;
         colors[nb++] = MR_UI_RGBA(30, 120, 190, 230);
@@ -647,7 +647,7 @@ const mr_ui_draw_list *mr_viewer_ui(mr_viewer *v, const mr_viewer_frame *f, mr_v
     column(v, out);
     messages(v, f);
     if (v->note_open) notes(v, f, out);
-    vw_measure_draw(v, f); /* issue 15 */
+    vw_measure_draw(v, f);
     if (v->help) help_panel(v);
     float tx, ty;
     const mr_ui_draw_list *dl = mr_ui_end(v->ui);
@@ -689,7 +689,7 @@ cJSON *mr_viewer_state_json(const mr_viewer *v) {
     else cJSON_AddNullToObject(j, "sigma_here_mm");
     static const char *const k_sigma_states[] = {"unknown", "ok", "warn", "bad"};
     cJSON_AddStringToObject(j, "sigma_state", k_sigma_states[mr_view_sigma_classify(v->sigma_known, v->sigma_m)]);
-    vw_measure_state_json(v, j); /* issue 15 */
+    vw_measure_state_json(v, j);
     cJSON_AddNumberToObject(j, "px_per_mm", mr_ui_px_per_mm(v->ui));
     cJSON_AddNumberToObject(j, "target_px", mr_ui_target_px(v->ui));
     /* Where each widget is (framebuffer pixels x y w h), for tests that

@@ -111,13 +111,13 @@ cJSON *mr_view_mark_line(const mr_capture_frame *f, const char *note, double px,
         snprintf(m.node, sizeof m.node, "%s", scene->nodes[pick->node].name);
         snprintf(m.layer, sizeof m.layer, "%s", pick->layer == MR_LAYER_HIDDEN ? "hidden" : "visible");
     }
-    /* issue 15: the registration's sigma at the marked point (absent when
+    /* The registration's sigma at the marked point (absent when
      * the pose has no covariance, e.g. an older recording, or nothing was
      * hit) */
     mr_viewer_frame sf = {.have_pose = f->have_pose, .world_from_camera = f->pose, .pose_cov = f->cov,
                           .corner_sigma_px = f->corner_sigma_px, .have_point = pick->hit, .point = pick->world};
     m.has_uncertainty = mr_view_sigma_here(&sf, &m.uncertainty_m);
-    m.has_measurement = measured != NULL; /* issue 15: a mark made by Measure */
+    m.has_measurement = measured != NULL; /* a mark made by Measure */
     if (measured) m.measurement = *measured;
     return mr_annotation_to_json(&m);
 }
@@ -131,11 +131,11 @@ void mr_view_frame_from_capture(mr_viewer_frame *vf, const mr_capture_frame *f, 
     vf->count = f->count;
     vf->tags_seen = f->tags_seen;
     vf->rms_px = f->rms_px;
-    /* issue 15: the pose's covariance */
+    /* The pose's covariance */
     vf->world_from_camera = f->pose;
     vf->pose_cov = f->cov;
     vf->corner_sigma_px = f->corner_sigma_px;
-    /* issue 15, Measure: taps are made on the undistorted picture */
+    /* Measure: taps are made on the undistorted picture */
     if (have_frame && f->image.width > 0) {
         *picture_cam = mr_camera_resized(cam, f->image.width, f->image.height);
         vf->camera = picture_cam;

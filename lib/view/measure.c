@@ -1,4 +1,4 @@
-/* The view's Measure (issue 15, item 4): taps of one real feature in
+/* The view's Measure: taps of one real feature in
  * several frames, each with its frame's pose and pose covariance,
  * triangulated by lib/track's mr_triangulate as soon as two taps from
  * different places exist. The distance to the plan comes back from the

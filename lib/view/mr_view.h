@@ -90,7 +90,7 @@ typedef enum mr_view_widget_id {
     MR_VW_ALPHA = 0, MR_VW_PLAY, MR_VW_BACK, MR_VW_FORWARD, MR_VW_RATE, MR_VW_SEEK,
     MR_VW_FREEZE, MR_VW_SNAPSHOT, MR_VW_MARK, MR_VW_VIDEO, MR_VW_HIDDEN, MR_VW_AO, MR_VW_GHOST, MR_VW_HELP,
     MR_VW_NOTE1, MR_VW_NOTE6 = MR_VW_NOTE1 + MR_VIEW_NOTE_COUNT - 1, MR_VW_CANCEL,
-    MR_VW_MEASURE,        /* issue 15: Measure; in the column right after Mark */
+    MR_VW_MEASURE,        /* Measure; in the column right after Mark */
     MR_VW_COUNT
 } mr_view_widget_id;
 
@@ -154,7 +154,7 @@ typedef enum mr_view_action_type {
     MR_VA_SHOT,           /* path: save this frame's screen as PNG (scripts) */
     MR_VA_STATE,          /* path: write a state snapshot JSON (scripts) */
     MR_VA_QUIT,
-    MR_VA_MEASURE_DONE,   /* issue 15: a measurement is finished (mr_viewer_measurement);
+    MR_VA_MEASURE_DONE,   /* a measurement is finished (mr_viewer_measurement);
                              measure it against the plan, answer with
                              mr_viewer_measure_distance, and mark it */
 } mr_view_action_type;
@@ -207,7 +207,7 @@ typedef struct mr_viewer_frame {
     bool dimmed;               /* the policy dimmed it */
     const char *passes;        /* the frame's pass list */
     double fps;
-    /* Registration uncertainty (issue 15): the pose shown, its covariance
+    /* Registration uncertainty: the pose shown, its covariance
      * (mr_pose.cov's convention; NULL or corner_sigma_px 0: unknown, as in
      * recordings made before it was written) and the world point to tell it
      * at: the model under the screen centre (mr_renderer_pick) or the point
@@ -217,7 +217,7 @@ typedef struct mr_viewer_frame {
     double corner_sigma_px;
     bool have_point;
     mr_dvec3 point;            /* world, scene units */
-    /* issue 15, Measure: the picture's camera (intrinsics at the frame's
+    /* Measure: the picture's camera (intrinsics at the frame's
      * image size; the picture is shown undistorted, so its distortion is
      * not used); NULL: taps cannot be measured */
     const mr_camera *camera;
@@ -281,7 +281,7 @@ const char *mr_viewer_status_text(const mr_viewer *v);
  * "sigma_here_mm" (null: unknown) and "sigma_state"). */
 cJSON *mr_viewer_state_json(const mr_viewer *v);
 
-/* ------------------------------------------------ Measure (issue 15) */
+/* ------------------------------------------------ Measure */
 
 /* The Measure button (key d): the planner taps the same real feature in
  * two or more frames (replay or live); each tap keeps its frame's pose and

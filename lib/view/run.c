@@ -113,16 +113,16 @@ typedef struct view_app {
     mr_ui_rect image_rect;
     int rw, rh;
     bool dimmed;
-    /* issue 15: the model under the picture's centre, for "+/- N mm here" */
+    /* The model under the picture's centre, for "+/- N mm here" */
     bool centre_hit;
     mr_dvec3 centre_world;
-    /* issue 15, Measure: the picture's camera, the planned surface's search
+    /* Measure: the picture's camera, the planned surface's search
      * (built on the first measurement), the measurement the open mark carries */
     mr_camera picture_cam;
     void *nearest;
     bool mark_measured;
     mr_measurement mark_measure;
-    /* issue 18: temporal AO (--ao-temporal); a frame after one without a valid pose restarts it */
+    /* Temporal AO (--ao-temporal); a frame after one without a valid pose restarts it */
     bool ao_temporal, ao_had_pose;
     /* stats */
     double t_start;
@@ -199,7 +199,7 @@ static void finish_mark(view_app *a, int note) {
     a->mark_measured = false;
 }
 
-/* issue 15: a finished measurement. Its distance to the planned surface
+/* A finished measurement. Its distance to the planned surface
  * (the nearest point of the model, the caller's search), told by the
  * controller; then a mark of it at the current frame, the note chooser
  * open, the line carrying the measured_* fields and the nearest planned
@@ -295,7 +295,7 @@ static void render_3d(view_app *a) {
     a->rw = rw;
     a->rh = rh;
     a->image_rect = fit;
-    /* issue 15: what is under the centre (one pixel read back per render) */
+    /* What is under the centre (one pixel read back per render) */
     mr_pick cp = {0};
     a->centre_hit = c.use_pose && mr_renderer_pick(a->rend, rw * 0.5 - 0.5, rh * 0.5 - 0.5, &cp, &err) && cp.hit;
     a->centre_world = cp.world;
@@ -382,7 +382,7 @@ static mr_viewer_frame frame_info(view_app *a, char *state_msg, size_t n) {
     f.dimmed = a->dimmed;
     f.passes = a->passes;
     f.fps = a->fps;
-    /* issue 15: the pose's covariance is told at the point being marked
+    /* The pose's covariance is told at the point being marked
      * while the note chooser is open, else at the model under the centre */
     bool marking = mr_viewer_note_is_open(a->vc);
     f.have_point = marking ? a->mark_pick.hit : a->centre_hit;

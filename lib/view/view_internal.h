@@ -55,7 +55,7 @@ struct mr_viewer {
     double script_t0;
     int64_t script_frame;
     bool script_started;
-    /* issue 15: Measure (measure.c) */
+    /* Measure (measure.c) */
     bool measure_mode;           /* collecting taps */
     bool measure_have;           /* a measurement exists (being made or finished) */
     bool measure_solved;         /* its taps triangulate */
@@ -69,7 +69,7 @@ struct mr_viewer {
 mr_view_action *vw_emit(mr_view_actions *out, mr_view_action_type t);
 /* Runs the script commands that are due (before the queued input is taken). */
 void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out);
-/* issue 15, Measure (measure.c): the button / key (start, finish or cancel),
+/* Measure (measure.c): the button / key (start, finish or cancel),
  * Esc, a tap on the picture, the banner text, the tap's cross, the state
  * snapshot's part. */
 void vw_measure_toggle(mr_viewer *v, mr_view_actions *out);
