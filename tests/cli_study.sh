@@ -31,23 +31,29 @@ n=$(ls "$tmp"/ao/*/hall_v*.png | wc -l)
 "$mr" study stimuli --family ghost --out "$tmp/ghost" --views 1 --width 96 --height 72 >"$tmp/sg.log" 2>&1 && ok || bad "ghost stimuli: $(cat "$tmp/sg.log")"
 [ "$(ls "$tmp"/ghost | tr '\n' ' ')" = "adaptive alpha g0 " ] && ok || bad "ghost methods: $(ls "$tmp/ghost")"
 cmp -s "$tmp/ghost/alpha/hall_v0.png" "$tmp/ghost/adaptive/hall_v0.png" && bad "ghost: alpha and adaptive give the same image" || ok
-# shadows: the hall (default sun) and both views of one suite case, four
-# methods and the ground truth as the reference; block II needs it.
-"$mr" study stimuli --family shadows --out "$tmp/sh" --views 1 --cases 1 --width 96 --height 72 --gt-samples 16 >"$tmp/ss.log" 2>&1 && ok || bad "shadows stimuli: $(cat "$tmp/ss.log")"
-[ "$(ls "$tmp"/sh | tr '\n' ' ')" = "bp hard pcf pcss reference " ] && ok || bad "shadows methods: $(ls "$tmp/sh")"
-for m in bp hard pcf pcss reference; do
-  [ "$(ls "$tmp/sh/$m" 2>/dev/null | tr '\n' ' ')" = "hall_v0.png simple_varying_overlap_v0.png simple_varying_overlap_v1.png " ] && ok ||
+# shadows: Hecher's set, two categories here (two scenes each), the
+# thesis's three methods and the ground truth as the reference; hard
+# shadows only when asked; block II needs the reference.
+"$mr" study stimuli --family shadows --out "$tmp/sh" --cases 2 --width 96 --height 54 --gt-samples 16 >"$tmp/ss.log" 2>&1 && ok || bad "shadows stimuli: $(cat "$tmp/ss.log")"
+[ "$(ls "$tmp"/sh | tr '\n' ' ')" = "bp pcf pcss reference " ] && ok || bad "shadows methods: $(ls "$tmp/sh")"
+for m in bp pcf pcss reference; do
+  [ "$(ls "$tmp/sh/$m" 2>/dev/null | tr '\n' ' ')" = "simple_constant.a.png simple_constant.b.png simple_constant_overlap.a.png simple_constant_overlap.b.png " ] && ok ||
     bad "shadows $m: $(ls "$tmp/sh/$m" 2>&1)"
 done
-grep -q "15 images of family shadows" "$tmp/ss.log" && ok || bad "shadows: expected 3 stimuli x 5 images: $(cat "$tmp/ss.log")"
-cmp -s "$tmp/sh/hard/hall_v0.png" "$tmp/sh/pcss/hall_v0.png" && bad "shadows: hard and pcss give the same hall image" || ok
-cmp -s "$tmp/sh/hard/simple_varying_overlap_v0.png" "$tmp/sh/reference/simple_varying_overlap_v0.png" && bad "shadows: the reference is the hard shadow" || ok
+grep -q "16 images of family shadows" "$tmp/ss.log" && ok || bad "shadows: expected 4 stimuli x 4 images: $(cat "$tmp/ss.log")"
+# The PNG header's width and height (big-endian at bytes 16..23).
+[ "$(od -An -tu1 -j16 -N8 "$tmp/sh/pcf/simple_constant.a.png" | tr -s ' ')" = " 0 0 0 96 0 0 0 54" ] && ok ||
+  bad "shadows: not 96 x 54: $(od -An -tu1 -j16 -N8 "$tmp/sh/pcf/simple_constant.a.png")"
+cmp -s "$tmp/sh/pcf/simple_constant.a.png" "$tmp/sh/pcf/simple_constant.b.png" && bad "shadows: scenes a and b are the same image" || ok
+cmp -s "$tmp/sh/pcf/simple_constant.a.png" "$tmp/sh/reference/simple_constant.a.png" && bad "shadows: the reference is pcf" || ok
+"$mr" study stimuli --family shadows --out "$tmp/shh" --cases 1 --width 48 --height 27 --gt-samples 4 --hard >"$tmp/ssh.log" 2>&1 && ok || bad "shadows --hard: $(cat "$tmp/ssh.log")"
+[ "$(ls "$tmp"/shh | tr '\n' ' ')" = "bp hard pcf pcss reference " ] && ok || bad "shadows --hard methods: $(ls "$tmp/shh")"
 # The default blocks I,II,III: block II shows the reference, so it needs one.
-"$mr" study plan "$tmp/sh" --out "$tmp/plan_sh.json" --seed 2 --fixation-ms 50 >"$tmp/psh.log" 2>&1 && ok || bad "plan of shadows: $(cat "$tmp/psh.log")"
-# 5 methods: C(5,2) = 10 pairs + 1 identical per stimulus, 3 stimuli, 3 blocks.
-grep -q "99 trials per participant, 1 schedule (5 methods with the reference, 3 stimuli, blocks I II III)" "$tmp/psh.log" && ok ||
-  bad "plan of shadows: expected blocks I,II,III with 99 trials: $(cat "$tmp/psh.log")"
-expect_fail stim_cases "" -- "$mr" study stimuli --family shadows --out "$tmp/sx" --cases 9
+"$mr" study plan "$tmp/sh" --out "$tmp/plan_sh.json" --seed 2 --fixation-ms 50 --participants 4 >"$tmp/psh.log" 2>&1 && ok || bad "plan of shadows: $(cat "$tmp/psh.log")"
+# 4 methods: C(4,2) = 6 pairs + 1 identical per category, 2 categories, 3 blocks.
+grep -q "42 trials per participant, 4 schedules (4 methods with the reference, 4 stimuli, blocks I II III)" "$tmp/psh.log" && ok ||
+  bad "plan of shadows: expected blocks I,II,III with 42 trials: $(cat "$tmp/psh.log")"
+expect_fail stim_cases "" -- "$mr" study stimuli --family shadows --out "$tmp/sx" --cases 14
 
 # --- plan: any DIR/<method>/<stimulus>.png folder; three methods, two stimuli
 mkdir -p "$tmp/small"

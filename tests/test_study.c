@@ -37,12 +37,24 @@ static void test_families(void) {
         CHECK(!seen[fp.shadow.method]);
         seen[fp.shadow.method] = true;
     }
-    CHECK(n == 4 && seen[MR_SHADOW_HARD] && seen[MR_SHADOW_PCF] && seen[MR_SHADOW_PCSS] && seen[MR_SHADOW_BP]);
+    /* The thesis's four: pcf, pcss, bp and the reference; hard only when asked. */
+    CHECK(n == 3 && seen[MR_SHADOW_PCF] && seen[MR_SHADOW_PCSS] && seen[MR_SHADOW_BP] && !seen[MR_SHADOW_HARD]);
+    CHECK(fam->optional && !strcmp(fam->optional, "hard"));
+    {
+        mr_frame_params fp = MR_FRAME_DEFAULTS;
+        fam->setup(&fp, n);
+        CHECK(fp.shadow.method == MR_SHADOW_HARD);
+    }
+    /* The thesis's stimuli: 800 x 450, antialiased, ambient 0.4. */
+    CHECK(fam->width == 800 && fam->height == 450 && fam->supersample == 2 && fabsf(fam->ambient - 0.4f) < 1e-6f);
+    /* Its 13 categories: the suite's 12 systematic ones and the factory. */
+    CHECK(MR_STUDY_SHADOW_CASES == 13);
     for (int c = 0; c < MR_STUDY_SHADOW_CASES; c++) {
         bool found = false;
         for (int i = 0; i < MR_SHADOW_SUITE_COUNT; i++)
             found |= strcmp(mr_shadow_suite_name(i), mr_study_shadow_cases[c]) == 0;
-        CHECK_MSG(found && strcmp(mr_study_shadow_cases[c], "factory") != 0, "case %s", mr_study_shadow_cases[c]);
+        CHECK_MSG(found, "case %s", mr_study_shadow_cases[c]);
+        for (int d = 0; d < c; d++) CHECK(strcmp(mr_study_shadow_cases[c], mr_study_shadow_cases[d]) != 0);
     }
     /* Out-of-range arguments fail before anything is rendered or written. */
     mr_study_stimuli_params p = MR_STUDY_STIMULI_DEFAULTS;

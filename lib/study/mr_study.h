@@ -1,15 +1,24 @@
-/* mr_study.h — pairwise comparison studies of rendering methods, designed
- * and analysed as in Hecher's soft-shadow study (thesis ch. 4.3 and 5):
- * stimuli (one image per method and stimulus), a plan (all pairs plus one
- * identical pair per stimulus, random order and sides, blocks I-III, block
- * II with the reference), a durable vote log that a killed run resumes
- * from, the statistics (consistence, agreement, indifference, binomial
- * tests, Bradley-Terry and Davidson scores) and the run window's controller.
+/* mr_study.h — user studies of rendering methods, in the three designs of
+ * the papers mrcheck follows, with one plan format, one run window, one
+ * vote log and one statistics module:
+ *  - pairwise (Hecher's soft-shadow study, thesis ch. 4.3 and 5): all pairs
+ *    plus an identical pair per category, blocks I-III (II with the
+ *    reference, III split into groups A and B), two scenes per category
+ *    alternating; consistence, agreement, indifference, binomial tests,
+ *    Bradley-Terry and Davidson scores, inconsistent participants excluded;
+ *  - rating (Scheer & Keutel): one image rated 1..7 on named scales,
+ *    virtual and with video; RM-ANOVA (Mauchly, Greenhouse-Geisser),
+ *    Bonferroni post hoc, paired t between the conditions;
+ *  - task (Kalkofen et al.): one image and a question with a right answer;
+ *    scores, RM-ANOVA where its assumptions hold, else Friedman + Wilcoxon.
+ * Stimuli (`study stimuli`), a plan per participant, a durable vote log a
+ * killed run resumes from, the run window's controller, the analyses.
  *
- * A stimulus folder is DIR/<method>/<stimulus>.png; the method folder named
- * "reference" (MR_STUDY_REFERENCE) is the ground truth: a method like the
- * others in the pairs, shown above the pair in block II, fixed at theta = 0
- * in the scores.
+ * A pairwise stimulus folder is DIR/<method>/<stimulus>.png; the method
+ * folder named "reference" (MR_STUDY_REFERENCE) is the ground truth: a
+ * method like the others in the pairs, shown above the pair in block II,
+ * fixed at theta = 0 in the scores. Rating and task folders add a
+ * condition level: DIR/<condition>/<method>/<stimulus>.png.
  *
  * Depends on: lib/core; lib/session (the durable line append); lib/ui (the
  * run controller's widgets); lib/eval (CSV, SVG plots, ray-traced AO); lib/render
@@ -59,26 +68,37 @@ bool mr_study_scan(const char *dir, mr_study_set *out, mr_error *err);
 void mr_study_set_free(mr_study_set *s);
 
 /* The families `study stimuli --family` renders, one row each, so a family
- * is one more row. Each renders the demo hall (lib/scene) from `views` of
- * its standing viewpoints through mr_render_frame; the shadows family also
- * renders both views of `cases` shadow-suite cases (mr_shadow_suite_build). */
+ * is one more row. ao and ghost render the demo hall (lib/scene) from
+ * `views` of its standing viewpoints through mr_render_frame. shadows is
+ * Hecher's stimulus set (thesis sec. 4.1-4.3): the 13 categories of the
+ * shadow suite (12 systematic and the factory), each as two scenes
+ * <category>.a and <category>.b (b: the objects turned 90 degrees about
+ * the vertical under the same light, a different arrangement; the
+ * factory's b is the hall as built), the thesis's four methods (pcf, pcss,
+ * bp and the ground truth as the reference; hard shadows with `hard`), at
+ * 800x450, ambient 0.4 and antialiased. */
 typedef struct mr_study_stimuli_params {
     int family;               /* index into mr_study_families; default 0 (ao) */
-    int width, height;        /* image size, px; default 320x240 */
+    int width, height;        /* image size, px; 0 = the family's (shadows 800x450, else 320x240) */
     int views;                /* demo viewpoints, 1..MR_DEMO_VIEWS; default 3 */
     int gt_rays;              /* reference AO: rays per pixel; default 128 */
-    int cases;                /* shadows: suite cases, 0..MR_STUDY_SHADOW_CASES; default 4 */
+    int cases;                /* shadows: categories, 1..MR_STUDY_SHADOW_CASES; default all 13 */
     int gt_samples;           /* reference shadows: light samples, 1..1024; default 256 */
+    int supersample;          /* render at N times the size, average N x N pixels; 0 = the
+                                 family's (shadows 2: the thesis's 2x MSAA, which the renderer
+                                 has no multisample target for, else 1) */
+    float ambient;            /* the scene's ambient term; 0 = the family's (shadows 0.4, the
+                                 thesis's; else the scene's own) */
+    bool hard;                /* shadows: also hard shadows (not in the thesis); default false */
 } mr_study_stimuli_params;
-/* The shadow-suite cases the shadows family draws from, in this order: one
- * per category kind (simple overlapping, furniture with contact hardening,
- * fence, plant); the suite's own factory case is left out (the demo hall
- * under the default sun is the family's hall stimulus). */
-#define MR_STUDY_SHADOW_CASES 4
+/* The shadow-suite cases the shadows family draws from, in suite order. */
+#define MR_STUDY_SHADOW_CASES 13
 extern const char *const mr_study_shadow_cases[MR_STUDY_SHADOW_CASES];
-#define MR_STUDY_STIMULI_DEFAULTS {.family = 0, .width = 320, .height = 240, .views = 3, .gt_rays = 128, \
-                                   .cases = MR_STUDY_SHADOW_CASES, .gt_samples = MR_SHADOW_DEFAULT_GT_SAMPLES}
-extern const mr_opt mr_study_stimuli_opts[];   /* family, width, height, views, gt-rays, cases, gt-samples */
+#define MR_STUDY_STIMULI_DEFAULTS {.family = 0, .width = 0, .height = 0, .views = 3, .gt_rays = 128, \
+                                   .cases = MR_STUDY_SHADOW_CASES, .gt_samples = MR_SHADOW_DEFAULT_GT_SAMPLES, \
+                                   .supersample = 0, .ambient = 0.0f, .hard = false}
+extern const mr_opt mr_study_stimuli_opts[];   /* family, width, height, views, gt-rays, cases, gt-samples,
+                                                  supersample, ambient, hard */
 
 /* A family's reference of one stimulus into res (its color is saved). */
 typedef bool (*mr_study_reference_fn)(mr_renderer *r, const mr_scene *scene, const mr_view *view,
@@ -93,7 +113,11 @@ typedef struct mr_study_family {
     /* Sets fp up for method m (index into methods). */
     void (*setup)(mr_frame_params *fp, int m);
     mr_study_reference_fn reference; /* NULL without a reference */
-    bool shadow_suite;        /* stimuli: also the shadow-suite cases (`cases`) */
+    bool shadow_suite;        /* the shadow suite's categories (`cases`, two scenes each) instead of the hall's views */
+    int width, height;        /* default image size */
+    int supersample;          /* default supersampling */
+    float ambient;            /* default ambient (0: the scene's) */
+    const char *optional;     /* a method rendered only when asked (shadows: "hard"), or NULL */
 } mr_study_family;
 extern const mr_study_family mr_study_families[];
 extern const int mr_study_family_count;

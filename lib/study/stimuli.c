@@ -1,11 +1,13 @@
 /* `mrcheck study stimuli`: one image per method and stimulus (a view of
- * the demo hall, for shadows also a view of a shadow-suite case), rendered
- * through mr_render_frame. The families are rows of one table: methods,
- * setup, how the reference is made and which scenes are the stimuli. */
+ * the demo hall; for shadows Hecher's categories, two scenes each),
+ * rendered through mr_render_frame. The families are rows of one table:
+ * methods, setup, how the reference is made, which scenes are the stimuli,
+ * the default size, antialiasing and ambient term. */
 #include "mr_eval.h"
 #include "mr_scene.h"
 #include "mr_study.h"
 
+#include <math.h>
 #include <string.h>
 
 static const char *const k_ao_methods[] = {"alchemy", "crytek", "filion", "hbao", "scheer", NULL};
@@ -16,12 +18,18 @@ static const char *const k_ghost_methods[] = {"adaptive", "alpha", "g0", NULL};
 static const mr_ghost_mode k_ghost_enum[] = {MR_GHOST_ADAPTIVE, MR_GHOST_ALPHA, MR_GHOST_G0};
 static void ghost_setup(mr_frame_params *fp, int m) { fp->ghost.mode = k_ghost_enum[m]; }
 
-static const char *const k_shadow_methods[] = {"bp", "hard", "pcf", "pcss", NULL};
-static const mr_shadow_method k_shadow_enum[] = {MR_SHADOW_BP, MR_SHADOW_HARD, MR_SHADOW_PCF, MR_SHADOW_PCSS};
+/* The thesis's four: PCF, PCSS, backprojection and the ground truth (the
+ * reference); hard shadows only when asked (index 3). */
+static const char *const k_shadow_methods[] = {"bp", "pcf", "pcss", NULL};
+static const mr_shadow_method k_shadow_enum[] = {MR_SHADOW_BP, MR_SHADOW_PCF, MR_SHADOW_PCSS, MR_SHADOW_HARD};
 static void shadow_setup(mr_frame_params *fp, int m) { fp->shadow.method = k_shadow_enum[m]; }
 
-const char *const mr_study_shadow_cases[MR_STUDY_SHADOW_CASES] = {"simple_varying_overlap", "furniture_varying",
-                                                                  "fence_constant", "plant_varying"};
+const char *const mr_study_shadow_cases[MR_STUDY_SHADOW_CASES] = {
+    "simple_constant",    "simple_constant_overlap",    "simple_varying",    "simple_varying_overlap",
+    "furniture_constant", "furniture_constant_overlap", "furniture_varying", "furniture_varying_overlap",
+    "fence_constant",     "fence_varying",              "plant_constant",    "plant_varying",
+    "factory",
+};
 
 static bool ao_reference(mr_renderer *r, const mr_scene *scene, const mr_view *view, const mr_frame_params *base,
                          const mr_study_stimuli_params *p, mr_frame_result *res, mr_error *err);
@@ -40,11 +48,11 @@ static bool shadow_reference(mr_renderer *r, const mr_scene *scene, const mr_vie
 
 const mr_study_family mr_study_families[] = {
     {"ao", "screen-space AO methods against ray-traced AO (lib/eval) as the reference", k_ao_methods, true, ao_setup,
-     ao_reference, false},
+     ao_reference, false, 320, 240, 1, 0.0f, NULL},
     {"ghost", "ghosted views of the hidden layer (alpha, g0, adaptive); no reference", k_ghost_methods, false,
-     ghost_setup, NULL, false},
-    {"shadows", "shadow-map soft shadows (hard, pcf, pcss, bp) against the GPU ground truth (many light samples)",
-     k_shadow_methods, true, shadow_setup, shadow_reference, true},
+     ghost_setup, NULL, false, 320, 240, 1, 0.0f, NULL},
+    {"shadows", "Hecher's study: pcf, pcss, bp against the GPU ground truth, 13 categories x 2 scenes, 800x450",
+     k_shadow_methods, true, shadow_setup, shadow_reference, true, 800, 450, 2, 0.4f, "hard"},
 };
 const int mr_study_family_count = (int)(sizeof mr_study_families / sizeof mr_study_families[0]);
 const char *const mr_study_family_names[] = {"ao", "ghost", "shadows", NULL};
@@ -55,16 +63,24 @@ _Static_assert(sizeof mr_study_family_names / sizeof mr_study_family_names[0] ==
 const mr_opt mr_study_stimuli_opts[] = {
     {"family", MR_OPT_ENUM, offsetof(mr_study_stimuli_params, family), 0, 0, 0, mr_study_family_names,
      "which methods to render", 0},
-    {"width", MR_OPT_INT, offsetof(mr_study_stimuli_params, width), 16, 4096, 320, NULL, "image width, pixels", 0},
-    {"height", MR_OPT_INT, offsetof(mr_study_stimuli_params, height), 16, 4096, 240, NULL, "image height, pixels", 0},
+    {"width", MR_OPT_INT, offsetof(mr_study_stimuli_params, width), 16, 4096, 0, NULL,
+     "image width, pixels (0: the family's, shadows 800, else 320)", MR_OPT_ZERO_AUTO},
+    {"height", MR_OPT_INT, offsetof(mr_study_stimuli_params, height), 16, 4096, 0, NULL,
+     "image height, pixels (0: the family's, shadows 450, else 240)", MR_OPT_ZERO_AUTO},
     {"views", MR_OPT_INT, offsetof(mr_study_stimuli_params, views), 1, MR_DEMO_VIEWS, 3, NULL,
      "stimuli: the first N standing viewpoints of the demo hall", 0},
     {"gt-rays", MR_OPT_INT, offsetof(mr_study_stimuli_params, gt_rays), 1, 4096, 128, NULL,
      "reference AO: ray-traced rays per pixel", 0},
-    {"cases", MR_OPT_INT, offsetof(mr_study_stimuli_params, cases), 0, MR_STUDY_SHADOW_CASES, MR_STUDY_SHADOW_CASES,
-     NULL, "shadows: also both views of the first N shadow-suite cases", 0},
+    {"cases", MR_OPT_INT, offsetof(mr_study_stimuli_params, cases), 1, MR_STUDY_SHADOW_CASES, MR_STUDY_SHADOW_CASES,
+     NULL, "shadows: the first N of the 13 categories (two scenes each)", 0},
     {"gt-samples", MR_OPT_INT, offsetof(mr_study_stimuli_params, gt_samples), 1, 1024, MR_SHADOW_DEFAULT_GT_SAMPLES,
      NULL, "reference shadows: light samples (hard shadow maps averaged)", 0},
+    {"supersample", MR_OPT_INT, offsetof(mr_study_stimuli_params, supersample), 1, 4, 0, NULL,
+     "antialiasing: render N times the size and average N x N pixels (0: the family's, shadows 2)", MR_OPT_ZERO_AUTO},
+    {"ambient", MR_OPT_FLOAT, offsetof(mr_study_stimuli_params, ambient), 0.01, 1, 0, NULL,
+     "the scenes' ambient term (0: the family's, shadows the thesis's 0.4)", MR_OPT_ZERO_AUTO},
+    {"hard", MR_OPT_BOOL, offsetof(mr_study_stimuli_params, hard), 0, 1, 0, NULL,
+     "shadows: also hard shadows (not one of the thesis's methods)", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 
@@ -85,30 +101,67 @@ static bool ao_reference(mr_renderer *r, const mr_scene *scene, const mr_view *v
     return mr_eval_render_groundtruth_ao(r, scene, view, base, &gtp, res, err);
 }
 
-/* One stimulus: every method of the family and its reference. */
-static bool render_stimulus(mr_renderer *r, const mr_study_family *fam, const mr_study_stimuli_params *p,
+/* The average of each ss x ss block of src (RGB8) into dst. */
+static bool downsample(const mr_image *src, int ss, mr_image *dst, mr_error *err) {
+    if (!mr_image_alloc(dst, src->width / ss, src->height / ss, 3, MR_PIX_U8, err)) return false;
+    const uint8_t *in = src->data;
+    uint8_t *out = dst->data;
+    for (int y = 0; y < dst->height; y++)
+        for (int x = 0; x < dst->width; x++)
+            for (int c = 0; c < 3; c++) {
+                int sum = 0;
+                for (int j = 0; j < ss; j++)
+                    for (int i = 0; i < ss; i++) sum += in[((size_t)(y * ss + j) * src->width + (x * ss + i)) * 3 + c];
+                out[((size_t)y * dst->width + x) * 3 + c] = (uint8_t)((sum + ss * ss / 2) / (ss * ss));
+            }
+    return true;
+}
+
+static bool save_frame(const char *dir, const char *method, const char *stim, const mr_image *img, int ss,
+                       mr_error *err) {
+    if (ss <= 1) return save(dir, method, stim, img, err);
+    mr_image small = {0};
+    bool ok = downsample(img, ss, &small, err) && save(dir, method, stim, &small, err);
+    mr_image_free(&small);
+    return ok;
+}
+
+/* One stimulus: every method of the family (the optional one when asked)
+ * and its reference, at ss times the size, averaged down. */
+static bool render_stimulus(mr_renderer *r, const mr_study_family *fam, const mr_study_stimuli_params *p, int ss,
                             const mr_scene *scene, const mr_view *view, const char *dir, const char *stim, int *count,
                             mr_error *err) {
     mr_frame_params base = MR_FRAME_DEFAULTS;
-    base.width = p->width;
-    base.height = p->height;
+    base.width = p->width * ss;
+    base.height = p->height * ss;
+    int n = 0;
+    while (fam->methods[n]) n++;
     bool ok = true;
-    for (int m = 0; ok && fam->methods[m]; m++) {
+    for (int m = 0; ok && m < n + (fam->optional && p->hard); m++) {
         mr_frame_params fp = base;
         fam->setup(&fp, m);
         mr_frame_result res = {0};
-        ok = mr_render_frame(r, view, &fp, &res, err) && save(dir, fam->methods[m], stim, &res.color, err);
+        ok = mr_render_frame(r, view, &fp, &res, err) &&
+             save_frame(dir, m < n ? fam->methods[m] : fam->optional, stim, &res.color, ss, err);
         mr_frame_result_free(&res);
         if (ok && count) (*count)++;
     }
     if (ok && fam->has_reference && fam->reference) {
         mr_frame_result res = {0};
         ok = fam->reference(r, scene, view, &base, p, &res, err) &&
-             save(dir, MR_STUDY_REFERENCE, stim, &res.color, err);
+             save_frame(dir, MR_STUDY_REFERENCE, stim, &res.color, ss, err);
         mr_frame_result_free(&res);
         if (ok && count) (*count)++;
     }
     return ok;
+}
+
+/* Scene b of a category: the objects (the floor too, a square) turned 90
+ * degrees about the vertical through the origin, the light kept. */
+static void turn_scene(mr_scene *s) {
+    mr_dmat4 r = mr_m4_rotate_axis(mr_v3(0, 1, 0), 1.5707963267948966);
+    for (int i = 0; i < s->node_count; i++) s->nodes[i].world = mr_m4_mul(&r, &s->nodes[i].world);
+    mr_scene_update_bounds(s);
 }
 
 /* Index of a suite case by name (-1 when the suite has no such case). */
@@ -123,38 +176,71 @@ bool mr_study_stimuli_render(mr_renderer *r, const mr_study_stimuli_params *pp, 
     mr_study_stimuli_params p = pp ? *pp : (mr_study_stimuli_params)MR_STUDY_STIMULI_DEFAULTS;
     if (count) *count = 0;
     if (p.family < 0 || p.family >= mr_study_family_count) return mr_fail(err, MR_ERR_INVALID, "unknown stimulus family");
-    if (p.views < 1 || p.views > mr_demo_view_count())
-        return mr_fail(err, MR_ERR_INVALID, "views must be in [1, %d]", mr_demo_view_count());
     const mr_study_family *fam = &mr_study_families[p.family];
-    if (fam->shadow_suite && (p.cases < 0 || p.cases > MR_STUDY_SHADOW_CASES))
-        return mr_fail(err, MR_ERR_INVALID, "cases must be in [0, %d]", MR_STUDY_SHADOW_CASES);
+    if (!p.width) p.width = fam->width;
+    if (!p.height) p.height = fam->height;
+    int ss = p.supersample > 0 ? p.supersample : fam->supersample;
+    float ambient = p.ambient > 0 ? p.ambient : fam->ambient;
+    if (p.width < 16 || p.height < 16 || p.width > 4096 || p.height > 4096 || ss < 1 || ss > 4)
+        return mr_fail(err, MR_ERR_INVALID, "size must be 16..4096 and supersample 1..4");
+    if (!fam->shadow_suite && (p.views < 1 || p.views > mr_demo_view_count()))
+        return mr_fail(err, MR_ERR_INVALID, "views must be in [1, %d]", mr_demo_view_count());
+    if (fam->shadow_suite && (p.cases < 1 || p.cases > MR_STUDY_SHADOW_CASES))
+        return mr_fail(err, MR_ERR_INVALID, "cases must be in [1, %d]", MR_STUDY_SHADOW_CASES);
     if (fam->shadow_suite && (p.gt_samples < 1 || p.gt_samples > 1024))
         return mr_fail(err, MR_ERR_INVALID, "gt-samples must be in [1, 1024]");
-    mr_demo_hall hall;
-    mr_demo_params dp = MR_DEMO_DEFAULTS;
-    if (!mr_demo_build(&dp, &hall, err)) return false;
-    /* The hall as planned has no lights: the shadows family sees it under
-     * the renderer's default sun. */
-    bool ok = mr_mkdirs(dir, err) && mr_renderer_set_scene(r, hall.planned, err);
-    for (int v = 0; ok && v < p.views; v++) {
-        mr_view view = mr_demo_view(v);
-        char stim[32];
-        snprintf(stim, sizeof stim, "hall_v%d", v);
-        ok = render_stimulus(r, fam, &p, hall.planned, &view, dir, stim, count, err);
+    if (!mr_mkdirs(dir, err)) return false;
+    bool ok = true;
+    if (!fam->shadow_suite) {
+        mr_demo_hall hall;
+        mr_demo_params dp = MR_DEMO_DEFAULTS;
+        if (!mr_demo_build(&dp, &hall, err)) return false;
+        if (ambient > 0) hall.planned->ambient = ambient;
+        ok = mr_renderer_set_scene(r, hall.planned, err);
+        for (int v = 0; ok && v < p.views; v++) {
+            mr_view view = mr_demo_view(v);
+            char stim[32];
+            snprintf(stim, sizeof stim, "hall_v%d", v);
+            ok = render_stimulus(r, fam, &p, ss, hall.planned, &view, dir, stim, count, err);
+        }
+        mr_renderer_set_scene(r, NULL, NULL);
+        mr_demo_free(&hall);
+        return ok;
     }
-    mr_renderer_set_scene(r, NULL, NULL);
-    mr_demo_free(&hall);
-    for (int c = 0; ok && fam->shadow_suite && c < p.cases; c++) {
+    for (int c = 0; ok && c < p.cases; c++) {
         int ci = suite_index(mr_study_shadow_cases[c]);
         if (ci < 0) return mr_fail(err, MR_ERR_INVALID, "no shadow suite case %s", mr_study_shadow_cases[c]);
         mr_shadow_suite_case sc;
-        ok = mr_shadow_suite_build(ci, &sc, err) && mr_renderer_set_scene(r, sc.scene, err);
-        for (int v = 0; ok && v < 2; v++) {
+        if (!mr_shadow_suite_build(ci, &sc, err)) return false;
+        for (int scene = 0; ok && scene < 2; scene++) {
+            mr_scene *s = sc.scene;
+            mr_demo_hall hall = {0};
+            if (scene == 1 && !strcmp(sc.name, "factory")) {
+                /* The factory's second scene: the hall as built, lit alike. */
+                mr_demo_params dp = MR_DEMO_DEFAULTS;
+                ok = mr_demo_build(&dp, &hall, err);
+                if (!ok) break;
+                s = hall.built;
+                s->light_count = sc.scene->light_count;
+                memcpy(s->lights, sc.scene->lights, sizeof s->lights);
+            } else if (scene == 1) {
+                turn_scene(s);
+            }
+            s->ambient = ambient > 0 ? ambient : s->ambient;
             char stim[MR_STUDY_NAME_MAX];
-            snprintf(stim, sizeof stim, "%s_v%d", sc.name, v);
-            ok = render_stimulus(r, fam, &p, sc.scene, &sc.views[v], dir, stim, count, err);
+            snprintf(stim, sizeof stim, "%s.%c", sc.name, 'a' + scene);
+            /* The suite's views are 320 x 240: the same field of view at the
+             * stimulus's size, the aspect kept by the wider side. */
+            mr_view view = sc.views[0];
+            double k = fmax((double)p.width / view.camera.width, (double)p.height / view.camera.height);
+            view.camera.fx *= k, view.camera.fy *= k;
+            view.camera.width = p.width * ss, view.camera.height = p.height * ss;
+            view.camera.fx *= ss, view.camera.fy *= ss;
+            view.camera.cx = 0.5 * view.camera.width - 0.5, view.camera.cy = 0.5 * view.camera.height - 0.5;
+            ok = mr_renderer_set_scene(r, s, err) && render_stimulus(r, fam, &p, ss, s, &view, dir, stim, count, err);
+            mr_renderer_set_scene(r, NULL, NULL);
+            if (hall.planned || hall.built) mr_demo_free(&hall);
         }
-        mr_renderer_set_scene(r, NULL, NULL);
         mr_shadow_suite_free(&sc);
     }
     return ok;
