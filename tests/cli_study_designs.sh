@@ -36,14 +36,12 @@ kill_after() {
   wait "$2" 2>/dev/null
 }
 
-# --- rating: DIR/<condition>/<method>/<stimulus>.png
-for c in virtual video; do
-  for m in D1 D2 D3; do
-    mkdir -p "$tmp/r/$c/$m"
-    src=$([ $m = D1 ] && echo alchemy || ([ $m = D2 ] && echo hbao || echo crytek))
-    for v in 0 1; do cp "$tmp/ao/$src/hall_v$v.png" "$tmp/r/$c/$m/hall.v$v.png"; done
-  done
-done
+# --- rating: Scheer & Keutel's D1, D2, D3, virtual and over the camera image
+"$mr" study stimuli --family depth --out "$tmp/r" --views 2 --width 96 --height 72 >"$tmp/sd.log" 2>&1 && ok || bad "depth stimuli: $(cat "$tmp/sd.log")"
+[ "$(ls "$tmp/r" | tr '\n' ' ')" = "video virtual " ] && [ "$(ls "$tmp/r/video" | tr '\n' ' ')" = "D1 D2 D3 " ] && ok || bad "depth stimuli: $(ls -R "$tmp/r")"
+cmp -s "$tmp/r/virtual/D1/hall_v0.png" "$tmp/r/virtual/D2/hall_v0.png" && bad "depth: D1 and D2 give the same image" || ok
+cmp -s "$tmp/r/virtual/D2/hall_v0.png" "$tmp/r/virtual/D3/hall_v0.png" && bad "depth: D2 and D3 give the same image" || ok
+cmp -s "$tmp/r/virtual/D2/hall_v0.png" "$tmp/r/video/D2/hall_v0.png" && bad "depth: the video condition shows no camera image" || ok
 "$mr" study plan "$tmp/r" --design rating --scales occlusion,contrast --out "$tmp/rplan.json" --fixation-ms 50 >"$tmp/rp.log" 2>&1 && ok || bad "rating plan: $(cat "$tmp/rp.log")"
 grep -q "(rating): 12 trials per participant, 1 schedule (3 methods, 2 stimuli, blocks virtual video)" "$tmp/rp.log" && ok ||
   bad "rating plan: expected 2 conditions x 3 methods x 2 stimuli: $(cat "$tmp/rp.log")"

@@ -76,7 +76,10 @@ void mr_study_set_free(mr_study_set *s);
  * the vertical under the same light, a different arrangement; the
  * factory's b is the hall as built), the thesis's four methods (pcf, pcss,
  * bp and the ground truth as the reference; hard shadows with `hard`), at
- * 800x450, ambient 0.4 and antialiased. */
+ * 800x450, ambient 0.4 and antialiased. depth is Scheer & Keutel's rating
+ * set: D1, D2, D3 (mr_render's AO methods none, scheer with a screen and
+ * with a view radius) of the hall's views in DIR/virtual/ and, over a
+ * camera image at alpha 0.5, in DIR/video/. */
 typedef struct mr_study_stimuli_params {
     int family;               /* index into mr_study_families; default 0 (ao) */
     int width, height;        /* image size, px; 0 = the family's (shadows 800x450, else 320x240) */
@@ -106,7 +109,7 @@ typedef bool (*mr_study_reference_fn)(mr_renderer *r, const mr_scene *scene, con
                                       mr_frame_result *res, mr_error *err);
 
 typedef struct mr_study_family {
-    const char *name;         /* "ao", "ghost", "shadows" */
+    const char *name;         /* "ao", "ghost", "shadows", "depth" */
     const char *help;
     const char *const *methods; /* NULL-terminated folder names */
     bool has_reference;       /* also renders DIR/reference/ (with `reference`) */
@@ -118,6 +121,7 @@ typedef struct mr_study_family {
     int supersample;          /* default supersampling */
     float ambient;            /* default ambient (0: the scene's) */
     const char *optional;     /* a method rendered only when asked (shadows: "hard"), or NULL */
+    bool conditions;          /* rating stimuli: DIR/virtual/ and DIR/video/ (camera image at alpha 0.5) */
 } mr_study_family;
 extern const mr_study_family mr_study_families[];
 extern const int mr_study_family_count;

@@ -14,6 +14,15 @@ static const char *const k_ao_methods[] = {"alchemy", "crytek", "filion", "hbao"
 static const mr_ao_method k_ao_enum[] = {MR_AO_ALCHEMY, MR_AO_CRYTEK, MR_AO_FILION, MR_AO_HBAO, MR_AO_SCHEER};
 static void ao_setup(mr_frame_params *fp, int m) { fp->ao.method = k_ao_enum[m]; }
 
+/* Scheer & Keutel's D1 (Phong shading, no AO), D2 (their SSAO: the
+ * radius constant on screen, so it grows with depth) and D3 (standard
+ * SSAO: a constant view-space radius, shrinking on screen with depth). */
+static const char *const k_depth_methods[] = {"D1", "D2", "D3", NULL};
+static void depth_setup(mr_frame_params *fp, int m) {
+    fp->ao.method = m == 0 ? MR_AO_NONE : MR_AO_SCHEER;
+    fp->ao.radius_mode = m == 2 ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
+}
+
 static const char *const k_ghost_methods[] = {"adaptive", "alpha", "g0", NULL};
 static const mr_ghost_mode k_ghost_enum[] = {MR_GHOST_ADAPTIVE, MR_GHOST_ALPHA, MR_GHOST_G0};
 static void ghost_setup(mr_frame_params *fp, int m) { fp->ghost.mode = k_ghost_enum[m]; }
@@ -48,14 +57,16 @@ static bool shadow_reference(mr_renderer *r, const mr_scene *scene, const mr_vie
 
 const mr_study_family mr_study_families[] = {
     {"ao", "screen-space AO methods against ray-traced AO (lib/eval) as the reference", k_ao_methods, true, ao_setup,
-     ao_reference, false, 320, 240, 1, 0.0f, NULL},
+     ao_reference, false, 320, 240, 1, 0.0f, NULL, false},
     {"ghost", "ghosted views of the hidden layer (alpha, g0, adaptive); no reference", k_ghost_methods, false,
-     ghost_setup, NULL, false, 320, 240, 1, 0.0f, NULL},
+     ghost_setup, NULL, false, 320, 240, 1, 0.0f, NULL, false},
     {"shadows", "Hecher's study: pcf, pcss, bp against the GPU ground truth, 13 categories x 2 scenes, 800x450",
-     k_shadow_methods, true, shadow_setup, shadow_reference, true, 800, 450, 2, 0.4f, "hard"},
+     k_shadow_methods, true, shadow_setup, shadow_reference, true, 800, 450, 2, 0.4f, "hard", false},
+    {"depth", "Scheer & Keutel's rating study: D1, D2, D3 in virtual/ and in video/ (camera image at alpha 0.5)",
+     k_depth_methods, false, depth_setup, NULL, false, 320, 240, 1, 0.0f, NULL, true},
 };
 const int mr_study_family_count = (int)(sizeof mr_study_families / sizeof mr_study_families[0]);
-const char *const mr_study_family_names[] = {"ao", "ghost", "shadows", NULL};
+const char *const mr_study_family_names[] = {"ao", "ghost", "shadows", "depth", NULL};
 _Static_assert(sizeof mr_study_family_names / sizeof mr_study_family_names[0] ==
                    sizeof mr_study_families / sizeof mr_study_families[0] + 1,
                "one name per family row");
@@ -129,11 +140,13 @@ static bool save_frame(const char *dir, const char *method, const char *stim, co
 /* One stimulus: every method of the family (the optional one when asked)
  * and its reference, at ss times the size, averaged down. */
 static bool render_stimulus(mr_renderer *r, const mr_study_family *fam, const mr_study_stimuli_params *p, int ss,
-                            const mr_scene *scene, const mr_view *view, const char *dir, const char *stim, int *count,
-                            mr_error *err) {
+                            const mr_scene *scene, const mr_view *view, const mr_image *video, const char *dir,
+                            const char *stim, int *count, mr_error *err) {
     mr_frame_params base = MR_FRAME_DEFAULTS;
     base.width = p->width * ss;
     base.height = p->height * ss;
+    base.video = video;
+    base.alpha = 0.5f; /* Scheer & Keutel's 50 % overlay */
     int n = 0;
     while (fam->methods[n]) n++;
     bool ok = true;
@@ -162,6 +175,35 @@ static void turn_scene(mr_scene *s) {
     mr_dmat4 r = mr_m4_rotate_axis(mr_v3(0, 1, 0), 1.5707963267948966);
     for (int i = 0; i < s->node_count; i++) s->nodes[i].world = mr_m4_mul(&r, &s->nodes[i].world);
     mr_scene_update_bounds(s);
+}
+
+/* The rating family's two conditions: DIR/virtual/<method>/hall_vN.png and
+ * DIR/video/<method>/hall_vN.png, the latter over a camera image at alpha
+ * 0.5. The camera image is the hall as built drawn plainly from the same
+ * viewpoint (the repository has no photographs of a factory; any real
+ * frame can take its place through `render --video`). */
+static bool conditions_render(mr_renderer *r, const mr_study_family *fam, const mr_study_stimuli_params *p, int ss,
+                              mr_demo_hall *hall, const char *dir, int *count, mr_error *err) {
+    bool ok = true;
+    for (int v = 0; ok && v < p->views; v++) {
+        mr_view view = mr_demo_view(v);
+        char stim[32], sub[4200];
+        snprintf(stim, sizeof stim, "hall_v%d", v);
+        /* The camera image: the as-built hall, plain shading. */
+        mr_frame_params vp = MR_FRAME_DEFAULTS;
+        vp.width = p->width * ss;
+        vp.height = p->height * ss;
+        mr_frame_result cam = {0};
+        ok = mr_renderer_set_scene(r, hall->built, err) && mr_render_frame(r, &view, &vp, &cam, err);
+        ok = ok && mr_renderer_set_scene(r, hall->planned, err);
+        mr_path_join(dir, "virtual", sub, sizeof sub);
+        ok = ok && render_stimulus(r, fam, p, ss, hall->planned, &view, NULL, sub, stim, count, err);
+        mr_path_join(dir, "video", sub, sizeof sub);
+        ok = ok && render_stimulus(r, fam, p, ss, hall->planned, &view, &cam.color, sub, stim, count, err);
+        mr_frame_result_free(&cam);
+        mr_renderer_set_scene(r, NULL, NULL);
+    }
+    return ok;
 }
 
 /* Index of a suite case by name (-1 when the suite has no such case). */
@@ -196,12 +238,17 @@ bool mr_study_stimuli_render(mr_renderer *r, const mr_study_stimuli_params *pp, 
         mr_demo_params dp = MR_DEMO_DEFAULTS;
         if (!mr_demo_build(&dp, &hall, err)) return false;
         if (ambient > 0) hall.planned->ambient = ambient;
+        if (fam->conditions) {
+            ok = conditions_render(r, fam, &p, ss, &hall, dir, count, err);
+            mr_demo_free(&hall);
+            return ok;
+        }
         ok = mr_renderer_set_scene(r, hall.planned, err);
         for (int v = 0; ok && v < p.views; v++) {
             mr_view view = mr_demo_view(v);
             char stim[32];
             snprintf(stim, sizeof stim, "hall_v%d", v);
-            ok = render_stimulus(r, fam, &p, ss, hall.planned, &view, dir, stim, count, err);
+            ok = render_stimulus(r, fam, &p, ss, hall.planned, &view, NULL, dir, stim, count, err);
         }
         mr_renderer_set_scene(r, NULL, NULL);
         mr_demo_free(&hall);
@@ -237,7 +284,7 @@ bool mr_study_stimuli_render(mr_renderer *r, const mr_study_stimuli_params *pp, 
             view.camera.width = p.width * ss, view.camera.height = p.height * ss;
             view.camera.fx *= ss, view.camera.fy *= ss;
             view.camera.cx = 0.5 * view.camera.width - 0.5, view.camera.cy = 0.5 * view.camera.height - 0.5;
-            ok = mr_renderer_set_scene(r, s, err) && render_stimulus(r, fam, &p, ss, s, &view, dir, stim, count, err);
+            ok = mr_renderer_set_scene(r, s, err) && render_stimulus(r, fam, &p, ss, s, &view, NULL, dir, stim, count, err);
             mr_renderer_set_scene(r, NULL, NULL);
             if (hall.planned || hall.built) mr_demo_free(&hall);
         }
