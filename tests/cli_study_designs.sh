@@ -117,5 +117,14 @@ for f in trials.csv scores.csv tests.csv posthoc.csv chart_conflict.svg chart_no
 done
 # The tap at 30 %, 60 % of the 96 x 72 image: (28.8, 43.2), 9.364 px from (20, 40), 0.468 units.
 [ "$(grep -c ',crossing,"28.8 43.2",1,9.364,0.468188,' "$tmp/ta/trials.csv")" -eq 4 ] && ok || bad "task taps scored: $(grep crossing "$tmp/ta/trials.csv")"
+# The xray family: Kalkofen's scenes with their answers, planned as a task study.
+"$mr" study stimuli --family xray --out "$tmp/x" --views 2 --targets 2 --width 96 --height 72 >"$tmp/sx.log" 2>&1 && ok || bad "xray stimuli: $(cat "$tmp/sx.log")"
+grep -q "24 images of family xray" "$tmp/sx.log" && ok || bad "xray: expected 2 conditions x 2 scenes x 2 targets x 3 modes: $(cat "$tmp/sx.log")"
+cmp -s "$tmp/x/conflict/adaptive/scene0.t0.png" "$tmp/x/no-conflict/adaptive/scene0.t0.png" && bad "xray: conflict and no-conflict look the same" || ok
+cmp -s "$tmp/x/conflict/alpha/scene0.t0.png" "$tmp/x/conflict/adaptive/scene0.t0.png" && bad "xray: alpha and adaptive look the same" || ok
+grep -q '"question":	"crossing"' "$tmp/x/conflict/answers.json" && grep -q '"correct":	"\(tall\|wide\)"' "$tmp/x/conflict/answers.json" && ok ||
+  bad "xray answers: $(cat "$tmp/x/conflict/answers.json")"
+"$mr" study plan "$tmp/x" --design task --participants 6 --out "$tmp/xplan.json" >"$tmp/xp.log" 2>&1 && grep -q "(task): 8 trials per participant, 6 schedules" "$tmp/xp.log" && ok ||
+  bad "xray plan: $(cat "$tmp/xp.log")"
 expect_fail plan_task_nokeys "$tmp/px.json" -- "$mr" study plan "$tmp/r" --design task --out "$tmp/px.json"
 cli_finish cli_study_designs

@@ -79,7 +79,11 @@ void mr_study_set_free(mr_study_set *s);
  * 800x450, ambient 0.4 and antialiased. depth is Scheer & Keutel's rating
  * set: D1, D2, D3 (mr_render's AO methods none, scheer with a screen and
  * with a view radius) of the hall's views in DIR/virtual/ and, over a
- * camera image at alpha 0.5, in DIR/video/. */
+ * camera image at alpha 0.5, in DIR/video/. xray is Kalkofen et al.'s
+ * task set: `views` scenes of `targets` arrangements each (a panelled wall,
+ * a tall and a wide hidden box, a hidden pipe up to the wall) through the
+ * ghosting modes, the hidden parts in the wall's colours (conflict/) and
+ * in clear ones (no-conflict/), each with its answers.json. */
 typedef struct mr_study_stimuli_params {
     int family;               /* index into mr_study_families; default 0 (ao) */
     int width, height;        /* image size, px; 0 = the family's (shadows 800x450, else 320x240) */
@@ -93,15 +97,17 @@ typedef struct mr_study_stimuli_params {
     float ambient;            /* the scene's ambient term; 0 = the family's (shadows 0.4, the
                                  thesis's; else the scene's own) */
     bool hard;                /* shadows: also hard shadows (not in the thesis); default false */
+    int targets;              /* xray: targets per scene (`views` scenes); default 6 (Kalkofen's) */
 } mr_study_stimuli_params;
 /* The shadow-suite cases the shadows family draws from, in suite order. */
 #define MR_STUDY_SHADOW_CASES 13
 extern const char *const mr_study_shadow_cases[MR_STUDY_SHADOW_CASES];
 #define MR_STUDY_STIMULI_DEFAULTS {.family = 0, .width = 0, .height = 0, .views = 3, .gt_rays = 128, \
                                    .cases = MR_STUDY_SHADOW_CASES, .gt_samples = MR_SHADOW_DEFAULT_GT_SAMPLES, \
-                                   .supersample = 0, .ambient = 0.0f, .hard = false}
+                                   .supersample = 0, .ambient = 0.0f, .hard = false, \
+                                   .targets = 6}
 extern const mr_opt mr_study_stimuli_opts[];   /* family, width, height, views, gt-rays, cases, gt-samples,
-                                                  supersample, ambient, hard */
+                                                  supersample, ambient, targets, hard */
 
 /* A family's reference of one stimulus into res (its color is saved). */
 typedef bool (*mr_study_reference_fn)(mr_renderer *r, const mr_scene *scene, const mr_view *view,
@@ -109,7 +115,7 @@ typedef bool (*mr_study_reference_fn)(mr_renderer *r, const mr_scene *scene, con
                                       mr_frame_result *res, mr_error *err);
 
 typedef struct mr_study_family {
-    const char *name;         /* "ao", "ghost", "shadows", "depth" */
+    const char *name;         /* "ao", "ghost", "shadows", "depth", "xray" */
     const char *help;
     const char *const *methods; /* NULL-terminated folder names */
     bool has_reference;       /* also renders DIR/reference/ (with `reference`) */
@@ -122,6 +128,7 @@ typedef struct mr_study_family {
     float ambient;            /* default ambient (0: the scene's) */
     const char *optional;     /* a method rendered only when asked (shadows: "hard"), or NULL */
     bool conditions;          /* rating stimuli: DIR/virtual/ and DIR/video/ (camera image at alpha 0.5) */
+    bool task;                /* task stimuli: DIR/conflict/ and DIR/no-conflict/ with answers.json */
 } mr_study_family;
 extern const mr_study_family mr_study_families[];
 extern const int mr_study_family_count;

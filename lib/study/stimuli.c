@@ -6,6 +6,7 @@
 #include "mr_eval.h"
 #include "mr_scene.h"
 #include "mr_study.h"
+#include "study_internal.h"
 
 #include <math.h>
 #include <string.h>
@@ -57,16 +58,19 @@ static bool shadow_reference(mr_renderer *r, const mr_scene *scene, const mr_vie
 
 const mr_study_family mr_study_families[] = {
     {"ao", "screen-space AO methods against ray-traced AO (lib/eval) as the reference", k_ao_methods, true, ao_setup,
-     ao_reference, false, 320, 240, 1, 0.0f, NULL, false},
+     ao_reference, false, 320, 240, 1, 0.0f, NULL, false, false},
     {"ghost", "ghosted views of the hidden layer (alpha, g0, adaptive); no reference", k_ghost_methods, false,
-     ghost_setup, NULL, false, 320, 240, 1, 0.0f, NULL, false},
+     ghost_setup, NULL, false, 320, 240, 1, 0.0f, NULL, false, false},
     {"shadows", "Hecher's study: pcf, pcss, bp against the GPU ground truth, 13 categories x 2 scenes, 800x450",
-     k_shadow_methods, true, shadow_setup, shadow_reference, true, 800, 450, 2, 0.4f, "hard", false},
+     k_shadow_methods, true, shadow_setup, shadow_reference, true, 800, 450, 2, 0.4f, "hard", false, false},
     {"depth", "Scheer & Keutel's rating study: D1, D2, D3 in virtual/ and in video/ (camera image at alpha 0.5)",
-     k_depth_methods, false, depth_setup, NULL, false, 320, 240, 1, 0.0f, NULL, true},
+     k_depth_methods, false, depth_setup, NULL, false, 320, 240, 1, 0.0f, NULL, true, false},
+    {"xray", "Kalkofen et al.'s task study: hidden boxes and a pipe behind a wall through alpha, g0, adaptive; "
+             "conflict/ and no-conflict/ with answers.json",
+     k_ghost_methods, false, ghost_setup, NULL, false, 320, 240, 1, 0.0f, NULL, false, true},
 };
 const int mr_study_family_count = (int)(sizeof mr_study_families / sizeof mr_study_families[0]);
-const char *const mr_study_family_names[] = {"ao", "ghost", "shadows", "depth", NULL};
+const char *const mr_study_family_names[] = {"ao", "ghost", "shadows", "depth", "xray", NULL};
 _Static_assert(sizeof mr_study_family_names / sizeof mr_study_family_names[0] ==
                    sizeof mr_study_families / sizeof mr_study_families[0] + 1,
                "one name per family row");
@@ -90,6 +94,8 @@ const mr_opt mr_study_stimuli_opts[] = {
      "antialiasing: render N times the size and average N x N pixels (0: the family's, shadows 2)", MR_OPT_ZERO_AUTO},
     {"ambient", MR_OPT_FLOAT, offsetof(mr_study_stimuli_params, ambient), 0.01, 1, 0, NULL,
      "the scenes' ambient term (0: the family's, shadows the thesis's 0.4)", MR_OPT_ZERO_AUTO},
+    {"targets", MR_OPT_INT, offsetof(mr_study_stimuli_params, targets), 1, 64, 6, NULL,
+     "xray: targets (questions) per scene; the scenes are `views`", 0},
     {"hard", MR_OPT_BOOL, offsetof(mr_study_stimuli_params, hard), 0, 1, 0, NULL,
      "shadows: also hard shadows (not one of the thesis's methods)", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
@@ -128,8 +134,8 @@ static bool downsample(const mr_image *src, int ss, mr_image *dst, mr_error *err
     return true;
 }
 
-static bool save_frame(const char *dir, const char *method, const char *stim, const mr_image *img, int ss,
-                       mr_error *err) {
+bool mr_study_save_frame(const char *dir, const char *method, const char *stim, const mr_image *img, int ss,
+                         mr_error *err) {
     if (ss <= 1) return save(dir, method, stim, img, err);
     mr_image small = {0};
     bool ok = downsample(img, ss, &small, err) && save(dir, method, stim, &small, err);
@@ -155,14 +161,14 @@ static bool render_stimulus(mr_renderer *r, const mr_study_family *fam, const mr
         fam->setup(&fp, m);
         mr_frame_result res = {0};
         ok = mr_render_frame(r, view, &fp, &res, err) &&
-             save_frame(dir, m < n ? fam->methods[m] : fam->optional, stim, &res.color, ss, err);
+             mr_study_save_frame(dir, m < n ? fam->methods[m] : fam->optional, stim, &res.color, ss, err);
         mr_frame_result_free(&res);
         if (ok && count) (*count)++;
     }
     if (ok && fam->has_reference && fam->reference) {
         mr_frame_result res = {0};
         ok = fam->reference(r, scene, view, &base, p, &res, err) &&
-             save_frame(dir, MR_STUDY_REFERENCE, stim, &res.color, ss, err);
+             mr_study_save_frame(dir, MR_STUDY_REFERENCE, stim, &res.color, ss, err);
         mr_frame_result_free(&res);
         if (ok && count) (*count)++;
     }
@@ -231,7 +237,9 @@ bool mr_study_stimuli_render(mr_renderer *r, const mr_study_stimuli_params *pp, 
         return mr_fail(err, MR_ERR_INVALID, "cases must be in [1, %d]", MR_STUDY_SHADOW_CASES);
     if (fam->shadow_suite && (p.gt_samples < 1 || p.gt_samples > 1024))
         return mr_fail(err, MR_ERR_INVALID, "gt-samples must be in [1, 1024]");
+    if (fam->task && (p.targets < 1 || p.targets > 64)) return mr_fail(err, MR_ERR_INVALID, "targets must be in [1, 64]");
     if (!mr_mkdirs(dir, err)) return false;
+    if (fam->task) return mr_study_task_stimuli_render(r, fam, &p, ss, dir, count, err);
     bool ok = true;
     if (!fam->shadow_suite) {
         mr_demo_hall hall;
