@@ -244,7 +244,8 @@ bool mr_render_fetch_probe(mr_renderer *r, int w, int h, int fetches, double rad
                            mr_error *err);
 const char *mr_ao_kernel_name(mr_ao_kernel k);
 bool mr_ao_kernel_parse(const char *name, mr_ao_kernel *out);
-/* The kernels the AO pass uses, deterministic for given arguments: out3
+/* The sampling kernels (kernels.c) of the AO pass, and of the shadow and
+ * probe passes, deterministic for given arguments: out3
  * (n x 3 floats) in the unit ball shell [r_min, r_max] for the view-space
  * methods, out2 (n x 2) in the unit disk of radius r_max for the screen-space
  * disk (alchemy: there only surface points within the radius count, so an

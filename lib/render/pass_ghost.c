@@ -401,7 +401,8 @@ static bool hidden_in_view(const frame *f) {
 
 static bool finite_in(float v, float lo, float hi) { return v >= lo && v <= hi; }
 
-bool mr_ghost_check_params(const mr_ghost_params *gp, mr_error *err) {
+static bool ghost_check(const mr_frame_params *p, mr_error *err) {
+    const mr_ghost_params *gp = &p->ghost;
     if (gp->mode == MR_GHOST_OFF) return true;
     if ((unsigned)gp->mode > MR_GHOST_ADAPTIVE || (unsigned)gp->importance > MR_GHOST_IMP_SALIENCY ||
         (unsigned)gp->saliency > MR_SALIENCY_GAUSS || (unsigned)gp->saliency_levels > MR_SAL_LEVELS_PRINTED)
@@ -731,7 +732,7 @@ bool mr_ghost_read_layers(mr_renderer *r, mr_image *occluder, mr_image *hidden, 
 #define GHOST_DESTROY .scene_changed = mr_ghost_scene_changed, .destroy = mr_ghost_free
 const pass_desc mr_pass_desc_ghost_hidden = {
     .name = "ghost_hidden", .needed = mr_pass_need_ghost, .prepare = mr_pass_prepare_ghost,
-    .run = mr_pass_ghost_hidden, GHOST_DESTROY,
+    .run = mr_pass_ghost_hidden, GHOST_DESTROY, .check = ghost_check,
     .writes = RES(RES_HIDDEN_DEPTH) | RES(RES_HIDDEN_NORMAL) | RES(RES_HIDDEN_IDS) | RES(RES_HIDDEN_SHADED)};
 const pass_desc mr_pass_desc_ghost_curvature = {
     .name = "ghost_curvature", .needed = mr_pass_need_ghost_curvature, .run = mr_pass_ghost_curvature, GHOST_DESTROY,

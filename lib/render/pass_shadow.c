@@ -929,7 +929,8 @@ static void run_pyramid(frame *f) {
 
 static void run_pyramid_reuse(frame *f) { frame_put(f, RES_SHADOW_PYRAMID, f->r->shadow->pyramid); }
 
-bool mr_pass_shadow_read_back(frame *f, mr_error *err) {
+/* Fills out->shadow (if asked). */
+static bool shadow_read_back(frame *f, mr_error *err) {
     if (!f->p->shadow.want_shadow || !frame_get(f, RES_SHADOW)) return true;
     mr_renderer *r = f->r;
     if (!mr_image_alloc(&f->out->shadow, r->w, r->h, 1, MR_PIX_F32, err)) return false;
@@ -953,4 +954,4 @@ const pass_desc mr_pass_desc_shadow_pyramid_reuse = {
 const pass_desc mr_pass_desc_shadow = {
     .name = "shadow", .needed = need_vis, .prepare = prepare_common, .run = run_vis,
     .reads = RES(RES_DEPTH) | RES(RES_NORMAL) | RES(RES_SHADOW_MAP) | RES(RES_SHADOW_PYRAMID), .reads_now = vis_reads_now,
-    .writes = RES(RES_SHADOW)};
+    .writes = RES(RES_SHADOW), .read_back = shadow_read_back};

@@ -112,6 +112,12 @@ typedef struct pass_desc {
     uint32_t uses;                          /* RES() bits it reads when some earlier pass made them */
     uint32_t writes;                        /* RES() bits */
     uint32_t (*reads_now)(const frame *f);  /* the part of `reads` this frame needs; NULL = all */
+    /* Checks the frame's settings of this pass file before any row runs
+     * (one line in err); NULL = nothing to check. */
+    bool (*check)(const mr_frame_params *p, mr_error *err);
+    /* After the frame: copies what the caller asked for (mr_frame_params'
+     * want_*) into f->out; called whether or not the row ran; NULL. */
+    bool (*read_back)(frame *f, mr_error *err);
 } pass_desc;
 
 /* A way to draw the scene: from the frame's camera or any other eye. */
@@ -130,7 +136,7 @@ typedef struct mr_geo_view {
 /* The frame's camera with a program and layers. */
 mr_geo_view mr_frame_view(const frame *f, GLuint program, uint32_t layers);
 
-/* Helpers (renderer.c). */
+/* GL helpers (gl_util.c). */
 GLuint mr_gl_make_tex(GLenum fmt, int w, int h, GLenum filter);
 bool mr_gl_target_make(target *t, int w, int h, const GLenum *fmts, int n, bool depth, mr_error *err);
 void mr_gl_target_free(target *t);
@@ -221,9 +227,6 @@ void mr_shade_draw(frame *f, GLuint albedo, GLuint normal, GLuint ao, const targ
 /* The lights of a scene without lights (the first, a sun, casts). */
 extern const mr_light mr_default_lights[2];
 
-/* pass_ghost.c: ghosted views. The G-buffer pass leaves the hidden layer
- * out when "hidden.*" is made this frame. */
-bool mr_ghost_check_params(const mr_ghost_params *gp, mr_error *err);
 
 /* pass_ao.c: ambient occlusion. */
 typedef struct mr_ao_state mr_ao_state;
@@ -232,14 +235,11 @@ typedef struct mr_ao_state mr_ao_state;
  * positions path. prepare before run; run returns the AO texture or 0. */
 bool mr_ao_hidden_prepare(frame *f, mr_error *err);
 GLuint mr_ao_hidden_run(frame *f, GLuint depth, GLuint normal);
-/* Fills out->ao (if asked) and the mask statistics. */
-bool mr_pass_ao_read_back(frame *f, mr_error *err);
 void mr_pass_ao_free(mr_renderer *r);
 
 /* pass_shadow.c: soft shadows. The index among the shaded lights of the
- * casting one (-1: none); fills out->shadow (if asked). */
+ * casting one (-1: none). */
 int mr_shadow_light_index(const mr_scene *s);
-bool mr_pass_shadow_read_back(frame *f, mr_error *err);
 void mr_pass_shadow_free(mr_renderer *r);
 /* The overlay's shadow catcher: sets its uniforms and textures on the bound
  * overlay program (catcher off when the scene marks no receivers). */

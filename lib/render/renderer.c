@@ -12,45 +12,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-GLuint mr_gl_make_tex(GLenum fmt, int w, int h, GLenum filter) {
-    GLuint t;
-    glCreateTextures(GL_TEXTURE_2D, 1, &t);
-    glTextureStorage2D(t, 1, fmt, w, h);
-    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, filter);
-    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, filter);
-    glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    return t;
-}
-
-
-void mr_gl_target_free(target *t) {
-    glDeleteFramebuffers(1, &t->fbo);
-    glDeleteTextures((GLsizei)(sizeof t->color / sizeof t->color[0]), t->color);
-    glDeleteTextures(1, &t->depth);
-    memset(t, 0, sizeof *t);
-}
-
-
-bool mr_gl_target_make(target *t, int w, int h, const GLenum *fmts, int n, bool depth, mr_error *err) {
-    glCreateFramebuffers(1, &t->fbo);
-    GLenum bufs[4];
-    for (int i = 0; i < n; i++) {
-        t->color[i] = mr_gl_make_tex(fmts[i], w, h, GL_NEAREST);
-        glNamedFramebufferTexture(t->fbo, GL_COLOR_ATTACHMENT0 + i, t->color[i], 0);
-        bufs[i] = GL_COLOR_ATTACHMENT0 + i;
-    }
-    glNamedFramebufferDrawBuffers(t->fbo, n, bufs);
-    if (depth) {
-        t->depth = mr_gl_make_tex(GL_DEPTH_COMPONENT32F, w, h, GL_NEAREST);
-        glNamedFramebufferTexture(t->fbo, GL_DEPTH_ATTACHMENT, t->depth, 0);
-    }
-    GLenum st = glCheckNamedFramebufferStatus(t->fbo, GL_FRAMEBUFFER);
-    if (st != GL_FRAMEBUFFER_COMPLETE) return mr_fail(err, MR_ERR_GL, "framebuffer incomplete (0x%x)", st);
-    return true;
-}
-
-
 const char *const mr_resource_names[RES_COUNT] = {
     [RES_DEPTH] = "depth", [RES_ALBEDO] = "albedo", [RES_NORMAL] = "normal", [RES_IDS] = "ids",
     [RES_POSITIONS] = "positions", [RES_AO_MASK] = "ao.mask", [RES_AO] = "ao",
@@ -138,7 +99,9 @@ void mr_renderer_destroy(mr_renderer **rp) {
     glBindVertexArray(0);
     for (size_t i = 0; i < PASS_COUNT; i++)
         if (k_passes[i]->destroy) k_passes[i]->destroy(r);
-    mr_render_rig_end(r); /* a rig frame left open */
+    /* A rig frame left open (mr_render_rig_begin). */
+    mr_geometry_share_end(r);
+    free((void *)r->rig);
     mr_geometry_free(r);
     glDeleteVertexArrays(1, &r->empty_vao);
     glDeleteQueries(MR_MAX_PASSES, r->queries);
@@ -184,22 +147,6 @@ double mr_render_near_plane(const mr_scene *s, const mr_dmat4 *world_from_camera
 }
 
 
-/* OpenCV intrinsics to a GL projection. Rows of the image are stored top
- * first, so image row v lands in framebuffer row v. Infinite far plane,
- * reversed Z: z_clip = near, w_clip = z, depth = near / z. */
-void mr_gl_projection(const mr_camera *c, double near_plane, float out[16]) {
-    mr_dmat4 p;
-    memset(&p, 0, sizeof p);
-    p.m[0] = 2 * c->fx / c->width;
-    p.m[2] = 2 * (c->cx + 0.5) / c->width - 1;
-    p.m[5] = 2 * c->fy / c->height;
-    p.m[6] = 2 * (c->cy + 0.5) / c->height - 1;
-    p.m[11] = near_plane;
-    p.m[14] = 1;
-    mr_m4_to_gl(&p, out);
-}
-
-
 static bool read_back(frame *f, mr_error *err) {
     mr_renderer *r = f->r;
     mr_frame_result *o = f->out;
@@ -218,7 +165,9 @@ static bool read_back(frame *f, mr_error *err) {
         if (!mr_image_alloc(&o->normal, r->w, r->h, 3, MR_PIX_F32, err)) return false;
         glGetTextureImage(frame_get(f, RES_NORMAL), 0, GL_RGB, GL_FLOAT, (GLsizei)mr_image_bytes(&o->normal), o->normal.data);
     }
-    return mr_pass_ao_read_back(f, err) && mr_pass_shadow_read_back(f, err);
+    for (size_t i = 0; i < PASS_COUNT; i++)
+        if (k_passes[i]->read_back && !k_passes[i]->read_back(f, err)) return false;
+    return true;
 }
 
 
@@ -238,7 +187,8 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
     int w = p->width > 0 ? p->width : view->camera.width;
     int h = p->height > 0 ? p->height : view->camera.height;
     if (w > 16384 || h > 16384) return mr_fail(err, MR_ERR_INVALID, "output size %dx%d too large", w, h);
-    if (!mr_ghost_check_params(&p->ghost, err)) return false;
+    for (size_t i = 0; i < PASS_COUNT; i++)
+        if (k_passes[i]->check && !k_passes[i]->check(p, err)) return false;
     /* The display mapping cannot be un-projected: AO reads positions. */
     mr_frame_params with_pos;
     if (p->display) {
