@@ -1521,24 +1521,24 @@ void mr_geometry_aux_free(mr_geo_aux *aux) {
     memset(aux, 0, sizeof *aux);
 }
 
-void mr_geometry_aux_draw(mr_renderer *r, const mr_geo_view *vw, const mr_geo_aux *aux) {
-    uint32_t layer_mask = vw->layers;
-    struct mr_geo *g = r->geo;
+/* Every node of the view's layers, each of its meshes with its camera-
+ * relative model-view (composed in double) and normal matrix set; draw()
+ * issues that mesh's own draw call. */
+typedef void (*instance_draw_fn)(const void *ctx, int32_t mesh);
+static void draw_instances(mr_renderer *r, const mr_geo_view *vw, int32_t mesh_limit, instance_draw_fn draw, const void *ctx) {
     const mr_scene *s = r->scene;
-    if (!g || !s || !aux->valid) return;
     glUseProgram(vw->program);
     float proj[16];
     mr_gl_projection(&vw->cam, vw->near_plane, proj);
     glUniformMatrix4fv(MR_LOC_PROJECTION, 1, GL_FALSE, proj);
     for (int32_t ni = 0; ni < s->node_count; ni++) {
         const mr_node *n = &s->nodes[ni];
-        if (n->mesh_first < 0 || n->mesh_count <= 0 || !(layer_mask & (1u << n->layer))) continue;
+        if (n->mesh_first < 0 || n->mesh_count <= 0 || !(vw->layers & (1u << n->layer))) continue;
         mr_dmat4 cam_from_node = mr_m4_mul(&vw->cam_from_world, &n->world);
         for (int32_t k = 0; k < n->mesh_count; k++) {
             int32_t mi = n->mesh_first + k;
-            if (mi >= g->mesh_count || mi >= s->mesh_count) break;
+            if (mi >= mesh_limit || mi >= s->mesh_count) break;
             const mr_mesh *m = &s->meshes[mi];
-            const geo_mesh *gm = &g->meshes[mi];
             /* Camera-relative in double, then float, as the main path. */
             mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
             mr_dmat4 mv = mr_m4_mul(&cam_from_node, &T), inv;
@@ -1549,10 +1549,106 @@ void mr_geometry_aux_draw(mr_renderer *r, const mr_geo_view *vw, const mr_geo_au
                 for (int cc = 0; cc < 3; cc++) nm[cc * 3 + rr] = (float)inv.m[cc * 4 + rr];
             glUniformMatrix4fv(MR_LOC_MODELVIEW, 1, GL_FALSE, mvf);
             glUniformMatrix3fv(MR_LOC_NORMAL_MATRIX, 1, GL_FALSE, nm);
-            glBindVertexArray(aux->vao[gm->pool]);
-            glDrawElementsBaseVertex(GL_TRIANGLES, (GLsizei)gm->count[0], GL_UNSIGNED_INT,
-                                     (const void *)((size_t)gm->first[0] * 4), gm->base_vertex);
+            draw(ctx, mi);
         }
     }
     glBindVertexArray(0);
+}
+
+typedef struct aux_ctx {
+    const struct mr_geo *g;
+    const mr_geo_aux *aux;
+} aux_ctx;
+
+static void draw_aux_mesh(const void *ctx, int32_t mi) {
+    const aux_ctx *c = ctx;
+    const geo_mesh *gm = &c->g->meshes[mi];
+    glBindVertexArray(c->aux->vao[gm->pool]);
+    glDrawElementsBaseVertex(GL_TRIANGLES, (GLsizei)gm->count[0], GL_UNSIGNED_INT, (const void *)((size_t)gm->first[0] * 4),
+                             gm->base_vertex);
+}
+
+void mr_geometry_aux_draw(mr_renderer *r, const mr_geo_view *vw, const mr_geo_aux *aux) {
+    struct mr_geo *g = r->geo;
+    if (!g || !r->scene || !aux->valid) return;
+    aux_ctx c = {g, aux};
+    draw_instances(r, vw, g->mesh_count, draw_aux_mesh, &c);
+}
+
+/* ------------------------------------------------------ meshes of a pass's own */
+
+bool mr_geometry_own_create(const mr_geo_own_mesh *meshes, int32_t n, GLuint attrib, mr_geo_own *o) {
+    memset(o, 0, sizeof *o);
+    size_t nv = 0, ni = 0;
+    for (int32_t i = 0; i < n; i++) {
+        nv += meshes[i].vertex_count;
+        ni += meshes[i].index_count;
+    }
+    o->first = calloc((size_t)n + 1, sizeof *o->first);
+    o->count = calloc((size_t)n + 1, sizeof *o->count);
+    o->base = calloc((size_t)n + 1, sizeof *o->base);
+    float *v = malloc((nv ? nv : 1) * 6 * sizeof *v);
+    uint32_t *idx = malloc((ni ? ni : 1) * sizeof *idx);
+    if (!o->first || !o->count || !o->base || !v || !idx || nv > INT32_MAX) {
+        free(v);
+        free(idx);
+        mr_geometry_own_free(o);
+        return false;
+    }
+    size_t vb = 0, ib = 0;
+    for (int32_t i = 0; i < n; i++) {
+        const mr_geo_own_mesh *m = &meshes[i];
+        o->first[i] = (uint32_t)ib;
+        o->count[i] = m->index_count;
+        o->base[i] = (int32_t)vb;
+        for (uint32_t k = 0; k < m->vertex_count; k++) {
+            memcpy(v + 6 * (vb + k), m->positions + 3 * (size_t)k, 3 * sizeof *v);
+            memcpy(v + 6 * (vb + k) + 3, m->attr + 3 * (size_t)k, 3 * sizeof *v);
+        }
+        if (m->index_count) memcpy(idx + ib, m->indices, m->index_count * sizeof *idx);
+        vb += m->vertex_count;
+        ib += m->index_count;
+    }
+    o->mesh_count = n;
+    glCreateBuffers(1, &o->vbo);
+    glNamedBufferStorage(o->vbo, (GLsizeiptr)((nv ? nv : 1) * 6 * sizeof *v), v, 0);
+    glCreateBuffers(1, &o->ibo);
+    glNamedBufferStorage(o->ibo, (GLsizeiptr)((ni ? ni : 1) * sizeof *idx), idx, 0);
+    free(v);
+    free(idx);
+    glCreateVertexArrays(1, &o->vao);
+    glVertexArrayVertexBuffer(o->vao, 0, o->vbo, 0, 6 * sizeof(float));
+    glEnableVertexArrayAttrib(o->vao, MR_ATTR_POSITION);
+    glVertexArrayAttribFormat(o->vao, MR_ATTR_POSITION, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(o->vao, MR_ATTR_POSITION, 0);
+    glEnableVertexArrayAttrib(o->vao, attrib);
+    glVertexArrayAttribFormat(o->vao, attrib, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float));
+    glVertexArrayAttribBinding(o->vao, attrib, 0);
+    glVertexArrayElementBuffer(o->vao, o->ibo);
+    o->valid = true;
+    return true;
+}
+
+void mr_geometry_own_free(mr_geo_own *o) {
+    if (!o) return;
+    if (o->vao) glDeleteVertexArrays(1, &o->vao);
+    if (o->vbo) glDeleteBuffers(1, &o->vbo);
+    if (o->ibo) glDeleteBuffers(1, &o->ibo);
+    free(o->first);
+    free(o->count);
+    free(o->base);
+    memset(o, 0, sizeof *o);
+}
+
+static void draw_own_mesh(const void *ctx, int32_t mi) {
+    const mr_geo_own *o = ctx;
+    if (!o->count[mi]) return;
+    glBindVertexArray(o->vao);
+    glDrawElementsBaseVertex(GL_TRIANGLES, (GLsizei)o->count[mi], GL_UNSIGNED_INT, (const void *)((size_t)o->first[mi] * 4),
+                             o->base[mi]);
+}
+
+void mr_geometry_own_draw(mr_renderer *r, const mr_geo_view *vw, const mr_geo_own *o) {
+    if (!r->scene || !o->valid) return;
+    draw_instances(r, vw, o->mesh_count, draw_own_mesh, o);
 }

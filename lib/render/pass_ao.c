@@ -73,8 +73,8 @@ struct mr_ao_state {
     bool valid;
     ao_key last;
     uint64_t scene_gen;
-    /* outline meshes, per scene mesh: integrated-normal directions */
-    mr_geo_aux outline;          /* outline directions as attribute 1, aligned with the geometry */
+    /* outline volumes, per scene mesh: miter-offset copies (mr_mesh_outline) */
+    mr_geo_own outline;          /* positions + offset per unit radius as attribute MR_ATTR_OUTLINE_DIR */
     bool outline_built;
     uint64_t outline_gen;
     /* this frame */
@@ -126,7 +126,7 @@ static void free_history(mr_ao_state *s) {
 }
 
 static void free_outlines(mr_ao_state *s) {
-    mr_geometry_aux_free(&s->outline);
+    mr_geometry_own_free(&s->outline);
     s->outline_built = false;
 }
 
@@ -505,32 +505,30 @@ static bool ensure_outlines(mr_renderer *r, mr_ao_state *s) {
     free_outlines(s);
     s->outline_built = true;
     s->outline_gen = s->scene_gen;
-    float **dirs = calloc((size_t)sc->mesh_count + 1, sizeof *dirs);
-    if (!dirs) return false;
-    for (int32_t i = 0; i < sc->mesh_count; i++) {
-        const mr_mesh *m = &sc->meshes[i];
+    mr_outline *ol = calloc((size_t)sc->mesh_count + 1, sizeof *ol);
+    mr_geo_own_mesh *gm = calloc((size_t)sc->mesh_count + 1, sizeof *gm);
+    bool ok = ol && gm;
+    for (int32_t i = 0; ok && i < sc->mesh_count; i++) {
         mr_error err = {0};
-        dirs[i] = malloc((size_t)m->vertex_count * 3 * sizeof **dirs + 1);
-        if (dirs[i] && !mr_mesh_outline_dirs(m, dirs[i], &err)) {
-            free(dirs[i]);
-            dirs[i] = NULL; /* no outline: the mesh never masks */
-        }
+        if (!mr_mesh_outline(&sc->meshes[i], &ol[i], &err)) continue; /* no outline: the mesh never masks */
+        gm[i] = (mr_geo_own_mesh){ol[i].positions, ol[i].dirs, ol[i].indices, ol[i].vertex_count, ol[i].index_count};
     }
-    bool ok = mr_geometry_aux_create(r, dirs, 3, MR_ATTR_OUTLINE_DIR, &s->outline);
-    for (int32_t i = 0; i < sc->mesh_count; i++) free(dirs[i]);
-    free(dirs);
+    ok = ok && mr_geometry_own_create(gm, sc->mesh_count, MR_ATTR_OUTLINE_DIR, &s->outline);
+    for (int32_t i = 0; ol && i < sc->mesh_count; i++) mr_outline_free(&ol[i]);
+    free(ol);
+    free(gm);
     return ok;
 }
 
 /* Park & Baek: draw every outline volume with additive blending into a
- * float target, +1 on entering faces and -1 on leaving ones, depth-tested
- * against the G-buffer without writing depth; a count >= 2 marks a pixel
- * where two volumes overlap at the visible surface: a corner. */
-
-/* Park & Baek: draw every outline volume with additive blending into a
- * float target, +1 on entering faces and -1 on leaving ones, depth-tested
- * against the G-buffer without writing depth; a count >= 2 marks a pixel
- * where two volumes overlap at the visible surface: a corner. */
+ * float target; a count >= 2 marks a pixel where two volumes overlap at the
+ * visible surface: a corner. The paper counts the faces in front of the
+ * surface (+1 entering, -1 leaving), which is wrong by one for every volume
+ * the camera stands in (the entering face is behind the eye). Counted here
+ * behind the surface instead (depth-tested farther than the G-buffer: +1
+ * leaving, -1 entering), which gives the number of volumes holding the
+ * surface point wherever the camera is: every volume is closed and the far
+ * plane is at infinity, so no face behind the surface is clipped. */
 static void mr_pass_ao_mask(frame *f) {
     mr_renderer *r = f->r;
     mr_ao_state *s = r->ao;
@@ -543,7 +541,7 @@ static void mr_pass_ao_mask(frame *f) {
     glViewport(0, 0, s->w, s->h);
     glDisable(GL_FRAMEBUFFER_SRGB);
     glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GREATER); /* reversed Z: in front of the visible surface */
+    glDepthFunc(GL_LESS); /* reversed Z: behind the visible surface */
     glDepthMask(GL_FALSE);
     glDisable(GL_CULL_FACE);
     glEnable(GL_BLEND);
@@ -556,7 +554,8 @@ static void mr_pass_ao_mask(frame *f) {
     uint32_t mask = 1u << MR_LAYER_VISIBLE;
     if (!f->p->hide_hidden_layer) mask |= 1u << MR_LAYER_HIDDEN;
     mr_geo_view v = mr_frame_view(f, s->prog_outline, mask);
-    mr_geometry_aux_draw(r, &v, &s->outline);
+    mr_geometry_own_draw(r, &v, &s->outline);
+    glDepthFunc(GL_GREATER);
     glDisable(GL_BLEND);
     glDisable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);

@@ -200,6 +200,27 @@ void mr_geometry_aux_free(mr_geo_aux *aux);
  * (camera relative, composed in double) and MR_LOC_NORMAL_MATRIX. */
 void mr_geometry_aux_draw(mr_renderer *r, const mr_geo_view *view, const mr_geo_aux *aux);
 
+/* Meshes of a pass's own, one per scene mesh (AO outline volumes): each a
+ * position and one 3-float stream (`attrib`) per vertex and its triangles,
+ * packed in one vertex and one index buffer; drawn with each scene node's
+ * transform like mr_geometry_aux_draw (a mesh with no triangles draws
+ * nothing). */
+typedef struct mr_geo_own_mesh {
+    const float *positions, *attr;  /* 3 floats per vertex each */
+    const uint32_t *indices;
+    uint32_t vertex_count, index_count;
+} mr_geo_own_mesh;
+typedef struct mr_geo_own {
+    GLuint vao, vbo, ibo;
+    uint32_t *first, *count;        /* per scene mesh: first index, index count */
+    int32_t *base;                  /* per scene mesh: base vertex */
+    int32_t mesh_count;
+    bool valid;
+} mr_geo_own;
+bool mr_geometry_own_create(const mr_geo_own_mesh *meshes, int32_t n, GLuint attrib, mr_geo_own *o);
+void mr_geometry_own_free(mr_geo_own *o);
+void mr_geometry_own_draw(mr_renderer *r, const mr_geo_view *view, const mr_geo_own *o);
+
 /* The registry's rows: each pass file defines its descriptors, renderer.c
  * lists them in order. */
 extern const pass_desc mr_pass_desc_gbuffer, mr_pass_desc_shade, mr_pass_desc_overlay;         /* passes.c */

@@ -229,12 +229,24 @@ typedef struct mr_demo_hall {
 
 /* ------------------------------------------------------ outline meshes */
 
-/* Corner masking (Park & Baek): the integrated-normal extrusion direction of
- * every vertex of mesh m (unit length, mesh space) into out (3 *
- * vertex_count floats): vertices welded by position, the distinct face
- * normals around each averaged. An outline mesh is the mesh with each vertex
- * moved by radius * out[v]. Computed once per mesh by the renderer. */
-bool mr_mesh_outline_dirs(const mr_mesh *m, float *out, mr_error *err);
+/* Corner masking (Park & Baek): the outline volume of a mesh. Vertex v of
+ * the volume at AO radius r is positions[v] + r * dirs[v] (mesh space):
+ * dirs is the miter of the distinct face normals around the welded vertex
+ * (the shortest d with d . n >= 1 for each: n on a face, (1,1,0) on a box
+ * edge, (1,1,1) at a box corner), so every point within r of the surface
+ * is inside. A closed mesh keeps its own vertices and triangles; an open
+ * one (open = true) becomes a shell: a copy moved to each side and a wall
+ * along every boundary edge, its rim moved out across the edge by r.
+ * Computed once per mesh by the renderer; free with mr_outline_free. */
+typedef struct mr_outline {
+    float *positions;          /* 3 * vertex_count, mesh space */
+    float *dirs;               /* 3 * vertex_count, offset per unit radius (length >= 1) */
+    uint32_t *indices;         /* index_count, triangles */
+    uint32_t vertex_count, index_count;
+    bool open;                 /* built as a two-sided shell */
+} mr_outline;
+bool mr_mesh_outline(const mr_mesh *m, mr_outline *out, mr_error *err);
+void mr_outline_free(mr_outline *o);
 
 bool mr_demo_build(const mr_demo_params *params, mr_demo_hall *out, mr_error *err);
 
