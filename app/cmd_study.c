@@ -20,7 +20,7 @@ static int study_stimuli(int argc, char **argv) {
     mr_cli_table tables[] = {{.prefix = "", .table = mr_study_stimuli_opts, .params = &sp}};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, tables, 1, NULL, 0, NULL,
-                          "usage: mrcheck study stimuli --family ao|ghost|shadows --out DIR [--views N] [--width W --height H]",
+                          "usage: mrcheck study stimuli --family ao|ghost|shadows|depth|xray --out DIR [--views N] [--width W --height H]",
                           &help))
         return 2;
     if (help) return 0;
@@ -181,7 +181,7 @@ int cmd_study(int argc, char **argv) {
         int (*run)(int, char **);
         const char *help;
     } subs[] = {
-        {"stimuli", study_stimuli, "render one image per method and stimulus: DIR/<method>/<stimulus>.png"},
+        {"stimuli", study_stimuli, "render the stimuli: DIR/[<condition>/]<method>/<stimulus>.png"},
         {"plan", study_plan, "pairwise (Hecher), rating (Scheer & Keutel) or task (Kalkofen et al.) trials per participant"},
         {"run", study_run, "the study window for one participant (resumes a killed run)"},
         {"analyze", study_analyze, "pairwise: consistence, agreement, indifference, binomial tests, Davidson scores; "
