@@ -95,10 +95,13 @@ fi
 grep -q '"trial":2,.*"answer":"neutral"' "$v" && ok || bad "run 1: third vote: $(sed -n 3p "$v")"
 # A torn line, as a kill in the middle of a write would leave.
 printf '{"plan":"' >>"$v"
-# The second run resumes at trial 4: five answers finish block I, the state
-# is taken on the first pair of block II (the reference shown), eight more.
+# The second run resumes at trial 4: five answers finish block I, the break
+# before block II and Continue, the state is taken on the first pair of
+# block II (the reference shown), eight more.
 {
   for _ in 1 2 3 4 5; do echo "0 tap @left"; done
+  echo "0 state $tmp/st_break.json"
+  echo "0 tap @continue"
   echo "0 state $tmp/st_b2.json"
   echo "0 shot $tmp/shot_b2.png"
   for _ in 1 2 3 4 5 6 7 8; do echo "0 tap @right"; done
@@ -108,6 +111,8 @@ printf '{"plan":"' >>"$v"
 timeout 120 "$mr" study run "$tmp/plan.json" --participant p1 --out "$v" --script "$tmp/run2.txt" --size 800x600 >"$tmp/r2.log" 2>&1 && ok || bad "run 2 failed: $(cat "$tmp/r2.log")"
 grep -q "resuming at trial 4 of 16 (3 answered)" "$tmp/r2.log" && ok || bad "run 2 did not resume at trial 4: $(cat "$tmp/r2.log")"
 grep -q "torn" "$tmp/r2.log" && ok || bad "run 2 said nothing about the torn line: $(cat "$tmp/r2.log")"
+[ "$(jget "$tmp/st_break.json" break)" = "true" ] && [ "$(jget "$tmp/st_break.json" images)" = "0" ] && ok ||
+  bad "between blocks I and II a break screen: $(cat "$tmp/st_break.json" 2>/dev/null)"
 [ "$(jget "$tmp/st_b2.json" block)" = "II" ] && [ "$(jget "$tmp/st_b2.json" images)" = "3" ] && ok ||
   bad "block II should show the reference above the pair: $(cat "$tmp/st_b2.json" 2>/dev/null)"
 [ "$(jget "$tmp/st_end.json" done)" = "true" ] && ok || bad "run 2 did not finish: $(cat "$tmp/st_end.json" 2>/dev/null)"

@@ -59,7 +59,9 @@ fi
 sed -n 1p "$rv" | grep -q '"design":"rating",.*"ratings":\[5,"X"\]' && ok || bad "rating run 1, first answer: $(sed -n 1p "$rv")"
 sed -n 3p "$rv" | grep -q '"ratings":\[1,1\]' && ok || bad "rating run 1, third answer: $(sed -n 3p "$rv")"
 {
-  for _ in $(seq 1 9); do echo "0 tap @r6"; echo "0 tap @r4"; done
+  for _ in 1 2 3; do echo "0 tap @r6"; echo "0 tap @r4"; done
+  echo "0 tap @continue" # the break before the video condition
+  for _ in 1 2 3 4 5 6; do echo "0 tap @r6"; echo "0 tap @r4"; done
   echo "0 state $tmp/rst.json"
   echo "0 quit"
 } >"$tmp/rs2.txt"
@@ -101,7 +103,7 @@ kill_after "$tv" $! 2
 [ "$(wc -l <"$tv" 2>/dev/null || echo 0)" -eq 2 ] && ok || bad "task run 1: expected 2 answers before the kill: $(cat "$tv" 2>/dev/null) $(cat "$tmp/tr1.log")"
 sed -n 2p "$tv" | grep -q '"design":"task",.*"choice":1' && ok || bad "task run 1, second answer: $(sed -n 2p "$tv")"
 {
-  echo "0 tap @a"; echo "0 tap @a"
+  echo "0 tap @a"; echo "0 tap @a"; echo "0 tap @continue"
   for _ in 1 2 3 4; do echo "0 tap @image 0.3 0.6"; echo "0 tap @confirm"; done
   echo "0 state $tmp/tst.json"
   echo "0 quit"

@@ -519,6 +519,32 @@ static void test_runner_designs(void) {
           v.ratings[1] == MR_STUDY_RATING_X);
     CHECK(!strcmp(v.left, plan.set.methods[plan.trials[0].left]));
     mr_study_runner_destroy(&r);
+    /* Resumed where block II begins: its break screen first, the fixation
+     * after Continue (Enter), then the trial. */
+    {
+        bool answered[6] = {true, true, true, false, false, false};
+        rp.first_trial = 3;
+        rp.answered = answered;
+        r = mr_study_runner_create(&rp, &err);
+        CHECK(r != NULL);
+        if (r) {
+            mr_study_runner_frame(r, 0.0, 1000, 700, &f, &v);
+            mr_study_runner_frame(r, 5.0, 1000, 700, &f, &v);
+            cJSON *st = mr_study_runner_state_json(r);
+            CHECK(cJSON_IsTrue(cJSON_GetObjectItem(st, "break")) && !f.fixation && f.image_count == 0 && f.trial == -1);
+            cJSON_Delete(st);
+            mr_event enter = {MR_EVENT_KEY, 0, 0, MR_KEY_ENTER};
+            mr_study_runner_push_event(r, &enter);
+            mr_study_runner_frame(r, 5.1, 1000, 700, &f, &v);
+            mr_study_runner_frame(r, 5.15, 1000, 700, &f, &v);
+            CHECK(f.fixation && !f.vote); /* the cross's full 100 ms after Continue */
+            mr_study_runner_frame(r, 5.25, 1000, 700, &f, &v);
+            CHECK(!f.fixation && f.trial == 3 && plan.trials[3].block == 2);
+            mr_study_runner_destroy(&r);
+        }
+        rp.first_trial = 0;
+        rp.answered = NULL;
+    }
     mr_study_plan_free(&plan);
     /* Task: a choice by key, then a tap on the image and Confirm. */
     char dir[4096];

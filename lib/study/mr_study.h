@@ -571,7 +571,8 @@ bool mr_study_analyze_task(const mr_study_votes *votes, const mr_study_plan *pla
  * appends the votes it hands out. Script commands (`T COMMAND ARGS`, T in
  * seconds from the start; a command also waits until its widget is on
  * screen and the previous one's input was taken):
- *   tap @left|@neutral|@right|@vote | tap X Y | drag @slider F0 F1
+ *   tap @left|@neutral|@right|@vote|@r1..@r7|@rx|@a|@b|@confirm|@continue
+ *   | tap @image FX FY (fractions of the image) | tap X Y | drag @slider F0 F1
  *   key K (left, right, down/space = neutral, enter = vote) | shot OUT.png | state OUT.json | quit */
 typedef struct mr_study_runner mr_study_runner;
 

@@ -32,10 +32,12 @@ typedef enum widget {
     W_LEFT = 0, W_NEUTRAL, W_RIGHT, W_SLIDER, W_VOTE,
     W_R1, W_R2, W_R3, W_R4, W_R5, W_R6, W_R7, W_RX, /* rating: 1..7 and X */
     W_CHOICE0, W_CHOICE1, W_IMAGE, W_CONFIRM,       /* task */
+    W_CONTINUE,                                     /* the break between blocks */
     W_COUNT
 } widget;
 static const char *const k_widget_names[W_COUNT] = {"left", "neutral", "right", "slider", "vote", "r1", "r2", "r3",
-                                                    "r4", "r5", "r6", "r7", "rx", "a", "b", "image", "confirm"};
+                                                    "r4", "r5", "r6", "r7", "rx", "a", "b", "image", "confirm",
+                                                    "continue"};
 
 static bool key_parse(const char *s, int *key) {
     static const struct { const char *n; int k; } names[] = {
@@ -130,6 +132,8 @@ struct mr_study_runner {
     int ratings[MR_STUDY_MAX_SCALES];
     bool tapped;              /* task: a tap on the image, in image pixels */
     double tap_x, tap_y;
+    int shown_block;          /* the block of the trial shown last (0: none yet) */
+    bool in_break;            /* the break screen before a new block is up */
     int answered_here;
     int last_voted;           /* the trial of the last vote handed out, -1 */
     char msg[256];
@@ -182,6 +186,9 @@ mr_study_runner *mr_study_runner_create(const mr_study_run_params *p, mr_error *
         return NULL;
     }
     r->trial = next_unanswered(r, p->first_trial > 0 ? p->first_trial : 0);
+    /* Resumed right at a new block: its break screen comes first. */
+    if (r->trial > 0 && r->trial < p->plan->trial_count && r->answered[r->trial - 1])
+        r->shown_block = p->plan->trials[r->trial - 1].block;
     r->fixation = true;
     r->last_voted = -1;
     r->now = r->t_start = r->phase_t0 = p->now;
@@ -245,7 +252,7 @@ static void script_tick(mr_study_runner *r) {
     if (!r->script || r->script_next >= r->script->n) return;
     const scmd *c = &r->script->c[r->script_next];
     if (r->qn > 0 || r->frames < r->script_frame + 2 || c->t > r->now - r->t_start) return;
-    if (c->op != S_QUIT && r->fixation && !done(r)) return;
+    if (c->op != S_QUIT && r->fixation && !done(r) && !r->in_break) return;
     double x = c->a, y = c->b;
     if (c->op == S_TAP || c->op == S_DRAG) {
         int w = -1;
@@ -321,6 +328,21 @@ static const char *question(const mr_study_plan *plan, const mr_study_trial *t) 
                : "Which image looks better?";
 }
 
+/* What the block about to start asks (shown on its break screen). */
+static void block_instruction(const mr_study_plan *plan, int block, char *out, size_t n) {
+    if (plan->design == MR_STUDY_PAIRWISE)
+        snprintf(out, n, "Block %s: %s", mr_study_block_name(block),
+                 block == 2 ? "the top image is the physically correct simulation; which image below is "
+                              "physically more plausible?"
+                 : !strcmp(mr_study_question_of(block, plan->group), "plausible")
+                     ? "which image is physically more plausible?"
+                     : "which image looks better?");
+    else if (plan->design == MR_STUDY_RATING)
+        snprintf(out, n, "Part %s: the scenes %s", mr_study_block_name(block),
+                 block == 2 ? "over the camera image (50 %)" : "alone");
+    else snprintf(out, n, "Part %s: new scenes, the same kind of questions", mr_study_block_name(block));
+}
+
 /* A scale's name for people: underscores as spaces, the first letter up. */
 static void scale_label(const char *name, char *out, size_t n) {
     snprintf(out, n, "%s", name);
@@ -357,7 +379,11 @@ const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, flo
     script_tick(r);
     int key = take_input(r);
     const mr_study_plan *plan = r->p.plan;
-    if (!done(r) && r->fixation && (now - r->phase_t0) * 1000.0 >= plan->fixation_ms) {
+    /* Between blocks a break (the thesis's recreational breaks) with the
+     * next block's instruction; the fixation starts after Continue. */
+    r->in_break = !done(r) && r->fixation && r->shown_block && plan->trials[r->trial].block != r->shown_block;
+    if (r->in_break) r->phase_t0 = now;
+    if (!done(r) && !r->in_break && r->fixation && (now - r->phase_t0) * 1000.0 >= plan->fixation_ms) {
         r->fixation = false;
         r->phase_t0 = now;
         r->slider = 0;
@@ -368,7 +394,7 @@ const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, flo
     r->image_count = 0;
     out->trial = -1;
     out->done = done(r);
-    out->fixation = r->fixation && !out->done;
+    out->fixation = r->fixation && !out->done && !r->in_break;
     mr_ui_rect screen = mr_ui_rect_make(0, 0, fb_w, fb_h);
     float pad = mr_ui_mm(r->ui, 4), target = mr_ui_target_px(r->ui);
     int answer = MR_STUDY_NEUTRAL; /* pairwise: an mr_study_answer; task: the choice */
@@ -376,6 +402,21 @@ const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, flo
     double slider_value = 0;
     if (out->done) {
         mr_ui_label(r->ui, screen, "All trials answered. Thank you!", MR_UI_RGBA(255, 255, 255, 255), true);
+    } else if (r->in_break) {
+        mr_ui_rect area = mr_ui_rect_inset(screen, pad);
+        mr_ui_rect b = mr_ui_cut_bottom(&area, target * 1.2f + pad);
+        b = mr_ui_fit(b, 4, 1);
+        char text[200];
+        block_instruction(plan, plan->trials[r->trial].block, text, sizeof text);
+        mr_ui_label(r->ui, mr_ui_cut_top(&area, area.h * 0.5f), text, MR_UI_RGBA(255, 255, 255, 255), true);
+        mr_ui_label(r->ui, area, "Take a short break. Continue when you are ready.", MR_UI_RGBA(220, 220, 220, 255), true);
+        r->shown[W_CONTINUE] = true;
+        r->rect[W_CONTINUE] = b;
+        if (mr_ui_button(r->ui, 50, b, "Continue", MR_UI_ACCENT) || key == MR_KEY_ENTER || key == ' ') {
+            r->shown_block = plan->trials[r->trial].block;
+            r->in_break = false;
+            r->phase_t0 = now;
+        }
     } else if (out->fixation) {
         /* A black fixation cross on white (thesis sec. 4.3). */
         mr_ui_draw_rect(dl, screen, MR_UI_RGBA(255, 255, 255, 255));
@@ -385,6 +426,7 @@ const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, flo
     } else {
         const mr_study_trial *t = &plan->trials[r->trial];
         out->trial = r->trial;
+        r->shown_block = t->block;
         mr_ui_rect area = mr_ui_rect_inset(screen, pad);
         char status[200];
         if (plan->design == MR_STUDY_PAIRWISE)
@@ -560,7 +602,8 @@ cJSON *mr_study_runner_state_json(const mr_study_runner *r) {
     cJSON_AddStringToObject(j, "participant", r->p.participant);
     cJSON_AddNumberToObject(j, "trial", done(r) ? -1 : r->trial);
     cJSON_AddStringToObject(j, "block", done(r) ? "" : mr_study_block_name(r->p.plan->trials[r->trial].block));
-    cJSON_AddBoolToObject(j, "fixation", r->fixation && !done(r));
+    cJSON_AddBoolToObject(j, "fixation", r->fixation && !done(r) && !r->in_break);
+    cJSON_AddBoolToObject(j, "break", r->in_break);
     cJSON_AddBoolToObject(j, "done", done(r));
     cJSON_AddNumberToObject(j, "images", r->image_count);
     cJSON_AddNumberToObject(j, "answered_here", r->answered_here);
