@@ -70,7 +70,7 @@
 #define MR_LOC_AO_USE_MASK                 14
 #define MR_LOC_AO_MASK_STRENGTH            15
 #define MR_LOC_AO_KERNEL                   16
-#define MR_AO_KERNEL_SIZE                  64 /* = MR_AO_MAX_SAMPLES (checked in pass_ao.c) */
+#define MR_AO_KERNEL_SIZE                  128/* = MR_AO_MAX_SAMPLES (checked in pass_ao.c) */
 #define MR_LOC_AO_KERNEL2                  (MR_LOC_AO_KERNEL + MR_AO_KERNEL_SIZE)
 #define MR_TEX_AO_MASK                     3
 /* gtao / bitmask / scheer-gt */

@@ -14,8 +14,8 @@
  * choosing a radius the reference does not use. Scheer & Keutel's three
  * renderings: D1 = no AO (AO = 1; the AO maps compared here do not depend
  * on the shading model), D2 = scheer with its depth-scaled radius (tuned,
- * and paper-pure: no cosine bias, whole-ball uniform kernel, c = 1, default
- * strength, the reference's radius, nothing tuned), D3 = "standard SSAO
+ * and paper-pure: no cosine bias, whole-ball uniform kernel, c = 1,
+ * strength 1, the reference's radius, nothing tuned), D3 = "standard SSAO
  * with a decreasing size of the sample radius in depth" = crytek
  * (Mittring) with a constant view-space radius; scheer with a constant
  * radius is an extra row (scheer-view), not D3. A second table times the
@@ -34,7 +34,7 @@ enum { MAXC = 32, MAXS = 4 };
 enum { SEQ_METHODS = 3, SEQ_CFG = 4, COST_METHODS = 3 }; /* the moving sequence, the cost steps */
 
 /* The methods raced. role: Scheer & Keutel's rendering it stands for, or
- * "-". radius: TUNE_RADIUS (tuned with the rest), REF_RADIUS (the
+ * "-", set from mr_ao_sk_role at the start (NULL here). radius: TUNE_RADIUS (tuned with the rest), REF_RADIUS (the
  * reference's own; the rest tuned) or PAPER (the reference's radius and
  * the paper's parameters; nothing tuned). */
 enum { TUNE_RADIUS, REF_RADIUS, PAPER };
@@ -49,37 +49,37 @@ typedef struct contender {
 static const char *const k_radius_policy[3] = {"tuned", "reference", "reference"};
 
 static const contender k_contenders[] = {
-    {"scheer", "D2", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
-    {"scheer@R", "D2", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
-    {"scheer-paper", "D2", MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, PAPER, {0}},
-    {"crytek", "D3", MR_AO_CRYTEK, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
-    {"crytek@R", "D3", MR_AO_CRYTEK, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
-    {"scheer-view", "-", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
-    {"scheer-view@R", "-", MR_AO_SCHEER, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
-    {"filion", "-", MR_AO_FILION, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
-    {"filion@R", "-", MR_AO_FILION, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
-    {"hbao", "-", MR_AO_HBAO, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
-    {"hbao@R", "-", MR_AO_HBAO, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
-    {"alchemy", "-", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
-    {"alchemy@R", "-", MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"scheer", NULL, MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
+    {"scheer@R", NULL, MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
+    {"scheer-paper", NULL, MR_AO_SCHEER, MR_AO_RADIUS_SCREEN, PAPER, {0}},
+    {"crytek", NULL, MR_AO_CRYTEK, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"crytek@R", NULL, MR_AO_CRYTEK, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"scheer-view", NULL, MR_AO_SCHEER, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"scheer-view@R", NULL, MR_AO_SCHEER, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"filion", NULL, MR_AO_FILION, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"filion@R", NULL, MR_AO_FILION, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"hbao", NULL, MR_AO_HBAO, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"hbao@R", NULL, MR_AO_HBAO, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"alchemy", NULL, MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"alchemy@R", NULL, MR_AO_ALCHEMY, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
     /* The modern integrators, with the depth-scaled and the fixed radius */
-    {"gtao", "-", MR_AO_GTAO, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
-    {"gtao@R", "-", MR_AO_GTAO, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
-    {"gtao-view", "-", MR_AO_GTAO, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
-    {"gtao-view@R", "-", MR_AO_GTAO, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
-    {"bitmask", "-", MR_AO_BITMASK, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
-    {"bitmask@R", "-", MR_AO_BITMASK, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
-    {"bitmask-view", "-", MR_AO_BITMASK, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
-    {"bitmask-view@R", "-", MR_AO_BITMASK, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
-    {"scheer-gt", "D2", MR_AO_SCHEER_GT, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
-    {"scheer-gt@R", "D2", MR_AO_SCHEER_GT, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
-    {"scheer-gt-view", "-", MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
-    {"scheer-gt-view@R", "-", MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"gtao", NULL, MR_AO_GTAO, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
+    {"gtao@R", NULL, MR_AO_GTAO, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
+    {"gtao-view", NULL, MR_AO_GTAO, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"gtao-view@R", NULL, MR_AO_GTAO, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"bitmask", NULL, MR_AO_BITMASK, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
+    {"bitmask@R", NULL, MR_AO_BITMASK, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
+    {"bitmask-view", NULL, MR_AO_BITMASK, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"bitmask-view@R", NULL, MR_AO_BITMASK, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"scheer-gt", NULL, MR_AO_SCHEER_GT, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
+    {"scheer-gt@R", NULL, MR_AO_SCHEER_GT, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
+    {"scheer-gt-view", NULL, MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"scheer-gt-view@R", NULL, MR_AO_SCHEER_GT, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
     /* Scheer's attenuation in the bitmask's sector weights */
-    {"scheer-bm", "D2", MR_AO_SCHEER_BM, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
-    {"scheer-bm@R", "D2", MR_AO_SCHEER_BM, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
-    {"scheer-bm-view", "-", MR_AO_SCHEER_BM, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
-    {"scheer-bm-view@R", "-", MR_AO_SCHEER_BM, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
+    {"scheer-bm", NULL, MR_AO_SCHEER_BM, MR_AO_RADIUS_SCREEN, TUNE_RADIUS, {0}},
+    {"scheer-bm@R", NULL, MR_AO_SCHEER_BM, MR_AO_RADIUS_SCREEN, REF_RADIUS, {0}},
+    {"scheer-bm-view", NULL, MR_AO_SCHEER_BM, MR_AO_RADIUS_VIEW, TUNE_RADIUS, {0}},
+    {"scheer-bm-view@R", NULL, MR_AO_SCHEER_BM, MR_AO_RADIUS_VIEW, REF_RADIUS, {0}},
 };
 #define NC (int)(sizeof k_contenders / sizeof k_contenders[0])
 _Static_assert(NC <= MAXC, "MAXC bounds the contenders");
@@ -111,6 +111,7 @@ typedef struct ao_bench {
     view_data vd[MAX_VIEWS + 1];
     contender cs[NC];
     agg_table agg_ms, agg_rf, agg_rs, agg_sf, agg_ss, agg_bf, agg_bs, agg_mf;
+    agg_table agg_ret; /* mask on: darkening kept, sum(1 - AO) masked / unmasked (Park & Baek promise 1) */
     agg_table agg_sync, agg_floor, agg_ratio; /* glFinish-timed ms, the fetch floor, their ratio */
     double pv_rf[MAX_VIEWS + 1][MAXC + 1], pv_rs[MAX_VIEWS + 1][MAXC + 1]; /* per view, reported samples, full, mask off */
     double none_rf, none_rs, none_sf, none_ss, none_bf, none_bs;
@@ -373,8 +374,9 @@ static bool ao_tune(ao_bench *b, mr_error *err) {
                         if (paper) {
                             /* Scheer & Keutel as printed: cosine weight without a
                              * bias, offsets uniform in the ball (the hemisphere
-                             * after the flip), c = 1, the method's default strength. */
-                            p.strength = 0;
+                             * after the flip), c = 1, strength 1 (the printed o(v)
+                             * averaged, nothing scaled). */
+                            p.strength = 1;
                             p.bias = 0;
                             p.c = 1;
                             p.kernel = MR_AO_KERNEL_UNIFORM;
@@ -447,6 +449,7 @@ static bool ao_grid_view(ao_bench *b, int v, mr_csv *csv, mr_error *err) {
     mr_csv_text(csv, "");
     mr_csv_text(csv, "");
     mr_csv_text(csv, ""); /* thickness */
+    mr_csv_text(csv, ""); /* retained */
     mr_csv_end_row(csv);
     b->pv_rf[v][0] = mf.rmse;
     b->pv_rs[v][0] = msr.rmse;
@@ -460,7 +463,8 @@ static bool ao_grid_view(ao_bench *b, int v, mr_csv *csv, mr_error *err) {
     b->montage[b->nmont++] = &vd->gt_screen;
     for (int c = 0; c < NC; c++)
         for (int si = 0; si < b->nsamp; si++)
-            for (int res = 0; res < b->nres; res++)
+            for (int res = 0; res < b->nres; res++) {
+                double dark_off = 0; /* the unmasked row's darkening, for the masked row's "retained" */
                 for (int mk = 0; mk < 2; mk++) {
                     mr_ao_params p = b->cs[c].tuned;
                     p.samples = b->samples[si];
@@ -487,7 +491,15 @@ static bool ao_grid_view(ao_bench *b, int v, mr_csv *csv, mr_error *err) {
                     mr_csv_num(csv, "%.4f", floor_ms);
                     mr_csv_num(csv, "%.3f", floor_ms > 0 ? sync / floor_ms : 0.0);
                     mr_csv_num(csv, "%g", p.thickness);
+                    double dark = 0;
+                    const float *a = b->ao.data;
+                    for (size_t i = 0; a && i < (size_t)b->ao.width * b->ao.height; i++)
+                        if (isfinite(a[i])) dark += 1.0 - a[i];
+                    if (!mk) dark_off = dark;
+                    double retained = mk ? (dark_off > 0 ? dark / dark_off : 1.0) : 1.0;
+                    mr_csv_num(csv, "%.4f", retained);
                     mr_csv_end_row(csv);
+                    b->agg_ret[c][si][res][mk] += retained / nv;
                     b->agg_sync[c][si][res][mk] += sync / nv;
                     b->agg_floor[c][si][res][mk] += floor_ms / nv;
                     b->agg_ratio[c][si][res][mk] += (floor_ms > 0 ? sync / floor_ms : 0.0) / nv;
@@ -513,7 +525,136 @@ static bool ao_grid_view(ao_bench *b, int v, mr_csv *csv, mr_error *err) {
                         }
                     }
                 }
+            }
     return true;
+}
+
+/* Scheer & Keutel's Tables 1 and 2 (bench_ao_sk.csv, bench_ao_sk.md): their
+ * method as printed (scheer, depth-scaled radius at the reference's, bias 0,
+ * whole-ball kernel, c 1, strength 1) at 16, 36, 64 and 128 samples, full
+ * and half resolution: AO time and RMSE against both references (Table 1);
+ * and the frame split into geometry (G-buffer), SSAO and blur at 16 samples
+ * with a 13 x 13 blur and 36 samples with a 9 x 9 one (Table 2). Means over
+ * the reported views; times are each pass between glFinish (llvmpipe
+ * defers its work past timer queries) and the timer-query GPU ms. */
+static bool ao_sk_tables(ao_bench *b, mr_error *err) {
+    static const int k_samp[4] = {16, 36, 64, 128};
+    static const double k_paper_t1[4][2] = {{12.4, 1.6}, {24.6, 3.5}, {47.0, 6.1}, {96.9, 12.4}};
+    double t1_sync[4][2] = {{0}}, t1_gpu[4][2] = {{0}}, t1_rf[4][2] = {{0}}, t1_rs[4][2] = {{0}};
+    double t2[2][4] = {{0}}; /* geometry, ssao, blur, whole frame (sync ms) */
+    mr_csv *csv = mr_csv_create(err);
+    if (!csv) return false;
+    mr_csv_comment(csv, "Scheer & Keutel as printed: scheer, depth-scaled radius (the reference's), bias 0, whole-ball uniform "
+                        "kernel, c 1, strength 1; table 1: AO passes; table 2: G-buffer, AO (+ upsample), blur and the whole "
+                        "frame, each pass between glFinish (sync) and by timer query (gpu)");
+    mr_csv_header(csv, "view,table,samples,resolution,blur,width,height,geometry_sync_ms,ssao_sync_ms,blur_sync_ms,frame_sync_ms,"
+                       "ssao_gpu_ms,rmse_fixed,rmse_screen");
+    const int nv = b->nv, frames = b->p.frames > 0 ? b->p.frames : 1;
+    for (int v = 1; v <= nv; v++) {
+        view_data *vd = &b->vd[v];
+        for (int row = 0; row < 4 * 2 + 2; row++) {
+            int table = row < 8 ? 1 : 2, si = row < 8 ? row / 2 : (row == 8 ? 0 : 1), half = row < 8 ? row % 2 : 0;
+            mr_ao_params ao = MR_AO_DEFAULTS;
+            ao.method = MR_AO_SCHEER;
+            ao.radius_mode = MR_AO_RADIUS_SCREEN;
+            ao.screen_radius = b->screen_radius;
+            ao.strength = 1;
+            ao.bias = 0;
+            ao.c = 1;
+            ao.kernel = MR_AO_KERNEL_UNIFORM;
+            ao.r_min = 0;
+            ao.r_max = 1;
+            ao.samples = k_samp[si];
+            ao.half_res = half;
+            ao.blur_radius = table == 1 ? 0 : (row == 8 ? 6 : 4);
+            ao.no_reuse = true;
+            ao.want_ao = true;
+            mr_frame_params fp = MR_FRAME_DEFAULTS;
+            fp.width = b->w;
+            fp.height = b->h;
+            fp.timing = true;
+            fp.timing_sync = true;
+            fp.ao = ao;
+            double g[64], a[64], bl[64], fr[64], ag[64];
+            int n = frames < 64 ? frames : 64;
+            mr_image_metrics mf = {0}, msr = {0};
+            for (int f = -1; f < n; f++) {
+                mr_frame_result res;
+                if (!mr_render_frame(b->gfx.renderer, &vd->view, &fp, &res, err)) {
+                    mr_csv_destroy(&csv);
+                    return false;
+                }
+                double sg = 0, sa = 0, sb = 0, sf = 0, sag = 0;
+                for (int k = 0; k < res.pass_count; k++) {
+                    const char *pn = res.passes[k];
+                    sf += res.cpu_ms[k];
+                    if (strcmp(pn, "gbuffer") == 0) sg += res.cpu_ms[k];
+                    else if (strcmp(pn, "ao_blur") == 0) sb += res.cpu_ms[k];
+                    else if (strncmp(pn, "ao", 2) == 0) {
+                        sa += res.cpu_ms[k];
+                        sag += res.gpu_ms[k];
+                    }
+                }
+                if (f >= 0) g[f] = sg, a[f] = sa, bl[f] = sb, fr[f] = sf, ag[f] = sag;
+                if (f == n - 1 && !metrics(&res.ao, vd, &mf, &msr, err)) {
+                    mr_frame_result_free(&res);
+                    mr_csv_destroy(&csv);
+                    return false;
+                }
+                mr_frame_result_free(&res);
+            }
+            double mg = mr_median(g, n), ma = mr_median(a, n), mb = mr_median(bl, n), mfr = mr_median(fr, n), mag = mr_median(ag, n);
+            mr_csv_quoted(csv, vd->name);
+            mr_csv_int(csv, table);
+            mr_csv_int(csv, ao.samples);
+            mr_csv_text(csv, half ? "half" : "full");
+            mr_csv_int(csv, ao.blur_radius ? 2 * ao.blur_radius + 1 : 0);
+            mr_csv_int(csv, b->w);
+            mr_csv_int(csv, b->h);
+            const double vals[7] = {mg, ma, mb, mfr, mag, mf.rmse, msr.rmse};
+            for (int k = 0; k < 7; k++) mr_csv_num(csv, "%.4f", vals[k]);
+            mr_csv_end_row(csv);
+            if (table == 1) {
+                t1_sync[si][half] += ma / nv;
+                t1_gpu[si][half] += mag / nv;
+                t1_rf[si][half] += mf.rmse / nv;
+                t1_rs[si][half] += msr.rmse / nv;
+            } else {
+                const double t[4] = {mg, ma, mb, mfr};
+                for (int k = 0; k < 4; k++) t2[row - 8][k] += t[k] / nv;
+            }
+        }
+    }
+    if (!save_csv(csv, b->p.out_dir, "bench_ao_sk.csv", err)) return false;
+    char md[8192];
+    size_t len = 0;
+    len += (size_t)snprintf(md + len, sizeof md - len,
+                            "Scheer & Keutel, Table 1 (SSAO computation time), their method as printed, %dx%d, mean of %d views, "
+                            "median of %d frames; the paper: 800x800 (Sec. 4), GTX 285; here: this machine's GL (`sync` = the AO "
+                            "passes between glFinish)\n\n| samples | paper full ms | paper half ms | full sync ms | half sync ms | "
+                            "full GPU ms | half GPU ms | half / full (paper) | half / full (here) | RMSE fixed full / half | RMSE "
+                            "depth-scaled full / half |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+                            b->w, b->h, nv, frames);
+    for (int si = 0; si < 4; si++)
+        len += (size_t)snprintf(md + len, sizeof md - len,
+                                "| %d | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.4f / %.4f | %.4f / %.4f |\n", k_samp[si],
+                                k_paper_t1[si][0], k_paper_t1[si][1], t1_sync[si][0], t1_sync[si][1], t1_gpu[si][0], t1_gpu[si][1],
+                                k_paper_t1[si][1] / k_paper_t1[si][0], t1_sync[si][0] > 0 ? t1_sync[si][1] / t1_sync[si][0] : 0,
+                                t1_rf[si][0], t1_rf[si][1], t1_rs[si][0], t1_rs[si][1]);
+    len += (size_t)snprintf(md + len, sizeof md - len,
+                            "\nScheer & Keutel, Table 2 (overall performance), same setting (sync ms)\n\n| samples | blur | paper "
+                            "geo / SSAO / blur / frame ms | geometry | SSAO | blur | frame | SSAO share (paper) | SSAO share (here) |\n"
+                            "|---|---|---|---|---|---|---|---|---|\n");
+    static const double k_paper_t2[2][4] = {{3.6, 12.4, 3.6, 19.6}, {3.6, 24.6, 2.8, 31.0}};
+    for (int r = 0; r < 2; r++)
+        len += (size_t)snprintf(md + len, sizeof md - len, "| %d | %s | %.1f / %.1f / %.1f / %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n",
+                                r ? 36 : 16, r ? "9x9" : "13x13", k_paper_t2[r][0], k_paper_t2[r][1], k_paper_t2[r][2],
+                                k_paper_t2[r][3], t2[r][0], t2[r][1], t2[r][2], t2[r][3], k_paper_t2[r][1] / k_paper_t2[r][3],
+                                t2[r][3] > 0 ? t2[r][1] / t2[r][3] : 0);
+    char path[4096];
+    mr_path_join(b->p.out_dir, "bench_ao_sk.md", path, sizeof path);
+    if (b->p.out) fputs(md, b->p.out);
+    return mr_file_write_atomic(path, md, len, err);
 }
 
 /* Step 3: the grid on the reported views (bench_ao.csv). */
@@ -526,7 +667,8 @@ static bool ao_grid(ao_bench *b, mr_error *err) {
                         "the depth-scaled R; sync_ms: the AO passes timed between glFinish (llvmpipe defers rasterisation past "
                         "a timer query); floor_ms: a full-screen pass of as many R32F fetches per AO pixel and nothing else, "
                         "timed the same way right after the row; floor_ratio = sync_ms / floor_ms; thickness: the "
-                        "bitmask / gtao / scheer-bm occluder thickness (fraction of the radius)");
+                        "bitmask / gtao / scheer-bm occluder thickness (fraction of the radius); retained: with the mask on, "
+                        "the darkening sum(1 - AO) kept of the same row unmasked (Park & Baek promise the same image: 1)");
     char tc[400];
     snprintf(tc, sizeof tc, "parameters tuned on the tuning view '%s' (not reported, bench_ao_tuning.csv) and frozen for these views",
              b->vd[0].name);
@@ -534,7 +676,7 @@ static bool ao_grid(ao_bench *b, mr_error *err) {
     mr_csv_header(csv, "view,contender,role,radius_policy,tuned,radius_mode,radius,screen_radius,strength,bias,c,kernel,r_min,"
                        "r_max,samples,resolution,mask,width,height,"
                        "gpu_ms_median,frames,rmse_fixed,ssim_fixed,bias_fixed,rmse_screen,ssim_screen,bias_screen,masked_fraction,"
-                       "sync_ms_median,floor_ms_median,floor_ratio,thickness");
+                       "sync_ms_median,floor_ms_median,floor_ratio,thickness,retained");
     for (int v = 1; v <= b->nv; v++) {
         if (!ao_grid_view(b, v, csv, err)) {
             mr_csv_destroy(&csv);
@@ -1055,7 +1197,7 @@ static bool ao_summary(ao_bench *b, mr_error *err) {
                             "D1 = no AO, D2 = scheer (depth-scaled radius), D3 = standard SSAO (crytek, constant "
                             "radius), as Scheer & Keutel name them. `@R`: the radius is the reference's own (R = %g "
                             "units, or %g of the height), only strength / bias / c tuned; `scheer-paper`: the "
-                            "paper's parameters (bias 0, whole-ball uniform kernel, c 1, default strength), nothing "
+                            "paper's parameters (bias 0, whole-ball uniform kernel, c 1, strength 1), nothing "
                             "tuned.\n\n"
                             "| method | role | radius | strength | bias | c | kernel | res | mask | GPU ms | RMSE fixed R | SSIM fixed | bias fixed | RMSE depth-scaled R | SSIM d-s | bias d-s | masked | sync ms | floor ms | x floor |\n"
                             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
@@ -1087,6 +1229,16 @@ static bool ao_summary(ao_bench *b, mr_error *err) {
                                         b->agg_sync[c][s16][res][mk], b->agg_floor[c][s16][res][mk],
                                         b->agg_ratio[c][s16][res][mk]);
             }
+    len += (size_t)snprintf(md + len, sizeof md - len,
+                            "\nCorner mask (Park & Baek: the same image, faster), %d samples, full resolution: darkening kept "
+                            "(sum of 1 - AO, masked / unmasked; the paper promises 1) and time with the mask against without "
+                            "(GPU ms; pays: < 1):\n\n| method | retained | ms off | ms on | on / off | masked fraction |\n|---|---|---|---|---|---|\n",
+                            b->samples[s16]);
+    for (int c = 0; c < NC; c++) {
+        double off = b->agg_ms[c][s16][0][0], on = b->agg_ms[c][s16][0][1];
+        len += (size_t)snprintf(md + len, sizeof md - len, "| %s | %.4f | %.2f | %.2f | %.2f | %.3f |\n", b->cs[c].label,
+                                b->agg_ret[c][s16][0][1], off, on, off > 0 ? on / off : 0, b->agg_mf[c][s16][0][1]);
+    }
     len = equal_ms_table(b, md, sizeof md, len);
     len += (size_t)snprintf(md + len, sizeof md - len, "\nRMSE per view (fixed R / depth-scaled R), %d samples, full resolution, mask off:\n\n| view | none |",
                             b->samples[s16]);
@@ -1204,8 +1356,9 @@ bool mr_bench_ao(const mr_bench_ao_params *params, mr_error *err) {
     b->nres = p->quick ? 1 : 2;
     b->s16 = p->quick ? 0 : 1;
     memcpy(b->cs, k_contenders, sizeof b->cs);
+    for (int c = 0; c < NC; c++) b->cs[c].role = mr_ao_sk_role(b->cs[c].method, b->cs[c].mode);
     b->t0 = mr_time_now();
-    bool ok = ao_setup(b, err) && ao_references(b, err) && ao_tune(b, err) && ao_grid(b, err) && ao_triangles(b, err) &&
+    bool ok = ao_setup(b, err) && ao_references(b, err) && ao_tune(b, err) && ao_grid(b, err) && ao_sk_tables(b, err) && ao_triangles(b, err) &&
               ao_plots(b, err) && ao_shaded(b, err) && ao_sequence(b, err) && ao_cost(b, err) &&
               ao_summary(b, err);
     ao_free(b);

@@ -62,7 +62,7 @@ bool mr_renderer_set_scene(mr_renderer *r, const mr_scene *scene, mr_error *err)
  * ambient term of the shading. */
 typedef enum mr_ao_method {
     MR_AO_NONE = 0,    /* plain shading (Scheer & Keutel's D1): no AO pass runs */
-    MR_AO_SCHEER,      /* occlusion vectors, depth-scaled radius (D2; D3 with radius_mode view);
+    MR_AO_SCHEER,      /* occlusion vectors, depth-scaled radius (D2; see mr_ao_sk_setup);
                           as printed with bias 0 and r_min 0 (the whole ball) */
     MR_AO_CRYTEK,      /* Mittring 2007: ratio of sphere samples behind the depth buffer */
     MR_AO_FILION,      /* Filion & McNaughton 2008: hemisphere samples, depth-difference falloff */
@@ -84,7 +84,8 @@ typedef enum mr_ao_method {
 
 typedef enum mr_ao_radius_mode {
     MR_AO_RADIUS_SCREEN = 0, /* r_S = screen_radius * Z_p * height / fy: the projected
-                                radius is constant (Scheer & Keutel); scale-free */
+                                radius is constant (Scheer & Keutel; their printed
+                                r_S = r_B s d / Z_p is a misprint, see pass_ao.c); scale-free */
     MR_AO_RADIUS_VIEW = 1,   /* constant view-space radius `radius` (scene units) */
 } mr_ao_radius_mode;
 
@@ -117,7 +118,7 @@ typedef enum mr_ao_noise {
  * another, so cells of one pixel would split it half the time. */
 #define MR_AO_NOISE_CELL_PX 4
 
-#define MR_AO_MAX_SAMPLES 64
+#define MR_AO_MAX_SAMPLES 128
 #define MR_AO_MAX_RADII 5 /* Doronin et al. merge 5 radii */
 
 typedef struct mr_ao_params {
@@ -230,6 +231,21 @@ extern const char *const mr_ao_method_names[MR_AO_METHOD_COUNT + 1];
 
 /* Names used on the command line ("none", "scheer", ...); NULL if out of range. */
 const char *mr_ao_method_name(mr_ao_method m);
+
+/* Scheer & Keutel's three renderings, as their Sec. 5 defines them, defined
+ * here once (the study stimuli, `bench ao` and the docs take them from
+ * here): D1 "standard phong shading" (no AO); D2 "our approach to SSAO"
+ * (occlusion vectors, the sampling radius constant on screen, so growing
+ * with depth: scheer, radius mode screen); D3 "standard SSAO with a
+ * decreasing size of the sample radius in depth": Mittring's SSAO (crytek),
+ * the paper's origin of standard SSAO [Mit07a], with a constant view-space
+ * radius. scheer with a constant radius isolates the radius rule; it is an
+ * extra row, not D3. */
+typedef enum mr_ao_sk_rendering { MR_AO_SK_D1, MR_AO_SK_D2, MR_AO_SK_D3, MR_AO_SK_COUNT } mr_ao_sk_rendering;
+/* Sets p's method and radius mode to rendering d's; the rest is kept. */
+void mr_ao_sk_setup(mr_ao_sk_rendering d, mr_ao_params *p);
+/* "D1", "D2" or "D3" when (method, radius mode) is one of them, else "-". */
+const char *mr_ao_sk_role(mr_ao_method m, mr_ao_radius_mode mode);
 /* Parses a method name; false if unknown. */
 bool mr_ao_method_parse(const char *name, mr_ao_method *out);
 /* gtao / bitmask / scheer-gt: how `samples` splits into slices and steps

@@ -163,3 +163,15 @@ const mr_opt mr_frame_opts[] = {
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef FR
+
+void mr_ao_sk_setup(mr_ao_sk_rendering d, mr_ao_params *p) {
+    p->method = d == MR_AO_SK_D1 ? MR_AO_NONE : d == MR_AO_SK_D2 ? MR_AO_SCHEER : MR_AO_CRYTEK;
+    p->radius_mode = d == MR_AO_SK_D3 ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
+}
+
+const char *mr_ao_sk_role(mr_ao_method m, mr_ao_radius_mode mode) {
+    if (m == MR_AO_NONE) return "D1";
+    if (m == MR_AO_SCHEER && mode == MR_AO_RADIUS_SCREEN) return "D2";
+    if (m == MR_AO_CRYTEK && mode == MR_AO_RADIUS_VIEW) return "D3";
+    return "-";
+}

@@ -382,6 +382,14 @@ static bool prepare_state(frame *f, mr_ao_state *s, mr_error *err) {
     s->p = resolve(&f->p->ao, r->scene);
     s->step = s->p.half_res ? 2 : 1;
     ensure_targets(s, r->w, r->h, s->step);
+    /* Scheer & Keutel's depth-scaled radius. Printed as r_S = r_B s_scene
+     * d / Z_p (d: depth of the image plane), which shrinks as Z_p grows: the
+     * opposite of their text ("the sampling radius [grows] linearly with
+     * increasing depth values, keeping its projection constant in screen
+     * space"). A radius whose projection r_S f / Z_p stays constant is
+     * r_S = (r_B s_scene / d) Z_p: the d / Z_p is a misprint for Z_p / d.
+     * Here the projection is a fraction F of the image height: r_S = k Z_p,
+     * k = F height / f_y (the same r_S with r_B s_scene = F height, d = f_y). */
     s->screen_k = (float)(s->p.screen_radius * f->cam.height / f->cam.fy);
     if (s->k_n != s->p.samples || s->k_kind != s->p.kernel || s->k_rmin != s->p.r_min || s->k_rmax != s->p.r_max) {
         float k3[MR_AO_MAX_SAMPLES * 3], k2[MR_AO_MAX_SAMPLES * 2];

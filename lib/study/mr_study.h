@@ -77,8 +77,8 @@ void mr_study_set_free(mr_study_set *s);
  * factory's b is the hall as built), the thesis's four methods (pcf, pcss,
  * bp and the ground truth as the reference; hard shadows with `hard`), at
  * 800x450, ambient 0.4 and antialiased. depth is Scheer & Keutel's rating
- * set: D1, D2, D3 (mr_render's AO methods none, scheer with a screen and
- * with a view radius) of the hall's views in DIR/virtual/ and, over a
+ * set: D1, D2, D3 (mr_ao_sk_setup: no AO, scheer with the depth-scaled
+ * radius, crytek with a constant radius) of the hall's views in DIR/virtual/ and, over a
  * camera image at alpha 0.5, in DIR/video/. xray is Kalkofen et al.'s
  * task set: `views` scenes of `targets` arrangements each (a panelled wall,
  * a tall and a wide hidden box, a hidden pipe up to the wall) through the

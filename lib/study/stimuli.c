@@ -15,14 +15,10 @@ static const char *const k_ao_methods[] = {"alchemy", "crytek", "filion", "hbao"
 static const mr_ao_method k_ao_enum[] = {MR_AO_ALCHEMY, MR_AO_CRYTEK, MR_AO_FILION, MR_AO_HBAO, MR_AO_SCHEER};
 static void ao_setup(mr_frame_params *fp, int m) { fp->ao.method = k_ao_enum[m]; }
 
-/* Scheer & Keutel's D1 (Phong shading, no AO), D2 (their SSAO: the
- * radius constant on screen, so it grows with depth) and D3 (standard
- * SSAO: a constant view-space radius, shrinking on screen with depth). */
+/* Scheer & Keutel's D1, D2 and D3, as mr_render defines them
+ * (mr_ao_sk_setup). */
 static const char *const k_depth_methods[] = {"D1", "D2", "D3", NULL};
-static void depth_setup(mr_frame_params *fp, int m) {
-    fp->ao.method = m == 0 ? MR_AO_NONE : MR_AO_SCHEER;
-    fp->ao.radius_mode = m == 2 ? MR_AO_RADIUS_VIEW : MR_AO_RADIUS_SCREEN;
-}
+static void depth_setup(mr_frame_params *fp, int m) { mr_ao_sk_setup((mr_ao_sk_rendering)m, &fp->ao); }
 
 static const char *const k_ghost_methods[] = {"adaptive", "alpha", "g0", NULL};
 static const mr_ghost_mode k_ghost_enum[] = {MR_GHOST_ADAPTIVE, MR_GHOST_ALPHA, MR_GHOST_G0};
