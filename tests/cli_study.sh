@@ -35,19 +35,22 @@ cmp -s "$tmp/ghost/alpha/hall_v0.png" "$tmp/ghost/adaptive/hall_v0.png" && bad "
 # thesis's three methods and the ground truth as the reference; hard
 # shadows only when asked; block II needs the reference.
 "$mr" study stimuli --family shadows --out "$tmp/sh" --cases 2 --width 96 --height 54 --gt-samples 16 >"$tmp/ss.log" 2>&1 && ok || bad "shadows stimuli: $(cat "$tmp/ss.log")"
-[ "$(ls "$tmp"/sh | tr '\n' ' ')" = "bp pcf pcss reference " ] && ok || bad "shadows methods: $(ls "$tmp/sh")"
+[ "$(ls "$tmp"/sh | grep -v "\.csv$" | tr '\n' ' ')" = "bp pcf pcss reference " ] && ok || bad "shadows methods: $(ls "$tmp/sh")"
 for m in bp pcf pcss reference; do
   [ "$(ls "$tmp/sh/$m" 2>/dev/null | tr '\n' ' ')" = "simple_constant.a.png simple_constant.b.png simple_constant_overlap.a.png simple_constant_overlap.b.png " ] && ok ||
     bad "shadows $m: $(ls "$tmp/sh/$m" 2>&1)"
 done
 grep -q "16 images of family shadows" "$tmp/ss.log" && ok || bad "shadows: expected 4 stimuli x 4 images: $(cat "$tmp/ss.log")"
+# The thesis's check of the scene pairs: each method's difference to the reference.
+[ "$(grep -c '^simple_constant[a-z_]*,simple_constant[a-z_]*\.[ab],\(bp\|pcf\|pcss\),0\.[0-9]*,0\.[0-9]*,0\.[0-9]*$' "$tmp/sh/differences.csv")" -eq 12 ] && ok ||
+  bad "shadows: differences.csv: $(cat "$tmp/sh/differences.csv")"
 # The PNG header's width and height (big-endian at bytes 16..23).
 [ "$(od -An -tu1 -j16 -N8 "$tmp/sh/pcf/simple_constant.a.png" | tr -s ' ')" = " 0 0 0 96 0 0 0 54" ] && ok ||
   bad "shadows: not 96 x 54: $(od -An -tu1 -j16 -N8 "$tmp/sh/pcf/simple_constant.a.png")"
 cmp -s "$tmp/sh/pcf/simple_constant.a.png" "$tmp/sh/pcf/simple_constant.b.png" && bad "shadows: scenes a and b are the same image" || ok
 cmp -s "$tmp/sh/pcf/simple_constant.a.png" "$tmp/sh/reference/simple_constant.a.png" && bad "shadows: the reference is pcf" || ok
 "$mr" study stimuli --family shadows --out "$tmp/shh" --cases 1 --width 48 --height 27 --gt-samples 4 --hard >"$tmp/ssh.log" 2>&1 && ok || bad "shadows --hard: $(cat "$tmp/ssh.log")"
-[ "$(ls "$tmp"/shh | tr '\n' ' ')" = "bp hard pcf pcss reference " ] && ok || bad "shadows --hard methods: $(ls "$tmp/shh")"
+[ "$(ls "$tmp"/shh | grep -v "\.csv$" | tr '\n' ' ')" = "bp hard pcf pcss reference " ] && ok || bad "shadows --hard methods: $(ls "$tmp/shh")"
 # The default blocks I,II,III: block II shows the reference, so it needs one.
 "$mr" study plan "$tmp/sh" --out "$tmp/plan_sh.json" --seed 2 --fixation-ms 50 --participants 4 >"$tmp/psh.log" 2>&1 && ok || bad "plan of shadows: $(cat "$tmp/psh.log")"
 # 4 methods: C(4,2) = 6 pairs + 1 identical per category, 2 categories, 3 blocks.

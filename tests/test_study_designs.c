@@ -289,6 +289,13 @@ static void test_rating_simulated(void) {
     char *md = read_text(dir, "summary.md");
     CHECK(md && strstr(md, "D1<D2, p < .001") && strstr(md, "S1<S2"));
     free(md), free(anova), free(post), free(tt);
+    /* Kalkofen's analysis of ratings: Friedman with Wilcoxon post hoc. */
+    ap.test = MR_STUDY_TEST_FRIEDMAN;
+    CHECK(mr_study_analyze_rating(&vs, &plan, &ap, dir, &err));
+    anova = read_text(dir, "anova.csv"), post = read_text(dir, "posthoc.csv");
+    CHECK(anova && strstr(anova, "\nvirtual,occlusion,friedman,20,"));
+    CHECK(post && strstr(post, "\nvirtual,occlusion,D1,D2,wilcoxon,"));
+    free(anova), free(post);
     mr_study_votes_free(&vs);
     mr_study_plan_free(&plan);
     mr_study_set_free(&set);

@@ -31,7 +31,8 @@ const mr_opt mr_study_analyze_opts[] = {
     {"adjust", MR_OPT_ENUM, offsetof(mr_study_analyze_params, adjust), 0, 0, 1, k_adjust_names,
      "rating, task: post hoc adjustment", 0},
     {"test", MR_OPT_ENUM, offsetof(mr_study_analyze_params, test), 0, 0, 0, k_test_names,
-     "task: auto (RM-ANOVA where the residuals look normal, else Friedman), anova or friedman", 0},
+     "task: auto (RM-ANOVA where the residuals look normal, else Friedman), anova or friedman; "
+     "rating: anova (auto) or friedman (with Wilcoxon post hoc)", 0},
     {"tap-tolerance", MR_OPT_DOUBLE, offsetof(mr_study_analyze_params, tap_tolerance), 0, 1e6, 40, NULL,
      "task: a tap this near the answer (image pixels) counts as right", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},

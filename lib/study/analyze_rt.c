@@ -329,8 +329,8 @@ bool mr_study_analyze_rating(const mr_study_votes *votes, const mr_study_plan *p
     mr_sbuf md = {0};
     mr_csv_comment(means, "per condition, method and scale: over participants of their mean rating (1..7, 'X' left out)");
     mr_csv_header(means, "condition,method,scale,n,mean,sd");
-    mr_csv_comment(anova, "per condition and scale: RM-ANOVA over the methods, participants with every method rated; "
-                          "p_reported is Greenhouse-Geisser's where Mauchly's test rejects sphericity");
+    mr_csv_comment(anova, "per condition and scale: RM-ANOVA over the methods (Friedman with --test friedman), participants "
+                          "with every method rated; p_reported is Greenhouse-Geisser's where Mauchly's test rejects sphericity");
     mr_csv_header(anova, OMNI_TESTS_HEADER);
     mr_csv_header(post, OMNI_POST_HEADER);
     mr_csv_comment(tt, "per method and scale: paired t-test of the participants' mean ratings, condition 1 (S1) against 2 (S2)");
@@ -339,12 +339,19 @@ bool mr_study_analyze_rating(const mr_study_votes *votes, const mr_study_plan *p
     for (int m = 0; m < M; m++) mr_sb_printf(&md, " %s", plan->set.methods[m]);
     mr_sb_printf(&md, "; %d stimuli; %d scales rated 1..7 (%d 'X' answers left out).\n\n", plan->set.stimulus_count, K,
                  x_count);
-    mr_sb_printf(&md, "Method (Scheer & Keutel, sec. 5): per participant the mean rating of each method on each scale; "
-                      "per condition and scale a repeated-measures ANOVA over the methods (participants who rated every "
-                      "method; Mauchly's test at %g, Greenhouse-Geisser-corrected df and p where it rejects "
-                      "sphericity), paired t-tests as post hoc with %s adjustment; per method and scale a paired "
-                      "t-test between the conditions.\n\n",
-                 p.level, mr_study_adjust_name((mr_study_adjust)p.adjust));
+    if (p.test == MR_STUDY_TEST_FRIEDMAN)
+        mr_sb_printf(&md, "Method (as Kalkofen et al. analysed their categorical comparisons): per participant the mean "
+                          "rating of each method on each scale; per condition and scale Friedman's test over the methods "
+                          "(participants who rated every method), Wilcoxon signed-rank tests as post hoc with %s "
+                          "adjustment; per method and scale a paired t-test between the conditions.\n\n",
+                     mr_study_adjust_name((mr_study_adjust)p.adjust));
+    else
+        mr_sb_printf(&md, "Method (Scheer & Keutel, sec. 5): per participant the mean rating of each method on each scale; "
+                          "per condition and scale a repeated-measures ANOVA over the methods (participants who rated every "
+                          "method; Mauchly's test at %g, Greenhouse-Geisser-corrected df and p where it rejects "
+                          "sphericity), paired t-tests as post hoc with %s adjustment; per method and scale a paired "
+                          "t-test between the conditions.\n\n",
+                     p.level, mr_study_adjust_name((mr_study_adjust)p.adjust));
     double *y = ok ? malloc((size_t)P.n * M * sizeof *y) : NULL, *yc = ok ? malloc((size_t)P.n * M * sizeof *yc) : NULL;
     double *bar_m = ok ? calloc((size_t)K * M, sizeof *bar_m) : NULL, *bar_s = ok ? calloc((size_t)K * M, sizeof *bar_s) : NULL;
     if (ok && (!y || !yc || !bar_m || !bar_s)) ok = mr_fail(err, MR_ERR_NOMEM, "out of memory");
@@ -353,7 +360,8 @@ bool mr_study_analyze_rating(const mr_study_votes *votes, const mr_study_plan *p
         const char *cond = mr_study_condition_name(MR_STUDY_RATING, b);
         mr_sb_printf(&md, "## Condition %s (%s)\n\n", mr_study_block_name(b),
                      b == 1 ? "virtual only" : "with the camera image at alpha 0.5");
-        mr_sb_printf(&md, "| scale | ANOVA | post hoc |\n|---|---|---|\n");
+        mr_sb_printf(&md, "| scale | %s | post hoc |\n|---|---|---|\n",
+                     p.test == MR_STUDY_TEST_FRIEDMAN ? "Friedman" : "ANOVA");
         for (int k = 0; ok && k < K; k++) {
             for (int m = 0; m < M; m++) {
                 double s = 0, s2 = 0;
@@ -377,7 +385,7 @@ bool mr_study_analyze_rating(const mr_study_votes *votes, const mr_study_plan *p
             int n = complete_rows(y, P.n, M, yc);
             omni o;
             char ftxt[64], pair[160];
-            if (M >= 2 && omnibus(yc, n, M, 1, &p, &o)) {
+            if (M >= 2 && omnibus(yc, n, M, p.test == MR_STUDY_TEST_FRIEDMAN ? 0 : 1, &p, &o)) {
                 omni_rows(anova, post, cond, plan->scales[k], &o, plan, (mr_study_adjust)p.adjust);
                 omni_text(&o, ftxt, sizeof ftxt);
                 mr_sb_printf(&md, "| %s | %s, %s%s |", plan->scales[k], ftxt, stars(o.p), o.gg ? " (GG)" : "");

@@ -525,7 +525,9 @@ typedef struct mr_study_analyze_params {
     double level;             /* rating, task: significance level (Mauchly, normality, post hoc); default 0.05 */
     int adjust;               /* rating, task: post hoc adjustment (mr_study_adjust); default bonferroni */
     int test;                 /* task: mr_study_test; auto = RM-ANOVA when the residuals pass
-                                 D'Agostino's test, else Friedman + Wilcoxon; default auto */
+                                 D'Agostino's test, else Friedman + Wilcoxon; rating: auto and anova
+                                 = RM-ANOVA (Scheer & Keutel's), friedman = Friedman + Wilcoxon
+                                 (Kalkofen et al.'s comparison stage); default auto */
     double tap_tolerance;     /* task: a tap this near the answer (image px) is correct; default 40 */
 } mr_study_analyze_params;
 #define MR_STUDY_ANALYZE_DEFAULTS {.alpha = 0.025, .min_consistence = 0.3, .pseudo = 0.5, .z = 1.96, .level = 0.05, \

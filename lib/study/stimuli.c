@@ -9,6 +9,7 @@
 #include "study_internal.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const char *const k_ao_methods[] = {"alchemy", "crytek", "filion", "hbao", "scheer", NULL};
@@ -130,6 +131,14 @@ static bool downsample(const mr_image *src, int ss, mr_image *dst, mr_error *err
     return true;
 }
 
+/* img (ss times the size) as the stimulus: averaged down, or copied. */
+static bool final_image(const mr_image *img, int ss, mr_image *out, mr_error *err) {
+    if (ss > 1) return downsample(img, ss, out, err);
+    if (!mr_image_alloc(out, img->width, img->height, 3, MR_PIX_U8, err)) return false;
+    memcpy(out->data, img->data, mr_image_bytes(out));
+    return true;
+}
+
 bool mr_study_save_frame(const char *dir, const char *method, const char *stim, const mr_image *img, int ss,
                          mr_error *err) {
     if (ss <= 1) return save(dir, method, stim, img, err);
@@ -139,11 +148,45 @@ bool mr_study_save_frame(const char *dir, const char *method, const char *stim, 
     return ok;
 }
 
+/* The thesis's check that a category's two scenes are alike (Fig. 4.5):
+ * per method the mean absolute difference to the reference (RGB, in
+ * [0, 1]) over the whole image and over the pixels the shadows touch --
+ * where the image without shadows differs from the reference. */
+static void difference_rows(mr_csv *csv, const char *stim, const mr_image *shots, const char *const *names, int n,
+                            const mr_image *ref, const mr_image *unlit) {
+    size_t px = (size_t)ref->width * ref->height;
+    const uint8_t *R = ref->data, *U = unlit->data;
+    size_t shadow = 0;
+    for (size_t i = 0; i < px; i++)
+        shadow += R[i * 3] != U[i * 3] || R[i * 3 + 1] != U[i * 3 + 1] || R[i * 3 + 2] != U[i * 3 + 2];
+    char cat[MR_STUDY_NAME_MAX];
+    mr_study_category_of(stim, cat, sizeof cat);
+    for (int m = 0; m < n; m++) {
+        const uint8_t *A = shots[m].data;
+        double whole = 0, inside = 0;
+        for (size_t i = 0; i < px; i++) {
+            double d = (abs(A[i * 3] - R[i * 3]) + abs(A[i * 3 + 1] - R[i * 3 + 1]) + abs(A[i * 3 + 2] - R[i * 3 + 2])) /
+                       (3 * 255.0);
+            whole += d;
+            if (R[i * 3] != U[i * 3] || R[i * 3 + 1] != U[i * 3 + 1] || R[i * 3 + 2] != U[i * 3 + 2]) inside += d;
+        }
+        mr_csv_text(csv, cat);
+        mr_csv_text(csv, stim);
+        mr_csv_text(csv, names[m]);
+        mr_csv_num(csv, "%.6f", whole / (double)px);
+        mr_csv_num(csv, "%.6f", shadow ? inside / (double)shadow : NAN);
+        mr_csv_num(csv, "%.6f", (double)shadow / (double)px);
+        mr_csv_end_row(csv);
+    }
+}
+
 /* One stimulus: every method of the family (the optional one when asked)
- * and its reference, at ss times the size, averaged down. */
+ * and its reference, at ss times the size, averaged down; with diff, the
+ * shadows family's differences to the reference (one more render, without
+ * shadows). */
 static bool render_stimulus(mr_renderer *r, const mr_study_family *fam, const mr_study_stimuli_params *p, int ss,
                             const mr_scene *scene, const mr_view *view, const mr_image *video, const char *dir,
-                            const char *stim, int *count, mr_error *err) {
+                            const char *stim, int *count, mr_csv *diff, mr_error *err) {
     mr_frame_params base = MR_FRAME_DEFAULTS;
     base.width = p->width * ss;
     base.height = p->height * ss;
@@ -151,23 +194,40 @@ static bool render_stimulus(mr_renderer *r, const mr_study_family *fam, const mr
     base.alpha = 0.5f; /* Scheer & Keutel's 50 % overlay */
     int n = 0;
     while (fam->methods[n]) n++;
+    int total = n + (fam->optional && p->hard);
+    mr_image shots[MR_STUDY_MAX_METHODS + 2];
+    const char *names[MR_STUDY_MAX_METHODS + 2];
+    memset(shots, 0, sizeof shots);
     bool ok = true;
-    for (int m = 0; ok && m < n + (fam->optional && p->hard); m++) {
+    for (int m = 0; ok && m < total; m++) {
         mr_frame_params fp = base;
         fam->setup(&fp, m);
         mr_frame_result res = {0};
-        ok = mr_render_frame(r, view, &fp, &res, err) &&
-             mr_study_save_frame(dir, m < n ? fam->methods[m] : fam->optional, stim, &res.color, ss, err);
+        names[m] = m < n ? fam->methods[m] : fam->optional;
+        ok = mr_render_frame(r, view, &fp, &res, err) && final_image(&res.color, ss, &shots[m], err) &&
+             save(dir, names[m], stim, &shots[m], err);
         mr_frame_result_free(&res);
         if (ok && count) (*count)++;
     }
+    mr_image ref = {0}, unlit = {0};
     if (ok && fam->has_reference && fam->reference) {
         mr_frame_result res = {0};
-        ok = fam->reference(r, scene, view, &base, p, &res, err) &&
-             mr_study_save_frame(dir, MR_STUDY_REFERENCE, stim, &res.color, ss, err);
+        ok = fam->reference(r, scene, view, &base, p, &res, err) && final_image(&res.color, ss, &ref, err) &&
+             save(dir, MR_STUDY_REFERENCE, stim, &ref, err);
         mr_frame_result_free(&res);
         if (ok && count) (*count)++;
+        if (ok && diff) {
+            mr_frame_params fp = base;
+            fp.shadow.method = MR_SHADOW_OFF;
+            mr_frame_result off = {0};
+            ok = mr_render_frame(r, view, &fp, &off, err) && final_image(&off.color, ss, &unlit, err);
+            mr_frame_result_free(&off);
+            if (ok) difference_rows(diff, stim, shots, names, total, &ref, &unlit);
+        }
     }
+    for (int m = 0; m < total; m++) mr_image_free(&shots[m]);
+    mr_image_free(&ref);
+    mr_image_free(&unlit);
     return ok;
 }
 
@@ -199,9 +259,9 @@ static bool conditions_render(mr_renderer *r, const mr_study_family *fam, const 
         ok = mr_renderer_set_scene(r, hall->built, err) && mr_render_frame(r, &view, &vp, &cam, err);
         ok = ok && mr_renderer_set_scene(r, hall->planned, err);
         mr_path_join(dir, "virtual", sub, sizeof sub);
-        ok = ok && render_stimulus(r, fam, p, ss, hall->planned, &view, NULL, sub, stim, count, err);
+        ok = ok && render_stimulus(r, fam, p, ss, hall->planned, &view, NULL, sub, stim, count, NULL, err);
         mr_path_join(dir, "video", sub, sizeof sub);
-        ok = ok && render_stimulus(r, fam, p, ss, hall->planned, &view, &cam.color, sub, stim, count, err);
+        ok = ok && render_stimulus(r, fam, p, ss, hall->planned, &view, &cam.color, sub, stim, count, NULL, err);
         mr_frame_result_free(&cam);
         mr_renderer_set_scene(r, NULL, NULL);
     }
@@ -252,17 +312,26 @@ bool mr_study_stimuli_render(mr_renderer *r, const mr_study_stimuli_params *pp, 
             mr_view view = mr_demo_view(v);
             char stim[32];
             snprintf(stim, sizeof stim, "hall_v%d", v);
-            ok = render_stimulus(r, fam, &p, ss, hall.planned, &view, NULL, dir, stim, count, err);
+            ok = render_stimulus(r, fam, &p, ss, hall.planned, &view, NULL, dir, stim, count, NULL, err);
         }
         mr_renderer_set_scene(r, NULL, NULL);
         mr_demo_free(&hall);
         return ok;
     }
+    mr_csv *diff = mr_csv_create(err);
+    if (!diff) return false;
+    mr_csv_comment(diff, "per stimulus and method: mean |method - reference| (RGB / 255) over the whole image and over the "
+                         "pixels the shadows touch (where the image without shadows differs from the reference); "
+                         "the thesis's Fig. 4.5 check that a category's two scenes are alike");
+    mr_csv_header(diff, "category,stimulus,method,diff_whole,diff_shadow,shadow_fraction");
     for (int c = 0; ok && c < p.cases; c++) {
         int ci = suite_index(mr_study_shadow_cases[c]);
-        if (ci < 0) return mr_fail(err, MR_ERR_INVALID, "no shadow suite case %s", mr_study_shadow_cases[c]);
         mr_shadow_suite_case sc;
-        if (!mr_shadow_suite_build(ci, &sc, err)) return false;
+        if (ci < 0) ok = mr_fail(err, MR_ERR_INVALID, "no shadow suite case %s", mr_study_shadow_cases[c]);
+        if (!ok || !mr_shadow_suite_build(ci, &sc, err)) {
+            ok = false;
+            break;
+        }
         for (int scene = 0; ok && scene < 2; scene++) {
             mr_scene *s = sc.scene;
             mr_demo_hall hall = {0};
@@ -288,11 +357,15 @@ bool mr_study_stimuli_render(mr_renderer *r, const mr_study_stimuli_params *pp, 
             view.camera.width = p.width * ss, view.camera.height = p.height * ss;
             view.camera.fx *= ss, view.camera.fy *= ss;
             view.camera.cx = 0.5 * view.camera.width - 0.5, view.camera.cy = 0.5 * view.camera.height - 0.5;
-            ok = mr_renderer_set_scene(r, s, err) && render_stimulus(r, fam, &p, ss, s, &view, NULL, dir, stim, count, err);
+            ok = mr_renderer_set_scene(r, s, err) && render_stimulus(r, fam, &p, ss, s, &view, NULL, dir, stim, count, diff, err);
             mr_renderer_set_scene(r, NULL, NULL);
             if (hall.planned || hall.built) mr_demo_free(&hall);
         }
         mr_shadow_suite_free(&sc);
     }
+    char path[4200];
+    mr_path_join(dir, "differences.csv", path, sizeof path);
+    ok = ok && mr_csv_save(diff, path, err);
+    mr_csv_destroy(&diff);
     return ok;
 }
