@@ -425,12 +425,12 @@ static void test_annotation_append(void) {
         const mr_annotation *x = &an.items[0], *y = &an.items[1];
         mr_dmat4 p0 = pose_of(0);
         CHECK_MSG(strcmp(x->type, "discrepancy") == 0 && x->time_unix == 1.7e9 && x->frame_index == 10 &&
-                      x->timestamp == 0 && strcmp(x->note, "missing") == 0 && x->has_pixel && x->pixel[0] == 12.5 &&
+                      x->timestamp == 0 && strcmp(x->category, "missing") == 0 && !x->note[0] && x->has_pixel && x->pixel[0] == 12.5 &&
                       x->pixel[1] == 7.25 && x->hit && x->world[2] == -3.5 && x->depth == 4.5 &&
                       strcmp(x->node, "pipe_03") == 0 && strcmp(x->layer, "hidden") == 0 && x->has_pose &&
                       x->pose_valid && same_m4(&x->world_from_camera, &p0),
                   "mark 1 read back with other fields");
-        CHECK_MSG(!y->hit && y->node[0] == 0 && y->frame_index == 11 && strcmp(y->note, "moved") == 0 &&
+        CHECK_MSG(!y->hit && y->node[0] == 0 && y->frame_index == 11 && strcmp(y->category, "moved") == 0 &&
                       cJSON_IsString(cJSON_GetObjectItem(cJSON_GetObjectItem(y->json, "snapshot"), "screen")),
                   "mark 2 read back with other fields");
     }
@@ -689,7 +689,7 @@ static void test_mark_files(void) {
     CHECK(dst.image.data && ((unsigned char *)dst.image.data)[0] == 7);
     mr_annotation m;
     mr_annotation_from_frame(&m, &src, "extra", 1000);
-    CHECK(!strcmp(m.type, "discrepancy") && !strcmp(m.note, "extra") && m.frame_index == 42 && m.timestamp == 4.2);
+    CHECK(!strcmp(m.type, "discrepancy") && !strcmp(m.category, "extra") && m.frame_index == 42 && m.timestamp == 4.2);
     CHECK(m.has_pose && m.pose_valid && m.world_from_camera.m[3] == 1 && m.pose_tags_seen == 3 && m.node_index == -1);
     char dir[1200];
     tmp_path("marks", dir, sizeof dir);
@@ -706,7 +706,7 @@ static void test_mark_files(void) {
     snprintf(path, sizeof path, "%s/annotations.jsonl", dir);
     mr_annotations a = {0};
     CHECK(mr_annotations_load(path, &a, &err));
-    CHECK_MSG(a.count == 1 && a.items[0].frame_index == 42 && !strcmp(a.items[0].note, "extra"),
+    CHECK_MSG(a.count == 1 && a.items[0].frame_index == 42 && !strcmp(a.items[0].category, "extra"),
               "mark line: %d read back", a.count);
     mr_annotations_free(&a);
     mr_capture_frame_free(&src);
@@ -782,8 +782,91 @@ static void test_input(void) {
     CHECK(mr_input_open(bad_path, NULL, &rec, &err) == NULL && rec == NULL && err.msg[0]);
 }
 
+/* What the planner says about a mark: the note with its inline fields,
+ * the title in words, and edits as new lines that supersede the old one
+ * (readers take the newest; the log only grows). */
+static void test_mark_words_and_edits(void) {
+    mr_annotation a;
+    memset(&a, 0, sizeof a);
+    a.node_index = -1;
+    snprintf(a.type, sizeof a.type, "discrepancy");
+    mr_mark_set_note(&a, "  duct   clashes @ann #hvac #level2 !high with tray ");
+    CHECK_MSG(!strcmp(a.note, "duct clashes with tray") && !strcmp(a.assignee, "ann") && !strcmp(a.priority, "high") &&
+                  a.label_count == 2 && !strcmp(a.labels[0], "hvac") && !strcmp(a.labels[1], "level2"),
+              "note '%s' assignee '%s' priority '%s' labels %d", a.note, a.assignee, a.priority, a.label_count);
+    /* Titles: the category and part; the measured offset's size and axis. */
+    char t[200];
+    snprintf(a.category, sizeof a.category, "moved");
+    snprintf(a.node, sizeof a.node, "Machine_2");
+    mr_mark_title(&a, t, sizeof t);
+    CHECK_MSG(!strcmp(t, "Moved: Machine_2"), "title '%s'", t);
+    a.has_measurement = true;
+    a.measurement.has_distance = true;
+    a.measurement.distance_m = 0.3;
+    a.measurement.tri.point = mr_v3(4.3, 1.5, -2.0);
+    a.measurement.planned = mr_v3(4.0, 1.49, -2.02);
+    mr_mark_title(&a, t, sizeof t);
+    CHECK_MSG(!strcmp(t, "Moved: Machine_2, 0.30 m along +x"), "title '%s'", t);
+    a.measurement.tri.point = mr_v3(4.0, 1.5, -2.5);
+    a.measurement.distance_m = 0.048;
+    mr_mark_title(&a, t, sizeof t);
+    CHECK_MSG(!strcmp(t, "Moved: Machine_2, 48 mm along -z"), "title '%s'", t);
+    a.has_measurement = false;
+    a.node[0] = 0;
+    a.category[0] = 0;
+    mr_mark_title(&a, t, sizeof t);
+    CHECK_MSG(!strcmp(t, "duct clashes with tray"), "a mark without a category is titled by its note: '%s'", t);
+    /* Edits: mark 1 (with an id) edited twice and closed, mark 2 (an
+     * older line without an id) edited once; mark 3 untouched. */
+    const char *text =
+        "{\"type\":\"discrepancy\",\"id\":\"m1\",\"revision\":1,\"category\":\"moved\",\"note\":\"first\","
+        "\"snapshot\":{\"frame\":\"s/a.png\"}}\n"
+        "{\"type\":\"discrepancy\",\"time_unix\":5,\"frame_index\":3,\"note\":\"extra\",\"pixel\":[1,2]}\n"
+        "{\"type\":\"discrepancy\",\"id\":\"m3\",\"category\":\"clash\"}\n";
+    mr_annotations an;
+    mr_error err = {0};
+    CHECK(mr_annotations_parse(text, strlen(text), &an, &err) && an.count == 3);
+    CHECK_MSG(an.count == 3 && !strcmp(an.items[1].category, "extra") && !an.items[1].note[0],
+              "an older line's note did not become its category");
+    char log[8192];
+    snprintf(log, sizeof log, "%s", text);
+    for (int round = 0; an.count == 3 && round < 3; round++) {
+        mr_annotation e;
+        memset(&e, 0, sizeof e);
+        int which = round == 1 ? 1 : 0;
+        snprintf(e.category, sizeof e.category, "%s", round == 0 ? "wrong size" : an.items[which].category);
+        mr_mark_set_note(&e, round == 2 ? "done @bob" : "edited");
+        snprintf(e.status, sizeof e.status, "%s", round == 2 ? "closed" : "");
+        cJSON *line = mr_annotation_edit_line(&an.items[which], &e, 100 + round);
+        char *l = line ? cJSON_PrintUnformatted(line) : NULL;
+        CHECK(l != NULL);
+        if (l) snprintf(log + strlen(log), sizeof log - strlen(log), "%s\n", l);
+        free(l);
+        cJSON_Delete(line);
+        mr_annotations_free(&an);
+        CHECK(mr_annotations_parse(log, strlen(log), &an, &err));
+        int dropped = mr_annotations_current(&an);
+        CHECK_MSG(an.count == 3 && dropped == round + 1, "round %d: %d marks, %d lines superseded", round, an.count, dropped);
+    }
+    if (an.count == 3) {
+        const mr_annotation *m1 = &an.items[0], *m2 = &an.items[1], *m3 = &an.items[2];
+        CHECK_MSG(!strcmp(m1->id, "m1") && m1->revision == 3 && !strcmp(m1->status, "closed") &&
+                      !strcmp(m1->category, "wrong size") && !strcmp(m1->note, "done") && !strcmp(m1->assignee, "bob"),
+                  "mark 1 after two edits: rev %d status '%s' category '%s' note '%s'", m1->revision, m1->status,
+                  m1->category, m1->note);
+        /* The edit keeps what it did not change (the snapshot). */
+        CHECK(cJSON_GetObjectItem(cJSON_GetObjectItem(m1->json, "snapshot"), "frame") != NULL);
+        CHECK(!strcmp(m1->title, "Wrong size") && cJSON_IsNumber(cJSON_GetObjectItem(m1->json, "edited_unix")));
+        CHECK_MSG(m2->revision == 2 && !strcmp(m2->note, "edited") && m2->frame_index == 3 && m2->id[0],
+                  "the older mark's edit did not supersede it (rev %d, note '%s')", m2->revision, m2->note);
+        CHECK(!strcmp(m3->id, "m3") && m3->revision == 0);
+    }
+    mr_annotations_free(&an);
+}
+
 int main(void) {
     if (!mr_test_fresh_dir("test_session", g_tmp, sizeof g_tmp)) return 1;
+    test_mark_words_and_edits();
     test_round_trip();
     test_mutations();
     test_replay();

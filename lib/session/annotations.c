@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <unistd.h>
 
 bool mr_annotation_append(const char *path, const cJSON *obj, mr_error *err) {
@@ -149,7 +150,19 @@ cJSON *mr_annotation_to_json(const mr_annotation *a) {
     cJSON_AddNumberToObject(line, "time_unix", a->time_unix);
     cJSON_AddNumberToObject(line, "frame_index", (double)a->frame_index);
     cJSON_AddNumberToObject(line, "timestamp", a->timestamp);
+    if (a->id[0]) cJSON_AddStringToObject(line, "id", a->id);
+    if (a->revision > 0) cJSON_AddNumberToObject(line, "revision", a->revision);
+    if (a->category[0]) cJSON_AddStringToObject(line, "category", a->category);
     cJSON_AddStringToObject(line, "note", a->note);
+    if (a->title[0]) cJSON_AddStringToObject(line, "title", a->title);
+    if (a->status[0]) cJSON_AddStringToObject(line, "status", a->status);
+    if (a->priority[0]) cJSON_AddStringToObject(line, "priority", a->priority);
+    if (a->assignee[0]) cJSON_AddStringToObject(line, "assignee", a->assignee);
+    if (a->label_count > 0) {
+        cJSON *l = cJSON_AddArrayToObject(line, "labels");
+        for (int i = 0; i < a->label_count && i < MR_MARK_MAX_LABELS; i++)
+            cJSON_AddItemToArray(l, cJSON_CreateString(a->labels[i]));
+    }
     cJSON_AddItemToObject(line, "pixel", mr_json_from_doubles(a->pixel, 2));
     cJSON_AddBoolToObject(line, "hit", a->hit);
     if (a->hit) {
@@ -183,6 +196,43 @@ cJSON *mr_sess_pose_json(bool valid, const mr_dmat4 *world_from_camera, int tags
     return p;
 }
 
+const char *const mr_mark_categories[MR_MARK_CATEGORY_COUNT] = {"missing", "extra", "moved", "wrong size", "clash", "other"};
+
+static int category_index(const char *s) {
+    for (int i = 0; i < MR_MARK_CATEGORY_COUNT; i++)
+        if (strcasecmp(s, mr_mark_categories[i]) == 0) return i;
+    return -1;
+}
+
+/* What the planner said: id, revision, category, note, title, status,
+ * priority, assignee, labels. */
+static bool parse_topic(const cJSON *o, mr_annotation *a) {
+    double rev = 0;
+    if (!get_str(o, "id", a->id, sizeof a->id, false) || !get_num(o, "revision", &rev) ||
+        !(rev >= 0 && rev < 1e9 && rev == floor(rev)) || !get_str(o, "category", a->category, sizeof a->category, false) ||
+        !get_str(o, "note", a->note, sizeof a->note, false) || !get_str(o, "title", a->title, sizeof a->title, false) ||
+        !get_str(o, "status", a->status, sizeof a->status, false) ||
+        !get_str(o, "priority", a->priority, sizeof a->priority, false) ||
+        !get_str(o, "assignee", a->assignee, sizeof a->assignee, false))
+        return false;
+    a->revision = (int)rev;
+    const cJSON *l = cJSON_GetObjectItemCaseSensitive(o, "labels");
+    if (l && !cJSON_IsNull(l)) {
+        if (!cJSON_IsArray(l) || cJSON_GetArraySize(l) > MR_MARK_MAX_LABELS) return false;
+        const cJSON *x;
+        cJSON_ArrayForEach(x, l) {
+            if (!cJSON_IsString(x) || strlen(x->valuestring) >= sizeof a->labels[0]) return false;
+            snprintf(a->labels[a->label_count++], sizeof a->labels[0], "%s", x->valuestring);
+        }
+    }
+    /* Before marks had a category, the chosen word was the note. */
+    if (!cJSON_GetObjectItemCaseSensitive(o, "category") && category_index(a->note) >= 0) {
+        snprintf(a->category, sizeof a->category, "%s", mr_mark_categories[category_index(a->note)]);
+        a->note[0] = 0;
+    }
+    return true;
+}
+
 static bool parse_annotation(const cJSON *o, mr_annotation *a) {
     memset(a, 0, sizeof *a);
     a->frame_index = -1;
@@ -198,7 +248,8 @@ static bool parse_annotation(const cJSON *o, mr_annotation *a) {
     if (fi != -1 && !(fi >= 0 && fi < 1e15 && fi == floor(fi))) return false;
     a->frame_index = (int64_t)fi;
     bool has_world = false;
-    if (!get_str(o, "note", a->note, sizeof a->note, false) || !get_str(o, "node", a->node, sizeof a->node, false) ||
+    if (!parse_topic(o, a)) return false;
+    if (!get_str(o, "node", a->node, sizeof a->node, false) ||
         !get_str(o, "layer", a->layer, sizeof a->layer, false) || !get_vec(o, "pixel", a->pixel, 2, &a->has_pixel) ||
         !get_vec(o, "world", a->world, 3, &has_world))
         return false;
@@ -275,6 +326,115 @@ bool mr_annotations_load(const char *path, mr_annotations *out, mr_error *err) {
     free(text);
     if (ok && out->bad_lines) mr_log(MR_LOG_WARN, "%s: skipped %d unreadable line(s)", path, out->bad_lines);
     return ok;
+}
+
+void mr_annotation_key(const mr_annotation *a, char *out, size_t n) {
+    if (a->id[0]) snprintf(out, n, "%s", a->id);
+    else snprintf(out, n, "t%.3f-f%lld-p%.2f,%.2f", a->time_unix, (long long)a->frame_index, a->pixel[0], a->pixel[1]);
+}
+
+cJSON *mr_annotation_edit_line(const mr_annotation *a, const mr_annotation *edited, double time_unix) {
+    mr_annotation e = *a;
+    e.json = NULL;
+    mr_annotation_key(a, e.id, sizeof e.id);
+    e.revision = (a->revision > 0 ? a->revision : 1) + 1;
+    snprintf(e.category, sizeof e.category, "%s", edited->category);
+    snprintf(e.note, sizeof e.note, "%s", edited->note);
+    snprintf(e.status, sizeof e.status, "%s", edited->status);
+    snprintf(e.priority, sizeof e.priority, "%s", edited->priority);
+    snprintf(e.assignee, sizeof e.assignee, "%s", edited->assignee);
+    memcpy(e.labels, edited->labels, sizeof e.labels);
+    e.label_count = edited->label_count;
+    mr_mark_title(&e, e.title, sizeof e.title);
+    cJSON *line = mr_annotation_to_json(&e);
+    if (!line) return NULL;
+    /* What the struct does not hold (the snapshot, distances, verdicts)
+     * comes along from the line edited. */
+    const cJSON *it;
+    if (a->json)
+        cJSON_ArrayForEach(it, a->json) {
+            if (!it->string || cJSON_GetObjectItemCaseSensitive(line, it->string)) continue;
+            /* fields the edit may have emptied stay empty */
+            static const char *const topic[] = {"id", "category", "note", "title", "status", "priority", "assignee", "labels"};
+            bool skip = false;
+            for (size_t k = 0; k < sizeof topic / sizeof topic[0]; k++) skip |= strcmp(it->string, topic[k]) == 0;
+            if (!skip) cJSON_AddItemToObject(line, it->string, cJSON_Duplicate(it, true));
+        }
+    cJSON_DeleteItemFromObjectCaseSensitive(line, "edited_unix");
+    cJSON_AddNumberToObject(line, "edited_unix", time_unix);
+    return line;
+}
+
+int mr_annotations_current(mr_annotations *a) {
+    int kept = 0, dropped = 0;
+    for (int i = 0; i < a->count; i++) {
+        mr_annotation *x = &a->items[i];
+        int first = -1;
+        char kx[64], kk[64];
+        mr_annotation_key(x, kx, sizeof kx);
+        for (int k = 0; k < kept && first < 0; k++) {
+            mr_annotation_key(&a->items[k], kk, sizeof kk);
+            if (strcmp(kk, kx) == 0) first = k;
+        }
+        if (first >= 0) {
+            /* The newer line takes the place of the mark's first line. */
+            cJSON_Delete(a->items[first].json);
+            a->items[first] = *x;
+            dropped++;
+        } else {
+            a->items[kept++] = *x;
+        }
+    }
+    a->count = kept;
+    return dropped;
+}
+
+void mr_mark_set_note(mr_annotation *a, const char *typed) {
+    char buf[sizeof a->note];
+    snprintf(buf, sizeof buf, "%s", typed ? typed : "");
+    size_t k = 0;
+    a->note[0] = 0;
+    for (char *save = NULL, *w = strtok_r(buf, " \t\r\n", &save); w; w = strtok_r(NULL, " \t\r\n", &save)) {
+        if (w[0] == '@' && w[1]) snprintf(a->assignee, sizeof a->assignee, "%s", w + 1);
+        else if (w[0] == '!' && w[1]) snprintf(a->priority, sizeof a->priority, "%s", w + 1);
+        else if (w[0] == '#' && w[1] && a->label_count < MR_MARK_MAX_LABELS)
+            snprintf(a->labels[a->label_count++], sizeof a->labels[0], "%s", w + 1);
+        else if (k + strlen(w) + 2 < sizeof a->note)
+            k += (size_t)snprintf(a->note + k, sizeof a->note - k, "%s%s", k ? " " : "", w);
+    }
+}
+
+void mr_mark_new_id(double time_unix, int counter, char *out, size_t n) {
+    snprintf(out, n, "m%llx-%x", (unsigned long long)(time_unix > 0 ? time_unix * 1000.0 : 0), (unsigned)counter);
+}
+
+/* "0.30 m" from 0.1 m up, "25 mm" below. */
+static void words_len(double m, char *out, size_t n) {
+    if (m >= 0.1) snprintf(out, n, "%.2f m", m);
+    else snprintf(out, n, "%.0f mm", m * 1000);
+}
+
+void mr_mark_title(const mr_annotation *a, char *out, size_t n) {
+    /* A mark without a category (written by another program): its note. */
+    if (!a->category[0] && a->note[0]) {
+        snprintf(out, n, "%.120s", a->note);
+        return;
+    }
+    char cat[32];
+    snprintf(cat, sizeof cat, "%s", a->category[0] ? a->category : "discrepancy");
+    if (cat[0] >= 'a' && cat[0] <= 'z') cat[0] = (char)(cat[0] - 'a' + 'A');
+    const char *part = a->node[0] ? a->node : a->has_measurement && a->measurement.planned_node[0]
+                                                  ? a->measurement.planned_node : "";
+    size_t k = (size_t)snprintf(out, n, "%s%s%s", cat, part[0] ? ": " : "", part);
+    if (k >= n || !a->has_measurement || !a->measurement.has_distance) return;
+    const mr_measurement *m = &a->measurement;
+    double d[3] = {m->tri.point.x - m->planned.x, m->tri.point.y - m->planned.y, m->tri.point.z - m->planned.z};
+    int ax = 0;
+    for (int i = 1; i < 3; i++)
+        if (fabs(d[i]) > fabs(d[ax])) ax = i;
+    char len[32];
+    words_len(m->distance_m, len, sizeof len);
+    snprintf(out + k, n - k, "%s%s along %c%c", part[0] ? ", " : ": ", len, d[ax] < 0 ? '-' : '+', "xyz"[ax]);
 }
 
 void mr_annotations_free(mr_annotations *a) {

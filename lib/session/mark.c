@@ -16,13 +16,14 @@ bool mr_capture_frame_copy(mr_capture_frame *dst, const mr_capture_frame *src, m
     return true;
 }
 
-void mr_annotation_from_frame(mr_annotation *m, const mr_capture_frame *f, const char *note, double time_unix) {
+void mr_annotation_from_frame(mr_annotation *m, const mr_capture_frame *f, const char *category, double time_unix) {
     memset(m, 0, sizeof *m);
     snprintf(m->type, sizeof m->type, "discrepancy");
     m->time_unix = time_unix;
     m->frame_index = f->index;
     m->timestamp = f->timestamp;
-    snprintf(m->note, sizeof m->note, "%s", note);
+    snprintf(m->category, sizeof m->category, "%s", category ? category : "");
+    m->revision = 1;
     m->node_index = -1;
     m->has_pose = true;
     m->pose_valid = f->pose_valid;

@@ -14,7 +14,9 @@
  *                      "world_from_camera", "still"}
  *   annotations.jsonl  discrepancy marks of `mrcheck view` (in its session
  *                      folder): {"type","time_unix","frame_index",
- *                      "timestamp","note","pixel":[x,y],"hit",
+ *                      "timestamp","id","revision","category","note",
+ *                      "title","status","priority","assignee","labels",
+ *                      "pixel":[x,y],"hit",
  *                      "world":[3]|null,"depth","node","layer",
  *                      "pose":{"valid","world_from_camera",...},
  *                      "snapshot":{"screen","frame","pose"}}
@@ -225,12 +227,29 @@ bool mr_annotation_append(const char *path, const cJSON *obj, mr_error *err);
 
 /* One mark as read back (the fields the exports need; `json` holds the
  * whole line for the rest). */
+/* The categories a mark is filed under (the view's chooser, in its order). */
+#define MR_MARK_CATEGORY_COUNT 6
+extern const char *const mr_mark_categories[MR_MARK_CATEGORY_COUNT]; /* missing extra moved "wrong size" clash other */
+#define MR_MARK_MAX_LABELS 8
+
 typedef struct mr_annotation {
     char type[32];                  /* "discrepancy" */
     double time_unix;               /* when it was marked, Unix seconds; 0 unknown */
     int64_t frame_index;            /* -1 unknown */
     double timestamp;               /* the frame's time, seconds */
-    char note[128];
+    /* What the planner said. Lines written before marks had a category
+     * carried it as "note" (one of the six words): read back, such a note
+     * becomes the category and the note is empty. */
+    char id[40];                    /* the mark's identity across edits; "" (older lines): the line's own */
+    int revision;                   /* 1 the first line of a mark, +1 per edit; 0 unknown */
+    char category[24];              /* one of mr_mark_categories, "" none */
+    char note[512];                 /* free text typed by the planner, "" none */
+    char title[200];                /* "Moved: Machine_2, 0.30 m along +x" (mr_mark_title) */
+    char status[24];                /* "open" (default, "" read as open), "in progress", "closed" */
+    char priority[24];              /* "" none, else e.g. "low", "normal", "high" */
+    char assignee[96];              /* "" none */
+    char labels[MR_MARK_MAX_LABELS][32];
+    int label_count;
     bool has_pixel;
     double pixel[2];                /* where it was marked, screen pixels */
     bool hit;                       /* the mark lies on the model */
@@ -255,7 +274,9 @@ typedef struct mr_annotation {
 
 /* The line of a mark, as `mrcheck view` writes it and the reader reads it
  * back (one place for the format): type, time_unix, frame_index,
- * timestamp, note, pixel, hit, world (null when no hit), depth (hit only),
+ * timestamp, id and revision (when set), category, note, title, status,
+ * priority, assignee, labels (each when not empty), pixel, hit, world
+ * (null when no hit), depth (hit only),
  * node (null when none; then node_index and layer), pose {valid,
  * world_from_camera, tags_seen, rms_px}, uncertainty_m (only when
  * has_uncertainty; older lines have none), and with has_measurement
@@ -268,6 +289,20 @@ typedef struct mr_annotation {
  * view adds "snapshot") before mr_annotation_append. NULL when out of
  * memory. */
 cJSON *mr_annotation_to_json(const mr_annotation *a);
+
+/* The title of a mark in words, from its category, its part and (where
+ * measured) its distance to the plan and the direction of the largest
+ * component of that offset in scene axes: "Moved: Machine_2, 0.30 m
+ * along +x", "Missing: Column_3", "Other" without a part; a mark with a
+ * note but no category (written by another program) is titled by its note. */
+void mr_mark_title(const mr_annotation *a, char *out, size_t n);
+/* The note as typed in the view, with its optional fields written inline:
+ * "@name" the assignee, "#word" a label (up to MR_MARK_MAX_LABELS), "!word"
+ * the priority; the rest (words joined by single spaces) is the note.
+ * Fields not named in the text are left as they are. */
+void mr_mark_set_note(mr_annotation *a, const char *typed);
+/* A new mark id ("m" + time + counter in hex), unique within a session. */
+void mr_mark_new_id(double time_unix, int counter, char *out, size_t n);
 
 typedef struct mr_annotations {
     mr_annotation *items;
@@ -286,6 +321,19 @@ typedef struct mr_annotations {
 bool mr_annotations_parse(const char *text, size_t size, mr_annotations *out, mr_error *err);
 bool mr_annotations_load(const char *path, mr_annotations *out, mr_error *err);
 void mr_annotations_free(mr_annotations *a); /* zeroes it */
+/* Edits and closings are new lines with the same "id" (the log stays
+ * append-only): keeps, for each mark, the newest line in the place of the
+ * mark's first line, and drops the lines it superseded (returns how many). */
+int mr_annotations_current(mr_annotations *a);
+/* The id a mark is known by: its "id", or for a line written before marks
+ * had one, an id made from its time, frame and pixel (an edit of such a
+ * mark carries that id, and so supersedes it). */
+void mr_annotation_key(const mr_annotation *a, char *out, size_t n);
+/* An edit of mark a: its line (a->json, all fields kept, those of edited
+ * replacing them) with edited's category, note, status, priority,
+ * assignee, labels, the revision after a's, the key as its id, a new title
+ * and "edited_unix". NULL when out of memory. */
+cJSON *mr_annotation_edit_line(const mr_annotation *a, const mr_annotation *edited, double time_unix);
 
 /* -------------------------------------------------------------- capture
  * capture.c: `mrcheck view`'s capture and tracking off the render thread.
@@ -387,10 +435,11 @@ void mr_snapshot_next_stem(const char *session_dir, const char *prefix, int *cou
 /* A deep copy of src (its image too) into dst, whose image is freed first;
  * false + err (dst without an image) when out of memory. */
 bool mr_capture_frame_copy(mr_capture_frame *dst, const mr_capture_frame *src, mr_error *err);
-/* A "discrepancy" annotation of a mark made on frame f with note: the
- * frame's index, time and pose; the rest zero (node_index -1) for the
- * caller to fill (pixel, pick, uncertainty, measurement). */
-void mr_annotation_from_frame(mr_annotation *m, const mr_capture_frame *f, const char *note, double time_unix);
+/* A "discrepancy" annotation of a mark made on frame f, filed under
+ * category (revision 1): the frame's index, time and pose; the rest zero
+ * (node_index -1) for the caller to fill (id, note, pixel, pick,
+ * uncertainty, measurement, title). */
+void mr_annotation_from_frame(mr_annotation *m, const mr_capture_frame *f, const char *category, double time_unix);
 /* A finished mark's files: the snapshot (sn) as session_dir/snapshots/<stem>_*
  * and line, with the snapshot's paths under "snapshot", appended to
  * session_dir/annotations.jsonl. The line is written even when the snapshot
