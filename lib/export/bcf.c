@@ -6,11 +6,36 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 #include <zip.h>
 
-static const char *k_status = "Open";
-static const char *k_type = "Issue";
+/* Topic types: the marks' categories in words; "Issue" for a mark
+ * without one. Statuses: the mark's, in BCF's usual words. */
+static const char *const k_types[] = {"Missing", "Extra", "Moved", "Wrong size", "Clash", "Other", "Issue"};
+#define K_TYPE_ISSUE 6
+_Static_assert(sizeof k_types / sizeof k_types[0] == MR_MARK_CATEGORY_COUNT + 1, "a type per category, and Issue");
+static const char *const k_statuses[] = {"Open", "In Progress", "Closed"};
+
+static const char *topic_type(const mr_annotation *a) {
+    for (int i = 0; i < MR_MARK_CATEGORY_COUNT; i++)
+        if (strcmp(a->category, mr_mark_categories[i]) == 0) return k_types[i];
+    return k_types[K_TYPE_ISSUE];
+}
+
+static const char *topic_status(const mr_annotation *a) {
+    if (strcasecmp(a->status, "closed") == 0) return k_statuses[2];
+    if (strcasecmp(a->status, "in progress") == 0 || strcasecmp(a->status, "in_progress") == 0) return k_statuses[1];
+    return k_statuses[0];
+}
+
+/* Adds s to a list of distinct strings (at most cap). */
+static void add_distinct(const char **list, int *n, int cap, const char *s) {
+    if (!s || !s[0]) return;
+    for (int i = 0; i < *n; i++)
+        if (strcmp(list[i], s) == 0) return;
+    if (*n < cap) list[(*n)++] = s;
+}
 
 static char *version_xml(mr_bcf_version v, size_t *n) {
     mr_xml x;
@@ -22,19 +47,40 @@ static char *version_xml(mr_bcf_version v, size_t *n) {
     return mr_xml_take(&x, n);
 }
 
-/* 3.0: the values the topics use must be declared. */
-static char *extensions_xml(const mr_export_params *p, size_t *n) {
+/* 3.0: the values the topics use must be declared (the schema's order:
+ * TopicTypes, TopicStatuses, Priorities, TopicLabels, Stages, Users). */
+static char *extensions_xml(const mr_findings *fs, const mr_export_params *p, size_t *n) {
+    enum { CAP = 256 };
+    const char *prio[CAP], *labels[CAP], *users[CAP];
+    int np = 0, nl = 0, nu = 0;
+    add_distinct(users, &nu, CAP, p->author);
+    for (int i = 0; i < fs->count; i++) {
+        const mr_annotation *a = fs->items[i].mark;
+        add_distinct(prio, &np, CAP, a->priority);
+        for (int l = 0; l < a->label_count; l++) add_distinct(labels, &nl, CAP, a->labels[l]);
+        add_distinct(users, &nu, CAP, a->assignee);
+    }
     mr_xml x;
     mr_xml_begin(&x);
     mr_xml_open(&x, "Extensions");
     mr_xml_open(&x, "TopicTypes");
-    mr_xml_text_elem(&x, "TopicType", k_type);
+    for (size_t i = 0; i < sizeof k_types / sizeof k_types[0]; i++) mr_xml_text_elem(&x, "TopicType", k_types[i]);
     mr_xml_close(&x);
     mr_xml_open(&x, "TopicStatuses");
-    mr_xml_text_elem(&x, "TopicStatus", k_status);
+    for (size_t i = 0; i < sizeof k_statuses / sizeof k_statuses[0]; i++) mr_xml_text_elem(&x, "TopicStatus", k_statuses[i]);
     mr_xml_close(&x);
+    if (np) {
+        mr_xml_open(&x, "Priorities");
+        for (int i = 0; i < np; i++) mr_xml_text_elem(&x, "Priority", prio[i]);
+        mr_xml_close(&x);
+    }
+    if (nl) {
+        mr_xml_open(&x, "TopicLabels");
+        for (int i = 0; i < nl; i++) mr_xml_text_elem(&x, "TopicLabel", labels[i]);
+        mr_xml_close(&x);
+    }
     mr_xml_open(&x, "Users");
-    mr_xml_text_elem(&x, "User", p->author);
+    for (int i = 0; i < nu; i++) mr_xml_text_elem(&x, "User", users[i]);
     mr_xml_close(&x);
     mr_xml_close(&x);
     return mr_xml_take(&x, n);
@@ -55,16 +101,27 @@ static char *markup_xml(const mr_finding *f, const mr_export_params *p, size_t *
     mr_xml x;
     mr_xml_begin(&x);
     mr_xml_open(&x, "Markup");
+    const mr_annotation *a = f->mark;
     mr_xml_open(&x, "Topic");
     mr_xml_attr(&x, "Guid", f->topic_guid);
-    mr_xml_attr(&x, "TopicType", k_type);
-    mr_xml_attr(&x, "TopicStatus", k_status);
+    mr_xml_attr(&x, "TopicType", topic_type(a));
+    mr_xml_attr(&x, "TopicStatus", topic_status(a));
     mr_xml_text_elem(&x, "Title", f->title);
+    if (a->priority[0]) mr_xml_text_elem(&x, "Priority", a->priority);
     char idx[32];
     snprintf(idx, sizeof idx, "%d", f->number);
     mr_xml_text_elem(&x, "Index", idx);
+    /* 2.1: one Labels element per label; 3.0: Labels holds Label elements. */
+    if (a->label_count > 0 && v3) mr_xml_open(&x, "Labels");
+    for (int l = 0; l < a->label_count; l++) mr_xml_text_elem(&x, v3 ? "Label" : "Labels", a->labels[l]);
+    if (a->label_count > 0 && v3) mr_xml_close(&x);
     mr_xml_text_elem(&x, "CreationDate", f->date);
     mr_xml_text_elem(&x, "CreationAuthor", p->author);
+    if (f->modified[0]) {
+        mr_xml_text_elem(&x, "ModifiedDate", f->modified);
+        mr_xml_text_elem(&x, "ModifiedAuthor", p->author);
+    }
+    if (a->assignee[0]) mr_xml_text_elem(&x, "AssignedTo", a->assignee);
     mr_xml_text_elem(&x, "Description", f->description);
     if (v3) {
         mr_xml_open(&x, "Comments");
@@ -209,7 +266,7 @@ static bool build_zip(const mr_findings *fs, const mr_export_params *p, void **o
     char *doc = version_xml(p->bcf_version, &n);
     bool ok = add_file(&w, "bcf.version", doc, n, err);
     if (ok && p->bcf_version == MR_BCF_3_0) {
-        doc = extensions_xml(p, &n);
+        doc = extensions_xml(fs, p, &n);
         ok = add_file(&w, "extensions.xml", doc, n, err);
     }
     for (int i = 0; ok && i < fs->count; i++) ok = add_topic(&w, &fs->items[i], p, err);

@@ -49,9 +49,10 @@ typedef struct mr_finding {
     double distance_m, uncertainty_m;
     bool has_distance_sigma;     /* the view's Measure (measured_sigma_m) */
     double distance_sigma_m;
-    double depth_m;              /* camera to the mark (hit only), metres */
+    double depth_m;              /* camera to the marked point (hit only), metres */
+    char modified[32];           /* xs:dateTime of its last edit, "" never edited */
     char topic_guid[37], viewpoint_guid[37], comment_guid[37];
-    char title[160];
+    char title[200];
     char description[1024];
     char date[32];               /* xs:dateTime, UTC */
 } mr_finding;

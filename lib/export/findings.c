@@ -39,10 +39,8 @@ static bool opt_num(const cJSON *line, const char *key, double *out) {
     return true;
 }
 
-static void format_len(double m, char *out, size_t n) {
-    if (m < 1) snprintf(out, n, "%.0f mm", m * 1000);
-    else snprintf(out, n, "%.3f m", m);
-}
+/* Deviations and uncertainties always in mm, so they compare at a glance. */
+static void format_len(double m, char *out, size_t n) { snprintf(out, n, "%.0f mm", m * 1000); }
 
 static bool load_one(const char *dir, const mr_export_params *p, mr_finding *f, mr_error *err) {
     const mr_annotation *a = f->mark;
@@ -85,22 +83,27 @@ static bool load_one(const char *dir, const mr_export_params *p, mr_finding *f, 
     f->has_distance_sigma = f->has_distance && opt_num(line, "measured_sigma_m", &f->distance_sigma_m);
     f->depth_m = a->hit ? a->depth * p->unit_m : -1;
 
-    /* GUIDs from the line itself: the same mark gives the same topic. */
-    char *text = cJSON_PrintUnformatted(line);
-    if (!text) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
-    size_t n = strlen(text);
-    mr_bcf_guid(text, n, 1, f->topic_guid);
-    mr_bcf_guid(text, n, 2, f->viewpoint_guid);
-    mr_bcf_guid(text, n, 3, f->comment_guid);
+    /* GUIDs from the mark's identity: the same mark gives the same topic,
+     * and an edit of it (a later line of the same mark) updates that topic
+     * in a BCF tool instead of adding one. Lines of older sessions without
+     * an id: from the line itself, as before. */
+    char *text = a->id[0] ? NULL : cJSON_PrintUnformatted(line);
+    if (!a->id[0] && !text) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    const char *key = a->id[0] ? a->id : text;
+    size_t n = strlen(key);
+    mr_bcf_guid(key, n, 1, f->topic_guid);
+    mr_bcf_guid(key, n, 2, f->viewpoint_guid);
+    mr_bcf_guid(key, n, 3, f->comment_guid);
     free(text);
 
-    snprintf(f->title, sizeof f->title, "%s", a->note[0] ? a->note : "discrepancy");
+    if (a->title[0]) snprintf(f->title, sizeof f->title, "%s", a->title);
+    else mr_mark_title(a, f->title, sizeof f->title);
     char len[64];
     size_t k = 0, cap = sizeof f->description;
     char *d = f->description;
 #define ADD(...) do { int w_ = snprintf(d + k, cap - k, __VA_ARGS__); if (w_ > 0) k = k + (size_t)w_ < cap ? k + (size_t)w_ : cap - 1; } while (0)
-    ADD("%s", a->note[0] ? a->note : "Discrepancy");
-    if (a->node[0]) ADD(" at %s", a->node);
+    ADD("%s", f->title);
+    if (a->note[0]) ADD(". Note: %s", a->note);
     if (f->has_distance) {
         format_len(f->distance_m, len, sizeof len);
         ADD(". Measured distance: %s", len);
@@ -116,14 +119,23 @@ static bool load_one(const char *dir, const mr_export_params *p, mr_finding *f, 
     }
     if (f->has_uncertainty) {
         format_len(f->uncertainty_m, len, sizeof len);
-        ADD(". Registration uncertainty: %s (1 sigma)", len);
+        ADD(". Registration uncertainty at the mark: %s (1 sigma)", len);
     } else {
         ADD(". Registration uncertainty: not available");
     }
-    if (f->depth_m >= 0) ADD(". Seen from %.2f m", f->depth_m);
-    if (!a->pose_valid) ADD(", pose not tracked");
+    if (f->depth_m >= 0) ADD(". The camera was %.2f m from the marked point", f->depth_m);
+    else ADD(". Camera");
+    if (!a->pose_valid) ADD(" (pose not tracked)");
     ADD(" (frame %lld, t = %.2f s).", (long long)a->frame_index, a->timestamp);
+    if (strcmp(a->status, "closed") == 0) ADD(" Closed.");
 #undef ADD
+    const cJSON *ed = cJSON_GetObjectItemCaseSensitive(line, "edited_unix");
+    if (cJSON_IsNumber(ed) && ed->valuedouble > 0 && ed->valuedouble < 253402300799.0) {
+        time_t te = (time_t)ed->valuedouble;
+        struct tm tme;
+        gmtime_r(&te, &tme);
+        strftime(f->modified, sizeof f->modified, "%Y-%m-%dT%H:%M:%SZ", &tme);
+    }
     time_t t = a->time_unix > 0 && a->time_unix < 253402300799.0 ? (time_t)a->time_unix : time(NULL);
     struct tm tm;
     gmtime_r(&t, &tm);
@@ -138,6 +150,7 @@ bool mr_findings_load(const char *dir, const mr_export_params *p, mr_findings *o
     if (!mr_file_exists(path)) return mr_fail(err, MR_ERR_IO, "%s: no marks to export (no annotations.jsonl)", dir);
     if (!mr_annotations_load(path, &out->marks, err)) return false;
     if (out->marks.torn_tail) mr_log(MR_LOG_WARN, "%s: ignored a torn last line", path);
+    mr_annotations_current(&out->marks); /* the newest line of each mark */
     if (out->marks.count == 0) {
         mr_findings_free(out);
         return mr_fail(err, MR_ERR_INVALID, "%s: no marks to export", path);

@@ -122,10 +122,19 @@ static void plan_svg(mr_xml *x, const mr_findings *fs, const mr_scene *s) {
     mr_xml_raw(x, "</svg>\n");
 }
 
+/* Deviations and uncertainties: always mm. */
 static void fmt_len(bool has, double m, char *out, size_t n) {
     if (!has) snprintf(out, n, "n/a");
-    else if (m < 1) snprintf(out, n, "%.0f mm", m * 1000);
-    else snprintf(out, n, "%.3f m", m);
+    else snprintf(out, n, "%.0f mm", m * 1000);
+}
+
+/* The planner's words on a mark: status, priority, assignee, labels. */
+static void topic_words(const mr_annotation *a, char *out, size_t n) {
+    size_t k = (size_t)snprintf(out, n, "%s", a->status[0] ? a->status : "open");
+    if (a->priority[0] && k < n) k += (size_t)snprintf(out + k, n - k, ", priority %s", a->priority);
+    if (a->assignee[0] && k < n) k += (size_t)snprintf(out + k, n - k, ", assigned to %s", a->assignee);
+    for (int i = 0; i < a->label_count && k < n; i++)
+        k += (size_t)snprintf(out + k, n - k, "%s%s", i ? ", " : ", labels: ", a->labels[i]);
 }
 
 /* "+- sigma" after a measured distance that has one. */
@@ -198,10 +207,14 @@ static char *html_doc(const mr_findings *fs, const mr_export_params *p, const bo
     mr_xml_escape_into(&x, p->title);
     mr_xml_raw(&x, "</title><style>%s</style></head><body>\n<h1>", k_css);
     mr_xml_escape_into(&x, p->title);
-    mr_xml_raw(&x, "</h1>\n<p>%d finding%s. Distances in metres; registration uncertainty is 1&nbsp;sigma "
-                   "where the session has it (n/a: not available).</p>\n", fs->count, fs->count == 1 ? "" : "s");
-    mr_xml_raw(&x, "<h2>Summary</h2>\n<table><tr><th>#</th><th>finding</th><th>on</th><th>measured distance</th>"
-                   "<th>uncertainty</th><th>seen from</th><th>frame</th><th>time in recording</th><th>marked</th></tr>\n");
+    mr_xml_raw(&x, "</h1>\n<p>%d finding%s. <b>distance to the plan</b>: how far the built part is from the planned "
+                   "surface, measured from two or more camera frames (mm, &plusmn; 1&nbsp;sigma); "
+                   "<b>registration</b>: the uncertainty of the model's placement over the camera picture at the mark "
+                   "(mm, 1&nbsp;sigma); <b>camera to the point</b>: how far the camera was from the marked point "
+                   "(m). n/a: not measured or not available.</p>\n", fs->count, fs->count == 1 ? "" : "s");
+    mr_xml_raw(&x, "<h2>Summary</h2>\n<table><tr><th>#</th><th>finding</th><th>part</th><th>status</th>"
+                   "<th>distance to the plan</th><th>registration</th><th>camera to the point</th><th>frame</th>"
+                   "<th>time in recording</th><th>marked</th></tr>\n");
     for (int i = 0; i < fs->count; i++) {
         const mr_finding *f = &fs->items[i];
         char d[64], u[64], when[64], seen[64];
@@ -215,11 +228,13 @@ static char *html_doc(const mr_findings *fs, const mr_export_params *p, const bo
         mr_xml_escape_into(&x, f->title);
         mr_xml_raw(&x, "</td><td>");
         mr_xml_escape_into(&x, f->mark->node[0] ? f->mark->node : "-");
+        mr_xml_raw(&x, "</td><td>");
+        mr_xml_escape_into(&x, f->mark->status[0] ? f->mark->status : "open");
         mr_xml_raw(&x, "</td><td>%s</td><td>%s</td><td>%s</td><td>%lld</td><td>%.2f s</td><td>%s</td></tr>\n", d, u,
                    seen, (long long)f->mark->frame_index, f->mark->timestamp, when);
     }
     mr_xml_raw(&x, "</table>\n<h2>Plan view</h2>\n<p>Seen from above (x to the right, z down the page). "
-                   "Red: the marks; blue: the camera and where it looked.</p>\n");
+                   "Red pins: the marks, numbered as above; blue: the camera and where it looked.</p>\n");
     plan_svg(&x, fs, p->scene);
     for (int i = 0; i < fs->count; i++) {
         const mr_finding *f = &fs->items[i];
@@ -227,12 +242,18 @@ static char *html_doc(const mr_findings *fs, const mr_export_params *p, const bo
         mr_xml_escape_into(&x, f->title);
         mr_xml_raw(&x, "</h2>\n<p>");
         mr_xml_escape_into(&x, f->description);
-        mr_xml_raw(&x, "</p>\n<div class=\"pics\">");
+        char words[512];
+        topic_words(f->mark, words, sizeof words);
+        mr_xml_raw(&x, "</p>\n<p>Status: ");
+        mr_xml_escape_into(&x, words);
+        mr_xml_raw(&x, ".</p>\n<div class=\"pics\">");
         if (overlay[i])
             mr_xml_raw(&x, "<figure><img src=\"img/mark_%d_overlay.png\" alt=\"with the overlay\">"
-                           "<figcaption>with the plan overlaid, as marked</figcaption></figure>", f->number);
+                           "<figcaption>the plan over the camera picture, as marked (magenta pin: the marked point)"
+                           "</figcaption></figure>", f->number);
         mr_xml_raw(&x, "<figure><img src=\"img/mark_%d_photo.png\" alt=\"camera image\">"
-                       "<figcaption>camera image, undistorted (the BCF snapshot)</figcaption></figure></div>\n",
+                       "<figcaption>the camera picture, undistorted (the BCF snapshot; magenta pin: the marked point)"
+                       "</figcaption></figure></div>\n",
                    f->number);
         const double *m = f->mark->world_from_camera.m;
         mr_xml_raw(&x, "<p>Camera at (%.3f, %.3f, %.3f), frame %lld, t = %.2f s", m[3], m[7], m[11],
@@ -249,8 +270,10 @@ static char *md_doc(const mr_findings *fs, const mr_export_params *p, const bool
     mr_xml x;
     memset(&x, 0, sizeof x);
     mr_xml_raw(&x, "# %s\n\n%d finding%s. ", p->title, fs->count, fs->count == 1 ? "" : "s");
-    mr_xml_raw(&x, "Registration uncertainty is 1 sigma where the session has it (n/a: not available).\n\n");
-    mr_xml_raw(&x, "| # | finding | on | measured distance | uncertainty | seen from | frame | time |\n"
+    mr_xml_raw(&x, "Distance to the plan: how far the built part is from the planned surface (mm, +- 1 sigma); "
+                   "registration: the uncertainty of the model's placement at the mark (mm, 1 sigma); camera to the "
+                   "point: how far the camera was from the marked point (m). n/a: not measured or not available.\n\n");
+    mr_xml_raw(&x, "| # | finding | part | distance to the plan | registration | camera to the point | frame | time |\n"
                    "|---|---|---|---|---|---|---|---|\n");
     for (int i = 0; i < fs->count; i++) {
         const mr_finding *f = &fs->items[i];
