@@ -54,9 +54,9 @@ int cmd_view(int argc, char **argv) {
     /* The names and defaults of --ao and --ghost from the settings table. */
     char ao_help[400], ghost_help[400], desc[256];
     mr_opt_describe(mr_opt_find(mr_view_settings_opts, "ao"), desc, sizeof desc);
-    snprintf(ao_help, sizeof ao_help, "start with this AO method instead of the saved one (the A key cycles): %s", desc);
+    snprintf(ao_help, sizeof ao_help, "start with AO on with this method (none: off) instead of the saved setting: %s", desc);
     mr_opt_describe(mr_opt_find(mr_view_settings_opts, "ghost"), desc, sizeof desc);
-    snprintf(ghost_help, sizeof ghost_help, "start with this ghosting mode instead of the saved one (the G key cycles): %s",
+    snprintf(ghost_help, sizeof ghost_help, "start with ghosting on in this mode (off: off) instead of the saved setting: %s",
              desc);
     mr_cli_opt opts[] = {
         {"scene", "FILE", "glTF/GLB or scene config JSON (required)", NULL},
@@ -73,7 +73,7 @@ int cmd_view(int argc, char **argv) {
         {"paused", NULL, "replay: start paused", NULL},
         {"retrack", NULL, "replay: track the frames again instead of using the recorded poses", NULL},
         {"script", "FILE", "timed input events (tests, demos): see lib/view/mr_view.h", NULL},
-        {"stats", NULL, "print the frame-time split on exit", NULL},
+        {"stats", NULL, "show the frame rate and render passes in the status line; print the frame-time split on exit", NULL},
         {"ao", "METHOD", ao_help, NULL},
         {"ghost", "MODE", ghost_help, NULL},
         {"ao-temporal", NULL, "accumulate the AO over frames (reprojected; restarts when tracking is regained)", NULL},

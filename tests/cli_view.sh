@@ -195,7 +195,7 @@ ann=$tmp/session/annotations.jsonl
 if [ -s "$ann" ]; then
   [ "$(wc -l <"$ann")" -eq 1 ] && [ "$(tail -c 1 "$ann" | od -An -c | tr -d ' ')" = '\n' ] && ok || bad "annotation is not one whole line"
   line=$(head -1 "$ann")
-  for k in '"note":"extra"' '"hit":true' '"world":\[' '"node":"' '"pose":{' '"world_from_camera":\[' '"snapshot":{' '"frame_index":2'; do
+  for k in '"category":"extra"' '"title":"Extra: ' '"id":"' '"hit":true' '"world":\[' '"node":"' '"pose":{' '"world_from_camera":\[' '"snapshot":{' '"frame_index":2'; do
     echo "$line" | grep -q "$k" && ok || bad "annotation lacks $k: $line"
   done
   if command -v python3 >/dev/null 2>&1; then
@@ -279,13 +279,13 @@ i, nd = [(i, n) for i, n in enumerate(g["nodes"]) if n.get("name") == "Machine_2
 assert not any(i in n.get("children", []) for n in g["nodes"]) and nd["matrix"][:3] == [1.0, 0.0, 0.0]
 hi = g["accessors"][g["meshes"][nd["mesh"]]["primitives"][0]["attributes"]["POSITION"]]["max"]
 X = [nd["matrix"][12] + hi[0], 1.5, nd["matrix"][14] + hi[2]]
-def window(m):  # ideal pinhole (the view shows the picture undistorted), 640x480 -> 480x360
+def window(m):  # ideal pinhole (the view shows the picture undistorted): fractions of the picture
     t = [m[3], m[7], m[11]]
     q = [sum(m[4 * r + c] * (X[r] - t[r]) for r in range(3)) for c in range(3)]
     if q[2] <= 0: return None
     u, v = cam["fx"] * q[0] / q[2] + cam["cx"], cam["fy"] * q[1] / q[2] + cam["cy"]
-    x, y = (u + 0.5) * 480 / cam["width"], (v + 0.5) * 360 / cam["height"]
-    return (x, y) if 10 < x < 295 and 40 < y < 270 else None  # clear of the two columns, the bars and the banner
+    x, y = (u + 0.5) / cam["width"], (v + 0.5) / cam["height"]
+    return (x, y) if 0.03 < x < 0.97 and 0.15 < y < 0.9 else None  # clear of the banners
 seen = [(g["frame"], window(g["world_from_camera"])) for g in gt if valid.get(g["frame"]) and g["frame"] < 25]
 seen = [s for s in seen if s[1]]
 a, b = seen[0], seen[-1]
@@ -295,7 +295,7 @@ for f in range(b[0] + 1):
     if f == a[0] or f == b[0]:
         x, y = (a if f == a[0] else b)[1]
         lines.append("%.2f frame %d" % (t, f))  # the step has landed, however loaded the machine
-        t += 0.5; lines.append("%.2f tap %.1f %.1f" % (t, x, y))
+        t += 0.5; lines.append("%.2f tap @picture %.5f %.5f" % (t, x, y))
         t += 0.5; lines.append("%.2f state %s/measure_%d.json" % (t, tmp, f))
     if f < b[0]:
         t += 0.3; lines.append("%.2f key ." % t)
@@ -366,23 +366,44 @@ if timeout 60 "$mr" view --scene "$d/scene_planned.json" --input /dev/video-mrch
   jget "$tmp/s_nocam.json" source_message | grep -q "no camera" && ok || bad "no camera message: $(jget "$tmp/s_nocam.json" source_message)"
 else bad "no-camera run failed: $(tail -3 "$tmp/nocam.err")"; fi
 
-# 5b. The camera appears later: the viewer keeps retrying and picks it up.
-printf '%s\n' "0.3 state $tmp/s_late0.json" "4.5 state $tmp/s_late1.json" "4.6 quit" >"$tmp/late.script"
-( sleep 5; cp "$d/frames/frame_002.png" "$tmp/late.png" ) &
-if timeout 60 "$mr" view --scene "$d/scene_planned.json" --input "$tmp/late.png" --camera "$d/camera.json" \
-     --view "$d/views/view_002.json" --config "$tmp/cfg2.json" --size 480x360 --script "$tmp/late.script" >/dev/null 2>"$tmp/late.err"; then
-  [ "$(jget "$tmp/s_late0.json" source_state)" = no_camera ] && [ "$(jget "$tmp/s_late1.json" have_frame)" = true ] \
-    && ok || bad "late camera: $(jget "$tmp/s_late0.json" source_state) -> have_frame $(jget "$tmp/s_late1.json" have_frame)"
-else bad "late-camera run failed: $(tail -3 "$tmp/late.err")"; fi
-wait
+# 5b/6. Inputs that cannot be opened end the program at start with one line
+#     and a non-zero exit: only a /dev/video device is retried (5 above). A
+#     missing video file, an image that is not there, a JPEG given as the
+#     scene, a scene that is not there, an empty recording folder.
+view_fails() { # view_fails NAME WHAT-THE-LINE-NAMES args...
+  local name=$1 want=$2
+  shift 2
+  timeout 60 "$mr" view --config "$tmp/cfg_bad.json" --size 480x360 --out "$tmp/bad_session" "$@" \
+    >"$tmp/$name.out" 2>"$tmp/$name.err"
+  local rc=$?
+  if [ $rc -ne 0 ] && [ $rc -ne 124 ] && [ $rc -lt 128 ] && [ "$(wc -l <"$tmp/$name.err")" -eq 1 ] &&
+    grep -q -- "$want" "$tmp/$name.err"; then ok
+  else bad "$name: want one line naming '$want' and a non-zero exit, got rc $rc: $(head -c 400 "$tmp/$name.err")"; fi
+}
+printf 'not a picture' >"$tmp/not_a_scene.jpg"
+mkdir -p "$tmp/empty_recording"
+view_fails bad_video "$tmp/missing.mp4" --scene "$d/scene_planned.json" --input "$tmp/missing.mp4" \
+  --camera "$d/camera.json" --markers "$d/markers.json"
+view_fails bad_image "$tmp/late.png" --scene "$d/scene_planned.json" --input "$tmp/late.png" --camera "$d/camera.json" \
+  --view "$d/views/view_002.json"
+view_fails bad_scene_jpeg "not_a_scene.jpg" --scene "$tmp/not_a_scene.jpg" --replay "$d" --paused
+view_fails bad_scene_missing "missing.glb" --scene "$tmp/missing.glb" --replay "$d" --paused
+view_fails bad_empty_recording "empty_recording" --scene "$d/scene_planned.json" --replay "$tmp/empty_recording"
+[ ! -e "$tmp/bad_session/annotations.jsonl" ] && ok || bad "a failed start wrote marks"
 
-# 6. A scene that does not load: message, the window stays usable.
-printf '%s\n' "0.3 tap @video" "0.8 state $tmp/s_noscene.json" "0.9 quit" >"$tmp/noscene.script"
-if timeout 60 "$mr" view --scene "$tmp/missing.glb" --replay "$d" --out "$tmp/session" --config "$tmp/cfg3.json" \
-     --size 480x360 --paused --script "$tmp/noscene.script" >/dev/null 2>"$tmp/noscene.err"; then
-  jget "$tmp/s_noscene.json" scene_message | grep -q "scene failed to load" && ok || bad "no scene message"
-  [ "$(jget "$tmp/s_noscene.json" show_video)" = false ] && ok || bad "controls dead without a scene"
-else bad "missing-scene run failed: $(tail -3 "$tmp/noscene.err")"; fi
+# 6b. Esc never quits: Esc with nothing going on, in mark mode, with the
+#     note chooser open and after cancelling it, with the help open, after
+#     q (it takes back the question); the view is still there to answer
+#     `state`, and it quits only by the script's own quit.
+printf '%s\n' "0.2 key esc" "0.3 key esc" "0.4 tap @mark" "0.6 key esc" "0.7 tap @mark" "0.9 tap @picture 0.5 0.5" \
+  "1.3 key esc" "1.4 key esc" "1.5 key esc" "1.6 key ?" "1.8 key esc" "1.9 key esc" "2.0 key q" "2.2 key esc" \
+  "2.3 key esc" "2.6 state $tmp/s_esc.json" "2.7 quit" >"$tmp/esc.script"
+if timeout 60 "$mr" view --scene "$d/scene_planned.json" --replay "$d" --out "$tmp/esc_session" --config "$tmp/cfg_esc.json" \
+     --size 480x360 --paused --script "$tmp/esc.script" >/dev/null 2>"$tmp/esc.err"; then
+  [ -s "$tmp/s_esc.json" ] && [ "$(jget "$tmp/s_esc.json" quit_asked)" = false ] && [ "$(jget "$tmp/s_esc.json" note_open)" = false ] \
+    && [ "$(jget "$tmp/s_esc.json" mark_mode)" = false ] && ok || bad "Esc: the view did not live to the end of the script, or left a mode open"
+  [ ! -s "$tmp/esc_session/annotations.jsonl" ] && ok || bad "Esc in the chooser saved a mark"
+else bad "the Esc run failed: $(tail -3 "$tmp/esc.err")"; fi
 
 # 6b. Shadows (issue 12): --shadows runs the shadow passes in the window.
 if view shadows "0.2 key .

@@ -204,7 +204,7 @@ typedef struct named_widget {
  * lib/view (mr_view_layout_compute, what the window draws), with each
  * shown rect drawn as its widget. Returns the count. */
 static int view_layout(mr_ui *ui, float fb_w, float fb_h, bool seekable, named_widget *out) {
-    mr_view_layout_params lp = {fb_w, fb_h, seekable, false, 0};
+    mr_view_layout_params lp = {fb_w, fb_h, seekable, false, 0, false, false, false};
     mr_view_layout L;
     mr_view_layout_compute(ui, &lp, &L);
     int n = 0;
@@ -280,7 +280,12 @@ static void test_touch_targets(const mr_ui_font *font) {
                  * (a density read as dots per cm, say, would pass above). */
                 CHECK_MSG(smallest <= 9.6f, "%s: the smallest touch target is %.2f mm, want 9 mm (sizes scaled wrongly)",
                           cases[c].what, smallest);
-                CHECK_MSG(n == (seek ? 15 : 10) /* with Measure (issue 15) */, "%s: %d widgets laid out", cases[c].what, n);
+                /* All of them (with Measure, Shadows and Quit), but in the
+                 * tiny window, which may leave out the column's last two
+                 * (Quit and help: the keys q and ? remain). */
+                int want = seek ? 17 : 12;
+                CHECK_MSG(n == want || (strstr(cases[c].what, "tiny") && n >= want - 2), "%s: %d widgets laid out",
+                          cases[c].what, n);
             }
             mr_ui_destroy(&ui);
         }

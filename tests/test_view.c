@@ -316,22 +316,71 @@ static void test_keys(rig *r) {
     CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 0, "Esc in mark mode quit");
     key(r, MR_KEY_ENTER);
     CHECK_MSG(count(r, MR_VA_MARK_AT, NULL) == 0, "Esc did not leave mark mode");
-    /* The chooser: 1..6 choose, Esc cancels, other keys do nothing. */
+    /* The chooser: 1..6 choose, Esc cancels, other keys do nothing; Esc
+     * again (the chooser gone) never quits. */
     key(r, 'm');
     mr_viewer_note_open(r->v, 0.5f, 0.5f);
     key(r, 'q');
+    CHECK_MSG(r->acts.count == 0, "q with the chooser open did something");
+    key(r, MR_KEY_ESCAPE);
     CHECK_MSG(count(r, MR_VA_MARK_FINISH, &x) == 1 && x.i == -1 && count(r, MR_VA_QUIT, NULL) == 0,
-              "q with the chooser open did not cancel the mark (or quit)");
+              "Esc with the chooser open did not cancel the mark (or quit)");
+    for (int i = 0; i < 3; i++) {
+        key(r, MR_KEY_ESCAPE);
+        CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 0, "Esc after cancelling the chooser quit (press %d)", i + 1);
+    }
     key(r, 'm');
     mr_viewer_note_open(r->v, 0.5f, 0.5f);
     key(r, 'v');
     CHECK_MSG(r->acts.count == 0, "v with the chooser open did something");
     key(r, '6');
-    CHECK_MSG(count(r, MR_VA_MARK_FINISH, &x) == 1 && x.i == 5, "6 did not choose note 6");
+    CHECK_MSG(count(r, MR_VA_MARK_FINISH, &x) == 1 && x.i == 5, "6 did not choose category 6");
+    /* The note's text field: Enter gives it the keyboard, what is typed
+     * goes in (digits too), Backspace deletes, Enter leaves it; the note
+     * goes with the category chosen. */
+    key(r, 'm');
+    mr_viewer_note_open(r->v, 0.5f, 0.5f);
+    key(r, MR_KEY_ENTER);
+    const char *typed = "pipe 2 moved @ann #hvac";
+    for (const char *c = typed; *c; c++) key(r, *c);
+    key(r, 'x');
+    key(r, MR_KEY_BACKSPACE);
+    CHECK_MSG(r->acts.count == 0, "typing a note did something else");
+    key(r, MR_KEY_ENTER);
+    key(r, '3');
+    CHECK_MSG(count(r, MR_VA_MARK_FINISH, &x) == 1 && x.i == 2 && x.path && strcmp(x.path, typed) == 0,
+              "the typed note did not go with the mark: '%s'", x.path ? x.path : "(none)");
+    /* Quitting asks first: q opens the question, Esc or n keeps the check
+     * going, Enter (or y, or q again) quits. */
     key(r, 'q');
-    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 1, "q did not quit");
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 0, "q quit without asking");
     key(r, MR_KEY_ESCAPE);
-    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 1, "Esc did not quit");
+    key(r, MR_KEY_ENTER);
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 0, "Esc did not take back the question");
+    key(r, 'q');
+    key(r, 'n');
+    key(r, 'y');
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 0, "n did not take back the question");
+    key(r, 'q');
+    key(r, MR_KEY_ENTER);
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 1, "q then Enter did not quit");
+    key(r, 'q');
+    tap(r, MR_VW_QUIT_NO);
+    key(r, MR_KEY_ENTER);
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 0, "Stay did not take back the question");
+    tap(r, MR_VW_QUIT);
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 0, "the Quit button quit without asking");
+    tap(r, MR_VW_QUIT_YES);
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 1, "Quit then Quit did not quit");
+    key(r, MR_KEY_ESCAPE);
+    CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 0, "Esc quit");
+    /* q and Esc are in the help. */
+    bool q_listed = false, esc_listed = false;
+    for (int i = 0; i < mr_view_keymap_count; i++) {
+        q_listed |= strcmp(mr_view_keymap[i].keys, "q") == 0 && strstr(mr_view_keymap[i].what, "quit");
+        esc_listed |= strcmp(mr_view_keymap[i].keys, "Esc") == 0 && strstr(mr_view_keymap[i].what, "never quits");
+    }
+    CHECK_MSG(q_listed && esc_listed, "the help does not list q (quit) and Esc (never quits)");
     /* Live input: no replay keys. */
     r->f.seekable = false;
     step(r);
@@ -344,47 +393,75 @@ static void test_keys(rig *r) {
     CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 1, "closing the window did not quit");
 }
 
-/* ---------------------------------------------------- AO / ghost order */
+/* ------------------------------------------- depth cues: toggles, methods */
 
+/* AO, ghosting and shadows are on/off toggles (keys a g c, the buttons);
+ * the method each uses when on is chosen in the settings panel (under ?),
+ * which cycles through the methods and never offers "none" / "off". */
 static void test_cycling(rig *r) {
     mr_view_settings s = *mr_viewer_settings(r->v);
-    s.ao = MR_AO_NONE;
-    s.ghost = MR_GHOST_OFF;
+    s.ao_on = s.ghost_on = s.shadows_on = false;
     mr_viewer_set_settings(r->v, &s);
     step(r);
-    for (int i = 1; i <= MR_AO_METHOD_COUNT; i++) {
+    for (int i = 1; i <= 4; i++) {
         if (i % 2) key(r, 'a');
         else tap(r, MR_VW_AO);
-        int want = i % MR_AO_METHOD_COUNT;
-        CHECK_MSG((int)mr_viewer_settings(r->v)->ao == want, "AO press %d (%s) gave %s, want %s", i,
-                  i % 2 ? "key a" : "button", mr_ao_method_name(mr_viewer_settings(r->v)->ao),
-                  mr_ao_method_name((mr_ao_method)want));
-        CHECK_MSG(count(r, MR_VA_RENDER, NULL) == 1, "AO change asked for no render");
+        bool want = i % 2;
+        CHECK_MSG(mr_viewer_settings(r->v)->ao_on == want && (mr_view_ao(mr_viewer_settings(r->v)) != MR_AO_NONE) == want,
+                  "AO press %d (%s): on %d, want %d", i, i % 2 ? "key a" : "button", mr_viewer_settings(r->v)->ao_on, want);
+        CHECK_MSG(count(r, MR_VA_RENDER, NULL) == 1, "an AO toggle asked for no render");
+        if (i % 2) key(r, 'g');
+        else tap(r, MR_VW_GHOST);
+        CHECK_MSG(mr_viewer_settings(r->v)->ghost_on == want && (mr_view_ghost(mr_viewer_settings(r->v)) != MR_GHOST_OFF) == want,
+                  "ghost press %d: on %d", i, mr_viewer_settings(r->v)->ghost_on);
+        if (i % 2) key(r, 'c');
+        else tap(r, MR_VW_SHADOWS);
+        CHECK_MSG(mr_viewer_settings(r->v)->shadows_on == want &&
+                      (mr_view_shadows(mr_viewer_settings(r->v)) != MR_SHADOW_OFF) == want,
+                  "shadows press %d: on %d", i, mr_viewer_settings(r->v)->shadows_on);
+        CHECK_MSG(count(r, MR_VA_RENDER, NULL) == 1, "a shadows toggle asked for no render");
     }
-    static const mr_ghost_mode order[] = {MR_GHOST_ALPHA, MR_GHOST_G0, MR_GHOST_ADAPTIVE, MR_GHOST_OFF, MR_GHOST_ALPHA};
-    for (int i = 0; i < 5; i++) {
-        if (i % 2) tap(r, MR_VW_GHOST);
-        else key(r, 'g');
-        CHECK_MSG(mr_viewer_settings(r->v)->ghost == order[i], "ghost press %d gave %s, want %s", i + 1,
+    /* The methods, in the settings panel. */
+    key(r, '?');
+    mr_ao_method a0 = mr_viewer_settings(r->v)->ao;
+    for (int i = 0; i < 2 * (MR_AO_METHOD_COUNT - 1); i++) {
+        tap(r, MR_VW_SET_AO);
+        CHECK_MSG(mr_viewer_settings(r->v)->ao != MR_AO_NONE, "the AO method cycle offered none");
+        CHECK_MSG(!mr_viewer_settings(r->v)->ao_on, "choosing the AO method turned AO on");
+    }
+    CHECK_MSG(mr_viewer_settings(r->v)->ao == a0, "the AO methods do not cycle back (every method but none, in order)");
+    static const mr_ghost_mode order[] = {MR_GHOST_ALPHA, MR_GHOST_G0, MR_GHOST_ADAPTIVE, MR_GHOST_ALPHA};
+    for (int i = 0; i < 4; i++) {
+        tap(r, MR_VW_SET_GHOST);
+        CHECK_MSG(mr_viewer_settings(r->v)->ghost == order[i], "ghost mode press %d gave %s, want %s", i + 1,
                   mr_view_ghost_name(mr_viewer_settings(r->v)->ghost), mr_view_ghost_name(order[i]));
     }
-    /* Shadows: C cycles off, hard, pcf, pcss, bp and back to off (never
-     * the ground truth), each press asking for a render. */
-    static const mr_shadow_method sorder[] = {MR_SHADOW_HARD, MR_SHADOW_PCF, MR_SHADOW_PCSS, MR_SHADOW_BP,
-                                              MR_SHADOW_OFF, MR_SHADOW_HARD};
-    for (int i = 0; i < 6; i++) {
-        key(r, 'c');
+    /* Shadows: hard, pcf, pcss, bp (never off, never the ground truth). */
+    static const mr_shadow_method sorder[] = {MR_SHADOW_BP, MR_SHADOW_HARD, MR_SHADOW_PCF, MR_SHADOW_PCSS, MR_SHADOW_BP};
+    for (int i = 0; i < 5; i++) {
+        tap(r, MR_VW_SET_SHADOWS);
         CHECK_MSG(mr_viewer_settings(r->v)->shadows == sorder[i], "shadows press %d gave %s, want %s", i + 1,
                   mr_shadow_method_names[mr_viewer_settings(r->v)->shadows], mr_shadow_method_names[sorder[i]]);
         CHECK_MSG(count(r, MR_VA_RENDER, NULL) == 1, "a shadow method change asked for no render");
     }
+    /* Reset: the defaults again, from the UI. */
+    mr_view_settings d = MR_VIEW_SETTINGS_DEFAULTS;
+    char changes[300];
+    CHECK(mr_view_settings_describe_changes(mr_viewer_settings(r->v), changes, sizeof changes) > 0 && changes[0]);
+    tap(r, MR_VW_RESET);
+    const mr_view_settings *now = mr_viewer_settings(r->v);
+    CHECK_MSG(now->ao == d.ao && now->ghost == d.ghost && now->shadows == d.shadows && now->alpha == d.alpha &&
+                  now->ao_on == d.ao_on && mr_view_settings_describe_changes(now, changes, sizeof changes) == 0,
+              "Reset did not bring the defaults back (%s)", changes);
+    key(r, '?');
 }
 
 /* ---------------------------------------------------------- settings */
 
 static bool same(const mr_view_settings *a, const mr_view_settings *b) {
     return a->alpha == b->alpha && a->show_video == b->show_video && a->hide_hidden == b->hide_hidden &&
-           a->rate_i == b->rate_i && a->ao == b->ao && a->ghost == b->ghost && a->shadows == b->shadows;
+           a->rate_i == b->rate_i && a->ao == b->ao && a->ghost == b->ghost && a->shadows == b->shadows &&
+           a->ao_on == b->ao_on && a->ghost_on == b->ghost_on && a->shadows_on == b->shadows_on;
 }
 
 static void test_settings(void) {
@@ -394,10 +471,11 @@ static void test_settings(void) {
     mr_view_settings d = MR_VIEW_SETTINGS_DEFAULTS, s;
     mr_view_settings_load(path, &s, warn, sizeof warn);
     CHECK_MSG(same(&s, &d) && !warn[0], "a missing settings file: not the defaults, or a warning '%s'", warn);
-    CHECK(d.alpha == 0.5f && d.show_video && !d.hide_hidden && d.rate_i == 2 && d.ao == MR_AO_NONE &&
-          d.ghost == MR_GHOST_OFF && d.shadows == MR_SHADOW_OFF);
+    CHECK(d.alpha == 0.5f && d.show_video && !d.hide_hidden && d.rate_i == 2 && !d.ao_on && !d.ghost_on &&
+          !d.shadows_on && mr_view_ao(&d) == MR_AO_NONE && mr_view_ghost(&d) == MR_GHOST_OFF &&
+          mr_view_shadows(&d) == MR_SHADOW_OFF && d.ao != MR_AO_NONE && d.ghost != MR_GHOST_OFF && d.shadows != MR_SHADOW_OFF);
     /* Round trip of every field, in a folder that does not exist yet. */
-    mr_view_settings w = {0.25f, false, true, 4, MR_AO_HBAO, MR_GHOST_G0, MR_SHADOW_PCSS};
+    mr_view_settings w = {0.25f, false, true, 4, true, false, true, MR_AO_HBAO, MR_GHOST_G0, MR_SHADOW_PCSS};
     mr_error err = {0};
     g_rn.renames = 0;
     CHECK_MSG(mr_view_settings_save(path, &w, &err), "save: %s", err.msg);
@@ -421,6 +499,14 @@ static void test_settings(void) {
     CHECK_MSG(old && now && strcmp(old, now) == 0, "a failed save changed the settings file in place (not atomic)");
     free(old);
     free(now);
+    /* A file from before the toggles: a method named is on; none is off
+     * with the default method. */
+    write_text(path, "{\"ao\": \"hbao\", \"ghost\": \"off\", \"shadows\": \"pcf\"}");
+    mr_view_settings_load(path, &s, warn, sizeof warn);
+    CHECK_MSG(!warn[0] && s.ao_on && s.ao == MR_AO_HBAO && !s.ghost_on && s.ghost == d.ghost && s.shadows_on &&
+                  s.shadows == MR_SHADOW_PCF,
+              "an older settings file read as ao %d/%s ghost %d/%s shadows %d (%s)", s.ao_on, mr_ao_method_name(s.ao),
+              s.ghost_on, mr_view_ghost_name(s.ghost), s.shadows_on, warn);
     /* Damaged files: a warning, defaults for what cannot be used, the rest
      * kept, never a crash. */
     static const struct {
@@ -584,7 +670,7 @@ static void test_sigma(rig *r) {
         step(r);
         char text[64];
         double mm = want * 1e3;
-        snprintf(text, sizeof text, mm < 9.95 ? "+/- %.1f mm here" : "+/- %.0f mm here", mm);
+        snprintf(text, sizeof text, mm < 9.95 ? "registration +/- %.1f mm at the centre" : "registration +/- %.0f mm at the centre", mm);
         CHECK_MSG(strstr(mr_viewer_status_text(r->v), text) != NULL, "status line '%s' lacks '%s'",
                   mr_viewer_status_text(r->v), text);
         CHECK_MSG(mr_view_sigma_classify(true, want) == want_state[k], "sigma %.1f mm: state %d, want %d", mm,
@@ -605,7 +691,7 @@ static void test_sigma(rig *r) {
         r->f.point = mr_v3(10.0, 0.0, k == 2 ? -3.0 : 3.0);
         CHECK_MSG(!mr_view_sigma_here(&r->f, NULL), "case %d: a sigma without covariance, point or depth", k);
         step(r);
-        CHECK_MSG(strstr(mr_viewer_status_text(r->v), "+/- ? mm here") != NULL, "case %d: status line '%s' "
+        CHECK_MSG(strstr(mr_viewer_status_text(r->v), "+/- ? mm at the centre") != NULL, "case %d: status line '%s' "
                   "does not say the sigma is unknown", k, mr_viewer_status_text(r->v));
         cJSON *st = mr_viewer_state_json(r->v);
         CHECK_MSG(cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(st, "sigma_here_mm")), "case %d: state has a sigma", k);
@@ -614,7 +700,7 @@ static void test_sigma(rig *r) {
     /* No pose at all: nothing to tell. */
     r->f.have_pose = r->f.pose_valid = false;
     step(r);
-    CHECK_MSG(strstr(mr_viewer_status_text(r->v), "mm here") == NULL, "no pose, yet '%s'", mr_viewer_status_text(r->v));
+    CHECK_MSG(strstr(mr_viewer_status_text(r->v), "mm at the") == NULL, "no pose, yet '%s'", mr_viewer_status_text(r->v));
     r->f.have_pose = r->f.pose_valid = true;
     r->f.pose_cov = NULL;
     r->f.have_point = false;
@@ -773,7 +859,8 @@ static void test_measure(rig *r) {
 
 /* The right column in priority order (Measure, issue 15, after Mark). */
 static const mr_view_widget_id k_column[] = {MR_VW_FREEZE, MR_VW_SNAPSHOT, MR_VW_MARK, MR_VW_MEASURE, MR_VW_VIDEO,
-                                             MR_VW_HIDDEN, MR_VW_AO, MR_VW_GHOST, MR_VW_HELP};
+                                             MR_VW_HIDDEN, MR_VW_AO, MR_VW_GHOST, MR_VW_SHADOWS, MR_VW_QUIT,
+                                             MR_VW_HELP};
 #define K_COLUMN_N ((int)(sizeof k_column / sizeof k_column[0]))
 
 /* Clearance between two rects in pixels (negative: they overlap). */
@@ -850,11 +937,11 @@ static void test_layout(const char *font_path) {
             bool seek = mode & 1, notes = mode & 2;
             char what[200];
             snprintf(what, sizeof what, "%s%s%s", cases[c].what, seek ? ", replay" : "", notes ? ", note chooser" : "");
-            mr_view_layout_params lp = {cases[c].w, cases[c].h, seek, notes, cases[c].w * 0.25f};
+            mr_view_layout_params lp = {cases[c].w, cases[c].h, seek, notes, cases[c].w * 0.25f, false, false, false};
             mr_view_layout L;
             mr_view_layout_compute(ui, &lp, &L);
             int n = check_layout(&L, ppmm, cases[c].w, cases[c].h, what);
-            int want = 10 + (seek ? 5 : 0) + (notes ? 7 : 0);
+            int want = 12 + (seek ? 5 : 0) + (notes ? 8 : 0);
             if (cases[c].all) {
                 CHECK_MSG(n == want && L.dropped == 0, "%s: %d widgets shown (%d dropped), want all %d", what, n,
                           L.dropped, want);
@@ -882,7 +969,7 @@ static void test_layout(const char *font_path) {
             }
         }
         /* The transparency slider, the main control, survives in tiny windows. */
-        mr_view_layout_params lp = {160 * (float)ppmm / 3.78f, 120 * (float)ppmm / 3.78f, true, false, 0};
+        mr_view_layout_params lp = {160 * (float)ppmm / 3.78f, 120 * (float)ppmm / 3.78f, true, false, 0, false, false, false};
         mr_view_layout L;
         if (ui) {
             mr_view_layout_compute(ui, &lp, &L);
@@ -906,11 +993,11 @@ static void test_layout_sweep(const char *font_path) {
         for (float h = 20; h <= 700; h += 23) {
             char what[64];
             snprintf(what, sizeof what, "replay window %gx%g at 96 dpi", w, h);
-            mr_view_layout_params lp = {w, h, true, false, 0};
+            mr_view_layout_params lp = {w, h, true, false, 0, false, false, false};
             mr_view_layout L;
             mr_view_layout_compute(ui, &lp, &L);
             int n = check_layout(&L, ppmm, w, h, what);
-            CHECK_MSG(n + L.dropped == 15, "%s: %d shown + %d dropped, want 15", what, n, L.dropped);
+            CHECK_MSG(n + L.dropped == 17, "%s: %d shown + %d dropped, want 17", what, n, L.dropped);
             for (int i = 1; i < K_COLUMN_N; i++)
                 CHECK_MSG(!L.shown[k_column[i]] || L.shown[k_column[i - 1]], "%s: %s shown but %s left out", what,
                           mr_view_widget_name(k_column[i]), mr_view_widget_name(k_column[i - 1]));
@@ -1067,7 +1154,8 @@ static void test_mark_line_and_setup(void) {
     f.image.width = 64;
     f.image.height = 48;
     mr_pick pick = {true, mr_v3(1, 2, 3), 3, 0, MR_LAYER_HIDDEN};
-    cJSON *line = mr_view_mark_line(&f, "missing", 10.5, 20.25, &pick, s, NULL);
+    mr_view_mark_words words = {"m1", 0, "pipe 2 @ann #hvac !high"};
+    cJSON *line = mr_view_mark_line(&f, &words, 10.5, 20.25, &pick, s, NULL);
     CHECK(line != NULL);
     if (line) {
         const cJSON *node = cJSON_GetObjectItem(line, "node"), *layer = cJSON_GetObjectItem(line, "layer");
@@ -1076,12 +1164,24 @@ static void test_mark_line_and_setup(void) {
         CHECK(cJSON_IsString(layer) && strcmp(layer->valuestring, "hidden") == 0);
         CHECK(cJSON_GetArraySize(px) == 2 && cJSON_GetArrayItem(px, 1)->valuedouble == 20.25);
         CHECK(!cJSON_GetObjectItem(line, "measured_point"));
+        /* What the planner said: the category, the note without its inline
+         * fields, the fields, a title in words. */
+        const cJSON *cat = cJSON_GetObjectItem(line, "category"), *note = cJSON_GetObjectItem(line, "note"),
+                    *title = cJSON_GetObjectItem(line, "title"), *lab = cJSON_GetObjectItem(line, "labels");
+        CHECK(cJSON_IsString(cat) && strcmp(cat->valuestring, "missing") == 0);
+        CHECK(cJSON_IsString(note) && strcmp(note->valuestring, "pipe 2") == 0);
+        CHECK(cJSON_IsString(title) && strcmp(title->valuestring, "Missing: Pipe_1") == 0);
+        CHECK(cJSON_GetArraySize(lab) == 1 && strcmp(cJSON_GetArrayItem(lab, 0)->valuestring, "hvac") == 0);
+        CHECK(!strcmp(cJSON_GetObjectItem(line, "assignee")->valuestring, "ann") &&
+              !strcmp(cJSON_GetObjectItem(line, "priority")->valuestring, "high") &&
+              !strcmp(cJSON_GetObjectItem(line, "id")->valuestring, "m1"));
         cJSON_Delete(line);
     }
     mr_measurement m;
     memset(&m, 0, sizeof m);
     m.tri.point = mr_v3(1, 2, 3);
-    line = mr_view_mark_line(&f, "moved", 1, 2, &pick, s, &m);
+    mr_view_mark_words moved = {"m2", 2, NULL};
+    line = mr_view_mark_line(&f, &moved, 1, 2, &pick, s, &m);
     CHECK(line && cJSON_GetObjectItem(line, "measured_point"));
     cJSON_Delete(line);
     mr_view_settings vs = MR_VIEW_SETTINGS_DEFAULTS;
@@ -1132,13 +1232,29 @@ static void test_source_load(void) {
     CHECK(!strcmp(s.desc, "live /dev/video9") && s.input == p.input && !s.replay_dir);
     mr_view_source_free(&s);
     CHECK(s.markers.count == 0);
-    mr_view_source_params pv = {.input = "frame.png", .view_path = view};
+    /* A still with a fixed pose: the image must be there now (only a
+     * /dev/video device may come later). */
+    char still[1200];
+    snprintf(still, sizeof still, "%s/tests/data/golden/ao_gtao_view.png", src);
+    mr_view_source_params pv = {.input = still, .view_path = view};
     CHECK_MSG(mr_view_source_load(&pv, &s, &err), "%s", err.msg);
     CHECK(s.have_fixed_pose && !s.have_markers && s.camera.width > 0);
     mr_view_source_free(&s);
+    pv.input = "no-such-frame.png";
+    memset(&err, 0, sizeof err);
+    CHECK_MSG(!mr_view_source_load(&pv, &s, &err) && strstr(err.msg, "no-such-frame.png"),
+              "a missing still was taken (or not named): %s", err.msg);
     mr_view_source_params pr = {.replay_dir = "/nonexistent-recording"};
     memset(&err, 0, sizeof err);
-    CHECK(!mr_view_source_load(&pr, &s, &err) && !strncmp(err.msg, "/nonexistent-recording: ", 24));
+    CHECK_MSG(!mr_view_source_load(&pr, &s, &err) && strstr(err.msg, "/nonexistent-recording"), "%s", err.msg);
+    /* An empty folder is no recording: refused at once. */
+    char empty[1200];
+    tmp_path(empty, sizeof empty, "empty_recording");
+    CHECK(mr_mkdirs(empty, &err));
+    mr_view_source_params pe = {.replay_dir = empty};
+    memset(&err, 0, sizeof err);
+    CHECK_MSG(!mr_view_source_load(&pe, &s, &err) && strstr(err.msg, "empty_recording"), "an empty recording folder: %s",
+              err.msg);
     mr_view_source_free(NULL);
 }
 

@@ -13,23 +13,25 @@ const mr_view_key_help mr_view_keymap[] = {
     {"Down / -", "more model (slider left)"},
     {"f", "freeze / unfreeze the frame and pose"},
     {"s", "snapshot (screen, raw frame, pose)"},
-    {"m", "mark mode: tap the scene, then pick a note"},
+    {"m", "mark mode: tap the scene, then type a note and pick what differs"},
     {"Enter", "in mark mode: mark the image centre"},
-    {"1..6", "choose a note / Esc cancels"},
+    {"1..6", "what differs (while not typing a note)"},
+    {"tap a pin", "edit or close that mark"},
     {"d", "measure: tap one feature in 2+ frames, d again to finish"},
     {"v", "video on/off"},
     {"h", "hidden layer on/off"},
-    {"a", "next ambient occlusion method"},
-    {"g", "next ghosting mode"},
-    {"c", "next shadow method (off, hard, pcf, pcss, bp)"},
+    {"a", "ambient occlusion on/off (method: in the settings below)"},
+    {"g", "ghosting on/off"},
+    {"c", "shadows on/off"},
     {"space", "replay: play / pause"},
     {". / Right", "replay: step forward"},
     {", / Left", "replay: step back"},
     {"Home / End", "replay: first / last frame"},
     {"[ / ]", "replay: slower / faster"},
     {"F11", "fullscreen"},
-    {"? / F1", "this help"},
-    {"q / Esc", "quit"},
+    {"? / F1", "this help and the settings"},
+    {"Esc", "cancel what is going on (never quits)"},
+    {"q", "quit (asks first; Enter or y confirms)"},
 };
 const int mr_view_keymap_count = (int)(sizeof mr_view_keymap / sizeof mr_view_keymap[0]);
 
@@ -37,7 +39,10 @@ static const char *const k_widget_names[MR_VW_COUNT] = {
     "alpha", "play", "back", "forward", "rate", "seek", "freeze", "snapshot", "mark", "video", "hidden", "ao",
     "ghost", "help", "note1", "note2", "note3", "note4", "note5", "note6", "cancel",
     "measure",
+    "shadows", "quit", "quit_yes", "quit_no", "note_text", "close_mark", "set_ao", "set_ghost", "set_shadows",
+    "reset",
 };
+_Static_assert(sizeof k_widget_names / sizeof k_widget_names[0] == MR_VW_COUNT, "a name for every widget");
 
 const char *mr_view_widget_name(mr_view_widget_id id) {
     return (int)id >= 0 && id < MR_VW_COUNT ? k_widget_names[id] : "";
@@ -45,13 +50,13 @@ const char *mr_view_widget_name(mr_view_widget_id id) {
 
 /* ---------------------------------------------------------------- layout */
 
-/* The column's i-th widget in priority order: Measure right
- * after Mark, then the rest as they are numbered. */
-static mr_view_widget_id column_widget(int i) {
-    const int after_mark = MR_VW_MARK - MR_VW_FREEZE + 1;
-    return i < after_mark ? (mr_view_widget_id)(MR_VW_FREEZE + i)
-           : i == after_mark ? MR_VW_MEASURE : (mr_view_widget_id)(MR_VW_FREEZE + i - 1);
-}
+/* The column's widgets in priority order (what a small window leaves out
+ * last comes first); Quit stays last but is never dropped before help. */
+static const mr_view_widget_id k_column[] = {MR_VW_FREEZE, MR_VW_SNAPSHOT, MR_VW_MARK, MR_VW_MEASURE,
+                                              MR_VW_VIDEO, MR_VW_HIDDEN, MR_VW_AO, MR_VW_GHOST,
+                                              MR_VW_SHADOWS, MR_VW_QUIT, MR_VW_HELP};
+#define COLUMN_N ((int)(sizeof k_column / sizeof k_column[0]))
+static mr_view_widget_id column_widget(int i) { return k_column[i]; }
 
 /* Shows a widget only when it keeps its full touch target inside the
  * window; a smaller one would be a target nobody can hit. */
@@ -103,7 +108,7 @@ void mr_view_layout_compute(const mr_ui *ui, const mr_view_layout_params *p, mr_
      * more columns when the window is short; what fits in neither is left
      * out from the end (help first). */
     float colw = fmaxf(T * 2.4f, mr_ui_text_width(font, "AO alchemy", th) + 3 * g);
-    const int n = MR_VW_HELP - MR_VW_FREEZE + 1 + 1 /* Measure */;
+    const int n = COLUMN_N;
     int per_col = (int)((full.h - g) / (T + g));
     int max_cols = (int)((full.w - g) / (colw + g));
     if (per_col < 0) per_col = 0;
@@ -129,7 +134,7 @@ void mr_view_layout_compute(const mr_ui *ui, const mr_view_layout_params *p, mr_
     /* The note chooser, over the picture on the side away from the mark
      * so the cross stays visible. Too little room: the keys 1..6 remain. */
     if (p->note_open) {
-        float w = fminf(full.w - 2 * g, 2 * colw + 3 * g), h = (T + g) * ((MR_VIEW_NOTE_COUNT + 1) / 2 + 2) + g;
+        float w = fminf(full.w - 2 * g, 2 * colw + 3 * g), h = (T + g) * ((MR_VIEW_NOTE_COUNT + 1) / 2 + 3) + g;
         float px = p->mark_x < full.x + full.w * 0.5f ? full.x + full.w - w - g : full.x + g;
         if (full.w < 2 * w) px = full.x + (full.w - w) / 2;
         L->notes = mr_ui_rect_make(px, full.y + (full.h - h) / 2, w, h);
@@ -137,19 +142,57 @@ void mr_view_layout_compute(const mr_ui *ui, const mr_view_layout_params *p, mr_
         mr_ui_cut_top(&in, T); /* the question */
         float bw = (in.w - g) / 2;
         bool fits = h <= full.h && w > 0 && bw + 1e-3f >= T;
+        /* The note's text field, then the categories, then Cancel (and
+         * Close when editing a saved mark). */
+        if (fits) place(L, MR_VW_NOTE_TEXT, mr_ui_rect_make(in.x, in.y, in.w, T), T, p);
+        else L->dropped++;
+        in.y += T + g;
         for (int i = 0; i <= MR_VIEW_NOTE_COUNT; i++) {
+            float cy = in.y + ((MR_VIEW_NOTE_COUNT + 1) / 2) * (T + g);
             mr_ui_rect b = i < MR_VIEW_NOTE_COUNT
                                ? mr_ui_rect_make(in.x + (i % 2) * (bw + g), in.y + (i / 2) * (T + g), bw, T)
-                               : mr_ui_rect_make(in.x, in.y + ((MR_VIEW_NOTE_COUNT + 1) / 2) * (T + g), in.w, T);
+                           : p->editing ? mr_ui_rect_make(in.x, cy, bw, T)
+                                        : mr_ui_rect_make(in.x, cy, in.w, T);
             if (fits) place(L, (mr_view_widget_id)(MR_VW_NOTE1 + i), b, T, p);
             else L->dropped++;
         }
+        if (fits && p->editing)
+            place(L, MR_VW_CLOSE_MARK,
+                  mr_ui_rect_make(in.x + bw + g, in.y + ((MR_VIEW_NOTE_COUNT + 1) / 2) * (T + g), bw, T), T, p);
         if (!fits) L->notes = mr_ui_rect_make(full.x, full.y, full.w, fminf(full.h, T + 2 * g));
+    }
+    /* "Quit?": a question and two buttons in the middle of the picture. */
+    if (p->quit_open) {
+        float w = fminf(full.w - 2 * g, 2 * colw + 3 * g), h = 2 * T + 3 * g;
+        L->quit = mr_ui_rect_make(full.x + (full.w - w) / 2, full.y + (full.h - h) / 2, w, h);
+        mr_ui_rect in = mr_ui_rect_inset(L->quit, g);
+        mr_ui_cut_top(&in, T + g);
+        float bw = (in.w - g) / 2;
+        place(L, MR_VW_QUIT_YES, mr_ui_rect_make(in.x, in.y, bw, T), T, p);
+        place(L, MR_VW_QUIT_NO, mr_ui_rect_make(in.x + bw + g, in.y, bw, T), T, p);
+    }
+    /* The help and settings panel: the keys, then a row of settings
+     * (the methods the toggles use, Reset) at its bottom. */
+    if (p->help_open) {
+        float w = fminf(full.w - 2 * g, mr_ui_mm(ui, 120)), h = full.h;
+        L->help = mr_ui_rect_make(full.x + (full.w - w) / 2, full.y, w, h);
+        mr_ui_rect in = mr_ui_rect_inset(L->help, g);
+        float bw = (in.w - 3 * g) / 4;
+        mr_ui_rect row = mr_ui_cut_bottom(&in, T);
+        for (int i = 0; i < 4; i++)
+            place(L, (mr_view_widget_id)(MR_VW_SET_AO + i), mr_ui_rect_make(row.x + i * (bw + g), row.y, bw, T), T, p);
     }
     L->picture = full;
 }
 
 /* --------------------------------------------------- tracking-lost policy */
+
+mr_ui_rect mr_viewer_picture_area(mr_viewer *v, float fb_w, float fb_h, bool seekable) {
+    mr_view_layout_params lp = {fb_w, fb_h, seekable, false, 0, false, false, false};
+    mr_view_layout L;
+    mr_view_layout_compute(v->ui, &lp, &L);
+    return L.picture;
+}
 
 mr_view_render_choice mr_view_render_policy(const mr_view_settings *s, bool have_pose, bool pose_valid,
                                             bool frozen) {
@@ -192,6 +235,7 @@ mr_viewer *mr_viewer_create(const mr_viewer_params *params, mr_error *err) {
     snprintf(v->config_path, sizeof v->config_path, "%s", v->p.config_path ? v->p.config_path : "");
     v->p.config_path = v->config_path;
     v->now = v->last_save = v->p.now;
+    v->edit_pin = -1;
     mr_ui_font_params fp = MR_UI_FONT_DEFAULTS;
     fp.path = v->p.font_path;
     fp.pixel_height = roundf((float)(3.2 * v->p.px_per_mm)); /* baked at the size it is drawn */
@@ -217,6 +261,7 @@ void mr_viewer_destroy(mr_viewer **pv) {
     mr_ui_destroy(&v->ui);
     mr_ui_font_destroy(&v->font);
     free(v->queue);
+    free(v->pins);
     mr_view_script_destroy(&v->script);
     free(v);
     *pv = NULL;
@@ -248,6 +293,47 @@ void mr_viewer_note_open(mr_viewer *v, float u, float vv) {
     v->mark_u = u;
     v->mark_v = vv;
     v->note_open = true;
+    v->edit_pin = -1;
+    v->note_text[0] = 0;
+    v->text_focus = false;
+}
+
+bool mr_viewer_pin_put(mr_viewer *v, int index, const mr_view_pin *pin) {
+    if (index < 0 || index > v->pin_count) return false;
+    if (index == v->pin_count) {
+        if (v->pin_count == v->pin_cap) {
+            int cap = v->pin_cap ? v->pin_cap * 2 : 16;
+            vw_pin *p = realloc(v->pins, (size_t)cap * sizeof *p);
+            if (!p) return false;
+            v->pins = p;
+            v->pin_cap = cap;
+        }
+        v->pin_count++;
+    }
+    memset(&v->pins[index], 0, sizeof v->pins[index]);
+    v->pins[index].p = *pin;
+    return true;
+}
+
+int mr_viewer_pin_count(const mr_viewer *v) { return v->pin_count; }
+
+bool mr_viewer_pin_at(const mr_viewer *v, int i, float *x, float *y) {
+    if (i < 0 || i >= v->pin_count || !v->pins[i].shown) return false;
+    *x = v->pins[i].x;
+    *y = v->pins[i].y;
+    return true;
+}
+
+/* Opens the chooser on saved mark i, its note and category as they are. */
+static void edit_pin(mr_viewer *v, int i) {
+    const mr_view_pin *p = &v->pins[i].p;
+    v->note_open = true;
+    v->edit_pin = i;
+    v->text_focus = false;
+    snprintf(v->note_text, sizeof v->note_text, "%s", p->note);
+    const mr_ui_rect ir = v->f.image_rect;
+    v->mark_u = ir.w > 0 ? (v->pins[i].x - ir.x) / ir.w : 0.5f;
+    v->mark_v = ir.h > 0 ? (v->pins[i].y - ir.y) / ir.h : 0.5f;
 }
 
 const mr_view_settings *mr_viewer_settings(const mr_viewer *v) { return &v->s; }
@@ -314,19 +400,42 @@ static void set_rate(mr_viewer *v, int i, mr_view_actions *out) {
 
 /* AO and ghosting cycle through the names of their settings rows, in
  * their order (the enums' order). */
+/* The next method of a settings row, skipping its "off" value (the toggle's). */
+static int next_method(const char *key, int cur, int off) {
+    const mr_opt *o = mr_opt_find(mr_view_settings_opts, key);
+    int m = mr_opt_enum_next(o, cur);
+    if (m == off) m = mr_opt_enum_next(o, m);
+    return m;
+}
+
 static void next_ao(mr_viewer *v, mr_view_actions *out) {
-    v->s.ao = (mr_ao_method)mr_opt_enum_next(mr_opt_find(mr_view_settings_opts, "ao"), (int)v->s.ao);
+    v->s.ao = (mr_ao_method)next_method("ao", (int)v->s.ao, MR_AO_NONE);
     changed(v, out);
 }
 
 static void next_ghost(mr_viewer *v, mr_view_actions *out) {
-    v->s.ghost = (mr_ghost_mode)mr_opt_enum_next(mr_opt_find(mr_view_settings_opts, "ghost"), (int)v->s.ghost);
+    v->s.ghost = (mr_ghost_mode)next_method("ghost", (int)v->s.ghost, MR_GHOST_OFF);
     changed(v, out);
 }
 
 static void next_shadows(mr_viewer *v, mr_view_actions *out) {
-    v->s.shadows = (mr_shadow_method)mr_opt_enum_next(mr_opt_find(mr_view_settings_opts, "shadows"), (int)v->s.shadows);
+    v->s.shadows = (mr_shadow_method)next_method("shadows", (int)v->s.shadows, MR_SHADOW_OFF);
     changed(v, out);
+}
+
+static void toggle(mr_viewer *v, bool *on, mr_view_actions *out) {
+    *on = !*on;
+    changed(v, out);
+}
+
+static void reset_settings(mr_viewer *v, mr_view_actions *out) {
+    static const mr_view_settings d = MR_VIEW_SETTINGS_DEFAULTS;
+    bool rate = v->s.rate_i != d.rate_i;
+    v->s = d;
+    changed(v, out);
+    if (rate) vw_emit(out, MR_VA_RATE)->x = mr_view_rates[d.rate_i];
+    v->notice_until = 0;
+    mr_viewer_toast(v, "settings reset to the defaults");
 }
 
 static void mark_at(mr_viewer *v, double x, double y, mr_view_actions *out) {
@@ -335,16 +444,66 @@ static void mark_at(mr_viewer *v, double x, double y, mr_view_actions *out) {
     a->y = y;
 }
 
-static void finish_mark(mr_viewer *v, int note, mr_view_actions *out) {
+/* The chooser's answer: a category (-1 cancelled), or closing the mark
+ * being edited. The note goes with it, as typed. */
+static void finish_mark(mr_viewer *v, int category, bool close, mr_view_actions *out) {
     v->note_open = false;
     v->mark_mode = false;
-    vw_emit(out, MR_VA_MARK_FINISH)->i = note;
+    v->text_focus = false;
+    mr_view_action *a;
+    if (v->edit_pin >= 0) {
+        if (category < 0 && !close) {
+            mr_viewer_toast(v, "edit cancelled");
+        } else {
+            a = vw_emit(out, MR_VA_MARK_EDIT);
+            a->x = v->edit_pin;
+            a->i = category >= 0 ? category : v->pins[v->edit_pin].p.category;
+            a->on = close;
+            a->path = v->note_text;
+        }
+    } else {
+        a = vw_emit(out, MR_VA_MARK_FINISH);
+        a->i = category;
+        a->path = v->note_text;
+    }
+    v->edit_pin = -1;
+}
+
+/* Keys while the note field has the keyboard: printable characters are
+ * typed, Backspace deletes, Enter and Esc leave the field. */
+static void type_key(mr_viewer *v, int k) {
+    size_t n = strlen(v->note_text);
+    if (k == MR_KEY_ENTER || k == MR_KEY_ESCAPE || k == MR_KEY_TAB) v->text_focus = false;
+    else if (k == MR_KEY_BACKSPACE && n > 0) v->note_text[n - 1] = 0;
+    else if (k >= 32 && k < 127 && n + 1 < sizeof v->note_text) v->note_text[n] = (char)k, v->note_text[n + 1] = 0;
+}
+
+/* Esc: the innermost thing going on ends; nothing else. */
+static void cancel(mr_viewer *v) {
+    if (v->quit_open) v->quit_open = false;
+    else if (v->text_focus) v->text_focus = false;
+    else if (v->note_open) return; /* handled by the caller: it emits the cancel */
+    else if (v->help) v->help = false;
+    else if (v->measure_mode) vw_measure_cancel(v);
+    else if (v->mark_mode) v->mark_mode = false;
+    else if (v->frozen) mr_viewer_toast(v, "frozen: f unfreezes; q quits");
+    else mr_viewer_toast(v, "nothing to cancel; q quits");
 }
 
 static void on_key(mr_viewer *v, int k, mr_view_actions *out) {
+    if (v->quit_open) {
+        if (k == MR_KEY_ENTER || k == 'y' || k == 'q') vw_emit(out, MR_VA_QUIT);
+        else if (k == MR_KEY_ESCAPE || k == 'n') v->quit_open = false;
+        return;
+    }
+    if (v->text_focus) {
+        type_key(v, k);
+        return;
+    }
     if (v->note_open) {
-        if (k >= '1' && k < '1' + MR_VIEW_NOTE_COUNT) finish_mark(v, k - '1', out);
-        else if (k == MR_KEY_ESCAPE || k == 'q') finish_mark(v, -1, out);
+        if (k >= '1' && k < '1' + MR_VIEW_NOTE_COUNT) finish_mark(v, k - '1', false, out);
+        else if (k == MR_KEY_ESCAPE) finish_mark(v, -1, false, out);
+        else if (k == MR_KEY_ENTER || k == 'n') v->text_focus = true;
         return;
     }
     if (v->help && (k == MR_KEY_ESCAPE || k == '?' || k == MR_KEY_F1)) {
@@ -369,9 +528,9 @@ static void on_key(mr_viewer *v, int k, mr_view_actions *out) {
         break;
     case 'v': v->s.show_video = !v->s.show_video; changed(v, out); break;
     case 'h': v->s.hide_hidden = !v->s.hide_hidden; changed(v, out); break;
-    case 'a': next_ao(v, out); break;
-    case 'g': next_ghost(v, out); break;
-    case 'c': next_shadows(v, out); break;
+    case 'a': toggle(v, &v->s.ao_on, out); break;
+    case 'g': toggle(v, &v->s.ghost_on, out); break;
+    case 'c': toggle(v, &v->s.shadows_on, out); break;
     case ' ': toggle_play(v, out); break;
     case '.': case MR_KEY_RIGHT: step(v, 1, out); break;
     case ',': case MR_KEY_LEFT: step(v, -1, out); break;
@@ -380,12 +539,8 @@ static void on_key(mr_viewer *v, int k, mr_view_actions *out) {
     case '[': set_rate(v, v->s.rate_i - 1, out); break;
     case ']': set_rate(v, v->s.rate_i + 1, out); break;
     case MR_KEY_F11: vw_emit(out, MR_VA_FULLSCREEN); break;
-    case MR_KEY_ESCAPE:
-        if (v->measure_mode) vw_measure_cancel(v);
-        else if (v->mark_mode) v->mark_mode = false;
-        else vw_emit(out, MR_VA_QUIT);
-        break;
-    case 'q': vw_emit(out, MR_VA_QUIT); break;
+    case MR_KEY_ESCAPE: cancel(v); break;
+    case 'q': v->quit_open = true; break;
     default: break;
     }
 }
@@ -456,35 +611,53 @@ mr_view_sigma_state mr_view_sigma_classify(bool known, double sigma_m) {
     return mm < MR_VIEW_SIGMA_OK_MM ? MR_VIEW_SIGMA_OK : mm <= MR_VIEW_SIGMA_WARN_MM ? MR_VIEW_SIGMA_WARN : MR_VIEW_SIGMA_BAD;
 }
 
+/* The planner's words: tracking, the registration's sigma at the centre,
+ * the frame (its number as in the files), the marks; the frame rate and the
+ * render passes only with --stats. */
 static void status_line(mr_viewer *v, const mr_viewer_frame *f) {
-    char line[512], track[128], src[160], here[48] = "";
-    if (!f->have_frame) snprintf(track, sizeof track, "no frame");
-    else if (f->pose_valid)
-        snprintf(track, sizeof track, "tracking: %d tags, %.2f px", f->tags_seen < 0 ? 0 : f->tags_seen,
-                 f->rms_px < 0 ? 0.0 : f->rms_px);
-    else snprintf(track, sizeof track, "TRACKING LOST (%d tags)", f->tags_seen < 0 ? 0 : f->tags_seen);
-    if (f->seekable && f->have_frame)
-        snprintf(src, sizeof src, "replay %lld/%lld %s %gx", (long long)f->index + 1, (long long)f->count,
-                 f->playing ? "playing" : "paused", mr_view_rates[v->s.rate_i]);
-    else snprintf(src, sizeof src, "%.150s", f->source_desc ? f->source_desc : "");
-    /* The registration's σ where the planner looks ("+/-": the UI font is
-     * printable ASCII only); "?" when the pose has
-     * no covariance (an older recording) or nothing is under the centre. */
+    char line[600], track[128], frame[160] = "", here[64] = "", marks[64] = "", stats[300] = "";
+    int tags = f->tags_seen < 0 ? 0 : f->tags_seen;
+    if (!f->have_frame) snprintf(track, sizeof track, "no camera frame yet");
+    else if (f->pose_valid) snprintf(track, sizeof track, "tracking OK (%d tag%s)", tags, tags == 1 ? "" : "s");
+    else if (f->have_pose) snprintf(track, sizeof track, "TRACKING LOST (%d tag%s)", tags, tags == 1 ? "" : "s");
+    else snprintf(track, sizeof track, "searching for markers");
+    if (f->have_frame && f->seekable)
+        snprintf(frame, sizeof frame, " | frame %lld of 0-%lld, %s %gx", (long long)f->index,
+                 (long long)(f->count > 0 ? f->count - 1 : 0), f->playing ? "playing" : "paused", mr_view_rates[v->s.rate_i]);
+    else if (f->have_frame) snprintf(frame, sizeof frame, " | frame %lld", (long long)f->index);
+    /* The registration's sigma where the planner looks ("+/-": the UI font
+     * is printable ASCII only); "?" when the pose has no covariance (an
+     * older recording) or nothing is under the centre. */
     v->sigma_known = f->have_frame && f->have_pose && mr_view_sigma_here(f, &v->sigma_m);
     if (!v->sigma_known) v->sigma_m = NAN;
     if (f->have_frame && f->have_pose) {
         double mm = v->sigma_m * 1e3;
-        if (!v->sigma_known) snprintf(here, sizeof here, " | +/- ? mm here");
-        else snprintf(here, sizeof here, mm < 9.95 ? " | +/- %.1f mm here" : " | +/- %.0f mm here", mm);
+        const char *where = v->note_open ? "at the mark" : "at the centre";
+        if (!v->sigma_known) snprintf(here, sizeof here, " | registration +/- ? mm %s", where);
+        else snprintf(here, sizeof here, mm < 9.95 ? " | registration +/- %.1f mm %s" : " | registration +/- %.0f mm %s", mm,
+                      where);
     }
-    snprintf(line, sizeof line, "%s%s | %s%s | %.1f fps | %.200s", v->frozen ? "FROZEN | " : "", src, track, here,
-             f->fps, v->passes[0] ? v->passes : "-");
+    int open_marks = 0;
+    for (int i = 0; i < v->pin_count; i++) open_marks += !v->pins[i].p.closed;
+    if (v->pin_count)
+        snprintf(marks, sizeof marks, " | %d mark%s (%d open)", v->pin_count, v->pin_count == 1 ? "" : "s", open_marks);
+    else snprintf(marks, sizeof marks, " | no marks");
+    if (v->p.show_stats) snprintf(stats, sizeof stats, " | %.1f fps | %.200s", f->fps, v->passes[0] ? v->passes : "-");
+    snprintf(line, sizeof line, "%s%s%s%s%s%s", v->frozen ? "FROZEN | " : "", track, here, frame, marks, stats);
     snprintf(v->status, sizeof v->status, "%s", line);
     mr_view_sigma_state st = mr_view_sigma_classify(v->sigma_known, v->sigma_m);
     uint32_t col = MR_UI_RGBA(235, 240, 245, 255);
     if (f->have_frame && !f->pose_valid) col = MR_UI_RGBA(255, 150, 120, 255);
     else if (st == MR_VIEW_SIGMA_BAD) col = MR_UI_RGBA(255, 120, 100, 255);
     else if (st == MR_VIEW_SIGMA_WARN) col = MR_UI_RGBA(255, 210, 110, 255);
+    /* A line longer than the window loses its end, not its start. */
+    float th = mr_ui_text_px(v->ui), room = v->lay.status.w - mr_ui_mm(v->ui, 2);
+    const mr_ui_font *font = mr_ui_get_font(v->ui);
+    size_t n = strlen(line);
+    while (n > 4 && mr_ui_text_width(font, line, th) > room) {
+        line[--n] = 0;
+        memcpy(line + n - 3, "...", 3);
+    }
     mr_ui_label(v->ui, v->lay.status, line, col, false);
 }
 
@@ -512,7 +685,7 @@ static void bottom_bar(mr_viewer *v, const mr_viewer_frame *f, mr_view_actions *
     if (!L->shown[MR_VW_SEEK]) return;
     int64_t count = f->have_frame && f->count > 0 ? f->count : 1;
     float pos = f->have_frame ? (float)f->index : 0;
-    snprintf(lab, sizeof lab, "frame %lld", (long long)(f->have_frame ? f->index + 1 : 0));
+    snprintf(lab, sizeof lab, "frame %lld", (long long)(f->have_frame ? f->index : 0));
     if (mr_ui_slider(v->ui, 2, L->rect[MR_VW_SEEK], lab, &pos, 0.0f, (float)(count > 1 ? count - 1 : 1))) {
         int64_t want = (int64_t)lroundf(pos);
         if (!f->have_frame || want != f->index) seek(v, want, out);
@@ -520,9 +693,6 @@ static void bottom_bar(mr_viewer *v, const mr_viewer_frame *f, mr_view_actions *
 }
 
 static void column(mr_viewer *v, mr_view_actions *out) {
-    char ao_label[32], ghost_label[32];
-    snprintf(ao_label, sizeof ao_label, "AO %s", mr_ao_method_name(v->s.ao));
-    snprintf(ghost_label, sizeof ghost_label, "Ghost %s", mr_view_ghost_name(v->s.ghost));
     if (v->lay.column.w > 0) mr_ui_panel(v->ui, v->lay.column);
     if (button(v, MR_VW_FREEZE, v->frozen ? "Frozen" : "Freeze", v->frozen)) set_frozen(v, !v->frozen, out);
     if (button(v, MR_VW_SNAPSHOT, "Snapshot", false)) vw_emit(out, MR_VA_SNAPSHOT);
@@ -540,8 +710,10 @@ static void column(mr_viewer *v, mr_view_actions *out) {
         v->s.hide_hidden = !v->s.hide_hidden;
         changed(v, out);
     }
-    if (button(v, MR_VW_AO, ao_label, v->s.ao != MR_AO_NONE)) next_ao(v, out);
-    if (button(v, MR_VW_GHOST, ghost_label, v->s.ghost != MR_GHOST_OFF)) next_ghost(v, out);
+    if (button(v, MR_VW_AO, "AO", v->s.ao_on)) toggle(v, &v->s.ao_on, out);
+    if (button(v, MR_VW_GHOST, "Ghost", v->s.ghost_on)) toggle(v, &v->s.ghost_on, out);
+    if (button(v, MR_VW_SHADOWS, "Shadows", v->s.shadows_on)) toggle(v, &v->s.shadows_on, out);
+    if (button(v, MR_VW_QUIT, "Quit", v->quit_open)) v->quit_open = true;
     if (button(v, MR_VW_HELP, "?", v->help)) v->help = !v->help;
 }
 
@@ -550,8 +722,8 @@ static void messages(mr_viewer *v, const mr_viewer_frame *f) {
     mr_ui *ui = v->ui;
     float g = mr_ui_mm(ui, 1.2f), th = mr_ui_text_px(ui);
     mr_ui_rect area = v->lay.picture;
-    const char *banners[5];
-    uint32_t colors[5];
+    const char *banners[6];
+    uint32_t colors[6];
     char measure_banner[160];
     int nb = 0;
     if (f->source_msg && f->source_msg[0]) { banners[nb] = f->source_msg; colors[nb++] = MR_UI_RGBA(200, 40, 40, 230); }
@@ -566,6 +738,10 @@ static void messages(mr_viewer *v, const mr_viewer_frame *f) {
     if (v->mark_mode && !v->note_open) {
         banners[nb] = "MARK: tap the discrepancy in the picture (Esc cancels)";
         colors[nb++] = MR_UI_RGBA(214, 120, 28, 230);
+    }
+    if (v->notice[0] && v->now < v->notice_until) {
+        banners[nb] = v->notice;
+        colors[nb++] = MR_UI_RGBA(40, 90, 150, 230);
     }
     if (v->measure_mode) {
         vw_measure_banner(v, measure_banner, sizeof measure_banner);
@@ -584,6 +760,23 @@ static void messages(mr_viewer *v, const mr_viewer_frame *f) {
     }
 }
 
+/* The note's text field: a tap gives it the keyboard (a tablet shows its
+ * on-screen keyboard for it); what is typed shows with a caret, its end
+ * kept in view. */
+static void note_field(mr_viewer *v, mr_ui_rect r) {
+    mr_ui *ui = v->ui;
+    if (mr_ui_button(ui, 75, r, "", v->text_focus ? MR_UI_ON : MR_UI_NORMAL)) v->text_focus = !v->text_focus;
+    float th = mr_ui_text_px(ui), pad = mr_ui_mm(ui, 1.5f);
+    mr_ui_rect in = mr_ui_rect_inset(r, pad);
+    char shown[sizeof v->note_text + 2];
+    bool empty = !v->note_text[0];
+    snprintf(shown, sizeof shown, "%s%s", empty && !v->text_focus ? "tap to type a note (@who #label !priority)" : v->note_text,
+             v->text_focus ? "_" : "");
+    const char *t = shown;
+    while (*t && mr_ui_text_width(mr_ui_get_font(ui), t, th) > in.w) t++;
+    mr_ui_label(ui, in, t, empty && !v->text_focus ? MR_UI_RGBA(170, 180, 190, 255) : MR_UI_RGBA(255, 255, 255, 255), false);
+}
+
 /* The note chooser and the cross of the mark being made. */
 static void notes(mr_viewer *v, const mr_viewer_frame *f, mr_view_actions *out) {
     mr_ui *ui = v->ui;
@@ -592,16 +785,25 @@ static void notes(mr_viewer *v, const mr_viewer_frame *f, mr_view_actions *out) 
     mr_ui_panel(ui, L->notes);
     mr_ui_panel(ui, L->notes); /* darker */
     mr_ui_rect in = mr_ui_rect_inset(L->notes, g);
-    mr_ui_label(ui, mr_ui_cut_top(&in, T), L->shown[MR_VW_NOTE1] ? "What differs here?" : "What differs? keys 1..6",
-                MR_UI_RGBA(255, 255, 255, 255), true);
+    char q[260];
+    if (v->edit_pin >= 0) snprintf(q, sizeof q, "Mark %d: %.200s", v->pins[v->edit_pin].p.number, v->pins[v->edit_pin].p.title);
+    else snprintf(q, sizeof q, "%s", L->shown[MR_VW_NOTE1] ? "Note, then what differs here?" : "What differs? keys 1..6");
+    mr_ui_label(ui, mr_ui_cut_top(&in, T), q, MR_UI_RGBA(255, 255, 255, 255), true);
+    if (L->shown[MR_VW_NOTE_TEXT]) note_field(v, L->rect[MR_VW_NOTE_TEXT]);
+    int current = v->edit_pin >= 0 ? v->pins[v->edit_pin].p.category : -1;
     for (int i = 0; i < MR_VIEW_NOTE_COUNT; i++) {
         char lb[48];
-        snprintf(lb, sizeof lb, "%d %s", i + 1, mr_view_notes[i]);
-        if (L->shown[MR_VW_NOTE1 + i] && mr_ui_button(ui, (uint32_t)(60 + i), L->rect[MR_VW_NOTE1 + i], lb, MR_UI_NORMAL))
-            finish_mark(v, i, out);
+        snprintf(lb, sizeof lb, "%d %s", i + 1, mr_mark_categories[i]);
+        if (L->shown[MR_VW_NOTE1 + i] &&
+            mr_ui_button(ui, (uint32_t)(60 + i), L->rect[MR_VW_NOTE1 + i], lb, i == current ? MR_UI_ON : MR_UI_NORMAL))
+            finish_mark(v, i, false, out);
     }
     if (L->shown[MR_VW_CANCEL] && mr_ui_button(ui, 70, L->rect[MR_VW_CANCEL], "Cancel", MR_UI_NORMAL))
-        finish_mark(v, -1, out);
+        finish_mark(v, -1, false, out);
+    if (L->shown[MR_VW_CLOSE_MARK] && v->edit_pin >= 0 &&
+        mr_ui_button(ui, 71, L->rect[MR_VW_CLOSE_MARK], v->pins[v->edit_pin].p.closed ? "Keep closed" : "Close mark",
+                     MR_UI_NORMAL))
+        finish_mark(v, -1, true, out);
     if (!f->have_image) return;
     mr_ui_rect ir = f->image_rect;
     float x = ir.x + v->mark_u * ir.w, y = ir.y + v->mark_v * ir.h;
@@ -610,23 +812,102 @@ static void notes(mr_viewer *v, const mr_viewer_frame *f, mr_view_actions *out) 
     mr_ui_draw_rect(mr_ui_list(ui), mr_ui_rect_make(x - t / 2, y - s, t, 2 * s), MR_UI_RGBA(255, 60, 60, 255));
 }
 
-static void help_panel(mr_viewer *v) {
+/* "Quit?" with its two answers. */
+static void quit_panel(mr_viewer *v, mr_view_actions *out) {
     mr_ui *ui = v->ui;
-    float g = mr_ui_mm(ui, 1.2f), th = mr_ui_text_px(ui), lh = th * 1.35f;
-    mr_ui_rect full = v->lay.picture;
-    float w = fminf(full.w - 2 * g, mr_ui_mm(ui, 120)), h = fminf(full.h, lh * (mr_view_keymap_count + 1) + 2 * g);
-    mr_ui_rect p = mr_ui_rect_make(full.x + (full.w - w) / 2, full.y + (full.h - h) / 2, w, h);
-    /* The whole panel is one button: a tap anywhere closes it. */
-    if (mr_ui_button(ui, 80, p, "", MR_UI_NORMAL)) v->help = false;
+    const mr_view_layout *L = &v->lay;
+    float g = mr_ui_mm(ui, 1.2f);
+    mr_ui_panel(ui, L->quit);
+    mr_ui_panel(ui, L->quit);
+    mr_ui_rect in = mr_ui_rect_inset(L->quit, g);
+    mr_ui_label(ui, mr_ui_cut_top(&in, mr_ui_target_px(ui)), "Quit the check? (marks are saved)", MR_UI_RGBA(255, 255, 255, 255),
+                true);
+    if (L->shown[MR_VW_QUIT_YES] && mr_ui_button(ui, 90, L->rect[MR_VW_QUIT_YES], "Quit", MR_UI_ACCENT))
+        vw_emit(out, MR_VA_QUIT);
+    if (L->shown[MR_VW_QUIT_NO] && mr_ui_button(ui, 91, L->rect[MR_VW_QUIT_NO], "Stay", MR_UI_NORMAL)) v->quit_open = false;
+}
+
+static void help_panel(mr_viewer *v, mr_view_actions *out) {
+    mr_ui *ui = v->ui;
+    const mr_view_layout *L = &v->lay;
+    float g = mr_ui_mm(ui, 1.2f), th = mr_ui_text_px(ui), lh = th * 1.35f, T = mr_ui_target_px(ui);
+    mr_ui_rect p = L->help;
+    mr_ui_panel(ui, p);
     mr_ui_panel(ui, p);
     mr_ui_rect in = mr_ui_rect_inset(p, g);
-    mr_ui_label(ui, mr_ui_cut_top(&in, lh), "Keys (tap or press ? to close)", MR_UI_RGBA(255, 220, 150, 255), false);
+    mr_ui_cut_bottom(&in, T + g); /* the settings row */
+    char changes[300], head[400];
+    int nc = mr_view_settings_describe_changes(&v->s, changes, sizeof changes);
+    snprintf(head, sizeof head, "Settings: %s", nc ? changes : "the defaults");
+    mr_ui_label(ui, mr_ui_cut_bottom(&in, lh), head, MR_UI_RGBA(255, 220, 150, 255), false);
+    char lb[4][48];
+    snprintf(lb[0], sizeof lb[0], "AO: %s", mr_ao_method_name(v->s.ao));
+    snprintf(lb[1], sizeof lb[1], "Ghost: %s", mr_view_ghost_name(v->s.ghost));
+    snprintf(lb[2], sizeof lb[2], "Shadows: %s",
+             mr_shadow_method_names[(int)v->s.shadows >= 0 && v->s.shadows < MR_SHADOW_METHOD_COUNT ? v->s.shadows : 0]);
+    snprintf(lb[3], sizeof lb[3], "Reset");
+    for (int i = 0; i < 4; i++) {
+        mr_view_widget_id id = (mr_view_widget_id)(MR_VW_SET_AO + i);
+        if (!L->shown[id] || !mr_ui_button(ui, 95 + (uint32_t)i, L->rect[id], lb[i], MR_UI_NORMAL)) continue;
+        if (i == 0) next_ao(v, out);
+        else if (i == 1) next_ghost(v, out);
+        else if (i == 2) next_shadows(v, out);
+        else reset_settings(v, out);
+    }
+    mr_ui_label(ui, mr_ui_cut_top(&in, lh), "Keys (? or Esc closes)", MR_UI_RGBA(255, 220, 150, 255), false);
     for (int i = 0; i < mr_view_keymap_count && in.h >= lh; i++) {
         mr_ui_rect row = mr_ui_cut_top(&in, lh);
         mr_ui_rect k = mr_ui_cut_left(&row, fminf(row.w * 0.3f, mr_ui_mm(ui, 30)));
         mr_ui_label(ui, k, mr_view_keymap[i].keys, MR_UI_RGBA(150, 200, 255, 255), false);
         mr_ui_label(ui, row, mr_view_keymap[i].what, MR_UI_RGBA(235, 240, 245, 255), false);
     }
+}
+
+/* Saved marks as pins: projected with this frame's pose into the picture. */
+static void pins(mr_viewer *v, const mr_viewer_frame *f) {
+    mr_ui *ui = v->ui;
+    const mr_ui_rect ir = f->image_rect;
+    bool can = f->have_image && f->have_pose && f->camera && f->camera->width > 0;
+    mr_camera pin_cam;
+    if (can) {
+        pin_cam = *f->camera;
+        memset(pin_cam.dist, 0, sizeof pin_cam.dist); /* the picture is undistorted */
+    }
+    float s = mr_ui_mm(ui, 2.2f), t = fmaxf(2, mr_ui_mm(ui, 0.5f)), th = mr_ui_text_px(ui);
+    for (int i = 0; i < v->pin_count; i++) {
+        vw_pin *p = &v->pins[i];
+        double u, w;
+        p->shown = can && p->p.has_world && mr_project_point(&pin_cam, &f->world_from_camera, p->p.world, &u, &w);
+        if (!p->shown) continue;
+        p->x = ir.x + (float)((u + 0.5) * ir.w / pin_cam.width);
+        p->y = ir.y + (float)((w + 0.5) * ir.h / pin_cam.height);
+        p->shown = mr_ui_rect_contains(ir, p->x, p->y);
+        if (!p->shown) continue;
+        uint32_t col = p->p.closed ? MR_UI_RGBA(150, 150, 150, 235) : MR_UI_RGBA(220, 40, 40, 240);
+        /* A head with the number above a stem whose tip is the point. */
+        mr_ui_rect head = mr_ui_rect_make(p->x - s, p->y - 3.2f * s, 2 * s, 2 * s);
+        mr_ui_draw_rect(mr_ui_list(ui), mr_ui_rect_make(p->x - t / 2, p->y - 1.2f * s, t, 1.2f * s), col);
+        mr_ui_draw_rect(mr_ui_list(ui), head, col);
+        mr_ui_draw_frame(mr_ui_list(ui), head, 1.0f, MR_UI_RGBA(255, 255, 255, 255));
+        mr_ui_draw_rect(mr_ui_list(ui), mr_ui_rect_make(p->x - t, p->y - t, 2 * t, 2 * t), MR_UI_RGBA(255, 255, 255, 255));
+        char num[16];
+        snprintf(num, sizeof num, "%d", p->p.number);
+        (void)th;
+        mr_ui_label(ui, head, num, MR_UI_RGBA(255, 255, 255, 255), true);
+    }
+}
+
+/* The saved mark whose pin is nearest a tap, within a touch target; -1 none. */
+static int pin_hit(const mr_viewer *v, float x, float y) {
+    float T = mr_ui_target_px(v->ui), s = mr_ui_mm(v->ui, 2.2f), best = T * T * 0.36f;
+    int hit = -1;
+    for (int i = 0; i < v->pin_count; i++) {
+        if (!v->pins[i].shown) continue;
+        /* the head and the stem count: measure to the middle of the pin */
+        float dx = x - v->pins[i].x, dy = y - (v->pins[i].y - 1.6f * s), d = dx * dx + dy * dy;
+        if (d < best) best = d, hit = i;
+    }
+    return hit;
 }
 
 const mr_ui_draw_list *mr_viewer_ui(mr_viewer *v, const mr_viewer_frame *f, mr_view_actions *out) {
@@ -636,8 +917,18 @@ const mr_ui_draw_list *mr_viewer_ui(mr_viewer *v, const mr_viewer_frame *f, mr_v
     snprintf(v->passes, sizeof v->passes, "%s", f->passes ? f->passes : "");
     v->f.source_desc = v->f.source_msg = v->f.scene_msg = v->f.passes = NULL;
 
+    if (!v->notice_done) {
+        /* Settings carried over from an earlier session are said at start. */
+        char changes[300];
+        v->notice_done = true;
+        if (mr_view_settings_describe_changes(&v->s, changes, sizeof changes) > 0) {
+            snprintf(v->notice, sizeof v->notice, "Settings differ from the defaults: %s (? > Reset)", changes);
+            v->notice_until = f->now + 10.0;
+        }
+    }
     mr_view_layout_params lp = {f->fb_w, f->fb_h, f->seekable, v->note_open,
-                                f->image_rect.x + v->mark_u * f->image_rect.w};
+                                f->image_rect.x + v->mark_u * f->image_rect.w, v->note_open && v->edit_pin >= 0,
+                                v->quit_open, v->help};
     mr_view_layout_compute(v->ui, &lp, &v->lay);
     mr_ui_input in = v->input;
     mr_ui_begin(v->ui, &in);
@@ -645,16 +936,22 @@ const mr_ui_draw_list *mr_viewer_ui(mr_viewer *v, const mr_viewer_frame *f, mr_v
     status_line(v, f);
     bottom_bar(v, f, out);
     column(v, out);
+    pins(v, f);
     messages(v, f);
     if (v->note_open) notes(v, f, out);
     vw_measure_draw(v, f);
-    if (v->help) help_panel(v);
+    if (v->help) help_panel(v, out);
+    if (v->quit_open) quit_panel(v, out);
     float tx, ty;
     const mr_ui_draw_list *dl = mr_ui_end(v->ui);
     if (mr_ui_scene_tap(v->ui, &tx, &ty)) {
+        int pin = -1;
         if (v->help) v->help = false;
-        else if (v->mark_mode && !v->note_open) mark_at(v, tx, ty, out);
-        else if (v->measure_mode && !v->note_open) vw_measure_tap(v, f, tx, ty);
+        else if (v->quit_open) v->quit_open = false;
+        else if (v->note_open) v->text_focus = false;
+        else if (v->mark_mode) mark_at(v, tx, ty, out);
+        else if (v->measure_mode) vw_measure_tap(v, f, tx, ty);
+        else if ((pin = pin_hit(v, tx, ty)) >= 0) edit_pin(v, pin);
     }
     v->frames++;
     /* Settings are saved a moment after they change, not per slider step. */
@@ -671,9 +968,30 @@ cJSON *mr_viewer_state_json(const mr_viewer *v) {
     cJSON_AddNumberToObject(j, "alpha", v->s.alpha);
     cJSON_AddBoolToObject(j, "show_video", v->s.show_video);
     cJSON_AddBoolToObject(j, "hide_hidden_layer", v->s.hide_hidden);
-    cJSON_AddStringToObject(j, "ao", mr_ao_method_name(v->s.ao));
-    cJSON_AddStringToObject(j, "ghost", mr_view_ghost_name(v->s.ghost));
-    cJSON_AddStringToObject(j, "shadows", mr_shadow_method_names[(int)v->s.shadows >= 0 && v->s.shadows < MR_SHADOW_METHOD_COUNT ? v->s.shadows : 0]);
+    /* What the toggles give (none / off when off), and the methods. */
+    mr_shadow_method sh = mr_view_shadows(&v->s);
+    cJSON_AddStringToObject(j, "ao", mr_ao_method_name(mr_view_ao(&v->s)));
+    cJSON_AddStringToObject(j, "ghost", mr_view_ghost_name(mr_view_ghost(&v->s)));
+    cJSON_AddStringToObject(j, "shadows", mr_shadow_method_names[(int)sh >= 0 && sh < MR_SHADOW_METHOD_COUNT ? sh : 0]);
+    cJSON_AddStringToObject(j, "ao_method", mr_ao_method_name(v->s.ao));
+    cJSON_AddStringToObject(j, "status_line", v->status);
+    cJSON_AddBoolToObject(j, "quit_asked", v->quit_open);
+    cJSON_AddBoolToObject(j, "note_open", v->note_open);
+    cJSON_AddStringToObject(j, "note_text", v->note_text);
+    cJSON_AddBoolToObject(j, "note_typing", v->text_focus);
+    cJSON_AddStringToObject(j, "notice", v->now < v->notice_until ? v->notice : "");
+    cJSON *pj = cJSON_AddArrayToObject(j, "pins");
+    for (int i = 0; i < v->pin_count; i++) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "number", v->pins[i].p.number);
+        cJSON_AddBoolToObject(o, "shown", v->pins[i].shown);
+        cJSON_AddBoolToObject(o, "closed", v->pins[i].p.closed);
+        if (v->pins[i].shown) {
+            double xy[2] = {v->pins[i].x, v->pins[i].y};
+            cJSON_AddItemToObject(o, "xy", mr_json_from_doubles(xy, 2));
+        }
+        cJSON_AddItemToArray(pj, o);
+    }
     cJSON_AddBoolToObject(j, "frozen", v->frozen);
     cJSON_AddBoolToObject(j, "mark_mode", v->mark_mode);
     cJSON_AddBoolToObject(j, "help", v->help);
@@ -683,6 +1001,8 @@ cJSON *mr_viewer_state_json(const mr_viewer *v) {
     cJSON_AddBoolToObject(j, "pose_valid", v->f.have_frame && v->f.pose_valid);
     cJSON_AddNumberToObject(j, "tags_seen", v->f.have_frame ? v->f.tags_seen : -1);
     cJSON_AddBoolToObject(j, "tracking_lost_dimmed", v->f.dimmed);
+    double ir[4] = {v->f.image_rect.x, v->f.image_rect.y, v->f.image_rect.w, v->f.image_rect.h};
+    cJSON_AddItemToObject(j, "image_rect", mr_json_from_doubles(ir, 4));
     cJSON_AddNumberToObject(j, "fb_width", v->f.fb_w);
     cJSON_AddNumberToObject(j, "fb_height", v->f.fb_h);
     if (v->sigma_known) cJSON_AddNumberToObject(j, "sigma_here_mm", v->sigma_m * 1e3);

@@ -4,6 +4,7 @@
  * the frame parameters the settings give. run.c carries them out. */
 #include "view_internal.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -14,6 +15,21 @@ bool mr_view_window_to_image(mr_ui_rect image_rect, int rw, int rh, double x, do
     *u = (x - r.x) * rw / r.w - 0.5;
     *v = (y - r.y) * rh / r.h - 0.5;
     return true;
+}
+
+void mr_view_draw_pin(mr_image *img, double u, double v) {
+    if (!img || !img->data || img->channels != 3 || img->type != MR_PIX_U8) return;
+    const double r_in = MR_VIEW_PIN_R, r_out = 7.0;
+    int x0 = (int)floor(u - r_out - 1), x1 = (int)ceil(u + r_out + 1), y0 = (int)floor(v - r_out - 1),
+        y1 = (int)ceil(v + r_out + 1);
+    for (int y = y0 < 0 ? 0 : y0; y <= y1 && y < img->height; y++)
+        for (int x = x0 < 0 ? 0 : x0; x <= x1 && x < img->width; x++) {
+            double d = hypot(x - u, y - v);
+            if (d > r_out) continue;
+            uint8_t *p = (uint8_t *)img->data + ((size_t)y * (size_t)img->width + (size_t)x) * 3;
+            bool in = d <= r_in;
+            p[0] = 255, p[1] = in ? 0 : 255, p[2] = 255;
+        }
 }
 
 void mr_view_image_to_camera(const mr_camera *cam, int rw, int rh, double u, double v, double *px, double *py) {
@@ -52,8 +68,8 @@ mr_shadow_method mr_view_shadow_choose(mr_view_shadow_choice *c, mr_shadow_metho
 
 void mr_view_frame_params(const mr_view_settings *s, mr_shadow_method shadows, mr_frame_params *fp) {
     fp->hide_hidden_layer = s->hide_hidden;
-    fp->ao.method = s->ao;
-    fp->ghost.mode = s->ghost;
+    fp->ao.method = mr_view_ao(s);
+    fp->ghost.mode = mr_view_ghost(s);
     fp->shadow.method = shadows;
 }
 
@@ -94,10 +110,13 @@ void mr_view_render_setup(const mr_view_settings *s, const mr_camera *cam, const
     if (!c->use_pose) view->world_from_camera = mr_m4_look_at_cv(mr_v3(0, 0, 0), mr_v3(0, 0, 1), mr_v3(0, -1, 0));
 }
 
-cJSON *mr_view_mark_line(const mr_capture_frame *f, const char *note, double px, double py, const mr_pick *pick,
-                         const mr_scene *scene, const mr_measurement *measured) {
+cJSON *mr_view_mark_line(const mr_capture_frame *f, const mr_view_mark_words *w, double px, double py,
+                         const mr_pick *pick, const mr_scene *scene, const mr_measurement *measured) {
     mr_annotation m;
-    mr_annotation_from_frame(&m, f, note, (double)time(NULL));
+    bool cat = w->category >= 0 && w->category < MR_MARK_CATEGORY_COUNT;
+    mr_annotation_from_frame(&m, f, cat ? mr_mark_categories[w->category] : "", (double)time(NULL));
+    snprintf(m.id, sizeof m.id, "%s", w->id ? w->id : "");
+    mr_mark_set_note(&m, w->typed);
     m.has_pixel = true;
     m.pixel[0] = px;
     m.pixel[1] = py;
@@ -119,6 +138,7 @@ cJSON *mr_view_mark_line(const mr_capture_frame *f, const char *note, double px,
     m.has_uncertainty = mr_view_sigma_here(&sf, &m.uncertainty_m);
     m.has_measurement = measured != NULL; /* a mark made by Measure */
     if (measured) m.measurement = *measured;
+    mr_mark_title(&m, m.title, sizeof m.title);
     return mr_annotation_to_json(&m);
 }
 

@@ -43,9 +43,9 @@ extern "C" {
 /* Replay rates the rate button and [ ] step through. */
 #define MR_VIEW_RATE_COUNT 5
 extern const double mr_view_rates[MR_VIEW_RATE_COUNT];   /* 0.25 .. 4 */
-/* Notes offered when marking (a tap is quicker than typing on a tablet). */
-#define MR_VIEW_NOTE_COUNT 6
-extern const char *const mr_view_notes[MR_VIEW_NOTE_COUNT];
+/* The categories offered when marking (lib/session's mr_mark_categories;
+ * a tap is quicker than typing on a tablet, the note field takes the rest). */
+#define MR_VIEW_NOTE_COUNT MR_MARK_CATEGORY_COUNT
 
 /* What persists between runs (~/.config/mrcheck/view.json). */
 typedef struct mr_view_settings {
@@ -53,19 +53,33 @@ typedef struct mr_view_settings {
     bool show_video;      /* default true */
     bool hide_hidden;     /* hide the hidden layer; default false */
     int rate_i;           /* index into mr_view_rates; default 2 (1x) */
-    mr_ao_method ao;      /* default MR_AO_NONE */
-    mr_ghost_mode ghost;  /* default MR_GHOST_OFF */
-    mr_shadow_method shadows; /* off, hard, pcf, pcss or bp (the C key cycles); default off */
+    /* The depth cues are on/off toggles for the planner (the AO, Ghost and
+     * Shadows buttons, keys a g c); which method each uses when on is a
+     * setting of its own (the settings panel under ?, the settings file). */
+    bool ao_on, ghost_on, shadows_on; /* default false */
+    mr_ao_method ao;      /* AO method when on; default MR_AO_SCHEER (never none) */
+    mr_ghost_mode ghost;  /* ghosting mode when on; default MR_GHOST_ADAPTIVE (never off) */
+    mr_shadow_method shadows; /* hard, pcf, pcss or bp when on; default pcss (never off) */
 } mr_view_settings;
 #define MR_VIEW_DEFAULT_ALPHA 0.5f
 #define MR_VIEW_DEFAULT_RATE_I 2
 #define MR_VIEW_SETTINGS_DEFAULTS {.alpha = MR_VIEW_DEFAULT_ALPHA, .show_video = true, .hide_hidden = false, \
-                                   .rate_i = MR_VIEW_DEFAULT_RATE_I, .ao = MR_AO_NONE, .ghost = MR_GHOST_OFF, \
-                                   .shadows = MR_SHADOW_OFF}
+                                   .rate_i = MR_VIEW_DEFAULT_RATE_I, .ao = MR_AO_SCHEER, .ghost = MR_GHOST_ADAPTIVE, \
+                                   .shadows = MR_SHADOW_PCSS}
+/* What the toggles give: the method when on, else none / off. */
+mr_ao_method mr_view_ao(const mr_view_settings *s);
+mr_ghost_mode mr_view_ghost(const mr_view_settings *s);
+mr_shadow_method mr_view_shadows(const mr_view_settings *s);
+/* The settings that differ from the defaults, in words ("video 70%, AO on
+ * (scheer)"); "" when none. Returns how many. */
+int mr_view_settings_describe_changes(const mr_view_settings *s, char *out, size_t n);
 /* The option table of the settings file (keys alpha, show_video,
- * hide_hidden_layer, ao, ghost, shadows); the A, G and C keys cycle through
- * the ao, ghost and shadows rows' names (shadows: off, hard, pcf, pcss,
- * bp; the ground truth is for the bench, too slow to look around in). The rate is stored as a rate, not as rate_i, so it is
+ * hide_hidden_layer, ao_on, ghost_on, shadows_on, ao, ghost, shadows); the
+ * settings panel cycles through the ao, ghost and shadows rows' names
+ * (shadows: hard, pcf, pcss, bp; the ground truth is for the bench, too
+ * slow to look around in). A file from before the toggles ("ao": "none",
+ * no "ao_on") reads as off with the default method, and a method other
+ * than none as on. The rate is stored as a rate, not as rate_i, so it is
  * read and written beside the table. */
 extern const mr_opt mr_view_settings_opts[];
 
@@ -91,6 +105,12 @@ typedef enum mr_view_widget_id {
     MR_VW_FREEZE, MR_VW_SNAPSHOT, MR_VW_MARK, MR_VW_VIDEO, MR_VW_HIDDEN, MR_VW_AO, MR_VW_GHOST, MR_VW_HELP,
     MR_VW_NOTE1, MR_VW_NOTE6 = MR_VW_NOTE1 + MR_VIEW_NOTE_COUNT - 1, MR_VW_CANCEL,
     MR_VW_MEASURE,        /* Measure; in the column right after Mark */
+    MR_VW_SHADOWS,        /* the shadows toggle, after Ghost */
+    MR_VW_QUIT,           /* last in the column: asks first */
+    MR_VW_QUIT_YES, MR_VW_QUIT_NO, /* the question */
+    MR_VW_NOTE_TEXT,      /* the note chooser's text field */
+    MR_VW_CLOSE_MARK,     /* the chooser of a mark being edited: close it */
+    MR_VW_SET_AO, MR_VW_SET_GHOST, MR_VW_SET_SHADOWS, MR_VW_RESET, /* the settings panel (under ?) */
     MR_VW_COUNT
 } mr_view_widget_id;
 
@@ -102,11 +122,16 @@ typedef struct mr_view_layout_params {
     bool seekable;        /* replay: the play / step / rate / seek row */
     bool note_open;       /* the note chooser after a tap in mark mode */
     float mark_x;         /* the mark's window x, to put the chooser on the other side */
+    bool editing;         /* the chooser edits a saved mark: a Close button */
+    bool quit_open;       /* "Quit?" */
+    bool help_open;       /* the help and settings panel */
 } mr_view_layout_params;
 
+typedef struct mr_viewer mr_viewer;
+
 typedef struct mr_view_layout {
-    mr_ui_rect status, bottom, column, notes; /* panels (zero size when absent) */
-    mr_ui_rect picture;   /* what is left for messages over the picture */
+    mr_ui_rect status, bottom, column, notes, quit, help; /* panels (zero size when absent) */
+    mr_ui_rect picture;   /* what the panels leave free: the camera picture is fitted into it */
     bool shown[MR_VW_COUNT];
     mr_ui_rect rect[MR_VW_COUNT];
     int dropped;          /* widgets left out because the window is too small */
@@ -120,6 +145,11 @@ typedef struct mr_view_layout {
  * leaves out the lowest priorities first (help, then ghost, AO, hidden, ...;
  * in the replay row rate, then seek); the keys still reach them all. */
 void mr_view_layout_compute(const mr_ui *ui, const mr_view_layout_params *p, mr_view_layout *out);
+
+/* The area the panels leave free in a window of fb_w x fb_h (the replay
+ * row when seekable): where the camera picture is fitted, so that no part
+ * of it lies under a control. */
+mr_ui_rect mr_viewer_picture_area(mr_viewer *v, float fb_w, float fb_h, bool seekable);
 
 /* --------------------------------------------------- tracking-lost policy */
 
@@ -144,7 +174,7 @@ typedef enum mr_view_action_type {
     MR_VA_FREEZE,         /* on: freeze frame and pose */
     MR_VA_SNAPSHOT,       /* screen + raw frame + pose, from this frame's screen */
     MR_VA_MARK_AT,        /* x, y: window pixel to mark; answer with mr_viewer_note_open */
-    MR_VA_MARK_FINISH,    /* i: note index, or -1 cancelled */
+    MR_VA_MARK_FINISH,    /* i: category index, or -1 cancelled; path: the note as typed */
     MR_VA_PLAY,           /* on: replay plays */
     MR_VA_STEP,           /* i: frames (+1 / -1) */
     MR_VA_SEEK,           /* i: frame index (large: the last) */
@@ -157,6 +187,9 @@ typedef enum mr_view_action_type {
     MR_VA_MEASURE_DONE,   /* a measurement is finished (mr_viewer_measurement);
                              measure it against the plan, answer with
                              mr_viewer_measure_distance, and mark it */
+    MR_VA_MARK_EDIT,      /* a saved mark edited: x its pin index, i its category,
+                             path the note as typed, on: close it; the answer
+                             is mr_viewer_pin_put with the new state */
 } mr_view_action_type;
 
 typedef struct mr_view_action {
@@ -174,8 +207,6 @@ typedef struct mr_view_actions {
     mr_view_action overflow; /* scratch: what a full list drops */
 } mr_view_actions;
 
-typedef struct mr_viewer mr_viewer;
-
 typedef struct mr_viewer_params {
     double px_per_mm;          /* screen density (already times any UI scale); 0 = 96 dpi */
     const char *font_path;     /* NULL = a system sans font */
@@ -183,8 +214,9 @@ typedef struct mr_viewer_params {
     double now;                /* clock at start, seconds (mr_time_now) */
     double save_delay_s;       /* settings are saved this long after a change; 0 = 1 s */
     double script_wait_s;      /* a script starts with the first picture, or after this; 0 = 3 s */
+    bool show_stats;           /* the status line adds the render passes and the frame rate (--stats) */
 } mr_viewer_params;
-#define MR_VIEWER_DEFAULTS {0.0, NULL, NULL, 0.0, 0.0, 0.0}
+#define MR_VIEWER_DEFAULTS {0.0, NULL, NULL, 0.0, 0.0, 0.0, false}
 
 /* Plain data about what the window shows, given each frame. */
 typedef struct mr_viewer_frame {
@@ -257,7 +289,27 @@ void mr_viewer_input(mr_viewer *v, double now, bool busy, mr_view_actions *out);
 const mr_ui_draw_list *mr_viewer_ui(mr_viewer *v, const mr_viewer_frame *f, mr_view_actions *out);
 
 /* Answers to actions. */
-void mr_viewer_note_open(mr_viewer *v, float mark_x, float mark_y); /* MARK_AT worked: window px */
+void mr_viewer_note_open(mr_viewer *v, float mark_x, float mark_y); /* MARK_AT worked: fractions of the picture */
+
+/* Saved marks, shown as pins anchored in the world: projected each frame
+ * with the frame's pose into the picture (none without a pose), numbered,
+ * grey once closed. A tap on a pin opens its mark for editing
+ * (MR_VA_MARK_EDIT). */
+typedef struct mr_view_pin {
+    mr_dvec3 world;            /* scene units */
+    bool has_world;            /* false: listed, not drawn */
+    int number;                /* shown on the pin */
+    bool closed;
+    int category;              /* index into mr_mark_categories, -1 none */
+    char note[512];            /* as the editor shows it (with @ # ! fields) */
+    char title[200];
+} mr_view_pin;
+/* index < count replaces that pin, index == count appends; false when out
+ * of memory or out of range. */
+bool mr_viewer_pin_put(mr_viewer *v, int index, const mr_view_pin *pin);
+int mr_viewer_pin_count(const mr_viewer *v);
+/* Where pin i is on screen this frame (window px); false when not drawn. */
+bool mr_viewer_pin_at(const mr_viewer *v, int i, float *x, float *y);
 void mr_viewer_toast(mr_viewer *v, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
@@ -307,6 +359,11 @@ void mr_viewer_measure_distance(mr_viewer *v, mr_dvec3 planned, double dist_m, d
  * rendered at rw x rh: the rendered image's pixel (OpenCV convention);
  * false outside the picture. */
 bool mr_view_window_to_image(mr_ui_rect image_rect, int rw, int rh, double x, double y, double *u, double *v);
+/* The pin of a snapshot: a filled disc of pure magenta (255, 0, 255),
+ * radius 4 px, centred on pixel (u, v) (OpenCV convention), in a white
+ * ring out to 7 px; RGB 8-bit images only (others are left as they are). */
+#define MR_VIEW_PIN_R 4.0
+void mr_view_draw_pin(mr_image *img, double u, double v);
 /* That pixel in the camera's own resolution (ideal pinhole), as marks store it. */
 void mr_view_image_to_camera(const mr_camera *cam, int rw, int rh, double u, double v, double *px, double *py);
 
@@ -351,12 +408,18 @@ void mr_view_render_setup(const mr_view_settings *s, const mr_camera *cam, const
                           mr_shadow_method shadows, bool ao_temporal, bool had_pose, int rw, int rh, mr_view *view,
                           mr_frame_params *fp, mr_view_render_choice *c);
 
+/* What the planner said about a mark. */
+typedef struct mr_view_mark_words {
+    const char *id;            /* the mark's id (mr_mark_new_id) */
+    int category;              /* index into mr_mark_categories, -1 none */
+    const char *typed;         /* the note as typed (mr_mark_set_note), may be NULL */
+} mr_view_mark_words;
 /* The annotation line (lib/session's format) of a mark made on frame f:
- * the note, the tapped camera pixel, what was picked there (its node's name
+ * its id, category, note and generated title, the tapped camera pixel, what was picked there (its node's name
  * and layer from scene), the registration's sigma at the picked point, and
  * the measurement of a Measure mark (NULL for a plain mark). */
-cJSON *mr_view_mark_line(const mr_capture_frame *f, const char *note, double px, double py, const mr_pick *pick,
-                         const mr_scene *scene, const mr_measurement *measured);
+cJSON *mr_view_mark_line(const mr_capture_frame *f, const mr_view_mark_words *w, double px, double py,
+                         const mr_pick *pick, const mr_scene *scene, const mr_measurement *measured);
 
 /* The capture frame's part of what the controller is told each frame
  * (pose, its covariance, tracking counts, the picture's undistorted camera
@@ -387,9 +450,12 @@ void mr_view_state_add_window(cJSON *j, const mr_view_window_state *w);
  * seconds from the first picture on screen. Widgets are named (`@alpha`),
  * so scripts survive layout changes:
  *   tap X Y | tap @name        down X Y | up X Y | move X Y
+ *   tap @picture U V           (U, V: fractions of the camera picture's width
+ *                               and height, wherever the layout put it)
  *   drag @slider F0 F1         (fractions of the slider's width)
- *   key K                      (a character, or esc enter left right up down home end f1 f11 space tab)
- *   resize W H | shot OUT.png | state OUT.json | quit
+ *   key K                      (a character, or esc enter left right up down home end f1 f11 space tab backspace)
+ *   text WORDS...              (typed, as a keyboard's characters: the rest of the line)
+ *   resize W H | shot OUT.png | state OUT.json | quit (at once, without the question)
  *   frame N                    (the commands after it wait, up to 60 s, until
  *                               frame N or a later one is shown: play tests
  *                               that do not depend on the machine's speed)
@@ -404,7 +470,8 @@ void mr_viewer_set_script(mr_viewer *v, mr_view_script **s);
 /* Parses a key name as scripts write it. */
 bool mr_view_key_parse(const char *s, int *key);
 
-/* Every key and what it does (what `?` shows). */
+/* Every key and what it does (what `?` shows). Esc only ever cancels;
+ * q (or the Quit button) asks before quitting. */
 typedef struct mr_view_key_help {
     const char *keys, *what;
 } mr_view_key_help;

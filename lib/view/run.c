@@ -40,6 +40,11 @@ static bool source_load(const mr_view_source_params *p, mr_view_source *out, mr_
         }
     }
     if (p->replay_dir) {
+        /* A folder with no frames (empty, or not a recording) ends here,
+         * not in a window that waits for frames forever. */
+        mr_replay *r = mr_replay_open(p->replay_dir, err);
+        if (!r) return false; /* the message names the folder */
+        mr_replay_close(&r);
         if (!mr_replay_meta_load(p->replay_dir, &out->camera, have_cam, &out->markers, &out->have_markers, err)) {
             mr_error_prefix(err, "%s: ", p->replay_dir);
             return false;
@@ -49,6 +54,14 @@ static bool source_load(const mr_view_source_params *p, mr_view_source *out, mr_
         if (!have_cam) return mr_fail(err, MR_ERR_INVALID, "--input needs --camera (or --view)");
         if (!out->have_markers && !out->have_fixed_pose)
             return mr_fail(err, MR_ERR_INVALID, "--input needs --markers (or --view)");
+        /* Only a camera device may come later (plugged in, or busy): a file
+         * or folder that cannot be opened now never will be. */
+        if (strncmp(p->input, "/dev/video", 10) != 0) {
+            mr_source_params sp = MR_SOURCE_DEFAULTS;
+            mr_source *probe = mr_source_open(p->input, &sp, err);
+            if (!probe) return false;
+            mr_source_close(&probe);
+        }
         snprintf(out->desc, sizeof out->desc, "live %.200s", p->input);
     }
     return true;
@@ -79,6 +92,8 @@ typedef struct view_app {
     mr_viewer *vc;
     int fb_w, fb_h;
     bool quit;
+    bool failed;           /* quit because an input turned out unusable: err says why */
+    mr_error fail_err;
     /* scene */
     mr_scene *scene;
     char scene_msg[600];
@@ -98,8 +113,11 @@ typedef struct view_app {
     mr_pick mark_pick;
     double mark_px, mark_py;       /* camera image pixel (ideal pinhole) */
     mr_capture_frame mark_frame;           /* the frame the mark was made on */
-    mr_image mark_screen;
-    bool mark_grab_screen, snap_request;
+    mr_image mark_screen;                  /* the rendered picture, no UI, with the pin */
+    double mark_u, mark_v;                 /* the mark in the rendered picture, px */
+    bool snap_request;
+    /* the session's marks (the newest line of each), shown as pins */
+    mr_annotations marks;
     char session_dir[4096];
     /* --shadows, the scene config's, the saved setting, the C key (mark.c) */
     mr_view_shadow_choice shadows;
@@ -148,6 +166,83 @@ static void do_snapshot(view_app *a, const mr_image *screen) {
     else mr_viewer_toast(a->vc, "snapshot failed: %s", err.msg);
 }
 
+/* The mark's picture: the rendered frame as the planner saw it, without
+ * the UI, and the raw camera frame, each with the pin at the marked point
+ * (the raw frame's pin distorted like the frame). */
+static void grab_mark_pictures(view_app *a, mr_error *err) {
+    mr_image_free(&a->mark_screen);
+    if (a->have_res && a->res.color.data &&
+        mr_image_alloc(&a->mark_screen, a->res.color.width, a->res.color.height, a->res.color.channels, MR_PIX_U8, err)) {
+        memcpy(a->mark_screen.data, a->res.color.data, mr_image_bytes(&a->res.color));
+        mr_view_draw_pin(&a->mark_screen, a->mark_u, a->mark_v);
+    }
+    mr_capture_frame_copy(&a->mark_frame, &a->frame, err);
+    const mr_camera *cam = &a->src->camera;
+    mr_image *fr = &a->mark_frame.image;
+    if (!fr->data || fr->width <= 0) return;
+    mr_camera c = mr_camera_resized(cam, fr->width, fr->height);
+    double sx = (double)fr->width / cam->width, sy = (double)fr->height / cam->height;
+    double px = (a->mark_px + 0.5) * sx - 0.5, py = (a->mark_py + 0.5) * sy - 0.5, xd, yd;
+    mr_camera_distort(&c, (px - c.cx) / c.fx, (py - c.cy) / c.fy, &xd, &yd);
+    mr_view_draw_pin(fr, c.fx * xd + c.cx, c.fy * yd + c.cy);
+}
+
+/* The session's marks read again (the newest line of each) and shown as pins. */
+static void reload_marks(view_app *a) {
+    char path[4200];
+    mr_path_join(a->session_dir, "annotations.jsonl", path, sizeof path);
+    mr_annotations_free(&a->marks);
+    mr_error err = {0};
+    if (!mr_annotations_load(path, &a->marks, &err)) {
+        mr_log(MR_LOG_WARN, "view: %s", err.msg);
+        return;
+    }
+    mr_annotations_current(&a->marks);
+    for (int i = 0; i < a->marks.count; i++) {
+        const mr_annotation *m = &a->marks.items[i];
+        mr_view_pin pin;
+        memset(&pin, 0, sizeof pin);
+        pin.number = i + 1;
+        pin.has_world = m->hit || m->has_measurement;
+        double *w = m->hit ? (double *)m->world : NULL;
+        pin.world = w ? mr_v3(w[0], w[1], w[2]) : m->measurement.tri.point;
+        pin.closed = strcmp(m->status, "closed") == 0;
+        pin.category = -1;
+        for (int k = 0; k < MR_MARK_CATEGORY_COUNT; k++)
+            if (strcmp(m->category, mr_mark_categories[k]) == 0) pin.category = k;
+        /* The editor shows the note with its fields written inline. */
+        size_t n = (size_t)snprintf(pin.note, sizeof pin.note, "%s", m->note);
+        if (m->assignee[0] && n < sizeof pin.note) n += (size_t)snprintf(pin.note + n, sizeof pin.note - n, " @%s", m->assignee);
+        for (int l = 0; l < m->label_count && n < sizeof pin.note; l++)
+            n += (size_t)snprintf(pin.note + n, sizeof pin.note - n, " #%s", m->labels[l]);
+        if (m->priority[0] && n < sizeof pin.note) snprintf(pin.note + n, sizeof pin.note - n, " !%s", m->priority);
+        if (m->title[0]) snprintf(pin.title, sizeof pin.title, "%s", m->title);
+        else mr_mark_title(m, pin.title, sizeof pin.title);
+        mr_viewer_pin_put(a->vc, i, &pin);
+    }
+}
+
+/* A saved mark edited or closed: a new line that supersedes it. */
+static void edit_mark(view_app *a, int i, int category, const char *typed, bool close) {
+    if (i < 0 || i >= a->marks.count) return;
+    const mr_annotation *m = &a->marks.items[i];
+    mr_annotation *e = calloc(1, sizeof *e);
+    if (!e) return;
+    snprintf(e->category, sizeof e->category, "%s",
+             category >= 0 && category < MR_MARK_CATEGORY_COUNT ? mr_mark_categories[category] : m->category);
+    mr_mark_set_note(e, typed);
+    snprintf(e->status, sizeof e->status, "%s", close ? "closed" : m->status);
+    cJSON *line = mr_annotation_edit_line(m, e, (double)time(NULL));
+    free(e);
+    char path[4200];
+    mr_path_join(a->session_dir, "annotations.jsonl", path, sizeof path);
+    mr_error err = {0};
+    if (!line || !mr_annotation_append(path, line, &err)) mr_viewer_toast(a->vc, "EDIT NOT SAVED: %s", line ? err.msg : "out of memory");
+    else mr_viewer_toast(a->vc, "mark %d %s", i + 1, close ? "closed" : "saved");
+    cJSON_Delete(line);
+    reload_marks(a);
+}
+
 /* A tap in mark mode: what is under it, and the screen as it is now. */
 static void begin_mark(view_app *a, double x, double y) {
     a->mark_measured = false; /* a mark of Mark, not of Measure */
@@ -163,12 +258,13 @@ static void begin_mark(view_app *a, double x, double y) {
     }
     const mr_camera *cam = &a->src->camera;
     mr_view_image_to_camera(cam, a->rw, a->rh, u, v, &a->mark_px, &a->mark_py);
-    mr_capture_frame_copy(&a->mark_frame, &a->frame, &err);
-    a->mark_grab_screen = true;
+    a->mark_u = u;
+    a->mark_v = v;
+    grab_mark_pictures(a, &err);
     mr_viewer_note_open(a->vc, (float)((a->mark_px + 0.5) / cam->width), (float)((a->mark_py + 0.5) / cam->height));
 }
 
-static void finish_mark(view_app *a, int note) {
+static void finish_mark(view_app *a, int note, const char *typed) {
     if (note < 0 || note >= MR_VIEW_NOTE_COUNT) {
         mr_viewer_toast(a->vc, "mark cancelled");
         mr_image_free(&a->mark_screen);
@@ -180,7 +276,10 @@ static void finish_mark(view_app *a, int note) {
     char stem[64];
     a->mark_count++;
     snprintf(stem, sizeof stem, "mark_%ld_%04d", (long)time(NULL), a->mark_count);
-    cJSON *line = mr_view_mark_line(&a->mark_frame, mr_view_notes[note], a->mark_px, a->mark_py, &a->mark_pick, a->scene,
+    char id[40];
+    mr_mark_new_id((double)time(NULL), a->mark_count, id, sizeof id);
+    mr_view_mark_words w = {id, note, typed};
+    cJSON *line = mr_view_mark_line(&a->mark_frame, &w, a->mark_px, a->mark_py, &a->mark_pick, a->scene,
                                     a->mark_measured ? &a->mark_measure : NULL);
     mr_snapshot sn = snapshot_of(a, &a->mark_screen, &a->mark_frame);
     bool ok;
@@ -190,10 +289,10 @@ static void finish_mark(view_app *a, int note) {
         mr_viewer_toast(a->vc, "MARK NOT SAVED: %s", aerr.msg);
     else if (!ok) mr_viewer_toast(a->vc, "mark %d saved (snapshot failed: %s)", a->mark_count, err.msg);
     else
-        mr_viewer_toast(a->vc, "mark %d saved: %s%s%s", a->mark_count, mr_view_notes[note],
-                        a->mark_pick.node >= 0 && sc ? " on " : "",
+        mr_viewer_toast(a->vc, "mark saved: %s%s%s", mr_mark_categories[note], a->mark_pick.node >= 0 && sc ? " on " : "",
                         a->mark_pick.node >= 0 && sc ? sc->nodes[a->mark_pick.node].name : "");
     cJSON_Delete(line);
+    reload_marks(a);
     mr_image_free(&a->mark_screen);
     mr_capture_frame_free(&a->mark_frame);
     a->mark_measured = false;
@@ -227,8 +326,9 @@ static void measure_done(view_app *a) {
     a->mark_pick = at.pick;
     a->mark_px = at.px;
     a->mark_py = at.py;
-    mr_capture_frame_copy(&a->mark_frame, &a->frame, &err);
-    a->mark_grab_screen = true;
+    a->mark_u = (at.px + 0.5) * a->rw / a->src->camera.width - 0.5;
+    a->mark_v = (at.py + 0.5) * a->rh / a->src->camera.height - 0.5;
+    grab_mark_pictures(a, &err);
     mr_viewer_note_open(a->vc, at.note_u, at.note_v);
 }
 
@@ -247,7 +347,8 @@ static void carry_out(view_app *a, const mr_view_actions *acts) {
         case MR_VA_FREEZE: set_frozen(a, x->on); break;
         case MR_VA_SNAPSHOT: a->snap_request = true; break;
         case MR_VA_MARK_AT: begin_mark(a, x->x, x->y); break;
-        case MR_VA_MARK_FINISH: finish_mark(a, (int)x->i); break;
+        case MR_VA_MARK_FINISH: finish_mark(a, (int)x->i, x->path); break;
+        case MR_VA_MARK_EDIT: edit_mark(a, (int)x->x, (int)x->i, x->path, x->on); break;
         case MR_VA_PLAY: if (seekable) mr_capture_play(a->cap, x->on); break;
         case MR_VA_STEP: if (seekable) mr_capture_step(a->cap, (int)x->i); break;
         case MR_VA_SEEK: if (a->cap) mr_capture_seek(a->cap, x->i); break;
@@ -263,15 +364,23 @@ static void carry_out(view_app *a, const mr_view_actions *acts) {
 }
 
 static mr_shadow_method view_shadows(view_app *a) {
-    return mr_view_shadow_choose(&a->shadows, mr_viewer_settings(a->vc)->shadows, a->scene ? a->scene->shadow_method : NULL);
+    return mr_view_shadow_choose(&a->shadows, mr_view_shadows(mr_viewer_settings(a->vc)),
+                                 a->scene ? a->scene->shadow_method : NULL);
+}
+
+/* Where the picture goes: the area the panels leave free, so that no part
+ * of it is under a control. */
+static mr_ui_rect picture_fit(view_app *a) {
+    bool seekable = a->cap && mr_capture_seekable(a->cap);
+    mr_ui_rect area = mr_viewer_picture_area(a->vc, (float)a->fb_w, (float)a->fb_h, seekable);
+    return mr_ui_fit(area, a->frame.image.width, a->frame.image.height);
 }
 
 /* Renders the 3D frame when something it depends on changed. */
 static void render_3d(view_app *a) {
     if (!a->have_frame || !a->need_render) return;
     a->need_render = false;
-    mr_ui_rect area = mr_ui_rect_make(0, 0, (float)a->fb_w, (float)a->fb_h);
-    mr_ui_rect fit = mr_ui_fit(area, a->frame.image.width, a->frame.image.height);
+    mr_ui_rect fit = picture_fit(a);
     int rw = (int)lround(fit.w), rh = (int)lround(fit.h);
     if (rw < 16 || rh < 16) return;
     mr_view view;
@@ -344,22 +453,19 @@ static void wake_window(void *ctx) { mr_window_wake(ctx); }
 /* Screen reads happen before the swap, while the back buffer holds exactly
  * what is about to be shown. */
 static void read_screen(view_app *a) {
-    if (!a->snap_request && !a->mark_grab_screen && !a->shot_path[0] && !a->state_path[0]) return;
+    if (!a->snap_request && !a->shot_path[0] && !a->state_path[0]) return;
     mr_image screen = {0};
     mr_error err = {0};
-    if (mr_draw2d_read(a->d2, &screen, &err)) {
-        if (a->snap_request) do_snapshot(a, &screen);
+    /* A snapshot is the picture as rendered, without the UI over it. */
+    if (a->snap_request && a->have_res && a->res.color.data) do_snapshot(a, &a->res.color);
+    else if (a->snap_request) mr_viewer_toast(a->vc, "nothing to snapshot yet");
+    if ((a->shot_path[0] || a->state_path[0]) && mr_draw2d_read(a->d2, &screen, &err)) {
         if (a->shot_path[0] && !mr_image_save_png(a->shot_path, &screen, &err))
             mr_log(MR_LOG_ERROR, "view: %s", err.msg);
         if (a->state_path[0]) write_state(a, &screen);
-        if (a->mark_grab_screen) {
-            mr_image_free(&a->mark_screen);
-            a->mark_screen = screen;
-            memset(&screen, 0, sizeof screen);
-        }
     }
     mr_image_free(&screen);
-    a->snap_request = a->mark_grab_screen = false;
+    a->snap_request = false;
     a->shot_path[0] = a->state_path[0] = 0;
 }
 
@@ -408,8 +514,7 @@ static void frame_tick(view_app *a) {
         a->have_frame = true;
         a->need_render = true;
     }
-    if (a->have_res && (a->image_rect.w != mr_ui_fit(mr_ui_rect_make(0, 0, (float)a->fb_w, (float)a->fb_h),
-                                                     a->frame.image.width, a->frame.image.height).w))
+    if (a->have_res && (a->image_rect.w != picture_fit(a).w || a->image_rect.x != picture_fit(a).x))
         a->need_render = true;
     render_3d(a);
 
@@ -497,8 +602,10 @@ static void poll_scene_load(view_app *a) {
     a->scene_msg[0] = 0;
     a->need_render = true;
     if (!a->scene) {
-        snprintf(a->scene_msg, sizeof a->scene_msg, "scene failed to load: %.500s", err.msg);
-        mr_log(MR_LOG_ERROR, "view: %s", a->scene_msg);
+        /* A plan that cannot be read ends the check: there is nothing to
+         * compare with (the caller says why, in one line). */
+        a->failed = a->quit = true;
+        a->fail_err = err;
         return;
     }
     char cache[4096];
@@ -561,18 +668,14 @@ static void poll_lod(view_app *a) {
     }
 }
 
-/* A scene that fails to load is shown as a message; the window still
- * opens, so the video and the controls stay usable. */
-static void start_scene_load(view_app *a, const char *path) {
-    mr_error err = {0};
+/* The scene loads on a thread while the window opens; one that cannot
+ * be loaded ends the program (poll_scene_load). */
+static bool start_scene_load(view_app *a, const char *path, mr_error *err) {
     mr_scene_params sp = MR_SCENE_DEFAULTS;
-    a->loader = mr_scene_load_async(path, &sp, &err);
-    if (!a->loader) {
-        snprintf(a->scene_msg, sizeof a->scene_msg, "scene failed to load: %.500s", err.msg);
-        mr_log(MR_LOG_ERROR, "view: %s", a->scene_msg);
-    } else {
-        snprintf(a->scene_msg, sizeof a->scene_msg, "loading scene ...");
-    }
+    a->loader = mr_scene_load_async(path, &sp, err);
+    if (!a->loader) return false;
+    snprintf(a->scene_msg, sizeof a->scene_msg, "loading scene ...");
+    return true;
 }
 
 /* The window, the renderer and the controller (with the settings file). */
@@ -595,14 +698,18 @@ static bool open_window(view_app *a, const mr_view_run_params *p, mr_error *err)
     vp.px_per_mm = mr_window_px_per_mm(a->win) * a->ui_scale;
     vp.config_path = config;
     vp.now = a->t_start;
+    vp.show_stats = p->stats != NULL;
     a->vc = mr_viewer_create(&vp, err);
     if (!a->vc) return false;
     /* Flags win over the saved settings for this run. */
     mr_view_settings s = *mr_viewer_settings(a->vc);
-    if (p->ao_given) s.ao = p->ao;
-    if (p->ghost_given) s.ghost = p->ghost;
+    /* --ao none / --ghost off turn the toggle off, a method turns it on with it. */
+    if (p->ao_given) s.ao_on = p->ao != MR_AO_NONE;
+    if (p->ao_given && p->ao != MR_AO_NONE) s.ao = p->ao;
+    if (p->ghost_given) s.ghost_on = p->ghost != MR_GHOST_OFF;
+    if (p->ghost_given && p->ghost != MR_GHOST_OFF) s.ghost = p->ghost;
     mr_viewer_set_settings(a->vc, &s);
-    a->shadows.start = s.shadows;
+    a->shadows.start = mr_view_shadows(&s);
     if (p->script && *p->script) mr_viewer_set_script(a->vc, p->script);
     return true;
 }
@@ -656,11 +763,15 @@ bool mr_view_run(const mr_view_run_params *p, mr_error *err) {
     else if (a->src->replay_dir) snprintf(a->session_dir, sizeof a->session_dir, "%s", a->src->replay_dir);
     else snprintf(a->session_dir, sizeof a->session_dir, "mrcheck-session");
 
-    start_scene_load(a, p->scene_path);
-    bool ok = open_window(a, p, err) && start_capture(a, p, err);
+    bool ok = start_scene_load(a, p->scene_path, err) && open_window(a, p, err) && start_capture(a, p, err);
     if (ok) {
         a->need_render = true;
+        reload_marks(a);
         run_loop(a);
+        if (a->failed) {
+            *err = a->fail_err;
+            ok = false;
+        }
         mr_error serr = {0};
         if (!mr_viewer_save_settings(a->vc, &serr)) mr_log(MR_LOG_WARN, "view: cannot save settings: %s", serr.msg);
         if (p->stats) print_stats(a, p->stats);
@@ -675,6 +786,7 @@ bool mr_view_run(const mr_view_run_params *p, mr_error *err) {
     mr_capture_frame_free(&a->frame);
     mr_capture_frame_free(&a->mark_frame);
     mr_image_free(&a->mark_screen);
+    mr_annotations_free(&a->marks);
     mr_frame_result_free(&a->res);
     mr_viewer_destroy(&a->vc);
     mr_draw2d_destroy(&a->d2);

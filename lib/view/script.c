@@ -9,7 +9,7 @@ bool mr_view_key_parse(const char *s, int *key) {
     static const struct { const char *n; int k; } names[] = {
         {"esc", MR_KEY_ESCAPE}, {"enter", MR_KEY_ENTER}, {"left", MR_KEY_LEFT}, {"right", MR_KEY_RIGHT},
         {"up", MR_KEY_UP}, {"down", MR_KEY_DOWN}, {"home", MR_KEY_HOME}, {"end", MR_KEY_END},
-        {"f1", MR_KEY_F1}, {"f11", MR_KEY_F11}, {"space", ' '}, {"tab", MR_KEY_TAB},
+        {"f1", MR_KEY_F1}, {"f11", MR_KEY_F11}, {"space", ' '}, {"tab", MR_KEY_TAB}, {"backspace", MR_KEY_BACKSPACE},
     };
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (strcmp(s, names[i].n) == 0) {
@@ -25,7 +25,11 @@ bool mr_view_key_parse(const char *s, int *key) {
 
 /* One line into *c; false with err on a bad command. */
 static bool parse_line(const char *path, int line_no, char *line, script_cmd *c, bool *empty, mr_error *err) {
-    char *hash = strchr(line, '#');
+    /* '#' starts a comment, except in typed text (where it names a label). */
+    char first_op[8] = "";
+    double t0;
+    bool is_text = sscanf(line, "%lf %7s", &t0, first_op) == 2 && strcmp(first_op, "text") == 0;
+    char *hash = is_text ? NULL : strchr(line, '#');
     if (hash) *hash = 0;
     memset(c, 0, sizeof *c);
     char op[32] = "", arg[4][1000];
@@ -54,6 +58,15 @@ static bool parse_line(const char *path, int line_no, char *line, script_cmd *c,
     else if (!strcmp(op, "state")) c->op = S_STATE, ok = na >= 1;
     else if (!strcmp(op, "quit")) c->op = S_QUIT, ok = true;
     else if (!strcmp(op, "frame")) c->op = S_FRAME, ok = na >= 1 && !target && c->a >= 0;
+    else if (!strcmp(op, "text")) {
+        /* The rest of the line after the command, as typed. */
+        const char *w = strstr(line, "text") + 4;
+        while (*w == ' ' || *w == '\t') w++;
+        snprintf(c->path, sizeof c->path, "%s", w);
+        size_t l = strlen(c->path);
+        while (l > 0 && (c->path[l - 1] == '\r' || c->path[l - 1] == ' ')) c->path[--l] = 0;
+        c->op = S_TEXT, ok = l > 0;
+    }
     else ok = false;
     if ((c->op == S_SHOT || c->op == S_STATE) && na >= 1) snprintf(c->path, sizeof c->path, "%s", arg[0]);
     if (!ok) return mr_fail(err, MR_ERR_PARSE, "%s:%d: bad command '%s'", path, line_no, op);
@@ -135,7 +148,11 @@ void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out) {
     double x = c->a, y = c->b;
     mr_ui_rect r = mr_ui_rect_make((float)x, (float)y, 0, 0);
     int id = -1;
-    if (c->target[0]) {
+    /* `@picture U V`: fractions of the camera picture as shown (wherever
+     * the layout put it), so a script can tap a point of the image. */
+    bool picture = strcmp(c->target, "picture") == 0;
+    if (picture && !v->f.have_image && v->now - v->script_t0 - c->t < MR_VIEW_SCRIPT_WIDGET_WAIT_S) return;
+    if (c->target[0] && !picture) {
         for (int i = 0; i < MR_VW_COUNT; i++)
             if (v->lay.shown[i] && strcmp(mr_view_widget_name((mr_view_widget_id)i), c->target) == 0) id = i;
         /* A widget that an earlier command brings up (the note chooser
@@ -149,7 +166,11 @@ void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out) {
     if (c->op == S_FRAME && !frame_reached && v->now - v->script_t0 - c->t < MR_VIEW_SCRIPT_FRAME_WAIT_S) return;
     v->script_next++;
     v->script_frame = v->frames;
-    if (c->target[0]) {
+    if (picture) {
+        r = v->f.image_rect;
+        x = r.x + r.w * c->a;
+        y = r.y + r.h * c->b;
+    } else if (c->target[0]) {
         if (id < 0) {
             mr_log(MR_LOG_WARN, "view: script: no widget named @%s on screen", c->target);
             return;
@@ -183,6 +204,12 @@ void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out) {
         mr_viewer_push_event(v, &e);
         break;
     }
+    case S_TEXT:
+        for (const char *ch = c->path; *ch; ch++) {
+            mr_event e = {MR_EVENT_KEY, v->input.x, v->input.y, (unsigned char)*ch};
+            mr_viewer_push_event(v, &e);
+        }
+        break;
     case S_RESIZE: {
         mr_view_action *a = vw_emit(out, MR_VA_RESIZE);
         a->x = c->a;

@@ -6,7 +6,7 @@
 #include "mr_view.h"
 #include "mr_track.h"
 
-typedef enum script_op { S_TAP, S_DOWN, S_UP, S_MOVE, S_DRAG, S_KEY, S_RESIZE, S_SHOT, S_STATE, S_QUIT, S_FRAME } script_op;
+typedef enum script_op { S_TAP, S_DOWN, S_UP, S_MOVE, S_DRAG, S_KEY, S_RESIZE, S_SHOT, S_STATE, S_QUIT, S_FRAME, S_TEXT } script_op;
 
 typedef struct script_cmd {
     double t;
@@ -14,8 +14,15 @@ typedef struct script_cmd {
     char target[24];     /* widget name (`@name`), or "" for coordinates */
     double a, b;
     int key;
-    char path[1024];
+    char path[1024];     /* shot, state: the file; text: the words */
 } script_cmd;
+
+/* A saved mark's pin and where it is on screen this frame. */
+typedef struct vw_pin {
+    mr_view_pin p;
+    bool shown;
+    float x, y;          /* window px */
+} vw_pin;
 
 struct mr_view_script {
     script_cmd *cmds;
@@ -44,7 +51,7 @@ struct mr_viewer {
     /* what the last frame showed */
     mr_viewer_frame f;           /* pointers cleared; strings copied below */
     char passes[256];
-    char status[512];            /* the status line as last drawn */
+    char status[600];            /* the status line as last drawn */
     bool sigma_known;            /* "± N mm here" of the last frame */
     double sigma_m;
     mr_view_layout lay;
@@ -64,6 +71,19 @@ struct mr_viewer {
     double measure_cov[MR_MEASURE_MAX_TAPS][36];
     bool measure_has_cov[MR_MEASURE_MAX_TAPS];
     char measure_msg[200];       /* its last message (also toasted) */
+    /* the note chooser: the text field, and the mark it edits */
+    char note_text[512];
+    bool text_focus;             /* keys go into the field */
+    int edit_pin;                /* -1: a new mark */
+    /* "Quit?" */
+    bool quit_open;
+    /* the settings that differ from the defaults, told at start */
+    char notice[400];
+    double notice_until;
+    bool notice_done;
+    /* saved marks */
+    vw_pin *pins;
+    int pin_count, pin_cap;
 };
 
 mr_view_action *vw_emit(mr_view_actions *out, mr_view_action_type t);
