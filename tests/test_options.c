@@ -468,7 +468,7 @@ static void test_tables(void) {
         N(mr_bench_tracking_params, "beta", beta, 1e-6, 1000),
     };
     const expect ex_rp[] = {
-        N(mr_batch_replay_params, "alpha", alpha, 0, 1),
+        N(mr_batch_replay_params, "alpha", frame.alpha, 0, 1),
         N(mr_batch_replay_params, "every", every, 1, 1 << 30),
         N(mr_batch_replay_params, "from", from, 0, 2147483647),
         N(mr_batch_replay_params, "to", to, 0, 2147483647),

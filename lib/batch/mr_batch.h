@@ -39,8 +39,7 @@ typedef struct mr_batch_replay_params {
     const mr_recording *recording; /* required (mr_recording_open) */
     const char *out_dir;        /* required; created */
     const char *video_path;     /* the AVI, or NULL */
-    mr_frame_params frame;      /* depth cues (AO, ghosting, ...); video and alpha are set per frame */
-    float alpha;                /* video transparency: 0 model only, 1 video only; default 0.5 */
+    mr_frame_params frame;      /* depth cues (AO, ghosting, ...), frame.alpha (--alpha); the video is set per frame */
     int every;                  /* every Nth frame counted from `from`; default 1 */
     int from;                   /* first frame number; default 0 */
     int to;                     /* last frame number; < 0 (the default): the last */
@@ -50,9 +49,8 @@ typedef struct mr_batch_replay_params {
     void *render_user;
     const mr_lod *lod;          /* the scene's levels of detail (built for it), or NULL: full detail */
 } mr_batch_replay_params;
-#define MR_BATCH_REPLAY_DEFAULT_ALPHA 0.5f
 #define MR_BATCH_REPLAY_DEFAULTS                                                                   \
-    {.frame = MR_FRAME_DEFAULTS, .alpha = MR_BATCH_REPLAY_DEFAULT_ALPHA, .every = 1, .from = 0, .to = -1}
+    {.frame = MR_FRAME_DEFAULTS, .every = 1, .from = 0, .to = -1}
 /* alpha, every, from, to, raw. */
 extern const mr_opt mr_batch_replay_opts[];
 

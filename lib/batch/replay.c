@@ -11,7 +11,7 @@
 
 #define RP(f) offsetof(mr_batch_replay_params, f)
 const mr_opt mr_batch_replay_opts[] = {
-    {"alpha", MR_OPT_FLOAT, RP(alpha), 0, 1, MR_BATCH_REPLAY_DEFAULT_ALPHA, NULL,
+    {"alpha", MR_OPT_FLOAT, RP(frame.alpha), 0, 1, MR_FRAME_DEFAULT_ALPHA, NULL,
      "video transparency: 0 = virtual only, 1 = video only", 0},
     {"every", MR_OPT_INT, RP(every), 1, 1 << 30, 1, NULL, "every Nth frame", 0},
     {"from", MR_OPT_INT, RP(from), 0, 2147483647, 0, NULL, "first frame number", 0},
@@ -109,7 +109,6 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
             mr_view view = {mr_camera_resized(&rec->camera, img.width, img.height), pose};
             mr_frame_params fp = p->frame;
             fp.video = &img;
-            fp.alpha = p->alpha;
             fp.ao.temporal_reset = ao_restart;
             ao_restart = false;
             mr_frame_result res;

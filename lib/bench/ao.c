@@ -286,12 +286,7 @@ static bool ao_setup(ao_bench *b, mr_error *err) {
         if (!mr_demo_build_tagged(NULL, 0, &b->hall, err)) return false;
         b->scene = b->hall.planned;
     }
-    if (!(b->radius > 0)) {
-        const mr_scene *s = b->scene;
-        double d2 = 0;
-        for (int i = 0; i < 3; i++) d2 += (s->bounds_max[i] - s->bounds_min[i]) * (s->bounds_max[i] - s->bounds_min[i]);
-        b->radius = d2 > 0 ? 0.02 * sqrt(d2) : 1;
-    }
+    if (!(b->radius > 0)) b->radius = mr_ao_default_radius(b->scene);
     return mr_mkdirs(p->out_dir, err) &&
            mr_renderer_set_scene(b->gfx.renderer, b->scene, err) && (b->gt = mr_eval_gt_create(b->scene, false, err));
 }

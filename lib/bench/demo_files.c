@@ -106,8 +106,7 @@ bool mr_demo_render_frames(const char *dir, const mr_bench_gpu *g, const mr_scen
         ok = ok && mr_image_save_png(path, &frame, err);
         /* The check itself: the planned model over the camera frame. */
         mr_frame_params op = MR_FRAME_DEFAULTS;
-        op.video = &frame;
-        op.alpha = 0.5f;
+        op.video = &frame; /* at MR_FRAME_DEFAULT_ALPHA */
         ok = ok && mr_renderer_set_scene(g->renderer, planned, err) &&
              mr_render_frame(g->renderer, &views[i], &op, &res, err);
         snprintf(sub, sizeof sub, "overlay/overlay_%03d.png", i);

@@ -175,8 +175,7 @@ static bool one_mark(const char *session, int i, const cJSON *d, const mr_bench_
     mr_frame_result_free(&res);
     /* The check: the plan over the frame, and the pick on the plan. */
     mr_frame_params op = MR_FRAME_DEFAULTS;
-    op.video = &frame;
-    op.alpha = 0.5f;
+    op.video = &frame; /* at MR_FRAME_DEFAULT_ALPHA */
     op.ghost.mode = MR_GHOST_ADAPTIVE;
     ok = ok && mr_renderer_set_scene(g->renderer, planned, err) && mr_render_frame(g->renderer, &view, &op, &res, err);
     mr_dmat4 cw = mr_m4_invert_rigid(&view.world_from_camera);

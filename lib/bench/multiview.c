@@ -142,12 +142,6 @@ static bool time_frame(mr_renderer *r, const mr_view *v, const mr_frame_params *
     return true;
 }
 
-static double diag_of(const mr_scene *s) {
-    double d2 = 0;
-    for (int i = 0; i < 3; i++) d2 += (s->bounds_max[i] - s->bounds_min[i]) * (s->bounds_max[i] - s->bounds_min[i]);
-    return sqrt(d2);
-}
-
 /* The shared work. Median ms of a rig frame (all views, read
  * back) with one cull and one shadow map per frame against the old per-view
  * work, side by side in one run (alternating, so load drifts hit both), on
@@ -352,7 +346,7 @@ bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err) 
         mr_demo_free(&hall);
         return ok;
     }
-    double radius = 0.02 * diag_of(scene);
+    double radius = mr_ao_default_radius(scene);
     mr_eval_gt *gt = NULL;
     bool ok = mr_renderer_set_scene(r, scene, err) && (gt = mr_eval_gt_create(scene, false, err)) != NULL;
     /* The rig: the display defaults (35 degree cone) around the camera's own

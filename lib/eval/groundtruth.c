@@ -37,13 +37,12 @@ mr_eval_gt *mr_eval_gt_create(const mr_scene *s, bool skip_hidden, mr_error *err
     rtcSetDeviceErrorFunction(g->device, gt_error, NULL);
     g->scene = rtcNewScene(g->device);
     rtcSetSceneBuildQuality(g->scene, RTC_BUILD_QUALITY_HIGH);
-    double d2 = 0;
     for (int i = 0; i < 3; i++) {
         g->origin[i] = 0.5 * (s->bounds_min[i] + s->bounds_max[i]);
         if (!isfinite(g->origin[i])) g->origin[i] = 0;
-        d2 += (s->bounds_max[i] - s->bounds_min[i]) * (s->bounds_max[i] - s->bounds_min[i]);
     }
-    g->diag = isfinite(d2) && d2 > 0 ? sqrt(d2) : 1.0;
+    g->diag = mr_scene_diagonal(s);
+    if (!(g->diag > 0)) g->diag = 1.0;
     mr_dmat4 shift = mr_m4_translate(-g->origin[0], -g->origin[1], -g->origin[2]);
     for (int32_t ni = 0; ni < s->node_count; ni++) {
         const mr_node *n = &s->nodes[ni];
@@ -222,8 +221,8 @@ bool mr_eval_ao_groundtruth(const mr_eval_gt *g, const mr_view *view, const mr_i
         return mr_fail(err, MR_ERR_INVALID, "ground truth needs an F32 depth image and an F32x3 normal image of one size");
     if (p.rays <= 0) p.rays = 256;
     if (p.seed == 0) p.seed = 1;
-    if (!(p.radius > 0) || !isfinite(p.radius)) p.radius = 0.02 * g->diag;
-    if (!(p.screen_radius > 0) || !isfinite(p.screen_radius)) p.screen_radius = 0.05;
+    if (!(p.radius > 0) || !isfinite(p.radius)) p.radius = MR_AO_DEFAULT_RADIUS_FRACTION * g->diag;
+    if (!(p.screen_radius > 0) || !isfinite(p.screen_radius)) p.screen_radius = MR_AO_DEFAULT_SCREEN_RADIUS;
     if (!mr_image_alloc(out, depth->width, depth->height, 1, MR_PIX_F32, err)) return false;
     gt_job j = {g, p};
     gt_rows rows = {.depth = depth, .normal = normal, .out = out, .display = p.display, .pixel = ao_pixel, .ctx = &j};

@@ -222,6 +222,14 @@ typedef struct mr_ao_params {
                         .blur_radius = MR_AO_DEFAULT_BLUR_RADIUS, .mask = MR_AO_MASK_OFF, \
                         .thickness = MR_AO_DEFAULT_THICKNESS, .mask_strength = MR_AO_DEFAULT_MASK_STRENGTH}
 
+/* The one home of the AO defaults that depend on the scene or are written
+ * as 0 = default: every zero / out-of-range field replaced by its default,
+ * the view-mode radius by MR_AO_DEFAULT_RADIUS_FRACTION of the scene's
+ * diagonal (1 scene unit without a scene). What the AO passes run with. */
+mr_ao_params mr_ao_params_resolve(const mr_ao_params *in, const mr_scene *scene);
+/* The view-mode radius a scene gets by default (scene units). */
+double mr_ao_default_radius(const mr_scene *scene);
+
 /* The option table of mr_ao_params (lib/render/options.c): on the command
  * line "--ao" + "-" + key ("" is --ao itself, the method). Its rows cover the
  * user's tunables; want_*, no_reuse and external are for programs. */
@@ -773,7 +781,8 @@ typedef struct mr_draw_params {
                               such cap (the default: only lod_pixels decides,
                               so no unit is assumed); < 0: no LOD at all */
     double lod_pixels;     /* largest projected error of a chosen level, pixels;
-                              0 = 1.0 */
+                              default MR_DRAW_DEFAULT_LOD_PIXELS (a zeroed
+                              struct's 0 is read as that default too) */
     bool occlusion;        /* occlusion culling within the frame: big
                               occluders first, then a hierarchical-Z test
                               of the rest on the CPU; exact (same image),
@@ -790,8 +799,8 @@ typedef struct mr_draw_params {
      * takes effect at the next scene upload. */
     bool no_cluster_cull;       /* default off: clusters are culled */
     int32_t cluster_triangles;  /* 0 = MR_DRAW_DEFAULT_CLUSTER_TRIANGLES */
-    /* The back-facing cone test of meshopt's meshlet bounds. It runs only where the draw culls back faces: the
-     * G-buffer's instances of single-sided materials (glTF doubleSided =
+    /* The back-facing cone test of meshopt's meshlet bounds. It runs only
+     * where the draw culls back faces: the G-buffer's instances of single-sided materials (glTF doubleSided =
      * false) under a similarity that does not mirror; there it removes
      * only triangles the rasteriser would cull, so the image is the same.
      * Default off: meshlets are cone-tested where valid. */
@@ -804,7 +813,7 @@ typedef struct mr_draw_params {
 } mr_draw_params;
 #define MR_DRAW_DEFAULT_LOD_PIXELS 1.0
 #define MR_DRAW_DEFAULT_CLUSTER_TRIANGLES 16384
-#define MR_DRAW_DEFAULTS {.no_cull = false, .lod_tolerance = 0.0, .lod_pixels = 0.0, .occlusion_auto = true} /* 0 = the defaults above */
+#define MR_DRAW_DEFAULTS {.no_cull = false, .lod_tolerance = 0.0, .lod_pixels = MR_DRAW_DEFAULT_LOD_PIXELS, .occlusion_auto = true}
 /* Option table (lib/render/options.c): --cull --batch --instancing
  * --occlusion (on|off), --lod-tolerance, --lod-pixels. Whether levels are
  * built at all (--lod auto|on|off) is the loading's choice, not a draw

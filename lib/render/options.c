@@ -136,7 +136,7 @@ const mr_opt mr_draw_opts[] = {
     {"lod-tolerance", MR_OPT_DOUBLE, DR(lod_tolerance), 1e-12, 1e12, 0, NULL,
      "largest geometric error of a level in scene units (auto: none, pixels decide)", MR_OPT_ZERO_AUTO},
     {"lod-pixels", MR_OPT_DOUBLE, DR(lod_pixels), 1e-3, 1e4, MR_DRAW_DEFAULT_LOD_PIXELS, NULL,
-     "largest projected error of a level in pixels", MR_OPT_ZERO_DEFAULT},
+     "largest projected error of a level in pixels", 0},
     {"occlusion", MR_OPT_BOOL, DR(occlusion), 0, 1, 0, NULL, "occlusion culling (exact; costs a depth read-back)",
      MR_OPT_ONOFF},
     {"occlusion-auto", MR_OPT_BOOL, DR(occlusion_auto), 0, 1, 1, NULL,

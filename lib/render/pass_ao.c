@@ -208,20 +208,19 @@ static void ensure_targets(mr_ao_state *s, int w, int h, int step) {
 
 /* Defaults and ranges applied, so that the shaders never see a value that
  * can make them divide by zero or loop without end. */
-static mr_ao_params resolve(const mr_ao_params *in, const mr_scene *scene) {
+double mr_ao_default_radius(const mr_scene *scene) {
+    double diag = mr_scene_diagonal(scene);
+    return diag > 0 ? MR_AO_DEFAULT_RADIUS_FRACTION * diag : 1.0;
+}
+
+mr_ao_params mr_ao_params_resolve(const mr_ao_params *in, const mr_scene *scene) {
     mr_ao_params p = *in;
     if (p.samples <= 0) p.samples = MR_AO_DEFAULT_SAMPLES;
     if (p.samples > MR_AO_MAX_SAMPLES) p.samples = MR_AO_MAX_SAMPLES;
     if (p.radii <= 0) p.radii = MR_AO_DEFAULT_RADII;
     if (p.radii > MR_AO_MAX_RADII) p.radii = MR_AO_MAX_RADII;
     if (!(p.screen_radius > 0) || !isfinite(p.screen_radius)) p.screen_radius = MR_AO_DEFAULT_SCREEN_RADIUS;
-    if (!(p.radius > 0) || !isfinite(p.radius)) {
-        double diag = 0;
-        if (scene)
-            for (int i = 0; i < 3; i++) diag += (scene->bounds_max[i] - scene->bounds_min[i]) * (scene->bounds_max[i] - scene->bounds_min[i]);
-        diag = sqrt(diag);
-        p.radius = diag > 0 && isfinite(diag) ? MR_AO_DEFAULT_RADIUS_FRACTION * diag : 1.0;
-    }
+    if (!(p.radius > 0) || !isfinite(p.radius)) p.radius = mr_ao_default_radius(scene);
     /* Each estimator has its own scale (scheer's attenuated cosines average
      * well below the visibility they stand for), so each has its own
      * default strength: the value `bench ao` found best against the ray-
@@ -326,7 +325,7 @@ static int plan_of(const frame *f, const mr_ao_state *s) {
     if (s && s->broken) return AO_PLAN_OFF;
     /* Accumulation keeps refining a frozen camera's AO: computed every frame. */
     if (!s || !s->valid || in->no_reuse || in->temporal) return AO_PLAN_RUN;
-    mr_ao_params p = resolve(in, f->r->scene);
+    mr_ao_params p = mr_ao_params_resolve(in, f->r->scene);
     ao_key key = key_of(f, &p, s->scene_gen);
     return memcmp(&key, &s->last, sizeof key) == 0 ? AO_PLAN_REUSE : AO_PLAN_RUN;
 }
@@ -336,10 +335,10 @@ static bool runs(const frame *f) { return plan_of(f, f->r->ao) == AO_PLAN_RUN; }
 static bool blur_wanted(const mr_ao_params *p) { return p->blur_radius > 0 || p->mask == MR_AO_MASK_STANDALONE; }
 
 static bool mr_pass_need_ao(const frame *f) { return runs(f); }
-static bool mr_pass_need_ao_mask(const frame *f) { return runs(f) && resolve(&f->p->ao, f->r->scene).mask != MR_AO_MASK_OFF; }
+static bool mr_pass_need_ao_mask(const frame *f) { return runs(f) && mr_ao_params_resolve(&f->p->ao, f->r->scene).mask != MR_AO_MASK_OFF; }
 static bool mr_pass_need_ao_blur(const frame *f) {
     if (!runs(f)) return false;
-    mr_ao_params p = resolve(&f->p->ao, f->r->scene);
+    mr_ao_params p = mr_ao_params_resolve(&f->p->ao, f->r->scene);
     return blur_wanted(&p);
 }
 /* The atlas path, for every method but not the
@@ -350,7 +349,7 @@ static bool deint_wanted(const mr_ao_params *p) {
 }
 static bool mr_pass_need_ao_deint(const frame *f) {
     if (!runs(f)) return false;
-    mr_ao_params p = resolve(&f->p->ao, f->r->scene);
+    mr_ao_params p = mr_ao_params_resolve(&f->p->ao, f->r->scene);
     return deint_wanted(&p);
 }
 static bool mr_pass_need_ao_upsample(const frame *f) { return runs(f) && f->p->ao.half_res; }
@@ -358,7 +357,7 @@ static bool mr_pass_need_ao_reuse(const frame *f) { return plan_of(f, f->r->ao) 
 static bool mr_pass_need_ao_external(const frame *f) { return plan_of(f, f->r->ao) == AO_PLAN_EXTERNAL; }
 
 static uint32_t mr_pass_ao_reads(const frame *f) {
-    mr_ao_params p = resolve(&f->p->ao, f->r->scene);
+    mr_ao_params p = mr_ao_params_resolve(&f->p->ao, f->r->scene);
     uint32_t r = RES(RES_DEPTH) | RES(RES_NORMAL);
     if (p.positions && p.mask != MR_AO_MASK_STANDALONE) r |= RES(RES_POSITIONS);
     if (p.mask != MR_AO_MASK_OFF) r |= RES(RES_AO_MASK);
@@ -379,7 +378,7 @@ static bool prepare_state(frame *f, mr_ao_state *s, mr_error *err) {
         return false;
     }
     mr_renderer *r = f->r;
-    s->p = resolve(&f->p->ao, r->scene);
+    s->p = mr_ao_params_resolve(&f->p->ao, r->scene);
     s->step = s->p.half_res ? 2 : 1;
     ensure_targets(s, r->w, r->h, s->step);
     /* Scheer & Keutel's depth-scaled radius. Printed as r_S = r_B s_scene

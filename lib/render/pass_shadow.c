@@ -242,10 +242,8 @@ static void scene_corners(const mr_scene *s, mr_dvec3 out[8]) {
 }
 
 static double scene_diag(const mr_scene *s) {
-    double d2 = 0;
-    for (int i = 0; i < 3; i++) d2 += (s->bounds_max[i] - s->bounds_min[i]) * (s->bounds_max[i] - s->bounds_min[i]);
-    double d = sqrt(d2);
-    return d > 0 && isfinite(d) ? d : 1.0;
+    double d = mr_scene_diagonal(s);
+    return d > 0 ? d : 1.0;
 }
 
 /* Sutherland-Hodgman: the part of polygon p (n points, camera space) on

@@ -126,16 +126,15 @@ bool mr_renderer_set_scene_lod(mr_renderer *r, const mr_scene *s, const mr_lod *
  * 1e-6 of the scene's size (so it scales with the scene's units). Reversed
  * float depth keeps precision at any distance, so only clipping matters. */
 static double choose_near(const mr_scene *s, mr_dvec3 eye) {
-    double d2 = 0, diag2 = 0;
+    double d2 = 0;
     for (int i = 0; i < 3; i++) {
         const double *e = &eye.x;
         double lo = s->bounds_min[i], hi = s->bounds_max[i];
         double v = e[i] < lo ? lo - e[i] : e[i] > hi ? e[i] - hi : 0;
         d2 += v * v;
-        diag2 += (hi - lo) * (hi - lo);
     }
-    double diag = sqrt(diag2);
-    if (!(diag > 0) || !isfinite(diag)) diag = 1;
+    double diag = mr_scene_diagonal(s);
+    if (!(diag > 0)) diag = 1;
     double n = 0.5 * sqrt(d2);
     return n > 1e-6 * diag ? n : 1e-6 * diag;
 }

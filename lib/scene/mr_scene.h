@@ -140,6 +140,10 @@ int32_t mr_scene_add_node(mr_scene *s, const mr_node *node);
 void mr_scene_update_bounds(mr_scene *s);
 /* Counts over drawn nodes (instances counted each time they are drawn). */
 uint64_t mr_scene_triangle_count(const mr_scene *s);
+/* Length of the diagonal of the scene's world bounds (scene units): the
+ * scale every scene-relative default is a fraction of. 0 for NULL, an empty
+ * scene or bounds that are not finite; callers choose their own fallback. */
+double mr_scene_diagonal(const mr_scene *s);
 /* Area-weighted smooth normals for a triangle list (out: 3*vertex_count). */
 void mr_mesh_generate_normals(const float *positions, uint32_t vertex_count,
                               const uint32_t *indices, uint32_t index_count, float *normals);

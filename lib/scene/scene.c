@@ -552,6 +552,14 @@ static bool node_meshes(const mr_scene *s, const mr_node *n, int32_t *first, int
     return true;
 }
 
+double mr_scene_diagonal(const mr_scene *s) {
+    if (!s) return 0;
+    double d2 = 0;
+    for (int i = 0; i < 3; i++) d2 += (s->bounds_max[i] - s->bounds_min[i]) * (s->bounds_max[i] - s->bounds_min[i]);
+    double d = sqrt(d2);
+    return d > 0 && isfinite(d) ? d : 0;
+}
+
 void mr_scene_update_bounds(mr_scene *s) {
     if (!s) return;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};

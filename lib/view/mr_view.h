@@ -61,7 +61,7 @@ typedef struct mr_view_settings {
     mr_ghost_mode ghost;  /* ghosting mode when on; default MR_GHOST_ADAPTIVE (never off) */
     mr_shadow_method shadows; /* hard, pcf, pcss or bp when on; default pcss (never off) */
 } mr_view_settings;
-#define MR_VIEW_DEFAULT_ALPHA 0.5f
+#define MR_VIEW_DEFAULT_ALPHA MR_FRAME_DEFAULT_ALPHA /* the renderer's overlay default */
 #define MR_VIEW_DEFAULT_RATE_I 2
 #define MR_VIEW_SETTINGS_DEFAULTS {.alpha = MR_VIEW_DEFAULT_ALPHA, .show_video = true, .hide_hidden = false, \
                                    .rate_i = MR_VIEW_DEFAULT_RATE_I, .ao = MR_AO_SCHEER, .ghost = MR_GHOST_ADAPTIVE, \
