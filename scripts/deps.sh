@@ -11,6 +11,7 @@ pkgs=(
   libopencv-dev libopencv-contrib-dev
   libceres-dev libzip-dev
   unzip
+  python3
   gltfpack libdraco-dev
 )
 missing=()
