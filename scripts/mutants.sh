@@ -72,10 +72,20 @@ study_mm_update|lib/study/stats.c|ng[i] = d > 0 ? W[i] / d : g[i];|ng[i] = d > 0
 study_no_pseudo_count|lib/study/stats.c|    if (mr_study_graph_connected(w, ties, t, &who)) return;|    if (1) return;|^test_study$
 study_se_not_centred|lib/study/stats.c|S[i * t + i] - 2 * row[i] + tot|S[i * t + i]|^test_study$
 study_no_indifference_baseline|lib/study/stats.c|return fmin(1.0, have ? num / den : num);|return fmin(1.0, num);|^test_study$
-study_plan_not_shuffled|lib/study/plan.c|for (int i = k - 1; i > first; i--) {|for (int i = k - 1; i > k; i--) {|^test_study$
+study_plan_not_shuffled|lib/study/plan.c|    for (int i = n - 1; i > 0; i--) {|    for (int i = n - 1; i > n; i--) {|^test_study$
 study_repeat_answer_kept|lib/study/votes.c|} else if (seen(out, &v)) {|} else if (seen(out, &v) && 0) {|^test_study$
 study_resume_skips_one|lib/study/votes.c|        if (!answered[k]) return k;|        if (!answered[k]) return k + 1;|^test_study$
 study_no_fixation|lib/study/run.c|>= plan->fixation_ms|>= 0|^test_study$
+study_gg_epsilon|lib/study/infer.c|o->eps_gg = tr2 > 0 ? tr * tr / (q * tr2) : 1.0;|o->eps_gg = tr2 > 0 ? tr * tr / tr2 : 1.0;|^test_study_stats$
+study_mauchly_plain_p|lib/study/infer.c|p0 + w2 * (p4 - p0)|p0 + 0 * w2 * (p4 - p0)|^test_study_stats$
+study_wilcoxon_lower_tail|lib/study/infer.c|if (s <= w) lo += c[s];|if (s < w) lo += c[s];|^test_study_stats$
+study_holm_not_monotone|lib/study/infer.c|run = fmax(run, fmin(1.0, p[ord[k]] * (m - k)));|run = fmin(1.0, p[ord[k]] * (m - k));|^test_study_stats$
+study_friedman_no_tie_correction|lib/study/infer.c|o->chi2 = corr > 0 ? chi / corr : NAN;|o->chi2 = corr > 0 ? chi : NAN;|^test_study_stats$
+study_eq56_clamped|lib/study/stats.c|return (neutral_distinct / n_per_pair) / (neutral_identical / n_identical);|return fmin(1.0, (neutral_distinct / n_per_pair) / (neutral_identical / n_identical));|^test_study_designs$
+study_scenes_not_alternating|lib/study/plan.c|int s = b == 1 ? sI : b == 2 ? sII : q < half ? sI : sII;|int s = b == 1 ? sI : b == 2 ? sI : q < half ? sI : sII;|^test_study_designs$
+study_no_exclusion|lib/study/analyze.c|if (!out) kept.v[kept.count++] = votes->v[i];|kept.v[kept.count++] = votes->v[i];|^test_study_designs$
+study_no_break|lib/study/run.c|r->in_break = !done(r) && r->fixation && r->shown_block|r->in_break = false && r->shown_block|^test_study_designs$
+study_tap_units|lib/study/analyze_rt.c|eu = epx * k->units_per_px;|eu = epx;|^test_study_designs$
 LIST
 )
 
