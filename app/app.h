@@ -21,11 +21,6 @@ void app_gfx_close(app_gfx *g);
 /* The ground truth's rays, --ao-rays (its params live in lib/eval). */
 #define APP_GT_TABLE(p) {.prefix = "ao", .table = mr_gt_opts, .params = (p)}
 #define APP_GHOST_TABLE(p) {.prefix = "ghost", .table = mr_ghost_opts, .params = (p)}
-/* The checks of the AO table's values that are not a plain range (--ao-radius
- * only in view mode, --ao-rmin <= --ao-rmax, --ao-mask-strength only for the
- * standalone mask), --ao groundtruth and the AO radius into gt; prints one line
- * and returns false on a bad value. */
-bool app_ao_check(const char *cmd, const mr_cli_table *t, bool *groundtruth, mr_gt_params *gt);
 
 /* Shadows: --shadows METHOD, --shadows-KEY from mr_shadow_opts;
  * without --shadows the scene config's "shadows" names the method (one line
@@ -93,24 +88,6 @@ int cmd_study(int argc, char **argv);
 /* --quilt into quilt (zeroed when not given); rig options without --views
  * or --quilt are a mistake. Prints one line and returns false on bad input. */
 bool app_rig_check(const char *cmd, const mr_cli_table *t, const mr_cli_opt *opts, mr_quilt *quilt, bool *have_quilt);
-/* The focal distance: --focal-distance, else *focal when > 0, else the
- * median depth the view sees in its middle third at w x h (one extra
- * frame), else the scene's centre; false + err if none lies ahead. */
-bool app_rig_focal(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, const mr_view *centre,
-                   const mr_frame_params *fp, int w, int h, double *focal, mr_error *err);
-/* --lightfield BAND: the centre camera of the rig's focal-plane rectangle
- * and the light-field display mapping for one frame around `view`. */
-bool app_lightfield_view(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, int band, const mr_view *view,
-                         const mr_frame_params *fp, mr_view *centre, mr_display_map *map, mr_error *err);
-/* Renders the rig around `centre`: view_NNN.png into views_dir (NULL:
- * none) and NAME_qs{C}x{R}a{A}.png into quilt_dir; the layout it used into
- * *layout. The focal distance is --focal-distance, else *focal when > 0,
- * else where the centre view looks (then stored in *focal, so a replay
- * keeps the first frame's). */
-bool app_rig_render(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, const mr_quilt *quilt,
-                    const mr_view *centre, const mr_frame_params *fp, const char *views_dir, const char *quilt_dir,
-                    const char *quilt_name, double *focal, mr_quilt_layout *layout, mr_rig_result *res, mr_error *err);
-
 /* mrcheck bench multiview (bench_multiview.c). */
 int bench_multiview(int argc, char **argv);
 

@@ -68,7 +68,8 @@ int cmd_render(int argc, char **argv) {
     const char *aux = mr_cli_get(opts, "aux");
     fp.want_depth = fp.want_normals = aux != NULL;
     bool groundtruth = false;
-    if (!app_ao_check(cmd, &tables[1], &groundtruth, &gtp)) return 2;
+    mr_error aerr = {0};
+    if (!mr_eval_ao_opts_check(&tables[1], &groundtruth, &gtp, &aerr)) return mr_cli_error(cmd, &aerr), 2;
     fp.ao.want_ao = aux != NULL;
     fp.ao.temporal = false; /* a single frame has nothing to accumulate */
     fp.shadow.want_shadow = aux != NULL;
@@ -84,7 +85,7 @@ int cmd_render(int argc, char **argv) {
         if (mr_cli_get(opts, "video") || fp.ghost.mode != MR_GHOST_OFF)
             return mr_cli_errorf(cmd, "--lightfield draws no --video and no --ghost"), 2;
     }
-    /* filled by app_lightfield_view once the GPU is there */
+    /* filled by mr_display_setup once the GPU is there */
     mr_display_map lf_map = {0};
     if (lf_band > 0) fp.display = gtp.display = &lf_map;
 
@@ -137,19 +138,18 @@ int cmd_render(int argc, char **argv) {
         if (!set) {
             rc = mr_cli_error(cmd, &err);
         } else if (multiview) {
-            mr_quilt_layout ql;
             mr_rig_result rr;
-            double focal = 0;
-            if (!app_rig_render(gfx.renderer, scene, &rp, &quilt, &view, &fp, out, out, "quilt", &focal, &ql, &rr, &err))
+            mr_rig_files job = {&rp, &quilt, out, out, "quilt", 0, {0}};
+            if (!mr_render_rig_files(gfx.renderer, scene, &job, &view, &fp, &rr, &err))
                 rc = mr_cli_error(cmd, &err);
             else if (!mr_cli_flag(opts, "quiet"))
                 printf("rendered %d views of %dx%d into %s/ (quilt %dx%d, focal distance %g) in %.0f ms\n", rr.views,
-                       ql.tile_w, ql.tile_h, out, ql.cols, ql.rows, focal, rr.ms_total);
+                       job.layout.tile_w, job.layout.tile_h, out, job.layout.cols, job.layout.rows, job.focal, rr.ms_total);
             /* What the views shared. */
             if (rc == 0 && mr_cli_flag(opts, "verbose"))
                 fprintf(stderr, "mrcheck: render: %d views: %d frustum culls, %d shadow map passes, culling %.2f ms\n",
                         rr.views, rr.frustum_culls, rr.shadow_maps, rr.cull_ms);
-        } else if (lf_band > 0 && !app_lightfield_view(gfx.renderer, scene, &rp, (int)lf_band, &view, &fp, &view, &lf_map,
+        } else if (lf_band > 0 && !mr_display_setup(gfx.renderer, scene, &rp, (int)lf_band, &view, &fp, &lf_map,
                                                        &err)) {
             rc = mr_cli_error(cmd, &err);
         } else if (!mr_render_frame(gfx.renderer, &view, &fp, &res, &err) ||

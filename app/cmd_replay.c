@@ -5,30 +5,6 @@
 
 #include <string.h>
 
-/* --views / --quilt: per frame a quilt overlay_NNNNNN_qs..png and its views
- * in overlay_NNNNNN/ (app_rig_render); the camera frame is seen from one
- * eye only, so the views show the plan alone. */
-typedef struct rig_replay {
-    const mr_scene *scene;
-    const mr_rig_params *rp;
-    const mr_quilt *quilt;
-    const char *out;
-    double focal; /* the first frame's, kept for the whole replay */
-} rig_replay;
-
-static bool render_rig(void *user, mr_renderer *r, const mr_view *view, const mr_frame_params *fp, int64_t index,
-                       char *name, size_t name_n, mr_error *err) {
-    rig_replay *rr = user;
-    char stem[64], vdir[4096];
-    snprintf(stem, sizeof stem, "overlay_%06lld", (long long)index);
-    mr_path_join(rr->out, stem, vdir, sizeof vdir);
-    mr_quilt_layout ql;
-    if (!app_rig_render(r, rr->scene, rr->rp, rr->quilt, view, fp, vdir, rr->out, stem, &rr->focal, &ql, NULL, err))
-        return false;
-    mr_quilt_file_name(stem, &ql, name, name_n);
-    return true;
-}
-
 int cmd_replay(int argc, char **argv) {
     static const char *cmd = "replay";
     mr_cli_opt opts[] = {
@@ -64,7 +40,8 @@ int cmd_replay(int argc, char **argv) {
     if (npos != 1 || !mr_cli_get(opts, "scene") || !mr_cli_get(opts, "out"))
         return mr_cli_errorf(cmd, "needs a recording folder, --scene and --out (see --help)"), 2;
     bool groundtruth = false;
-    if (!app_ao_check(cmd, &tables[1], &groundtruth, &gtp)) return 2;
+    mr_error aerr = {0};
+    if (!mr_eval_ao_opts_check(&tables[1], &groundtruth, &gtp, &aerr)) return mr_cli_error(cmd, &aerr), 2;
     if (groundtruth) return mr_cli_errorf(cmd, "--ao groundtruth is for single frames (mrcheck render), not replays"), 2;
     p.out_dir = mr_cli_get(opts, "out");
     p.video_path = mr_cli_get(opts, "video");
@@ -74,10 +51,9 @@ int cmd_replay(int argc, char **argv) {
     if (!app_rig_check(cmd, &tables[5], opts, &quilt, &have_quilt)) return 2;
     if (mr_cli_get(opts, "lightfield")) return mr_cli_errorf(cmd, "--lightfield is for single frames (mrcheck render)"), 2;
     bool multiview = rp.views > 0 || have_quilt;
-    rig_replay rig = {NULL, &rp, &quilt, p.out_dir, 0};
     if (multiview) {
-        p.render = render_rig;
-        p.render_user = &rig;
+        p.rig = &rp;
+        p.quilt = &quilt;
     }
     mr_error err = {0};
     /* Everything that can be checked without a GPU is checked first. */
@@ -113,7 +89,6 @@ int cmd_replay(int argc, char **argv) {
         if (!lod) mr_log(MR_LOG_WARN, "%s: full detail (no levels of detail: %s)", cmd, lerr.msg);
     }
     p.lod = lod;
-    rig.scene = scene;
     app_gfx gfx = {0};
     mr_batch_replay_stats st;
     bool ok = scene && app_gfx_open(&gfx, &err) && mr_batch_replay(&p, gfx.renderer, scene, &st, &err);

@@ -47,6 +47,12 @@ typedef struct mr_batch_replay_params {
     bool progress;              /* "replay: frame N" on a terminal */
     mr_batch_replay_render_fn render; /* NULL: the overlay PNG (and the AVI) */
     void *render_user;
+    /* --views / --quilt: per frame a quilt overlay_NNNNNN_qs..png and its
+     * views in overlay_NNNNNN/ (mr_render_rig_files) instead of the overlay;
+     * the camera frame is seen from one eye only, so the views show the
+     * plan alone; the first frame's focal distance is kept. NULL: none. */
+    const mr_rig_params *rig;
+    const mr_quilt *quilt;      /* with rig */
     const mr_lod *lod;          /* the scene's levels of detail (built for it), or NULL: full detail */
 } mr_batch_replay_params;
 #define MR_BATCH_REPLAY_DEFAULTS                                                                   \

@@ -23,7 +23,7 @@ const mr_opt mr_batch_replay_opts[] = {
 
 bool mr_batch_replay_check(const mr_batch_replay_params *p, mr_error *err) {
     if (!p->out_dir) return mr_fail(err, MR_ERR_INVALID, "replay needs an output folder");
-    if (p->render && p->video_path) return mr_fail(err, MR_ERR_INVALID, "--video is for single views, not --views");
+    if ((p->render || p->rig) && p->video_path) return mr_fail(err, MR_ERR_INVALID, "--video is for single views, not --views");
     if (p->to >= 0 && p->to < p->from)
         return mr_fail(err, MR_ERR_INVALID, "--to %d is before --from %d", p->to, p->from);
     return true;
@@ -58,6 +58,19 @@ static void replay_count_draws(const mr_renderer *r, mr_batch_replay_stats *st) 
     st->lod_instances += ds.lod_instances;
 }
 
+/* One rig frame: overlay_NNNNNN_qs...png and its views in overlay_NNNNNN/. */
+static bool rig_frame(const mr_batch_replay_params *p, mr_renderer *r, const mr_scene *scene, const mr_view *view,
+                      const mr_frame_params *fp, int64_t index, double *focal, char *name, size_t name_n, mr_error *err) {
+    char stem[64], vdir[4096];
+    snprintf(stem, sizeof stem, "overlay_%06lld", (long long)index);
+    mr_path_join(p->out_dir, stem, vdir, sizeof vdir);
+    mr_rig_files job = {p->rig, p->quilt, vdir, p->out_dir, stem, *focal, {0}};
+    if (!mr_render_rig_files(r, scene, &job, view, fp, NULL, err)) return false;
+    *focal = job.focal;
+    mr_quilt_file_name(stem, &job.layout, name, name_n);
+    return true;
+}
+
 bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_scene *scene,
                      mr_batch_replay_stats *stats, mr_error *err) {
     mr_batch_replay_stats st = {0};
@@ -72,6 +85,7 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
     const double fps = recording_fps(rec, every);
     const bool tty = p->progress && isatty(2);
     int selected = 0;
+    double rig_focal = 0; /* the first rig frame's, kept */
     bool ao_restart = true; /* --ao-temporal restarts after a frame without a pose (a tracking reset) */
     for (int i = 0; ok && i < rec->frame_count; i++) {
         const mr_rec_frame *f = &rec->frames[i];
@@ -91,13 +105,14 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
         char name[64], path[4096];
         snprintf(name, sizeof name, "overlay_%06lld.png", (long long)f->index);
         mr_path_join(p->out_dir, name, path, sizeof path);
-        if (p->render) {
+        if (p->render || p->rig) {
             if (has_pose) {
                 mr_view view = {mr_camera_resized(&rec->camera, img.width, img.height), pose};
                 mr_frame_params fp = p->frame;
                 fp.ao.temporal_reset = ao_restart;
                 ao_restart = false;
-                ok = p->render(p->render_user, r, &view, &fp, f->index, name, sizeof name, err);
+                ok = p->rig ? rig_frame(p, r, scene, &view, &fp, f->index, &rig_focal, name, sizeof name, err)
+                            : p->render(p->render_user, r, &view, &fp, f->index, name, sizeof name, err);
                 replay_count_draws(r, &st);
                 st.overlays++;
             } else {

@@ -43,11 +43,17 @@ typedef struct mr_gt_params {
                                       own ray at band 1); NULL = pinhole */
 } mr_gt_params;
 #define MR_GT_DEFAULT_RAYS 256
-#define MR_GT_DEFAULTS {.radius_mode = MR_AO_RADIUS_VIEW, .radius = 0.0, .screen_radius = 0.05, \
+#define MR_GT_DEFAULTS {.radius_mode = MR_AO_RADIUS_VIEW, .radius = 0.0, .screen_radius = MR_AO_DEFAULT_SCREEN_RADIUS, \
                         .rays = MR_GT_DEFAULT_RAYS, .seed = 1, .threads = 0}
 /* The option table of what a user sets directly: rays (`--ao-rays` on
  * render, spliced with the "ao" prefix); the radius follows the AO options. */
 extern const mr_opt mr_gt_opts[];
+/* The checks of the AO table's values (t: mr_ao_opts over mr_ao_params,
+ * extra "groundtruth") that are not a plain range: --ao-radius only in view
+ * mode, --ao-rmin <= --ao-rmax, --ao-mask-strength only for the standalone
+ * mask. Then --ao groundtruth (*groundtruth; the GPU method off) and the
+ * AO radius into gt. false + err (one line) on a bad combination. */
+bool mr_eval_ao_opts_check(const mr_cli_table *t, bool *groundtruth, mr_gt_params *gt, mr_error *err);
 
 /* Ambient visibility (fraction of cosine-weighted rays of length R that
  * escape; 1 = unoccluded, 1 where depth is 0) for each pixel of a rendered

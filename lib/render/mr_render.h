@@ -668,6 +668,35 @@ bool mr_render_rig(mr_renderer *r, const mr_rig *rig, const mr_view *centre, con
                    const mr_quilt_layout *layout, const char *views_dir, mr_image *quilt, mr_rig_result *res,
                    mr_error *err);
 
+/* The focal distance of a rig around `centre`: rp->focal_distance when
+ * set, else *focal when > 0, else the median depth the centre view sees in
+ * its middle third at fp's output size (one extra frame), else the scene's
+ * centre; stored in *focal. false + err if nothing lies ahead. */
+bool mr_rig_focus(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, const mr_view *centre,
+                  const mr_frame_params *fp, double *focal, mr_error *err);
+
+/* One rig frame written as files (`render --views`, `replay --views`). */
+typedef struct mr_rig_files {
+    const mr_rig_params *rig;     /* views (0: one per quilt tile), cone, fov, focal distance */
+    const mr_quilt *quilt;        /* the quilt's tiles; cols 0 = fitted to the views */
+    const char *views_dir;        /* view_NNN.png go here (NULL: none) */
+    const char *quilt_dir;        /* NAME_qs{C}x{R}a{A}.png goes here ... */
+    const char *quilt_name;       /* ... with this NAME */
+    double focal;                 /* in/out: 0 = found by mr_rig_focus on the first call,
+                                     then kept (a replay keeps the first frame's) */
+    mr_quilt_layout layout;       /* out: the layout used */
+} mr_rig_files;
+/* Renders the rig around `centre` with mr_render_rig and writes its views
+ * and quilt; res (may be NULL) gets what the views shared. */
+bool mr_render_rig_files(mr_renderer *r, const mr_scene *scene, mr_rig_files *job, const mr_view *centre,
+                         const mr_frame_params *fp, mr_rig_result *res, mr_error *err);
+
+/* --lightfield: for one frame around *view, the display mapping with `band`
+ * columns per eye into *map, and *view replaced by the centre camera of the
+ * rig's focal-plane rectangle (the focal distance from mr_rig_focus). */
+bool mr_display_setup(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, int band, mr_view *view,
+                      const mr_frame_params *fp, mr_display_map *map, mr_error *err);
+
 /* The work a rig frame shares. The views (width x height pixels,
  * mr_rig_view) are translated along the centre camera's x axis and share
  * its orientation, so every view's frustum lies in one convex volume: the

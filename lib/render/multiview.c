@@ -479,3 +479,65 @@ fail:
     if (quilt) mr_image_free(quilt);
     return false;
 }
+
+bool mr_rig_focus(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, const mr_view *centre,
+                  const mr_frame_params *fp, double *focal, mr_error *err) {
+    double d = rp->focal_distance > 0 ? rp->focal_distance : *focal;
+    if (!(d > 0)) {
+        /* Where the centre view looks: one frame of depth at the view size. */
+        mr_frame_params dp = *fp;
+        dp.video = NULL;
+        dp.display = NULL;
+        dp.want_depth = true;
+        dp.ao.method = MR_AO_NONE;
+        dp.ao.external = NULL;
+        mr_frame_result fr;
+        if (!mr_render_frame(r, centre, &dp, &fr, err)) return false;
+        d = mr_rig_focal_from_depth(&fr.depth);
+        mr_frame_result_free(&fr);
+        if (!(d > 0)) d = mr_rig_auto_focal_distance(scene, centre);
+    }
+    if (!(d > 0)) return mr_fail(err, MR_ERR_INVALID, "nothing in front of the camera to focus on: give --focal-distance");
+    *focal = d;
+    return true;
+}
+
+bool mr_display_setup(mr_renderer *r, const mr_scene *scene, const mr_rig_params *rp, int band, mr_view *view,
+                      const mr_frame_params *fp, mr_display_map *map, mr_error *err) {
+    mr_frame_params sized = *fp;
+    sized.width = fp->width > 0 ? fp->width : view->camera.width;
+    sized.height = fp->height > 0 ? fp->height : view->camera.height;
+    double d = 0;
+    if (!mr_rig_focus(r, scene, rp, view, &sized, &d, err)) return false;
+    mr_rig_params one = *rp;
+    one.views = 1;
+    mr_rig rig;
+    if (!mr_rig_make(&one, (double)sized.width / sized.height, d, &rig, err)) return false;
+    rig.cone = rp->cone_deg * DEG; /* the observer line's, not a single view's */
+    *view = mr_rig_view(&rig, view, 0, sized.width, sized.height);
+    *map = mr_display_from_rig(&rig, band);
+    return true;
+}
+
+bool mr_render_rig_files(mr_renderer *r, const mr_scene *scene, mr_rig_files *job, const mr_view *centre,
+                         const mr_frame_params *fp, mr_rig_result *res, mr_error *err) {
+    mr_rig_params p = *job->rig;
+    const mr_quilt *q = job->quilt;
+    int w = fp->width > 0 ? fp->width : centre->camera.width, h = fp->height > 0 ? fp->height : centre->camera.height;
+    if (p.views == 0) p.views = q->cols * q->rows; /* --quilt alone: a view per tile */
+    if (!mr_quilt_layout_make(q->cols ? q : NULL, p.views, w, h, &job->layout, err)) return false;
+    mr_frame_params tile = *fp;
+    tile.width = job->layout.tile_w;
+    tile.height = job->layout.tile_h;
+    if (!mr_rig_focus(r, scene, &p, centre, &tile, &job->focal, err)) return false;
+    mr_rig rig;
+    if (!mr_rig_make(&p, job->layout.aspect, job->focal, &rig, err)) return false;
+    mr_image img = {0};
+    if (!mr_render_rig(r, &rig, centre, fp, &job->layout, job->views_dir, &img, res, err)) return false;
+    char name[256], path[4096];
+    mr_quilt_file_name(job->quilt_name, &job->layout, name, sizeof name);
+    mr_path_join(job->quilt_dir, name, path, sizeof path);
+    bool ok = mr_image_save_png(path, &img, err);
+    mr_image_free(&img);
+    return ok;
+}
