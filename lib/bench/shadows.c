@@ -8,8 +8,12 @@
  * maps redrawn every frame) and the error of the visibility buffer against
  * Embree's ground truth (mr_eval_shadow_groundtruth) over the shadow region
  * S: the geometry pixels where the reference or the method is below 0.99.
- * RMSE over S, the thesis's sqrt(D) / |S| (D the sum of squared
- * differences over S) and SSIM over S. Tuned on the tuning cases (one per
+ * RMSE over S (the thesis's measure: Hecher calls D "the mean squared
+ * error" over the shadow pixels and uses sqrt(D), "the root mean squared
+ * error", Sec. 5.1), sqrt(D) / |S| with D the *sum* of squared differences
+ * over S (an extra column, not his measure: it shrinks with the shadow's
+ * size) and SSIM over S. Measured on the visibility buffer; the thesis
+ * measures the shaded image. Tuned on the tuning cases (one per
  * group: simple, furniture, fence, plant), which run first: PCF's kernel
  * radius (view 0, 32 taps) and then each method's reported setting (the
  * lowest mean RMSE there at the case's light size); the other cases are
@@ -186,8 +190,10 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
     mr_csv *csv = mr_csv_create(err);
     mr_csv_comment(csv, "mrcheck bench shadows: soft-shadow methods on the shadow suite against Embree's ground truth.\n"
                         "S = geometry pixels where the reference or the method is below 0.99.\n"
-                        "rmse_S = sqrt(D / |S|), sqrtD_over_S = sqrt(D) / |S| (Hecher's measure), D = sum over S of "
-                        "(method - reference)^2; ssim_S = mean SSIM over S.\n"
+                        "rmse_S = sqrt(D / |S|) (Hecher's sqrt(D), which he names the RMSE: his D is the mean over S), "
+                        "sqrtD_over_S = sqrt(D) / |S| (not his measure), D = sum over S of "
+                        "(method - reference)^2, on the visibility buffer (the thesis: the shaded image); "
+                        "ssim_S = mean SSIM over S.\n"
                         "gpu_ms = median GPU time of the shadow passes (maps redrawn every frame); the ground "
                         "truth's is one frame.\n"
                         "setting = what varies, value = its value: map (shadow-map side; filters at 32 taps), taps "
