@@ -652,6 +652,100 @@ static bool ao_sk_tables(ao_bench *b, mr_error *err) {
     return mr_file_write_atomic(path, md, len, err);
 }
 
+/* Doronin et al.'s sampling strategies and multi-radius AO, raced
+ * (bench_ao_sampling.csv, bench_ao_sampling.md): crytek (their SSAO's
+ * base: sphere samples against the depth buffer, constant radius) and
+ * scheer (D2) at their tuned settings, kernel (uniform, jittered, Latin,
+ * Poisson) x samples (4..64) x radii (1..5), RMSE against the reference of
+ * the method's radius mode (Embree), mean over the reported views; then
+ * each (kernel, radii) curve's RMSE at equal time: interpolated in log ms
+ * at the ms of the uniform kernel, one radius, 16 samples (`*`: outside
+ * the curve, its nearest end). */
+enum { SMP_KERNELS = 4, SMP_COUNTS = 5, SMP_RADII = 5, SMP_METHODS = 2 };
+static bool ao_sampling(ao_bench *b, mr_error *err) {
+    static const int k_n[SMP_COUNTS] = {4, 8, 16, 32, 64};
+    static const char *const k_method_label[SMP_METHODS] = {"crytek", "scheer"};
+    static double ms[SMP_METHODS][SMP_KERNELS][SMP_RADII][SMP_COUNTS], rm[SMP_METHODS][SMP_KERNELS][SMP_RADII][SMP_COUNTS];
+    memset(ms, 0, sizeof ms);
+    memset(rm, 0, sizeof rm);
+    mr_csv *csv = mr_csv_create(err);
+    if (!csv) return false;
+    mr_csv_comment(csv, "Doronin et al.'s kernels and multi-radius AO: rmse_own = against the reference of the method's radius "
+                        "mode (crytek: fixed R, scheer: depth-scaled); gpu_ms: AO passes, median of the frames");
+    mr_csv_header(csv, "view,method,kernel,radii,samples,width,height,gpu_ms,rmse_own,rmse_fixed,rmse_screen");
+    const int nv = b->nv;
+    for (int mi = 0; mi < SMP_METHODS; mi++) {
+        const contender *cs = NULL;
+        for (int c = 0; c < NC && !cs; c++)
+            if (strcmp(b->cs[c].label, k_method_label[mi]) == 0) cs = &b->cs[c];
+        if (!cs) continue;
+        for (int v = 1; v <= nv; v++)
+            for (int k = 0; k < SMP_KERNELS; k++)
+                for (int ra = 0; ra < SMP_RADII; ra++)
+                    for (int si = 0; si < SMP_COUNTS; si++) {
+                        mr_ao_params p = cs->tuned;
+                        p.kernel = (mr_ao_kernel)k;
+                        p.radii = ra + 1;
+                        p.samples = k_n[si];
+                        double t = 0;
+                        mr_image_metrics mf, msr;
+                        if (!run_ao(b->gfx.renderer, &b->vd[v].view, &p, b->w, b->h, b->p.frames, &t, NULL, &b->ao, NULL, err) ||
+                            !metrics(&b->ao, &b->vd[v], &mf, &msr, err)) {
+                            mr_csv_destroy(&csv);
+                            return false;
+                        }
+                        double own = cs->mode == MR_AO_RADIUS_SCREEN ? msr.rmse : mf.rmse;
+                        mr_csv_quoted(csv, b->vd[v].name);
+                        mr_csv_text(csv, k_method_label[mi]);
+                        mr_csv_text(csv, mr_ao_kernel_name(p.kernel));
+                        mr_csv_int(csv, p.radii);
+                        mr_csv_int(csv, p.samples);
+                        mr_csv_int(csv, b->w);
+                        mr_csv_int(csv, b->h);
+                        mr_csv_num(csv, "%.4f", t);
+                        mr_csv_num(csv, "%.5f", own);
+                        mr_csv_num(csv, "%.5f", mf.rmse);
+                        mr_csv_num(csv, "%.5f", msr.rmse);
+                        mr_csv_end_row(csv);
+                        ms[mi][k][ra][si] += t / nv;
+                        rm[mi][k][ra][si] += own / nv;
+                    }
+    }
+    if (!save_csv(csv, b->p.out_dir, "bench_ao_sampling.csv", err)) return false;
+    static char md[16384];
+    size_t len = 0;
+    for (int mi = 0; mi < SMP_METHODS; mi++) {
+        double target = ms[mi][0][0][2];
+        len += (size_t)snprintf(md + len, sizeof md - len,
+                                "\n%s, %dx%d, mean of %d views: RMSE against its own reference at %d samples, and at equal "
+                                "time (%.2f ms: uniform, 1 radius, 16 samples; `*` outside the curve)\n\n| kernel | radii | "
+                                "RMSE 4 | RMSE 8 | RMSE 16 | RMSE 32 | RMSE 64 | ms 16 | RMSE at %.2f ms |\n|---|---|---|---|---|---|---|---|---|\n",
+                                k_method_label[mi], b->w, b->h, nv, 16, target, target);
+        for (int k = 0; k < SMP_KERNELS; k++)
+            for (int ra = 0; ra < SMP_RADII; ra++) {
+                const double *x = ms[mi][k][ra], *y = rm[mi][k][ra];
+                double at = y[0];
+                bool outside = true;
+                if (target <= x[0]) at = y[0];
+                else if (target >= x[SMP_COUNTS - 1]) at = y[SMP_COUNTS - 1];
+                for (int i = 0; i + 1 < SMP_COUNTS; i++)
+                    if (x[i] > 0 && x[i + 1] > x[i] && target >= x[i] && target <= x[i + 1]) {
+                        double f = log(target / x[i]) / log(x[i + 1] / x[i]);
+                        at = y[i] + f * (y[i + 1] - y[i]);
+                        outside = false;
+                        break;
+                    }
+                len += (size_t)snprintf(md + len, sizeof md - len, "| %s | %d | %.4f | %.4f | %.4f | %.4f | %.4f | %.2f | %.4f%s |\n",
+                                        mr_ao_kernel_name((mr_ao_kernel)k), ra + 1, y[0], y[1], y[2], y[3], y[4], x[2], at,
+                                        outside ? "*" : "");
+            }
+    }
+    char path[4096];
+    mr_path_join(b->p.out_dir, "bench_ao_sampling.md", path, sizeof path);
+    if (b->p.out) fputs(md, b->p.out);
+    return mr_file_write_atomic(path, md, len, err);
+}
+
 /* Step 3: the grid on the reported views (bench_ao.csv). */
 static bool ao_grid(ao_bench *b, mr_error *err) {
     mr_csv *csv = mr_csv_create(err);
@@ -1353,7 +1447,7 @@ bool mr_bench_ao(const mr_bench_ao_params *params, mr_error *err) {
     memcpy(b->cs, k_contenders, sizeof b->cs);
     for (int c = 0; c < NC; c++) b->cs[c].role = mr_ao_sk_role(b->cs[c].method, b->cs[c].mode);
     b->t0 = mr_time_now();
-    bool ok = ao_setup(b, err) && ao_references(b, err) && ao_tune(b, err) && ao_grid(b, err) && ao_sk_tables(b, err) && ao_triangles(b, err) &&
+    bool ok = ao_setup(b, err) && ao_references(b, err) && ao_tune(b, err) && ao_grid(b, err) && ao_sk_tables(b, err) && ao_sampling(b, err) && ao_triangles(b, err) &&
               ao_plots(b, err) && ao_shaded(b, err) && ao_sequence(b, err) && ao_cost(b, err) &&
               ao_summary(b, err);
     ao_free(b);
