@@ -52,7 +52,7 @@ echo "{$cam \"world_from_camera\": [-1,0,0,0, 0,-1,0,1.6, 0,0,1,100, 0,0,0,1]}" 
 expect_fail bad_mode "$tmp/b1.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b1.png" --ghost sometimes
 expect_fail bad_importance "$tmp/b2.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b2.png" --ghost g0 --ghost-importance colour
 expect_fail bad_saliency "$tmp/b3.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b3.png" --ghost g0 --ghost-saliency dog
-expect_fail bad_t "$tmp/b4.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b4.png" --ghost g0 --ghost-t 1.5
+expect_fail bad_t "$tmp/b4.png" -- "$mr" render --scene "$s" --view "$v" --out "$tmp/b4.png" --ghost g0 --ghost-opacity 1.5
 expect_fail bad_bench "" -- "$mr" bench ghost --frames 0
 # The bench runs end to end and reports the legibility that does not use
 # the adaptive stage's own target, with the definitions in the CSV.

@@ -426,7 +426,7 @@ static void test_compose(void) {
     scene_imgs s = conflict(w, h);
     mr_ghost_params gp = MR_GHOST_DEFAULTS;
     gp.mode = MR_GHOST_ADAPTIVE;
-    gp.t = 0.6f;
+    gp.opacity = 0.6f;
     mr_ghost_output out;
     /* Nothing desired: C = 0 everywhere and G_A is G0 exactly. */
     mr_ghost_params none = gp;
@@ -439,7 +439,7 @@ static void test_compose(void) {
         CHECK_MSG(worst < 1e-6, "G_A differs from G0 by %g where C = 0", worst);
         /* G0 follows eq. 2 with alpha = t * IM. */
         float *g0 = px(&out.g0, 48, 36), *o = px(&s.o, 48, 36), *d = px(&s.d, 48, 36);
-        float a = gp.t * *px(&s.im, 48, 36);
+        float a = gp.opacity * *px(&s.im, 48, 36);
         CHECK_NEAR(*px(&out.alpha, 48, 36), a, 1e-6);
         CHECK_NEAR(g0[0], o[0] * a + d[0] * (1 - a), 1e-5);
         /* Outside the region: O unchanged. */
@@ -478,7 +478,7 @@ static void test_compose(void) {
                 sum += ((float *)s.im.data)[i];
                 n++;
             }
-        CHECK_NEAR(*px(&out.alpha, 30, 30), ap.t * sum / n, 2e-3);
+        CHECK_NEAR(*px(&out.alpha, 30, 30), ap.opacity * sum / n, 2e-3);
         CHECK_NEAR(*px(&out.alpha, 31, 30), *px(&out.alpha, 40, 40), 0);
         mr_ghost_output_free(&out);
     }
@@ -508,7 +508,7 @@ static void test_unified_sign(void) {
         }
     mr_ghost_params gp = MR_GHOST_DEFAULTS;
     gp.mode = MR_GHOST_ADAPTIVE;
-    gp.t = 0.5f;
+    gp.opacity = 0.5f;
     gp.tc_minimal = 0.6f;
     /* variant 0: one object id everywhere; 1: two ids; 2: connected regions */
     for (int variant = 0; variant < 3; variant++) {
@@ -669,11 +669,11 @@ static void test_frame(void) {
     /* Bad parameters fail the frame with one clear error. */
     {
         mr_frame_params bad = p;
-        bad.ghost.t = 2;
+        bad.ghost.opacity = 2;
         mr_view v = {{96, 72, 80, 80, 47.5, 35.5, {0}}, mr_m4_identity()};
         mr_error err = {0};
         CHECK(!mr_render_frame(g_r, &v, &bad, &res, &err) && err.code == MR_ERR_INVALID);
-        bad.ghost.t = 1;
+        bad.ghost.opacity = 1;
         bad.ghost.sigma_c = NAN;
         CHECK(!mr_render_frame(g_r, &v, &bad, &res, &err) && err.code == MR_ERR_INVALID);
     }
@@ -792,7 +792,7 @@ static void test_frame_hidden_ao(void) {
     mr_frame_params p = MR_FRAME_DEFAULTS;
     p.ghost.mode = MR_GHOST_G0;
     p.ghost.importance = MR_GHOST_IMP_CURVATURE;
-    p.ghost.t = 0.0f;
+    p.ghost.opacity = 0.0f;
     mr_frame_result plain, ao;
     if (render(s, &p, &plain, passes, sizeof passes)) {
         p.ao.method = MR_AO_SCHEER;
@@ -843,7 +843,7 @@ static void test_frame_legibility(void) {
     for (int c = 0; c < 3; c++) {
         p.ghost.mode = c == ADAPTIVE ? MR_GHOST_ADAPTIVE : MR_GHOST_G0;
         p.ghost.curv_bias = c == OCCLUDER ? 1.0f : 0.35f;
-        p.ghost.t = c == FULL ? 0.0f : 1.0f;
+        p.ghost.opacity = c == FULL ? 0.0f : 1.0f;
         mr_frame_result res;
         if (!render(s, &p, &res, passes, sizeof passes)) continue;
         mr_image o, d, reg;

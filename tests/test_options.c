@@ -351,7 +351,7 @@ static void test_tables(void) {
         E(mr_ghost_params, "", mode, "off alpha g0 adaptive"),
         E(mr_ghost_params, "importance", importance, "auto curvature saliency"),
         E(mr_ghost_params, "saliency", saliency, "mipmap gauss"),
-        N(mr_ghost_params, "t", t, 0, 1),
+        N(mr_ghost_params, "opacity", opacity, 0, 1),
         N(mr_ghost_params, "curv-scale", curv_scale, 0, 1e3),
         N(mr_ghost_params, "curv-bias", curv_bias, -1, 1),
         N(mr_ghost_params, "tc-min", tc_minimal, 0, 4),

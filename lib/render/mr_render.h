@@ -321,7 +321,8 @@ typedef struct mr_ghost_params {
     mr_ghost_mode mode;          /* default MR_GHOST_OFF */
     mr_ghost_importance importance; /* default auto */
     mr_saliency_impl saliency;   /* default mip-map pyramid */
-    float t;                     /* user transparency: alpha = t * IM, in [0,1]; default 1 */
+    float opacity;               /* Kalkofen et al.'s t, which they call a transparency: alpha = t * IM
+                                    is the occluder's opacity, so t scales it; in [0,1]; default 1 */
     float curv_scale;            /* IM = curv_scale * curvature (radians per pixel) + curv_bias; default 2 */
     float curv_bias;             /* default 0.35 (higher: denser occluder, lower: sparser) */
     float saliency_gain;         /* saliency S = gain * |centre-surround| / 100 L* units; default 4 */
@@ -336,7 +337,7 @@ typedef struct mr_ghost_params {
     bool stats;                  /* fill mr_frame_result.ghost (extra GPU work and a read-back) */
     mr_saliency_levels saliency_levels; /* eq. 9's levels; default MR_SAL_LEVELS_OFFSET */
 } mr_ghost_params;
-#define MR_GHOST_DEFAULT_T 1.0f
+#define MR_GHOST_DEFAULT_OPACITY 1.0f
 #define MR_GHOST_DEFAULT_CURV_SCALE 2.0f
 #define MR_GHOST_DEFAULT_CURV_BIAS 0.35f
 #define MR_GHOST_DEFAULT_SALIENCY_GAIN 4.0f
@@ -347,7 +348,7 @@ typedef struct mr_ghost_params {
 #define MR_GHOST_DEFAULT_SIGMA_C 3.0f
 #define MR_GHOST_DEFAULT_SIGMA_D 3.0f
 #define MR_GHOST_DEFAULTS {.mode = MR_GHOST_OFF, .importance = MR_GHOST_IMP_AUTO, .saliency = MR_SALIENCY_MIPMAP, \
-                           .t = MR_GHOST_DEFAULT_T, .curv_scale = MR_GHOST_DEFAULT_CURV_SCALE, \
+                           .opacity = MR_GHOST_DEFAULT_OPACITY, .curv_scale = MR_GHOST_DEFAULT_CURV_SCALE, \
                            .curv_bias = MR_GHOST_DEFAULT_CURV_BIAS, .saliency_gain = MR_GHOST_DEFAULT_SALIENCY_GAIN, \
                            .tc_minimal = MR_GHOST_DEFAULT_TC_MINIMAL, .gamma = MR_GHOST_DEFAULT_GAMMA, \
                            .tc_silhouette = MR_GHOST_DEFAULT_TC_SILHOUETTE, \

@@ -68,7 +68,7 @@ const mr_opt mr_ghost_opts[] = {
     {"", MR_OPT_ENUM, GH(mode), 0, 0, MR_GHOST_OFF, mr_ghost_mode_names, "ghosted views of the hidden layer", 0},
     {"importance", MR_OPT_ENUM, GH(importance), 0, 0, MR_GHOST_IMP_AUTO, k_importance_names, "importance map", 0},
     {"saliency", MR_OPT_ENUM, GH(saliency), 0, 0, MR_SALIENCY_MIPMAP, k_saliency_names, "saliency pyramid", 0},
-    {"t", MR_OPT_FLOAT, GH(t), 0, 1, MR_GHOST_DEFAULT_T, NULL, "user transparency t: alpha = t * IM", 0},
+    {"opacity", MR_OPT_FLOAT, GH(opacity), 0, 1, MR_GHOST_DEFAULT_OPACITY, NULL, "occluder opacity scale (the paper's t, called a transparency there): alpha = t * IM", 0},
     {"curv-scale", MR_OPT_FLOAT, GH(curv_scale), 0, 1e3, MR_GHOST_DEFAULT_CURV_SCALE, NULL,
      "curvature (rad/px) to importance scale", 0},
     {"curv-bias", MR_OPT_FLOAT, GH(curv_bias), -1, 1, MR_GHOST_DEFAULT_CURV_BIAS, NULL,

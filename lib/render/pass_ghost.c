@@ -262,7 +262,7 @@ static void saliency(mr_ghost_state *g, GLuint src, GLuint dst, mr_saliency_impl
 static void stage_g0(mr_ghost_state *g, GLuint o, GLuint d, const mr_ghost_params *gp) {
     glUseProgram(g->prog_g0);
     glUniform1i(MR_LOC_G0_MODE, (int)gp->mode);
-    glUniform1f(MR_LOC_G0_T, gp->t);
+    glUniform1f(MR_LOC_G0_T, gp->opacity);
     glBindTextureUnit(MR_TEX_G0_O, o);
     glBindTextureUnit(MR_TEX_G0_D, d);
     glBindTextureUnit(MR_TEX_G0_MASK, g->mask);
@@ -407,7 +407,7 @@ static bool ghost_check(const mr_frame_params *p, mr_error *err) {
     if ((unsigned)gp->mode > MR_GHOST_ADAPTIVE || (unsigned)gp->importance > MR_GHOST_IMP_SALIENCY ||
         (unsigned)gp->saliency > MR_SALIENCY_GAUSS || (unsigned)gp->saliency_levels > MR_SAL_LEVELS_PRINTED)
         return mr_fail(err, MR_ERR_INVALID, "ghost: unknown mode, importance source or saliency implementation");
-    if (!finite_in(gp->t, 0, 1)) return mr_fail(err, MR_ERR_INVALID, "ghost: t must be in [0,1]");
+    if (!finite_in(gp->opacity, 0, 1)) return mr_fail(err, MR_ERR_INVALID, "ghost: opacity must be in [0,1]");
     if (!finite_in(gp->curv_scale, 0, 1e6f) || !finite_in(gp->curv_bias, -1e6f, 1e6f) ||
         !finite_in(gp->saliency_gain, 0, 1e6f) || !finite_in(gp->tc_minimal, 0, 1e6f) || !finite_in(gp->gamma, 0, 1e6f) ||
         !finite_in(gp->tc_silhouette, 0, 1e6f) || !finite_in(gp->emphasis_gain, 0, 1e6f))
