@@ -99,9 +99,11 @@ typedef struct ghost_run {
  * median GPU ms of the ghosting passes over the timed frames after 2
  * warm-up frames, then the legibility measures in one untimed frame.
  * *occ_ratio: the occluder's saliency ratio, measured once per hall. */
-static bool measure(const ghost_run *g, int im, int sa, int lv, int mo, ghost_row *r, double *occ_ratio, mr_error *err) {
+static bool measure(const ghost_run *g, int im, int sa, int lv, int mo, float opacity, ghost_row *r, double *occ_ratio,
+                    mr_error *err) {
     bool ok = true;
     mr_frame_params fp = MR_FRAME_DEFAULTS;
+    fp.ghost.opacity = opacity;
     fp.width = g->w;
     fp.height = g->h;
     fp.timing = true;
@@ -178,6 +180,11 @@ bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err) {
     enum { NROWS = 2 * 2 * 2 * 2 * 3 };
     ghost_row rows[NROWS];
     int nrows = 0;
+    enum { SWEEP_T = 4 };
+    static const float k_sweep_t[SWEEP_T] = {0.25f, 0.5f, 0.75f, 1.0f};
+    ghost_row sweep[2 * SWEEP_T * 2];
+    float sweep_t[2 * SWEEP_T * 2];
+    int nsweep = 0;
     const mr_bench_gpu gfx = p.gfx;
     bool ok = bench_gpu_check(&gfx, "bench ghost", err) && mr_mkdirs(out_dir, err);
     double *samples = ok ? calloc((size_t)frames * 8, sizeof *samples) : NULL;
@@ -199,11 +206,26 @@ bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err) {
                     r->levels = levels[lv];
                     r->mode = modes[mo];
                     r->mode_index = mo;
-                    if (!(ok = measure(&run, im, sa, lv, mo, r, &occ_ratio, err))) break;
+                    if (!(ok = measure(&run, im, sa, lv, mo, MR_GHOST_DEFAULT_OPACITY, r, &occ_ratio, err))) break;
                     nrows++;
                     if (ok && p.progress)
                         fprintf(stderr, "\rbench ghost: %d/%d configurations", nrows, NROWS);
                 }
+        /* Fig. 8: the state-of-the-art ghosted view (alpha) against the
+         * adaptive one as the opacity t rises (curvature importance). */
+        for (int oi = 0; ok && oi < SWEEP_T; oi++)
+            for (int mo = 0; ok && mo < 3; mo += 2) {
+                ghost_row *r = &sweep[nsweep];
+                memset(r, 0, sizeof *r);
+                r->scene = scenes[sc];
+                r->importance = imps[0];
+                r->saliency = sals[0];
+                r->levels = levels[0];
+                r->mode = modes[mo];
+                r->mode_index = mo;
+                ok = measure(&run, 0, 0, 0, mo, k_sweep_t[oi], r, &occ_ratio, err);
+                if (ok) sweep_t[nsweep++] = k_sweep_t[oi];
+            }
         mr_renderer_set_scene(gfx.renderer, NULL, NULL);
         mr_demo_free(&hall);
     }
@@ -264,6 +286,37 @@ bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err) {
         mr_path_join(out_dir, "bench_ghost.svg", path, sizeof path);
         ok = ok && write_svg(path, title, rows, nrows, err);
         if (ok) BENCH_PRINT(out, "wrote %s/bench_ghost.csv and bench_ghost.svg\n", out_dir);
+    }
+    if (ok) {
+        /* Kalkofen et al.'s Fig. 8 as numbers: legibility of the hidden
+         * layer over the occluder as the opacity t rises. */
+        mr_csv *csv = mr_csv_create(err);
+        ok = csv != NULL;
+        mr_csv_comment(csv, "Fig. 8's sweep: curvature importance, alpha (state-of-the-art ghosted view) and adaptive, the occluder "
+                            "opacity t (alpha = t * IM; the paper's 'transparency') from 0.25 to 1; columns as bench_ghost.csv");
+        mr_csv_header(csv, "scene,mode,opacity,legibility_edge_transfer,edge_contrast_dE,full_contrast_dE,mean_abs_dL,width,height");
+        BENCH_PRINT(out, "bench ghost, Fig. 8 sweep (curvature importance):\n  %-10s %-8s %7s %10s %9s\n", "scene", "mode", "t",
+                    "legibility", "contrast");
+        for (int i = 0; ok && i < nsweep; i++) {
+            const ghost_row *r = &sweep[i];
+            mr_csv_text(csv, r->scene);
+            mr_csv_text(csv, r->mode);
+            mr_csv_num(csv, "%.2f", sweep_t[i]);
+            mr_csv_num(csv, "%.4f", r->leg.legibility);
+            mr_csv_num(csv, "%.3f", r->leg.edge_contrast);
+            mr_csv_num(csv, "%.3f", r->leg.full_contrast);
+            mr_csv_num(csv, "%.3f", r->st.mean_abs_dL);
+            mr_csv_int(csv, w);
+            mr_csv_int(csv, h);
+            mr_csv_end_row(csv);
+            BENCH_PRINT(out, "  %-10s %-8s %7.2f %10.3f %9.3f\n", r->scene, r->mode, sweep_t[i], r->leg.legibility, r->leg.edge_contrast);
+        }
+        char path[4096];
+        if (ok) {
+            mr_path_join(out_dir, "bench_ghost_sweep.csv", path, sizeof path);
+            ok = mr_csv_save(csv, path, err);
+        }
+        mr_csv_destroy(&csv);
     }
     free(samples);
     return ok;
