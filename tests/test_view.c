@@ -393,6 +393,28 @@ static void test_keys(rig *r) {
     CHECK_MSG(count(r, MR_VA_QUIT, NULL) == 1, "closing the window did not quit");
 }
 
+/* Taps are queued, never lost: eleven taps on AO that arrive at once (as
+ * a slow render leaves them in the queue) are eleven toggles, one render
+ * asked for each. */
+static void test_tap_queue(rig *r) {
+    step(r);
+    bool on0 = mr_viewer_settings(r->v)->ao_on;
+    mr_ui_rect b = wrect(r, MR_VW_AO);
+    for (int i = 0; i < 11; i++) {
+        ev(r, MR_EVENT_POINTER_MOVE, cx(b), cy(b));
+        ev(r, MR_EVENT_POINTER_DOWN, cx(b), cy(b));
+        ev(r, MR_EVENT_POINTER_UP, cx(b), cy(b));
+    }
+    int renders = 0;
+    for (int i = 0; i < 100; i++) {
+        step(r);
+        renders += count(r, MR_VA_RENDER, NULL);
+    }
+    CHECK_MSG(renders == 11 && mr_viewer_settings(r->v)->ao_on == !on0 && mr_viewer_pending(r->v) == 0,
+              "11 queued taps on AO gave %d renders (want 11), AO %s", renders,
+              mr_viewer_settings(r->v)->ao_on == !on0 ? "toggled" : "not toggled an odd number of times");
+}
+
 /* ------------------------------------------- depth cues: toggles, methods */
 
 /* AO, ghosting and shadows are on/off toggles (keys a g c, the buttons);
@@ -1280,6 +1302,7 @@ int main(void) {
         test_toggles(&r);
         test_keys(&r);
         test_cycling(&r);
+        test_tap_queue(&r);
         test_replay(&r);
         test_sigma(&r);
         test_measure(&r);
