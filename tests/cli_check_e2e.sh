@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # The planner's check end to end, under Xvfb, on the synthetic demo hall:
 # calibrate the camera from the demo's board images, replay the demo's
-# recording in `mrcheck view` with that camera (tracked again) driven by a
+# recording in `mrcheck view` with that camera (the recorded poses) driven by a
 # --script as a planner would: mark the moved machine with a typed note,
 # measure its edge from two frames, measure an unchanged column's edge from
-# two frames; then export BCF 2.1 and 3.0 and the HTML report. Checks: the
+# several frames; then export BCF 2.1 and 3.0 and the HTML report. Checks: the
 # mark's part, category, note and fields; the measured distances (the
 # demo's 0.30 m shift, the column's 0); the pin in both snapshot pictures
 # within 2 px of where the marked world point projects; the snapshot of the
@@ -39,7 +39,7 @@ python3 "$here/e2e_check.py" script "$d" "$tmp" >"$tmp/plan.txt" 2>"$tmp/plan.er
 cat "$tmp/plan.txt"
 
 # 3. The check in the window.
-if timeout 300 "$mr" view --scene "$d/scene_planned.json" --replay "$d/recording" --camera "$tmp/camera.json" --retrack \
+if timeout 300 "$mr" view --scene "$d/scene_planned.json" --replay "$d/recording" --camera "$tmp/camera.json" \
      --out "$tmp/session" --config "$tmp/cfg.json" --size 800x600 --paused --script "$tmp/check.script" \
      >"$tmp/view.out" 2>"$tmp/view.err"; then ok
 else bad "view: $(tail -3 "$tmp/view.err")"; fi

@@ -143,14 +143,21 @@ def frames_seeing(d, X, margin=(0.05, 0.2, 0.95, 0.9), last=40):
     return out
 
 
+def spread(frames, n):
+    """Up to n of frames, spread evenly, the first and the last among them."""
+    if len(frames) <= n:
+        return frames
+    return [frames[round(i * (len(frames) - 1) / (n - 1))] for i in range(n)]
+
+
 def plan(d):
-    """The three findings' world points and frames: an unchanged column's
-    corner edge seen close and from two places (the pair of frames with
-    the widest angle per squared distance), the moved machine's edge from
-    the first and the last frame before those (the script only steps
-    forward), the machine marked in the first."""
+    """The three findings: the moved machine's edge seen in several frames,
+    the machine marked where the camera points at it, and an unchanged
+    column's corner edge seen in several frames (the corner seen from
+    nearest, on average)."""
     planned, built = glb_json(d + "/hall_planned.glb"), glb_json(d + "/hall_built.glb")
     gt = {json.loads(l)["frame"]: json.loads(l)["world_from_camera"] for l in open(d + "/recording/groundtruth.jsonl") if l.strip()}
+    cam_at = lambda f: [gt[f][3], gt[f][7], gt[f][11]]
     best = None
     for node in built["nodes"]:
         name = node.get("name", "")
@@ -163,86 +170,64 @@ def plan(d):
             continue
         for c in ([hi[0], 1.5, hi[2]], [lo[0], 1.5, hi[2]], [hi[0], 1.5, lo[2]], [lo[0], 1.5, lo[2]]):
             s = frames_seeing(d, c, margin=(0.15, 0.25, 0.85, 0.85))
-            for a in s:
-                for b in s:
-                    if b[0] <= a[0]:
-                        continue
-                    va = [c[i] - gt[a[0]][4 * i + 3] for i in range(3)]
-                    vb = [c[i] - gt[b[0]][4 * i + 3] for i in range(3)]
-                    cosang = sum(va[i] * vb[i] for i in range(3)) / math.hypot(*va) / math.hypot(*vb)
-                    q = math.degrees(math.acos(max(-1, min(1, cosang)))) / max(math.hypot(*va), math.hypot(*vb)) ** 2
-                    if best is None or q > best[0]:
-                        best = (q, name, c, a, b)
-    assert best, "no column is seen from two frames"
-    _, col, corner, ca, cb = best
+            if len(s) < 3:
+                continue
+            q = sum(math.dist(c, cam_at(f)) for f, _ in s) / len(s) / math.sqrt(len(s))
+            if best is None or q < best[0]:
+                best = (q, name, c, s)
+    assert best, "no column is seen from three frames"
+    _, col, corner, col_seen = best
     lo, hi = node_box(planned, "Machine_2")
     machine_centre = [(lo[k] + hi[k]) / 2 for k in range(3)]
     blo, bhi = node_box(built, "Machine_2")
     edge = [bhi[0], 1.5, bhi[2]]  # the built machine's +x,+z vertical edge
-    edge_seen = [e for e in frames_seeing(d, edge) if e[0] < ca[0]]
+    edge_seen = frames_seeing(d, edge)
     seen = dict(frames_seeing(d, machine_centre))
-    assert len(edge_seen) >= 2 and edge_seen[0][0] in seen, "the machine is not seen before the column"
-    # The mark: in the frame, up to the first of the edge's, where the
-    # camera is nearest the machine (least in front of it).
-    cand = [f for f in seen if f <= edge_seen[-1][0]]
-    mf = min(cand, key=lambda f: math.dist(machine_centre, [gt[f][3], gt[f][7], gt[f][11]]))
-    return machine_centre, (mf, seen[mf]), edge, edge_seen[0], edge_seen[-1], col, corner, ca, cb
+    assert len(edge_seen) >= 2 and seen, "the machine is not seen"
+    mf = min(seen, key=lambda f: math.hypot(seen[f][0] - 0.5, seen[f][1] - 0.5))  # pointed at it
+    return machine_centre, (mf, seen[mf]), edge, spread(edge_seen, 4), col, corner, spread(col_seen, 6)
 
 
 def write_script(d, tmp):
-    machine_centre, mark, edge, a, b, col, corner, ca, cb = plan(d)
-    lines, t, cur = [], 0.3, [0]
+    machine_centre, mark, edge, edge_taps, col, corner, col_taps = plan(d)
+    lines, t = [], 0.3
 
     def add(dt, cmd):
         nonlocal t
         t += dt
         lines.append("%.2f %s" % (t, cmd))
 
-    def goto(f):
-        assert f >= cur[0], "the script only steps forward"
-        while cur[0] < f:
-            add(0.3, "key .")
-            cur[0] += 1
-        add(0.1, "frame %d" % f)
+    def measure(taps, category):
+        add(0.5, "tap @measure")
+        for f, uv in taps:
+            add(0.3, "seek %d" % f)
+            add(0.5, "tap @picture %.5f %.5f" % uv)
+        add(0.5, "tap @measure")
+        add(1.0, "state %s/s_measured_%d.json" % (tmp, taps[0][0]))
+        add(0.3, "tap @note%d" % category)
 
-    # Measure the built machine's edge from two frames.
-    for f, uv, first in ((a[0], a[1], True), (b[0], b[1], False)):
-        goto(f)
-        if first:
-            add(0.5, "tap @measure")
-        add(0.5, "tap @picture %.5f %.5f" % uv)
-        add(0.5, "state %s/s_measure_%d.json" % (tmp, f))
-    add(0.5, "tap @measure")
-    add(1.0, "state %s/s_measured.json" % tmp)
-    add(0.3, "tap @note3")
-    add(1.0, "state %s/s_measured_saved.json" % tmp)
-    # Mark the moved machine where the plan shows it, with a typed note.
-    goto(mark[0])
-    mu, mv = mark[1]
+    # The moved machine's edge, measured (3: moved).
+    measure(edge_taps, 3)
+    # The machine marked where the plan shows it, with a typed note.
+    add(1.0, "seek %d" % mark[0])
     add(0.5, "tap @mark")
-    add(0.4, "tap @picture %.5f %.5f" % (mu, mv))
+    add(0.4, "tap @picture %.5f %.5f" % mark[1])
     add(0.8, "state %s/s_chooser.json" % tmp)
     add(0.3, "tap @note_text")
     add(0.3, "text stands too far to the right @planner #layout !high")
     add(0.5, "key enter")
     add(0.3, "tap @note3")
     add(1.0, "state %s/s_marked.json" % tmp)
-    # Measure an unchanged column's edge from two frames.
-    for f, uv, first in ((ca[0], ca[1], True), (cb[0], cb[1], False)):
-        goto(f)
-        if first:
-            add(0.5, "tap @measure")
-        add(0.5, "tap @picture %.5f %.5f" % uv)
-    add(0.5, "tap @measure")
-    add(1.0, "tap @note6")
+    # An unchanged column's edge, measured (6: other).
+    measure(col_taps, 6)
     add(1.0, "state %s/s_end.json" % tmp)
     add(0.3, "shot %s/view_end.png" % tmp)
     add(0.5, "quit")
     open(tmp + "/check.script", "w").write("\n".join(lines) + "\n")
     json.dump({"machine_centre": machine_centre, "edge": edge, "column": col, "column_point": corner},
               open(tmp + "/plan.json", "w"))
-    print("plan: mark Machine_2 at frame %d; its edge from frames %d and %d; %s's edge from frames %d and %d"
-          % (mark[0], a[0], b[0], col, ca[0], cb[0]))
+    print("plan: Machine_2's edge from frames %s; the machine marked at frame %d; %s's edge from frames %s"
+          % ([f for f, _ in edge_taps], mark[0], col, [f for f, _ in col_taps]))
 
 
 # ------------------------------------------------------------------- check

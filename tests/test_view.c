@@ -1096,6 +1096,28 @@ static void test_script(void) {
         mr_viewer_destroy(&r.v);
     }
     mr_view_script_destroy(&s);
+    /* `seek N`: asks for frame N and waits until N itself is shown, also
+     * backwards (a later frame on screen does not count). */
+    write_text(sp, "0.1 seek 3\n0.2 quit\n");
+    s = mr_view_script_load(sp, &err);
+    CHECK_MSG(s != NULL, "script with seek: %s", err.msg);
+    if (s && rig_open(&r, NULL, 96 / 25.4, &err)) {
+        mr_viewer_set_script(r.v, &s);
+        r.f.index = 9;
+        double t_q = -1;
+        bool asked = false;
+        for (int i = 0; i < 2000 && t_q < 0; i++) {
+            if (i == 600) r.f.index = 3; /* 10 s in: the seek lands */
+            step(&r);
+            mr_view_action x;
+            if (count(&r, MR_VA_SEEK, &x)) asked = x.i == 3;
+            if (count(&r, MR_VA_QUIT, NULL)) t_q = r.t;
+        }
+        CHECK_MSG(asked && t_q > 10 && t_q < 11, "script `seek 3`: asked %d, went on at %.2f s (want just after 10 s)",
+                  asked, t_q);
+        mr_viewer_destroy(&r.v);
+    }
+    mr_view_script_destroy(&s);
     write_text(sp, "0.1 frame\n");
     memset(&err, 0, sizeof err);
     s = mr_view_script_load(sp, &err);

@@ -456,6 +456,9 @@ void mr_view_state_add_window(cJSON *j, const mr_view_window_state *w);
  *   key K                      (a character, or esc enter left right up down home end f1 f11 space tab backspace)
  *   text WORDS...              (typed, as a keyboard's characters: the rest of the line)
  *   resize W H | shot OUT.png | state OUT.json | quit (at once, without the question)
+ *   seek N                     (replay: shows frame N, forwards or back; the
+ *                               commands after it wait, up to 60 s, until
+ *                               frame N itself is shown)
  *   frame N                    (the commands after it wait, up to 60 s, until
  *                               frame N or a later one is shown: play tests
  *                               that do not depend on the machine's speed)

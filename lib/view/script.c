@@ -58,6 +58,7 @@ static bool parse_line(const char *path, int line_no, char *line, script_cmd *c,
     else if (!strcmp(op, "state")) c->op = S_STATE, ok = na >= 1;
     else if (!strcmp(op, "quit")) c->op = S_QUIT, ok = true;
     else if (!strcmp(op, "frame")) c->op = S_FRAME, ok = na >= 1 && !target && c->a >= 0;
+    else if (!strcmp(op, "seek")) c->op = S_SEEK, ok = na >= 1 && !target && c->a >= 0 && c->a < 1e15;
     else if (!strcmp(op, "text")) {
         /* The rest of the line after the command, as typed. */
         const char *w = strstr(line, "text") + 4;
@@ -117,6 +118,7 @@ void mr_viewer_set_script(mr_viewer *v, mr_view_script **s) {
     *s = NULL;
     v->script_next = 0;
     v->script_started = false;
+    v->script_seek = -1;
 }
 
 static void push(mr_viewer *v, mr_event_type t, double x, double y) {
@@ -143,6 +145,14 @@ void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out) {
      * the one before has been taken and its effect drawn, so a slow machine
      * shifts the script but never reorders it. */
     if (mr_viewer_pending(v) > 0 || busy || v->frames < v->script_frame + 2) return;
+    /* After `seek N`: wait until frame N itself is shown (a seek back is
+     * not done while a later frame is still on screen). */
+    if (v->script_seek >= 0) {
+        bool there = v->f.have_frame && v->f.index == v->script_seek;
+        if (!there && v->now - v->script_seek_t < MR_VIEW_SCRIPT_FRAME_WAIT_S) return;
+        if (!there) mr_log(MR_LOG_WARN, "view: script: frame %lld not shown after a seek", (long long)v->script_seek);
+        v->script_seek = -1;
+    }
     const script_cmd *c = &v->script->cmds[v->script_next];
     if (c->t > v->now - v->script_t0) return;
     double x = c->a, y = c->b;
@@ -219,6 +229,11 @@ void vw_script_tick(mr_viewer *v, bool busy, mr_view_actions *out) {
     case S_SHOT: vw_emit(out, MR_VA_SHOT)->path = c->path; break;
     case S_STATE: vw_emit(out, MR_VA_STATE)->path = c->path; break;
     case S_QUIT: vw_emit(out, MR_VA_QUIT); break;
+    case S_SEEK:
+        vw_emit(out, MR_VA_SEEK)->i = (int64_t)c->a;
+        v->script_seek = (int64_t)c->a;
+        v->script_seek_t = v->now;
+        break;
     case S_FRAME:
         if (!frame_reached) mr_log(MR_LOG_WARN, "view: script: frame %.0f not shown in %.0f s", c->a, MR_VIEW_SCRIPT_FRAME_WAIT_S);
         break;

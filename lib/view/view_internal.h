@@ -6,7 +6,7 @@
 #include "mr_view.h"
 #include "mr_track.h"
 
-typedef enum script_op { S_TAP, S_DOWN, S_UP, S_MOVE, S_DRAG, S_KEY, S_RESIZE, S_SHOT, S_STATE, S_QUIT, S_FRAME, S_TEXT } script_op;
+typedef enum script_op { S_TAP, S_DOWN, S_UP, S_MOVE, S_DRAG, S_KEY, S_RESIZE, S_SHOT, S_STATE, S_QUIT, S_FRAME, S_TEXT, S_SEEK } script_op;
 
 typedef struct script_cmd {
     double t;
@@ -61,6 +61,8 @@ struct mr_viewer {
     int script_next;
     double script_t0;
     int64_t script_frame;
+    int64_t script_seek;         /* `seek N`: what follows waits until frame N is shown; -1 none */
+    double script_seek_t;
     bool script_started;
     /* Measure (measure.c) */
     bool measure_mode;           /* collecting taps */
