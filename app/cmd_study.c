@@ -46,6 +46,7 @@ static int study_plan(int argc, char **argv) {
         {"blocks", "I,II,III", "blocks in the plan (default I,II,III with a reference, I without; rating, task: I,II "
                                "= the condition folders present); II shows the reference", NULL},
         {"scales", "A,B,..", "rating: the scales (default Scheer & Keutel's eight depth cues)", NULL},
+        {"overall", NULL, "rating: first ask which method supports the depth cues best as a whole (all side by side)", NULL},
         {"verbose", NULL, "more log output", NULL},
         {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
@@ -68,6 +69,7 @@ static int study_plan(int argc, char **argv) {
     if (mr_cli_get(opts, "blocks") && !mr_study_blocks_parse(mr_cli_get(opts, "blocks"), &pp.blocks, &err))
         return mr_cli_error(cmd, &err), 2;
     pp.scales = mr_cli_get(opts, "scales");
+    pp.overall = mr_cli_flag(opts, "overall");
     mr_study_plan plan;
     bool ok = mr_study_plan_scan_make(pos[0], &pp, &plan, &err) && mr_study_plan_save(out, &plan, &err);
     if (!ok) return mr_cli_error(cmd, &err);

@@ -86,6 +86,7 @@ study_scenes_not_alternating|lib/study/plan.c|int s = b == 1 ? sI : b == 2 ? sII
 study_no_exclusion|lib/study/analyze.c|if (!out) kept.v[kept.count++] = votes->v[i];|kept.v[kept.count++] = votes->v[i];|^test_study_designs$
 study_no_break|lib/study/run.c|r->in_break = !done(r) && r->fixation && r->shown_block|r->in_break = false && r->shown_block|^test_study_designs$
 study_tap_units|lib/study/analyze_rt.c|eu = epx * k->units_per_px;|eu = epx;|^test_study_designs$
+study_overall_rotation|lib/study/run.c|answered = true, answer = (t->right + i) % n;|answered = true, answer = i;|^test_study_designs$
 LIST
 )
 

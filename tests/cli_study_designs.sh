@@ -75,6 +75,16 @@ for f in means.csv anova.csv posthoc.csv ttest.csv chart_virtual.svg chart_video
   [ -s "$tmp/ra/$f" ] && ok || bad "rating analyze: no $f"
 done
 grep -q "too few participants" "$tmp/ra/summary.md" && ok || bad "rating analyze of one participant should say too few: $(head -30 "$tmp/ra/summary.md")"
+# Scheer & Keutel's overall question first in each condition: all three side by side.
+"$mr" study plan "$tmp/r" --design rating --scales occlusion --overall --out "$tmp/roplan.json" --fixation-ms 50 >"$tmp/rop.log" 2>&1 &&
+  grep -q "(rating): 16 trials per participant" "$tmp/rop.log" && ok || bad "rating plan --overall: $(cat "$tmp/rop.log")"
+printf '0 tap @p2\n0 state %s\n0 tap @p3\n0 tap @r4\n0 quit\n' "$tmp/ost.json" >"$tmp/ro.txt"
+timeout 60 "$mr" study run "$tmp/roplan.json" --participant o1 --out "$tmp/ovotes.jsonl" --script "$tmp/ro.txt" --size 900x500 >"$tmp/ro.log" 2>&1 && ok || bad "overall run: $(cat "$tmp/ro.log")"
+[ "$(jget "$tmp/ost.json" images)" = "3" ] && ok || bad "overall: three images side by side: $(cat "$tmp/ost.json" 2>/dev/null)"
+[ "$(grep -c '"left":"\*",.*"choice":[0-2]' "$tmp/ovotes.jsonl")" -eq 2 ] && [ "$(grep -c '"ratings":\[4\]' "$tmp/ovotes.jsonl")" -eq 1 ] && ok ||
+  bad "overall votes: $(cat "$tmp/ovotes.jsonl")"
+"$mr" study analyze "$tmp/ovotes.jsonl" --plan "$tmp/roplan.json" --out "$tmp/roa" >"$tmp/roa.log" 2>&1 && [ -s "$tmp/roa/overall.csv" ] && ok ||
+  bad "overall analyze: $(cat "$tmp/roa.log")"
 expect_fail an_rating_noplan "$tmp/ra2" -- "$mr" study analyze "$rv" --out "$tmp/ra2"
 expect_fail plan_rating_nocond "$tmp/px.json" -- "$mr" study plan "$tmp/ao" --design rating --out "$tmp/px.json"
 expect_fail plan_rating_scale "$tmp/px.json" -- "$mr" study plan "$tmp/r" --design rating --scales "a b" --out "$tmp/px.json"

@@ -48,8 +48,13 @@ static mr_study_vote vote_for(const mr_study_plan *p, const char *who, int k) {
     v.group = p->group;
     v.choice = -1;
     snprintf(v.stimulus, sizeof v.stimulus, "%s", p->set.stimuli[t->stimulus]);
-    snprintf(v.left, sizeof v.left, "%s", p->set.methods[t->left]);
-    snprintf(v.right, sizeof v.right, "%s", p->set.methods[t->right]);
+    if (t->left < 0) { /* a rating plan's overall question */
+        snprintf(v.left, sizeof v.left, "*");
+        snprintf(v.right, sizeof v.right, "%d", t->right);
+    } else {
+        snprintf(v.left, sizeof v.left, "%s", p->set.methods[t->left]);
+        snprintf(v.right, sizeof v.right, "%s", p->set.methods[t->right]);
+    }
     return v;
 }
 
@@ -642,6 +647,106 @@ static void test_vote_lines(void) {
     mr_study_votes_free(&vs);
 }
 
+/* Scheer & Keutel's overall question: first in each condition, one per
+ * stimulus, every method side by side in a rotation; the runner hands out
+ * the method chosen; the log resumes over it; the analysis counts it. */
+static void test_rating_overall(void) {
+    static const char *const methods[3] = {"D1", "D2", "D3"};
+    static const char *const stimuli[2] = {"hall_v0", "hall_v1"};
+    mr_study_set set;
+    set_make(&set, methods, 3, stimuli, 2);
+    mr_study_plan_params pp = MR_STUDY_PLAN_DEFAULTS;
+    pp.design = MR_STUDY_RATING;
+    pp.scales = "occlusion";
+    pp.overall = true;
+    pp.fixation_ms = 100;
+    mr_study_plan plan;
+    mr_error err = {0};
+    CHECK(mr_study_plan_make("unused", &set, &pp, &plan, &err));
+    CHECK(plan.overall && plan.trial_count == 2 * (2 + 6));
+    for (int k = 0; k < plan.trial_count; k++) {
+        const mr_study_trial *t = &plan.trials[k];
+        bool first = k % 8 < 2;
+        CHECK(t->block == 1 + k / 8);
+        CHECK((t->left < 0) == first);
+        if (first) CHECK(t->right >= 0 && t->right < 3);
+    }
+    char dir[4096], path[4200];
+    CHECK(mr_test_fresh_dir("study_overall", dir, sizeof dir));
+    snprintf(path, sizeof path, "%s/plan.json", dir);
+    mr_study_plan b;
+    CHECK(mr_study_plan_save(path, &plan, &err) && mr_study_plan_load(path, &b, &err));
+    CHECK(b.overall && !strcmp(b.id, plan.id) && !memcmp(b.trials, plan.trials, 16 * sizeof(mr_study_trial)));
+    mr_study_plan_free(&b);
+    /* Too many methods to show side by side. */
+    static const char *const six[6] = {"a", "b", "c", "d", "e", "f"};
+    mr_study_set s6;
+    set_make(&s6, six, 6, stimuli, 2);
+    CHECK(!mr_study_plan_make("unused", &s6, &pp, &b, &err));
+    mr_study_set_free(&s6);
+    /* The runner: all three images, key 2 picks the second position. */
+    mr_study_run_params rp = MR_STUDY_RUN_DEFAULTS;
+    rp.plan = &plan;
+    rp.participant = "o1";
+    rp.image_w = 8, rp.image_h = 6;
+    mr_study_runner *r = mr_study_runner_create(&rp, &err);
+    CHECK(r != NULL);
+    mr_study_vote v;
+    if (r) {
+        mr_study_frame f;
+        mr_study_runner_frame(r, 0.0, 1200, 700, &f, &v);
+        mr_study_runner_frame(r, 0.2, 1200, 700, &f, &v);
+        int rot = plan.trials[0].right;
+        CHECK(f.image_count == 3 && f.image_method[0] == rot && f.image_method[1] == (rot + 1) % 3);
+        CHECK(f.image_rect[0].x < f.image_rect[1].x && f.image_rect[1].x < f.image_rect[2].x);
+        mr_event k2 = {MR_EVENT_KEY, 0, 0, '2'};
+        mr_study_runner_push_event(r, &k2);
+        mr_study_runner_frame(r, 0.3, 1200, 700, &f, &v);
+        CHECK(f.vote && v.design == MR_STUDY_RATING && v.choice == (rot + 1) % 3 && !strcmp(v.left, "*"));
+        mr_study_runner_destroy(&r);
+        /* Through the log and back; the resume takes it as trial 0. */
+        snprintf(path, sizeof path, "%s/votes.jsonl", dir);
+        mr_study_votes vs = {0};
+        CHECK(mr_study_vote_append(path, &v, &err) && mr_study_votes_read(path, false, &vs, &err) && vs.count == 1);
+        if (vs.count == 1) CHECK(vs.v[0].choice == v.choice && vs.v[0].rating_count == 0);
+        bool answered[16];
+        CHECK(mr_study_resume(&plan, &vs, "o1", answered, &err) == 1 && answered[0]);
+        mr_study_votes_free(&vs);
+    }
+    /* The analysis: 10 participants choose D2 seven times, D3 twice, D1
+     * once per stimulus and condition; by hand: 20 answers, 2 / 14 / 4,
+     * chi2 = ((2-20/3)^2 + (14-20/3)^2 + (4-20/3)^2) / (20/3) = 12.4. */
+    mr_study_votes vs = {0};
+    for (int q = 0; q < 10; q++) {
+        char who[8];
+        snprintf(who, sizeof who, "s%d", q);
+        int pick = q < 7 ? 1 : q < 9 ? 2 : 0;
+        for (int k = 0; k < plan.trial_count; k++) {
+            mr_study_vote x = vote_for(&plan, who, k);
+            const mr_study_trial *t = &plan.trials[k];
+            if (t->left < 0) {
+                snprintf(x.left, sizeof x.left, "*");
+                snprintf(x.right, sizeof x.right, "%d", t->right);
+                x.choice = pick;
+            } else {
+                x.rating_count = 1;
+                x.ratings[0] = 3 + t->left;
+            }
+            push_vote(&vs, &x);
+        }
+    }
+    snprintf(path, sizeof path, "%s/analysis", dir);
+    mr_study_analyze_params ap = MR_STUDY_ANALYZE_DEFAULTS;
+    CHECK_MSG(mr_study_analyze_rating(&vs, &plan, &ap, path, &err), "%s", err.msg);
+    char *o = read_text(path, "overall.csv");
+    CHECK(o && strstr(o, "\nvirtual,D1,2,0.100000,12.400000,2,") && strstr(o, "\nvirtual,D2,14,0.700000,12.400000,2,") &&
+          strstr(o, "\nvideo,D3,4,0.200000,12.400000,2,"));
+    free(o);
+    mr_study_votes_free(&vs);
+    mr_study_plan_free(&plan);
+    mr_study_set_free(&set);
+}
+
 int main(void) {
     test_pairwise_schedules();
     test_indifference_eq56();
@@ -650,5 +755,6 @@ int main(void) {
     test_task_simulated();
     test_runner_designs();
     test_vote_lines();
+    test_rating_overall();
     return mr_test_finish("test_study_designs");
 }

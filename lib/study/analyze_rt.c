@@ -32,6 +32,7 @@ static bool gather(const mr_study_votes *votes, const mr_study_plan *plan, peopl
         const mr_study_vote *v = &votes->v[i];
         use[i] = false;
         stim[i] = meth[i] = -1;
+        if (plan->overall && v->design == MR_STUDY_RATING && !strcmp(v->left, "*")) continue; /* the overall question */
         if (strcmp(v->plan, plan->id) != 0 || v->design != plan->design || v->block < 1 || v->block > 2 ||
             !(plan->blocks & (1u << (v->block - 1)))) {
             other++;
@@ -407,6 +408,43 @@ bool mr_study_analyze_rating(const mr_study_votes *votes, const mr_study_plan *p
                         M, bar_m, bar_s, 7.0, err);
         mr_sb_printf(&md, "\n![%s](%s)\n\n", cond, name);
     }
+    /* Scheer & Keutel's overall question: how often each method was chosen,
+     * against an even split (chi-square goodness of fit, t - 1 df). */
+    mr_csv *overall = ok && plan->overall ? mr_csv_create(err) : NULL;
+    if (overall) {
+        mr_csv_comment(overall, "the overall question: choices per condition and method; chi2 against an even split");
+        mr_csv_header(overall, "condition,method,chosen,share,chi2,df,p");
+        mr_sb_printf(&md, "## Which representation supports the depth cues best as a whole\n\n");
+    }
+    for (int b = 1; overall && b <= 2; b++) {
+        if (!(plan->blocks & (1u << (b - 1)))) continue;
+        double n[MR_STUDY_MAX_METHODS] = {0}, tot = 0;
+        for (int i = 0; i < votes->count; i++) {
+            const mr_study_vote *v = &votes->v[i];
+            if (strcmp(v->plan, plan->id) || v->design != MR_STUDY_RATING || v->block != b || strcmp(v->left, "*") ||
+                v->choice < 0 || v->choice >= M)
+                continue;
+            n[v->choice] += 1, tot += 1;
+        }
+        double chi = 0;
+        for (int m = 0; m < M; m++) chi += tot > 0 ? (n[m] - tot / M) * (n[m] - tot / M) / (tot / M) : 0;
+        double pv = tot > 0 ? mr_stat_chi2_sf(chi, M - 1) : NAN;
+        mr_sb_printf(&md, "%s: %.0f answers;", mr_study_condition_name(MR_STUDY_RATING, b), tot);
+        for (int m = 0; m < M; m++) {
+            mr_csv_text(overall, mr_study_condition_name(MR_STUDY_RATING, b));
+            mr_csv_text(overall, plan->set.methods[m]);
+            mr_csv_num(overall, "%g", n[m]);
+            mr_csv_num(overall, "%.6f", tot > 0 ? n[m] / tot : NAN);
+            mr_csv_num(overall, "%.6f", chi);
+            mr_csv_int(overall, M - 1);
+            mr_csv_num(overall, "%.6g", pv);
+            mr_csv_end_row(overall);
+            mr_sb_printf(&md, "%s %s %.0f (%.1f %%)", m ? "," : "", plan->set.methods[m], n[m],
+                         tot > 0 ? 100 * n[m] / tot : NAN);
+        }
+        mr_sb_printf(&md, "; against an even split chi2(%d) = %.2f, p = %.4g.\n\n", M - 1, chi, pv);
+    }
+    if (overall) ok = save_csv(&overall, out_dir, "overall.csv", err);
     /* Table 4: the conditions against each other per method and scale. */
     if (ok && (plan->blocks & 3u) == 3u) {
         mr_sb_printf(&md, "## Virtual (S1) against video (S2), paired t\n\n| scale |");

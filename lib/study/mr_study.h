@@ -195,7 +195,9 @@ typedef struct mr_study_trial {
     int block;                /* 1..3 */
     int stimulus;             /* index into the plan's stimuli */
     int left, right;          /* pairwise: method indices, equal for an identical pair;
-                                 rating, task: left is the method, right = left */
+                                 rating, task: left is the method, right = left; a rating
+                                 plan's overall question: left = -1 and right = r, every
+                                 method side by side, position i showing method (r + i) mod t */
 } mr_study_trial;
 
 /* One participant's trials (a plan made with participants > 0), or the
@@ -217,8 +219,13 @@ typedef struct mr_study_plan_params {
                                  (pairwise: its own scene per block and a balanced group);
                                  0: one schedule shared by all; default 0 */
     const char *scales;       /* rating: comma-separated scale names; NULL = MR_STUDY_DEFAULT_SCALES */
+#define MR_STUDY_OVERALL_MAX 4   /* methods side by side in the overall question */
+    bool overall;             /* rating: first in each condition, per stimulus, Scheer & Keutel's
+                                 question which rendering supports the depth cues best as a whole
+                                 (all methods side by side); default false */
 } mr_study_plan_params;
-#define MR_STUDY_PLAN_DEFAULTS {.seed = 1, .fixation_ms = 2000, .blocks = 0, .design = 0, .participants = 0, .scales = NULL}
+#define MR_STUDY_PLAN_DEFAULTS {.seed = 1, .fixation_ms = 2000, .blocks = 0, .design = 0, .participants = 0, .scales = NULL, \
+                                .overall = false}
 extern const mr_opt mr_study_plan_opts[];      /* seed, fixation-ms, design, participants */
 
 typedef struct mr_study_plan {
@@ -228,6 +235,7 @@ typedef struct mr_study_plan {
     mr_study_set set;
     int seed, fixation_ms;
     unsigned blocks;
+    bool overall;             /* rating: the overall question trials (left = -1) */
     int scale_count;          /* rating */
     char scales[MR_STUDY_MAX_SCALES][MR_STUDY_NAME_MAX];
     mr_study_key *keys;       /* task: [(block - 1) * stimulus_count + stimulus], else NULL */
@@ -305,7 +313,8 @@ typedef struct mr_study_vote {
     double slider;            /* pairwise: [-1, 1]: -1 left, 0 neutral, +1 right */
     int rating_count;         /* rating: one per scale of the plan, in its order */
     int ratings[MR_STUDY_MAX_SCALES]; /* 1..7, or MR_STUDY_RATING_X */
-    int choice;               /* task, choice question: 0 or 1; -1 none */
+    int choice;               /* task, choice question: 0 or 1; rating, overall question: the
+                                 method chosen (index in the plan); -1 none */
     bool has_tap;             /* task, tap question */
     double tap_x, tap_y;      /* image pixels */
     double ms;                /* response time from the stimulus's appearance */
@@ -632,9 +641,9 @@ void mr_study_runner_push_event(mr_study_runner *r, const mr_event *e);
 typedef struct mr_study_frame {
     int trial;                    /* shown trial, -1 during fixation / when done */
     bool fixation, done;
-    int image_count;              /* 0..3 */
-    int image_method[3];          /* method index of each placed image */
-    mr_ui_rect image_rect[3];     /* where (framebuffer px) */
+    int image_count;              /* 0..3, or every method (a rating plan's overall question) */
+    int image_method[MR_STUDY_MAX_METHODS]; /* method index of each placed image */
+    mr_ui_rect image_rect[MR_STUDY_MAX_METHODS]; /* where (framebuffer px) */
     bool vote;                    /* a vote was cast this frame: *vote_out is filled */
     bool quit;                    /* the script or Esc asked to stop */
     char shot_path[1024], state_path[1024]; /* scripts: save the screen / the state (empty: none) */

@@ -186,8 +186,15 @@ static void trial_json(cJSON *arr, const mr_study_plan *p, const mr_study_trial 
     cJSON_AddNumberToObject(o, "trial", i);
     cJSON_AddStringToObject(o, "block", mr_study_block_name(x->block));
     cJSON_AddStringToObject(o, "stimulus", p->set.stimuli[x->stimulus]);
-    cJSON_AddStringToObject(o, "left", p->set.methods[x->left]);
-    cJSON_AddStringToObject(o, "right", p->set.methods[x->right]);
+    if (x->left < 0) { /* the overall question: every method, from rotation right */
+        char r[16];
+        snprintf(r, sizeof r, "%d", x->right);
+        cJSON_AddStringToObject(o, "left", "*");
+        cJSON_AddStringToObject(o, "right", r);
+    } else {
+        cJSON_AddStringToObject(o, "left", p->set.methods[x->left]);
+        cJSON_AddStringToObject(o, "right", p->set.methods[x->right]);
+    }
     cJSON_AddItemToArray(arr, o);
 }
 
@@ -207,6 +214,7 @@ static cJSON *content_json(const mr_study_plan *p) {
     for (int i = 1; i <= MR_STUDY_MAX_BLOCKS; i++)
         if (p->blocks & (1u << (i - 1))) cJSON_AddItemToArray(b, cJSON_CreateString(mr_study_block_name(i)));
     if (p->design == MR_STUDY_RATING) {
+        if (p->overall) cJSON_AddBoolToObject(j, "overall", true);
         cJSON *sc = cJSON_AddArrayToObject(j, "scales");
         for (int i = 0; i < p->scale_count; i++) cJSON_AddItemToArray(sc, cJSON_CreateString(p->scales[i]));
     }
@@ -369,11 +377,17 @@ static int pairwise_schedule(const mr_study_set *set, const cats *C, unsigned bl
 
 /* One rating or task schedule: per block every (method, stimulus), or
  * (task with participants) the method of category c is (c + rot) mod t. */
-static int single_schedule(const mr_study_set *set, const cats *C, unsigned blocks, int rot, mr_rng *rng,
-                           mr_study_trial *out) {
+static int single_schedule(const mr_study_set *set, const cats *C, unsigned blocks, int rot, bool overall,
+                           mr_rng *rng, mr_study_trial *out) {
     int t = set->method_count, k = 0;
     for (int b = 1; b <= 2; b++) {
         if (!(blocks & (1u << (b - 1)))) continue;
+        /* The overall question first (Scheer & Keutel asked it before the
+         * ratings), one per stimulus, the methods in a random rotation. */
+        int first = k;
+        for (int s = 0; overall && s < set->stimulus_count; s++)
+            out[k++] = (mr_study_trial){b, s, -1, (int)rng_below(rng, (uint64_t)t)};
+        shuffle(rng, out + first, k - first);
         int start = k;
         for (int s = 0; s < set->stimulus_count; s++) {
             if (rot >= 0) {
@@ -484,16 +498,20 @@ bool mr_study_plan_make(const char *dir, const mr_study_set *set, const mr_study
         if (blocks & 4u) return mr_fail(err, MR_ERR_INVALID, "the %s design has blocks I and II only", mr_study_design_names[d]);
     }
     if (p.fixation_ms < 0) return mr_fail(err, MR_ERR_INVALID, "fixation-ms must be >= 0");
+    if (p.overall && d == MR_STUDY_RATING && (set->method_count < 2 || set->method_count > MR_STUDY_OVERALL_MAX))
+        return mr_fail(err, MR_ERR_INVALID, "the overall question shows 2..%d methods side by side, not %d",
+                       MR_STUDY_OVERALL_MAX, set->method_count);
     if (p.participants < 0 || p.participants > 999) return mr_fail(err, MR_ERR_INVALID, "participants must be in [0, 999]");
     cats C = {0};
     bool ok = cats_make(set, d == MR_STUDY_PAIRWISE, &C, err);
     int t = set->method_count, nblocks = 0;
     for (int b = 0; b < MR_STUDY_MAX_BLOCKS; b++) nblocks += (blocks >> b) & 1u;
     size_t per = d == MR_STUDY_PAIRWISE ? (size_t)nblocks * C.n * (t * (t - 1) / 2 + 1)
-                                        : (size_t)nblocks * set->stimulus_count * t;
+                                        : (size_t)nblocks * set->stimulus_count * (t + (p.overall ? 1 : 0));
     int nsched = p.participants > 0 ? p.participants : 1;
     out->design = d;
     out->blocks = blocks;
+    out->overall = p.overall && d == MR_STUDY_RATING;
     out->seed = p.seed;
     out->fixation_ms = p.fixation_ms;
     snprintf(out->dir, sizeof out->dir, "%s", dir);
@@ -532,7 +550,7 @@ bool mr_study_plan_make(const char *dir, const mr_study_set *set, const mr_study
         }
         int rot = d == MR_STUDY_TASK && p.participants > 0 ? q % t : -1;
         sc->trial_count = d == MR_STUDY_PAIRWISE ? pairwise_schedule(set, &C, blocks, &rng, sc->trials)
-                                                 : single_schedule(set, &C, blocks, rot, &rng, sc->trials);
+                                                 : single_schedule(set, &C, blocks, rot, out->overall, &rng, sc->trials);
         if (sc->trial_count < 0) ok = mr_fail(err, MR_ERR_NOMEM, "out of memory");
     }
     free(order);
@@ -691,8 +709,19 @@ static bool load_trials(const cJSON *trials, const char *path, mr_study_plan *pl
         tr->stimulus = name_index((const char(*)[MR_STUDY_NAME_MAX])plan->set.stimuli, ns, str_item(x, "stimulus"));
         tr->left = name_index((const char(*)[MR_STUDY_NAME_MAX])plan->set.methods, t, str_item(x, "left"));
         tr->right = name_index((const char(*)[MR_STUDY_NAME_MAX])plan->set.methods, t, str_item(x, "right"));
+        const char *l = str_item(x, "left"), *r = str_item(x, "right");
+        if (plan->overall && l && r && !strcmp(l, "*")) {
+            char *end = NULL;
+            long rot = strtol(r, &end, 10);
+            tr->left = -1;
+            tr->right = end && !*end && end != r && rot >= 0 && rot < t ? (int)rot : -1;
+            if (tr->right < 0) return mr_fail(err, MR_ERR_INVALID, "%s: trial %d: bad rotation", path, i);
+            tr->left = 0; /* checked like the others below, then marked */
+        }
+        bool all = plan->overall && l && !strcmp(l, "*");
         if (!tr->block || !(plan->blocks & (1u << (tr->block - 1))) || tr->stimulus < 0 || tr->left < 0 || tr->right < 0)
             return mr_fail(err, MR_ERR_INVALID, "%s: trial %d names an unknown block, stimulus or method", path, i);
+        if (all) tr->left = -1;
     }
     sc->trial_count = nt;
     return true;
@@ -750,6 +779,7 @@ static bool load_json(const cJSON *j, const char *path, mr_study_plan *plan, mr_
         plan->blocks |= 1u << (k - 1);
     }
     if (plan->design == MR_STUDY_RATING) {
+        plan->overall = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(j, "overall"));
         const cJSON *sc = cJSON_GetObjectItemCaseSensitive(j, "scales");
         int n = cJSON_IsArray(sc) ? cJSON_GetArraySize(sc) : 0;
         if (n < 1 || n > MR_STUDY_MAX_SCALES) return mr_fail(err, MR_ERR_INVALID, "%s: a rating plan needs 1..%d scales", path, MR_STUDY_MAX_SCALES);

@@ -33,11 +33,12 @@ typedef enum widget {
     W_R1, W_R2, W_R3, W_R4, W_R5, W_R6, W_R7, W_RX, /* rating: 1..7 and X */
     W_CHOICE0, W_CHOICE1, W_IMAGE, W_CONFIRM,       /* task */
     W_CONTINUE,                                     /* the break between blocks */
+    W_PICK1, W_PICK2, W_PICK3, W_PICK4,             /* rating: the overall question */
     W_COUNT
 } widget;
 static const char *const k_widget_names[W_COUNT] = {"left", "neutral", "right", "slider", "vote", "r1", "r2", "r3",
                                                     "r4", "r5", "r6", "r7", "rx", "a", "b", "image", "confirm",
-                                                    "continue"};
+                                                    "continue", "p1", "p2", "p3", "p4"};
 
 static bool key_parse(const char *s, int *key) {
     static const struct { const char *n; int k; } names[] = {
@@ -317,6 +318,8 @@ static int take_input(mr_study_runner *r) {
 }
 
 static const char *question(const mr_study_plan *plan, const mr_study_trial *t) {
+    if (plan->design == MR_STUDY_RATING && t->left < 0)
+        return "Which representation supports your perception of depth best as a whole?";
     if (plan->design == MR_STUDY_RATING) return "How well can you perceive this depth cue in the whole scene?";
     if (plan->design == MR_STUDY_TASK) {
         const mr_study_key *k = mr_study_plan_key(plan, t->block, t->stimulus);
@@ -456,6 +459,23 @@ const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, flo
             out->image_method[r->image_count++] = t->left;
             out->image_rect[r->image_count] = mr_ui_fit(mr_ui_rect_inset(rh, pad / 2), iw, ih);
             out->image_method[r->image_count++] = t->right;
+        } else if (t->left < 0) {
+            /* The overall question: every method side by side, position i
+             * showing method (r + i) mod t, a button under each. */
+            int n = plan->set.method_count;
+            float w = area.w / n;
+            for (int i = 0; i < n; i++) {
+                mr_ui_rect cell = mr_ui_rect_inset(mr_ui_rect_make(area.x + i * w, area.y, w, area.h), pad / 2);
+                out->image_rect[r->image_count] = mr_ui_fit(cell, iw, ih);
+                out->image_method[r->image_count++] = (t->right + i) % n;
+                mr_ui_rect b = mr_ui_rect_inset(mr_ui_rect_make(bottom.x + i * w, bottom.y, w, bottom.h), pad / 2);
+                r->shown[W_PICK1 + i] = true;
+                r->rect[W_PICK1 + i] = b;
+                static const char *const labels[MR_STUDY_OVERALL_MAX] = {"This one (1)", "This one (2)", "This one (3)",
+                                                                         "This one (4)"};
+                if (mr_ui_button(r->ui, (uint32_t)(60 + i), b, labels[i], MR_UI_ACCENT) || key == '1' + i)
+                    answered = true, answer = (t->right + i) % n;
+            }
         } else {
             if (plan->design == MR_STUDY_RATING) {
                 /* The scale asked now, above its buttons. */
@@ -472,7 +492,9 @@ const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, flo
             r->shown[W_IMAGE] = true;
             r->rect[W_IMAGE] = ir;
         }
-        if (plan->design == MR_STUDY_RATING) {
+        if (plan->design == MR_STUDY_RATING && t->left < 0) {
+            /* answered above */
+        } else if (plan->design == MR_STUDY_RATING) {
             int got = rating_row(r, bottom, pad, key);
             if (got >= 0) {
                 r->ratings[r->scale++] = got;
@@ -556,14 +578,20 @@ const mr_ui_draw_list *mr_study_runner_frame(mr_study_runner *r, double now, flo
             v->block = t->block;
             v->trial = r->trial;
             snprintf(v->stimulus, sizeof v->stimulus, "%s", plan->set.stimuli[t->stimulus]);
-            snprintf(v->left, sizeof v->left, "%s", plan->set.methods[t->left]);
-            snprintf(v->right, sizeof v->right, "%s", plan->set.methods[t->right]);
+            if (t->left >= 0) {
+                snprintf(v->left, sizeof v->left, "%s", plan->set.methods[t->left]);
+                snprintf(v->right, sizeof v->right, "%s", plan->set.methods[t->right]);
+            }
             v->design = plan->design;
             v->choice = -1;
             if (plan->design == MR_STUDY_PAIRWISE) {
                 v->group = plan->group;
                 v->answer = answer;
                 v->slider = slider_value;
+            } else if (plan->design == MR_STUDY_RATING && t->left < 0) {
+                v->choice = answer;
+                snprintf(v->left, sizeof v->left, "*");
+                snprintf(v->right, sizeof v->right, "%d", t->right);
             } else if (plan->design == MR_STUDY_RATING) {
                 v->rating_count = plan->scale_count;
                 memcpy(v->ratings, r->ratings, sizeof v->ratings);

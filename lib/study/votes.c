@@ -30,6 +30,8 @@ bool mr_study_vote_append(const char *path, const mr_study_vote *v, mr_error *er
         cJSON_AddStringToObject(j, "question", mr_study_question_of(v->block, v->group));
         cJSON_AddStringToObject(j, "answer", answer_name(v->answer));
         cJSON_AddNumberToObject(j, "slider", v->slider);
+    } else if (v->design == MR_STUDY_RATING && v->choice >= 0) {
+        cJSON_AddNumberToObject(j, "choice", v->choice); /* the overall question: the method's index */
     } else if (v->design == MR_STUDY_RATING) {
         cJSON *r = cJSON_AddArrayToObject(j, "ratings");
         for (int k = 0; k < v->rating_count; k++)
@@ -90,6 +92,12 @@ static bool parse_vote(const cJSON *o, mr_study_vote *v) {
             v->group = !strcmp(group, "A") ? MR_STUDY_GROUP_A : !strcmp(group, "B") ? MR_STUDY_GROUP_B : -1;
             if ((int)v->group < 0) return false;
         }
+    } else if (v->design == MR_STUDY_RATING && cJSON_GetObjectItemCaseSensitive(o, "choice")) {
+        const cJSON *c = cJSON_GetObjectItemCaseSensitive(o, "choice");
+        if (!cJSON_IsNumber(c) || c->valuedouble < 0 || c->valuedouble >= MR_STUDY_MAX_METHODS ||
+            c->valuedouble != (int)c->valuedouble)
+            return false;
+        v->choice = (int)c->valuedouble;
     } else if (v->design == MR_STUDY_RATING) {
         const cJSON *r = cJSON_GetObjectItemCaseSensitive(o, "ratings");
         int n = cJSON_IsArray(r) ? cJSON_GetArraySize(r) : 0;
@@ -226,8 +234,12 @@ int mr_study_resume(const mr_study_plan *plan, const mr_study_votes *votes, cons
             return -1;
         }
         const mr_study_trial *t = v->trial < plan->trial_count ? &plan->trials[v->trial] : NULL;
+        char rot[16] = "";
+        if (t && t->left < 0) snprintf(rot, sizeof rot, "%d", t->right);
         if (!t || v->design != plan->design || t->block != v->block || strcmp(plan->set.stimuli[t->stimulus], v->stimulus) != 0 ||
-            strcmp(plan->set.methods[t->left], v->left) != 0 || strcmp(plan->set.methods[t->right], v->right) != 0) {
+            strcmp(t->left < 0 ? "*" : plan->set.methods[t->left], v->left) != 0 ||
+            strcmp(t->left < 0 ? rot : plan->set.methods[t->right], v->right) != 0 ||
+            (t->left < 0) != (v->choice >= 0 && v->design == MR_STUDY_RATING)) {
             mr_fail(err, MR_ERR_INVALID, "the log's vote for trial %d of participant %s does not match the plan", v->trial,
                     participant);
             return -1;
