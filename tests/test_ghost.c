@@ -246,6 +246,27 @@ static void test_legibility_metric(void) {
         for (int k = 0; k < 3; k++) mr_image_free(dst[k]);
         mr_image_free(&fl);
     }
+    /* The occluder's own features (H2): its stripes (dE 10, important at a
+     * threshold of 0.3) are kept in full by the pure occluder, gone when D
+     * is shown in full, about half at alpha 0.5. */
+    {
+        mr_legibility_params lp = MR_LEGIBILITY_DEFAULTS;
+        lp.edge_threshold = 0.3;
+        const float oa[3] = {1.0f, 0.0f, 0.5f};
+        double kept[3] = {0};
+        for (int k = 0; k < 3; k++) {
+            mr_image f = blend_final(&o, &d, &reg, oa[k]);
+            mr_ghost_legibility_images in = {&f, &o, &d, &reg};
+            mr_legibility l;
+            CHECK_MSG(mr_eval_ghost_legibility(&in, &lp, &l, &err), "%s", err.msg);
+            CHECK_MSG(l.occluder_important > 100, "the occluder's stripes: only %lld important edges", l.occluder_important);
+            kept[k] = l.occluder_kept;
+            mr_image_free(&f);
+        }
+        CHECK_MSG(kept[0] > 0.999, "pure occluder: occluder features kept %.4f, want 1", kept[0]);
+        CHECK_MSG(kept[1] < 1e-6, "D in full: occluder features kept %.4f, want 0", kept[1]);
+        CHECK_MSG(kept[2] > 0.3 && kept[2] < 0.7, "alpha 0.5: occluder features kept %.3f, want about 0.5", kept[2]);
+    }
     /* The occluder's own stripes never count as hidden structure: an F
      * that keeps O but doubles its stripe contrast adds nothing of D. */
     mr_image f = blend_final(&o, &d, &reg, 1.0f);

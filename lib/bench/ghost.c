@@ -238,12 +238,13 @@ bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err) {
                             "edge_contrast_dE / full_contrast_dE: mean dE the final image / D in full adds over the "
                             "occluder there; cv_saliency_ratio: OpenCV spectral-residual saliency, region mean / mean "
                             "elsewhere (_occluder: of the occluder alone); target_reached: pixels reaching C_desired, the "
-                            "adaptive stage's own target (a diagnostic, not legibility)");
+                            "adaptive stage's own target (a diagnostic, not legibility); occluder_kept: the same measure "
+                            "for the occluder's own important edges (Experiment 2's H2): 1 = kept in full, 0 = gone");
         char cols[1024];
         int cl = snprintf(cols, sizeof cols, "scene,importance,saliency,saliency_levels,mode");
         for (int k = 0; k < 6; k++) cl += snprintf(cols + cl, sizeof cols - (size_t)cl, ",%s_gpu_ms", k_pass_names[k]);
         snprintf(cols + cl, sizeof cols - (size_t)cl,
-                 ",ghost_gpu_ms,frame_wall_ms,legibility_edge_transfer,edge_contrast_dE,full_contrast_dE,"
+                 ",ghost_gpu_ms,frame_wall_ms,legibility_edge_transfer,occluder_kept,edge_contrast_dE,full_contrast_dE,"
                  "important_edge_fraction,cv_saliency_ratio,cv_saliency_ratio_occluder,target_reached,"
                  "mean_abs_dL,region_fraction,mean_importance,mean_contrast_missing,width,height,frames");
         mr_csv_header(csv, cols);
@@ -259,7 +260,7 @@ bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err) {
             for (int k = 0; k < 6; k++) mr_csv_num(csv, "%.4f", r->pass_ms[k]);
             /* value, format: the columns after the pass times */
             const struct { double v; const char *f; } cells[] = {
-                {r->ghost_ms, "%.4f"}, {r->frame_ms, "%.4f"}, {r->leg.legibility, "%.4f"},
+                {r->ghost_ms, "%.4f"}, {r->frame_ms, "%.4f"}, {r->leg.legibility, "%.4f"}, {r->leg.occluder_kept, "%.4f"},
                 {r->leg.edge_contrast, "%.3f"}, {r->leg.full_contrast, "%.3f"}, {r->leg.important_fraction, "%.4f"},
                 {r->sal_ratio, "%.3f"}, {r->sal_ratio_occluder, "%.3f"}, {r->st.target_reached, "%.4f"},
                 {r->st.mean_abs_dL, "%.3f"}, {r->st.region_fraction, "%.4f"}, {r->st.mean_importance, "%.4f"},
@@ -294,22 +295,24 @@ bool mr_bench_ghost(const mr_bench_ghost_params *params, mr_error *err) {
         ok = csv != NULL;
         mr_csv_comment(csv, "Fig. 8's sweep: curvature importance, alpha (state-of-the-art ghosted view) and adaptive, the occluder "
                             "opacity t (alpha = t * IM; the paper's 'transparency') from 0.25 to 1; columns as bench_ghost.csv");
-        mr_csv_header(csv, "scene,mode,opacity,legibility_edge_transfer,edge_contrast_dE,full_contrast_dE,mean_abs_dL,width,height");
+        mr_csv_header(csv, "scene,mode,opacity,legibility_edge_transfer,occluder_kept,edge_contrast_dE,full_contrast_dE,mean_abs_dL,width,"
+                           "height");
         BENCH_PRINT(out, "bench ghost, Fig. 8 sweep (curvature importance):\n  %-10s %-8s %7s %10s %9s\n", "scene", "mode", "t",
-                    "legibility", "contrast");
+                    "legibility", "occl.kept");
         for (int i = 0; ok && i < nsweep; i++) {
             const ghost_row *r = &sweep[i];
             mr_csv_text(csv, r->scene);
             mr_csv_text(csv, r->mode);
             mr_csv_num(csv, "%.2f", sweep_t[i]);
             mr_csv_num(csv, "%.4f", r->leg.legibility);
+            mr_csv_num(csv, "%.4f", r->leg.occluder_kept);
             mr_csv_num(csv, "%.3f", r->leg.edge_contrast);
             mr_csv_num(csv, "%.3f", r->leg.full_contrast);
             mr_csv_num(csv, "%.3f", r->st.mean_abs_dL);
             mr_csv_int(csv, w);
             mr_csv_int(csv, h);
             mr_csv_end_row(csv);
-            BENCH_PRINT(out, "  %-10s %-8s %7.2f %10.3f %9.3f\n", r->scene, r->mode, sweep_t[i], r->leg.legibility, r->leg.edge_contrast);
+            BENCH_PRINT(out, "  %-10s %-8s %7.2f %10.3f %9.3f\n", r->scene, r->mode, sweep_t[i], r->leg.legibility, r->leg.occluder_kept);
         }
         char path[4096];
         if (ok) {

@@ -59,8 +59,8 @@ bool mr_eval_ghost_legibility(const mr_ghost_legibility_images *in, const mr_leg
                               mr_legibility *out, mr_error *err) {
     mr_legibility_params lp = MR_LEGIBILITY_DEFAULTS;
     if (params) lp = *params;
-    out->region = out->edges = out->important = 0;
-    out->important_fraction = out->legibility = out->edge_contrast = out->full_contrast = NAN;
+    out->region = out->edges = out->important = out->occluder_important = 0;
+    out->important_fraction = out->legibility = out->edge_contrast = out->full_contrast = out->occluder_kept = NAN;
     if (!in || !in->final || !in->region) return mr_fail(err, MR_ERR_INVALID, "legibility: missing image");
     int w = in->final->width, h = in->final->height;
     if (!rgb_ok(in->final, w, h) || !rgb_ok(in->occluder, w, h) || !rgb_ok(in->hidden, w, h) ||
@@ -79,8 +79,8 @@ bool mr_eval_ghost_legibility(const mr_ghost_legibility_images *in, const mr_leg
         lab_at(in->hidden, i, lab + i * 9 + 6);
         if (reg[i] > 0.5f) out->region++;
     }
-    double sum_leg = 0, sum_hf = 0, sum_hr = 0;
-    long long used = 0;
+    double sum_leg = 0, sum_hf = 0, sum_hr = 0, sum_kept = 0;
+    long long used = 0, used_o = 0;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
             size_t p = (size_t)y * w + x;
@@ -91,14 +91,26 @@ bool mr_eval_ghost_legibility(const mr_ghost_legibility_images *in, const mr_leg
                 if (!in_p && !in_q) continue;
                 out->edges++;
                 const double *a = lab + p * 9, *b = lab + q * 9;
-                double dd[3], hf[3], hr[3];
+                double dd[3], hf[3], hr[3], dob[3], gf[3], gr[3];
                 for (int k = 0; k < 3; k++) {
                     double dO = a[3 + k] - b[3 + k];
+                    dob[k] = dO;
                     dd[k] = a[6 + k] - b[6 + k];
                     hf[k] = (a[k] - b[k]) - dO;
                     /* R = D inside the region, O outside. */
                     double rp = in_p ? a[6 + k] : a[3 + k], rq = in_q ? b[6 + k] : b[3 + k];
                     hr[k] = (rp - rq) - dO;
+                    gf[k] = (a[k] - b[k]) - (rp - rq);
+                    gr[k] = dO - (rp - rq);
+                }
+                if (lp.gain * norm3(dob) / 100.0 > lp.edge_threshold) {
+                    out->occluder_important++;
+                    double ng = norm3(gr);
+                    if (ng >= 1.0) {
+                        double t = (gf[0] * gr[0] + gf[1] * gr[1] + gf[2] * gr[2]) / (ng * ng);
+                        sum_kept += t > 0 ? (t < 1 ? t : 1) : 0;
+                        used_o++;
+                    }
                 }
                 if (!(lp.gain * norm3(dd) / 100.0 > lp.edge_threshold)) continue;
                 out->important++;
@@ -113,6 +125,7 @@ bool mr_eval_ghost_legibility(const mr_ghost_legibility_images *in, const mr_leg
         }
     free(lab);
     if (out->edges > 0) out->important_fraction = (double)out->important / (double)out->edges;
+    if (used_o > 0) out->occluder_kept = sum_kept / used_o;
     if (used > 0) {
         out->legibility = sum_leg / used;
         out->edge_contrast = sum_hf / used;

@@ -173,6 +173,14 @@ typedef struct mr_legibility {
                                   0 = only the occluder, 1 = D in full; NaN if none */
     double edge_contrast;      /* mean |h_F|: dE*ab the hidden edges add over the occluder */
     double full_contrast;      /* mean |h_R|: the same with D shown in full */
+    /* The occluder's own features (Kalkofen et al.'s Experiment 2, H2), the
+     * same measure with the roles swapped: over O's important edges that
+     * touch the region (gain dE(O) / 100 > edge_threshold), the part of O's
+     * contrast over R (D in the region, O outside) that the final image
+     * shows: mean clamp(g_F . g_R / |g_R|^2, 0, 1), g_F = dF - dR,
+     * g_R = dO - dR. 1 = the occluder's edge in full, 0 = gone. NaN if none. */
+    long long occluder_important;
+    double occluder_kept;
 } mr_legibility;
 
 bool mr_eval_ghost_legibility(const mr_ghost_legibility_images *in, const mr_legibility_params *params,
