@@ -912,7 +912,7 @@ static void bench_and_suite(mr_gpu *gpu, mr_renderer *r) {
     size_t n = 0;
     char *csv = mr_file_read(path, &n, 1 << 20, &err);
     const char *cols = "case,varying,overlap,view,tuning,method,setting,value,pcf_radius,gpu_ms,S_pixels,rmse_S,"
-                       "sqrtD_over_S,ssim_S\n";
+                       "sqrtD_over_S,ssim_S,rmse_floor_S,rmse_objects_S\n";
     const char *h = csv ? strstr(csv, "\ncase,") : NULL;
     CHECK_MSG(h && strncmp(h + 1, cols, strlen(cols)) == 0, "bench_shadows.csv header");
     int rows = 0;

@@ -74,6 +74,7 @@ static const float k_pcf_radii[] = {1, 2, 4, 8};
 typedef struct measure {
     double ms, rmse, sqrtd, ssim;
     long long s_count;
+    double rmse_floor, rmse_objects; /* over S on the floor / on everything else (NaN if empty) */
 } measure;
 
 static void apply(const setting *st, float pcf_radius, mr_shadow_params *sp) {
@@ -104,6 +105,7 @@ static bool run_one(const mr_bench_shadows_params *p, const mr_view *view, const
     fp.width = p->width;
     fp.height = p->height;
     fp.timing = true;
+    fp.want_depth = fp.want_normals = true; /* the floor / object split (read back after the timed passes) */
     fp.shadow = *sp;
     int frames = sp->method == MR_SHADOW_GROUNDTRUTH ? 1 : (p->frames > 0 ? p->frames : 3);
     double ms[64];
@@ -135,6 +137,42 @@ static bool run_one(const mr_bench_shadows_params *p, const mr_view *view, const
     }
     m->s_count = cnt;
     m->rmse = cnt ? sqrt(se / cnt) : 0;
+    /* The floor: up-facing (world normal y > 0.99) and within 1 % of the
+     * view's depth range above the lowest up-facing pixel; the rest of S is
+     * the objects' own faces (their partly lit sides and tops). */
+    m->rmse_floor = m->rmse_objects = NAN;
+    if (ok && res.normal.data && res.depth.data && res.depth.width == ref->width && res.depth.height == ref->height) {
+        mr_camera c = mr_camera_resized(&view->camera, ref->width, ref->height);
+        const mr_dmat4 *W = &view->world_from_camera;
+        const float *nv = res.normal.data, *zz = res.depth.data;
+        double *wy = malloc(n * sizeof *wy);
+        bool *up = malloc(n * sizeof *up);
+        double ymin = INFINITY, zmax = 0;
+        for (size_t i = 0; wy && up && i < n; i++) {
+            up[i] = false;
+            double z = zz[i];
+            if (!(z > 0)) continue;
+            int x = (int)(i % (size_t)ref->width), y = (int)(i / (size_t)ref->width);
+            mr_dvec3 pw = mr_m4_point(W, mr_v3((x - c.cx) / c.fx * z, (y - c.cy) / c.fy * z, z));
+            double ny = W->m[4] * nv[3 * i] + W->m[5] * nv[3 * i + 1] + W->m[6] * nv[3 * i + 2];
+            wy[i] = pw.y;
+            up[i] = ny > 0.99;
+            if (up[i] && pw.y < ymin) ymin = pw.y;
+            if (z > zmax) zmax = z;
+        }
+        double sf = 0, so = 0;
+        long long nf = 0, no = 0;
+        for (size_t i = 0; wy && up && i < n; i++) {
+            if (!(((float *)mask.data)[i] > 0.5f)) continue;
+            double d = (double)a[i] - b[i], e = isfinite(d) ? d * d : 1;
+            if (up[i] && wy[i] < ymin + 0.01 * zmax) sf += e, nf++;
+            else so += e, no++;
+        }
+        if (nf) m->rmse_floor = sqrt(sf / nf);
+        if (no) m->rmse_objects = sqrt(so / no);
+        free(wy);
+        free(up);
+    }
     m->sqrtd = cnt ? sqrt(se) / cnt : 0;
     mr_image_metrics im;
     m->ssim = NAN;
@@ -205,10 +243,11 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
                         "RMSE there, light size 1) were chosen on these; they are left out of the plot and the "
                         "summary.");
     mr_csv_header(csv, "case,varying,overlap,view,tuning,method,setting,value,pcf_radius,gpu_ms,S_pixels,rmse_S,"
-                       "sqrtD_over_S,ssim_S");
+                       "sqrtD_over_S,ssim_S,rmse_floor_S,rmse_objects_S");
     /* Per setting: the values over reported (case, view) pairs. */
     int maxr = MR_SHADOW_SUITE_COUNT * 2;
     double *agg_ms = calloc((size_t)NS * maxr, sizeof(double)), *agg_rmse = calloc((size_t)NS * maxr, sizeof(double));
+    double *agg_rf = calloc((size_t)NS * maxr, sizeof(double)), *agg_ro = calloc((size_t)NS * maxr, sizeof(double));
     int agg_n[NS] = {0};
     /* Per case and setting, view 0 (the markdown table); per setting, the
      * RMSE summed over the tuning cases' views. */
@@ -217,8 +256,8 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
         for (int m = 0; m < NS; m++) tab_ms[i][m] = tab_rmse[i][m] = NAN;
     double tune_sum[NS] = {0};
     int tune_n[NS] = {0};
-    bool ok = csv && agg_ms && agg_rmse;
-    if (!agg_ms || !agg_rmse) mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    bool ok = csv && agg_ms && agg_rmse && agg_rf && agg_ro;
+    if (!agg_ms || !agg_rmse || !agg_rf || !agg_ro) mr_fail(err, MR_ERR_NOMEM, "out of memory");
 
     /* 1. Tuning PCF's radius (tuning cases within the range, view 0). */
     float pcf_radius = MR_SHADOW_DEFAULT_PCF_RADIUS;
@@ -315,10 +354,14 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
                 mr_csv_num(csv, "%.5f", m.rmse);
                 mr_csv_num(csv, "%.3e", m.sqrtd);
                 mr_csv_num(csv, "%.4f", m.ssim);
+                mr_csv_num(csv, "%.5f", m.rmse_floor);
+                mr_csv_num(csv, "%.5f", m.rmse_objects);
                 mr_csv_end_row(csv);
                 if (!k_tuning_case[ci]) {
                     agg_ms[si * maxr + agg_n[si]] = m.ms;
                     agg_rmse[si * maxr + agg_n[si]] = m.rmse;
+                    agg_rf[si * maxr + agg_n[si]] = isfinite(m.rmse_floor) ? m.rmse_floor : 0;
+                    agg_ro[si * maxr + agg_n[si]] = isfinite(m.rmse_objects) ? m.rmse_objects : 0;
                     agg_n[si]++;
                 } else {
                     tune_sum[si] += m.rmse;
@@ -412,13 +455,14 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
                 MD(" %.2f ms / %.4f |", tab_ms[ci][chosen[m]], tab_rmse[ci][chosen[m]]);
             MD("\n");
         }
-        MD("\nMedian over the reported categories and views, chosen settings:\n\n| method | setting | GPU ms | RMSE over S |"
-           "\n|---|---|---|---|\n");
+        MD("\nMedian over the reported categories and views, chosen settings (S split: the floor's penumbrae / the "
+           "objects' own faces):\n\n| method | setting | GPU ms | RMSE over S | floor | objects |\n|---|---|---|---|---|---|\n");
         int rank[MR_SHADOW_METHOD_COUNT], nk = 0;
         for (int m = MR_SHADOW_HARD; m < MR_SHADOW_METHOD_COUNT; m++) {
             int si = chosen[m];
-            MD("| %s | %s %g | %.2f | %.4f |\n", mr_shadow_method_names[m], k_settings[si].key,
-               setting_value(&k_settings[si]), med_ms[si], med_rmse[si]);
+            MD("| %s | %s %g | %.2f | %.4f | %.4f | %.4f |\n", mr_shadow_method_names[m], k_settings[si].key,
+               setting_value(&k_settings[si]), med_ms[si], med_rmse[si],
+               agg_n[si] ? mr_median(agg_rf + si * maxr, agg_n[si]) : NAN, agg_n[si] ? mr_median(agg_ro + si * maxr, agg_n[si]) : NAN);
             rank[nk++] = si;
         }
         MD("\nLight size (median RMSE over S over the reported categories at the default settings: hard, pcf and pcss "
@@ -456,6 +500,8 @@ bool mr_bench_shadows(const mr_bench_shadows_params *params, mr_error *err) {
     }
     free(agg_ms);
     free(agg_rmse);
+    free(agg_rf);
+    free(agg_ro);
     mr_csv_destroy(&csv);
     return ok;
 }
