@@ -53,7 +53,7 @@ else
   bad "groundtruth failed: $(cat "$tmp/gt.err")"
 fi
 # Bad values: one line on stderr, non-zero exit, no output.
-for args in "--ao ssao" "--ao scheer --ao-samples 0" "--ao scheer --ao-samples 65" "--ao scheer --ao-radius-mode far" \
+for args in "--ao ssao" "--ao scheer --ao-samples 0" "--ao scheer --ao-samples 129" "--ao scheer --ao-radius-mode far" \
             "--ao scheer --ao-mask maybe" "--ao scheer --ao-kernel sobol" "--ao scheer --ao-c -1" "--ao scheer --ao-radius 0" \
             "--ao scheer --ao-rmin 0.9 --ao-rmax 0.5" "--ao scheer --ao-radius-mode screen --ao-radius 1" \
             "--ao scheer --ao-radii 0" "--ao scheer --ao-radii 6" "--ao scheer --ao-radii -1" \
