@@ -434,7 +434,9 @@ void mr_mark_title(const mr_annotation *a, char *out, size_t n) {
         if (fabs(d[i]) > fabs(d[ax])) ax = i;
     char len[32];
     words_len(m->distance_m, len, sizeof len);
-    snprintf(out + k, n - k, "%s%s along %c%c", part[0] ? ", " : ": ", len, d[ax] < 0 ? '-' : '+', "xyz"[ax]);
+    /* Under half a millimetre there is no direction to speak of. */
+    if (m->distance_m < 0.0005) snprintf(out + k, n - k, "%s%s", part[0] ? ", " : ": ", len);
+    else snprintf(out + k, n - k, "%s%s along %c%c", part[0] ? ", " : ": ", len, d[ax] < 0 ? '-' : '+', "xyz"[ax]);
 }
 
 void mr_annotations_free(mr_annotations *a) {
