@@ -15,6 +15,10 @@ int cmd_measure(int argc, char **argv) {
         {"observations", "OBS.json", "{\"taps\": [{\"frame\": N, \"px\": [u, v]}, ...], \"planned\": [x, y, z]}", NULL},
         {"out", "RESULT.json", "also write the result there", NULL},
         {"scene", "S", "the plan (glTF/GLB or scene config): also the distance to its nearest surface point", NULL},
+        {"tolerances", "T.json", "the tolerance table (default: DIN 18202 Table 1 by nominal size)", NULL},
+        {"nominal", "M", "the nominal size the tolerance is looked up for, metres (default: the planned\n"
+                         "point's distance from the table's reference point)", NULL},
+        {"part", "NAME", "the part the planned point belongs to (for a part's tolerance)", NULL},
         {NULL, NULL, NULL, NULL},
     };
     mr_triangulate_params tp = MR_TRIANGULATE_DEFAULTS;
@@ -25,7 +29,8 @@ int cmd_measure(int argc, char **argv) {
                    "Triangulates the feature tapped in two or more frames (linear, then refined, with the taps'\n"
                    "noise and each frame's pose covariance) and reports its distance to the planned point\n"
                    "(\"planned\" in OBS.json) and, with --scene, to the nearest point of the planned model, in mm\n"
-                   "with its 1-sigma uncertainty.",
+                   "with its 1-sigma uncertainty, and the verdict against the tolerance: within, out of tolerance\n"
+                   "or undecided (the 95 % interval, k = 2, straddles the limit).",
                    &help))
         return 2;
     if (help) return 0;
@@ -37,6 +42,18 @@ int cmd_measure(int argc, char **argv) {
     mr_eval_nearest *near = NULL;
     int rc = 1;
     mr_observations o;
+    mr_tolerances tols = MR_TOLERANCES_DEFAULTS;
+    const mr_tolerances *tol = NULL;
+    double nominal = -1;
+    if (mr_cli_get(opts, "nominal") && !mr_cli_double("nominal", mr_cli_get(opts, "nominal"), 0, 1e9, &nominal))
+        return 2;
+    if (mr_cli_get(opts, "tolerances")) {
+        if (!mr_tolerances_load(mr_cli_get(opts, "tolerances"), &tols, &err)) goto fail;
+        tol = &tols;
+    }
+    const char *part = mr_cli_get(opts, "part");
+    char line[320];
+    mr_verdict v = {0}, sv = {0};
     rec = mr_recording_open(dir, &err);
     if (!rec || !mr_observations_load(obsf, rec, &o, &err)) goto fail;
     if (mr_cli_get(opts, "scene")) {
@@ -59,6 +76,9 @@ int cmd_measure(int argc, char **argv) {
     if (has_planned) {
         mr_triangulation_distance(&tr, mr_v3(planned[0], planned[1], planned[2]), &dist, &dsig);
         printf("distance to the planned point: %.1f mm +- %.1f mm (1 sigma)\n", dist * 1e3, dsig * 1e3);
+        if (!mr_verdict_measure(tol, part, NULL, planned, nominal, dist, dsig, &v, &err)) goto fail;
+        mr_verdict_format(&v, line, sizeof line);
+        printf("verdict: %s\n", line);
     }
     /* The nearest point of the planned surface (exact, lib/eval). */
     mr_nearest_hit nh = {0};
@@ -72,6 +92,13 @@ int cmd_measure(int argc, char **argv) {
         printf("distance to the planned surface: %.1f mm +- %.1f mm (1 sigma), nearest point %.4f %.4f %.4f on %s\n",
                nh.distance * 1e3, nsig * 1e3, nh.point.x, nh.point.y, nh.point.z,
                nh.node >= 0 ? scene->nodes[nh.node].name : "?");
+        double np[3] = {nh.point.x, nh.point.y, nh.point.z};
+        const mr_node *sn = nh.node >= 0 ? &scene->nodes[nh.node] : NULL;
+        if (!mr_verdict_measure(tol, sn ? sn->name : part, sn && sn->layer == MR_LAYER_HIDDEN ? "hidden" : "visible", np,
+                                nominal, nh.distance, nsig, &sv, &err))
+            goto fail;
+        mr_verdict_format(&sv, line, sizeof line);
+        printf("verdict (surface): %s\n", line);
     }
     if (out) {
         cJSON *r = cJSON_CreateObject();
@@ -86,6 +113,7 @@ int cmd_measure(int argc, char **argv) {
             cJSON_AddItemToObject(r, "planned", mr_json_from_doubles(planned, 3));
             cJSON_AddNumberToObject(r, "distance_mm", dist * 1e3);
             cJSON_AddNumberToObject(r, "distance_sigma_mm", dsig * 1e3);
+            cJSON_AddItemToObject(r, "verdict", mr_verdict_to_json(&v));
         }
         if (nh.found) {
             double np[3] = {nh.point.x, nh.point.y, nh.point.z};
@@ -93,6 +121,7 @@ int cmd_measure(int argc, char **argv) {
             cJSON_AddStringToObject(r, "nearest_node", nh.node >= 0 ? scene->nodes[nh.node].name : "");
             cJSON_AddNumberToObject(r, "surface_distance_mm", nh.distance * 1e3);
             cJSON_AddNumberToObject(r, "surface_distance_sigma_mm", nsig * 1e3);
+            cJSON_AddItemToObject(r, "surface_verdict", mr_verdict_to_json(&sv));
         }
         bool ok = mr_json_save(out, r, &err);
         cJSON_Delete(r);

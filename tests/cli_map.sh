@@ -159,6 +159,17 @@ PY
   cat "$tmp/measure.out"
   grep -q "distance to the planned point: .* mm +- .* mm" "$tmp/measure.out" && ok || bad "measure printed no distance"
   grep -q '"distance_sigma_mm"' "$tmp/measured.json" && ok || bad "measure wrote no result"
+  # The verdict against DIN 18202 (the default) and against a hall's table.
+  grep -Eq "^verdict: (within tolerance|out of tolerance|undecided): .* limit ±[0-9]+ mm \(DIN 18202 Table 1, " \
+    "$tmp/measure.out" && ok || bad "measure printed no verdict"
+  grep -Eq '"verdict":[[:space:]]*"(within|out|undecided)"' "$tmp/measured.json" && ok || bad "measure wrote no verdict"
+  printf '{"default_mm": 5000}' >"$tmp/wide_tol.json"
+  "$mr" measure --recording "$rec" --observations "$tmp/obs.json" --tolerances "$tmp/wide_tol.json" >"$tmp/wide.out" 2>&1
+  grep -q "^verdict: within tolerance: .* limit ±5000 mm (hall table, default)" "$tmp/wide.out" \
+    && ok || bad "measure --tolerances: $(cat "$tmp/wide.out")"
+  printf '{"default_mm": -5}' >"$tmp/bad_tol.json"
+  expect_fail measure_bad_tolerances "$tmp/m4.json" -- "$mr" measure --recording "$rec" --observations "$tmp/obs.json" \
+    --tolerances "$tmp/bad_tol.json" --out "$tmp/m4.json"
   # issue 15: against the planned surface (the nearest point of the model).
   "$mr" measure --recording "$rec" --observations "$tmp/obs.json" --scene "$src/configs/scenes/demo_planned.json" \
     --out "$tmp/surface.json" >"$tmp/surface.out" 2>&1 && ok || bad "measure --scene: $(cat "$tmp/surface.out")"

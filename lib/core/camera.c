@@ -1,6 +1,7 @@
 /* Pinhole camera with OpenCV distortion; camera and view JSON formats. */
 #include "mr_core.h"
 
+#include <ctype.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -226,4 +227,60 @@ cJSON *mr_view_to_json(const mr_view *v) {
     cJSON_AddItemToObject(o, "camera", mr_camera_to_json(&v->camera));
     cJSON_AddItemToObject(o, "world_from_camera", mr_json_from_dmat4(&v->world_from_camera));
     return o;
+}
+
+/* Levenshtein distance, case-insensitive, of two short keys. */
+static int key_distance(const char *a, const char *b) {
+    size_t na = strlen(a), nb = strlen(b);
+    if (na > 63 || nb > 63) return 1 << 20;
+    int row[64];
+    for (size_t j = 0; j <= nb; j++) row[j] = (int)j;
+    for (size_t i = 1; i <= na; i++) {
+        int diag = row[0];
+        row[0] = (int)i;
+        for (size_t j = 1; j <= nb; j++) {
+            int up = row[j];
+            int cost = tolower((unsigned char)a[i - 1]) == tolower((unsigned char)b[j - 1]) ? 0 : 1;
+            int best = diag + cost;
+            if (row[j] + 1 < best) best = row[j] + 1;
+            if (row[j - 1] + 1 < best) best = row[j - 1] + 1;
+            row[j] = best;
+            diag = up;
+        }
+    }
+    return row[nb];
+}
+
+const char *mr_nearest_key(const char *key, const char *const *known) {
+    const char *best = NULL;
+    int bd = (int)strlen(key) / 2 + 1;
+    for (int i = 0; known && known[i]; i++) {
+        int d = key_distance(key, known[i]);
+        if (d <= bd && (!best || d < key_distance(key, best))) best = known[i];
+    }
+    return best;
+}
+
+int mr_json_warn_unknown(const cJSON *obj, const char *const *known, const char *what) {
+    int n = 0;
+    const cJSON *it;
+    cJSON_ArrayForEach(it, obj) {
+        const char *k = it->string;
+        if (!k || k[0] == '_' || strncmp(k, "comment", 7) == 0) continue;
+        bool found = false;
+        for (int i = 0; known[i] && !found; i++) found = strcmp(k, known[i]) == 0;
+        if (found) continue;
+        n++;
+        const char *near = mr_nearest_key(k, known);
+        if (near)
+            mr_log(MR_LOG_WARN, "%s: unknown key \"%s\" (did you mean \"%s\"?)", what, k, near);
+        else {
+            char list[512] = "";
+            size_t len = 0;
+            for (int i = 0; known[i] && len + 1 < sizeof list; i++)
+                len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", known[i]);
+            mr_log(MR_LOG_WARN, "%s: unknown key \"%s\" ignored (known keys: %s)", what, k, list);
+        }
+    }
+    return n;
 }

@@ -150,6 +150,13 @@ bool mr_json_save(const char *path, const cJSON *json, mr_error *err);
 bool mr_json_number(const cJSON *obj, const char *key, double *out, bool required, mr_error *err);
 bool mr_json_numbers(const cJSON *obj, const char *key, double *out, int n, mr_error *err);
 bool mr_json_dmat4(const cJSON *obj, const char *key, mr_dmat4 *out, mr_error *err);
+/* The known key nearest to key (edit distance, case-insensitive), or NULL
+ * if none is within half of key's length (+1). known ends with NULL. */
+const char *mr_nearest_key(const char *key, const char *const *known);
+/* Warns (MR_LOG_WARN) about each key of obj not in known: "what: unknown
+ * key \"hiden\" (did you mean \"hidden\"?)"; keys starting with '_' or
+ * "comment" are notes and pass. Returns the number of unknown keys. */
+int mr_json_warn_unknown(const cJSON *obj, const char *const *known, const char *what);
 cJSON *mr_json_from_dmat4(const mr_dmat4 *m);
 cJSON *mr_json_from_doubles(const double *v, int n);
 

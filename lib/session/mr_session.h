@@ -448,6 +448,123 @@ void mr_annotation_from_frame(mr_annotation *m, const mr_capture_frame *f, const
 bool mr_mark_save(const char *session_dir, const char *stem, cJSON *line, const mr_snapshot *sn, bool *snapshot_ok,
                   mr_error *snapshot_err, mr_error *err);
 
+/* ------------------------------------------------------------- verdicts
+ * verdict.c: a measured deviation judged against a tolerance.
+ *
+ * The tolerance is a limit deviation (±limit) that depends on the nominal
+ * size, the dimension the deviation belongs to. By default DIN 18202:2019
+ * Table 1, row 1 (dimensions in plan: lengths, widths, axis and grid
+ * dimensions):
+ *
+ *   nominal size   <= 1 m   1-3 m   3-6 m   6-15 m   15-30 m   > 30 m
+ *   limit          ±10 mm   ±12     ±16     ±20      ±24       ±30
+ *
+ * Each class includes its upper edge ("over 1 up to 3 m": 3.000 m is
+ * ±12 mm, 3.001 m ±16 mm). Under 1 m the standard (since its 2013 edition)
+ * gives ±10 mm in row 1; that is what applies to a nominal size of 0 to 1 m.
+ * For the position of a part, DIN 18202 (4.6) measures the deviation
+ * against a reference point, and the nominal size is the distance between
+ * the planned point and that reference (mr_tolerances.reference, default
+ * the world origin, i.e. the marker map's).
+ *
+ * A hall may replace the default by its own table (hall.json "tolerances",
+ * or a file it names):
+ *   {"default_mm": 20,                      (optional; absent: DIN 18202)
+ *    "layers": {"hidden": 30},              (layer name -> ±mm)
+ *    "parts": {"Machine_*": 5, "Column_3": 10},   (node-name glob -> ±mm)
+ *    "reference": [x, y, z]}                (optional, scene units)
+ * A part rule wins over a layer rule, which wins over default_mm; the first
+ * matching part glob in file order applies.
+ *
+ * The verdict uses the measurement's 95 % interval, deviation ± k·sigma
+ * with k = 2 (sigma the 1-sigma of the deviation, the registration's
+ * uncertainty included, as mr_triangulate gives it):
+ *   within            |deviation| + k·sigma <= limit
+ *   out of tolerance  |deviation| - k·sigma >  limit
+ *   undecided         otherwise: the interval straddles the limit (measure
+ *                     again, closer or from a wider baseline).
+ * Deviations are in scene units taken as metres. */
+
+#define MR_VERDICT_K 2.0             /* coverage factor of the 95 % interval */
+#define MR_TOLERANCE_RULES_MAX 64
+
+typedef enum mr_verdict_kind {
+    MR_VERDICT_NONE = 0,             /* not judged */
+    MR_VERDICT_WITHIN,
+    MR_VERDICT_OUT,
+    MR_VERDICT_UNDECIDED,
+} mr_verdict_kind;
+
+typedef struct mr_tolerance_rule {
+    char pattern[96];                /* node-name glob ("parts") or layer name */
+    double limit_m;                  /* ± limit, metres (> 0) */
+} mr_tolerance_rule;
+
+typedef struct mr_tolerances {
+    double default_m;                /* hall-wide ± limit; 0: DIN 18202 Table 1 */
+    mr_tolerance_rule parts[MR_TOLERANCE_RULES_MAX];
+    int part_count;
+    mr_tolerance_rule layers[MR_TOLERANCE_RULES_MAX];
+    int layer_count;
+    double reference[3];             /* the nominal size's reference point */
+} mr_tolerances;
+#define MR_TOLERANCES_DEFAULTS {0}
+
+/* The tolerance that applies to one deviation. */
+typedef struct mr_tolerance {
+    double limit_m;                  /* ± limit, metres */
+    double nominal_m;                /* the nominal size it was looked up for */
+    char source[96];                 /* "DIN 18202 Table 1, 6-15 m", "part Machine_*", ... */
+} mr_tolerance;
+
+typedef struct mr_verdict {
+    mr_verdict_kind kind;
+    double deviation_m;              /* as measured (a distance: >= 0) */
+    double sigma_m;                  /* its 1-sigma */
+    double k;                        /* coverage factor (MR_VERDICT_K) */
+    double lo_m, hi_m;               /* the 95 % interval, deviation ± k·sigma;
+                                        for a deviation >= 0 (a distance) lo_m >= 0 */
+    mr_tolerance tol;
+} mr_verdict;
+
+/* DIN 18202 Table 1 row 1's limit for a nominal size (metres, >= 0; a
+ * negative or non-finite size gives NAN); *cls (may be NULL) gets the
+ * class's words ("6-15 m"). */
+double mr_din18202_limit_m(double nominal_m, const char **cls);
+/* Parses a tolerance table (format above) into t (defaults first). Unknown
+ * keys are warned about with the nearest known key; a limit that is not a
+ * positive number is an error. */
+bool mr_tolerances_from_json(const cJSON *obj, mr_tolerances *t, mr_error *err);
+bool mr_tolerances_load(const char *path, mr_tolerances *t, mr_error *err);
+/* The tolerance for a deviation of part (node name, may be NULL or "") on
+ * layer ("visible" / "hidden", may be NULL) at nominal size nominal_m;
+ * t NULL: DIN 18202. */
+mr_tolerance mr_tolerance_lookup(const mr_tolerances *t, const char *part, const char *layer, double nominal_m);
+/* The nominal size of a planned point: its distance from t's reference
+ * (the origin if t is NULL). */
+double mr_tolerance_nominal(const mr_tolerances *t, const double planned[3]);
+/* Judges deviation_m ± MR_VERDICT_K·sigma_m against tol. False + err for a
+ * non-finite deviation, a negative or non-finite sigma or a limit <= 0. */
+bool mr_verdict_judge(double deviation_m, double sigma_m, const mr_tolerance *tol, mr_verdict *out, mr_error *err);
+/* The whole rule for one measured distance: the tolerance for part / layer
+ * (either may be NULL) at the nominal size of planned (its distance from
+ * t's reference; nominal_m >= 0 overrides it), then the verdict. t NULL:
+ * DIN 18202. */
+bool mr_verdict_measure(const mr_tolerances *t, const char *part, const char *layer, const double planned[3],
+                        double nominal_m, double deviation_m, double sigma_m, mr_verdict *out, mr_error *err);
+/* "within", "out", "undecided" (JSON), and the planner's words: "within
+ * tolerance", "out of tolerance", "undecided". "" for NONE. */
+const char *mr_verdict_key(mr_verdict_kind k);
+const char *mr_verdict_words(mr_verdict_kind k);
+/* One line: "out of tolerance: 300.2 mm, 95 % interval 290.0 .. 310.4 mm,
+ * limit ±20 mm (DIN 18202 Table 1, 6-15 m)". */
+void mr_verdict_format(const mr_verdict *v, char *buf, size_t n);
+/* {"verdict", "deviation_mm", "sigma_mm", "k", "interval_mm": [lo, hi],
+ *  "limit_mm", "nominal_m", "tolerance"}; and back (false + err when a
+ * field is missing or of the wrong kind). */
+cJSON *mr_verdict_to_json(const mr_verdict *v);
+bool mr_verdict_from_json(const cJSON *obj, mr_verdict *v, mr_error *err);
+
 #ifdef __cplusplus
 }
 #endif
