@@ -13,6 +13,7 @@ pkgs=(
   unzip
   python3
   gltfpack libdraco-dev
+  libifcplusplus-dev
 )
 missing=()
 for p in "${pkgs[@]}"; do

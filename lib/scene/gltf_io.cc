@@ -7,6 +7,7 @@
 #include <tiny_gltf.h>  // never TINYGLTF_IMPLEMENTATION: we link the shared lib
 
 #include "draco_internal.h"
+#include "ifc_internal.h"
 #include "prepare_internal.h"
 #include <meshoptimizer.h>
 
@@ -155,6 +156,45 @@ const int k_max_image_side = 16384;
 
 // Decodes PNG/JPEG/... to RGBA8 with stb_image. Bytes are trusted to be in
 // bounds here (the caller checked them).
+// glTF extras <-> cJSON, for the element identity they carry (element.c).
+cJSON *value_to_json(const tinygltf::Value &v, int depth = 0) {
+    if (depth > 32) return cJSON_CreateNull();
+    if (v.IsBool()) return cJSON_CreateBool(v.Get<bool>());
+    if (v.IsNumber()) return cJSON_CreateNumber(v.GetNumberAsDouble());
+    if (v.IsString()) return cJSON_CreateString(v.Get<std::string>().c_str());
+    if (v.IsArray()) {
+        cJSON *a = cJSON_CreateArray();
+        for (size_t i = 0; a && i < v.ArrayLen(); i++) cJSON_AddItemToArray(a, value_to_json(v.Get((int)i), depth + 1));
+        return a;
+    }
+    if (v.IsObject()) {
+        cJSON *o = cJSON_CreateObject();
+        for (const std::string &k : v.Keys())
+            if (o) cJSON_AddItemToObject(o, k.c_str(), value_to_json(v.Get(k), depth + 1));
+        return o;
+    }
+    return cJSON_CreateNull();
+}
+
+tinygltf::Value json_to_value(const cJSON *j) {
+    if (cJSON_IsBool(j)) return tinygltf::Value(cJSON_IsTrue(j) ? true : false);
+    if (cJSON_IsNumber(j)) return tinygltf::Value(j->valuedouble);
+    if (cJSON_IsString(j)) return tinygltf::Value(std::string(j->valuestring));
+    if (cJSON_IsArray(j)) {
+        tinygltf::Value::Array a;
+        const cJSON *c;
+        cJSON_ArrayForEach(c, j) a.push_back(json_to_value(c));
+        return tinygltf::Value(a);
+    }
+    if (cJSON_IsObject(j)) {
+        tinygltf::Value::Object o;
+        const cJSON *c;
+        cJSON_ArrayForEach(c, j) if (c->string) o[c->string] = json_to_value(c);
+        return tinygltf::Value(o);
+    }
+    return tinygltf::Value();
+}
+
 bool decode_image(const unsigned char *bytes, size_t size, tinygltf::Image *img, std::string *why) {
     if (!bytes || size == 0 || size > (size_t)INT_MAX) {
         *why = "empty or oversized image data";
@@ -2504,6 +2544,11 @@ struct Loader {
             }
             int32_t idx = mr_scene_add_node(s, &n);
             if (idx < 0) fail(MR_ERR_NOMEM, "cannot add node '%s'", n.name);
+            if (gn.extras.IsObject() || gn.name.size() == 22) {  // IFC identity (element.c)
+                cJSON *ex = value_to_json(gn.extras);
+                mr_scene_element_from_extras(s, idx, ex);
+                cJSON_Delete(ex);
+            }
             if (later) node_fix.push_back(std::array<int32_t, 3>{{idx, first, count}});
             for (size_t c = gn.children.size(); c-- > 0;) stack.push_back(Item{gn.children[c], idx});
         }
@@ -2613,6 +2658,12 @@ mr_scene *load_memory(const void *data, size_t size, const char *base_dir, const
             if (params->hidden_globs) L.globs.push_back(params->hidden_globs[i]);
     for (const std::string &g : extra_globs) L.globs.push_back(g.c_str());
     L.run();
+    if (model.asset.extras.IsObject() && model.asset.extras.Has("mrcheck_source")) {
+        const tinygltf::Value &k = model.asset.extras.Get("mrcheck_source");
+        if (k.IsString()) std::snprintf(scene->source_key, sizeof scene->source_key, "%s", k.Get<std::string>().c_str());
+    }
+    if (scene->element_count > 0)
+        mr_scene_hide_classes(scene, params ? params->hidden_classes : nullptr, params ? params->hidden_class_count : 0);
     std::string all = one_line(twarn + (terr.empty() ? "" : "\n" + terr) + "\n" + L.warn);
     if (!all.empty()) mr_log(MR_LOG_WARN, "%s: %s", label, all.c_str());
     return guard.release();
@@ -2767,13 +2818,33 @@ mr_scene *load_config(const cJSON *cfg, const char *path, const mr_scene_params 
         ambient = json_finite(ja, "'ambient'", path);
         if (ambient < 0 || ambient > 1) fail(MR_ERR_INVALID, "%s: 'ambient' must be in [0,1]", path);
     }
+    // "hidden_classes": IFC class globs for the hidden layer (mr_scene_params).
+    std::vector<std::string> classes;
+    std::vector<const char *> class_ptrs;
+    mr_scene_params cp;
+    std::memset(&cp, 0, sizeof cp);
+    if (params) cp = *params;
+    const cJSON *hc = cJSON_GetObjectItemCaseSensitive(cfg, "hidden_classes");
+    if (hc) {
+        if (!cJSON_IsArray(hc)) fail(MR_ERR_INVALID, "%s: 'hidden_classes' must be an array of IFC class globs", path);
+        const cJSON *h;
+        cJSON_ArrayForEach(h, hc) {
+            if (!cJSON_IsString(h)) fail(MR_ERR_INVALID, "%s: 'hidden_classes' must be an array of IFC class globs", path);
+            classes.push_back(h->valuestring);
+        }
+        for (const std::string &c : classes) class_ptrs.push_back(c.c_str());
+        static const char *const k_none[1] = {""};
+        cp.hidden_classes = class_ptrs.empty() ? k_none : class_ptrs.data();
+        cp.hidden_class_count = (int)class_ptrs.size();
+    }
     const cJSON *g = cJSON_GetObjectItemCaseSensitive(cfg, "gltf");
+    if (!cJSON_IsString(g)) g = cJSON_GetObjectItemCaseSensitive(cfg, "ifc");  // the same: recognised by content
     mr_scene *s;
     if (cJSON_IsString(g)) {
         char dir[4096], gpath[4096];
         mr_path_dir(path, dir, sizeof dir);
         mr_path_join(dir, g->valuestring, gpath, sizeof gpath);
-        s = load_path(gpath, params, globs, false);  // throws with the glTF's own message
+        s = load_path(gpath, &cp, globs, false);  // throws with the model's own message
     } else {
         s = demo_scene(cJSON_GetObjectItemCaseSensitive(cfg, "demo"), path, globs);
     }
@@ -2798,6 +2869,51 @@ mr_scene *load_config(const cJSON *cfg, const char *path, const mr_scene_params 
     return s;
 }
 
+// An IFC file: converted by IFC++ (ifc_io.cc), or read from the converted
+// scene cached beside it ("<file>.mrscene.glb", valid while its asset
+// extras name the IFC bytes' key). The cache keeps every node visible; the
+// hidden layer (name globs, IFC classes) is applied after either.
+mr_scene *load_ifc(const char *path, const void *data, size_t size, const mr_scene_params *params,
+                   const std::vector<std::string> &globs) {
+    uint64_t h = 1469598103934665603ull;
+    const unsigned char *b = static_cast<const unsigned char *>(data);
+    for (size_t i = 0; i < size; i++) h = (h ^ b[i]) * 1099511628211ull;
+    char key[40];
+    std::snprintf(key, sizeof key, "ifc1-%016llx-%llu", (unsigned long long)h,
+                  (unsigned long long)(size % 1000000000000ull));
+    const bool cached = !(params && params->no_cache);
+    std::string cache = std::string(path) + ".mrscene.glb";
+    mr_scene *s = nullptr;
+    struct stat st;
+    if (cached && ::stat(cache.c_str(), &st) == 0) {
+        try {
+            s = load_path(cache.c_str(), params, globs, false);
+        } catch (const Fail &) {
+            s = nullptr;  // a broken cache is rebuilt, never trusted
+        }
+        if (s && std::strcmp(s->source_key, key) != 0) mr_scene_destroy(&s);
+        if (s) return s;
+    }
+    mr_error e;
+    s = mr_ifc_load_memory(data, size, params, &e);
+    if (!s) fail(e.code, "%s", e.msg);
+    std::snprintf(s->source_key, sizeof s->source_key, "%s", key);
+    if (cached) {
+        mr_error we;
+        if (!mr_scene_save_glb(s, cache.c_str(), &we))
+            mr_log(MR_LOG_WARN, "%s: the converted scene is not cached: %s", path, we.msg);
+    }
+    std::vector<const char *> all;
+    if (params && params->hidden_globs)
+        for (int i = 0; i < params->hidden_glob_count; i++) all.push_back(params->hidden_globs[i]);
+    for (const std::string &g : globs) all.push_back(g.c_str());
+    for (int32_t i = 0; i < s->node_count; i++)
+        for (const char *g : all)
+            if (g && mr_glob_match(g, s->nodes[i].name)) s->nodes[i].layer = MR_LAYER_HIDDEN;
+    mr_scene_hide_classes(s, params ? params->hidden_classes : nullptr, params ? params->hidden_class_count : 0);
+    return s;
+}
+
 mr_scene *load_path(const char *path, const mr_scene_params *params, const std::vector<std::string> &extra_globs,
                     bool allow_config) {
     size_t size = 0;
@@ -2814,6 +2930,8 @@ mr_scene *load_path(const char *path, const mr_scene_params *params, const std::
     try {
         if (size >= 4 && std::memcmp(data, "glTF", 4) == 0) {
             s = load_memory(data, size, dir, params, extra_globs, path, &fm);
+        } else if (mr_ifc_sniff(data, size)) {
+            s = load_ifc(path, data, size, params, extra_globs);
         } else {
             size_t bom = size >= 3 && std::memcmp(data, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
         JsonGuard j{cJSON_ParseWithLength(static_cast<const char *>(data) + bom, size - bom)};
@@ -2822,7 +2940,8 @@ mr_scene *load_path(const char *path, const mr_scene_params *params, const std::
             const cJSON *g = cJSON_GetObjectItemCaseSensitive(j.j, "gltf");
             if (cJSON_GetObjectItemCaseSensitive(j.j, "asset")) {
                 s = load_memory(data, size, dir, params, extra_globs, path, &fm);
-            } else if (cJSON_IsString(g) || cJSON_GetObjectItemCaseSensitive(j.j, "demo")) {
+            } else if (cJSON_IsString(g) || cJSON_IsString(cJSON_GetObjectItemCaseSensitive(j.j, "ifc")) ||
+                       cJSON_GetObjectItemCaseSensitive(j.j, "demo")) {
                 if (!allow_config) fail(MR_ERR_INVALID, "%s: a scene config cannot point to another scene config", path);
                 s = load_config(j.j, path, params, extra_globs);
             } else {
@@ -2947,6 +3066,11 @@ struct Writer {
     std::string run(const mr_scene *s) {
         m.asset.version = "2.0";
         m.asset.generator = "mrcheck";
+        if (s->source_key[0]) {
+            tinygltf::Value::Object ax;
+            ax["mrcheck_source"] = tinygltf::Value(std::string(s->source_key));
+            m.asset.extras = tinygltf::Value(ax);
+        }
         for (int32_t i = 0; i < s->texture_count; i++) texture(s->textures[i], i);
         for (int32_t i = 0; i < s->material_count; i++) {
             const mr_material &mat = s->materials[i];
@@ -2983,11 +3107,14 @@ struct Writer {
             gn.matrix.resize(16);
             for (int r = 0; r < 4; r++)
                 for (int c = 0; c < 4; c++) gn.matrix[(size_t)(c * 4 + r)] = world.m[r * 4 + c];
-            if (n.layer == MR_LAYER_HIDDEN) {
-                tinygltf::Value::Object ex;
-                ex["mrcheck_layer"] = tinygltf::Value(std::string("hidden"));
-                gn.extras = tinygltf::Value(ex);
+            tinygltf::Value::Object ex;
+            if (n.layer == MR_LAYER_HIDDEN) ex["mrcheck_layer"] = tinygltf::Value(std::string("hidden"));
+            if (cJSON *ej = mr_scene_element_extras(s, i)) {
+                const cJSON *c;
+                cJSON_ArrayForEach(c, ej) if (c->string) ex[c->string] = json_to_value(c);
+                cJSON_Delete(ej);
             }
+            if (!ex.empty()) gn.extras = tinygltf::Value(ex);
             m.nodes.push_back(gn);
             scene.nodes.push_back(i);
         }

@@ -112,7 +112,67 @@ typedef struct mr_scene {
     struct mr_scene_block *blocks;
     int32_t block_count, block_cap;
     bool blocks_sorted;
+    /* What the model says its parts are (element.c): IFC identity of the
+     * nodes that have one, sorted by node; the storeys they name. */
+    struct mr_element *elements; int32_t element_count, element_cap;
+    struct mr_storey *storeys;   int32_t storey_count, storey_cap;
+    /* Where the scene came from, for a cache beside a converted file: a key
+     * of the source bytes ("" none); written into and read from the .glb's
+     * asset extras ("mrcheck_source"). */
+    char source_key[40];
 } mr_scene;
+
+/* ------------------------------------------------- elements (element.c)
+ * A node that stands for a building element: an IFC product (an IFC file,
+ * or a glTF whose node extras or names carry IFC identity). Other nodes
+ * have none. The element of a node is its own or its nearest ancestor's. */
+typedef struct mr_element {
+    int32_t node;             /* the scene node */
+    char guid[24];            /* IFC GlobalId (22 chars, IFC base64), "" if none */
+    char ifc_class[48];       /* e.g. "IfcWall", "" if unknown */
+    int32_t storey;           /* index into scene->storeys, -1: none */
+    char *props;              /* property sets as a JSON object
+                                 {"Pset_WallCommon": {"IsExternal": true}} (values in the
+                                 file's units), malloc'd and owned by the scene, or NULL */
+} mr_element;
+
+typedef struct mr_storey {
+    char name[64];
+    char guid[24];
+    double elevation;         /* metres, as the file gives it (0 if not) */
+} mr_storey;
+
+/* Copies *e (taking over e->props) and keeps the list sorted by node;
+ * returns false (e->props freed) for a bad node or no memory. A node's
+ * second element replaces its first. */
+bool mr_scene_add_element(mr_scene *s, mr_element *e);
+/* The storey named `name` (guid may be NULL or ""), added if new; -1 on no
+ * memory. */
+int32_t mr_scene_storey(mr_scene *s, const char *name, const char *guid, double elevation);
+/* The element of node (its own or its nearest ancestor's), or NULL. */
+const mr_element *mr_scene_element_of(const mr_scene *s, int32_t node);
+/* The node whose element has this GlobalId, or -1. */
+int32_t mr_scene_node_of_guid(const mr_scene *s, const char *guid);
+/* True if text is 22 characters of IFC's base64 alphabet (0-9A-Za-z_$)
+ * with a first character of 0-3: the shape of an IFC GlobalId. */
+bool mr_ifc_guid_valid(const char *text);
+/* The default hidden layer of a model: IFC's distribution elements (pipes,
+ * ducts, cable carriers and their fittings, terminals, equipment: the
+ * subtypes of IfcDistributionElement in IFC2x3 and IFC4). Case-insensitive;
+ * a trailing "StandardCase" or "Type" is ignored. */
+bool mr_ifc_class_is_distribution(const char *ifc_class);
+/* Sets the layer of every node with an element from its class: hidden if
+ * any of the globs (case-insensitive, over the class name) matches, or, when
+ * globs is NULL, if mr_ifc_class_is_distribution. Children follow their
+ * parents' hidden layer. Nodes are only ever moved into the hidden layer. */
+void mr_scene_hide_classes(mr_scene *s, const char *const *globs, int glob_count);
+void mr_scene_elements_free(mr_scene *s); /* called by mr_scene_destroy */
+/* A node's element from its glTF extras (cJSON object, may be NULL) and its
+ * name (element.c lists the keys read); false if it carries no identity. */
+bool mr_scene_element_from_extras(mr_scene *s, int32_t node, const cJSON *extras);
+/* The extras mr_scene_save_glb writes for node's own element (caller frees),
+ * or NULL: ifc_guid, ifc_class, ifc_storey, ifc_storey_elevation, ifc_props. */
+cJSON *mr_scene_element_extras(const mr_scene *s, int32_t node);
 
 /* ------------------------------------------------------------- building */
 
@@ -159,6 +219,15 @@ typedef struct mr_scene_params {
      * its fraction done in [0,1]; NULL: none. */
     void (*progress)(void *user, const char *stage, double fraction);
     void *progress_user;
+    /* IFC class globs (case-insensitive) whose elements form the hidden
+     * layer, for models that carry IFC identity (an IFC file, or glTF
+     * extras); NULL: the distribution elements (mr_ifc_class_is_distribution);
+     * non-NULL with count 0: none by class. A scene config sets it with
+     * "hidden_classes": ["IfcPipe*", ...]. */
+    const char *const *hidden_classes;
+    int hidden_class_count;
+    /* IFC: no cache beside the file (neither read nor written). */
+    bool no_cache;
 } mr_scene_params;
 #define MR_SCENE_DEFAULTS {0}
 

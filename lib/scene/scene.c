@@ -81,6 +81,7 @@ void mr_scene_destroy(mr_scene **scene) {
     free(s->materials);
     free(s->textures);
     free(s->nodes);
+    mr_scene_elements_free(s);
     free(s);
     *scene = NULL;
 }
