@@ -8,6 +8,7 @@
 # any mutant survived. Not part of CI (about 2 minutes on 2 cores):
 #   bash scripts/mutants.sh            # all mutants
 #   bash scripts/mutants.sh flip rot   # only those whose name contains a word
+#   bash scripts/mutants.sh --check    # only that every entry still matches
 # Needs a configured build/ (bash scripts/build.sh) and a clean tree for the
 # files it touches.
 set -uo pipefail
@@ -34,8 +35,8 @@ prev_pose_always|lib/track/tracker.c|t->prev.valid && age >= 0 && age < t->prev_
 prev_pose_backwards|lib/track/tracker.c|age >= 0 && age < t->prev_max_age_s|age < t->prev_max_age_s|^test_track
 annotation_folder_not_synced|lib/session/annotations.c|    bool existed = mr_file_exists(path);|    bool existed = true;|^test_session$
 replay_seek_time_strict|lib/session/replay.c|if (r->frames[mid].t <= t) lo = mid + 1;|if (r->frames[mid].t < t) lo = mid + 1;|^test_session$
-lod_one_sided_ab|lib/scene/lod.c|    return fmax(ab, ba);\n}|    (void)ba;\n    return ab;\n}|^test_cull_lod$
-lod_one_sided_ba|lib/scene/lod.c|    return fmax(ab, ba);\n}|    (void)ab;\n    return ba;\n}|^test_cull_lod$
+lod_one_sided_ab|lib/scene/lod.c|r = dmax(ab, ba);|r = ab; (void)ba;|^test_cull_lod$
+lod_one_sided_ba|lib/scene/lod.c|r = dmax(ab, ba);|r = ba; (void)ab;|^test_cull_lod$
 atomic_write_in_place|lib/core/file.c|snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid())|snprintf(tmp, sizeof tmp, "%s", path)|^test_core$
 atomic_temp_left|lib/core/file.c|        int e = errno;\n        remove(tmp);\n        return mr_fail(err, MR_ERR_IO, "cannot write %s: %s", path, strerror(e));\n    }\n    if|        int e = errno;\n        return mr_fail(err, MR_ERR_IO, "cannot write %s: %s", path, strerror(e));\n    }\n    if|^test_core$
 touch_target_px|lib/ui/widgets.c|ceilf(mr_ui_mm(ui, ui->p.min_target_mm))|ceilf(ui->p.min_target_mm)|^test_ui$
@@ -44,12 +45,12 @@ overlay_p1_p2_swapped|shaders/overlay.frag.glsl|p1 = u_dist[2], p2 = u_dist[3]|p
 overlay_p2_sign|shaders/overlay.frag.glsl|2.0 * p1 * xy.x * xy.y + p2 * (r2|2.0 * p1 * xy.x * xy.y - p2 * (r2|^test_render$
 view_act_on_press|lib/ui/widgets.c|bool clicked = enabled && ui->released && ui->active == id && over;|bool clicked = enabled && ui->pressed && over;|^test_view$
 view_slide_off_acts|lib/ui/widgets.c|bool clicked = enabled && ui->released && ui->active == id && over;|bool clicked = enabled && ui->released && ui->active == id;|^test_view$
-view_ao_cycle_backwards|lib/view/controller.c|v->s.ao = (mr_ao_method)mr_opt_enum_next(mr_opt_find(mr_view_settings_opts, "ao"), (int)v->s.ao);|v->s.ao = (mr_ao_method)((v->s.ao + MR_AO_METHOD_COUNT - 1) % MR_AO_METHOD_COUNT);|^test_view$
+view_ao_cycle_backwards|lib/view/controller.c|v->s.ao = (mr_ao_method)next_method("ao", (int)v->s.ao, MR_AO_NONE);|v->s.ao = (mr_ao_method)((v->s.ao + MR_AO_METHOD_COUNT - 1) % MR_AO_METHOD_COUNT);|^test_view$
 view_settings_in_place|lib/view/settings.c|    bool ok = (!dir[0] |    FILE *fo = fopen(path, "wb");\n    char *txt = cJSON_Print(j);\n    if (fo && txt) fputs(txt, fo);\n    if (fo) fclose(fo);\n    free(txt);\n    bool ok = true;\n    if (0) ok = (!dir[0] |^test_view$
 view_lost_fades_to_model|lib/view/controller.c|1.0f - (1.0f - s->alpha) * 0.35f|s->alpha * 0.35f|^test_view$
 view_layout_drops_first|lib/view/controller.c|        if (i >= shown) {|        if (i < n - shown) {|^test_view$
 gl_context_4.9|lib/render/gpu.c|EGL_CONTEXT_MINOR_VERSION, 5,|EGL_CONTEXT_MINOR_VERSION, 9,|^(test_render|cli_render)$
-gl_target_leaks_positions|lib/render/renderer.c|glDeleteTextures((GLsizei)(sizeof t->color / sizeof t->color[0]), t->color);|glDeleteTextures(3, t->color);|^test_gl_objects$
+gl_target_leaks_positions|lib/render/gl_util.c|glDeleteTextures((GLsizei)(sizeof t->color / sizeof t->color[0]), t->color);|glDeleteTextures(3, t->color);|^test_gl_objects$
 ao_reuse_never|lib/render/pass_ao.c|return memcmp(&key, &s->last, sizeof key) == 0 ? AO_PLAN_REUSE : AO_PLAN_RUN;|(void)key; return AO_PLAN_RUN;|^test_ao$
 registry_gbuffer_skipped|lib/render/passes.c|.name = "gbuffer", .prepare|.name = "gbuffer", .needed = mr_pass_need_overlay, .prepare|^test_render$
 ghost_hidden_in_gbuffer|lib/render/passes.c|!(f->writing & RES(RES_HIDDEN_DEPTH))|true|^test_ghost$
@@ -59,7 +60,7 @@ opt_wrong_offset|lib/render/options.c|{"rmin", MR_OPT_FLOAT, AO(r_min)|{"rmin", 
 opt_wrong_offset_untabled|lib/render/options.c|GH(curv_scale)|GH(saliency_gain)|^test_options$
 opt_range_off_by_one|lib/render/options.c|AO(blur_radius), 0, 32,|AO(blur_radius), 0, 33,|^test_options$
 opt_upper_bound_exclusive|lib/core/options.c|v > o->hi) return range_fail(o, text, err);\n        store(o, params, to_field(o, (double)v));|v >= o->hi) return range_fail(o, text, err);\n        store(o, params, to_field(o, (double)v));|^test_options$
-opt_cli_value_ignored|app/args.c|if (mr_opt_set_row(o, t->params, v, &err)) continue;|if (mr_opt_set_row(o, t->params, v, &err) + 1) continue;|^cli_options$
+opt_cli_value_ignored|lib/core/cli.c|if (mr_opt_set_row(o, t->params, v, &err)) continue;|if (mr_opt_set_row(o, t->params, v, &err) + 1) continue;|^cli_options$
 replay_meta_markers_key|lib/session/replay.c|cJSON_GetObjectItemCaseSensitive(meta, "markers") : NULL;|cJSON_GetObjectItemCaseSensitive(meta, "marker") : NULL;|^test_session$
 opt_zero_default_user_zero_is_default|lib/core/options.c|(o->flags & MR_OPT_ZERO_DEFAULT) && v == 0 ? -1 : v;|(o->flags & MR_OPT_ZERO_DEFAULT) && v < 0 ? -1 : v;|^test_options$
 opt_detector_refine_default_off|lib/track/options.c|DT(refine_edges), 0, 1, 1,|DT(refine_edges), 0, 1, 0,|^test_options$
@@ -76,6 +77,8 @@ study_plan_not_shuffled|lib/study/plan.c|    for (int i = n - 1; i > 0; i--) {| 
 study_repeat_answer_kept|lib/study/votes.c|} else if (seen(out, &v)) {|} else if (seen(out, &v) && 0) {|^test_study$
 study_resume_skips_one|lib/study/votes.c|        if (!answered[k]) return k;|        if (!answered[k]) return k + 1;|^test_study$
 study_no_fixation|lib/study/run.c|>= plan->fixation_ms|>= 0|^test_study$
+core_parallel_one_thread|lib/core/parallel.c|    if (nt < 1) nt = 1;|    nt = 1;|^test_core$
+core_parallel_stop_ignored|lib/core/parallel.c|            q->stopped = true;|            q->stopped = false;|^test_core$
 study_gg_epsilon|lib/study/infer.c|o->eps_gg = tr2 > 0 ? tr * tr / (q * tr2) : 1.0;|o->eps_gg = tr2 > 0 ? tr * tr / tr2 : 1.0;|^test_study_stats$
 study_mauchly_plain_p|lib/study/infer.c|p0 + w2 * (p4 - p0)|p0 + 0 * w2 * (p4 - p0)|^test_study_stats$
 study_wilcoxon_lower_tail|lib/study/infer.c|if (s <= w) lo += c[s];|if (s < w) lo += c[s];|^test_study_stats$
@@ -89,6 +92,25 @@ study_tap_units|lib/study/analyze_rt.c|eu = epx * k->units_per_px;|eu = epx;|^te
 study_overall_rotation|lib/study/run.c|answered = true, answer = (t->right + i) % n;|answered = true, answer = i;|^test_study_designs$
 LIST
 )
+
+# --check: only verify that every mutant's text is in its file exactly once
+# (no build, seconds): a stale entry fails, it is never skipped.
+if [ "${1:-}" = --check ]; then
+  bad=0
+  while IFS='|' read -r name file text repl tests; do
+    [ -n "$name" ] || continue
+    if ! FROM="$text" perl -0ne '
+          my $f = $ENV{FROM} =~ s/\\n/\n/gr;
+          my $n = () = /\Q$f\E/g;
+          exit($n == 1 ? 0 : 1);' "$file" 2>/dev/null; then
+      echo "ERROR    $name: the text to mutate in $file is not there exactly once (update the list)"
+      bad=$((bad + 1))
+    fi
+  done <<<"$mutants"
+  echo "mutants --check: $bad stale of $(grep -c . <<<"$mutants")"
+  [ $bad -eq 0 ]
+  exit
+fi
 
 backup=$(mktemp -d)
 current=""

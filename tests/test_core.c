@@ -488,14 +488,32 @@ typedef struct pf_ctx {
     int hits[1000];
     pthread_t who[1000];
     int stop_at;
+    int stopping; /* set by item stop_at just before it returns false */
 } pf_ctx;
 
+/* No assumption about scheduling or core count: item 0 holds its thread
+ * until another thread has run an item (so a second thread must take one,
+ * however loaded the machine), and items after the stop wait until the
+ * stopping item is returning, then take 20 ms each: all 1000 would run only
+ * if the stop were ignored (or after 18 s with one thread descheduled between
+ * two instructions). */
 static bool pf_item(void *arg, size_t i) {
     pf_ctx *c = arg;
-    __atomic_fetch_add(&c->hits[i], 1, __ATOMIC_RELAXED);
     c->who[i] = pthread_self();
-    if (i % 64 == 0) usleep(200); /* let the other thread take some */
-    if (c->stop_at >= 0 && (int)i > c->stop_at) usleep(1000); /* after the stop: slow, so few start */
+    __atomic_fetch_add(&c->hits[i], 1, __ATOMIC_RELEASE);
+    if (i == 0 && c->stop_at < 0)
+        for (int t = 0; t < 100000; t++) { /* up to 10 s */
+            bool other = false;
+            for (int k = 1; k < 1000 && !other; k++)
+                other = __atomic_load_n(&c->hits[k], __ATOMIC_ACQUIRE) && !pthread_equal(c->who[k], pthread_self());
+            if (other) break;
+            usleep(100);
+        }
+    if (c->stop_at >= 0 && (int)i > c->stop_at) {
+        for (int t = 0; t < 100000 && !__atomic_load_n(&c->stopping, __ATOMIC_ACQUIRE); t++) usleep(100);
+        usleep(20000);
+    }
+    if ((int)i == c->stop_at) __atomic_store_n(&c->stopping, 1, __ATOMIC_RELEASE);
     return (int)i != c->stop_at;
 }
 
@@ -521,8 +539,8 @@ static void test_parallel_for(void) {
         upto += i <= 100 && c.hits[i] == 1;
     }
     /* Items up to 100 ran once; after it, only those the other thread took
-     * before it saw the stop (each then takes 1 ms: a handful at most). */
-    CHECK_MSG(upto == 101 && ran < 200 && twice == 0, "stopped at 100: %d ran (%d of 0..100), %d twice", ran, upto, twice);
+     * before it saw the stop (each waits for the stop, then takes 20 ms). */
+    CHECK_MSG(upto == 101 && ran < 1000 && twice == 0, "stopped at 100: %d ran (%d of 0..100), %d twice", ran, upto, twice);
     CHECK(mr_parallel_for(0, 0, pf_item, &c)); /* nothing to do */
 }
 
