@@ -49,6 +49,12 @@ for k in planned built; do
 done
 "$mr" replay "$src/recordings/demo" --scene "$src/configs/scenes/demo_planned.json" --out "$tmp/rp_cfg" --from 20 --to 20 \
   >/dev/null 2>"$tmp/rp_cfg.err" && [ -s "$tmp/rp_cfg/overlay_000020.png" ] && ok || bad "replay with the shipped config: $(cat "$tmp/rp_cfg.err") $(ls "$tmp/rp_cfg" 2>&1)"
+# A misspelt key is named with the nearest known one; the shipped configs have none.
+printf '{"demo": "planned", "hiden": ["Pipe_*"], "lights": [{"direction": [0, 1, 0], "colour": [1, 1, 1]}]}' >"$tmp/typo.json"
+"$mr" render --scene "$tmp/typo.json" --view "$d/views/view_000.json" --size 64x48 --out "$tmp/typo.png" 2>"$tmp/typo.err" \
+  && grep -q 'unknown key "hiden" (did you mean "hidden"?)' "$tmp/typo.err" \
+  && grep -q 'unknown key "colour" (did you mean "color"?)' "$tmp/typo.err" && ok || bad "config typo: $(cat "$tmp/typo.err")"
+grep -q "unknown key" "$tmp/cfg_planned.err" "$tmp/cfg_built.err" && bad "shipped configs warn: $(cat "$tmp/cfg_"*.err)" || ok
 printf '{"demo": "later"}' >"$tmp/bad_demo.json"
 expect_fail bad_demo_config "$tmp/o9.png" -- "$mr" render --scene "$tmp/bad_demo.json" --view "$v" --out "$tmp/o9.png"
 expect_fail missing_scene "$tmp/o1.png" -- "$mr" render --scene "$tmp/nope.glb" --view "$v" --out "$tmp/o1.png"

@@ -2762,6 +2762,12 @@ mr_scene *demo_scene(const cJSON *d, const char *path, const std::vector<std::st
 
 mr_scene *load_config(const cJSON *cfg, const char *path, const mr_scene_params *params,
                       std::vector<std::string> globs) {
+    /* A typo ("hiden") would silently change the check: name it. */
+    static const char *const known[] = {"gltf", "demo", "hidden", "lights", "receivers", "shadows", "ambient",
+                                        "description", nullptr};
+    static const char *const light_keys[] = {"direction", "color", "kind", "position", "shadows", "angle", "size",
+                                             "axis", nullptr};
+    mr_json_warn_unknown(cfg, known, path);
     const cJSON *hidden = cJSON_GetObjectItemCaseSensitive(cfg, "hidden");
     if (hidden) {
         if (!cJSON_IsArray(hidden)) fail(MR_ERR_INVALID, "%s: 'hidden' must be an array of name globs", path);
@@ -2781,6 +2787,7 @@ mr_scene *load_config(const cJSON *cfg, const char *path, const mr_scene_params 
         const cJSON *l;
         cJSON_ArrayForEach(l, jl) {
             if (!cJSON_IsObject(l)) fail(MR_ERR_INVALID, "%s: each light must be an object", path);
+            mr_json_warn_unknown(l, light_keys, path);
             mr_light &L = lights[nlights++];
             double d[3], c[3] = {1, 1, 1};
             json_vec3(l, "direction", d, path);
