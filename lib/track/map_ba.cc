@@ -110,11 +110,15 @@ extern "C" bool mr_ba_solve(mr_ba_problem *p, char *msg, size_t msg_size) {
      * minimiser's stops); mrcheck reports on its own, in one line. */
     FLAGS_minloglevel = google::GLOG_FATAL;
     try {
-        std::vector<double> tq(4 * (size_t)p->ntags), tt(3 * (size_t)p->ntags);
-        std::vector<double> cq(4 * (size_t)p->nphotos), ct(3 * (size_t)p->nphotos);
+        /* Every parameter block in one buffer, in a fixed order: Ceres
+         * orders the covariance's blocks by address, so separate heap
+         * blocks would make its last digits depend on the heap's state. */
+        std::vector<double> buf(7 * (size_t)p->ntags + 7 * (size_t)p->nphotos + 9);
+        double *tq = buf.data(), *tt = tq + 4 * (size_t)p->ntags;
+        double *cq = tt + 3 * (size_t)p->ntags, *ct = cq + 4 * (size_t)p->nphotos;
+        double *k = ct + 3 * (size_t)p->nphotos;
         for (int i = 0; i < p->ntags; i++) split_pose(p->tag + 16 * i, &tq[4 * i], &tt[3 * i]);
         for (int j = 0; j < p->nphotos; j++) split_pose(p->cam + 16 * j, &cq[4 * j], &ct[3 * j]);
-        double k[9];
         for (int i = 0; i < 9; i++) k[i] = p->intr[i];
 
         ceres::Problem::Options po;
