@@ -13,14 +13,19 @@
  * for its mean: IPPE's mirror branch is typically tens of degrees away. */
 #define PAIR_INLIER_DEG 5.0
 /* A sighting whose corners miss the photo's initial pose by more than this
- * (px RMS) is a misdetection or a wrong IPPE branch of a lone tag: left
- * out of the adjustment rather than merely down-weighted. */
-#define OBS_REJECT_PX 100.0
+ * fraction of the image diagonal (px RMS; 100 px at 320 x 240) is a
+ * misdetection or a wrong IPPE branch of a lone tag: left out of the
+ * adjustment rather than merely down-weighted. A fraction, not pixels: the
+ * initial map's angular error is what it must allow for. */
+#define OBS_REJECT_FRAC 0.25
 /* After an adjustment, sightings whose corners miss by more than this many
  * estimated corner sigmas (and at least OBS_REJECT_MIN_PX) are left out
  * and the adjustment runs again. */
 #define OBS_REJECT_SIGMA 6.0
 #define OBS_REJECT_MIN_PX 3.0
+/* Placing a tag through a sighting: its pose may be off by this fraction
+ * of the sightings' distances before the sighting counts as wrong. */
+#define PLACE_LEVER 0.1
 
 typedef struct obs_t {
     int tag, photo;          /* tag index, photo index */
@@ -233,6 +238,22 @@ static int build_edges(const ctx_t *c, bool used_only, pair_t *pairs, edge_t *ed
     return ne;
 }
 
+/* Does one of candidate e's poses (a new tag's pose through a placed
+ * tag, e->a and e->b the two sightings) agree with the mean m? Within
+ * twice the pair angle, and lim_t plus PLACE_LEVER of both sightings'
+ * distances: a few degrees of a far tag's IPPE rotation move the other
+ * tag by that lever, and far sightings are not misdetections for it. */
+static bool agrees(const ctx_t *c, const pair_t *e, const mr_dmat4 *m, double lim_t) {
+    const mr_dmat4 *ca = &c->obs[e->a].cft[0], *cb = &c->obs[e->b].cft[0];
+    double lim = lim_t + PLACE_LEVER * (mr_v3_len(mr_v3(ca->m[3], ca->m[7], ca->m[11])) +
+                                        mr_v3_len(mr_v3(cb->m[3], cb->m[7], cb->m[11])));
+    for (int k = 0; k < e->n; k++) {
+        mr_dvec3 d = mr_v3(e->rel[k].m[3] - m->m[3], e->rel[k].m[7] - m->m[7], e->rel[k].m[11] - m->m[11]);
+        if (mr_pose_angle_deg(&e->rel[k], m) <= 2 * PAIR_INLIER_DEG && mr_v3_len(d) <= lim) return true;
+    }
+    return false;
+}
+
 /* The initial map again, one tag at a time by view count (Prim's order:
  * next the unplaced tag sharing the most photos with placed ones), each
  * from the robust mean of its poses through every such photo. A photo
@@ -291,22 +312,13 @@ static int place_tags(ctx_t *c, const bool *in_part, int root, mr_dmat4 *rft, bo
         robust_mean(buf, n, &m);
         double lim_t = 2 * c->size[best];
         for (int i = 0; i < n; i++) {
-            bool in = false;
-            for (int k = 0; k < buf[i].n && !in; k++) {
-                mr_dvec3 d = mr_v3(buf[i].rel[k].m[3] - m.m[3], buf[i].rel[k].m[7] - m.m[7], buf[i].rel[k].m[11] - m.m[11]);
-                in = mr_pose_angle_deg(&buf[i].rel[k], &m) <= 2 * PAIR_INLIER_DEG && mr_v3_len(d) <= lim_t;
-            }
+            bool in = agrees(c, &buf[i], &m, lim_t);
             /* Out: either sighting may be the wrong one; the new tag's is
              * dropped unless it agrees through another placed tag. */
             if (!in) {
                 bool other = false;
                 for (int q = 0; q < n && !other; q++)
-                    if (q != i && buf[q].a == buf[i].a)
-                        for (int k = 0; k < buf[q].n && !other; k++) {
-                            mr_dvec3 d = mr_v3(buf[q].rel[k].m[3] - m.m[3], buf[q].rel[k].m[7] - m.m[7],
-                                               buf[q].rel[k].m[11] - m.m[11]);
-                            other = mr_pose_angle_deg(&buf[q].rel[k], &m) <= 2 * PAIR_INLIER_DEG && mr_v3_len(d) <= lim_t;
-                        }
+                    if (q != i && buf[q].a == buf[i].a) other = agrees(c, &buf[q], &m, lim_t);
                 obs_t *drop = &c->obs[other ? buf[i].b : buf[i].a];
                 if (drop->use && drop->tag != root) {
                     drop->use = false;
@@ -954,9 +966,10 @@ static bool refine_photo(const map_state *s, int a, int b, int n, mr_dmat4 *cfw)
 }
 
 /* Step 8: each photo's pose from all its tags of the part; sightings
- * that miss it by OBS_REJECT_PX leave; photos without one keep slot -1. */
+ * that miss it by OBS_REJECT_FRAC leave; photos without one keep slot -1. */
 static bool photo_poses(map_state *s) {
     ctx_t *c = &s->c;
+    double lim = OBS_REJECT_FRAC * hypot(c->cam->width, c->cam->height);
     for (int a = 0; a < c->nobs;) {
         int b = a;
         while (b < c->nobs && c->obs[b].photo == c->obs[a].photo) b++;
@@ -969,7 +982,7 @@ static bool photo_poses(map_state *s) {
             for (int y = a; y < b; y++) {
                 obs_t *o = &c->obs[y];
                 if (!o->use) continue;
-                o->use = obs_rms_px(c->cam, o, c->size[o->tag], &wfc, &s->wft[s->tag_of[o->tag]]) < OBS_REJECT_PX;
+                o->use = obs_rms_px(c->cam, o, c->size[o->tag], &wfc, &s->wft[s->tag_of[o->tag]]) < lim;
                 n += o->use;
             }
             if (n > 0) {
