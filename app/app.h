@@ -98,6 +98,7 @@ int cmd_export(int argc, char **argv);
 int bench_scene(int argc, char **argv);
 /* mrcheck bench map (bench_map.c). */
 int bench_map(int argc, char **argv);
+int bench_measure(int argc, char **argv); /* bench_map.c */
 
 /* mrcheck bench load (bench_load.c). */
 int bench_load(int argc, char **argv);

@@ -23,3 +23,25 @@ int bench_map(int argc, char **argv) {
     mr_error err = {0};
     return mr_bench_map(&p, &err) ? 0 : mr_cli_error(cmd, &err);
 }
+
+/* mrcheck bench measure: wiring for mr_bench_measure (lib/bench/measure.c). */
+int bench_measure(int argc, char **argv) {
+    static const char *cmd = "bench measure";
+    mr_cli_opt opts[] = {{"out", "DIR", "write bench_measure.csv and .svg there (default bench-out)", NULL},
+                         {NULL, NULL, NULL, NULL}};
+    mr_bench_measure_params p = {MR_BENCH_MEASURE_DEFAULTS};
+    mr_cli_table table = {"", mr_bench_measure_opts, &p, NULL, false, {0}};
+    bool help;
+    if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
+                             "usage: mrcheck bench measure [--out DIR] [--maps N] [--points N] [--quick]\n"
+                             "A measured point against known built deviations in synthetic halls: error, predicted\n"
+                             "sigma, 95 % coverage and verdicts against the tolerance.",
+                             &help))
+        return 2;
+    if (help) return 0;
+    if (mr_cli_get(opts, "out")) p.out_dir = mr_cli_get(opts, "out");
+    p.out = stdout;
+    p.progress = true;
+    mr_error err = {0};
+    return mr_bench_measure(&p, &err) ? 0 : mr_cli_error(cmd, &err);
+}

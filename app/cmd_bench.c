@@ -63,12 +63,13 @@ int cmd_bench(int argc, char **argv) {
     if (argc >= 3 && strcmp(argv[2], "shadows") == 0) return app_bench_shadows(argc, argv);
     if (argc >= 3 && strcmp(argv[2], "multiview") == 0) return bench_multiview(argc, argv);
     if (argc >= 3 && strcmp(argv[2], "map") == 0) return bench_map(argc, argv);
+    if (argc >= 3 && strcmp(argv[2], "measure") == 0) return bench_measure(argc, argv);
     if (argc >= 3 && strcmp(argv[2], "load") == 0) return bench_load(argc, argv);
     if (argc >= 3 && (strcmp(argv[2], "--help") == 0 || strcmp(argv[2], "-h") == 0)) {
-        printf("usage: mrcheck bench {frame,ao,ghost,tracking,map,scene,shadows,multiview,load} [options]   (mrcheck bench NAME --help)\n");
+        printf("usage: mrcheck bench {frame,ao,ghost,tracking,map,measure,scene,shadows,multiview,load} [options]   (mrcheck bench NAME --help)\n");
         return 0;
     }
-    fprintf(stderr, "mrcheck: bench: unknown or missing benchmark%s%s (available: frame, ao, ghost, tracking, map, scene, shadows, multiview, load)\n", argc >= 3 ? " " : "",
+    fprintf(stderr, "mrcheck: bench: unknown or missing benchmark%s%s (available: frame, ao, ghost, tracking, map, measure, scene, shadows, multiview, load)\n", argc >= 3 ? " " : "",
             argc >= 3 ? argv[2] : "");
     return 2;
 }

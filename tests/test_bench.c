@@ -373,6 +373,40 @@ static void test_load_runner(const char *tmp) {
     read_svg(path, "bench_load.svg");
 }
 
+/* bench measure at its smallest (the base row and the distances, one map,
+ * 2 points): the documented columns, a row each, and a map of the 30 x 20 m
+ * hall from 100 phone photos that is good to centimetres (a map whose
+ * initial photo poses dropped the far sightings was 0.7 m off). */
+static void test_measure_runner(const char *tmp) {
+    char out[4096], path[4096];
+    mr_path_join(tmp, "measure", out, sizeof out);
+    mr_bench_measure_params p = {MR_BENCH_MEASURE_DEFAULTS};
+    p.out_dir = out;
+    p.maps = 1;
+    p.points = 2;
+    p.quick = true;
+    mr_error err = {0};
+    CHECK_MSG(mr_bench_measure(&p, &err), "mr_bench_measure: %s", err.msg);
+    mr_path_join(out, "bench_measure.csv", path, sizeof path);
+    size_t n = 0;
+    const char *csv = slurp(path, &n);
+    const char *cols = "hall,tag_m,photos,map_res,track_res,dist_m,taps,samples,failed,map_err_rms_mm,map_sigma_med_mm,"
+                       "point_err_med_mm,dev_sigma_med_mm,point_sigma3d_med_mm,z_rms,coverage95,correct,undecided,wrong,"
+                       "correct_at_0,wrong_at_0,correct_at_50,wrong_at_50\n";
+    CHECK_MSG(csv && strncmp(csv, cols, strlen(cols)) == 0, "bench_measure.csv must start with the documented header");
+    CHECK(csv && count(csv, "\n") == 5 && count(csv, ",") == 22 * 5);
+    const char *row = csv ? strchr(csv, '\n') : NULL;
+    double map_mm = NAN;
+    if (row) {
+        const char *f = row + 1;
+        for (int k = 0; k < 9 && f; k++) f = strchr(f, ',') ? strchr(f, ',') + 1 : NULL;
+        if (f) map_mm = atof(f);
+    }
+    CHECK_MSG(map_mm < 20, "the 30 x 20 m hall's map is %.1f mm off (RMS)", map_mm);
+    mr_path_join(out, "bench_measure.svg", path, sizeof path);
+    read_svg(path, "bench_measure.svg");
+}
+
 int main(void) {
     const char *tmp = getenv("MR_TEST_TMP");
     char dir[4096];
@@ -387,6 +421,7 @@ int main(void) {
     test_plot(dir);
     test_runner(dir);
     test_map_runner(dir);
+    test_measure_runner(dir);
     test_load_runner(dir);
     return mr_test_finish("test_bench");
 }

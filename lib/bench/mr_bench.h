@@ -191,6 +191,37 @@ typedef struct mr_bench_map_params {
 bool mr_bench_map(const mr_bench_map_params *params, mr_error *err);
 extern const mr_opt mr_bench_map_opts[]; /* seeds, max-photos, noise, misdetect */
 
+/* bench measure (measure.c): what a measured point is worth to a verdict.
+ * Synthetic halls (30 x 20 m with 60 tags on 15 columns; the demo hall)
+ * with known tag poses; the marker map from `photos` random photos
+ * (projected corners, noise_px) with 4 control points (1 mm); feature
+ * points 0.3..3 m up with built deviations of 0, 5, 10, 20 and 50 mm
+ * along a horizontal normal, tapped in `taps` frames at `dist` metres on
+ * a 30 degree arc, each pose solved against the built map; the deviation
+ * triangulated with its predicted sigma. Per row (distance, photos, map
+ * and tracking resolution, tag size, taps): the map's error and sigma,
+ * the point's median error and sigma, the RMS of error/sigma (1 = honest),
+ * the 95 % (k = 2) interval's coverage and the verdict against
+ * +-tolerance_mm: correct, undecided, wrong (bench_measure.csv,
+ * bench_measure.svg: error and sigma against distance). */
+typedef struct mr_bench_measure_params {
+    const char *out_dir;    /* default "bench-out" */
+    int maps;               /* map seeds per row, default 2 */
+    int points;             /* feature points per map (x 5 deviations), default 20 */
+    double noise_px;        /* map photos' corner noise, default 0.3 px */
+    double track_noise_px;  /* tracked frames' corner noise, default 0.5 px */
+    double tap_px;          /* a tap's noise, default 1 px */
+    double tolerance_mm;    /* default 20 (DIN 18202, 6..15 m) */
+    bool quick;             /* the base row and the distances only */
+    bool progress;          /* a line per map on stderr */
+    FILE *out;              /* the table; NULL: silent */
+} mr_bench_measure_params;
+#define MR_BENCH_MEASURE_DEFAULTS \
+    .out_dir = "bench-out", .maps = 2, .points = 20, .noise_px = 0.3, .track_noise_px = 0.5, .tap_px = 1.0, \
+    .tolerance_mm = 20.0
+bool mr_bench_measure(const mr_bench_measure_params *params, mr_error *err);
+extern const mr_opt mr_bench_measure_opts[]; /* maps, points, noise, track-noise, tap-px, tolerance, quick */
+
 /* Bench load (load.c): the instanced factory
  * (mr_synth_build, `triangles` drawn) and the unique one (mr_synth_cad_build,
  * `unique_triangles`) as .glb and packed by gltfpack (default, -c, -cc);

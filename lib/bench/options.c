@@ -90,6 +90,19 @@ const mr_opt mr_bench_map_opts[] = {
 };
 #undef MP
 
+#define MS(f) offsetof(mr_bench_measure_params, f)
+const mr_opt mr_bench_measure_opts[] = {
+    {"maps", MR_OPT_INT, MS(maps), 1, 16, 2, NULL, "map seeds per row", 0},
+    {"points", MR_OPT_INT, MS(points), 1, 1000, 20, NULL, "feature points per map (each at 5 deviations)", 0},
+    {"noise", MR_OPT_DOUBLE, MS(noise_px), 0, 10, 0.3, NULL, "map photos' corner noise sigma, px", 0},
+    {"track-noise", MR_OPT_DOUBLE, MS(track_noise_px), 0, 10, 0.5, NULL, "tracked frames' corner noise sigma, px", 0},
+    {"tap-px", MR_OPT_DOUBLE, MS(tap_px), 0.01, 20, 1.0, NULL, "a tap's noise sigma, px", 0},
+    {"tolerance", MR_OPT_DOUBLE, MS(tolerance_mm), 1, 1000, 20, NULL, "the verdict's tolerance, +- mm", 0},
+    {"quick", MR_OPT_BOOL, MS(quick), 0, 1, 0, NULL, "the base row and the distances only", 0},
+    {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
+};
+#undef MS
+
 /* Bench load */
 #define LD(f) offsetof(mr_bench_load_params, f)
 const mr_opt mr_bench_load_opts[] = {
