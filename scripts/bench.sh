@@ -3,7 +3,7 @@
 # docs/bench/ (ao, ghost, tracking, scene, multiview, map), each stamped with
 # the commit it was made at and the exact command.
 #
-#   scripts/bench.sh [ao|ghost|tracking|scene|scene-unique|scene-instanced|multiview|map|shadows|load ...]
+#   scripts/bench.sh [ao|ghost|tracking|scene|scene-unique|scene-instanced|multiview|map|measure|shadows|load ...]
 #   (default: ao ghost tracking scene multiview map)
 #
 # Commit first, then run: the stamp names HEAD and says "dirty" when the
@@ -131,12 +131,17 @@ for b in "${benches[@]}"; do
         run bench_scene_instanced docs/bench/scene_instanced $mr bench scene --sizes 2M,10M,20M --frames 3 --full-detail-frames 1 --size 320x240 --out docs/bench/scene_instanced --quiet
         find docs/bench/scene_instanced -type f ! -name '*.csv' ! -name '*.md' ! -name '*.svg' ! -name '*.log' -delete
         find docs/bench/scene_instanced -mindepth 1 -type d -empty -delete ;;
+    measure)
+        # CPU only, about 2 minutes here: synthetic halls, projected
+        # corners with noise (no rendering), 2 map seeds x 20 points x 5
+        # deviations per row; not in the default list.
+        run bench_measure docs/bench/measure $mr bench measure --out docs/bench/measure ;;
     load)
         # issue 17 (lane gltf): first loads of the factories and their
         # gltfpack files, CPU only, about 60 s; not in the default list.
         run bench_load docs/bench/load $mr bench load --runs 45 --out docs/bench/load
         find docs/bench/load -type f -name '*.glb' -delete ;;
-    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, scene-unique, scene-instanced, multiview, map, shadows, load)" >&2; exit 2 ;;
+    *) echo "bench.sh: unknown bench '$b' (ao, ghost, tracking, scene, scene-unique, scene-instanced, multiview, map, measure, shadows, load)" >&2; exit 2 ;;
     esac
 done
 echo "bench.sh: wrote docs/bench/ at commit $commit ($dirty)" >&2
