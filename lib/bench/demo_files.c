@@ -3,6 +3,7 @@
  * camera and the views; then the synthetic camera frames of the hall as
  * built with the planned model over them. */
 #include "mr_bench.h"
+#include "mr_session.h"
 
 #include <string.h>
 
@@ -76,6 +77,10 @@ bool mr_demo_write_files(const char *dir, mr_view *views, int *discrepancy_count
         ok = mr_json_save(path, vj, err);
         cJSON_Delete(vj);
     }
+    /* The folder is a hall too: `mrcheck view DIR --replay recording`. */
+    const char *items[MR_HALL_ITEM_COUNT] = {[MR_HALL_SCENE] = "scene_planned.json", [MR_HALL_CAMERA] = "camera.json",
+                                             [MR_HALL_MARKERS] = "markers.json"};
+    ok = ok && mr_hall_write_manifest(dir, items, "mrcheck demo hall (as planned)", err);
     *discrepancy_count = cJSON_GetArraySize(hall.discrepancies);
     mr_demo_free(&hall);
     return ok;

@@ -565,6 +565,131 @@ void mr_verdict_format(const mr_verdict *v, char *buf, size_t n);
 cJSON *mr_verdict_to_json(const mr_verdict *v);
 bool mr_verdict_from_json(const cJSON *obj, mr_verdict *v, mr_error *err);
 
+/* ------------------------------------------------------------ the hall
+ * hall.c: one folder that holds what a check needs, named by a small
+ * manifest, HALL/hall.json (paths relative to the folder):
+ *
+ *   {"mrcheck_hall": 1,
+ *    "name": "Hall 3",                     (optional, for people)
+ *    "scene": "../plan/hall3.json",        the plan: glTF/GLB, IFC or a scene config
+ *    "camera": "camera.json",              the tablet camera (mrcheck calibrate)
+ *    "markers": "markers.json",            the marker map (mrcheck map)
+ *    "control": "control.json",            surveyed control points (optional)
+ *    "tolerances": "tolerances.json",      the tolerance table (optional;
+ *                                          absent: DIN 18202 Table 1)
+ *    "input": "/dev/video0",               the live camera (default /dev/video0)
+ *    "sessions": "sessions"}               recordings and marks, one folder each
+ *
+ * Adding a file checks it first (it must load as what it is named for). The
+ * small files (camera, markers, control, tolerances) are copied into the
+ * folder under those names, so the hall keeps its own calibration and map
+ * and a later calibration replaces them in place; the plan is referenced
+ * by a path relative to the folder (a plan is big, and a scene config
+ * points at further files beside it). Unknown keys are warned about with
+ * the nearest known key; keys starting with '_' are notes. */
+
+typedef enum mr_hall_item {
+    MR_HALL_SCENE = 0,
+    MR_HALL_CAMERA,
+    MR_HALL_MARKERS,
+    MR_HALL_CONTROL,
+    MR_HALL_TOLERANCES,
+    MR_HALL_ITEM_COUNT
+} mr_hall_item;
+/* The manifest keys (and command-line flags) of the items, by item:
+ * "scene", "camera", "markers", "control", "tolerances". */
+extern const char *const mr_hall_item_keys[MR_HALL_ITEM_COUNT];
+#define MR_HALL_MANIFEST "hall.json"
+#define MR_HALL_DEFAULT_INPUT "/dev/video0"
+#define MR_HALL_DEFAULT_SESSIONS "sessions"
+
+typedef struct mr_hall {
+    char dir[1024];                        /* the folder as given (relative to the working directory) */
+    char items[MR_HALL_ITEM_COUNT][1024];  /* as in the manifest (relative to dir, or absolute); "" not set */
+    char name[128];                        /* "" none */
+    char input[256];                       /* the live camera; "" none (MR_HALL_DEFAULT_INPUT applies) */
+    char sessions[1024];                   /* relative to dir; MR_HALL_DEFAULT_SESSIONS when not set */
+} mr_hall;
+
+/* True if dir holds a hall.json. */
+bool mr_hall_is(const char *dir);
+/* Reads dir/hall.json. false + err (one line naming the file) when it is
+ * missing, not JSON, or a known key has the wrong type. */
+bool mr_hall_load(const char *dir, mr_hall *h, mr_error *err);
+/* An item's file as a path from the working directory (dir joined with
+ * the manifest's path); false (out "") when the hall names none. */
+bool mr_hall_path(const mr_hall *h, mr_hall_item item, char *out, size_t n);
+/* The sessions folder from the working directory. */
+void mr_hall_sessions_dir(const mr_hall *h, char *out, size_t n);
+/* A session named on a command line: an existing path as given, else
+ * HALL/sessions/NAME, else HALL/NAME when either exists; else name as given
+ * (the command then says what is missing). */
+void mr_hall_session_resolve(const mr_hall *h, const char *name, char *out, size_t n);
+/* True if path lies inside the hall folder (after resolving links). */
+bool mr_hall_contains(const mr_hall *h, const char *path);
+/* A new session folder's path (not created): HALL/sessions/PREFIXYYYYmmdd-
+ * HHMMSS (local time of t_unix), with "-2", "-3", ... if taken. */
+void mr_hall_new_session(const mr_hall *h, const char *prefix, double t_unix, char *out, size_t n);
+
+/* Loads a plan to check it (the scene loader lives above lib/session). */
+typedef bool (*mr_hall_scene_check_fn)(void *user, const char *path, mr_error *err);
+/* What hall init / add set: each file given replaces the hall's. */
+typedef struct mr_hall_update {
+    const char *files[MR_HALL_ITEM_COUNT]; /* paths from the working directory; NULL: keep */
+    const char *input;                     /* NULL: keep */
+    const char *name;                      /* NULL: keep */
+    mr_hall_scene_check_fn check_scene;    /* required when a scene is given */
+    void *check_user;
+} mr_hall_update;
+#define MR_HALL_UPDATE_DEFAULTS {{NULL}, NULL, NULL, NULL, NULL}
+/* Checks path as the file of item (scene: through check). false + err
+ * naming the file and what is wrong. */
+bool mr_hall_check_file(mr_hall_item item, const char *path, mr_hall_scene_check_fn check, void *user, mr_error *err);
+/* hall init (create true: the folder may be new; a new hall needs a scene)
+ * and hall add (create false: dir must be a hall). Every given file is
+ * checked before anything is written; then the small files are copied in
+ * and hall.json is written (each atomically), keeping the manifest's
+ * other keys. *out (may be NULL) gets the hall as written. */
+bool mr_hall_update_files(const char *dir, const mr_hall_update *u, bool create, mr_hall *out, mr_error *err);
+/* Prints the hall, each file checked ("  camera      camera.json: ok" or
+ * what is wrong), the live input and the sessions folder, to out; returns
+ * the number of files that do not load. */
+int mr_hall_print(const mr_hall *h, mr_hall_scene_check_fn check, void *user, FILE *out);
+/* Writes a new hall.json for dir naming the given items' paths as they are
+ * (relative to dir, not checked, nothing copied): for programs that write
+ * a hall's files themselves (mrcheck demo). */
+bool mr_hall_write_manifest(const char *dir, const char *const items[MR_HALL_ITEM_COUNT], const char *name,
+                            mr_error *err);
+
+/* ------------------------------------------- a hall on any command line
+ * hall_args.c: `mrcheck CMD HALL ...` (HALL: the first argument, a folder
+ * with hall.json) or `mrcheck CMD ... --hall HALL` stands for the files the
+ * hall names: each flag of the command's row that was not given is added
+ * from the manifest, a session argument is looked up in the hall's
+ * sessions, and an output not given goes inside the hall. */
+typedef struct mr_hall_args {
+    int argc;
+    char **argv;                /* the command line to run (owned) */
+    bool have_hall;
+    mr_hall hall;
+    int update_item;            /* after a successful run: record this file
+                                   in the manifest (-1 none) */
+    char update_path[1024];
+    char *pool[24];             /* strings argv points at (owned) */
+    int pool_count;
+} mr_hall_args;
+/* Expands argv (argv[1] the command) into a; a command without a hall on
+ * its line is passed through unchanged. false + err on a bad hall (the
+ * caller prints one line). */
+bool mr_hall_args_expand(int argc, char **argv, mr_hall_args *a, mr_error *err);
+/* The help section of a command that takes a hall (NULL if it takes none). */
+const char *mr_hall_args_help(const char *cmd);
+/* Called with the command's exit status: records the file the command
+ * wrote into the hall (map, calibrate) when it succeeded. false + err if
+ * the manifest could not be written. */
+bool mr_hall_args_finish(mr_hall_args *a, int rc, mr_error *err);
+void mr_hall_args_free(mr_hall_args *a);
+
 #ifdef __cplusplus
 }
 #endif
