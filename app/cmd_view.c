@@ -72,6 +72,7 @@ int cmd_view(int argc, char **argv) {
         {"ui-scale", "S", "scale the UI beyond the screen's density (default 1)", NULL},
         {"paused", NULL, "replay: start paused", NULL},
         {"retrack", NULL, "replay: track the frames again instead of using the recorded poses", NULL},
+        {"tolerances", "T.json", "Measure's tolerance table (default: DIN 18202 Table 1 by nominal size)", NULL},
         {"script", "FILE", "timed input events (tests, demos): see lib/view/mr_view.h", NULL},
         {"stats", NULL, "show the frame rate and render passes in the status line; print the frame-time split on exit", NULL},
         {"ao", "METHOD", ao_help, NULL},
@@ -104,6 +105,7 @@ int cmd_view(int argc, char **argv) {
     p.retrack = mr_cli_flag(opts, "retrack");
     p.stats = mr_cli_flag(opts, "stats") ? stdout : NULL;
     p.ao_temporal = mr_cli_flag(opts, "ao-temporal");
+    p.tolerances_path = mr_cli_get(opts, "tolerances");
     p.nearest = (mr_view_nearest_fns){nearest_create, nearest_query, nearest_destroy, NULL};
     mr_view_source_params sp = {input, replay, mr_cli_get(opts, "camera"), mr_cli_get(opts, "markers"),
                                 mr_cli_get(opts, "view")};

@@ -825,9 +825,33 @@ static void test_measure(rig *r) {
     /* Finish: one MEASURE_DONE, then the distance comes back. */
     tap(r, MR_VW_MEASURE);
     CHECK(count(r, MR_VA_MEASURE_DONE, NULL) == 1 && !mr_viewer_measuring(r->v));
-    mr_viewer_measure_distance(r->v, mr_v3(0.0, 1.2, 5.0), 0.3, 0.004, "Machine_2");
+    /* Judged against DIN 18202 (no table): the planned point is 5.14 m
+     * from the origin, so +-16 mm; 12 +- 2*4 mm straddles it. */
+    mr_verdict vd;
+    mr_viewer_measure_distance(r->v, mr_v3(0.0, 1.2, 5.0), 0.012, 0.004, "Machine_2", "visible");
+    CHECK(mr_viewer_measure_verdict(r->v, &vd) && vd.kind == MR_VERDICT_UNDECIDED);
+    CHECK_MSG(strstr(state_str(r, "measure_message", msg, sizeof msg), "undecided") != NULL, "'%s'", msg);
+    mr_viewer_measure_distance(r->v, mr_v3(0.0, 1.2, 5.0), 0.003, 0.004, "Machine_2", "visible");
+    CHECK(mr_viewer_measure_verdict(r->v, &vd) && vd.kind == MR_VERDICT_WITHIN);
+    mr_viewer_measure_distance(r->v, mr_v3(0.0, 1.2, 5.0), 0.3, 0.004, "Machine_2", "visible");
     CHECK(mr_viewer_measurement(r->v, &m) && m.has_distance && m.distance_m == 0.3);
     CHECK_MSG(strstr(state_str(r, "measure_message", msg, sizeof msg), "300.0 mm +/- 4.0 mm") != NULL, "'%s'", msg);
+    CHECK(mr_viewer_measure_verdict(r->v, &vd) && vd.kind == MR_VERDICT_OUT);
+    CHECK_NEAR(vd.tol.limit_m, 0.016, 1e-12);
+    CHECK_NEAR(vd.lo_m, 0.292, 1e-9);
+    CHECK_NEAR(vd.hi_m, 0.308, 1e-9);
+    /* On screen, in words, with the interval and the tolerance; in the state. */
+    step(r);
+    CHECK_MSG(strstr(state_str(r, "verdict_banner", msg, sizeof msg), "OUT OF TOLERANCE Machine_2: 300 mm, 95 % 292..308 mm, "
+                                                                     "limit +/-16 mm (DIN 18202 Table 1, 3-6 m)") != NULL,
+              "banner '%s'", msg);
+    st = mr_viewer_state_json(r->v);
+    const cJSON *sv = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(st, "measure"), "verdict");
+    CHECK(cJSON_IsString(cJSON_GetObjectItemCaseSensitive(sv, "verdict")) &&
+          strcmp(cJSON_GetObjectItemCaseSensitive(sv, "verdict")->valuestring, "out") == 0);
+    CHECK(cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(st, "measure"), "taps_with_pose_covariance")
+              ->valueint == 3);
+    cJSON_Delete(st);
     /* The mark's fields, as the view appends them, read back. */
     mr_annotation a;
     memset(&a, 0, sizeof a);
@@ -837,6 +861,12 @@ static void test_measure(rig *r) {
     a.world_from_camera = r->f.world_from_camera;
     a.has_measurement = true;
     a.measurement = m;
+    a.has_verdict = true;
+    a.verdict = vd;
+    snprintf(a.category, sizeof a.category, "moved");
+    mr_mark_title(&a, a.title, sizeof a.title);
+    CHECK_MSG(strstr(a.title, "Moved: Machine_2, 0.30 m along ") == a.title && strstr(a.title, ", out of tolerance"),
+              "title '%s'", a.title);
     cJSON *line = mr_annotation_to_json(&a);
     char *text = line_of(line);
     mr_annotations back;
@@ -850,11 +880,22 @@ static void test_measure(rig *r) {
         CHECK_NEAR(b->distance_sigma_m, 0.004, 1e-12);
         CHECK_NEAR(b->tri.cov[4], m.tri.cov[4], 1e-15);
         CHECK(strcmp(b->planned_node, "Machine_2") == 0);
+        const mr_verdict *bv = &back.items[0].verdict;
+        CHECK(back.items[0].has_verdict && bv->kind == MR_VERDICT_OUT && strcmp(bv->tol.source, vd.tol.source) == 0);
+        CHECK_NEAR(bv->tol.limit_m, 0.016, 1e-12);
+        CHECK_NEAR(bv->hi_m, vd.hi_m, 1e-12);
     }
     mr_annotations_free(&back);
     free(text);
     /* A damaged measurement makes the line garbage, not a half mark. */
     cJSON_ReplaceItemInObject(line, "measured_sigma_m", cJSON_CreateString("x"));
+    text = line_of(line);
+    CHECK(text && mr_annotations_parse(text, strlen(text), &back, &err) && back.count == 0 && back.bad_lines == 1);
+    mr_annotations_free(&back);
+    free(text);
+    /* So does a damaged verdict. */
+    cJSON_ReplaceItemInObject(line, "measured_sigma_m", cJSON_CreateNumber(0.004));
+    cJSON_ReplaceItemInObject(cJSON_GetObjectItem(line, "verdict"), "verdict", cJSON_CreateString("fine"));
     text = line_of(line);
     CHECK(text && mr_annotations_parse(text, strlen(text), &back, &err) && back.count == 0 && back.bad_lines == 1);
     mr_annotations_free(&back);
@@ -1199,7 +1240,7 @@ static void test_mark_line_and_setup(void) {
     f.image.height = 48;
     mr_pick pick = {true, mr_v3(1, 2, 3), 3, 0, MR_LAYER_HIDDEN};
     mr_view_mark_words words = {"m1", 0, "pipe 2 @ann #hvac !high"};
-    cJSON *line = mr_view_mark_line(&f, &words, 10.5, 20.25, &pick, s, NULL);
+    cJSON *line = mr_view_mark_line(&f, &words, 10.5, 20.25, &pick, s, NULL, NULL);
     CHECK(line != NULL);
     if (line) {
         const cJSON *node = cJSON_GetObjectItem(line, "node"), *layer = cJSON_GetObjectItem(line, "layer");
@@ -1224,9 +1265,22 @@ static void test_mark_line_and_setup(void) {
     mr_measurement m;
     memset(&m, 0, sizeof m);
     m.tri.point = mr_v3(1, 2, 3);
+    m.has_distance = true;
+    m.distance_m = 0.3;
     mr_view_mark_words moved = {"m2", 2, NULL};
-    line = mr_view_mark_line(&f, &moved, 1, 2, &pick, s, &m);
+    mr_verdict vd;
+    mr_tolerance tol = {0.02, 5, "test"};
+    mr_error verr = {0};
+    CHECK(mr_verdict_judge(0.3, 0.01, &tol, &vd, &verr));
+    line = mr_view_mark_line(&f, &moved, 1, 2, &pick, s, &m, &vd);
     CHECK(line && cJSON_GetObjectItem(line, "measured_point"));
+    const cJSON *lv = line ? cJSON_GetObjectItem(line, "verdict") : NULL;
+    CHECK(lv && strcmp(cJSON_GetObjectItem(lv, "verdict")->valuestring, "out") == 0);
+    CHECK(line && strstr(cJSON_GetObjectItem(line, "title")->valuestring, "out of tolerance"));
+    cJSON_Delete(line);
+    /* A plain mark carries no verdict, even if one is given. */
+    line = mr_view_mark_line(&f, &moved, 1, 2, &pick, s, NULL, &vd);
+    CHECK(line && !cJSON_GetObjectItem(line, "verdict"));
     cJSON_Delete(line);
     mr_view_settings vs = MR_VIEW_SETTINGS_DEFAULTS;
     mr_camera cam = mr_demo_camera();

@@ -184,6 +184,7 @@ cJSON *mr_annotation_to_json(const mr_annotation *a) {
     if (a->has_uncertainty && isfinite(a->uncertainty_m) && a->uncertainty_m >= 0)
         cJSON_AddNumberToObject(line, "uncertainty_m", a->uncertainty_m);
     if (a->has_measurement) measurement_json(line, &a->measurement);
+    if (a->has_verdict) cJSON_AddItemToObject(line, "verdict", mr_verdict_to_json(&a->verdict));
     return line;
 }
 
@@ -277,6 +278,11 @@ static bool parse_annotation(const cJSON *o, mr_annotation *a) {
         if (!cJSON_IsNumber(u) || !isfinite(u->valuedouble) || u->valuedouble < 0) return false;
         a->has_uncertainty = true;
         a->uncertainty_m = u->valuedouble;
+    }
+    const cJSON *vd = cJSON_GetObjectItemCaseSensitive(o, "verdict");
+    if (vd && !cJSON_IsNull(vd)) {
+        if (!mr_verdict_from_json(vd, &a->verdict, NULL)) return false;
+        a->has_verdict = true;
     }
     return parse_measurement(o, a);
 }
@@ -435,8 +441,10 @@ void mr_mark_title(const mr_annotation *a, char *out, size_t n) {
     char len[32];
     words_len(m->distance_m, len, sizeof len);
     /* Under half a millimetre there is no direction to speak of. */
-    if (m->distance_m < 0.0005) snprintf(out + k, n - k, "%s%s", part[0] ? ", " : ": ", len);
-    else snprintf(out + k, n - k, "%s%s along %c%c", part[0] ? ", " : ": ", len, d[ax] < 0 ? '-' : '+', "xyz"[ax]);
+    if (m->distance_m < 0.0005) k += (size_t)snprintf(out + k, n - k, "%s%s", part[0] ? ", " : ": ", len);
+    else k += (size_t)snprintf(out + k, n - k, "%s%s along %c%c", part[0] ? ", " : ": ", len, d[ax] < 0 ? '-' : '+', "xyz"[ax]);
+    if (k < n && a->has_verdict && a->verdict.kind != MR_VERDICT_NONE)
+        snprintf(out + k, n - k, ", %s", mr_verdict_words(a->verdict.kind));
 }
 
 void mr_annotations_free(mr_annotations *a) {

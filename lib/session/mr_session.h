@@ -217,6 +217,85 @@ const mr_recording *mr_replay_recording(const mr_replay *r);
 bool mr_replay_meta_load(const char *dir, mr_camera *cam, bool have_cam, mr_marker_map *map, bool *have_map,
                          mr_error *err);
 
+/* ------------------------------------------------------------- verdicts
+ * verdict.c: a measured deviation judged against a tolerance.
+ *
+ * The tolerance is a limit deviation (±limit) that depends on the nominal
+ * size, the dimension the deviation belongs to. By default DIN 18202:2019
+ * Table 1, row 1 (dimensions in plan: lengths, widths, axis and grid
+ * dimensions):
+ *
+ *   nominal size   <= 1 m   1-3 m   3-6 m   6-15 m   15-30 m   > 30 m
+ *   limit          ±10 mm   ±12     ±16     ±20      ±24       ±30
+ *
+ * Each class includes its upper edge ("over 1 up to 3 m": 3.000 m is
+ * ±12 mm, 3.001 m ±16 mm). Under 1 m the standard (since its 2013 edition)
+ * gives ±10 mm in row 1; that is what applies to a nominal size of 0 to 1 m.
+ * For the position of a part, DIN 18202 (4.6) measures the deviation
+ * against a reference point, and the nominal size is the distance between
+ * the planned point and that reference (mr_tolerances.reference, default
+ * the world origin, i.e. the marker map's).
+ *
+ * A hall may replace the default by its own table (hall.json "tolerances",
+ * or a file it names):
+ *   {"default_mm": 20,                      (optional; absent: DIN 18202)
+ *    "layers": {"hidden": 30},              (layer name -> ±mm)
+ *    "parts": {"Machine_*": 5, "Column_3": 10},   (node-name glob -> ±mm)
+ *    "reference": [x, y, z]}                (optional, scene units)
+ * A part rule wins over a layer rule, which wins over default_mm; the first
+ * matching part glob in file order applies.
+ *
+ * The verdict uses the measurement's 95 % interval, deviation ± k·sigma
+ * with k = 2 (sigma the 1-sigma of the deviation, the registration's
+ * uncertainty included, as mr_triangulate gives it):
+ *   within            |deviation| + k·sigma <= limit
+ *   out of tolerance  |deviation| - k·sigma >  limit
+ *   undecided         otherwise: the interval straddles the limit (measure
+ *                     again, closer or from a wider baseline).
+ * Deviations are in scene units taken as metres. */
+
+#define MR_VERDICT_K 2.0             /* coverage factor of the 95 % interval */
+#define MR_TOLERANCE_RULES_MAX 64
+
+typedef enum mr_verdict_kind {
+    MR_VERDICT_NONE = 0,             /* not judged */
+    MR_VERDICT_WITHIN,
+    MR_VERDICT_OUT,
+    MR_VERDICT_UNDECIDED,
+} mr_verdict_kind;
+
+typedef struct mr_tolerance_rule {
+    char pattern[96];                /* node-name glob ("parts") or layer name */
+    double limit_m;                  /* ± limit, metres (> 0) */
+} mr_tolerance_rule;
+
+typedef struct mr_tolerances {
+    double default_m;                /* hall-wide ± limit; 0: DIN 18202 Table 1 */
+    mr_tolerance_rule parts[MR_TOLERANCE_RULES_MAX];
+    int part_count;
+    mr_tolerance_rule layers[MR_TOLERANCE_RULES_MAX];
+    int layer_count;
+    double reference[3];             /* the nominal size's reference point */
+} mr_tolerances;
+#define MR_TOLERANCES_DEFAULTS {0}
+
+/* The tolerance that applies to one deviation. */
+typedef struct mr_tolerance {
+    double limit_m;                  /* ± limit, metres */
+    double nominal_m;                /* the nominal size it was looked up for */
+    char source[96];                 /* "DIN 18202 Table 1, 6-15 m", "part Machine_*", ... */
+} mr_tolerance;
+
+typedef struct mr_verdict {
+    mr_verdict_kind kind;
+    double deviation_m;              /* as measured (a distance: >= 0) */
+    double sigma_m;                  /* its 1-sigma */
+    double k;                        /* coverage factor (MR_VERDICT_K) */
+    double lo_m, hi_m;               /* the 95 % interval, deviation ± k·sigma;
+                                        for a deviation >= 0 (a distance) lo_m >= 0 */
+    mr_tolerance tol;
+} mr_verdict;
+
 /* ------------------------------------------------------------ annotations */
 
 /* Appends obj as one line to path durably: O_APPEND and one write (the line
@@ -268,6 +347,8 @@ typedef struct mr_annotation {
                                        scene units taken as metres) */
     bool has_measurement;           /* "measured_point" present */
     mr_measurement measurement;     /* the view's Measure (measured_* fields) */
+    bool has_verdict;               /* "verdict" present: the measured distance judged */
+    mr_verdict verdict;             /* against the tolerance (mr_verdict_to_json) */
     cJSON *json;                    /* the whole line (owned); NULL for one
                                        not read from a file */
 } mr_annotation;
@@ -284,7 +365,8 @@ typedef struct mr_annotation {
  * (9, row-major), measured_point_sigma_m, measured_angle_deg,
  * measured_rms_px, measured_frames [..], measured_pixels [[u,v]..] and,
  * when it has a distance, measured_distance_m, measured_sigma_m (the
- * distance's 1-sigma), measured_planned [x,y,z], measured_planned_node.
+ * distance's 1-sigma), measured_planned [x,y,z], measured_planned_node,
+ * and with has_verdict "verdict" (mr_verdict_to_json's object).
  * The caller may add fields (the
  * view adds "snapshot") before mr_annotation_append. NULL when out of
  * memory. */
@@ -293,8 +375,10 @@ cJSON *mr_annotation_to_json(const mr_annotation *a);
 /* The title of a mark in words, from its category, its part and (where
  * measured) its distance to the plan and the direction of the largest
  * component of that offset in scene axes: "Moved: Machine_2, 0.30 m
- * along +x", "Missing: Column_3", "Other" without a part; a mark with a
- * note but no category (written by another program) is titled by its note. */
+ * along +x", "Missing: Column_3", "Other" without a part; a judged
+ * measurement adds the verdict ("..., 0.30 m along +x, out of tolerance");
+ * a mark with a note but no category (written by another program) is
+ * titled by its note. */
 void mr_mark_title(const mr_annotation *a, char *out, size_t n);
 /* The note as typed in the view, with its optional fields written inline:
  * "@name" the assignee, "#word" a label (up to MR_MARK_MAX_LABELS), "!word"
@@ -315,7 +399,8 @@ typedef struct mr_annotations {
  * counted and skipped; a line is garbage if it is not a JSON object with a
  * non-empty string "type", or if a present field has the wrong shape (non-finite
  * numbers, pixel not [x,y], world not [x,y,z] or null, a non-rigid pose,
- * uncertainty_m not a number >= 0, measured_* fields of the wrong shape).
+ * uncertainty_m not a number >= 0, measured_* fields of the wrong shape,
+ * a verdict mr_verdict_from_json refuses).
  * Fails only when out of memory. mr_annotations_load: a missing file is
  * zero annotations. */
 bool mr_annotations_parse(const char *text, size_t size, mr_annotations *out, mr_error *err);
@@ -448,84 +533,9 @@ void mr_annotation_from_frame(mr_annotation *m, const mr_capture_frame *f, const
 bool mr_mark_save(const char *session_dir, const char *stem, cJSON *line, const mr_snapshot *sn, bool *snapshot_ok,
                   mr_error *snapshot_err, mr_error *err);
 
-/* ------------------------------------------------------------- verdicts
- * verdict.c: a measured deviation judged against a tolerance.
- *
- * The tolerance is a limit deviation (±limit) that depends on the nominal
- * size, the dimension the deviation belongs to. By default DIN 18202:2019
- * Table 1, row 1 (dimensions in plan: lengths, widths, axis and grid
- * dimensions):
- *
- *   nominal size   <= 1 m   1-3 m   3-6 m   6-15 m   15-30 m   > 30 m
- *   limit          ±10 mm   ±12     ±16     ±20      ±24       ±30
- *
- * Each class includes its upper edge ("over 1 up to 3 m": 3.000 m is
- * ±12 mm, 3.001 m ±16 mm). Under 1 m the standard (since its 2013 edition)
- * gives ±10 mm in row 1; that is what applies to a nominal size of 0 to 1 m.
- * For the position of a part, DIN 18202 (4.6) measures the deviation
- * against a reference point, and the nominal size is the distance between
- * the planned point and that reference (mr_tolerances.reference, default
- * the world origin, i.e. the marker map's).
- *
- * A hall may replace the default by its own table (hall.json "tolerances",
- * or a file it names):
- *   {"default_mm": 20,                      (optional; absent: DIN 18202)
- *    "layers": {"hidden": 30},              (layer name -> ±mm)
- *    "parts": {"Machine_*": 5, "Column_3": 10},   (node-name glob -> ±mm)
- *    "reference": [x, y, z]}                (optional, scene units)
- * A part rule wins over a layer rule, which wins over default_mm; the first
- * matching part glob in file order applies.
- *
- * The verdict uses the measurement's 95 % interval, deviation ± k·sigma
- * with k = 2 (sigma the 1-sigma of the deviation, the registration's
- * uncertainty included, as mr_triangulate gives it):
- *   within            |deviation| + k·sigma <= limit
- *   out of tolerance  |deviation| - k·sigma >  limit
- *   undecided         otherwise: the interval straddles the limit (measure
- *                     again, closer or from a wider baseline).
- * Deviations are in scene units taken as metres. */
-
-#define MR_VERDICT_K 2.0             /* coverage factor of the 95 % interval */
-#define MR_TOLERANCE_RULES_MAX 64
-
-typedef enum mr_verdict_kind {
-    MR_VERDICT_NONE = 0,             /* not judged */
-    MR_VERDICT_WITHIN,
-    MR_VERDICT_OUT,
-    MR_VERDICT_UNDECIDED,
-} mr_verdict_kind;
-
-typedef struct mr_tolerance_rule {
-    char pattern[96];                /* node-name glob ("parts") or layer name */
-    double limit_m;                  /* ± limit, metres (> 0) */
-} mr_tolerance_rule;
-
-typedef struct mr_tolerances {
-    double default_m;                /* hall-wide ± limit; 0: DIN 18202 Table 1 */
-    mr_tolerance_rule parts[MR_TOLERANCE_RULES_MAX];
-    int part_count;
-    mr_tolerance_rule layers[MR_TOLERANCE_RULES_MAX];
-    int layer_count;
-    double reference[3];             /* the nominal size's reference point */
-} mr_tolerances;
-#define MR_TOLERANCES_DEFAULTS {0}
-
-/* The tolerance that applies to one deviation. */
-typedef struct mr_tolerance {
-    double limit_m;                  /* ± limit, metres */
-    double nominal_m;                /* the nominal size it was looked up for */
-    char source[96];                 /* "DIN 18202 Table 1, 6-15 m", "part Machine_*", ... */
-} mr_tolerance;
-
-typedef struct mr_verdict {
-    mr_verdict_kind kind;
-    double deviation_m;              /* as measured (a distance: >= 0) */
-    double sigma_m;                  /* its 1-sigma */
-    double k;                        /* coverage factor (MR_VERDICT_K) */
-    double lo_m, hi_m;               /* the 95 % interval, deviation ± k·sigma;
-                                        for a deviation >= 0 (a distance) lo_m >= 0 */
-    mr_tolerance tol;
-} mr_verdict;
+/* ------------------------------------------------- verdicts (verdict.c)
+ * The rule and the types are above, before the annotations that carry a
+ * verdict. */
 
 /* DIN 18202 Table 1 row 1's limit for a nominal size (metres, >= 0; a
  * negative or non-finite size gives NAN); *cls (may be NULL) gets the

@@ -439,6 +439,7 @@ static void reset_settings(mr_viewer *v, mr_view_actions *out) {
 }
 
 static void mark_at(mr_viewer *v, double x, double y, mr_view_actions *out) {
+    v->verdict_note = false; /* a plain mark: not the measurement's */
     mr_view_action *a = vw_emit(out, MR_VA_MARK_AT);
     a->x = x;
     a->y = y;
@@ -448,6 +449,8 @@ static void mark_at(mr_viewer *v, double x, double y, mr_view_actions *out) {
  * being edited. The note goes with it, as typed. */
 static void finish_mark(mr_viewer *v, int category, bool close, mr_view_actions *out) {
     v->note_open = false;
+    if (v->verdict_note) v->verdict_until = v->now + 6.0; /* the verdict stays a moment longer */
+    v->verdict_note = false;
     v->mark_mode = false;
     v->text_focus = false;
     mr_view_action *a;
@@ -722,8 +725,8 @@ static void messages(mr_viewer *v, const mr_viewer_frame *f) {
     mr_ui *ui = v->ui;
     float g = mr_ui_mm(ui, 1.2f), th = mr_ui_text_px(ui);
     mr_ui_rect area = v->lay.picture;
-    const char *banners[6];
-    uint32_t colors[6];
+    const char *banners[8];
+    uint32_t colors[8];
     char measure_banner[160];
     int nb = 0;
     if (f->source_msg && f->source_msg[0]) { banners[nb] = f->source_msg; colors[nb++] = MR_UI_RGBA(200, 40, 40, 230); }
@@ -747,6 +750,13 @@ static void messages(mr_viewer *v, const mr_viewer_frame *f) {
         vw_measure_banner(v, measure_banner, sizeof measure_banner);
         banners[nb] = measure_banner;
         colors[nb++] = MR_UI_RGBA(30, 120, 190, 230);
+    }
+    /* A measurement's verdict: while its mark is filed, and a while after. */
+    if (v->verdict_banner[0] && (v->now < v->verdict_until || (v->note_open && v->verdict_note))) {
+        banners[nb] = v->verdict_banner;
+        colors[nb++] = v->verdict_kind == MR_VERDICT_WITHIN ? MR_UI_RGBA(30, 130, 50, 235)
+                       : v->verdict_kind == MR_VERDICT_OUT  ? MR_UI_RGBA(190, 30, 30, 235)
+                                                            : MR_UI_RGBA(200, 125, 10, 235);
     }
     for (int i = 0; i < nb; i++) {
         mr_ui_rect b = mr_ui_rect_inset(mr_ui_cut_top(&area, th * 2.0f), g * 0.5f);
@@ -883,7 +893,11 @@ static void pins(mr_viewer *v, const mr_viewer_frame *f) {
         p->y = ir.y + (float)((w + 0.5) * ir.h / pin_cam.height);
         p->shown = mr_ui_rect_contains(ir, p->x, p->y);
         if (!p->shown) continue;
-        uint32_t col = p->p.closed ? MR_UI_RGBA(150, 150, 150, 235) : MR_UI_RGBA(220, 40, 40, 240);
+        /* Grey once closed; a measured mark in its verdict's colour. */
+        uint32_t col = p->p.closed                              ? MR_UI_RGBA(150, 150, 150, 235)
+                       : p->p.verdict == MR_VERDICT_WITHIN    ? MR_UI_RGBA(40, 150, 60, 240)
+                       : p->p.verdict == MR_VERDICT_UNDECIDED ? MR_UI_RGBA(215, 140, 20, 240)
+                                                              : MR_UI_RGBA(220, 40, 40, 240);
         /* A head with the number above a stem whose tip is the point. */
         mr_ui_rect head = mr_ui_rect_make(p->x - s, p->y - 3.2f * s, 2 * s, 2 * s);
         mr_ui_draw_rect(mr_ui_list(ui), mr_ui_rect_make(p->x - t / 2, p->y - 1.2f * s, t, 1.2f * s), col);
@@ -980,12 +994,16 @@ cJSON *mr_viewer_state_json(const mr_viewer *v) {
     cJSON_AddStringToObject(j, "note_text", v->note_text);
     cJSON_AddBoolToObject(j, "note_typing", v->text_focus);
     cJSON_AddStringToObject(j, "notice", v->now < v->notice_until ? v->notice : "");
+    bool verdict_shown = v->verdict_banner[0] && (v->now < v->verdict_until || (v->note_open && v->verdict_note));
+    cJSON_AddStringToObject(j, "verdict_banner", verdict_shown ? v->verdict_banner : "");
     cJSON *pj = cJSON_AddArrayToObject(j, "pins");
     for (int i = 0; i < v->pin_count; i++) {
         cJSON *o = cJSON_CreateObject();
         cJSON_AddNumberToObject(o, "number", v->pins[i].p.number);
         cJSON_AddBoolToObject(o, "shown", v->pins[i].shown);
         cJSON_AddBoolToObject(o, "closed", v->pins[i].p.closed);
+        cJSON_AddStringToObject(o, "verdict", mr_verdict_key(v->pins[i].p.verdict));
+        cJSON_AddStringToObject(o, "title", v->pins[i].p.title);
         if (v->pins[i].shown) {
             double xy[2] = {v->pins[i].x, v->pins[i].y};
             cJSON_AddItemToObject(o, "xy", mr_json_from_doubles(xy, 2));

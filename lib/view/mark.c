@@ -111,7 +111,8 @@ void mr_view_render_setup(const mr_view_settings *s, const mr_camera *cam, const
 }
 
 cJSON *mr_view_mark_line(const mr_capture_frame *f, const mr_view_mark_words *w, double px, double py,
-                         const mr_pick *pick, const mr_scene *scene, const mr_measurement *measured) {
+                         const mr_pick *pick, const mr_scene *scene, const mr_measurement *measured,
+                         const mr_verdict *verdict) {
     mr_annotation m;
     bool cat = w->category >= 0 && w->category < MR_MARK_CATEGORY_COUNT;
     mr_annotation_from_frame(&m, f, cat ? mr_mark_categories[w->category] : "", (double)time(NULL));
@@ -138,6 +139,8 @@ cJSON *mr_view_mark_line(const mr_capture_frame *f, const mr_view_mark_words *w,
     m.has_uncertainty = mr_view_sigma_here(&sf, &m.uncertainty_m);
     m.has_measurement = measured != NULL; /* a mark made by Measure */
     if (measured) m.measurement = *measured;
+    m.has_verdict = measured && verdict && verdict->kind != MR_VERDICT_NONE;
+    if (m.has_verdict) m.verdict = *verdict;
     mr_mark_title(&m, m.title, sizeof m.title);
     return mr_annotation_to_json(&m);
 }

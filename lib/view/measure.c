@@ -36,7 +36,8 @@ void vw_measure_toggle(mr_viewer *v, mr_view_actions *out) {
         v->measure_mode = true;
         v->mark_mode = false;
         v->measure_have = true;
-        v->measure_solved = false;
+        v->measure_solved = v->measure_judged = v->verdict_note = false;
+        v->verdict_banner[0] = 0;
         memset(&v->measure, 0, sizeof v->measure);
         v->measure_msg[0] = 0;
         return;
@@ -110,7 +111,8 @@ void vw_measure_tap(mr_viewer *v, const mr_viewer_frame *f, float x, float y) {
     solve(v, f->camera);
 }
 
-void mr_viewer_measure_distance(mr_viewer *v, mr_dvec3 planned, double dist_m, double sigma_m, const char *node) {
+void mr_viewer_measure_distance(mr_viewer *v, mr_dvec3 planned, double dist_m, double sigma_m, const char *node,
+                                const char *layer) {
     if (!v->measure_have || !v->measure_solved) return;
     mr_measurement *m = &v->measure;
     m->has_distance = isfinite(dist_m) && isfinite(sigma_m);
@@ -118,9 +120,42 @@ void mr_viewer_measure_distance(mr_viewer *v, mr_dvec3 planned, double dist_m, d
     m->distance_sigma_m = sigma_m;
     m->planned = planned;
     snprintf(m->planned_node, sizeof m->planned_node, "%s", node ? node : "");
-    if (m->has_distance)
-        say(v, "measured: %.1f mm +/- %.1f mm from the plan%s%s", dist_m * 1e3, sigma_m * 1e3,
-                        m->planned_node[0] ? " at " : "", m->planned_node);
+    v->measure_judged = false;
+    if (!m->has_distance) return;
+    /* The verdict: the distance's 95 % interval (its sigma carries the taps'
+     * noise and each frame's pose covariance) against the tolerance of the
+     * part, its layer or its nominal size. */
+    double p[3] = {planned.x, planned.y, planned.z};
+    mr_error err = {0};
+    v->measure_judged = mr_verdict_measure(v->p.tolerances, node, layer, p, -1, dist_m, sigma_m, &v->measure_verdict, &err);
+    if (!v->measure_judged) {
+        say(v, "measured: %.1f mm +/- %.1f mm from the plan%s%s (no verdict: %s)", dist_m * 1e3, sigma_m * 1e3,
+            m->planned_node[0] ? " at " : "", m->planned_node, err.msg);
+        return;
+    }
+    const mr_verdict *vd = &v->measure_verdict;
+    say(v, "measured: %.1f mm +/- %.1f mm from the plan%s%s: %s", dist_m * 1e3, sigma_m * 1e3,
+        m->planned_node[0] ? " at " : "", m->planned_node, mr_verdict_words(vd->kind));
+    /* The result stays on screen while the mark is filed, in the
+     * verdict's colour: the numbers a planner acts on. */
+    vw_verdict_words(vd, m->planned_node, v->verdict_banner, sizeof v->verdict_banner);
+    v->verdict_kind = vd->kind;
+    v->verdict_until = v->now + 6.0;
+    v->verdict_note = true; /* the mark's chooser opens next */
+}
+
+void vw_verdict_words(const mr_verdict *vd, const char *part, char *buf, size_t n) {
+    snprintf(buf, n, "%s%s%s: %.0f mm, 95 %% %.0f..%.0f mm, limit +/-%.0f mm (%s)%s",
+             vd->kind == MR_VERDICT_OUT ? "OUT OF TOLERANCE" : vd->kind == MR_VERDICT_WITHIN ? "WITHIN TOLERANCE" : "UNDECIDED",
+             part && part[0] ? " " : "", part ? part : "", vd->deviation_m * 1e3, vd->lo_m * 1e3, vd->hi_m * 1e3,
+             vd->tol.limit_m * 1e3, vd->tol.source,
+             vd->kind == MR_VERDICT_UNDECIDED ? ": measure again, closer or from a wider baseline" : "");
+}
+
+bool mr_viewer_measure_verdict(const mr_viewer *v, mr_verdict *out) {
+    if (!v->measure_have || !v->measure_judged) return false;
+    if (out) *out = v->measure_verdict;
+    return true;
 }
 
 void vw_measure_draw(mr_viewer *v, const mr_viewer_frame *f) {
@@ -167,4 +202,10 @@ void vw_measure_state_json(const mr_viewer *v, cJSON *j) {
         cJSON_AddNumberToObject(o, "distance_mm", m->distance_m * 1e3);
         cJSON_AddNumberToObject(o, "distance_sigma_mm", m->distance_sigma_m * 1e3);
     }
+    /* How many taps carried their frame's pose covariance: the
+     * registration's share of the sigma (0: only the taps' noise). */
+    int with_cov = 0;
+    for (int i = 0; i < m->taps; i++) with_cov += v->measure_has_cov[i];
+    cJSON_AddNumberToObject(o, "taps_with_pose_covariance", with_cov);
+    if (v->measure_judged) cJSON_AddItemToObject(o, "verdict", mr_verdict_to_json(&v->measure_verdict));
 }

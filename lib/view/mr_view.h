@@ -215,8 +215,9 @@ typedef struct mr_viewer_params {
     double save_delay_s;       /* settings are saved this long after a change; 0 = 1 s */
     double script_wait_s;      /* a script starts with the first picture, or after this; 0 = 3 s */
     bool show_stats;           /* the status line adds the render passes and the frame rate (--stats) */
+    const mr_tolerances *tolerances; /* Measure's verdicts (borrowed); NULL: DIN 18202 Table 1 */
 } mr_viewer_params;
-#define MR_VIEWER_DEFAULTS {0.0, NULL, NULL, 0.0, 0.0, 0.0, false}
+#define MR_VIEWER_DEFAULTS {0.0, NULL, NULL, 0.0, 0.0, 0.0, false, NULL}
 
 /* Plain data about what the window shows, given each frame. */
 typedef struct mr_viewer_frame {
@@ -301,6 +302,8 @@ typedef struct mr_view_pin {
     int number;                /* shown on the pin */
     bool closed;
     int category;              /* index into mr_mark_categories, -1 none */
+    mr_verdict_kind verdict;   /* a measured mark's verdict: the pin's colour
+                                  (within green, undecided amber, out red) */
     char note[512];            /* as the editor shows it (with @ # ! fields) */
     char title[200];
 } mr_view_pin;
@@ -349,9 +352,16 @@ bool mr_viewer_measuring(const mr_viewer *v);
  * covariance, and the distance once given); false when there is none. */
 bool mr_viewer_measurement(const mr_viewer *v, mr_measurement *out);
 /* The answer to MR_VA_MEASURE_DONE: the distance (scene units taken as
- * metres) and its 1-sigma to `planned` (on node `node`, may be NULL),
- * shown to the planner and kept in the measurement. */
-void mr_viewer_measure_distance(mr_viewer *v, mr_dvec3 planned, double dist_m, double sigma_m, const char *node);
+ * metres) and its 1-sigma to `planned` (on node `node` of layer `layer`
+ * ("visible" / "hidden"), either may be NULL), kept in the measurement and
+ * judged (mr_verdict_measure with the params' tolerances: the part's, the
+ * layer's, else by the planned point's nominal size); the verdict, the
+ * interval and the tolerance stay on screen in the verdict's colour while
+ * the mark is filed. */
+void mr_viewer_measure_distance(mr_viewer *v, mr_dvec3 planned, double dist_m, double sigma_m, const char *node,
+                                const char *layer);
+/* The last measurement's verdict; false when it has none (no distance yet). */
+bool mr_viewer_measure_verdict(const mr_viewer *v, mr_verdict *out);
 
 /* ----------------------------------------- marking and rendering (mark.c) */
 
@@ -417,9 +427,11 @@ typedef struct mr_view_mark_words {
 /* The annotation line (lib/session's format) of a mark made on frame f:
  * its id, category, note and generated title, the tapped camera pixel, what was picked there (its node's name
  * and layer from scene), the registration's sigma at the picked point, and
- * the measurement of a Measure mark (NULL for a plain mark). */
+ * the measurement of a Measure mark and its verdict (NULL for a plain
+ * mark, or a measurement without one). */
 cJSON *mr_view_mark_line(const mr_capture_frame *f, const mr_view_mark_words *w, double px, double py,
-                         const mr_pick *pick, const mr_scene *scene, const mr_measurement *measured);
+                         const mr_pick *pick, const mr_scene *scene, const mr_measurement *measured,
+                         const mr_verdict *verdict);
 
 /* The capture frame's part of what the controller is told each frame
  * (pose, its covariance, tracking counts, the picture's undistorted camera
@@ -550,6 +562,8 @@ typedef struct mr_view_run_params {
     mr_view_script **script;   /* handed to the controller (*script NULLed) once it exists; NULL: none */
     FILE *stats;               /* the frame-time split is printed here on exit; NULL: not */
     mr_view_nearest_fns nearest; /* Measure's planned surface; zero: none */
+    const char *tolerances_path; /* Measure's tolerance table (--tolerances, the hall's); NULL: DIN 18202
+                                    Table 1. One that does not load ends the run before the window opens */
     double start_time;         /* mr_time_now() when the command started (the stats' wall clock); 0 = now */
 } mr_view_run_params;
 #define MR_VIEW_RUN_DEFAULT_WIDTH 960

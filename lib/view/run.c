@@ -85,6 +85,7 @@ typedef struct view_app {
     const mr_view_source *src;
     double ui_scale;
     mr_view_nearest_fns nearest_fns;
+    mr_tolerances *tolerances;  /* Measure's verdicts; NULL: DIN 18202 */
     /* window, drawing, the controller */
     mr_window *win;
     mr_renderer *rend;
@@ -140,6 +141,8 @@ typedef struct view_app {
     void *nearest;
     bool mark_measured;
     mr_measurement mark_measure;
+    bool mark_judged;                      /* the measurement has a verdict */
+    mr_verdict mark_verdict;
     /* Temporal AO (--ao-temporal); a frame after one without a valid pose restarts it */
     bool ao_temporal, ao_had_pose;
     /* stats */
@@ -208,6 +211,7 @@ static void reload_marks(view_app *a) {
         pin.world = w ? mr_v3(w[0], w[1], w[2]) : m->measurement.tri.point;
         pin.closed = strcmp(m->status, "closed") == 0;
         pin.category = -1;
+        pin.verdict = m->has_verdict ? m->verdict.kind : MR_VERDICT_NONE;
         for (int k = 0; k < MR_MARK_CATEGORY_COUNT; k++)
             if (strcmp(m->category, mr_mark_categories[k]) == 0) pin.category = k;
         /* The editor shows the note with its fields written inline. */
@@ -280,7 +284,8 @@ static void finish_mark(view_app *a, int note, const char *typed) {
     mr_mark_new_id((double)time(NULL), a->mark_count, id, sizeof id);
     mr_view_mark_words w = {id, note, typed};
     cJSON *line = mr_view_mark_line(&a->mark_frame, &w, a->mark_px, a->mark_py, &a->mark_pick, a->scene,
-                                    a->mark_measured ? &a->mark_measure : NULL);
+                                    a->mark_measured ? &a->mark_measure : NULL,
+                                    a->mark_measured && a->mark_judged ? &a->mark_verdict : NULL);
     mr_snapshot sn = snapshot_of(a, &a->mark_screen, &a->mark_frame);
     bool ok;
     mr_error aerr = {0};
@@ -310,14 +315,18 @@ static void measure_done(view_app *a) {
     mr_view_nearest_hit h = {0};
     const mr_view_nearest_fns *nf = &a->nearest_fns;
     if (a->scene && !a->nearest && nf->create) a->nearest = nf->create(nf->user, a->scene, &err);
-    if (a->nearest && nf->query(nf->user, a->nearest, m.tri.point, m.tri.cov, &h))
-        mr_viewer_measure_distance(a->vc, h.point, h.distance, h.sigma, h.node >= 0 ? a->scene->nodes[h.node].name : NULL);
+    if (a->nearest && nf->query(nf->user, a->nearest, m.tri.point, m.tri.cov, &h)) {
+        const mr_node *n = h.node >= 0 ? &a->scene->nodes[h.node] : NULL;
+        mr_viewer_measure_distance(a->vc, h.point, h.distance, h.sigma, n ? n->name : NULL,
+                                   n ? (n->layer == MR_LAYER_HIDDEN ? "hidden" : "visible") : NULL);
+    }
     else
         mr_viewer_toast(a->vc, "measured point +/- %.1f mm; no planned surface to measure it against%s%s",
                         m.tri.sigma * 1e3, err.msg[0] ? ": " : "", err.msg);
     if (!a->have_frame) return;
     mr_viewer_measurement(a->vc, &a->mark_measure);
-    a->mark_measured = true; /* the mark opened below carries it */
+    a->mark_judged = mr_viewer_measure_verdict(a->vc, &a->mark_verdict);
+    a->mark_measured = true; /* the mark opened below carries it and its verdict */
     mr_view_planned planned = {h.found, h.point, h.node, 0};
     if (h.found && h.node >= 0) planned.layer = a->scene->nodes[h.node].layer;
     mr_view_mark_at at;
@@ -699,6 +708,7 @@ static bool open_window(view_app *a, const mr_view_run_params *p, mr_error *err)
     vp.config_path = config;
     vp.now = a->t_start;
     vp.show_stats = p->stats != NULL;
+    vp.tolerances = a->tolerances;
     a->vc = mr_viewer_create(&vp, err);
     if (!a->vc) return false;
     /* Flags win over the saved settings for this run. */
@@ -763,7 +773,13 @@ bool mr_view_run(const mr_view_run_params *p, mr_error *err) {
     else if (a->src->replay_dir) snprintf(a->session_dir, sizeof a->session_dir, "%s", a->src->replay_dir);
     else snprintf(a->session_dir, sizeof a->session_dir, "mrcheck-session");
 
-    bool ok = start_scene_load(a, p->scene_path, err) && open_window(a, p, err) && start_capture(a, p, err);
+    bool ok = true;
+    if (p->tolerances_path) {
+        ok = (a->tolerances = malloc(sizeof *a->tolerances)) != NULL;
+        if (!ok) mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        ok = ok && mr_tolerances_load(p->tolerances_path, a->tolerances, err);
+    }
+    ok = ok && start_scene_load(a, p->scene_path, err) && open_window(a, p, err) && start_capture(a, p, err);
     if (ok) {
         a->need_render = true;
         reload_marks(a);
@@ -789,6 +805,7 @@ bool mr_view_run(const mr_view_run_params *p, mr_error *err) {
     mr_annotations_free(&a->marks);
     mr_frame_result_free(&a->res);
     mr_viewer_destroy(&a->vc);
+    free(a->tolerances);
     mr_draw2d_destroy(&a->d2);
     mr_renderer_destroy(&a->rend);
     mr_lod_destroy(&a->lod);

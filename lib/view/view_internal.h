@@ -73,6 +73,14 @@ struct mr_viewer {
     double measure_cov[MR_MEASURE_MAX_TAPS][36];
     bool measure_has_cov[MR_MEASURE_MAX_TAPS];
     char measure_msg[200];       /* its last message (also toasted) */
+    bool measure_judged;         /* its distance has a verdict */
+    mr_verdict measure_verdict;
+    /* The verdict's banner: over the picture while the mark is filed and a
+     * while after, in the verdict's colour */
+    char verdict_banner[300];
+    mr_verdict_kind verdict_kind;
+    double verdict_until;
+    bool verdict_note;           /* the note chooser open is the measurement's mark */
     /* the note chooser: the text field, and the mark it edits */
     char note_text[512];
     bool text_focus;             /* keys go into the field */
@@ -100,5 +108,8 @@ void vw_measure_tap(mr_viewer *v, const mr_viewer_frame *f, float x, float y);
 void vw_measure_banner(const mr_viewer *v, char *buf, size_t n);
 void vw_measure_draw(mr_viewer *v, const mr_viewer_frame *f); /* a cross at this frame's tap */
 void vw_measure_state_json(const mr_viewer *v, cJSON *j);
+/* The verdict in the planner's words, for the banner: "OUT OF TOLERANCE
+ * Machine_2: 298 mm, 95 % 224..372 mm, limit +/-20 mm (DIN 18202 ...)". */
+void vw_verdict_words(const mr_verdict *vd, const char *part, char *buf, size_t n);
 
 #endif
