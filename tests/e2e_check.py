@@ -339,6 +339,32 @@ def check(d, tmp, mr):
         d3, s3 = m3.get("measured_distance_m"), m3.get("measured_sigma_m")
         ok(d3 is not None and d3 <= max(2 * s3, 0.02), "the unchanged column measured %r m +- %r" % (d3, s3))
         print("info: measured: machine %.3f m +- %.3f, column %.3f m +- %.3f" % (d2 or -1, s2 or -1, d3 or -1, s3 or -1))
+        # The verdicts: the moved machine out of tolerance, the unchanged
+        # column within, each with its 95 % interval (k = 2) and the
+        # tolerance used, and in the mark's title.
+        v2, v3 = m2.get("verdict") or {}, m3.get("verdict") or {}
+        for v, d_, s_ in ((v2, d2, s2), (v3, d3, s3)):
+            ok(v and v.get("k") == 2 and abs(v["interval_mm"][1] - (d_ + 2 * s_) * 1000) < 1e-6
+               and abs(v["sigma_mm"] - s_ * 1000) < 1e-9 and v.get("tolerance", "").startswith(("DIN 18202", "hall table")),
+               "a measured mark's verdict lacks its interval, k or tolerance: %r" % v)
+        ok(v2.get("verdict") == "out", "the moved machine's verdict is %r, want out: %r" % (v2.get("verdict"), v2))
+        ok(v3.get("verdict") == "within", "the unchanged column's verdict is %r, want within: %r" % (v3.get("verdict"), v3))
+        ok(m2.get("title", "").endswith(", out of tolerance") and m3.get("title", "").endswith(", within tolerance"),
+           "the measured marks' titles lack the verdict: %r, %r" % (m2.get("title"), m3.get("title")))
+        print("info: verdicts: machine %s (%s), column %s (%s)" % (v2.get("verdict"), v2.get("tolerance"),
+                                                                 v3.get("verdict"), v3.get("tolerance")))
+        # The registration's uncertainty is in the interval: every tap of
+        # each measurement carried its frame's pose covariance.
+        for f in ("s_measured_%d.json" % m2["measured_frames"][0], "s_measured_%d.json" % m3["measured_frames"][0]):
+            st = json.load(open(tmp + "/" + f)) if os.path.exists(tmp + "/" + f) else {}
+            me = st.get("measure") or {}
+            ok(me.get("taps", 0) >= 2 and me.get("taps_with_pose_covariance") == me.get("taps"),
+               "%s: %r of %r taps carried the pose covariance" % (f, me.get("taps_with_pose_covariance"), me.get("taps")))
+            ok((me.get("verdict") or {}).get("verdict") in ("within", "out", "undecided"),
+               "%s: the view showed no verdict" % f)
+        st = json.load(open(tmp + "/s_end.json")) if os.path.exists(tmp + "/s_end.json") else {}
+        pv = [p.get("verdict") for p in st.get("pins", [])]
+        ok(sorted(pv) == ["", "out", "within"], "the pins' verdicts are %r" % pv)
     # The exports.
     for path, v3 in ((tmp + "/findings.bcf", False), (tmp + "/findings-3.0.bcf", True)):
         if not ok(os.path.exists(path), "no " + path):
@@ -353,6 +379,15 @@ def check(d, tmp, mr):
             ok('TopicType="Moved"' in x and "<AssignedTo>planner</AssignedTo>" in x and "<Priority>high</Priority>" in x
                and ("<Label>layout</Label>" if v3 else "<Labels>layout</Labels>") in x,
                "%s: the topic's type, assignee, priority or label is missing" % path)
+        # The measured findings: the verdict in the title, the description
+        # (with the interval and the tolerance) and the labels.
+        lab = "<Label>%s</Label>" if v3 else "<Labels>%s</Labels>"
+        tv = [x for x in mk if ", out of tolerance</Title>" in x]
+        ok(len(tv) == 1 and "Verdict: out of tolerance: " in tv[0] and "95 % interval" in tv[0]
+           and lab % "out of tolerance" in tv[0], "%s: no topic of the machine's verdict (title, description, label)" % path)
+        tw = [x for x in mk if ", within tolerance</Title>" in x]
+        ok(len(tw) == 1 and "Verdict: within tolerance: " in tw[0] and lab % "within tolerance" in tw[0],
+           "%s: no topic of the column's verdict" % path)
         if v3:
             ext = z.read("extensions.xml").decode()
             ok("<TopicType>Moved</TopicType>" in ext and "<User>planner</User>" in ext and "<TopicLabel>layout</TopicLabel>" in ext,
@@ -362,6 +397,9 @@ def check(d, tmp, mr):
        "the report lacks the mark's title or its pictures")
     ok("Distances in metres" not in html and "camera to the point" in html,
        "the report's units or the words for its distances")
+    ok("<th>verdict</th>" in html and html.count(">out of tolerance (95 %: ") == 1
+       and html.count(">within tolerance (95 %: ") == 1 and "Verdict: out of tolerance: " in html
+       and "straddles the limit" in html, "the report lacks the verdict column or its words")
     print("ok %d" % ok.passed)
 
 

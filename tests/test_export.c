@@ -136,6 +136,7 @@ static mr_dmat4 pose_at(double ex, double ey, double ez, double tx, double ty, d
 
 /* issue 15: a measurement the next write_mark carries (NULL: none). */
 static const mr_measurement *g_mark_measure;
+static const mr_verdict *g_mark_verdict;     /* with g_mark_measure: its verdict */
 
 static bool write_mark(const char *dir, int i, const char *note, const mr_dmat4 *pose, double dist, double unc) {
     mr_camera cam = test_camera();
@@ -169,6 +170,8 @@ static bool write_mark(const char *dir, int i, const char *note, const mr_dmat4 
     if (g_mark_measure) {
         m.has_measurement = true;
         m.measurement = *g_mark_measure;
+        m.has_verdict = g_mark_verdict != NULL;
+        if (g_mark_verdict) m.verdict = *g_mark_verdict;
     }
     char stem[32];
     snprintf(stem, sizeof stem, "mark_%04d", i);
@@ -572,9 +575,15 @@ static void test_measured(void) {
     ms.planned = mr_v3(1, 1, 1);
     snprintf(ms.planned_node, sizeof ms.planned_node, "Machine_2");
     mr_dmat4 pose = pose_at(0, 1.5, 5, 1, 1, 1);
+    /* 301 +- 2 * 4 mm against +-20 mm: out of tolerance. */
+    mr_tolerance tol = mr_tolerance_lookup(NULL, "Machine_2", "visible", 8.0);
+    mr_verdict vd;
+    CHECK(mr_verdict_judge(ms.distance_m, ms.distance_sigma_m, &tol, &vd, NULL) && vd.kind == MR_VERDICT_OUT);
     g_mark_measure = &ms;
+    g_mark_verdict = &vd;
     bool ok = write_mark(dir, 1, "machine moved", &pose, -1, 0.002);
     g_mark_measure = NULL;
+    g_mark_verdict = NULL;
     if (!ok) return;
     mr_export_params p = MR_EXPORT_DEFAULTS;
     mr_error err = {0};
@@ -586,9 +595,44 @@ static void test_measured(void) {
     CHECK_MSG(html && strstr(html, "Measured distance: 301 mm +- 4 mm (1 sigma, triangulated from 3 taps, to the "
                                    "planned Machine_2)"),
               "the finding's text lacks the measurement");
+    /* The verdict: a column of the summary, and words with the interval
+     * and the tolerance used in the finding's text. */
+    CHECK_MSG(html && strstr(html, "<th>verdict</th>") &&
+                  strstr(html, ">out of tolerance (95 %: 293 .. 309 mm; limit +- 20 mm, DIN 18202 Table 1, 6-15 m)</td>"),
+              "the summary lacks the verdict");
+    CHECK_MSG(html && strstr(html, "Verdict: out of tolerance: 301.0 mm, 95 % interval 293.0 .. 309.0 mm, limit "
+                                   "\xc2\xb1" "20 mm (DIN 18202 Table 1, 6-15 m)"),
+              "the finding's text lacks the verdict");
     free(html);
-    snprintf(path, sizeof path, "%s/m.bcf", g_tmp);
-    CHECK_MSG(mr_export_bcf(dir, path, &p, &err), "bcf: %s", err.msg);
+    snprintf(path, sizeof path, "%s/report.md", out);
+    char *md = mr_file_read(path, &n, 0, &err);
+    CHECK_MSG(md && strstr(md, "| 301 mm +- 4 mm | out of tolerance (95 %: 293 .. 309 mm"), "report.md lacks the verdict");
+    free(md);
+    /* In both BCF versions: the description, and a label to filter by
+     * (declared in 3.0's extensions). */
+    for (int v3 = 0; v3 < 2; v3++) {
+        p.bcf_version = v3 ? MR_BCF_3_0 : MR_BCF_2_1;
+        snprintf(path, sizeof path, "%s/m%d.bcf", g_tmp, v3);
+        CHECK_MSG(mr_export_bcf(dir, path, &p, &err), "bcf: %s", err.msg);
+        int ze = 0;
+        zip_t *z = zip_open(path, ZIP_RDONLY, &ze);
+        CHECK(z != NULL);
+        if (!z) continue;
+        char *mk = NULL;
+        for (zip_int64_t i = 0; i < zip_get_num_entries(z, 0) && !mk; i++) {
+            const char *name = zip_get_name(z, (zip_uint64_t)i, 0);
+            if (name && strstr(name, "/markup.bcf")) mk = zip_read(z, name, NULL);
+        }
+        CHECK_MSG(mk && strstr(mk, v3 ? "<Label>out of tolerance</Label>" : "<Labels>out of tolerance</Labels>"),
+                  "BCF %s: no verdict label", v3 ? "3.0" : "2.1");
+        CHECK_MSG(mk && strstr(mk, "Verdict: out of tolerance: 301.0 mm, 95 % interval 293.0 .. 309.0 mm"),
+                  "BCF %s: the description lacks the verdict", v3 ? "3.0" : "2.1");
+        free(mk);
+        char *ext = v3 ? zip_read(z, "extensions.xml", NULL) : NULL;
+        CHECK(!v3 || (ext && strstr(ext, "<TopicLabel>out of tolerance</TopicLabel>")));
+        free(ext);
+        zip_close(z);
+    }
 }
 
 int main(void) {

@@ -117,6 +117,14 @@ static bool load_one(const char *dir, const mr_export_params *p, mr_finding *f, 
     } else {
         ADD(". Measured distance: not measured");
     }
+    /* The verdict in words, with its interval and the tolerance it used. */
+    if (a->has_verdict && a->verdict.kind != MR_VERDICT_NONE) {
+        char vline[320];
+        mr_verdict_format(&a->verdict, vline, sizeof vline);
+        ADD(". Verdict: %s", vline);
+    } else if (f->has_distance) {
+        ADD(". No verdict (no uncertainty of the distance to judge it with)");
+    }
     if (f->has_uncertainty) {
         format_len(f->uncertainty_m, len, sizeof len);
         ADD(". Registration uncertainty at the mark: %s (1 sigma)", len);
@@ -161,6 +169,13 @@ bool mr_findings_load(const char *dir, const mr_export_params *p, mr_findings *o
         return mr_fail(err, MR_ERR_NOMEM, "out of memory");
     }
     for (int i = 0; i < out->marks.count; i++) {
+        /* A judged mark is labelled with its verdict's words, so a BIM
+         * tool can filter the topics that are out of tolerance. */
+        mr_annotation *m = &out->marks.items[i];
+        const char *vw = m->has_verdict ? mr_verdict_words(m->verdict.kind) : "";
+        bool have = !vw[0];
+        for (int l = 0; l < m->label_count; l++) have |= strcmp(m->labels[l], vw) == 0;
+        if (!have && m->label_count < MR_MARK_MAX_LABELS) snprintf(m->labels[m->label_count++], sizeof m->labels[0], "%s", vw);
         mr_finding *f = &out->items[out->count++];
         f->mark = &out->marks.items[i];
         f->number = i + 1;

@@ -15,6 +15,10 @@
  *                    Measure: the triangulated distance to the plan
  *                    (used when "distance_m" is absent) and its 1 sigma
  *   "snapshot": {"screen"}  the screen with the overlay (report only)
+ *   "verdict"        a measured distance judged against the tolerance
+ *                    (mr_verdict_to_json): in the description with its
+ *                    interval and tolerance, and its words ("out of
+ *                    tolerance") added to the topic's labels
  *
  * BCF conventions (the standard's, not ours): Z up, metres. glTF is Y up, so
  * a point (x, y, z) of the scene becomes (x, -z, y) (a rotation of +90°

@@ -50,6 +50,25 @@ static void plan_px(const plan *p, double x, double z, double *u, double *v) {
     *v = p->pad + (z - p->lo[1]) * p->scale; /* seen from above: +z down the page */
 }
 
+/* A judged mark's colour: red out of tolerance, green within, amber
+ * undecided; marks without a verdict red as before. */
+static const char *verdict_colour(const mr_annotation *a) {
+    if (!a->has_verdict) return "#d32f2f";
+    return a->verdict.kind == MR_VERDICT_WITHIN ? "#2e7d32" : a->verdict.kind == MR_VERDICT_UNDECIDED ? "#ef8f00" : "#d32f2f";
+}
+
+/* The summary's verdict cell: "out of tolerance (95 %: 224 .. 372 mm;
+ * limit +-20 mm, DIN 18202 Table 1, 6-15 m)", "-" when not judged. */
+static void verdict_cell(const mr_annotation *a, char *out, size_t n) {
+    if (!a->has_verdict || a->verdict.kind == MR_VERDICT_NONE) {
+        snprintf(out, n, "-");
+        return;
+    }
+    const mr_verdict *v = &a->verdict;
+    snprintf(out, n, "%s (95 %%: %.0f .. %.0f mm; limit +- %.0f mm, %s)", mr_verdict_words(v->kind), v->lo_m * 1e3,
+             v->hi_m * 1e3, v->tol.limit_m * 1e3, v->tol.source);
+}
+
 /* The plan view as SVG: the scene's node footprints, each camera with its
  * viewing direction, each mark numbered. */
 static void plan_svg(mr_xml *x, const mr_findings *fs, const mr_scene *s) {
@@ -107,8 +126,8 @@ static void plan_svg(mr_xml *x, const mr_findings *fs, const mr_scene *s) {
                    cu, cv, mu, mv);
         mr_xml_raw(x, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#1565c0\" stroke-width=\"2\"/>"
                       "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"#1565c0\"/>\n", cu, cv, du, dv, cu, cv);
-        mr_xml_raw(x, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"9\" fill=\"#d32f2f\" stroke=\"white\" stroke-width=\"1.5\">"
-                      "<title>", mu, mv);
+        mr_xml_raw(x, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"9\" fill=\"%s\" stroke=\"white\" stroke-width=\"1.5\">"
+                      "<title>", mu, mv, verdict_colour(f->mark));
         mr_xml_escape_into(x, f->title);
         mr_xml_raw(x, "</title></circle><text x=\"%.1f\" y=\"%.1f\" fill=\"white\" text-anchor=\"middle\" "
                       "font-weight=\"bold\">%d</text>\n", mu, mv + 4, f->number);
@@ -211,17 +230,23 @@ static char *html_doc(const mr_findings *fs, const mr_export_params *p, const bo
                    "surface, measured from two or more camera frames (mm, &plusmn; 1&nbsp;sigma); "
                    "<b>registration</b>: the uncertainty of the model's placement over the camera picture at the mark "
                    "(mm, 1&nbsp;sigma); <b>camera to the point</b>: how far the camera was from the marked point "
-                   "(m). n/a: not measured or not available.</p>\n", fs->count, fs->count == 1 ? "" : "s");
+                   "(m); <b>verdict</b>: the distance to the plan judged against the tolerance with its 95&nbsp;%% interval "
+                   "(&plusmn; 2&nbsp;sigma, the registration's uncertainty included): <b>within tolerance</b> when the "
+                   "whole interval is inside the limit, <b>out of tolerance</b> when it is wholly outside, "
+                   "<b>undecided</b> when it straddles the limit (measure again, closer or from a wider baseline); the "
+                   "limit is DIN 18202 Table 1's for the nominal size unless the hall's table gives one for the part "
+                   "or layer. n/a: not measured or not available.</p>\n", fs->count, fs->count == 1 ? "" : "s");
     mr_xml_raw(&x, "<h2>Summary</h2>\n<table><tr><th>#</th><th>finding</th><th>part</th><th>status</th>"
-                   "<th>distance to the plan</th><th>registration</th><th>camera to the point</th><th>frame</th>"
+                   "<th>distance to the plan</th><th>verdict</th><th>registration</th><th>camera to the point</th><th>frame</th>"
                    "<th>time in recording</th><th>marked</th></tr>\n");
     for (int i = 0; i < fs->count; i++) {
         const mr_finding *f = &fs->items[i];
-        char d[64], u[64], when[64], seen[64];
+        char d[64], u[64], when[64], seen[64], vc[256];
         fmt_len(f->has_distance, f->distance_m, d, sizeof d);
         dist_sigma(f, d, sizeof d);
         fmt_len(f->has_uncertainty, f->uncertainty_m, u, sizeof u);
         fmt_time(f->mark->time_unix, when, sizeof when);
+        verdict_cell(f->mark, vc, sizeof vc);
         if (f->depth_m >= 0) snprintf(seen, sizeof seen, "%.2f m", f->depth_m);
         else snprintf(seen, sizeof seen, "n/a");
         mr_xml_raw(&x, "<tr><td><a href=\"#f%d\">%d</a></td><td>", f->number, f->number);
@@ -230,11 +255,14 @@ static char *html_doc(const mr_findings *fs, const mr_export_params *p, const bo
         mr_xml_escape_into(&x, f->mark->node[0] ? f->mark->node : "-");
         mr_xml_raw(&x, "</td><td>");
         mr_xml_escape_into(&x, f->mark->status[0] ? f->mark->status : "open");
-        mr_xml_raw(&x, "</td><td>%s</td><td>%s</td><td>%s</td><td>%lld</td><td>%.2f s</td><td>%s</td></tr>\n", d, u,
-                   seen, (long long)f->mark->frame_index, f->mark->timestamp, when);
+        mr_xml_raw(&x, "</td><td>%s</td><td style=\"color:%s\">", d, verdict_colour(f->mark));
+        mr_xml_escape_into(&x, vc);
+        mr_xml_raw(&x, "</td><td>%s</td><td>%s</td><td>%lld</td><td>%.2f s</td><td>%s</td></tr>\n", u, seen,
+                   (long long)f->mark->frame_index, f->mark->timestamp, when);
     }
     mr_xml_raw(&x, "</table>\n<h2>Plan view</h2>\n<p>Seen from above (x to the right, z down the page). "
-                   "Red pins: the marks, numbered as above; blue: the camera and where it looked.</p>\n");
+                   "Pins: the marks, numbered as above (green within tolerance, amber undecided, red out of "
+                   "tolerance or not judged); blue: the camera and where it looked.</p>\n");
     plan_svg(&x, fs, p->scene);
     for (int i = 0; i < fs->count; i++) {
         const mr_finding *f = &fs->items[i];
@@ -272,12 +300,16 @@ static char *md_doc(const mr_findings *fs, const mr_export_params *p, const bool
     mr_xml_raw(&x, "# %s\n\n%d finding%s. ", p->title, fs->count, fs->count == 1 ? "" : "s");
     mr_xml_raw(&x, "Distance to the plan: how far the built part is from the planned surface (mm, +- 1 sigma); "
                    "registration: the uncertainty of the model's placement at the mark (mm, 1 sigma); camera to the "
-                   "point: how far the camera was from the marked point (m). n/a: not measured or not available.\n\n");
-    mr_xml_raw(&x, "| # | finding | part | distance to the plan | registration | camera to the point | frame | time |\n"
-                   "|---|---|---|---|---|---|---|---|\n");
+                   "point: how far the camera was from the marked point (m); verdict: the distance judged against the "
+                   "tolerance with its 95 %% interval (+- 2 sigma, the registration included): within, out of tolerance, "
+                   "or undecided (the interval straddles the limit: measure again, closer or from a wider baseline). "
+                   "n/a: not measured or not available.\n\n");
+    mr_xml_raw(&x, "| # | finding | part | distance to the plan | verdict | registration | camera to the point | frame | time |\n"
+                   "|---|---|---|---|---|---|---|---|---|\n");
     for (int i = 0; i < fs->count; i++) {
         const mr_finding *f = &fs->items[i];
-        char d[64], u[64], seen[64];
+        char d[64], u[64], seen[64], vc[256];
+        verdict_cell(f->mark, vc, sizeof vc);
         fmt_len(f->has_distance, f->distance_m, d, sizeof d);
         dist_sigma(f, d, sizeof d);
         fmt_len(f->has_uncertainty, f->uncertainty_m, u, sizeof u);
@@ -288,8 +320,8 @@ static char *md_doc(const mr_findings *fs, const mr_export_params *p, const bool
         snprintf(title, sizeof title, "%s", f->title);
         for (char *c = title; *c; c++)
             if (*c == '|' || *c == '\n') *c = '/';
-        mr_xml_raw(&x, "| %d | %s | %s | %s | %s | %s | %lld | %.2f s |\n", f->number, title,
-                   f->mark->node[0] ? f->mark->node : "-", d, u, seen, (long long)f->mark->frame_index,
+        mr_xml_raw(&x, "| %d | %s | %s | %s | %s | %s | %s | %lld | %.2f s |\n", f->number, title,
+                   f->mark->node[0] ? f->mark->node : "-", d, vc, u, seen, (long long)f->mark->frame_index,
                    f->mark->timestamp);
     }
     mr_xml_raw(&x, "\n![plan view](img/plan.svg)\n");
