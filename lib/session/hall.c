@@ -40,7 +40,7 @@ static bool str_key(const cJSON *j, const char *key, char *out, size_t n, const 
     return true;
 }
 
-static bool hall_from_json(const cJSON *j, const char *dir, const char *file, mr_hall *h, mr_error *err) {
+static bool hall_from_json(const cJSON *j, const char *dir, const char *file, bool warn, mr_hall *h, mr_error *err) {
     memset(h, 0, sizeof *h);
     if (strlen(dir) >= sizeof h->dir) return mr_fail(err, MR_ERR_INVALID, "hall folder name too long: %.60s...", dir);
     snprintf(h->dir, sizeof h->dir, "%s", dir);
@@ -48,7 +48,7 @@ static bool hall_from_json(const cJSON *j, const char *dir, const char *file, mr
     const cJSON *ver = cJSON_GetObjectItemCaseSensitive(j, "mrcheck_hall");
     if (ver && (!cJSON_IsNumber(ver) || ver->valuedouble != 1))
         return mr_fail(err, MR_ERR_UNSUPPORTED, "%s: \"mrcheck_hall\" must be 1 (this version's format)", file);
-    mr_json_warn_unknown(j, k_known, file);
+    if (warn) mr_json_warn_unknown(j, k_known, file);
     for (int i = 0; i < MR_HALL_ITEM_COUNT; i++)
         if (!str_key(j, mr_hall_item_keys[i], h->items[i], sizeof h->items[i], file, err)) return false;
     if (!str_key(j, "name", h->name, sizeof h->name, file, err) ||
@@ -65,7 +65,7 @@ bool mr_hall_load(const char *dir, mr_hall *h, mr_error *err) {
     if (!mr_hall_is(dir)) return mr_fail(err, MR_ERR_IO, "%s is not a hall folder (no %s in it)", dir, MR_HALL_MANIFEST);
     cJSON *j = mr_json_load(file, err);
     if (!j) return false;
-    bool ok = hall_from_json(j, dir, file, h, err);
+    bool ok = hall_from_json(j, dir, file, true, h, err);
     cJSON_Delete(j);
     return ok;
 }
@@ -254,7 +254,11 @@ bool mr_hall_update_files(const char *dir, const mr_hall_update *u, bool create,
     if (!ok && !err->msg[0]) mr_fail(err, MR_ERR_NOMEM, "out of memory");
     ok = ok && mr_json_save(file, j, err);
     mr_hall h;
-    if (ok && out) ok = hall_from_json(j, dir, file, &h, err), *out = h;
+    /* The sessions folder, so that a recording can be copied in at once. */
+    if (ok) ok = hall_from_json(j, dir, file, false, &h, err);
+    char sd[4096];
+    if (ok) mr_hall_sessions_dir(&h, sd, sizeof sd), ok = mr_mkdirs(sd, err);
+    if (ok && out) *out = h;
     cJSON_Delete(j);
     return ok;
 }

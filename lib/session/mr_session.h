@@ -236,8 +236,8 @@ bool mr_replay_meta_load(const char *dir, mr_camera *cam, bool have_cam, mr_mark
  * the planned point and that reference (mr_tolerances.reference, default
  * the world origin, i.e. the marker map's).
  *
- * A hall may replace the default by its own table (hall.json "tolerances",
- * or a file it names):
+ * A hall may replace the default by its own table (the file hall.json's
+ * "tolerances" names):
  *   {"default_mm": 20,                      (optional; absent: DIN 18202)
  *    "layers": {"hidden": 30},              (layer name -> ±mm)
  *    "parts": {"Machine_*": 5, "Column_3": 10},   (node-name glob -> ±mm)
