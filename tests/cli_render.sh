@@ -107,11 +107,12 @@ echo '{"gltf": "missing.glb"}' >"$tmp/cfg_missing.json"
 expect_fail config_missing_gltf "$tmp/o15.png" -- "$mr" render --scene "$tmp/cfg_missing.json" --view "$v" --out "$tmp/o15.png"
 ls "$tmp"/*.tmp.* >/dev/null 2>&1 && bad "temporary files left behind" || ok
 
-# issue 16: the demo ends with three marks at the known discrepancies, as
-# BCF 2.1 and 3.0 (a topic folder each) and the report.
+# The demo ends with three marks at the known discrepancies and a control
+# measurement of an unchanged column, as BCF 2.1 and 3.0 (a topic folder
+# each) and the report.
 for b in findings.bcf findings-3.0.bcf; do
   n=$(unzip -l "$tmp/demo/$b" 2>/dev/null | grep -cE ' [0-9a-f-]{36}/$')
-  [ "$n" = 3 ] && ok || bad "demo: $b has ${n:-no} topic folders, want 3"
+  [ "$n" = 4 ] && ok || bad "demo: $b has ${n:-no} topic folders, want 4"
 done
 [ -s "$tmp/demo/report/index.html" ] && [ -s "$tmp/demo/report/img/mark_3_overlay.png" ] && ok || bad "demo: no report"
 grep -q "Machine_2" "$tmp/demo/report/index.html" && grep -q "Column_1_0" "$tmp/demo/report/index.html" && ok ||
@@ -119,8 +120,19 @@ grep -q "Machine_2" "$tmp/demo/report/index.html" && grep -q "Column_1_0" "$tmp/
 # The marks are placed on frames of the demo's recording at the tracker's
 # poses, so each carries the registration's uncertainty and its frame.
 ann=$tmp/demo/session/annotations.jsonl
-[ "$(grep -c '"uncertainty_m":' "$ann" 2>/dev/null)" = 3 ] && ok || bad "demo: marks without uncertainty_m: $(cat "$ann" 2>&1 | head -c 300)"
-[ "$(grep -cE 'recording frame [0-9]+, \+/- [0-9]+ mm' "$tmp/demo.log")" = 3 ] && ok ||
-  bad "demo: not three marks on tracked recording frames: $(grep mark "$tmp/demo.log")"
+[ "$(grep -c '"uncertainty_m":' "$ann" 2>/dev/null)" = 4 ] && ok || bad "demo: marks without uncertainty_m: $(cat "$ann" 2>&1 | head -c 300)"
+[ "$(grep -cE 'recording frame [0-9]+, \+/- [0-9]+ mm' "$tmp/demo.log")" = 4 ] && ok ||
+  bad "demo: not four marks on tracked recording frames: $(grep mark "$tmp/demo.log")"
+# The moved machine and the control column are measured from several
+# recorded frames and judged: the machine's 0.30 m out of tolerance, the
+# column within; the report shows both verdicts.
+grep -A2 "on Machine_2" "$tmp/demo.log" | grep -Eq "^    verdict: out of tolerance: " && ok ||
+  bad "demo: the moved machine is not out of tolerance: $(grep -A2 'on Machine_2' "$tmp/demo.log")"
+grep -A2 "control: " "$tmp/demo.log" | grep -Eq "^    verdict: within tolerance: " && ok ||
+  bad "demo: the control column is not within tolerance: $(grep -A2 'control: ' "$tmp/demo.log")"
+[ "$(grep -c '"verdict":{"verdict":"out"' "$ann")" = 1 ] && [ "$(grep -c '"verdict":{"verdict":"within"' "$ann")" = 1 ] && ok ||
+  bad "demo: the marks do not carry the verdicts"
+grep -q ">out of tolerance (95 %: " "$tmp/demo/report/index.html" && grep -q ">within tolerance (95 %: " "$tmp/demo/report/index.html" &&
+  ok || bad "demo: the report does not show the verdicts"
 
 cli_finish cli_render

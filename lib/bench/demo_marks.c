@@ -1,9 +1,11 @@
 /* The last part of `mrcheck demo`: three marks at the hall's known
  * discrepancies, as a planner would place them in `mrcheck view` while
  * walking the demo's recording (a frame of it, the tracker's pose of that
- * frame with its covariance, the plan overlaid, a pick on the plan), then
- * the findings as BCF 2.1 and 3.0 and as the HTML report (lib/export). */
-#include "mr_bench.h"
+ * frame with its covariance, the plan overlaid, a pick on the plan), the
+ * moved part measured from several frames and judged against the
+ * tolerance, then the findings as BCF 2.1 and 3.0 and as the HTML report
+ * (lib/export). */
+#include "bench_internal.h"
 #include "mr_export.h"
 #include "mr_session.h"
 
@@ -125,10 +127,19 @@ static int pick_frame(const mr_recording *rec, const mr_bench_gpu *g, const mr_s
     return -1;
 }
 
+static void print_measured(const mr_demo_measured *d) {
+    char line[320];
+    mr_verdict_format(&d->verdict, line, sizeof line);
+    printf("    measured from %d frames (baseline %.0f deg): %.0f mm +/- %.0f mm from the plan (known: %.0f mm)\n"
+           "    verdict: %s\n", d->m.taps, d->m.tri.angle_deg, d->m.distance_m * 1e3, d->m.distance_sigma_m * 1e3,
+           d->truth_m * 1e3, line);
+}
+
 static bool one_mark(const char *session, int i, const cJSON *d, const mr_bench_gpu *g, const mr_scene *built,
                      const mr_scene *planned, const mr_recording *rec, mr_error *err) {
     const cJSON *desc = cJSON_GetObjectItemCaseSensitive(d, "description");
     const cJSON *node = cJSON_GetObjectItemCaseSensitive(d, "node");
+    const cJSON *kind = cJSON_GetObjectItemCaseSensitive(d, "kind");
     double at[3], delta[3] = {0, 0, 0};
     bool has_delta = mr_json_numbers(d, "delta", delta, 3, NULL);
     if (!mr_json_numbers(d, "built_position", at, 3, NULL) && !mr_json_numbers(d, "planned_position", at, 3, err))
@@ -173,6 +184,18 @@ static bool one_mark(const char *session, int i, const cJSON *d, const mr_bench_
              mr_demo_camera_frame(&cam, &res.color, 1, margin, scale, 1.0, 2.5, &rng, &frame, err);
     }
     mr_frame_result_free(&res);
+    /* A part that was built elsewhere is measured, as the planner would
+     * with Measure: its edge tapped in several frames. A missing part has
+     * nothing to measure, a hidden one is not in the pictures. */
+    mr_demo_measured meas;
+    bool measured = false;
+    if (ok && tracked && has_delta && !hidden && cJSON_IsString(node)) {
+        mr_error me = {0};
+        measured = mr_demo_measure(rec, g, built, node->valuestring, mr_v3(delta[0], delta[1], delta[2]),
+                                   3000u + (uint64_t)i, &meas, &me);
+        if (!measured) mr_log(MR_LOG_WARN, "demo: mark %d not measured: %s", i + 1, me.msg);
+        ok = mr_renderer_set_scene(g->renderer, planned, err);
+    }
     /* The check: the plan over the frame, and the pick on the plan. */
     mr_frame_params op = MR_FRAME_DEFAULTS;
     op.video = &frame; /* at MR_FRAME_DEFAULT_ALPHA */
@@ -194,6 +217,12 @@ static bool one_mark(const char *session, int i, const cJSON *d, const mr_bench_
     m.frame_index = tracked ? rec->frames[fi].index : i;
     m.timestamp = tracked ? rec->frames[fi].t : 0;
     snprintf(m.note, sizeof m.note, "%s", cJSON_IsString(desc) ? desc->valuestring : "discrepancy");
+    /* The discrepancy's kind as a mark's category (a height is a move up;
+     * the control measurement is "other"). */
+    const char *k = cJSON_IsString(kind) ? kind->valuestring : "";
+    bool move = strcmp(k, "moved") == 0 || strcmp(k, "height") == 0;
+    snprintf(m.category, sizeof m.category, "%s", move ? "moved" : strcmp(k, "missing") == 0 || strcmp(k, "extra") == 0 ? k
+                                                  : "other");
     m.has_pixel = true;
     m.pixel[0] = px, m.pixel[1] = py;
     m.hit = pick.hit;
@@ -209,10 +238,18 @@ static bool one_mark(const char *session, int i, const cJSON *d, const mr_bench_
     m.world_from_camera = view.world_from_camera;
     m.pose_tags_seen = tracked ? tracked->tags_seen : -1;
     m.pose_rms_px = tracked ? tracked->rms_px : -1;
+    m.has_measurement = m.has_verdict = measured;
+    if (measured) m.measurement = meas.m, m.verdict = meas.verdict;
+    /* Titled by the part the discrepancy is about (a hidden part's pick
+     * lands on what hides it). */
+    mr_annotation about = m;
+    if (node_name[0]) snprintf(about.node, sizeof about.node, "%s", node_name);
+    mr_mark_title(&about, m.title, sizeof m.title);
     char stem[32];
     snprintf(stem, sizeof stem, "mark_%04d", i + 1);
     mr_mark_files fl = {.stem = stem, .frame = &frame, .screen = &res.color, .camera = &cam,
-                        .distance_m = has_delta ? mr_v3_len(mr_v3(delta[0], delta[1], delta[2])) : -1,
+                        /* the known displacement, where nothing measured it */
+                        .distance_m = has_delta && !measured ? mr_v3_len(mr_v3(delta[0], delta[1], delta[2])) : -1,
                         .uncertainty_m = tracked ? sigma : -1};
     ok = ok && mr_export_mark_write(session, &m, &fl, err);
     if (ok && tracked)
@@ -222,6 +259,7 @@ static bool one_mark(const char *session, int i, const cJSON *d, const mr_bench_
     else if (ok)
         printf("  mark %d at (%.2f, %.2f, %.2f) on %s (no recorded frame sees it: a rendered view): %s\n", i + 1,
                target.x, target.y, target.z, cJSON_IsString(node) ? node->valuestring : "?", m.note);
+    if (ok && measured) print_measured(&meas);
     mr_frame_result_free(&res);
     mr_image_free(&frame);
     return ok;
@@ -243,8 +281,30 @@ bool mr_demo_marks(const char *dir, const mr_bench_gpu *g, const mr_scene *built
     remove(path);
     bool ok = mr_mkdirs(session, err);
     printf("marks at the known discrepancies (%s/session/):\n", dir);
-    for (int i = 0; ok && i < cJSON_GetArraySize(list); i++)
+    int nd = cJSON_GetArraySize(list);
+    for (int i = 0; ok && i < nd; i++)
         ok = one_mark(session, i, cJSON_GetArrayItem(list, i), g, built, planned, rec, err);
+    /* A control: an unchanged column measured the same way, so that the
+     * findings show what "within tolerance" looks like next to the rest. */
+    const char *col = rec ? mr_demo_control_part(rec, built, planned) : NULL;
+    int32_t ci = -1;
+    for (int32_t n = 0; col && n < planned->node_count && ci < 0; n++)
+        if (strcmp(planned->nodes[n].name, col) == 0) ci = n;
+    double lo[3], hi[3];
+    if (ok && ci >= 0 && mr_scene_node_bounds(planned, ci, lo, hi)) {
+        char words[160];
+        snprintf(words, sizeof words, "control: %s stands where it was planned", col);
+        double at[3] = {0.5 * (lo[0] + hi[0]), fmin(lo[1] + 0.75 * (hi[1] - lo[1]), lo[1] + 1.5), 0.5 * (lo[2] + hi[2])},
+               zero[3] = {0, 0, 0};
+        cJSON *c = cJSON_CreateObject();
+        cJSON_AddStringToObject(c, "kind", "control");
+        cJSON_AddStringToObject(c, "node", col);
+        cJSON_AddStringToObject(c, "description", words);
+        cJSON_AddItemToObject(c, "built_position", mr_json_from_doubles(at, 3));
+        cJSON_AddItemToObject(c, "delta", mr_json_from_doubles(zero, 3));
+        ok = one_mark(session, nd, c, g, built, planned, rec, err);
+        cJSON_Delete(c);
+    }
     cJSON_Delete(list);
     mr_recording_close(&rec);
     mr_export_params p = MR_EXPORT_DEFAULTS;

@@ -278,7 +278,9 @@ extern const mr_opt mr_synth_recording_opts[];
  * around, rendered on the CPU through the demo camera. */
 /* The last part of `mrcheck demo` (demo_marks.c): three marks at the
  * hall's known discrepancies in dir/session/, as a planner would place them
- * in `mrcheck view`, then dir/findings.bcf (2.1), dir/findings-3.0.bcf and
+ * in `mrcheck view` (the moved part measured from several recorded frames
+ * and judged against DIN 18202), a control measurement of an unchanged
+ * column, then dir/findings.bcf (2.1), dir/findings-3.0.bcf and
  * dir/report/ through lib/export. */
 bool mr_demo_marks(const char *dir, const mr_bench_gpu *g, const mr_scene *built, const mr_scene *planned,
                    mr_error *err);

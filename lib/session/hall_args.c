@@ -28,8 +28,8 @@ typedef struct hall_cmd {
 } hall_cmd;
 
 static const hall_cmd k_cmds[] = {
-    {"view", BIT(MR_HALL_SCENE), true, "replay", NULL, OUT_SESSION, 0,
-     "--scene, and for live input --camera, --markers and --input (the manifest's, default /dev/video0);\n"
+    {"view", BIT(MR_HALL_SCENE) | BIT(MR_HALL_TOLERANCES), true, "replay", NULL, OUT_SESSION, 0,
+     "--scene, --tolerances, and for live input --camera, --markers and --input (the manifest's, default /dev/video0);\n"
      "  --replay SESSION: a folder in HALL/sessions/ (or a path); --out: that session's folder in the hall,\n"
      "  a new HALL/sessions/<date-time>/ when live"},
     {"record", 0, true, NULL, NULL, OUT_NEW_SESSION, 0,
