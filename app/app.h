@@ -17,15 +17,15 @@ typedef struct app_gfx {
 bool app_gfx_open(app_gfx *g, mr_error *err);
 void app_gfx_close(app_gfx *g);
 /* The AO and ghosting tables of a command (fill .params, then parse). */
-#define APP_AO_TABLE(p) {.prefix = "ao", .table = mr_ao_opts, .params = (p), .extra = "groundtruth"}
+#define APP_AO_TABLE(p) {.prefix = "ao", .table = mr_ao_opts, .params = (p), .extra = "groundtruth", .research = true}
 /* The ground truth's rays, --ao-rays (its params live in lib/eval). */
-#define APP_GT_TABLE(p) {.prefix = "ao", .table = mr_gt_opts, .params = (p)}
-#define APP_GHOST_TABLE(p) {.prefix = "ghost", .table = mr_ghost_opts, .params = (p)}
+#define APP_GT_TABLE(p) {.prefix = "ao", .table = mr_gt_opts, .params = (p), .research = true}
+#define APP_GHOST_TABLE(p) {.prefix = "ghost", .table = mr_ghost_opts, .params = (p), .research = true}
 
 /* Shadows: --shadows METHOD, --shadows-KEY from mr_shadow_opts;
  * without --shadows the scene config's "shadows" names the method (one line
  * and false if it names none). In shadow_opts.c. */
-#define APP_SHADOW_TABLE(p) {.prefix = "shadows", .table = mr_shadow_opts, .params = (p)}
+#define APP_SHADOW_TABLE(p) {.prefix = "shadows", .table = mr_shadow_opts, .params = (p), .research = true}
 bool app_shadow_scene_default(const char *cmd, const mr_cli_table *t, const mr_scene *s, mr_shadow_params *p);
 
 
@@ -73,7 +73,7 @@ bool app_draw_lod(const char *cmd, const mr_cli_opt *opts, mr_draw_params *dp);
 void app_lod_auto(const mr_cli_opt *opts, const mr_scene *s, mr_draw_params *dp);
 /* The draw table (no prefix) and --lod auto|on|off, which decides whether
  * levels are built or read at all. */
-#define APP_DRAW_TABLE(p) {.prefix = "", .table = mr_draw_opts, .params = (p)}
+#define APP_DRAW_TABLE(p) {.prefix = "", .table = mr_draw_opts, .params = (p), .research = true}
 #define APP_DRAW_OPTS                                                                                          \
     {"lod", "auto|on|off", "simplified levels within the tolerance, cached next to the scene (default auto: on for scenes over 500k triangles)", NULL}
 
@@ -84,7 +84,7 @@ int cmd_study(int argc, char **argv);
  * and replay. */
 #define APP_RIG_OPTS {"quilt", "SPEC", "multi-view quilt: portrait, go, 4k, 8k, CxR or CxR@WxH (default: about square)", NULL}, \
     {"lightfield", "BAND", "one image under a light-field display's mapping (each column its own eye on the observer line of --view-cone), drawn in slices of BAND columns (1 = exact)", NULL}
-#define APP_RIG_TABLE(p) {.prefix = "", .table = mr_rig_opts, .params = (p)}
+#define APP_RIG_TABLE(p) {.prefix = "", .table = mr_rig_opts, .params = (p), .research = true}
 /* --quilt into quilt (zeroed when not given); rig options without --views
  * or --quilt are a mistake. Prints one line and returns false on bad input. */
 bool app_rig_check(const char *cmd, const mr_cli_table *t, const mr_cli_opt *opts, mr_quilt *quilt, bool *have_quilt);

@@ -23,7 +23,7 @@
 /* The detector rows (--decimate, --threads, --refine-edges, --sharpening)
  * from mr_detector_opts, parsed into *dp (an mr_detector_params holding its
  * defaults) by mr_cli_parse_tables. */
-#define APP_TRACK_TABLE(dp) {"", mr_detector_opts, (dp), NULL, false, {0}}
+#define APP_TRACK_TABLE(dp) {.prefix = "", .table = mr_detector_opts, .params = (dp), .research = true}
 
 /* A command's tracker: the one mr_tracker (lib/track) set up from the
  * options, plus what was loaded for it. */

@@ -22,7 +22,7 @@ int bench_ao(int argc, char **argv) {
     const char *pos[MAX_VIEWS];
     int npos = 0;
     mr_bench_ao_params p = {MR_BENCH_AO_DEFAULTS};
-    mr_cli_table table = {"", mr_bench_ao_opts, &p, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_bench_ao_opts, .params = &p};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, pos, MAX_VIEWS - 1, &npos,
                    "usage: mrcheck bench ao [--scene S] [--views V1.json [V2.json ...]] [--tune-view T.json] [--size WxH] [--out DIR]",

@@ -17,7 +17,7 @@ int app_bench_ghost(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_ghost_params p = {MR_BENCH_GHOST_DEFAULTS};
-    mr_cli_table table = {"", mr_bench_ghost_opts, &p, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_bench_ghost_opts, .params = &p};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck bench ghost [--size WxH] [--frames N] [--view I] [--out DIR]", &help))

@@ -9,7 +9,7 @@ int bench_load(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_load_params p = {MR_BENCH_LOAD_DEFAULTS};
-    mr_cli_table table = {"", mr_bench_load_opts, &p, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_bench_load_opts, .params = &p};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
                              "usage: mrcheck bench load [--out DIR] [--runs N] [--triangles N] [--unique-triangles N]\n"

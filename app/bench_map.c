@@ -9,7 +9,7 @@ int bench_map(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_map_params p = {MR_BENCH_MAP_DEFAULTS};
-    mr_cli_table table = {"", mr_bench_map_opts, &p, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_bench_map_opts, .params = &p};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck bench map [--out DIR] [--seeds N] [--max-photos N]\n"
@@ -30,7 +30,7 @@ int bench_measure(int argc, char **argv) {
     mr_cli_opt opts[] = {{"out", "DIR", "write bench_measure.csv and .svg there (default bench-out)", NULL},
                          {NULL, NULL, NULL, NULL}};
     mr_bench_measure_params p = {MR_BENCH_MEASURE_DEFAULTS};
-    mr_cli_table table = {"", mr_bench_measure_opts, &p, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_bench_measure_opts, .params = &p};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
                              "usage: mrcheck bench measure [--out DIR] [--maps N] [--points N] [--quick]\n"

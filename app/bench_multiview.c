@@ -18,7 +18,7 @@ int bench_multiview(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_multiview_params p = {MR_BENCH_MULTIVIEW_DEFAULTS};
-    mr_cli_table table = {"", mr_bench_multiview_opts, &p, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_bench_multiview_opts, .params = &p};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck bench multiview [--budget WxH] [--view-size WxH] [--table-size WxH] [--frames N] "

@@ -34,7 +34,7 @@ int bench_scene(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_scene_params p = {MR_BENCH_SCENE_DEFAULTS};
-    mr_cli_table table = {"", mr_bench_scene_opts, &p, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_bench_scene_opts, .params = &p};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck bench scene [--out DIR] [--sizes 1M,5M,20M] [--size WxH] [--frames N] [--unique [--unit U]]", &help))

@@ -12,7 +12,7 @@ int app_bench_shadows(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_shadows_params p = {MR_BENCH_SHADOWS_DEFAULTS};
-    mr_cli_table table = {"", mr_bench_shadows_opts, &p, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_bench_shadows_opts, .params = &p};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck bench shadows [--size WxH] [--frames N] [--rays N] [--first I --count N] [--views N] "

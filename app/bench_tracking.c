@@ -15,7 +15,7 @@ int bench_tracking(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_tracking_params p = {MR_BENCH_TRACKING_DEFAULTS};
-    mr_cli_table table = {"", mr_bench_tracking_opts, &p, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_bench_tracking_opts, .params = &p};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck bench tracking [--recording DIR] [--out DIR]\n"

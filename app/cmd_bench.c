@@ -26,7 +26,7 @@ static int bench_frame(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_frame_params p = {MR_BENCH_FRAME_DEFAULTS};
-    mr_cli_table table = {"", mr_bench_frame_opts, &p, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_bench_frame_opts, .params = &p};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 3, opts, &table, 1, NULL, 0, NULL, "usage: mrcheck bench frame [--scene S] [--view V] [--size WxH] [--frames N] [--out DIR]", &help))
         return 2;

@@ -15,7 +15,7 @@ int cmd_calibrate(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_board_calib_params bp = {.min_tags = 0};
-    mr_cli_table table = {"", mr_board_calib_opts, &bp, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_board_calib_opts, .params = &bp};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 2, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck calibrate --images DIR --board BOARD.json --out CAMERA.json\n"

@@ -30,7 +30,7 @@ int cmd_factory(int argc, char **argv) {
     bool help;
     mr_synth_params sp = MR_SYNTH_DEFAULTS;
     mr_synth_cad_params cp = MR_SYNTH_CAD_DEFAULTS;
-    mr_cli_table tables[] = {{"", mr_synth_opts, &sp, NULL, false, {0}}, {"", mr_synth_cad_opts, &cp, NULL, false, {0}}};
+    mr_cli_table tables[] = {{.prefix = "", .table = mr_synth_opts, .params = &sp}, {.prefix = "", .table = mr_synth_cad_opts, .params = &cp}};
     if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 2, NULL, 0, NULL,
                    "usage: mrcheck factory --out FILE.glb [--triangles N | --halls N] [--seed S] [--views DIR] [--unique [--unit U]]", &help))
         return 2;

@@ -33,7 +33,7 @@ int cmd_map(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_map_params mp = MR_MAP_DEFAULTS;
-    mr_cli_table table = {"", mr_map_opts, &mp, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_map_opts, .params = &mp};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 2, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck map (--images DIR | --video FILE) --camera C.json --tag-size S\n"

@@ -22,7 +22,7 @@ int cmd_measure(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_triangulate_params tp = MR_TRIANGULATE_DEFAULTS;
-    mr_cli_table table = {"", mr_triangulate_opts, &tp, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_triangulate_opts, .params = &tp};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 2, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck measure --recording DIR --observations OBS.json [--scene S] [--out RESULT.json]\n"

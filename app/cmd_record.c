@@ -29,7 +29,7 @@ int cmd_record(int argc, char **argv) {
     };
     mr_detector_params dp = MR_DETECTOR_DEFAULTS;
     mr_recorder_params rp = MR_RECORDER_DEFAULTS;
-    mr_cli_table tables[] = {APP_TRACK_TABLE(&dp), {"", mr_recorder_opts, &rp, NULL, false, {0}}};
+    mr_cli_table tables[] = {APP_TRACK_TABLE(&dp), {.prefix = "", .table = mr_recorder_opts, .params = &rp}};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 2, NULL, 0, NULL,
                    "usage: mrcheck record --input /dev/videoN|VIDEO --camera C --markers M --out DIR\n"

@@ -31,20 +31,21 @@ int cmd_render(int argc, char **argv) {
         {"out", "OUT.png", "output image (required)", NULL},
         {"size", "WxH", "output size (default: the camera's)", NULL},
         {"video", "IMG", "camera frame to overlay (raw, distorted)", NULL},
-        {"aux", "DIR", "also write depth.pfm (linear view depth), normal.pfm, ao.pfm (1 = unoccluded) and shadow.pfm", NULL},
         {"hidden", "GLOB", "extra node-name glob for the hidden layer", NULL},
+        {"verbose", NULL, "print the passes that ran and more", NULL},
+        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_RESEARCH_ROWS,
+        {"aux", "DIR", "also write depth.pfm (linear view depth), normal.pfm, ao.pfm (1 = unoccluded) and shadow.pfm", NULL},
         APP_DRAW_OPTS,
         APP_RIG_OPTS,
         {"lod-cache", "on|off", "read/write LOD levels in <scene>.mrlod and meshlets in <scene>.mrclu (default on)", NULL},
-        {"verbose", NULL, "print the passes that ran and more", NULL},
-        {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
     mr_frame_params fp = MR_FRAME_DEFAULTS;
     mr_gt_params gtp = MR_GT_DEFAULTS;
     mr_rig_params rp = MR_RIG_DEFAULTS;
     mr_draw_params dp = MR_DRAW_DEFAULTS;
-    mr_cli_table tables[] = {{"", mr_frame_opts, &fp, NULL, false, {0}}, APP_AO_TABLE(&fp.ao), APP_GT_TABLE(&gtp),
+    mr_cli_table tables[] = {{.prefix = "", .table = mr_frame_opts, .params = &fp}, APP_AO_TABLE(&fp.ao), APP_GT_TABLE(&gtp),
                              APP_GHOST_TABLE(&fp.ghost),
                              APP_SHADOW_TABLE(&fp.shadow), APP_RIG_TABLE(&rp), APP_DRAW_TABLE(&dp)};
     bool help;

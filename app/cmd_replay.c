@@ -11,10 +11,11 @@ int cmd_replay(int argc, char **argv) {
         {"scene", "S", "glTF/GLB or scene config of the plan (required)", NULL},
         {"out", "OUTDIR", "where overlay_NNNNNN.png and replay.jsonl go (required)", NULL},
         {"video", "FILE.avi", "also write the overlays as a Motion-JPEG AVI at the recording's rate", NULL},
-        APP_RIG_OPTS,
-        APP_DRAW_OPTS,
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
+        MR_CLI_RESEARCH_ROWS,
+        APP_RIG_OPTS,
+        APP_DRAW_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     const char *pos[1];
@@ -23,7 +24,7 @@ int cmd_replay(int argc, char **argv) {
     /* Depth cues as on render: the same option tables and checks. */
     mr_gt_params gtp = MR_GT_DEFAULTS;
     mr_rig_params rp = MR_RIG_DEFAULTS;
-    mr_cli_table tables[] = {{"", mr_batch_replay_opts, &p, NULL, false, {0}}, APP_AO_TABLE(&p.frame.ao),
+    mr_cli_table tables[] = {{.prefix = "", .table = mr_batch_replay_opts, .params = &p}, APP_AO_TABLE(&p.frame.ao),
                              APP_GT_TABLE(&gtp), APP_GHOST_TABLE(&p.frame.ghost), APP_SHADOW_TABLE(&p.frame.shadow),
                              APP_RIG_TABLE(&rp)};
     bool help;

@@ -64,29 +64,31 @@ int cmd_view(int argc, char **argv) {
         {"camera", "C.json", "camera intrinsics of the input (required with --input)", NULL},
         {"markers", "M.json", "marker map (required with --input unless --view is given)", NULL},
         {"replay", "DIR", "replay a recording (frames/ + frames.jsonl + meta.json)", NULL},
-        {"view", "V.json", "with --input IMG: a fixed pose instead of tracking", NULL},
         {"out", "DIR", "where annotations.jsonl and snapshots go (default: the recording, or ./mrcheck-session)", NULL},
+        {"tolerances", "T.json", "Measure's tolerance table (default: DIN 18202 Table 1 by nominal size)", NULL},
         {"config", "FILE", "settings file (default ~/.config/mrcheck/view.json)", NULL},
         {"size", "WxH", "window size (default 960x720)", NULL},
         {"fullscreen", NULL, "start fullscreen (F11 toggles)", NULL},
         {"ui-scale", "S", "scale the UI beyond the screen's density (default 1)", NULL},
         {"paused", NULL, "replay: start paused", NULL},
+        {"verbose", NULL, "more log output", NULL},
+        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_RESEARCH_ROWS,
+        {"view", "V.json", "with --input IMG: a fixed pose instead of tracking", NULL},
         {"retrack", NULL, "replay: track the frames again instead of using the recorded poses", NULL},
-        {"tolerances", "T.json", "Measure's tolerance table (default: DIN 18202 Table 1 by nominal size)", NULL},
         {"script", "FILE", "timed input events (tests, demos): see lib/view/mr_view.h", NULL},
         {"stats", NULL, "show the frame rate and render passes in the status line; print the frame-time split on exit", NULL},
         {"ao", "METHOD", ao_help, NULL},
         {"ghost", "MODE", ghost_help, NULL},
         {"ao-temporal", NULL, "accumulate the AO over frames (reprojected; restarts when tracking is regained)", NULL},
         {"shadows", "METHOD", "soft shadows: off, hard, pcf, pcss, bp, groundtruth (default: the scene config's, else off)", NULL},
-        {"verbose", NULL, "more log output", NULL},
-        {"quiet", NULL, "errors only", NULL},
         {NULL, NULL, NULL, NULL},
     };
     bool help;
     if (!mr_cli_parse(argc, argv, 2, opts, NULL, 0, NULL,
-                   "usage: mrcheck view --scene S (--input /dev/videoN|VIDEO --camera C --markers M | --replay DIR) "
-                   "[--out DIR] [--fullscreen] [--stats]",
+                   "usage: mrcheck view HALL [--replay SESSION]\n"
+                   "       mrcheck view --scene S (--input /dev/videoN|VIDEO --camera C --markers M | --replay DIR) "
+                   "[--out DIR] [--fullscreen]",
                    &help))
         return 2;
     if (help) return 0;

@@ -51,7 +51,7 @@ int cmd_synth(int argc, char **argv) {
         {NULL, NULL, NULL, NULL},
     };
     mr_synth_recording_params p = {MR_SYNTH_RECORDING_DEFAULTS};
-    mr_cli_table table = {"", mr_synth_recording_opts, &p, NULL, false, {0}};
+    mr_cli_table table = {.prefix = "", .table = mr_synth_recording_opts, .params = &p};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 2, opts, &table, 1, NULL, 0, NULL,
                    "usage: mrcheck synth --out DIR [--frames N] [--size WxH] [--noise S] [--motion-blur N] [--exposure A] [--jpeg Q]\n"

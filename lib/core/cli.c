@@ -28,21 +28,38 @@ static const char *row_arg(const mr_opt *o) {
     }
 }
 
+static void print_table_row(const mr_cli_table *t, const mr_opt *o) {
+    char name[64], desc[320], help[512];
+    row_name(t, o, name, sizeof name);
+    mr_opt_describe(o, desc, sizeof desc);
+    const char *sep = o->type == MR_OPT_BOOL ? " " : "; ";
+    if (!o->key[0] && t->extra) snprintf(help, sizeof help, "%s%s%s; or %s", o->help, sep, desc, t->extra);
+    else snprintf(help, sizeof help, "%s%s%s", o->help, sep, desc);
+    print_row(name, row_arg(o), help);
+}
+
+/* The options a planner uses first, then the research settings under their
+ * own heading: a command's rows after MR_CLI_RESEARCH_ROWS, the rows of
+ * research tables and MR_OPT_RESEARCH rows. */
 static void print_usage(const char *usage, const mr_cli_opt *opts, const mr_cli_table *tables, int ntables) {
     printf("%s\n\noptions:\n", usage);
-    for (const mr_cli_opt *o = opts; o->name; o++) print_row(o->name, o->arg, o->help);
-    for (int i = 0; i < ntables; i++)
-        for (const mr_opt *o = tables[i].table; o->key; o++) {
-            char name[64], desc[320], help[512];
-            row_name(&tables[i], o, name, sizeof name);
-            mr_opt_describe(o, desc, sizeof desc);
-            const char *sep = o->type == MR_OPT_BOOL ? " " : "; ";
-            if (!o->key[0] && tables[i].extra)
-                snprintf(help, sizeof help, "%s%s%s; or %s", o->help, sep, desc, tables[i].extra);
-            else snprintf(help, sizeof help, "%s%s%s", o->help, sep, desc);
-            print_row(name, row_arg(o), help);
+    const mr_cli_opt *o = opts;
+    for (; o->name && o->name[0]; o++) print_row(o->name, o->arg, o->help);
+    for (int pass = 0; pass < 2; pass++) {
+        if (pass == 1) {
+            bool any = o->name != NULL;
+            for (int i = 0; i < ntables && !any; i++)
+                for (const mr_opt *r = tables[i].table; r->key && !any; r++)
+                    any = tables[i].research || (r->flags & MR_OPT_RESEARCH);
+            if (!any) break;
+            printf("\nresearch options:\n");
+            for (o = o->name ? o + 1 : o; o->name; o++) print_row(o->name, o->arg, o->help);
         }
-    printf("  %-24s %s\n", "--help", "show this help");
+        for (int i = 0; i < ntables; i++)
+            for (const mr_opt *r = tables[i].table; r->key; r++)
+                if ((tables[i].research || (r->flags & MR_OPT_RESEARCH)) == (pass == 1)) print_table_row(&tables[i], r);
+        if (pass == 0) printf("  %-24s %s\n", "--help", "show this help");
+    }
 }
 
 bool mr_cli_table_given(const mr_cli_table *t, const char *key) {
@@ -130,7 +147,7 @@ bool mr_cli_parse_tables(int argc, char **argv, int first, mr_cli_opt *opts, mr_
         size_t nlen = eq ? (size_t)(eq - name) : strlen(name);
         mr_cli_opt *o = opts;
         for (; o->name; o++)
-            if (strlen(o->name) == nlen && strncmp(o->name, name, nlen) == 0) break;
+            if (o->name[0] && strlen(o->name) == nlen && strncmp(o->name, name, nlen) == 0) break;
         mr_cli_table *tab = NULL;
         const mr_opt *row = NULL;
         if (!o->name && !find_table_row(tables, ntables, name, nlen, &tab, &row)) {

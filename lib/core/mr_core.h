@@ -276,6 +276,9 @@ typedef enum mr_opt_type {
 /* Bool rows: on the command line the option takes a value, on or off
  * (--cull off), instead of being a flag. */
 #define MR_OPT_ONOFF 16u
+/* A research setting (a method's tuning), listed under "research options"
+ * in --help, after the options a planner uses. */
+#define MR_OPT_RESEARCH 32u
 
 typedef struct mr_opt {
     const char *key;          /* file / UI name; on the command line prefix + key,
@@ -286,7 +289,7 @@ typedef struct mr_opt {
     double def;               /* default (enums: the index) */
     const char *const *names; /* enums: names by value, NULL-terminated */
     const char *help;         /* one line, no default or range (added from the row) */
-    unsigned flags;           /* MR_OPT_ZERO_AUTO, _ZERO_DEFAULT, _NEG_AUTO, _NEGATE, _ONOFF */
+    unsigned flags;           /* MR_OPT_ZERO_AUTO, _ZERO_DEFAULT, _NEG_AUTO, _NEGATE, _ONOFF, _RESEARCH */
 } mr_opt;
 
 /* The row named key; NULL if none. */
@@ -334,6 +337,11 @@ typedef struct mr_cli_opt {
     const char *help;
     const char *value;  /* filled by mr_cli_parse: the value, "1" for a set flag, or NULL */
 } mr_cli_opt;
+/* A row of a command's options after which its own options are research
+ * settings: --help lists them under "research options", after the options
+ * a planner uses (the tables' rows likewise, by mr_cli_table.research and
+ * MR_OPT_RESEARCH). */
+#define MR_CLI_RESEARCH_ROWS {"", NULL, NULL, NULL}
 
 /* A params struct whose option table is spliced into a command's options:
  * --PREFIX (the table's "" row) and --PREFIX-KEY for each other row, with
@@ -349,6 +357,8 @@ typedef struct mr_cli_table {
                                  names (--ao groundtruth), or NULL */
     bool extra_given;         /* filled: --PREFIX EXTRA was given */
     const char *values[MR_CLI_TABLE_MAX]; /* filled: the text given for each row, or NULL */
+    bool research;            /* every row is a research setting (--help lists it
+                                 under "research options") */
 } mr_cli_table;
 /* True if the row `key` of t was on the command line. */
 bool mr_cli_table_given(const mr_cli_table *t, const char *key);
