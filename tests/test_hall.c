@@ -172,6 +172,19 @@ int main(void) {
     CHECK_MSG(v && strncmp(v, "../../h/sessions/", 17) == 0, "--out %s", v ? v : "(none)");
     mr_hall_args_free(&ha);
 
+    /* Live without a marker map in the hall: one line that says how the
+     * hall gets one (a recorded session needs none). */
+    CHECK(write_text("../../h/hall.json.bak", "x") && rename("../../h/hall.json", "../../h/hall.json.bak") == 0);
+    CHECK(write_text("../../h/hall.json", "{\"scene\": \"../plan/demo_planned.json\", \"camera\": \"camera.json\"}"));
+    argc = line(argv, "mrcheck", "view", "../../h", NULL);
+    memset(&err, 0, sizeof err);
+    CHECK(!mr_hall_args_expand(argc, argv, &ha, &err) && strstr(err.msg, "no marker map") && strstr(err.msg, "mrcheck map"));
+    mr_hall_args_free(&ha);
+    argc = line(argv, "mrcheck", "view", "../../h", "--replay", "walk", NULL);
+    CHECK_MSG(mr_hall_args_expand(argc, argv, &ha, &err), "%s", err.msg);
+    mr_hall_args_free(&ha);
+    CHECK(rename("../../h/hall.json.bak", "../../h/hall.json") == 0);
+
     /* A recording outside the hall: its marks go into the hall, never
      * next to it (shipped recordings stay as they are). */
     char rec[4096];

@@ -135,7 +135,16 @@ static bool fill(mr_hall_args *a, const hall_cmd *c, const char *session, mr_err
         if (c->live && (i == MR_HALL_CAMERA || i == MR_HALL_MARKERS)) want = !recorded;
         if (i == MR_HALL_CONTROL && c->unless && find_flag(a->argc, a->argv, c->unless, NULL) >= 0) want = false;
         if (!want || find_flag(a->argc, a->argv, mr_hall_item_keys[i], NULL) >= 0) continue;
-        if (!mr_hall_path(h, (mr_hall_item)i, p, sizeof p)) continue; /* the command says what it lacks */
+        if (!mr_hall_path(h, (mr_hall_item)i, p, sizeof p)) {
+            /* Live tracking needs both: say how the hall gets them. */
+            if (c->live && i == MR_HALL_CAMERA && find_flag(a->argc, a->argv, "view", NULL) < 0)
+                return mr_fail(err, MR_ERR_INVALID, "hall %s has no camera yet: mrcheck calibrate %s --images DIR --board B.json "
+                               "(or mrcheck hall add %s --camera C.json)", h->dir, h->dir, h->dir);
+            if (c->live && i == MR_HALL_MARKERS && find_flag(a->argc, a->argv, "view", NULL) < 0)
+                return mr_fail(err, MR_ERR_INVALID, "hall %s has no marker map yet: mrcheck map %s --images DIR --tag-size S "
+                               "(or mrcheck hall add %s --markers M.json)", h->dir, h->dir, h->dir);
+            continue; /* the command says what it lacks */
+        }
         if (!add_flag(a, mr_hall_item_keys[i], p)) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
     }
     if (c->live && !session && find_flag(a->argc, a->argv, "input", NULL) < 0 && find_flag(a->argc, a->argv, "view", NULL) < 0 &&
