@@ -28,20 +28,6 @@ static const struct {
     {"hall", cmd_hall, "a hall folder: plan, camera, marker map, tolerances and sessions in one place"},
 };
 
-/* A hall on the command line stands for the files it names (lib/session). */
-static int run(int (*cmd)(int, char **), int argc, char **argv) {
-    mr_hall_args ha;
-    mr_error err = {0};
-    int rc = 2;
-    if (mr_hall_args_expand(argc, argv, &ha, &err)) rc = cmd(ha.argc, ha.argv);
-    else mr_cli_error(argv[1], &err);
-    for (int i = 2; rc == 0 && i < argc && mr_hall_args_help(argv[1]); i++)
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) fputs(mr_hall_args_help(argv[1]), stdout);
-    if (!mr_hall_args_finish(&ha, rc, &err)) rc = mr_cli_error(argv[1], &err);
-    mr_hall_args_free(&ha);
-    return rc;
-}
-
 static void usage(FILE *f) {
     fprintf(f, "usage: mrcheck <command> [options]   (mrcheck <command> --help for details)\n\ncommands:\n");
     for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)
@@ -62,7 +48,7 @@ int main(int argc, char **argv) {
         return 0;
     }
     for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)
-        if (strcmp(argv[1], k_commands[i].name) == 0) return run(k_commands[i].run, argc, argv);
+        if (strcmp(argv[1], k_commands[i].name) == 0) return mr_hall_run(k_commands[i].run, argc, argv); /* HALL stands for its files */
     fprintf(stderr, "mrcheck: unknown command '%s' (see mrcheck --help)\n", argv[1]);
     return 2;
 }

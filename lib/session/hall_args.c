@@ -226,3 +226,20 @@ void mr_hall_args_free(mr_hall_args *a) {
     free(a->argv);
     memset(a, 0, sizeof *a);
 }
+
+int mr_hall_run(int (*cmd)(int argc, char **argv), int argc, char **argv) {
+    mr_hall_args ha;
+    mr_error err = {0};
+    int rc = 2;
+    if (mr_hall_args_expand(argc, argv, &ha, &err)) rc = cmd(ha.argc, ha.argv);
+    else mr_cli_error(argv[1], &err);
+    const char *help = argc >= 2 ? mr_hall_args_help(argv[1]) : NULL;
+    for (int i = 2; rc == 0 && help && i < argc; i++)
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            fputs(help, stdout);
+            break;
+        }
+    if (!mr_hall_args_finish(&ha, rc, &err)) rc = mr_cli_error(argv[1], &err);
+    mr_hall_args_free(&ha);
+    return rc;
+}

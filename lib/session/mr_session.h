@@ -699,6 +699,11 @@ const char *mr_hall_args_help(const char *cmd);
  * the manifest could not be written. */
 bool mr_hall_args_finish(mr_hall_args *a, int rc, mr_error *err);
 void mr_hall_args_free(mr_hall_args *a);
+/* Runs a command (argv[1] its name) with its hall expanded: a bad hall is
+ * one line and exit status 2; --help adds mr_hall_args_help; after a
+ * successful run the file it wrote into the hall is named in hall.json.
+ * Returns the command's exit status. */
+int mr_hall_run(int (*cmd)(int argc, char **argv), int argc, char **argv);
 
 #ifdef __cplusplus
 }
