@@ -90,6 +90,10 @@ study_no_exclusion|lib/study/analyze.c|if (!out) kept.v[kept.count++] = votes->v
 study_no_break|lib/study/run.c|r->in_break = !done(r) && r->fixation && r->shown_block|r->in_break = false && r->shown_block|^test_study_designs$
 study_tap_units|lib/study/analyze_rt.c|eu = epx * k->units_per_px;|eu = epx;|^test_study_designs$
 study_overall_rotation|lib/study/run.c|answered = true, answer = (t->right + i) % n;|answered = true, answer = i;|^test_study_designs$
+gltf_sparse_values_at_index_offset|lib/scene/gltf_io.cc|        vp += sp.values.byteOffset;|        vp += sp.indices.byteOffset;|^test_gltf_ext$
+gltf_sparse_short_32768|lib/scene/gltf_io.cc|return norm ? std::max(v / 32767.0, -1.0) : (double)v;|return norm ? std::max(v / 32768.0, -1.0) : (double)v;|^test_gltf_ext$
+bcf_viewpoint_guid_is_topic|lib/export/findings.c|mr_bcf_guid(key, n, 2, f->viewpoint_guid);|mr_bcf_guid(key, n, 1, f->viewpoint_guid);|^test_export$
+study_cmax_odd_even_formula|lib/study/stats.c|(t % 2) ? (td * td * td - td) / 24.0|(t % 2) ? (td * td * td - 4 * td) / 24.0|^test_study$
 LIST
 )
 

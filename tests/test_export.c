@@ -273,6 +273,57 @@ static void test_undistort(void) {
     mr_image_free(&src);
 }
 
+/* Every Guid="..." attribute of doc, with what it names: a viewpoint's
+ * Guid appears where it is defined and where it is referred to
+ * (Viewpoints, ViewPoint, Viewpoint, VisualizationInfo); a topic's and a
+ * comment's once. Two different things (or two topics' things) sharing a
+ * GUID is a broken archive for any BCF reader. */
+typedef struct {
+    char guid[40];
+    char kind[24];
+    int topic;
+} guid_use;
+
+static int collect_guids(const char *doc, int topic, guid_use *u, int n, int cap) {
+    for (const char *p = doc; (p = strstr(p, " Guid=\"")) && n < cap; p++) {
+        const char *lt = p;
+        while (lt > doc && *lt != '<') lt--;
+        char elem[24] = "";
+        size_t k = 0;
+        for (const char *q = lt + 1; q < p && k + 1 < sizeof elem && *q != ' '; q++) elem[k++] = *q;
+        elem[k] = 0;
+        bool vp = strcmp(elem, "Viewpoints") == 0 || strcmp(elem, "ViewPoint") == 0 || strcmp(elem, "Viewpoint") == 0 ||
+                  strcmp(elem, "VisualizationInfo") == 0;
+        snprintf(u[n].kind, sizeof u[n].kind, "%s", vp ? "viewpoint" : elem);
+        const char *a = p + 7, *e = strchr(a, '"');
+        size_t l = e ? (size_t)(e - a) : 0;
+        if (l >= sizeof u[n].guid) l = sizeof u[n].guid - 1;
+        memcpy(u[n].guid, a, l);
+        u[n].guid[l] = 0;
+        u[n].topic = topic;
+        n++;
+    }
+    return n;
+}
+
+/* The GUIDs of distinct things are distinct: one GUID, one thing. */
+static void check_guids_distinct(const guid_use *u, int n) {
+    int things = 0;
+    for (int i = 0; i < n; i++) {
+        CHECK_MSG(is_lower_guid(u[i].guid), "%s Guid '%s'", u[i].kind, u[i].guid);
+        bool first = true;
+        for (int j = 0; j < i; j++)
+            if (strcmp(u[i].guid, u[j].guid) == 0) {
+                first = false;
+                CHECK_MSG(strcmp(u[i].kind, u[j].kind) == 0 && u[i].topic == u[j].topic,
+                          "GUID %s names a %s of topic %d and a %s of topic %d", u[i].guid, u[i].kind, u[i].topic,
+                          u[j].kind, u[j].topic);
+            }
+        things += first;
+    }
+    CHECK_MSG(things >= 3, "only %d distinct GUIDs", things);
+}
+
 static void check_archive(const char *path, mr_bcf_version v, const mr_dmat4 *poses, const char *const *titles,
                           int n, bool descs) {
     int ze = 0;
@@ -310,6 +361,8 @@ static void check_archive(const char *path, mr_bcf_version v, const mr_dmat4 *po
         }
     }
     CHECK(dirs == n);
+    guid_use guids[64];
+    int nguid = 0;
     for (zip_int64_t i = 0; i < entries; i++) {
         const char *name = zip_get_name(z, (zip_uint64_t)i, 0);
         if (!name || strlen(name) != 37 || name[36] != '/') continue;
@@ -326,6 +379,8 @@ static void check_archive(const char *path, mr_bcf_version v, const mr_dmat4 *po
             free(mk), free(vp), free(png);
             continue;
         }
+        nguid = collect_guids(mk, (int)i, guids, nguid, 64);
+        nguid = collect_guids(vp, (int)i, guids, nguid, 64);
         /* Which mark: the title. */
         char title[160] = "";
         CHECK(tag_text(mk, "Title", title, sizeof title));
@@ -408,6 +463,7 @@ static void check_archive(const char *path, mr_bcf_version v, const mr_dmat4 *po
         free(mk), free(vp), free(png);
     }
     CHECK(topics == n);
+    check_guids_distinct(guids, nguid);
     zip_close(z);
 }
 

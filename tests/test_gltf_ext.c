@@ -277,6 +277,81 @@ static void test_sparse_and_zeros(void) {
     expect_refused(bad, NULL, 0, "without a bufferView", __LINE__);
 }
 
+/* Sparse accessors over a strided bufferView, every part at its own
+ * non-zero offset (accessor, sparse indices, sparse values) and other
+ * bytes where a wrong offset would land: float POSITION with ushort
+ * indices, normalised SHORT TEXCOORD_0 with ubyte indices. Every value
+ * bit for bit as the specification converts it (c / 32767, -32768 clamps
+ * to -1). */
+static void put16(unsigned char *b, size_t at, int v) {
+    uint16_t h = (uint16_t)(v & 0xffff);
+    memcpy(b + at, &h, 2);
+}
+
+static void test_sparse_offsets(void) {
+    enum { nv = 6 };
+    unsigned char bin[256];
+    for (size_t i = 0; i < sizeof bin; i++) bin[i] = (unsigned char)(0x5a ^ (i * 37)); /* no zeros to hide in */
+    /* view 0 (0..100): positions, stride 16, accessor offset 4 */
+    float pos[nv][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {2, 0, 1}, {3, 0, 1}, {2, 1.5f, 1}};
+    for (int v = 0; v < nv; v++) memcpy(bin + 4 + 16 * v, pos[v], 12);
+    /* view 1 (100..176): uvs, stride 12, accessor offset 4, normalised SHORT */
+    int uv[nv][2] = {{100, -200}, {3000, 4000}, {-5000, 6000}, {7000, -8000}, {9000, 10000}, {-11000, 12000}};
+    for (int v = 0; v < nv; v++) put16(bin, 100 + 4 + 12 * (size_t)v, uv[v][0]), put16(bin, 100 + 6 + 12 * (size_t)v, uv[v][1]);
+    /* view 2 (176..184): position sparse indices (ushort 0, 3) at offset 2 */
+    put16(bin, 178, 0), put16(bin, 180, 3);
+    /* view 3 (184..216): position sparse values (2 float3) at offset 6 */
+    const float spv[2][3] = {{-1.25f, 0.5f, 0.75f}, {2.5f, -0.5f, 1.125f}};
+    memcpy(bin + 190, spv, 24);
+    /* view 4 (216..224): uv sparse indices (ubyte 1, 4, 5) at offset 3 */
+    bin[219] = 1, bin[220] = 4, bin[221] = 5;
+    /* view 5 (224..256): uv sparse values (3 short2) at offset 8 */
+    const int suv[3][2] = {{32767, -32768}, {-32767, 12345}, {1, -1}};
+    for (int i = 0; i < 3; i++) put16(bin, 224 + 8 + 4 * (size_t)i, suv[i][0]), put16(bin, 224 + 10 + 4 * (size_t)i, suv[i][1]);
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{%s\"extensionsUsed\":[\"KHR_mesh_quantization\"],\"extensionsRequired\":[\"KHR_mesh_quantization\"],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1}}]}],"
+             "\"buffers\":[{\"byteLength\":256}],\"bufferViews\":["
+             "{\"buffer\":0,\"byteLength\":100,\"byteStride\":16},{\"buffer\":0,\"byteOffset\":100,\"byteLength\":76,\"byteStride\":12},"
+             "{\"buffer\":0,\"byteOffset\":176,\"byteLength\":8},{\"buffer\":0,\"byteOffset\":184,\"byteLength\":32},"
+             "{\"buffer\":0,\"byteOffset\":216,\"byteLength\":8},{\"buffer\":0,\"byteOffset\":224,\"byteLength\":32}],"
+             "\"accessors\":[{\"bufferView\":0,\"byteOffset\":4,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\","
+             "\"sparse\":{\"count\":2,\"indices\":{\"bufferView\":2,\"byteOffset\":2,\"componentType\":5123},"
+             "\"values\":{\"bufferView\":3,\"byteOffset\":6}}},"
+             "{\"bufferView\":1,\"byteOffset\":4,\"componentType\":5122,\"normalized\":true,\"count\":%d,\"type\":\"VEC2\","
+             "\"sparse\":{\"count\":3,\"indices\":{\"bufferView\":4,\"byteOffset\":3,\"componentType\":5121},"
+             "\"values\":{\"bufferView\":5,\"byteOffset\":8}}}]}",
+             k_head, nv, nv);
+    memcpy(pos[0], spv[0], 12);
+    memcpy(pos[3], spv[1], 12);
+    for (int i = 0; i < 3; i++) uv[(int[]){1, 4, 5}[i]][0] = suv[i][0], uv[(int[]){1, 4, 5}[i]][1] = suv[i][1];
+    mr_error err = {0};
+    mr_scene *s = load_glb(json, bin, sizeof bin, &err);
+    CHECK_MSG(s && s->mesh_count == 1 && s->meshes[0].vertex_count == nv && s->meshes[0].uvs, "sparse offsets: %s",
+              err.msg);
+    if (s && s->mesh_count == 1 && s->meshes[0].vertex_count == nv && s->meshes[0].uvs) {
+        const mr_mesh *m = &s->meshes[0];
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int v = 0; v < nv; v++)
+            for (int k = 0; k < 3; k++) lo[k] = fmin(lo[k], pos[v][k]), hi[k] = fmax(hi[k], pos[v][k]);
+        int bad = 0;
+        for (int v = 0; v < nv; v++) {
+            for (int k = 0; k < 3; k++) {
+                float want = (float)((double)pos[v][k] - (0.5 * lo[k] + 0.5 * hi[k]));
+                bad += memcmp(&want, &m->positions[3 * v + k], 4) != 0 && !(want == 0 && m->positions[3 * v + k] == 0);
+            }
+            for (int k = 0; k < 2; k++) {
+                float want = (float)fmax(uv[v][k] / 32767.0, -1.0);
+                CHECK_MSG(memcmp(&want, &m->uvs[2 * v + k], 4) == 0, "uv %d.%d: %.9g, want %.9g", v, k, m->uvs[2 * v + k],
+                          want);
+            }
+        }
+        CHECK_MSG(bad == 0, "%d sparse-substituted positions differ", bad);
+    }
+    mr_scene_destroy(&s);
+}
+
 /* The GLB container and its lies. */
 static void test_glb_lies(void) {
     float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
@@ -1177,6 +1252,7 @@ int main(void) {
     test_quantization();
     test_quantized_values();
     test_sparse_and_zeros();
+    test_sparse_offsets();
     test_glb_lies();
     test_meshopt();
     test_meshopt_shared();

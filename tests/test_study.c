@@ -92,6 +92,46 @@ static void test_consistence_table51(void) {
     CHECK_NEAR(c.xi_kendall, 0, 1e-12);
 }
 
+/* Consistence at odd and even t >= 5, where Kendall's maximum differs by
+ * parity ((t^3-t)/24 odd, (t^3-4t)/24 even) and no clamp hides it: a
+ * transitive tournament 0 > 1 > ... > t-1 with one result reversed, the
+ * circular triads counted by hand (each j between the reversed pair's
+ * ends closes one). */
+static void test_consistence_odd_even(void) {
+    static const struct { int t, lo, hi; double c, xi, xik; } cases[] = {
+        {5, 0, 2, 1, 1 - 24.0 * 1 / 120, 1 - 1.0 / 5},   /* cmax 5 */
+        {5, 0, 4, 3, 1 - 24.0 * 3 / 120, 1 - 3.0 / 5},   /* cmax 5 */
+        {6, 0, 3, 2, 1 - 24.0 * 2 / 210, 1 - 2.0 / 8},   /* cmax 8 */
+        {7, 0, 6, 5, 1 - 24.0 * 5 / 336, 1 - 5.0 / 14},  /* cmax 14 */
+        {8, 1, 5, 3, 1 - 24.0 * 3 / 504, 1 - 3.0 / 20}}; /* cmax 20 */
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        int t = cases[k].t;
+        double A[64] = {0};
+        for (int i = 0; i < t; i++)
+            for (int j = i + 1; j < t; j++) A[i * t + j] = 1;
+        A[cases[k].lo * t + cases[k].hi] = 0, A[cases[k].hi * t + cases[k].lo] = 1;
+        mr_study_consistence c = mr_study_consistence_of(A, t);
+        CHECK_MSG(fabs(c.c - cases[k].c) < 1e-12, "t %d: c %g, want %g", t, c.c, cases[k].c);
+        CHECK_MSG(fabs(c.xi - cases[k].xi) < 1e-12, "t %d: xi %g, want %g", t, c.xi, cases[k].xi);
+        CHECK_MSG(fabs(c.xi_kendall - cases[k].xik) < 1e-12, "t %d: Kendall's xi %g, want %g", t, c.xi_kendall,
+                  cases[k].xik);
+    }
+    /* Agreement at t = 5 and 6, three judges: a pair 3:0 adds 3 agreeing
+     * judge pairs, 2:1 adds 1, of 3 possible; u = 2 tau / max_tau - 1. */
+    for (int t = 5; t <= 6; t++) {
+        double A[36] = {0};
+        int pairs = 0, split = 0;
+        for (int i = 0; i < t; i++)
+            for (int j = i + 1; j < t; j++, pairs++) {
+                bool s = (i + j) % 3 == 0;
+                split += s;
+                A[i * t + j] = s ? 2 : 3, A[j * t + i] = s ? 1 : 0;
+            }
+        double want = 2.0 * (3 * (pairs - split) + split) / (3.0 * pairs) - 1;
+        CHECK_MSG(fabs(mr_study_agreement(A, t) - want) < 1e-12, "t %d: u %g, want %g", t, mr_study_agreement(A, t), want);
+    }
+}
+
 static void test_agreement_tables(void) {
     /* Table 5.2: each pair 48 : 0 one way or the other, N = 48 -> u = 1. */
     const double A2[16] = {0, 0, 48, 0,  48, 0, 0, 48,  0, 48, 0, 0,  48, 0, 48, 0};
@@ -589,6 +629,7 @@ static void test_runner(void) {
 int main(void) {
     test_families();
     test_consistence_table51();
+    test_consistence_odd_even();
     test_agreement_tables();
     test_split_and_indifference();
     test_binomial();
