@@ -389,6 +389,12 @@ view_fails bad_image "$tmp/late.png" --scene "$d/scene_planned.json" --input "$t
 view_fails bad_scene_jpeg "not_a_scene.jpg" --scene "$tmp/not_a_scene.jpg" --replay "$d" --paused
 view_fails bad_scene_missing "missing.glb" --scene "$tmp/missing.glb" --replay "$d" --paused
 view_fails bad_empty_recording "empty_recording" --scene "$d/scene_planned.json" --replay "$tmp/empty_recording"
+# A real JPEG (a camera frame) as the scene, and a tolerance table that
+# does not load (Measure's verdicts need it): at start, one line each.
+view_fails bad_scene_real_jpeg "000000.jpg" --scene "$d/recording/frames/000000.jpg" --replay "$d/recording" --paused
+printf '{"parts": {"Machine_*": -5}}' >"$tmp/bad_tolerances.json"
+view_fails bad_tolerances "bad_tolerances.json" --scene "$d/scene_planned.json" --replay "$d/recording" --paused \
+  --tolerances "$tmp/bad_tolerances.json"
 [ ! -e "$tmp/bad_session/annotations.jsonl" ] && ok || bad "a failed start wrote marks"
 
 # 6b. Esc never quits: Esc with nothing going on, in mark mode, with the
