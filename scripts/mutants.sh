@@ -2,13 +2,18 @@
 # Plants known bugs one at a time and checks that the test suite catches
 # each: the bugs a reviewer planted for issue 10, and variants of them.
 # For every mutant: the source is changed (a literal text replacement that
-# must match exactly once), build/ is rebuilt, the named tests run through
-# ctest-strict.sh (so a skip counts as caught, as in scripts/test.sh), and
-# the source is restored. Prints one line per mutant and exits non-zero if
-# any mutant survived. Not part of CI (about 2 minutes on 2 cores):
+# must match exactly once), the test targets the mutant names are rebuilt
+# in build/ (the same build for every mutant, so only the mutated file
+# recompiles), the named tests run through ctest-strict.sh (so a skip
+# counts as caught, as in scripts/test.sh), and the source is restored.
+# Prints one line per mutant and exits non-zero if any mutant survived,
+# does not compile, or names text that is no longer in its file.
 #   bash scripts/mutants.sh            # all mutants
 #   bash scripts/mutants.sh flip rot   # only those whose name contains a word
 #   bash scripts/mutants.sh --check    # only that every entry still matches
+#   bash scripts/mutants.sh --changed [BASE]
+#       # only the mutants a change since BASE can affect (CI runs this;
+#       # docs/development.md gives the rule and how BASE is chosen)
 # Needs a configured build/ (bash scripts/build.sh) and a clean tree for the
 # files it touches.
 set -uo pipefail
@@ -116,6 +121,50 @@ if [ "${1:-}" = --check ]; then
   exit
 fi
 
+# --changed [BASE]: the mutants a change since BASE can affect. BASE is the
+# argument, else $MR_MUTANTS_BASE, else the commit in .ci/mutants-base (the
+# last commit CI passed on, recorded by whoever lands a green CI run). The
+# change is git diff from merge-base(BASE, HEAD) to the working tree. A
+# mutant runs when its file changed, when a test its regex names changed
+# (tests/NAME.c or .sh: a weakened test must still catch it), or when its
+# own line in this list is new or edited. Every mutant runs when a shared
+# header changed (lib/*/mr_*.h, lib/*/*_internal.h, tests/mr_test*.h, a
+# shader include: shaders/NAME.h or NAME.glsl without a stage), and when
+# BASE is not in this clone's history (a shallow clone, a rewritten main):
+# running more is safe, fewer is not.
+only=""
+if [ "${1:-}" = --changed ]; then
+  base=${2:-${MR_MUTANTS_BASE:-$(cat .ci/mutants-base 2>/dev/null || true)}}
+  base=${base%%[[:space:]]*}
+  if [ -z "$base" ] || ! git cat-file -e "$base^{commit}" 2>/dev/null || ! mb=$(git merge-base "$base" HEAD 2>/dev/null); then
+    echo "mutants: base '${base:-none}' is not in this clone's history: running every mutant"
+    only=all
+  else
+    changed=$( { git diff --name-only "$mb"; git ls-files --others --exclude-standard; } | sort -u)
+    echo "mutants: changes since ${base:0:12} (merge-base ${mb:0:12}): $(grep -c . <<<"$changed" || true) file(s)"
+    if grep -qE '^(lib/[^/]+/mr_[^/]+\.h|lib/[^/]+/[^/]+_internal\.h|tests/mr_test[^/]*\.h|shaders/[^/.]+\.(h|glsl))$' <<<"$changed"; then
+      echo "mutants: a shared header changed: running every mutant"
+      only=all
+    else
+      newlines=$(git diff "$mb" -- scripts/mutants.sh | sed -n 's/^+\([^+|][^|]*\)|.*/\1/p')
+      while IFS='|' read -r name file text repl tests; do
+        [ -n "$name" ] || continue
+        hit=0
+        grep -qxF -- "$file" <<<"$changed" && hit=1
+        grep -qxF -- "$name" <<<"$newlines" && hit=1
+        for t in $(grep -oE '(test|cli|fuzz)_[A-Za-z0-9_]+' <<<"$tests"); do
+          grep -qxE "tests/$t\.(c|cc|sh)" <<<"$changed" && hit=1
+        done
+        [ $hit -eq 1 ] && only="$only $name"
+      done <<<"$mutants"
+      [ -n "$only" ] || { echo "mutants: no mutant's file, test or entry changed: nothing to run"; exit 0; }
+      echo "mutants: to run:$only"
+    fi
+  fi
+  set --
+  [ -z "${MR_MUTANTS_DRY:-}" ] || exit 0
+fi
+
 backup=$(mktemp -d)
 current=""
 restore() {
@@ -124,9 +173,13 @@ restore() {
 trap 'restore; rm -rf "$backup"' EXIT
 trap 'exit 130' INT TERM
 
-survived=0 caught=0
+survived=0 caught=0 built=""
+start=$(date +%s)
 while IFS='|' read -r name file text repl tests; do
   [ -n "$name" ] || continue
+  if [ -n "$only" ] && [ "$only" != all ]; then
+    [[ " $only " == *" $name "* ]] || continue
+  fi
   if [ $# -gt 0 ]; then
     want=0
     for w in "$@"; do case $name in *"$w"*) want=1 ;; esac; done
@@ -145,7 +198,22 @@ while IFS='|' read -r name file text repl tests; do
     survived=$((survived + 1))
     continue
   fi
-  if ! cmake --build build -j"$(nproc)" >"$backup/build.log" 2>&1; then
+  # Build only what the named tests run when the regex names them exactly
+  # (^name$ or ^(a|b)$; cli_* scripts run mrcheck); otherwise everything.
+  targets=""
+  if [[ $tests =~ ^\^\(?([A-Za-z0-9_|]+)\)?\$$ ]]; then
+    for t in ${BASH_REMATCH[1]//|/ }; do
+      case $t in
+        cli_* | module_map | header_alone_*) targets="$targets mrcheck" ;;
+        *) targets="$targets $t" ;;
+      esac
+    done
+    # test_track_retrack runs the binary too (tests/CMakeLists.txt)
+    [[ " $targets " == *" test_track_retrack "* ]] && targets="$targets mrcheck"
+  fi
+  if [ -n "$targets" ]; then build_args=(--target $targets); else build_args=(); fi
+  built="$built ${targets:-all}"
+  if ! cmake --build build -j"$(nproc)" "${build_args[@]}" >"$backup/build.log" 2>&1; then
     echo "ERROR    $name: the mutant does not compile"
     tail -n 5 "$backup/build.log"
     restore
@@ -164,7 +232,7 @@ while IFS='|' read -r name file text repl tests; do
 done <<<"$mutants"
 
 # A hidden EGL (no vendor library) must fail the suite, not skip it.
-if [ $# -eq 0 ] || [[ " $* " == *" egl"* ]]; then
+if { [ $# -eq 0 ] && { [ -z "$only" ] || [ "$only" = all ] || [[ " $only " == *" gl_"* ]]; }; } || [[ " $* " == *" egl"* ]]; then
   if __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent bash scripts/ctest-strict.sh build -R '^(test_render|cli_render)$' >"$backup/test.log" 2>&1; then
     echo "SURVIVED egl_hidden: the suite passes without EGL"
     survived=$((survived + 1))
@@ -174,7 +242,13 @@ if [ $# -eq 0 ] || [[ " $* " == *" egl"* ]]; then
   fi
 fi
 
+# Rebuild what was built from a mutant (the restored sources are newer).
 echo "rebuilding the unmutated tree ..."
-cmake --build build -j"$(nproc)" >/dev/null 2>&1
-echo "mutants: $caught caught, $survived survived or broken"
+if [[ " $built " == *" all "* ]] || [ -z "$built" ]; then
+  cmake --build build -j"$(nproc)" >/dev/null 2>&1
+else
+  # shellcheck disable=SC2086
+  cmake --build build -j"$(nproc)" --target $(tr ' ' '\n' <<<"$built" | sort -u | paste -sd ' ') >/dev/null 2>&1
+fi
+echo "mutants: $caught caught, $survived survived or broken ($(($(date +%s) - start)) s)"
 [ $survived -eq 0 ]
