@@ -99,6 +99,9 @@ gltf_sparse_values_at_index_offset|lib/scene/gltf_io.cc|        vp += sp.values.
 gltf_sparse_short_32768|lib/scene/gltf_io.cc|return norm ? std::max(v / 32767.0, -1.0) : (double)v;|return norm ? std::max(v / 32768.0, -1.0) : (double)v;|^test_gltf_ext$
 bcf_viewpoint_guid_is_topic|lib/export/findings.c|mr_bcf_guid(key, n, 2, f->viewpoint_guid);|mr_bcf_guid(key, n, 1, f->viewpoint_guid);|^test_export$
 study_cmax_odd_even_formula|lib/study/stats.c|(t % 2) ? (td * td * td - td) / 24.0|(t % 2) ? (td * td * td - 4 * td) / 24.0|^test_study$
+map_huber_scale_unweighted|lib/track/map_ba.cc|ceres::HuberLoss loss2(loss_px * w);|ceres::HuberLoss loss2(loss_px);|^test_map$
+map_control_residual_sign|lib/track/map.c|cr->residual[1] = pr.y - p->controls[q].world.y;|cr->residual[1] = p->controls[q].world.y - pr.y;|^test_map$
+map_control_loo_sign|lib/track/map.c|cr->loo[1] = pr.y - p->controls[q].world.y;|cr->loo[1] = p->controls[q].world.y - pr.y;|^test_map$
 LIST
 )
 

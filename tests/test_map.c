@@ -264,6 +264,13 @@ static void test_control_points(void) {
     for (int q = 0; q < 5; q++) CHECK(r.controls[q].outlier == (q == 2) && r.controls[q].used == (q != 2));
     map_error(&r, &s.truth, &e_rms, &e_max, &e_deg, &z);
     CHECK(e_max < 0.010);
+    /* Its residual and leave-one-out offset are adjusted minus measured:
+     * measured 5 cm high in y, so -5 cm in y, near 0 in x and z. */
+    const mr_map_control_result *c2 = &r.controls[2];
+    CHECK_MSG(fabs(c2->residual[1] + 0.05) < 0.01 && fabs(c2->residual[0]) < 0.01 && fabs(c2->residual[2]) < 0.01,
+              "residual %.4f %.4f %.4f m, want 0 -0.05 0", c2->residual[0], c2->residual[1], c2->residual[2]);
+    CHECK_MSG(fabs(c2->loo[1] + 0.05) < 0.01 && fabs(c2->loo[0]) < 0.01 && fabs(c2->loo[2]) < 0.01,
+              "leave-one-out %.4f %.4f %.4f m, want 0 -0.05 0", c2->loo[0], c2->loo[1], c2->loo[2]);
     mr_map_result_free(&r);
     ctl[2].world.y -= 0.05;
 
@@ -345,10 +352,42 @@ static void test_refine_intrinsics(void) {
     mr_synth_map_free(&s);
 }
 
+/* The Huber scale is in pixels in both passes: the second pass weighs the
+ * corners by 1/sigma, so its loss scale must be weighed the same. On a
+ * clean set (0.2 px corners, no misdetection) no residual reaches 1 px,
+ * so the default loss gives the same map as a loss that never bends
+ * (1000 px); a scale left unweighted (0.2 px in effect) bends a third of
+ * them and moves the tags by millimetres. */
+static void test_loss_scale_in_pixels(void) {
+    mr_synth_map_params sp = room_params(8, 24);
+    mr_synth_map s;
+    mr_error err = {0};
+    mr_map_photo ph[128];
+    CHECK(room_make(&sp, &s, ph, &err));
+    mr_map_params mp = MR_MAP_DEFAULTS;
+    mp.tag_size = sp.tag_size;
+    mp.fix_id = 0;
+    mp.fix_pose = &s.truth.tags[0].world_from_tag;
+    mr_map_result def, wide;
+    CHECK_MSG(mr_map_build(&s.camera, ph, s.photo_count, &mp, &def, &err), "%s", err.msg);
+    mp.loss_px = 1000;
+    CHECK_MSG(mr_map_build(&s.camera, ph, s.photo_count, &mp, &wide, &err), "%s", err.msg);
+    double worst = 0;
+    CHECK(def.tag_count == wide.tag_count);
+    for (int i = 0; i < def.tag_count && i < wide.tag_count; i++)
+        worst = fmax(worst, mr_pose_dist(&def.tags[i].world_from_tag, &wide.tags[i].world_from_tag));
+    printf("loss 1 px against 1000 px: tags differ by up to %.4f mm\n", worst * 1e3);
+    CHECK_MSG(worst < 1e-4, "tags differ by up to %.3f mm", worst * 1e3);
+    mr_map_result_free(&def);
+    mr_map_result_free(&wide);
+    mr_synth_map_free(&s);
+}
+
 int main(void) {
     test_refine_intrinsics();
     test_fixed_gauge_and_chaining();
     test_disconnected_mixed_misdetect();
     test_control_points();
+    test_loss_scale_in_pixels();
     return mr_test_finish("test_map");
 }
