@@ -102,6 +102,9 @@ study_cmax_odd_even_formula|lib/study/stats.c|(t % 2) ? (td * td * td - td) / 24
 map_huber_scale_unweighted|lib/track/map_ba.cc|ceres::HuberLoss loss2(loss_px * w);|ceres::HuberLoss loss2(loss_px);|^test_map$
 map_control_residual_sign|lib/track/map.c|cr->residual[1] = pr.y - p->controls[q].world.y;|cr->residual[1] = p->controls[q].world.y - pr.y;|^test_map$
 map_control_loo_sign|lib/track/map.c|cr->loo[1] = pr.y - p->controls[q].world.y;|cr->loo[1] = p->controls[q].world.y - pr.y;|^test_map$
+shadow_cascade_ratio_8|lib/render/pass_shadow.c|log(vis_far / vis_near) / log(CASCADE_RATIO)|log(vis_far / vis_near) / log(8.0)|^test_rules$
+shadow_cascade_unclamped|lib/render/pass_shadow.c|return n < 1 ? 1 : n > MR_SHADOW_MAX_CASCADES ? MR_SHADOW_MAX_CASCADES : n;|return n < 1 ? 1 : n;|^test_rules$
+shadow_cascade_atlas_unchecked|lib/render/pass_shadow.c|2 * (long)map_size > (long)max_tex) return 1;|2 * (long)map_size > 4 * (long)max_tex) return 1;|^test_rules$
 LIST
 )
 

