@@ -105,6 +105,11 @@ map_control_loo_sign|lib/track/map.c|cr->loo[1] = pr.y - p->controls[q].world.y;
 shadow_cascade_ratio_8|lib/render/pass_shadow.c|log(vis_far / vis_near) / log(CASCADE_RATIO)|log(vis_far / vis_near) / log(8.0)|^test_rules$
 shadow_cascade_unclamped|lib/render/pass_shadow.c|return n < 1 ? 1 : n > MR_SHADOW_MAX_CASCADES ? MR_SHADOW_MAX_CASCADES : n;|return n < 1 ? 1 : n;|^test_rules$
 shadow_cascade_atlas_unchecked|lib/render/pass_shadow.c|2 * (long)map_size > (long)max_tex) return 1;|2 * (long)map_size > 4 * (long)max_tex) return 1;|^test_rules$
+hlod_bound_no_simplification_error|lib/scene/hlod.c|n->error = e_in + h_err + rounding;|n->error = e_in + rounding;|^test_hlod$
+hlod_cut_unprojected|lib/scene/hlod.c|n->error * (p->fmax / zmin) <= p->pixels|n->error * p->fmax <= p->pixels|^test_hlod$
+hlod_cache_index_unchecked|lib/scene/hlod.c|if (n->indices[k] >= n->vertex_count) return false;|if (n->indices[k] > 0xffffffffu) return false;|^test_hlod$
+hlod_draw_one_id_per_proxy|lib/render/hlod_draw.c|gi->ids[0] = (uint32_t)q->node + 1;|gi->ids[0] = (uint32_t)hn->runs[0].node + 1;|^test_hlod_draw$
+hlod_draw_all_layers|lib/render/hlod_draw.c|cp.layers = vw->layers;|cp.layers = 3;|^test_hlod_draw$
 LIST
 )
 

@@ -28,24 +28,28 @@ typedef struct bench_config {
     bool no_cull, no_batch, no_instancing, no_lod, occlusion;
     bool no_occl_auto; /* automatic occlusion culling off */
     bool no_cluster;   /* cluster culling off */
+    bool hier;         /* the LOD hierarchy drawn (unique scenes build one) */
 } bench_config;
 
 /* "all" is the defaults, automatic occlusion culling included;
  * "none" switches everything off; "all+occl" forces occlusion on. */
 static const bench_config k_configs[] = {
-    {"all", false, false, false, false, false, false, false},
-    {"no-cull", true, false, false, false, false, false, false},
-    {"no-batch", false, true, true, false, false, false, false},
-    {"no-lod", false, false, false, true, false, false, false},
-    {"none", true, true, true, true, false, true, true},
-    {"all+occl", false, false, false, false, true, false, false},
-    {"no-occl-auto", false, false, false, false, false, true, false},
+    {"all", false, false, false, false, false, false, false, false},
+    {"no-cull", true, false, false, false, false, false, false, false},
+    {"no-batch", false, true, true, false, false, false, false, false},
+    {"no-lod", false, false, false, true, false, false, false, false},
+    {"none", true, true, true, true, false, true, true, false},
+    {"all+occl", false, false, false, false, true, false, false, false},
+    {"no-occl-auto", false, false, false, false, false, true, false, false},
     /* Big meshes drawn whole, no meshlet culling */
-    {"no-cluster", false, false, false, false, false, false, true},
+    {"no-cluster", false, false, false, false, false, false, true, false},
+    /* "all" with the LOD hierarchy above the parts (the other rows: the
+     * part levels alone, as before) */
+    {"hier", false, false, false, false, false, false, false, true},
 };
 #define N_CONFIGS (int)(sizeof k_configs / sizeof k_configs[0])
 /* The defaults and the full-detail reference */
-enum { k_all = 0, k_none = 4 };
+enum { k_all = 0, k_none = 4, k_hier = 8 };
 
 
 typedef struct row {
@@ -145,6 +149,19 @@ static void report_goals(FILE *out, mr_csv *csv, const double *sizes, int nsizes
                      "frame ratio %s: frame_ms(%s, all) / frame_ms(%s, all) = %.1f / %.1f = %.2f; CPU ms %.1f / %.1f = %.2f",
                      mr_synth_view_name(v), size_label(sizes[si], la, sizeof la), size_label(sizes[0], lb, sizeof lb),
                      a->frame_ms, b->frame_ms, a->frame_ms / b->frame_ms, a->cpu_ms, b->cpu_ms, a->cpu_ms / b->cpu_ms);
+            goal_line(out, csv, line);
+        }
+    for (int v = 0; v < MR_SYNTH_VIEW_COUNT; v++)
+        for (int si = 1; si < nsizes; si++) {
+            const row *a = find_row(rows, n, si, v, k_hier), *b = find_row(rows, n, 0, v, k_hier);
+            if (!a || !b) continue;
+            snprintf(line, sizeof line,
+                     "hierarchy %s: frame_ms(%s, hier) / frame_ms(%s, hier) = %.1f / %.1f = %.2f; CPU ms %.1f / %.1f = "
+                     "%.2f; triangles %llu / %llu = %.2f",
+                     mr_synth_view_name(v), size_label(sizes[si], la, sizeof la), size_label(sizes[0], lb, sizeof lb),
+                     a->frame_ms, b->frame_ms, a->frame_ms / b->frame_ms, a->cpu_ms, b->cpu_ms, a->cpu_ms / b->cpu_ms,
+                     (unsigned long long)a->st.triangles, (unsigned long long)b->st.triangles,
+                     (double)a->st.triangles / (double)(b->st.triangles ? b->st.triangles : 1));
             goal_line(out, csv, line);
         }
     static const struct {
@@ -261,6 +278,10 @@ typedef struct size_info {
      * levels (mr_cluster_info.build_s, both cores), and the first build's
      * rate: input triangles per second of LOD and meshlets together */
     double cluster_build_s;
+    /* The LOD hierarchy (unique scenes): first build, cached open, its
+     * proxies' triangles */
+    double hlod_s, hlod_cached_s;
+    uint64_t hlod_tris;
 } size_info;
 
 /* One case: its line of the table and its CSV row. */
@@ -304,6 +325,11 @@ static void report_row(FILE *out, mr_csv *csv, const size_info *z, int v, int c,
         mr_csv_num(csv, "%.3f", r->cpu_ms);
         mr_csv_num(csv, "%.3f", z->cluster_build_s);
         mr_csv_num(csv, "%.3f", z->li.unique_triangles / (z->lod_s + z->cluster_build_s) / 1e6);
+        mr_csv_num(csv, "%.3f", z->hlod_s);
+        mr_csv_num(csv, "%.3f", z->hlod_cached_s);
+        mr_csv_int(csv, (long long)z->hlod_tris);
+        mr_csv_int(csv, (long long)st->hlod_proxies);
+        mr_csv_int(csv, (long long)st->hlod_triangles);
     }
     mr_csv_end_row(csv);
 }
@@ -337,12 +363,13 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
         failed = !mr_fail(err, MR_ERR_NOMEM, "out of memory");
         goto done;
     }
-    char header[1024];
+    char header[1280];
     snprintf(header, sizeof header, "scene_triangles,stored_triangles,nodes,file_mb,raw_parse_s,load_s,upload_s,load_upload_mb_s,"
                        "raw_parse_mb_s,lod_s,lod_from_cache,peak_rss_mb,view,config,frame_ms,cull_ms,gpu_geometry_ms,"
                        "triangles_submitted,draw_calls,commands,nodes_visible,nodes_drawable,nodes_occluded,lod_instances%s",
              p.unique ? ",lod_cached_s,unit,image_diff_pct,image_edge_pct,open_first_s,open_cached_s,timed_frames,frame_cpu_ms,"
-                       "cluster_build_s,lod_cluster_mtris_s" : "");
+                       "cluster_build_s,lod_cluster_mtris_s,hlod_s,hlod_cached_s,hlod_stored_triangles,hlod_proxies,"
+                       "hlod_triangles" : "");
     mr_csv_header(csv, header);
     BENCH_PRINT(out, "bench scene: %s, %dx%d, median of %ld frames", mr_gpu_description(gfx.gpu), w, h, frames);
     if (full_frames != frames) BENCH_PRINT(out, " (no-lod and none: %ld)", full_frames);
@@ -475,11 +502,44 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
             mr_scene_destroy(&s);
             goto done;
         }
+        /* The LOD hierarchy over the parts' levels: built (timed, the
+         * cache removed first), then opened from its cache, then set. */
+        mr_hlod *hl = NULL;
+        double hlod_s = 0, hlod_cached_s = 0;
+        if (p.unique) {
+            char hc[4096];
+            mr_hlod_cache_path(glb, hc, sizeof hc);
+            remove(hc);
+            mr_hlod_info hi;
+            t0 = mr_time_now();
+            hl = mr_hlod_load_or_build(s, lod, hc, NULL, &hi, err);
+            hlod_s = mr_time_now() - t0;
+            t0 = mr_time_now();
+            mr_hlod *again = hl ? mr_hlod_load_or_build(s, lod, hc, NULL, &hi, err) : NULL;
+            hlod_cached_s = mr_time_now() - t0;
+            if (again && !hi.from_cache) BENCH_PRINT(out, "  warning: the hierarchy cache %s was not used\n", hc);
+            if (again) {
+                mr_hlod_destroy(&hl);
+                hl = again;
+            }
+            ok = hl && mr_renderer_set_hlod(gfx.renderer, hl, err);
+            if (!ok) {
+                failed = true;
+                mr_hlod_destroy(&hl);
+                mr_lod_destroy(&lod);
+                mr_scene_destroy(&s);
+                goto done;
+            }
+            BENCH_PRINT(out, "  LOD hierarchy: %d tree nodes, %llu proxy triangles, built in %.2f s (%.0f scene triangles/s), "
+                        "from the cache %.3f s\n", (int)hl->node_count, (unsigned long long)hl->proxy_triangles, hlod_s,
+                        li.unique_triangles / hlod_s, hlod_cached_s);
+        }
         double mb = fsize / 1e6;
         /* The open as a user's: load, levels, upload with them */
         const size_info z = {li, (int)s->node_count, mb, parse_s, upload_s, lod_s, linfo.from_cache, p.unique,
                              lod_cached_s, cp.unit, li.load_s + lod_s + lod_upload_s,
-                             li.load_s + lod_cached_s + lod_upload_cached_s, ci_first.build_s};
+                             li.load_s + lod_cached_s + lod_upload_cached_s, ci_first.build_s, hlod_s, hlod_cached_s,
+                             hl ? hl->proxy_triangles : 0};
         for (int v = 0; v < MR_SYNTH_VIEW_COUNT && ok; v++) {
             mr_view view = mr_synth_view(&sp, p.unique ? &cp : NULL, v);
             /* All configurations of the view first,
@@ -496,6 +556,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
                 dp.occlusion = k_configs[c].occlusion;
                 dp.occlusion_auto = !k_configs[c].no_occl_auto;
                 dp.no_cluster_cull = k_configs[c].no_cluster;
+                dp.no_hlod = !k_configs[c].hier;
                 row *r = &rows[nrows];
                 r->tri_scene = (double)li.triangles;
                 r->view = v;
@@ -527,6 +588,7 @@ bool mr_bench_scene(const mr_bench_scene_params *params, mr_error *err) {
             BENCH_PRINT(out, "  open (load + LOD + upload with levels): first %.2f s, with the LOD cache %.2f s\n",
                         z.open_first_s, z.open_cached_s);
         mr_renderer_set_scene(gfx.renderer, NULL, err);
+        mr_hlod_destroy(&hl);
         mr_lod_destroy(&lod);
         mr_scene_destroy(&s);
         if (!ok) {

@@ -16,7 +16,7 @@
  * one glMultiDrawElementsIndirect. GL calls therefore grow with the number
  * of textures, not with the number of nodes, and a culled node costs nothing
  * on the GPU. */
-#include "render_internal.h"
+#include "geo_internal.h"
 #include "cluster_cache.h"
 
 #include <math.h>
@@ -26,21 +26,6 @@
 #include <string.h>
 
 #define LEVELS (MR_LOD_MAX_LEVELS + 1) /* full detail + simplified levels */
-
-/* One instance as the G-buffer vertex shader reads it (attributes 3..11). */
-typedef struct gpu_instance {
-    float modelview[16]; /* camera (OpenCV axes) from mesh, column-major */
-    float normal[12];    /* inverse transpose of its 3x3: 3 columns padded to vec4 */
-    float color[4];      /* linear RGBA base colour */
-    uint32_t ids[4];     /* node index + 1, layer, has texture, unused */
-} gpu_instance;
-
-/* glMultiDrawElementsIndirect's command layout. */
-typedef struct draw_cmd {
-    uint32_t count, instance_count, first_index;
-    int32_t base_vertex;
-    uint32_t base_instance;
-} draw_cmd;
 
 typedef struct geo_mesh {
     int32_t group;                 /* draw group: 0 untextured, 1 + t for texture t */
@@ -159,6 +144,7 @@ void mr_cluster_cache_path(const char *scene_path, char *out, size_t n) {
 
 void mr_geometry_free(mr_renderer *r) {
     mr_geometry_share_end(r); /* its lists index this geometry */
+    mr_hlod_gpu_free(r);      /* its proxies name this scene's nodes */
     struct mr_geo *g = r->geo;
     if (g) {
         glDeleteVertexArrays(2, g->vao);
@@ -194,26 +180,6 @@ void mr_geometry_free(mr_renderer *r) {
     r->textures = NULL;
     r->texture_count = 0;
     r->scene = NULL;
-}
-
-/* Upper bound of the largest singular value of the node's 3x3: the square
- * root of Gershgorin's bound on the largest eigenvalue of M^T M. Exact for
- * rotations and (rotated) axis scales, conservative for shears; LOD errors
- * in mesh units are multiplied by it. */
-static double stretch_bound(const mr_dmat4 *w) {
-    double mtm[3][3];
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) {
-            double acc = 0;
-            for (int k = 0; k < 3; k++) acc += w->m[k * 4 + i] * w->m[k * 4 + j];
-            mtm[i][j] = acc;
-        }
-    double best = 0;
-    for (int i = 0; i < 3; i++) {
-        double row = fabs(mtm[i][0]) + fabs(mtm[i][1]) + fabs(mtm[i][2]);
-        if (row > best) best = row;
-    }
-    return sqrt(best);
 }
 
 static bool upload_textures(mr_renderer *r, const mr_scene *s, mr_error *err) {
@@ -470,6 +436,18 @@ static level_job *level_job_at(level_job *job, size_t count, size_t *cursor, int
     return NULL;
 }
 
+void mr_geo_vao_instances(GLuint vao) {
+    for (GLuint a = 0; a < MR_ATTR_INSTANCE_SLOTS; a++) {
+        GLuint slot = MR_ATTR_INSTANCE + a;
+        glEnableVertexArrayAttrib(vao, slot);
+        if (slot == MR_ATTR_INST_IDS)
+            glVertexArrayAttribIFormat(vao, slot, 4, GL_UNSIGNED_INT, (GLuint)offsetof(gpu_instance, ids));
+        else glVertexArrayAttribFormat(vao, slot, 4, GL_FLOAT, GL_FALSE, a * 16);
+        glVertexArrayAttribBinding(vao, slot, 1);
+    }
+    glVertexArrayBindingDivisor(vao, 1, 1);
+}
+
 static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_error *err) {
     if (lod && lod->mesh_count != s->mesh_count) lod = NULL;
     if (!upload_textures(r, s, err)) return false;
@@ -566,15 +544,7 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
          * 1); the command's baseInstance offsets into it, so this works on
          * plain GL 4.5 (no gl_BaseInstance needed), and llvmpipe fetches
          * attributes much faster than it loads from an SSBO per vertex. */
-        for (GLuint a = 0; a < MR_ATTR_INSTANCE_SLOTS; a++) {
-            GLuint slot = MR_ATTR_INSTANCE + a;
-            glEnableVertexArrayAttrib(g->vao[p], slot);
-            if (slot == MR_ATTR_INST_IDS)
-                glVertexArrayAttribIFormat(g->vao[p], slot, 4, GL_UNSIGNED_INT, (GLuint)offsetof(gpu_instance, ids));
-            else glVertexArrayAttribFormat(g->vao[p], slot, 4, GL_FLOAT, GL_FALSE, a * 16);
-            glVertexArrayAttribBinding(g->vao[p], slot, 1);
-        }
-        glVertexArrayBindingDivisor(g->vao[p], 1, 1);
+        mr_geo_vao_instances(g->vao[p]);
     }
     glCreateBuffers(1, &g->ibo);
     glNamedBufferStorage(g->ibo, (GLsizeiptr)(indices ? indices : 1) * 4, NULL, GL_DYNAMIC_STORAGE_BIT);
@@ -635,7 +605,7 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
     size_t recs = 0;
     for (size_t i = 0; i < nn; i++) {
         const mr_node *n = &s->nodes[i];
-        g->node_scale[i] = stretch_bound(&n->world);
+        g->node_scale[i] = mr_stretch_bound(&n->world);
         const double *w = n->world.m; /* mirroring? */
         double det = w[0] * (w[5] * w[10] - w[6] * w[9]) - w[1] * (w[4] * w[10] - w[6] * w[8]) +
                      w[2] * (w[4] * w[9] - w[5] * w[8]);
@@ -733,12 +703,8 @@ static int choose_level(const geo_mesh *gm, double scale, double ppu, double tol
     return best;
 }
 
-/* Camera-relative model-view of one instance, in double, then float. */
-static bool fill_instance(const mr_geo_view *vw, const mr_node *n, const mr_mesh *m, const geo_mesh *gm, int32_t node,
-                          gpu_instance *out) {
-    mr_dmat4 cn = mr_m4_mul(&vw->cam_from_world, &n->world);
-    mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
-    mr_dmat4 mv = mr_m4_mul(&cn, &T);
+bool mr_geo_instance_matrices(const mr_dmat4 *mvp, gpu_instance *out) {
+    const mr_dmat4 mv = *mvp;
     const double *a = mv.m;
     /* Cofactors of the 3x3 = det * inverse transpose; normals are
      * renormalised in the shader, the sign keeps det's orientation. */
@@ -748,7 +714,7 @@ static bool fill_instance(const mr_geo_view *vw, const mr_node *n, const mr_mesh
     double det = a[0] * c00 + a[1] * c01 + a[2] * c02, mx = 0;
     for (int k = 0; k < 12; k++)
         if (k % 4 != 3 && fabs(a[k]) > mx) mx = fabs(a[k]);
-    if (!(fabs(det) > 1e-14 * mx * mx * mx) || !isfinite(det)) return false; /* degenerate: nothing to draw */
+    if (!(fabs(det) > 1e-14 * mx * mx * mx) || !isfinite(det)) return false;
     mr_m4_to_gl(&mv, out->modelview);
     double inv = 1.0 / det;
     /* Column j of the normal matrix = row j of the cofactor matrix / det
@@ -758,6 +724,16 @@ static bool fill_instance(const mr_geo_view *vw, const mr_node *n, const mr_mesh
         for (int row = 0; row < 3; row++) out->normal[col * 4 + row] = (float)(C[row][col] * inv);
         out->normal[col * 4 + 3] = 0;
     }
+    return true;
+}
+
+/* Camera-relative model-view of one instance, in double, then float. */
+static bool fill_instance(const mr_geo_view *vw, const mr_node *n, const mr_mesh *m, const geo_mesh *gm, int32_t node,
+                          gpu_instance *out) {
+    mr_dmat4 cn = mr_m4_mul(&vw->cam_from_world, &n->world);
+    mr_dmat4 T = mr_m4_translate(m->origin[0], m->origin[1], m->origin[2]);
+    mr_dmat4 mv = mr_m4_mul(&cn, &T);
+    if (!mr_geo_instance_matrices(&mv, out)) return false; /* degenerate: nothing to draw */
     memcpy(out->color, gm->color, sizeof out->color);
     out->ids[0] = (uint32_t)node + 1;
     out->ids[1] = n->layer;
@@ -886,11 +862,7 @@ static uint64_t emit_clusters(mr_renderer *r, const mr_geo_view *vw, const mr_no
 
 /* Largest pixels per unit of x/z over the image (its corners, with the
  * margin): the LOD choice's projected-error factor. */
-double mr_geometry_lod_fmax(const mr_camera *c) {
-    double ax = fmax(fabs((-1.5 - c->cx) / c->fx), fabs((c->width + 0.5 - c->cx) / c->fx));
-    double ay = fmax(fabs((-1.5 - c->cy) / c->fy), fabs((c->height + 0.5 - c->cy) / c->fy));
-    return fmax(c->fx, c->fy) * sqrt(1 + ax * ax + ay * ay);
-}
+double mr_geometry_lod_fmax(const mr_camera *c) { return mr_lod_fmax(c); }
 
 /* Step 2 for a list of visible nodes: LOD choice (the depth row of
  * vw->cam_from_world, its near plane and fmax_t decide) and bucketing of
@@ -1324,7 +1296,8 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
 
     /* A rig's view draws the frame's shared list (occlusion culling reads
      * each view's own depth, so it stays per view). */
-    if (vw->shared && r->share && !(dp->occlusion && !dp->no_cull)) {
+    bool hier = mr_hlod_active(r);
+    if (vw->shared && r->share && !hier && !(dp->occlusion && !dp->no_cull)) {
         const share_list *l = shared_list(r, layer_mask);
         if (l) {
             for (int k = 0; k < MR_LAYER_COUNT; k++)
@@ -1338,7 +1311,10 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     /* 1. Frustum culling. */
     mr_frustum fr = mr_frustum_from_camera(&vw->cam, &vw->world_from_camera, vw->near_plane, 1.0);
     mr_bvh_stats bst;
-    int32_t nvis = mr_bvh_cull(g->bvh, dp->no_cull ? NULL : &fr, layer_mask, g->visible, &bst);
+    /* With the LOD hierarchy its cut replaces the BVH's: proxies first
+     * (drawn now, so they are occluders too), the nodes it reached after. */
+    int32_t nvis = hier ? mr_hlod_draw(r, vw, dp->no_cull ? NULL : &fr, g->visible, out)
+                        : mr_bvh_cull(g->bvh, dp->no_cull ? NULL : &fr, layer_mask, g->visible, &bst);
     r->stats.frustum_culls++;
     uint32_t ndrawable = 0;
     for (int l = 0; l < MR_LAYER_COUNT; l++)

@@ -846,6 +846,9 @@ typedef struct mr_draw_params {
      * tested against the same depth pyramid (exact: the same image).
      * Default off: they are. */
     bool no_cluster_occlusion;
+    /* The LOD hierarchy set with mr_renderer_set_hlod is not drawn (the
+     * part levels alone). Default off: it is, where one is set. */
+    bool no_hlod;
 } mr_draw_params;
 #define MR_DRAW_DEFAULT_LOD_PIXELS 1.0
 #define MR_DRAW_DEFAULT_CLUSTER_TRIANGLES 16384
@@ -884,6 +887,10 @@ typedef struct mr_draw_stats {
      * occlusion test, themselves skipped by it (their bounding spheres lie
      * behind the occluders' depth) */
     uint64_t clusters_occluded;
+    /* The LOD hierarchy: proxies drawn and their triangles (counted in
+     * `triangles` too) */
+    uint32_t hlod_proxies;
+    uint64_t hlod_triangles;
 } mr_draw_stats;
 
 /* Sets how geometry is submitted from the next frame on (NULL: defaults). */
@@ -902,6 +909,12 @@ bool mr_renderer_set_lod(mr_renderer *r, const mr_lod *lod, mr_error *err);
 /* mr_renderer_set_scene and mr_renderer_set_lod in one upload (a big
  * scene's upload, meshlets included, costs seconds: not twice). */
 bool mr_renderer_set_scene_lod(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_error *err);
+
+/* Draws the proxies of `h` (built for the scene that is set, from the
+ * levels set; it must stay alive while set; NULL: none) where a view's
+ * cut reaches them (mr_hlod_cut: projected error under lod_pixels), and
+ * the part levels below. Setting a scene or levels drops it. */
+bool mr_renderer_set_hlod(mr_renderer *r, const mr_hlod *h, mr_error *err);
 
 /* The meshlets of big meshes cached beside the
  * scene file. From the next upload (set_scene / set_lod) on, each level's

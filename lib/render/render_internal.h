@@ -50,6 +50,7 @@ struct mr_renderer {
     mr_gpu *gpu;
     const mr_scene *scene;
     struct mr_geo *geo;    /* geometry.c: buffers, BVH, per-frame scratch */
+    struct mr_hlod_gpu *hlod; /* hlod_draw.c: the LOD hierarchy's proxies (NULL: none) */
     /* A multi-view rig's shared culling (geometry.c) and its
      * views' common fitting set (multiview.c); NULL outside a rig frame. */
     struct mr_geo_share *share;

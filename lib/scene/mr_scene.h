@@ -572,6 +572,124 @@ double mr_lod_hausdorff_bound_within(const float *positions, uint32_t vertex_cou
                                      uint32_t a_count, const uint32_t *b, uint32_t b_count, double accept,
                                      double resolution, double limit);
 
+/* ------------------------- levels of detail above the part (hlod.c)
+ *
+ * A binary tree over the scene's drawn nodes (one tree per layer; the
+ * leaves are the nodes themselves, split at the median of their centres
+ * along the longest axis) whose inner nodes carry a proxy: the triangles of
+ * everything below, merged across node and mesh boundaries into one
+ * triangle list and simplified (meshoptimizer, edge collapses or vertex
+ * clustering), built bottom-up from the children's proxies and, at the
+ * bottom, from each part's coarsest LOD level. `error` is a certified upper
+ * bound (world units) of the two-sided Hausdorff distance between the proxy
+ * and the full-detail geometry below: the steps are certified with
+ * mr_lod_hausdorff_bound_within and add up by the triangle inequality, plus
+ * the rounding of the proxy's float positions. Each proxy triangle keeps
+ * the (node, mesh) it came from (`runs`: its triangles are sorted by
+ * source), so a frame drawing proxies still names the real part under a
+ * pixel and shows each part's colour. */
+typedef struct mr_hlod_run {
+    uint32_t first, count;      /* index range within the proxy's indices */
+    int32_t node, mesh;         /* the scene node and mesh it came from */
+} mr_hlod_run;
+
+typedef struct mr_hlod_node {
+    double lo[3], hi[3];        /* world bounds of the full detail below */
+    double center[3];           /* proxy positions are relative to it */
+    double error;               /* certified bound, world units; INFINITY: no proxy (leaves) */
+    int32_t child[2];           /* tree nodes; -1 for leaves */
+    int32_t item;               /* leaves: the scene node; -1 otherwise */
+    uint8_t layer;              /* mr_layer */
+    uint32_t vertex_count, index_count, run_count;
+    float *positions, *normals; /* 3 * vertex_count each */
+    uint32_t *indices;
+    mr_hlod_run *runs;
+} mr_hlod_node;
+
+typedef struct mr_hlod {
+    int32_t node_count;
+    mr_hlod_node *nodes;        /* breadth first: roots, then their children, ... */
+    int32_t root[MR_LAYER_COUNT]; /* -1: the layer has no tree */
+    uint64_t scene_hash;        /* mr_lod_scene_hash of the scene it was built for */
+    uint64_t lod_hash;          /* of the part levels it was built from */
+    uint64_t proxy_triangles;   /* over all proxies */
+    int32_t scene_node_count;
+    int32_t scene_mesh_count;
+} mr_hlod;
+
+typedef struct mr_hlod_params {
+    /* Proxy triangles as a fraction of their input (the children's proxies
+     * or parts); 0 = 0.5. */
+    double reduction;
+    /* Called after each proxy with the fraction of proxies done, one call
+     * at a time; returning false stops the build. NULL: none. */
+    bool (*on_progress)(void *user, double fraction);
+    void *progress_user;
+    int threads;                /* 0: one per core */
+} mr_hlod_params;
+#define MR_HLOD_DEFAULTS {0.0, NULL, NULL, 0}
+
+/* The default: a hierarchy only for scenes drawing at least this many
+ * triangles in at least MR_HLOD_AUTO_NODES nodes: below, the part levels
+ * alone keep the frame cheap and the build would not pay. */
+#define MR_HLOD_AUTO_TRIANGLES 1000000u
+#define MR_HLOD_AUTO_NODES 16
+/* Whether a scene gets a hierarchy: mode "on" always (when it has two or
+ * more drawn nodes), "off" never, "auto" (or NULL) above the thresholds. */
+bool mr_hlod_wanted(const char *mode, uint64_t drawn_triangles, int32_t drawn_nodes);
+
+/* Builds the hierarchy over s from its part levels (lod may be NULL: full
+ * detail then). NULL + err on failure (or when there is nothing to build:
+ * fewer than two drawn nodes). */
+mr_hlod *mr_hlod_build(const mr_scene *s, const mr_lod *lod, const mr_hlod_params *params, mr_error *err);
+void mr_hlod_destroy(mr_hlod **h); /* NULLs, accepts NULL */
+/* Hash of the part levels the proxies are built from. */
+uint64_t mr_hlod_lod_hash(const mr_lod *lod);
+
+typedef struct mr_hlod_info {
+    bool from_cache;
+    bool cache_written;
+    double build_s;
+    uint64_t input_triangles;  /* triangles the proxies were simplified from */
+} mr_hlod_info;
+/* Reads the hierarchy from cache_path if it holds one for exactly this
+ * scene and these part levels (hashes, a checksum and every index and id
+ * in range; a short, damaged or stale file is ignored with one warning,
+ * never used), else builds it and writes the file atomically (nodes in the
+ * order a cut reaches them: breadth first). cache_path NULL: no cache. */
+mr_hlod *mr_hlod_load_or_build(const mr_scene *s, const mr_lod *lod, const char *cache_path,
+                               const mr_hlod_params *params, mr_hlod_info *info, mr_error *err);
+/* "<scene>.mrhlod" */
+void mr_hlod_cache_path(const char *scene_path, char *out, size_t n);
+
+/* Where a view cuts the tree: a node's proxy is drawn where its error,
+ * projected at the node's nearest depth (fmax / z pixels per unit, as the
+ * part levels are chosen), is at most `pixels` and at most `tolerance`;
+ * else its children are visited; a leaf reached hands its scene node to
+ * the part levels. Nodes whose bounds miss the frustum (NULL: none) are
+ * skipped. */
+typedef struct mr_hlod_cut_params {
+    mr_dmat4 cam_from_world;
+    double near_plane;
+    double fmax;               /* mr_geometry_lod_fmax of the camera */
+    double pixels;             /* > 0 */
+    double tolerance;          /* scene units; INFINITY: none */
+    const mr_frustum *frustum; /* NULL: no culling */
+    uint32_t layers;           /* 1 << mr_layer */
+} mr_hlod_cut_params;
+/* Writes the proxies to draw (tree nodes) into proxies (room for
+ * h->node_count) and the scene nodes left to the part levels into nodes
+ * (room for h->node_count); returns false only for bad arguments. */
+bool mr_hlod_cut(const mr_hlod *h, const mr_hlod_cut_params *p, int32_t *proxies, int32_t *proxy_count,
+                 int32_t *nodes, int32_t *node_count);
+/* Upper bound of the largest singular value of a world transform's 3x3
+ * (Gershgorin on M^T M): errors in mesh units times this are world units. */
+double mr_stretch_bound(const mr_dmat4 *w);
+/* Largest pixels per unit of x/z over the camera's image (its corners, with
+ * a 1.5 px margin): a displacement e at depth z moves the image point by at
+ * most fmax * e / z pixels. The projected-error factor of every LOD choice. */
+double mr_lod_fmax(const mr_camera *c);
+
 /* ------------------------------------ synthetic factories (synth.c) */
 
 typedef struct mr_synth_params {
