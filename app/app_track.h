@@ -50,9 +50,6 @@ bool app_tracker_init(app_tracker *t, const char *cmd, const mr_cli_opt *opts, c
                       const mr_recording *rec);
 void app_tracker_free(app_tracker *t);
 
-/* Called once by `mrcheck demo`: writes DIR/recording and DIR/calib. */
-bool app_demo_track(const char *dir, mr_error *err);
-
 int cmd_track(int argc, char **argv);
 int cmd_record(int argc, char **argv);
 int cmd_replay(int argc, char **argv);

@@ -15,8 +15,7 @@ int bench_ao(int argc, char **argv) {
         {"size", "WxH", "resolution (default 320x240)", NULL},
         {"sequence", "DIR", "recording whose poses are the moving sequence for temporal accumulation (default recordings/demo if there)", NULL},
         {"out", "DIR", "output folder (default bench-out)", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     const char *pos[MAX_VIEWS];
@@ -54,8 +53,7 @@ int bench_ao(int argc, char **argv) {
         p.views = views;
         p.view_names = names;
     }
-    app_gfx g;
-    bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_ao(&p, &err);
-    app_gfx_close(&g);
+    bool ok = mr_gfx_open(&p.gfx, &err) && mr_bench_ao(&p, &err);
+    mr_gfx_close(&p.gfx);
     return ok ? 0 : mr_cli_error(cmd, &err);
 }

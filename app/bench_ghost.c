@@ -12,8 +12,7 @@ int app_bench_ghost(int argc, char **argv) {
     mr_cli_opt opts[] = {
         {"size", "WxH", "output size (default 640x480, the demo camera)", NULL},
         {"out", "DIR", "write bench_ghost.csv and bench_ghost.svg there (default bench-out)", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_ghost_params p = {MR_BENCH_GHOST_DEFAULTS};
@@ -29,8 +28,7 @@ int app_bench_ghost(int argc, char **argv) {
     p.progress = isatty(2) && !mr_cli_flag(opts, "quiet");
     p.out = stdout;
     mr_error err = {0};
-    app_gfx g;
-    bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_ghost(&p, &err);
-    app_gfx_close(&g);
+    bool ok = mr_gfx_open(&p.gfx, &err) && mr_bench_ghost(&p, &err);
+    mr_gfx_close(&p.gfx);
     return ok ? 0 : mr_cli_error(cmd, &err);
 }

@@ -13,8 +13,7 @@ int bench_multiview(int argc, char **argv) {
         {"view-size", "WxH", "per-view size of the fixed-size rows and the display slices (default 160x120)", NULL},
         {"table-size", "WxH", "size of the no-SSAO / SSAO table (default 1024x768, as the paper)", NULL},
         {"out", "DIR", "output folder (default bench-out)", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_multiview_params p = {MR_BENCH_MULTIVIEW_DEFAULTS};
@@ -40,8 +39,7 @@ int bench_multiview(int argc, char **argv) {
         if (!mr_view_load(mr_cli_get(opts, "view"), &view, &err)) return mr_cli_error(cmd, &err);
         p.view = &view;
     }
-    app_gfx g;
-    bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_multiview(&p, &err);
-    app_gfx_close(&g);
+    bool ok = mr_gfx_open(&p.gfx, &err) && mr_bench_multiview(&p, &err);
+    mr_gfx_close(&p.gfx);
     return ok ? 0 : mr_cli_error(cmd, &err);
 }

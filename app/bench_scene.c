@@ -3,24 +3,6 @@
 #include "app.h"
 #include "mr_bench.h"
 
-#include <stdlib.h>
-
-/* "1M,5M,20M" -> triangle targets. */
-static int parse_sizes(const char *spec, double *out, int max) {
-    int n = 0;
-    const char *p = spec;
-    while (*p && n < max) {
-        const char *end;
-        double v;
-        if (!mr_cli_count_prefix(p, &v, &end) || !(v >= 1e4 && v <= 1e9)) return -1;
-        out[n++] = v;
-        if (*end == ',') end++;
-        else if (*end) return -1;
-        p = end;
-    }
-    return n;
-}
-
 int bench_scene(int argc, char **argv) {
     static const char *cmd = "bench scene";
     mr_cli_opt opts[] = {
@@ -29,8 +11,7 @@ int bench_scene(int argc, char **argv) {
         {"size", "WxH", "frame size (default 1024x768)", NULL},
         {"unique", NULL, "unique CAD-like geometry (every part its own mesh) instead of instanced parts", NULL},
         {"unit", "U", "scene units per metre of the unique factory (default 1; 1000: millimetres)", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_scene_params p = {MR_BENCH_SCENE_DEFAULTS};
@@ -42,7 +23,8 @@ int bench_scene(int argc, char **argv) {
     if (help) return 0;
     mr_cli_log_level(opts);
     if (mr_cli_get(opts, "out")) p.out_dir = mr_cli_get(opts, "out");
-    int nsizes = parse_sizes(mr_cli_get(opts, "sizes") ? mr_cli_get(opts, "sizes") : "1M,5M,20M", p.sizes, MR_BENCH_SCENE_MAX_SIZES);
+    int nsizes = mr_cli_counts(mr_cli_get(opts, "sizes") ? mr_cli_get(opts, "sizes") : "1M,5M,20M", 1e4, 1e9, p.sizes,
+                               MR_BENCH_SCENE_MAX_SIZES);
     if (nsizes <= 0) return mr_cli_errorf(cmd, "--sizes must be a list like 1M,5M,20M (10k..1000M each)"), 2;
     if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &p.width, &p.height)) return 2;
     p.size_count = nsizes;
@@ -50,8 +32,7 @@ int bench_scene(int argc, char **argv) {
     p.unique = mr_cli_get(opts, "unique") != NULL;
     if (mr_cli_get(opts, "unit") && !mr_cli_double("unit", mr_cli_get(opts, "unit"), 1e-6, 1e9, &p.unit)) return 2;
     mr_error err = {0};
-    app_gfx g;
-    bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_scene(&p, &err);
-    app_gfx_close(&g);
+    bool ok = mr_gfx_open(&p.gfx, &err) && mr_bench_scene(&p, &err);
+    mr_gfx_close(&p.gfx);
     return ok ? 0 : mr_cli_error(cmd, &err);
 }

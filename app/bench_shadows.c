@@ -7,8 +7,7 @@ int app_bench_shadows(int argc, char **argv) {
     mr_cli_opt opts[] = {
         {"size", "WxH", "output size (default 320x240)", NULL},
         {"out", "DIR", "write bench_shadows.{csv,svg,md} and the montages there (default bench-out)", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_shadows_params p = {MR_BENCH_SHADOWS_DEFAULTS};
@@ -28,8 +27,7 @@ int app_bench_shadows(int argc, char **argv) {
     if (mr_cli_get(opts, "out")) p.out_dir = mr_cli_get(opts, "out");
     p.out = stdout;
     mr_error err = {0};
-    app_gfx g;
-    bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_shadows(&p, &err);
-    app_gfx_close(&g);
+    bool ok = mr_gfx_open(&p.gfx, &err) && mr_bench_shadows(&p, &err);
+    mr_gfx_close(&p.gfx);
     return ok ? 0 : mr_cli_error(cmd, &err);
 }

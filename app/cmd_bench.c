@@ -6,13 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-bool app_bench_gpu(app_gfx *g, mr_bench_gpu *out, mr_error *err) {
-    if (!app_gfx_open(g, err)) return false;
-    out->gpu = g->gpu;
-    out->renderer = g->renderer;
-    return true;
-}
-
 static int bench_frame(int argc, char **argv) {
     static const char *cmd = "bench frame";
     mr_cli_opt opts[] = {
@@ -21,8 +14,7 @@ static int bench_frame(int argc, char **argv) {
         {"size", "WxH", "output size (default 1024x768)", NULL},
         {"video", "IMG", "camera frame to overlay (default: a synthetic frame, so the overlay pass runs)", NULL},
         {"out", "DIR", "write bench_frame.csv and bench_frame.svg there (default bench-out)", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_bench_frame_params p = {MR_BENCH_FRAME_DEFAULTS};
@@ -47,9 +39,8 @@ static int bench_frame(int argc, char **argv) {
         if (!mr_image_load(mr_cli_get(opts, "video"), 3, &video, &err)) return mr_cli_error(cmd, &err);
         p.video = &video;
     }
-    app_gfx g;
-    bool ok = app_bench_gpu(&g, &p.gfx, &err) && mr_bench_frame(&p, &err);
-    app_gfx_close(&g);
+    bool ok = mr_gfx_open(&p.gfx, &err) && mr_bench_frame(&p, &err);
+    mr_gfx_close(&p.gfx);
     mr_image_free(&video);
     return ok ? 0 : mr_cli_error(cmd, &err);
 }

@@ -5,15 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* "5M", "200k", "1e6" or a plain number of triangles. */
-static bool parse_count(const char *s, uint64_t *out) {
-    const char *end;
-    double v;
-    if (!mr_cli_count_prefix(s, &v, &end) || *end || !(v >= 1 && v <= 1e11)) return false;
-    *out = (uint64_t)v;
-    return true;
-}
-
 int cmd_factory(int argc, char **argv) {
     static const char *cmd = "factory";
     mr_cli_opt opts[] = {
@@ -23,8 +14,7 @@ int cmd_factory(int argc, char **argv) {
         {"offset", "X,Z", "move the whole plant (tests far from the origin)", NULL},
         {"views", "DIR", "also write view_floor.json, view_aisle.json, view_overview.json there", NULL},
         {"unique", NULL, "unique CAD-like geometry: every part its own mesh (20k triangles), split at normal seams", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     bool help;
@@ -44,11 +34,11 @@ int cmd_factory(int argc, char **argv) {
     if (!unique && mr_cli_table_given(&tables[1], "unit")) return mr_cli_errorf(cmd, "--unit needs --unique"), 2;
     if (halls && mr_cli_get(opts, "triangles")) return mr_cli_errorf(cmd, "give --halls or --triangles, not both"), 2;
     if (!halls) {
-        uint64_t tri = 1000000;
-        if (mr_cli_get(opts, "triangles") && !parse_count(mr_cli_get(opts, "triangles"), &tri))
+        double tri = 1e6;
+        if (mr_cli_get(opts, "triangles") && mr_cli_counts(mr_cli_get(opts, "triangles"), 1, 1e11, &tri, 1) != 1)
             return mr_cli_errorf(cmd, "--triangles: '%s' is not a count like 5M", mr_cli_get(opts, "triangles")), 2;
-        sp.halls = mr_synth_halls_for(tri);
-        cp.parts = mr_synth_cad_parts_for(&cp, (double)tri);
+        sp.halls = mr_synth_halls_for((uint64_t)tri);
+        cp.parts = mr_synth_cad_parts_for(&cp, tri);
     }
     if (mr_cli_get(opts, "seed")) {
         long seed;

@@ -4,25 +4,6 @@
 #include <stddef.h>
 #include <string.h>
 
-bool app_gfx_open(app_gfx *g, mr_error *err) {
-    memset(g, 0, sizeof *g);
-    mr_gpu_params gp = MR_GPU_DEFAULTS;
-    gp.debug = mr_log_get_level() >= MR_LOG_DEBUG;
-    g->gpu = mr_gpu_create_headless(&gp, err);
-    if (!g->gpu) return false;
-    g->renderer = mr_renderer_create(g->gpu, err);
-    if (!g->renderer) {
-        mr_gpu_destroy(&g->gpu);
-        return false;
-    }
-    return true;
-}
-
-void app_gfx_close(app_gfx *g) {
-    mr_renderer_destroy(&g->renderer);
-    mr_gpu_destroy(&g->gpu);
-}
-
 int cmd_render(int argc, char **argv) {
     static const char *cmd = "render";
     mr_cli_opt opts[] = {
@@ -62,7 +43,9 @@ int cmd_render(int argc, char **argv) {
     if (!scene_path || !view_path || !out) return mr_cli_errorf(cmd, "--scene, --view and --out are required"), 2;
 
     if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &fp.width, &fp.height)) return 2;
-    if (!app_draw_lod(cmd, opts, &dp)) return 2;
+    mr_error err = {0};
+    mr_lod_mode lod_mode;
+    if (!mr_lod_mode_parse(mr_cli_get(opts, "lod"), &lod_mode, &err)) return mr_cli_error(cmd, &err), 2;
     const char *lod_cache = mr_cli_get(opts, "lod-cache");
     if (lod_cache && strcmp(lod_cache, "on") != 0 && strcmp(lod_cache, "off") != 0)
         return mr_cli_errorf(cmd, "--lod-cache must be 'on' or 'off'"), 2;
@@ -76,7 +59,9 @@ int cmd_render(int argc, char **argv) {
     fp.shadow.want_shadow = aux != NULL;
     mr_quilt quilt = {0};
     bool have_quilt;
-    if (!app_rig_check(cmd, &tables[5], opts, &quilt, &have_quilt)) return 2;
+    if (!mr_rig_opts_check(&tables[5], mr_cli_get(opts, "quilt"), mr_cli_get(opts, "lightfield") != NULL, &quilt,
+                           &have_quilt, &err))
+        return mr_cli_error(cmd, &err), 2;
     bool multiview = rp.views > 0 || have_quilt;
     if (multiview && (aux || groundtruth || mr_cli_get(opts, "video")))
         return mr_cli_errorf(cmd, "--aux, --video and --ao groundtruth are for single views, not --views"), 2;
@@ -92,7 +77,6 @@ int cmd_render(int argc, char **argv) {
 
     /* Everything that can be checked without a GPU is checked first, so a
      * bad input never costs a context. */
-    mr_error err = {0};
     mr_view view;
     if (!mr_view_load(view_path, &view, &err)) return mr_cli_error(cmd, &err);
     mr_image video = {0};
@@ -104,28 +88,29 @@ int cmd_render(int argc, char **argv) {
     mr_scene_params sp = MR_SCENE_DEFAULTS;
     sp.hidden_globs = globs;
     sp.hidden_glob_count = globs[0] ? 1 : 0;
-    mr_scene *scene = app_load_scene(scene_path, &sp, NULL, &err);
+    mr_scene *scene = mr_scene_load_logged(scene_path, &sp, &err);
     if (!scene) {
         mr_image_free(&video);
         return mr_cli_error(cmd, &err);
     }
-    if (!app_shadow_scene_default(cmd, &tables[4], scene, &fp.shadow)) {
+    if (!mr_shadow_scene_default(&tables[4], scene, &fp.shadow, &err)) {
+        mr_cli_error(cmd, &err);
         mr_scene_destroy(&scene);
         mr_image_free(&video);
         return 2;
     }
     mr_lod *lod = NULL;
-    app_lod_auto(opts, scene, &dp);
-    if (!dp.no_lod && !(lod = app_load_lod(scene, scene->source, !lod_cache || strcmp(lod_cache, "on") == 0, &err))) {
+    dp.no_lod = !mr_lod_wanted(lod_mode, scene);
+    if (!dp.no_lod && !(lod = mr_lod_load_logged(scene, scene->source, !lod_cache || strcmp(lod_cache, "on") == 0, &err))) {
         mr_scene_destroy(&scene);
         mr_image_free(&video);
         return mr_cli_error(cmd, &err);
     }
 
     int rc = 0;
-    app_gfx gfx;
+    mr_gfx gfx;
     mr_frame_result res = {0};
-    if (!app_gfx_open(&gfx, &err)) {
+    if (!mr_gfx_open(&gfx, &err)) {
         rc = mr_cli_error(cmd, &err);
     } else {
         /* Meshlets cached beside the file too */
@@ -158,29 +143,9 @@ int cmd_render(int argc, char **argv) {
             rc = mr_cli_error(cmd, &err);
         else if (!mr_image_save_png(out, &res.color, &err) || (aux && !mr_frame_result_save_aux(aux, &res, &err)))
             rc = mr_cli_error(cmd, &err);
-        if (rc == 0 && !multiview && mr_cli_flag(opts, "verbose")) {
-            char passes[256];
-            mr_frame_result_passes(&res, passes, sizeof passes);
-            fprintf(stderr, "mrcheck: render: passes: %s; %u draw calls, %llu triangles, near plane %g\n", passes,
-                    res.draw_calls, (unsigned long long)res.triangles, res.near_plane);
-            mr_draw_stats ds;
-            mr_renderer_draw_stats(gfx.renderer, &ds);
-            fprintf(stderr, "mrcheck: render: geometry: %u of %u nodes visible, %u instances (%u at a simplified level) in %u "
-                    "commands, %llu of %llu triangles, culling %.2f ms; peak RSS %.0f MB\n", ds.nodes_visible,
-                    ds.nodes_drawable, ds.instances, ds.lod_instances, ds.commands, (unsigned long long)ds.triangles,
-                    (unsigned long long)ds.triangles_full, ds.cull_ms, mr_peak_rss_bytes() / 1048576.0);
-            if (ds.clusters_tested)
-                fprintf(stderr, "mrcheck: render: clusters: %llu of %llu meshlets drawn (%llu occluded)\n",
-                        (unsigned long long)ds.clusters_drawn, (unsigned long long)ds.clusters_tested,
-                        (unsigned long long)ds.clusters_occluded);
-            mr_cluster_info ci;
-            mr_renderer_cluster_info(gfx.renderer, &ci);
-            fprintf(stderr, "mrcheck: render: upload %.2f s; meshlets: %llu levels from the cache, %llu built in %.2f s%s\n",
-                    t_upload, (unsigned long long)ci.levels_cached, (unsigned long long)ci.levels_built, ci.build_s,
-                    ci.cache_written ? " (cache written)" : "");
-        }
+        if (rc == 0 && !multiview && mr_cli_flag(opts, "verbose")) mr_render_report(stderr, gfx.renderer, &res, t_upload);
         mr_frame_result_free(&res);
-        app_gfx_close(&gfx);
+        mr_gfx_close(&gfx);
     }
     mr_lod_destroy(&lod);
     mr_scene_destroy(&scene);

@@ -36,8 +36,9 @@ int cmd_replay(int argc, char **argv) {
         return 2;
     if (help) return 0;
     mr_cli_log_level(opts);
-    mr_draw_params dp = MR_DRAW_DEFAULTS; /* only --lod: whether levels are drawn */
-    if (!app_draw_lod(cmd, opts, &dp)) return 2;
+    mr_lod_mode lod_mode; /* --lod: whether levels are drawn */
+    mr_error lerr = {0};
+    if (!mr_lod_mode_parse(mr_cli_get(opts, "lod"), &lod_mode, &lerr)) return mr_cli_error(cmd, &lerr), 2;
     if (npos != 1 || !mr_cli_get(opts, "scene") || !mr_cli_get(opts, "out"))
         return mr_cli_errorf(cmd, "needs a recording folder, --scene and --out (see --help)"), 2;
     bool groundtruth = false;
@@ -49,7 +50,9 @@ int cmd_replay(int argc, char **argv) {
     p.progress = true;
     mr_quilt quilt = {0};
     bool have_quilt;
-    if (!app_rig_check(cmd, &tables[5], opts, &quilt, &have_quilt)) return 2;
+    if (!mr_rig_opts_check(&tables[5], mr_cli_get(opts, "quilt"), mr_cli_get(opts, "lightfield") != NULL, &quilt,
+                           &have_quilt, &lerr))
+        return mr_cli_error(cmd, &lerr), 2;
     if (mr_cli_get(opts, "lightfield")) return mr_cli_errorf(cmd, "--lightfield is for single frames (mrcheck render)"), 2;
     bool multiview = rp.views > 0 || have_quilt;
     if (multiview) {
@@ -74,7 +77,8 @@ int cmd_replay(int argc, char **argv) {
         }
     }
     mr_scene *scene = mr_scene_load(mr_cli_get(opts, "scene"), NULL, &err);
-    if (scene && !app_shadow_scene_default(cmd, &tables[4], scene, &p.frame.shadow)) {
+    if (scene && !mr_shadow_scene_default(&tables[4], scene, &p.frame.shadow, &err)) {
+        mr_cli_error(cmd, &err);
         mr_scene_destroy(&scene);
         mr_recording_close(&rec);
         return 2;
@@ -83,17 +87,15 @@ int cmd_replay(int argc, char **argv) {
      * from the cache next to the scene; where they cannot be had, the
      * frames are drawn in full detail. */
     mr_lod *lod = NULL;
-    if (scene) app_lod_auto(opts, scene, &dp);
-    if (scene && !dp.no_lod) {
-        mr_error lerr = {0};
-        lod = app_load_lod(scene, scene->source, scene->source[0] != 0, &lerr);
+    if (scene && mr_lod_wanted(lod_mode, scene)) {
+        lod = mr_lod_load_logged(scene, scene->source, scene->source[0] != 0, &lerr);
         if (!lod) mr_log(MR_LOG_WARN, "%s: full detail (no levels of detail: %s)", cmd, lerr.msg);
     }
     p.lod = lod;
-    app_gfx gfx = {0};
+    mr_gfx gfx = {0};
     mr_batch_replay_stats st;
-    bool ok = scene && app_gfx_open(&gfx, &err) && mr_batch_replay(&p, gfx.renderer, scene, &st, &err);
-    app_gfx_close(&gfx);
+    bool ok = scene && mr_gfx_open(&gfx, &err) && mr_batch_replay(&p, gfx.renderer, scene, &st, &err);
+    mr_gfx_close(&gfx);
     mr_lod_destroy(&lod);
     mr_scene_destroy(&scene);
     mr_recording_close(&rec);

@@ -13,8 +13,7 @@ static int study_stimuli(int argc, char **argv) {
     mr_study_stimuli_params sp = MR_STUDY_STIMULI_DEFAULTS;
     mr_cli_opt opts[] = {
         {"out", "DIR", "where DIR/<method>/<stimulus>.png go (required)", NULL},
-        {"verbose", NULL, "more log output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_cli_table tables[] = {{.prefix = "", .table = mr_study_stimuli_opts, .params = &sp}};
@@ -27,12 +26,12 @@ static int study_stimuli(int argc, char **argv) {
     mr_cli_log_level(opts);
     const char *out = mr_cli_get(opts, "out");
     if (!out) return mr_cli_errorf(cmd, "--out DIR is required"), 2;
-    app_gfx g;
+    mr_gfx g;
     mr_error err = {0};
-    if (!app_gfx_open(&g, &err)) return mr_cli_error(cmd, &err);
+    if (!mr_gfx_open(&g, &err)) return mr_cli_error(cmd, &err);
     int n = 0;
     bool ok = mr_study_stimuli_render(g.renderer, &sp, out, &n, &err);
-    app_gfx_close(&g);
+    mr_gfx_close(&g);
     if (!ok) return mr_cli_error(cmd, &err);
     printf("study stimuli: %d images of family %s in %s\n", n, mr_study_families[sp.family].name, out);
     return 0;
@@ -47,8 +46,7 @@ static int study_plan(int argc, char **argv) {
                                "= the condition folders present); II shows the reference", NULL},
         {"scales", "A,B,..", "rating: the scales (default Scheer & Keutel's eight depth cues)", NULL},
         {"overall", NULL, "rating: first ask which method supports the depth cues best as a whole (all side by side)", NULL},
-        {"verbose", NULL, "more log output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_cli_table tables[] = {{.prefix = "", .table = mr_study_plan_opts, .params = &pp}};
@@ -73,12 +71,7 @@ static int study_plan(int argc, char **argv) {
     mr_study_plan plan;
     bool ok = mr_study_plan_scan_make(pos[0], &pp, &plan, &err) && mr_study_plan_save(out, &plan, &err);
     if (!ok) return mr_cli_error(cmd, &err);
-    printf("study plan %s (%s): %d trials per participant, %d schedule%s (%d methods%s, %d stimuli, blocks", plan.id,
-           mr_study_design_names[plan.design], plan.trial_count, plan.schedule_count, plan.schedule_count > 1 ? "s" : "",
-           plan.set.method_count, plan.set.reference >= 0 ? " with the reference" : "", plan.set.stimulus_count);
-    for (int b = 1; b <= MR_STUDY_MAX_BLOCKS; b++)
-        if (plan.blocks & (1u << (b - 1))) printf(" %s", mr_study_condition_name(plan.design, b));
-    printf(") -> %s\n", out);
+    mr_study_plan_describe(&plan, out, stdout);
     mr_study_plan_free(&plan);
     return 0;
 }
@@ -89,8 +82,7 @@ static int study_analyze(int argc, char **argv) {
     mr_cli_opt opts[] = {
         {"out", "DIR", "where the tables, charts and summary.md go (required)", NULL},
         {"plan", "PLAN.json", "only votes of this plan (others are left out with a warning)", NULL},
-        {"verbose", NULL, "more log output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_cli_table tables[] = {{.prefix = "", .table = mr_study_analyze_opts, .params = &ap}};
@@ -107,25 +99,8 @@ static int study_analyze(int argc, char **argv) {
     if (npos < 1) return mr_cli_errorf(cmd, "give one or more votes files"), 2;
     if (!out) return mr_cli_errorf(cmd, "--out DIR is required"), 2;
     mr_error err = {0};
-    mr_study_plan plan;
-    bool have_plan = mr_cli_get(opts, "plan") != NULL;
-    if (have_plan && !mr_study_plan_load(mr_cli_get(opts, "plan"), &plan, &err)) return mr_cli_error(cmd, &err);
-    mr_study_votes votes = {0};
-    bool ok = true;
-    for (int i = 0; ok && i < npos; i++) ok = mr_study_votes_read(pos[i], false, &votes, &err);
-    bool other = have_plan && plan.design != MR_STUDY_PAIRWISE;
-    for (int i = 0; ok && !have_plan && i < votes.count; i++)
-        if (votes.v[i].design != MR_STUDY_PAIRWISE)
-            ok = mr_fail(&err, MR_ERR_INVALID, "%s answers need their plan: give --plan plan.json",
-                         mr_study_design_names[votes.v[i].design]);
-    if (ok && other)
-        ok = plan.design == MR_STUDY_RATING ? mr_study_analyze_rating(&votes, &plan, &ap, out, &err)
-                                            : mr_study_analyze_task(&votes, &plan, &ap, out, &err);
-    else ok = ok && mr_study_analyze(&votes, have_plan ? &plan : NULL, &ap, out, &err);
-    int n = votes.count;
-    mr_study_votes_free(&votes);
-    if (have_plan) mr_study_plan_free(&plan);
-    if (!ok) return mr_cli_error(cmd, &err);
+    int n = 0;
+    if (!mr_study_analyze_files(pos, npos, mr_cli_get(opts, "plan"), &ap, out, &n, &err)) return mr_cli_error(cmd, &err);
     printf("study analyze: %d votes -> %s/summary.md\n", n, out);
     return 0;
 }
@@ -143,8 +118,7 @@ static int study_run(int argc, char **argv) {
         {"ui-scale", "S", "scale the UI beyond the screen's density (default 1)", NULL},
         {"script", "FILE", "timed input (tests): see lib/study/mr_study.h", NULL},
         {"group", "A|B", "a shared pairwise plan's block III question: A looks better (default), B plausible", NULL},
-        {"verbose", NULL, "more log output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     const char *pos[1];

@@ -1,42 +1,10 @@
-/* `mrcheck synth` and the tracking part of `mrcheck demo`: the options and
- * the wiring; the recording and the calibration set are made by
- * mr_synth_recording / mr_synth_calibration (lib/bench). */
+/* `mrcheck synth`: the options and the wiring; the recording and the
+ * calibration set are made by mr_synth_recording / mr_synth_calibration
+ * (lib/bench). */
 #include "app_track.h"
 #include "mr_bench.h"
 
 #include <unistd.h>
-
-/* The synthetic recording on a headless GPU of its own, with the progress
- * line on a terminal unless logging says more. */
-static bool synth_recording(const char *dir, mr_synth_recording_params *p, mr_error *err) {
-    app_gfx g = {0};
-    mr_bench_gpu gpu = {0};
-    p->progress = isatty(2) && mr_log_get_level() < MR_LOG_INFO;
-    bool ok = app_bench_gpu(&g, &gpu, err) && mr_synth_recording(dir, p, &gpu, err);
-    app_gfx_close(&g);
-    return ok;
-}
-
-bool app_demo_track(const char *dir, mr_error *err) {
-    char path[4096];
-    mr_path_join(dir, "calib", path, sizeof path);
-    if (!mr_synth_calibration(path, 12, err)) return false;
-    mr_path_join(dir, "recording", path, sizeof path);
-    char fl[4096];
-    mr_path_join(path, "frames.jsonl", fl, sizeof fl);
-    if (mr_file_exists(fl)) {
-        /* A recording is never overwritten: say where the old one is. */
-        printf("  recording exists, kept:        %s/\n", path);
-        return true;
-    }
-    mr_synth_recording_params sp = {MR_SYNTH_RECORDING_DEFAULTS};
-    sp.frames = 40; /* the path subsampled: the demo stays quick */
-    sp.motion_blur = 1;
-    if (!synth_recording(path, &sp, err)) return false;
-    printf("  synthetic recording (tracked, with ground truth): %s/\n", path);
-    printf("  calibration board and images:  %s/calib/\n", dir);
-    return true;
-}
 
 int cmd_synth(int argc, char **argv) {
     static const char *cmd = "synth";
@@ -46,8 +14,7 @@ int cmd_synth(int argc, char **argv) {
         {"seed", "N", "noise seed (default 1)", NULL},
         {"calibration", "DIR", "instead: write a calibration board and 12 images there", NULL},
         {"map-photos", "DIR", "instead: write a synthetic photo set for `mrcheck map` there (images/, photos.avi, camera.json, truth.json, control.json)", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_synth_recording_params p = {MR_SYNTH_RECORDING_DEFAULTS};
@@ -81,7 +48,11 @@ int cmd_synth(int argc, char **argv) {
         p.seed = (uint64_t)l;
     }
     double t0 = mr_time_now();
-    if (!synth_recording(mr_cli_get(opts, "out"), &p, &err)) return mr_cli_error(cmd, &err);
+    p.progress = isatty(2) && mr_log_get_level() < MR_LOG_INFO;
+    mr_gfx g;
+    bool ok = mr_gfx_open(&g, &err) && mr_synth_recording(mr_cli_get(opts, "out"), &p, &g, &err);
+    mr_gfx_close(&g);
+    if (!ok) return mr_cli_error(cmd, &err);
     printf("wrote %s/ (%d frames, %dx%d) in %.1f s\n", mr_cli_get(opts, "out"), p.frames > 0 ? p.frames : mr_synth_path_frames(),
            p.width, p.height, mr_time_now() - t0);
     return 0;

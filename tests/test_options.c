@@ -626,6 +626,13 @@ static void test_count_prefix(void) {
     CHECK(mr_cli_count_prefix("1e6", &v, &end) && v == 1e6 && *end == 0);
     CHECK(mr_cli_count_prefix("12x", &v, &end) && v == 12 && *end == 'x');
     CHECK(!mr_cli_count_prefix("M5", &v, &end));
+    double list[3];
+    CHECK(mr_cli_counts("1M,5M,20M", 1e4, 1e9, list, 3) == 3 && list[0] == 1e6 && list[2] == 2e7);
+    CHECK(mr_cli_counts("200k", 1, 1e11, list, 1) == 1 && list[0] == 2e5);
+    CHECK(mr_cli_counts("1M,5M", 1e4, 1e9, list, 1) == -1); /* more than max */
+    CHECK(mr_cli_counts("1M,", 1e4, 1e9, list, 3) == -1);
+    CHECK(mr_cli_counts("5k", 1e4, 1e9, list, 3) == -1);     /* under lo */
+    CHECK(mr_cli_counts("5Mx", 1e4, 1e9, list, 3) == -1);
 }
 
 int main(void) {

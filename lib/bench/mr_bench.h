@@ -20,13 +20,11 @@
 extern "C" {
 #endif
 
-/* The GPU a rendering bench uses: a headless context and a renderer on it,
- * made and destroyed by the caller. A bench sets its scenes on the renderer
- * and leaves none set when it returns. Required by ao, frame, ghost, scene. */
-typedef struct mr_bench_gpu {
-    mr_gpu *gpu;
-    mr_renderer *renderer;
-} mr_bench_gpu;
+/* The GPU a rendering bench uses: a headless context and a renderer on it
+ * (mr_gfx_open), made and destroyed by the caller. A bench sets its scenes
+ * on the renderer and leaves none set when it returns. Required by ao,
+ * frame, ghost, scene. */
+typedef mr_gfx mr_bench_gpu;
 
 /* -------------------------------------------------------------- shadows */
 
@@ -276,6 +274,12 @@ extern const mr_opt mr_synth_recording_opts[];
 /* The calibration set: dir/board.json (the board of mr_demo_board_tag as a
  * marker map) and dir/images/board_NN.png, `images` (>= 1) views of it from
  * around, rendered on the CPU through the demo camera. */
+bool mr_synth_calibration(const char *dir, int images, mr_error *err);
+/* `mrcheck demo` (demo.c): the files, the tracking part (dir/calib and a
+ * synthetic recording in dir/recording, never overwritten), the frames, the
+ * marks and the ghosted triptychs, on a headless GPU of its own; what was
+ * written, on stdout. */
+bool mr_demo_run(const char *dir, mr_error *err);
 /* The last part of `mrcheck demo` (demo_marks.c): three marks at the
  * hall's known discrepancies in dir/session/, as a planner would place them
  * in `mrcheck view` (the moved part measured from several recorded frames
@@ -284,7 +288,6 @@ extern const mr_opt mr_synth_recording_opts[];
  * dir/report/ through lib/export. */
 bool mr_demo_marks(const char *dir, const mr_bench_gpu *g, const mr_scene *built, const mr_scene *planned,
                    mr_error *err);
-bool mr_synth_calibration(const char *dir, int images, mr_error *err);
 /* The first parts of `mrcheck demo` (demo_files.c). Files: dir/ and its
  * frames/ overlay/ virtual/ views/ folders, both halls as .glb with
  * scene_planned.json and scene_built.json, markers.json, discrepancies.json,

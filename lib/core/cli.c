@@ -260,3 +260,16 @@ bool mr_cli_count_prefix(const char *s, double *out, const char **end) {
     *end = e;
     return true;
 }
+
+int mr_cli_counts(const char *s, double lo, double hi, double *out, int max) {
+    int n = 0;
+    for (const char *p = s;; n++) {
+        const char *end;
+        double v;
+        if (n >= max || !mr_cli_count_prefix(p, &v, &end) || !(v >= lo && v <= hi)) return -1;
+        out[n] = v;
+        if (*end == 0) return n + 1;
+        if (*end != ',') return -1;
+        p = end + 1;
+    }
+}

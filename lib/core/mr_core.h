@@ -381,6 +381,10 @@ bool mr_cli_size(const char *opt, const char *s, int *w, int *h);
  * like "5M", "200k", "1e6"; *end is where it stops. false if s does not
  * start with a number. */
 bool mr_cli_count_prefix(const char *s, double *out, const char **end);
+/* A comma list of such counts ("1M,5M,20M"; one count is a list of one),
+ * each within [lo, hi]: how many were read into out (at most max), or -1
+ * where s is not such a list. */
+int mr_cli_counts(const char *s, double lo, double hi, double *out, int max);
 /* Exit status of a command that found no GPU device, GL context or display
  * (MR_ERR_NODEVICE): EX_UNAVAILABLE of sysexits.h. Tests skip on this status
  * only, never on the text of a message. */
@@ -395,6 +399,8 @@ int mr_cli_errorf(const char *cmd, const char *fmt, ...)
     ;
 /* Sets the log level from --verbose / --quiet. */
 void mr_cli_log_level(const mr_cli_opt *opts);
+/* The two rows of every command that mr_cli_log_level reads. */
+#define MR_CLI_LOG_OPTS {"verbose", NULL, "more output", NULL}, {"quiet", NULL, "errors only", NULL}
 
 /* ------------------------------------------------------------------- RNG */
 

@@ -37,6 +37,16 @@ void mr_gpu_destroy(mr_gpu **gpu);
 /* "vendor / renderer / version" of the context. */
 const char *mr_gpu_description(const mr_gpu *gpu);
 
+/* A headless GPU and a renderer on it: what a command or a bench renders
+ * with (headless.c). GL debug output follows the log level (debug). Close
+ * also after a failed open. */
+typedef struct mr_gfx {
+    mr_gpu *gpu;
+    struct mr_renderer *renderer;
+} mr_gfx;
+bool mr_gfx_open(mr_gfx *g, mr_error *err);
+void mr_gfx_close(mr_gfx *g);
+
 /* For lib/window's 2D layer, which draws with the same context: a GL
  * program built from embedded shaders/<name> files (NULL-terminated list;
  * 0 + err on failure). GL object names travel as plain integers so that no
@@ -424,6 +434,10 @@ extern const mr_opt mr_shadow_opts[];
 /* "off", "hard", "pcf", "pcss", "bp", "groundtruth", NULL */
 extern const char *const mr_shadow_method_names[MR_SHADOW_METHOD_COUNT + 1];
 bool mr_shadow_method_parse(const char *name, mr_shadow_method *out);
+/* Without --shadows given in t (the parsed mr_shadow_opts table), the
+ * scene config's "shadows" names the method; false + one line if it names
+ * none. */
+bool mr_shadow_scene_default(const mr_cli_table *t, const mr_scene *s, mr_shadow_params *p, mr_error *err);
 /* The light a frame's shadows come from: the scene's first casting light, or
  * the default sun when the scene has no lights; false when none casts. */
 bool mr_shadow_light(const mr_scene *s, mr_light *out);
@@ -598,6 +612,13 @@ typedef struct mr_quilt {
  * "4k" (5x9, 4096x4096, a 1.7778), "8k" (5x9, 8192x8192, a 1.7778), or
  * "CxR" (tiles of the view size) or "CxR@WxH" (tiles cut from W x H). */
 bool mr_quilt_parse(const char *spec, mr_quilt *q, mr_error *err);
+/* The multi-view options of a command that depend on each other: t is
+ * the parsed mr_rig_opts table, quilt_spec --quilt (parsed into *quilt,
+ * *have_quilt set; zeroed when NULL), lightfield whether --lightfield was
+ * given. Rig options without --views, --quilt or --lightfield, and
+ * --lightfield with either, are one line in err. */
+bool mr_rig_opts_check(const mr_cli_table *t, const char *quilt_spec, bool lightfield, mr_quilt *quilt,
+                       bool *have_quilt, mr_error *err);
 /* The layout for n views: a tiles grid of the spec (or, with spec NULL,
  * ceil(sqrt(n)) columns and as many rows as needed) and the tile size: the
  * quilt's size / grid, else view_w x view_h. false + one line if the quilt
@@ -932,6 +953,10 @@ typedef struct mr_cluster_info {
 } mr_cluster_info;
 /* What the last upload took from the cache. */
 void mr_renderer_cluster_info(const mr_renderer *r, mr_cluster_info *out);
+/* `render --verbose`: the frame's passes, draw calls, the geometry's and
+ * meshlets' counts (mr_renderer_draw_stats, mr_renderer_cluster_info), the
+ * upload time given and the peak RSS, as lines "mrcheck: render: ..." on f. */
+void mr_render_report(FILE *f, const mr_renderer *r, const mr_frame_result *res, double upload_s);
 /* The default cache path next to a scene file: "<scene>.mrclu". */
 void mr_cluster_cache_path(const char *scene_path, char *out, size_t n);
 

@@ -5,6 +5,7 @@
 #include "mr_render.h"
 
 #include <stddef.h>
+#include <string.h>
 
 const char *const mr_ao_method_names[MR_AO_METHOD_COUNT + 1] = {"none", "scheer", "crytek", "filion",
                                                                 "hbao", "alchemy",
@@ -174,4 +175,33 @@ const char *mr_ao_sk_role(mr_ao_method m, mr_ao_radius_mode mode) {
     if (m == MR_AO_SCHEER && mode == MR_AO_RADIUS_SCREEN) return "D2";
     if (m == MR_AO_CRYTEK && mode == MR_AO_RADIUS_VIEW) return "D3";
     return "-";
+}
+
+bool mr_shadow_scene_default(const mr_cli_table *t, const mr_scene *s, mr_shadow_params *p, mr_error *err) {
+    if (mr_cli_table_given(t, "") || !s || !s->shadow_method[0]) return true;
+    if (!mr_shadow_method_parse(s->shadow_method, &p->method))
+        return mr_fail(err, MR_ERR_INVALID, "%s: 'shadows' must be off, hard, pcf, pcss, bp or groundtruth, not '%s'",
+                       s->source[0] ? s->source : "the scene config", s->shadow_method);
+    return true;
+}
+
+bool mr_rig_opts_check(const mr_cli_table *t, const char *quilt_spec, bool lightfield, mr_quilt *quilt,
+                       bool *have_quilt, mr_error *err) {
+    const mr_rig_params *rp = t->params;
+    *have_quilt = false;
+    memset(quilt, 0, sizeof *quilt);
+    if (quilt_spec) {
+        mr_error qe = {0};
+        if (!mr_quilt_parse(quilt_spec, quilt, &qe)) return mr_fail(err, MR_ERR_INVALID, "--quilt: %s", qe.msg);
+        *have_quilt = true;
+    }
+    const bool rig_opt = mr_cli_table_given(t, "view-cone") || mr_cli_table_given(t, "view-fov") ||
+                         mr_cli_table_given(t, "focal-distance");
+    if (rp->views == 0 && !*have_quilt && !lightfield && rig_opt)
+        return mr_fail(err, MR_ERR_INVALID, "--view-cone, --view-fov and --focal-distance need --views, --quilt or --lightfield");
+    if (rp->views == 0 && !*have_quilt && mr_cli_table_given(t, "views-per-view-work"))
+        return mr_fail(err, MR_ERR_INVALID, "--views-per-view-work needs --views or --quilt");
+    if (lightfield && (rp->views > 0 || *have_quilt))
+        return mr_fail(err, MR_ERR_INVALID, "--lightfield is one display image: not with --views or --quilt");
+    return true;
 }

@@ -556,6 +556,19 @@ void mr_lod_builder_cancel(mr_lod_builder **b); /* NULLs *b, accepts NULL */
 #define MR_LOD_AUTO_TRIANGLES 500000u
 /* The default cache path next to a scene file: "<scene>.mrlod". */
 void mr_lod_cache_path(const char *scene_path, char *out, size_t n);
+/* Whether a scene gets levels at all (the commands' --lod auto|on|off;
+ * the view draws as auto): auto gives them to scenes drawing
+ * MR_LOD_AUTO_TRIANGLES or more. mr_lod_mode_parse takes NULL as auto;
+ * a bad value is one line in err. In load_report.c. */
+typedef enum mr_lod_mode { MR_LOD_MODE_AUTO, MR_LOD_MODE_ON, MR_LOD_MODE_OFF } mr_lod_mode;
+bool mr_lod_mode_parse(const char *s, mr_lod_mode *out, mr_error *err);
+bool mr_lod_wanted(mr_lod_mode mode, const mr_scene *s);
+/* The commands' loads (load_report.c): the scene with a progress line on
+ * a terminal once a load takes a second, then an info line (nodes, meshes,
+ * triangles drawn and stored, MB, s, MB/s, peak RSS); the levels from the
+ * cache next to scene_path (use_cache) or built, with an info line. */
+mr_scene *mr_scene_load_logged(const char *path, const mr_scene_params *params, mr_error *err);
+mr_lod *mr_lod_load_logged(const mr_scene *s, const char *scene_path, bool use_cache, mr_error *err);
 /* Certified upper bound of the two-sided Hausdorff distance between the
  * triangle lists a and b over the same vertex positions (3 floats each),
  * found by branch and bound on subdivided triangles down to `resolution`

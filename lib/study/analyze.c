@@ -755,3 +755,25 @@ bool mr_study_analyze(const mr_study_votes *votes, const mr_study_plan *plan, co
     free(a);
     return ok;
 }
+
+bool mr_study_analyze_files(const char *const *votes_paths, int n, const char *plan_path,
+                            const mr_study_analyze_params *p, const char *out_dir, int *vote_count, mr_error *err) {
+    mr_study_plan plan;
+    const bool have_plan = plan_path != NULL;
+    if (have_plan && !mr_study_plan_load(plan_path, &plan, err)) return false;
+    mr_study_votes votes = {0};
+    bool ok = true;
+    for (int i = 0; ok && i < n; i++) ok = mr_study_votes_read(votes_paths[i], false, &votes, err);
+    for (int i = 0; ok && !have_plan && i < votes.count; i++)
+        if (votes.v[i].design != MR_STUDY_PAIRWISE)
+            ok = mr_fail(err, MR_ERR_INVALID, "%s answers need their plan: give --plan plan.json",
+                         mr_study_design_names[votes.v[i].design]);
+    if (ok && have_plan && plan.design != MR_STUDY_PAIRWISE)
+        ok = plan.design == MR_STUDY_RATING ? mr_study_analyze_rating(&votes, &plan, p, out_dir, err)
+                                            : mr_study_analyze_task(&votes, &plan, p, out_dir, err);
+    else ok = ok && mr_study_analyze(&votes, have_plan ? &plan : NULL, p, out_dir, err);
+    *vote_count = votes.count;
+    mr_study_votes_free(&votes);
+    if (have_plan) mr_study_plan_free(&plan);
+    return ok;
+}

@@ -267,6 +267,9 @@ bool mr_study_plan_make(const char *dir, const mr_study_set *set, const mr_study
  * stimuli) and makes the plan. */
 bool mr_study_plan_scan_make(const char *dir, const mr_study_plan_params *p, mr_study_plan *out, mr_error *err);
 bool mr_study_plan_save(const char *path, const mr_study_plan *plan, mr_error *err);
+/* One line on f: the plan's id, design, trials, schedules, methods,
+ * stimuli and blocks, and where it was written (plan.c). */
+void mr_study_plan_describe(const mr_study_plan *plan, const char *path, FILE *f);
 /* Checks the id against the content (an edited plan is an error) and
  * resolves dir as given, else relative to the plan file's folder. */
 bool mr_study_plan_load(const char *path, mr_study_plan *plan, mr_error *err);
@@ -574,6 +577,11 @@ bool mr_study_analyze_rating(const mr_study_votes *votes, const mr_study_plan *p
  * tests.csv, posthoc.csv, chart_<condition>.svg and summary.md. */
 bool mr_study_analyze_task(const mr_study_votes *votes, const mr_study_plan *plan, const mr_study_analyze_params *p,
                            const char *out_dir, mr_error *err);
+/* `study analyze` over files (analyze.c): the votes of n files, read and
+ * analysed by the design of the plan at plan_path (NULL: pairwise votes
+ * only; other designs need their plan); *vote_count out. */
+bool mr_study_analyze_files(const char *const *votes_paths, int n, const char *plan_path,
+                            const mr_study_analyze_params *p, const char *out_dir, int *vote_count, mr_error *err);
 
 /* ------------------------------------------------------------- run window */
 

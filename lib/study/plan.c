@@ -841,3 +841,13 @@ bool mr_study_plan_load(const char *path, mr_study_plan *plan, mr_error *err) {
     if (!ok) mr_study_plan_free(plan);
     return ok;
 }
+
+void mr_study_plan_describe(const mr_study_plan *plan, const char *path, FILE *f) {
+    fprintf(f, "study plan %s (%s): %d trials per participant, %d schedule%s (%d methods%s, %d stimuli, blocks", plan->id,
+            mr_study_design_names[plan->design], plan->trial_count, plan->schedule_count,
+            plan->schedule_count > 1 ? "s" : "", plan->set.method_count,
+            plan->set.reference >= 0 ? " with the reference" : "", plan->set.stimulus_count);
+    for (int b = 1; b <= MR_STUDY_MAX_BLOCKS; b++)
+        if (plan->blocks & (1u << (b - 1))) fprintf(f, " %s", mr_study_condition_name(plan->design, b));
+    fprintf(f, ") -> %s\n", path);
+}

@@ -620,7 +620,7 @@ static void poll_scene_load(view_app *a) {
     char cache[4096];
     mr_lod_cache_path(a->scene->source, cache, sizeof cache);
     const bool has_file = a->scene->source[0] != 0;
-    if (mr_scene_triangle_count(a->scene) >= MR_LOD_AUTO_TRIANGLES) {
+    if (mr_lod_wanted(MR_LOD_MODE_AUTO, a->scene)) {
         mr_lod_params lp = MR_LOD_DEFAULTS;
         a->lod_builder = mr_lod_build_async(a->scene, has_file ? cache : NULL, &lp, &err);
         if (!a->lod_builder) mr_log(MR_LOG_WARN, "view: no levels of detail: %s", err.msg);
