@@ -13,6 +13,7 @@
 #include "mr_render.h"
 #include "mr_scene.h"
 #include "mr_session.h"
+#include "mr_track.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -75,6 +76,26 @@ bool mr_batch_replay_check(const mr_batch_replay_params *p, mr_error *err);
  * range or a failed write: false + err. */
 bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_scene *scene,
                      mr_batch_replay_stats *stats, mr_error *err);
+
+/* `mrcheck measure` (measure.c): the feature tapped in the recording's
+ * frames (observations: mr_observations_load) triangulated with the taps'
+ * noise and each frame's pose covariance; its distance to the planned point
+ * and, with a scene, to the planned surface's nearest point (lib/eval), in
+ * mm with its 1-sigma uncertainty, each with its verdict against the
+ * tolerance. Report lines on out; with out_json also the result as JSON. */
+typedef struct mr_batch_measure_params {
+    const char *recording;    /* folder, required */
+    const char *observations; /* OBS.json, required */
+    const char *scene;        /* the plan; NULL: no surface distance */
+    const char *tolerances;   /* T.json; NULL: DIN 18202 Table 1 by nominal size */
+    double nominal;           /* m; < 0 (default): the planned point's distance from the table's reference point */
+    const char *part;         /* the planned point's part (its tolerance); NULL: none */
+    const char *out_json;     /* NULL: no file */
+    mr_triangulate_params triangulate;
+    FILE *out;                /* required */
+} mr_batch_measure_params;
+#define MR_BATCH_MEASURE_DEFAULTS {.nominal = -1, .triangulate = MR_TRIANGULATE_DEFAULTS}
+bool mr_batch_measure(const mr_batch_measure_params *p, mr_error *err);
 
 #ifdef __cplusplus
 }
