@@ -59,8 +59,4 @@ int cmd_map(int argc, char **argv);
 int cmd_measure(int argc, char **argv);
 int bench_tracking(int argc, char **argv);
 
-/* Set by SIGINT/SIGTERM while a long command runs (app/track_util.c). */
-void app_catch_signals(void);
-bool app_interrupted(void);
-
 #endif

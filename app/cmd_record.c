@@ -73,11 +73,11 @@ int cmd_record(int argc, char **argv) {
         mr_source_close(&src);
         return mr_cli_error(cmd, &err);
     }
-    app_catch_signals();
+    mr_stop_catch();
     int rc = 0;
     long frames = 0, with_pose = 0, warned = 0;
     double t_first = 0, wall0 = mr_time_now();
-    while (!app_interrupted() && (max_frames < 0 || frames < max_frames)) {
+    while (!mr_stop_requested() && (max_frames < 0 || frames < max_frames)) {
         mr_frame f;
         mr_read_status st = mr_source_read(src, &f, &err);
         if (st == MR_READ_END) break;

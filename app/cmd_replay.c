@@ -10,6 +10,7 @@ int cmd_replay(int argc, char **argv) {
     mr_cli_opt opts[] = {
         {"scene", "S", "glTF/GLB or scene config of the plan (required)", NULL},
         {"out", "OUTDIR", "where overlay_NNNNNN.png and replay.jsonl go (required)", NULL},
+        {"force", NULL, "write into an --out folder that already holds files", NULL},
         {"video", "FILE.avi", "also write the overlays as a Motion-JPEG AVI at the recording's rate", NULL},
         {"verbose", NULL, "more output", NULL},
         {"quiet", NULL, "errors only", NULL},
@@ -48,6 +49,8 @@ int cmd_replay(int argc, char **argv) {
     p.out_dir = mr_cli_get(opts, "out");
     p.video_path = mr_cli_get(opts, "video");
     p.progress = true;
+    p.force = mr_cli_flag(opts, "force");
+    mr_stop_catch();
     mr_quilt quilt = {0};
     bool have_quilt;
     if (!mr_rig_opts_check(&tables[5], mr_cli_get(opts, "quilt"), mr_cli_get(opts, "lightfield") != NULL, &quilt,

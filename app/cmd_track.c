@@ -3,6 +3,7 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 int cmd_track(int argc, char **argv) {
     static const char *cmd = "track";
@@ -54,14 +55,16 @@ int cmd_track(int argc, char **argv) {
         mr_source_close(&src);
         return mr_cli_errorf(cmd, "--out needs --camera and --markers (or a recording as input)");
     }
-    app_catch_signals();
+    mr_stop_catch();
     mr_jsonl poses = {0};
     long frames = 0, failed = 0, with_tags = 0, with_pose = 0;
     int rc = 0;
     /* The first bad frame's message is held back: if no frame at all can be
      * processed (a single tiny image, say) it becomes the one error line. */
     char held[600] = "";
-    while (!app_interrupted() && (max_frames < 0 || frames < max_frames)) {
+    const bool tty = isatty(2) && mr_log_get_level() >= MR_LOG_WARN;
+    double shown = mr_time_now();
+    while (!mr_stop_requested() && (max_frames < 0 || frames < max_frames)) {
         mr_frame f;
         mr_read_status st = mr_source_read(src, &f, &err);
         if (st == MR_READ_END) break;
@@ -70,6 +73,10 @@ int cmd_track(int argc, char **argv) {
             break;
         }
         frames++;
+        if (tty && mr_time_now() - shown > 0.25) {
+            fprintf(stderr, "\rtrack: frame %lld, %ld with a pose", (long long)f.index, with_pose);
+            shown = mr_time_now();
+        }
         mr_tracker_result r;
         mr_error fe = {0};
         if (!mr_tracker_frame(t.tracker, &f.image, f.timestamp, &r, &fe)) {
@@ -114,10 +121,13 @@ int cmd_track(int argc, char **argv) {
     if (rc == 0 && frames == 0) rc = mr_cli_errorf(cmd, "%s: no frames", input);
     else if (rc == 0 && failed == frames)
         rc = mr_cli_errorf(cmd, "no frame could be processed (%ld failed; %s)", failed, held[0] ? held : "see above");
+    if (tty) fprintf(stderr, "\r\033[K");
     if (rc == 0 && out && !mr_jsonl_save(&poses, out, &err)) rc = mr_cli_error(cmd, &err);
-    if (rc == 0 && mr_log_get_level() >= MR_LOG_INFO)
-        fprintf(stderr, "track: %ld frames, %ld with tags, %ld with a pose, %ld failed\n", frames, with_tags, with_pose,
-                failed);
+    if (rc == 0 && mr_log_get_level() >= MR_LOG_WARN) /* the summary, on stderr: stdout may be the poses */
+        fprintf(stderr, "track: %s%ld frames, %ld with tags, %ld with a pose, %ld failed%s%s\n",
+                mr_stop_requested() ? "interrupted after " : "", frames, with_tags, with_pose, failed,
+                out ? "; wrote " : "", out ? out : "");
+    if (rc == 0 && mr_stop_requested()) rc = 128 + mr_stop_signal();
     mr_jsonl_free(&poses);
     app_tracker_free(&t);
     mr_source_close(&src);

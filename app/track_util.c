@@ -1,26 +1,7 @@
 /* Shared wiring of the tracking commands: input, tracker, line formats. */
 #include "app_track.h"
 
-#include <signal.h>
 #include <string.h>
-
-static volatile sig_atomic_t g_interrupted = 0; /* app only: signal flag */
-
-static void on_signal(int sig) {
-    (void)sig;
-    g_interrupted = 1;
-}
-
-void app_catch_signals(void) {
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
-}
-
-bool app_interrupted(void) { return g_interrupted != 0; }
 
 mr_source *app_open_input(const char *uri, bool gray, mr_recording **rec_info, mr_error *err) {
     mr_source_params sp = MR_SOURCE_DEFAULTS;

@@ -110,6 +110,10 @@ hlod_cut_unprojected|lib/scene/hlod.c|n->error * (p->fmax / zmin) <= p->pixels|n
 hlod_cache_index_unchecked|lib/scene/hlod.c|if (n->indices[k] >= n->vertex_count) return false;|if (n->indices[k] > 0xffffffffu) return false;|^test_hlod$
 hlod_draw_one_id_per_proxy|lib/render/hlod_draw.c|gi->ids[0] = (uint32_t)q->node + 1;|gi->ids[0] = (uint32_t)hn->runs[0].node + 1;|^test_hlod_draw$
 hlod_draw_all_layers|lib/render/hlod_draw.c|cp.layers = vw->layers;|cp.layers = 3;|^test_hlod_draw$
+replay_stop_ignored|lib/batch/replay.c|if (mr_stop_requested()) {|if (false) {|^(test_batch|cli_batch_stop)$
+replay_no_index_after_stop|lib/batch/replay.c|    if (written > 0) {|    if (written > 0 && !st->interrupted) {|^cli_batch_stop$
+outdir_not_refused|lib/core/stop.c|if (!force && mr_dir_has_entries(path))|if (0)|^cli_batch_stop$
+outdir_left_after_failure|lib/batch/replay.c|    if (written == 0) mr_outdir_abandon(od);|    (void)od;|^test_batch$
 LIST
 )
 

@@ -28,10 +28,12 @@ static int count_lines(const char *path, int *overlays) {
 }
 
 static int g_hook_calls;
+static int g_stop_at; /* the hook call that asks for a stop as SIGINT would; 0: none */
 static bool hook(void *user, mr_renderer *r, const mr_view *view, const mr_frame_params *fp, int64_t index, char *name,
                  size_t name_n, mr_error *err) {
     (void)user, (void)r, (void)view, (void)fp, (void)err;
     g_hook_calls++;
+    if (g_hook_calls == g_stop_at) mr_stop_request(2);
     snprintf(name, name_n, "hook_%lld", (long long)index);
     return true;
 }
@@ -121,12 +123,54 @@ int main(void) {
     snprintf(path, sizeof path, "%s/overlay_%06d.png", dir3, 10);
     CHECK(!mr_file_exists(path));
 
-    /* A range past the recording's end selects nothing: an error. */
+    /* A folder that holds files is refused before anything is drawn;
+     * --force writes into it. */
+    memset(&err, 0, sizeof err);
+    g_hook_calls = 0;
+    CHECK(!mr_batch_replay_check(&p, &err) && strstr(err.msg, "not empty"));
+    CHECK(r && !mr_batch_replay(&p, r, scene, &st, &err) && g_hook_calls == 0);
+    p.force = true;
+    CHECK_MSG(r && mr_batch_replay(&p, r, scene, &st, &err), "%s", err.msg);
+    p.force = false;
+
+    /* A stop (SIGINT) during the first tracked frame ends the run before
+     * the next one: the index lists exactly the frames done, the error
+     * says interrupted. */
+    char dir4[4200];
+    snprintf(dir4, sizeof dir4, "%s/stopped", dir);
+    p.out_dir = dir4;
+    g_hook_calls = 0;
+    g_stop_at = 1;
+    memset(&err, 0, sizeof err);
+    CHECK(r && !mr_batch_replay(&p, r, scene, &st, &err) && err.code == MR_ERR_INTERRUPTED);
+    CHECK_MSG(st.interrupted && st.written >= 1 && st.written < 4, "%d written", st.written);
+    snprintf(path, sizeof path, "%s/replay.jsonl", dir4);
+    CHECK(count_lines(path, &overlays) == st.written && overlays == 1);
+    CHECK(g_hook_calls == 1);
+    mr_stop_request(0);
+    g_stop_at = 0;
+    /* Stopped before the first frame: nothing written, no folder left. */
+    char dir5[4200];
+    snprintf(dir5, sizeof dir5, "%s/new/stopped_early", dir);
+    p.out_dir = dir5;
+    mr_stop_request(15);
+    memset(&err, 0, sizeof err);
+    CHECK(r && !mr_batch_replay(&p, r, scene, &st, &err) && err.code == MR_ERR_INTERRUPTED);
+    mr_stop_request(0);
+    snprintf(path, sizeof path, "%s/new", dir);
+    CHECK_MSG(!mr_file_exists(path), "%s left behind", path);
+
+    /* A range past the recording's end selects nothing: an error, and no
+     * folder is left behind. */
+    char dir6[4200];
+    snprintf(dir6, sizeof dir6, "%s/past_end", dir);
+    p.out_dir = dir6;
     p.render = NULL;
     p.from = 100000;
     p.to = -1;
     memset(&err, 0, sizeof err);
     CHECK(r && !mr_batch_replay(&p, r, scene, &st, &err) && strstr(err.msg, "no recorded frame"));
+    CHECK(!mr_file_exists(dir6));
 
     mr_renderer_destroy(&r);
     mr_gpu_destroy(&gpu);

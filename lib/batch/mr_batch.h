@@ -24,6 +24,12 @@ extern "C" {
  * frame alone where the frame has no pose, so the sequence stays complete),
  * out_dir/replay.jsonl ({"frame", "t", "image", "overlay",
  * "world_from_camera"} per written image, written atomically at the end),
+ * The folder must be new or empty unless force. A stop (SIGINT/SIGTERM,
+ * mr_stop_requested) ends the run at the next frame, a failure at the
+ * frame that failed; either way replay.jsonl then lists exactly the images
+ * written so far (and the video holds them), or, if none was, the folder
+ * this run made is removed again. A stop returns false with
+ * MR_ERR_INTERRUPTED and the summary in err.
  * and optionally a Motion-JPEG AVI at the recording's median frame rate
  * divided by `every` (no half-written video after a failure).
  * Deterministic: the same recording gives the same images. */
@@ -45,7 +51,8 @@ typedef struct mr_batch_replay_params {
     int from;                   /* first frame number; default 0 */
     int to;                     /* last frame number; < 0 (the default): the last */
     bool raw;                   /* the raw pose, not the filtered one */
-    bool progress;              /* "replay: frame N" on a terminal */
+    bool progress;              /* "replay: frame N (i/n)" on a terminal */
+    bool force;                 /* write into a folder that already holds files (else refused) */
     mr_batch_replay_render_fn render; /* NULL: the overlay PNG (and the AVI) */
     void *render_user;
     /* --views / --quilt: per frame a quilt overlay_NNNNNN_qs..png and its
@@ -66,10 +73,14 @@ typedef struct mr_batch_replay_stats {
     int plain;                  /* frames written without a pose (camera frame only) */
     uint64_t triangles;         /* submitted, summed over the overlays (a rig's: its last draw per frame) */
     uint64_t lod_instances;     /* instances drawn at a simplified level, summed likewise */
+    int written;                /* images listed in replay.jsonl */
+    int64_t last_frame;         /* the last one written */
+    bool interrupted;           /* stopped by mr_stop_requested() */
 } mr_batch_replay_stats;
 
-/* The checks that need neither the recording nor a GPU: a folder is given,
- * to is not before from. False + one line in err. */
+/* The checks that need neither the recording nor a GPU: a folder is given
+ * and new or empty (or force), to is not before from. False + one line in
+ * err. */
 bool mr_batch_replay_check(const mr_batch_replay_params *p, mr_error *err);
 /* Sets scene on r, renders, and leaves no scene set. A frame whose image
  * cannot be read is skipped with a warning on stderr; no frame in the

@@ -23,6 +23,7 @@ const mr_opt mr_batch_replay_opts[] = {
 
 bool mr_batch_replay_check(const mr_batch_replay_params *p, mr_error *err) {
     if (!p->out_dir) return mr_fail(err, MR_ERR_INVALID, "replay needs an output folder");
+    if (!mr_outdir_check(p->out_dir, p->force, err)) return false;
     if ((p->render || p->rig) && p->video_path) return mr_fail(err, MR_ERR_INVALID, "--video is for single views, not --views");
     if (p->to >= 0 && p->to < p->from)
         return mr_fail(err, MR_ERR_INVALID, "--to %d is before --from %d", p->to, p->from);
@@ -71,6 +72,40 @@ static bool rig_frame(const mr_batch_replay_params *p, mr_renderer *r, const mr_
     return true;
 }
 
+/* A frame of the selection (every Nth from `from` up to `to`). */
+static bool replay_selected(const mr_batch_replay_params *p, int every, int64_t index) {
+    return index >= p->from && (p->to < 0 || index <= p->to) && (index - p->from) % every == 0;
+}
+
+/* After the loop: the index of what was written (also after a stop or a
+ * failure, so the folder always matches its replay.jsonl), the video
+ * closed, or the folder removed again if nothing was written. */
+static bool replay_finish(const mr_batch_replay_params *p, mr_outdir *od, mr_jsonl *log, mr_video_writer **vw,
+                          const mr_batch_replay_stats *st, bool ok, mr_error *err) {
+    const int written = st->written;
+    if (written > 0) {
+        char path[4096];
+        mr_path_join(p->out_dir, "replay.jsonl", path, sizeof path);
+        mr_error ie = {0};
+        bool indexed = mr_jsonl_save(log, path, &ie);
+        if (ok && !indexed) ok = mr_fail(err, ie.code, "%s", ie.msg);
+        if (ok || st->interrupted) {
+            mr_error ve = {0};
+            if (*vw && !mr_video_writer_close(vw, &ve) && ok) ok = mr_fail(err, ve.code, "%s", ve.msg);
+        }
+    }
+    mr_video_writer_abort(vw); /* after a failure: no half-written video */
+    if (written == 0) mr_outdir_abandon(od);
+    if (ok && st->interrupted) {
+        if (written > 0)
+            ok = mr_fail(err, MR_ERR_INTERRUPTED, "interrupted after frame %lld: %d images and replay.jsonl in %s/%s",
+                         (long long)st->last_frame, written, p->out_dir, p->video_path ? " (and the video)" : "");
+        else
+            ok = mr_fail(err, MR_ERR_INTERRUPTED, "interrupted before the first frame; nothing written");
+    }
+    return ok;
+}
+
 bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_scene *scene,
                      mr_batch_replay_stats *stats, mr_error *err) {
     mr_batch_replay_stats st = {0};
@@ -79,7 +114,12 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
     if (!p->recording) return mr_fail(err, MR_ERR_INVALID, "replay needs a recording");
     const int every = p->every > 0 ? p->every : 1;
     const mr_recording *rec = p->recording;
-    bool ok = mr_mkdirs(p->out_dir, err) && mr_renderer_set_scene_lod(r, scene, p->lod, err);
+    int total = 0;
+    for (int i = 0; i < rec->frame_count; i++) total += replay_selected(p, every, rec->frames[i].index);
+    if (total == 0) return mr_fail(err, MR_ERR_INVALID, "no recorded frame in the selected range");
+    mr_outdir od;
+    if (!mr_outdir_create(&od, p->out_dir, p->force, err)) return false;
+    bool ok = mr_renderer_set_scene_lod(r, scene, p->lod, err);
     mr_jsonl log = {0};
     mr_video_writer *vw = NULL;
     const double fps = recording_fps(rec, every);
@@ -89,9 +129,13 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
     bool ao_restart = true; /* --ao-temporal restarts after a frame without a pose (a tracking reset) */
     for (int i = 0; ok && i < rec->frame_count; i++) {
         const mr_rec_frame *f = &rec->frames[i];
-        if (f->index < p->from || (p->to >= 0 && f->index > p->to) || (f->index - p->from) % every != 0) continue;
+        if (!replay_selected(p, every, f->index)) continue;
+        if (mr_stop_requested()) {
+            st.interrupted = true;
+            break;
+        }
         selected++;
-        if (tty) fprintf(stderr, "\rreplay: frame %lld", (long long)f->index);
+        if (tty) fprintf(stderr, "\rreplay: frame %lld (%d/%d)", (long long)f->index, selected, total);
         mr_image img;
         mr_error fe = {0};
         if (!mr_recording_load_image(rec, i, false, &img, &fe)) {
@@ -151,6 +195,8 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
             st.plain++;
         }
         mr_image_free(&img);
+        if (!ok) break;
+        st.last_frame = f->index;
         cJSON *o = cJSON_CreateObject();
         cJSON_AddNumberToObject(o, "frame", (double)f->index);
         cJSON_AddNumberToObject(o, "t", f->t);
@@ -158,19 +204,13 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
         cJSON_AddBoolToObject(o, "overlay", has_pose);
         if (has_pose) cJSON_AddItemToObject(o, "world_from_camera", mr_json_from_dmat4(&pose));
         if (have_centre_sigma) cJSON_AddNumberToObject(o, "centre_uncertainty_m", centre_sigma);
-        mr_jsonl_add(&log, o);
+        if (!mr_jsonl_add(&log, o)) ok = mr_fail(err, MR_ERR_NOMEM, "out of memory");
+        else st.written++;
         cJSON_Delete(o);
     }
     if (tty && selected) fprintf(stderr, "\r\033[K");
-    if (ok && selected == 0) ok = mr_fail(err, MR_ERR_INVALID, "no recorded frame in the selected range");
-    if (ok) {
-        char path[4096];
-        mr_path_join(p->out_dir, "replay.jsonl", path, sizeof path);
-        ok = mr_jsonl_save(&log, path, err);
-    }
+    ok = replay_finish(p, &od, &log, &vw, &st, ok, err);
     mr_jsonl_free(&log);
-    if (ok && vw) ok = mr_video_writer_close(&vw, err);
-    mr_video_writer_abort(&vw); /* after a failure: no half-written video */
     mr_renderer_set_scene(r, NULL, &(mr_error){0});
     if (stats) *stats = st;
     return ok;

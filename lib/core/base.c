@@ -56,6 +56,7 @@ const char *mr_err_name(mr_err_code code) {
     case MR_ERR_UNSUPPORTED: return "unsupported";
     case MR_ERR_NODEVICE: return "nodevice";
     case MR_ERR_GL: return "gl";
+    case MR_ERR_INTERRUPTED: return "interrupted";
     }
     return "unknown";
 }

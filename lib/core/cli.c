@@ -227,6 +227,7 @@ bool mr_cli_size(const char *opt, const char *s, int *w, int *h) {
 
 int mr_cli_error(const char *cmd, const mr_error *err) {
     fprintf(stderr, "mrcheck: %s: %s\n", cmd, err->msg[0] ? err->msg : "failed");
+    if (err->code == MR_ERR_INTERRUPTED) return 128 + (mr_stop_signal() > 0 ? mr_stop_signal() : 2);
     return err->code == MR_ERR_NODEVICE ? MR_CLI_EXIT_NODEVICE : 1;
 }
 

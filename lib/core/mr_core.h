@@ -39,6 +39,7 @@ typedef enum mr_err_code {
     MR_ERR_NODEVICE,    /* no EGL/GL device, GL context or display (only these: the
                            command-line exit status and test skips rely on it) */
     MR_ERR_GL,          /* a GL call or shader failed */
+    MR_ERR_INTERRUPTED, /* stopped by SIGINT/SIGTERM (mr_stop_requested) */
 } mr_err_code;
 
 /* An error: a stable code and one human-readable line (no newline). */
@@ -201,6 +202,41 @@ bool mr_jsonl_save(const mr_jsonl *b, const char *path, mr_error *err);
 void mr_jsonl_free(mr_jsonl *b);
 bool mr_file_exists(const char *path);
 bool mr_mkdirs(const char *path, mr_error *err); /* mkdir -p */
+
+/* The output folder of a batch run (--out DIR). mr_outdir_check refuses a
+ * folder that exists and holds anything (or a path that is a file) unless
+ * force, so a rerun never mixes its files with an earlier run's; it writes
+ * nothing, so it can run before any slow work. mr_outdir_create makes the
+ * folder (mkdir -p) and remembers the folders it made; after a failure
+ * mr_outdir_abandon removes those of them that are still empty, so a run
+ * that failed before writing leaves no folder behind. */
+typedef struct mr_outdir {
+    char path[4096];
+    char made[4096]; /* the topmost folder this run created ("" if none) */
+} mr_outdir;
+bool mr_outdir_check(const char *path, bool force, mr_error *err);
+bool mr_outdir_create(mr_outdir *d, const char *path, bool force, mr_error *err);
+void mr_outdir_abandon(mr_outdir *d);
+/* True if path is a folder with at least one entry besides . and .. */
+bool mr_dir_has_entries(const char *path);
+
+/* ------------------------------------------------------------- stopping */
+
+/* Batch runs stop cleanly on SIGINT and SIGTERM: mr_stop_catch installs a
+ * handler (sigaction) that only sets a flag; the libraries' per-frame loops
+ * ask mr_stop_requested() and end at the next frame, with their index
+ * written and MR_ERR_INTERRUPTED in err, and mr_cli_error turns that into
+ * exit status 128 + the signal. The flag is, with the log level, the only
+ * process-wide state. A second signal while a stop is pending ends the
+ * process at once (the default action), so a stuck run can still be
+ * killed. */
+void mr_stop_catch(void);
+bool mr_stop_requested(void);
+/* The signal that asked (SIGINT, SIGTERM; tests may pass any), 0 if none. */
+int mr_stop_signal(void);
+/* Asks for a stop as a signal would (tests, a UI's stop button); 0 clears
+ * the request. */
+void mr_stop_request(int sig);
 /* Directory part of a path ("." if none), into out (size n). */
 void mr_path_dir(const char *path, char *out, size_t n);
 /* Joins dir and rel unless rel is absolute. */
@@ -390,7 +426,8 @@ int mr_cli_counts(const char *s, double lo, double hi, double *out, int max);
  * only, never on the text of a message. */
 #define MR_CLI_EXIT_NODEVICE 69
 /* Prints "mrcheck: <cmd>: <message>" on stderr and returns 1, or
- * MR_CLI_EXIT_NODEVICE for MR_ERR_NODEVICE. */
+ * MR_CLI_EXIT_NODEVICE for MR_ERR_NODEVICE, or 128 + the signal for
+ * MR_ERR_INTERRUPTED (130 after Ctrl-C). */
 int mr_cli_error(const char *cmd, const mr_error *err);
 int mr_cli_errorf(const char *cmd, const char *fmt, ...)
 #if defined(__GNUC__)
