@@ -114,6 +114,11 @@ replay_stop_ignored|lib/batch/replay.c|if (mr_stop_requested()) {|if (false) {|^
 replay_no_index_after_stop|lib/batch/replay.c|    if (written > 0) {|    if (written > 0 && !st->interrupted) {|^cli_batch_stop$
 outdir_not_refused|lib/core/stop.c|if (!force && mr_dir_has_entries(path))|if (0)|^cli_batch_stop$
 outdir_left_after_failure|lib/batch/replay.c|    if (written == 0) mr_outdir_abandon(od);|    (void)od;|^test_batch$
+hall_mkdir_before_checks|lib/session/hall.c|    bool ok = true;\n    for (int i = 0; ok && i < MR_HALL_ITEM_COUNT; i++)|    bool ok = mr_mkdirs(dir, err);\n    for (int i = 0; ok && i < MR_HALL_ITEM_COUNT; i++)|^test_hall$
+hall_plan_not_relative|lib/session/hall.c|            relative_to(dir, u->files[i], rel, sizeof rel);|            relative_to(dir, u->files[i], rel, sizeof rel), snprintf(rel, sizeof rel, "%s", u->files[i]);|^test_hall$
+hall_marks_next_to_recording|lib/session/hall_args.c|    if (mr_hall_contains(h, session)) {|    if (1) {|^test_hall$
+hall_no_unknown_key_warning|lib/session/hall.c|    if (warn) mr_json_warn_unknown(j, k_known, file);|    (void)warn, (void)k_known;|^cli_hall$
+help_research_not_apart|lib/core/cli.c|for (; o->name && o->name[0]; o++) print_row(o->name, o->arg, o->help);|for (; o->name; o++) if (o->name[0]) print_row(o->name, o->arg, o->help);|^cli_help$
 LIST
 )
 
