@@ -119,6 +119,9 @@ hall_plan_not_relative|lib/session/hall.c|            relative_to(dir, u->files[
 hall_marks_next_to_recording|lib/session/hall_args.c|    if (mr_hall_contains(h, session)) {|    if (1) {|^test_hall$
 hall_no_unknown_key_warning|lib/session/hall.c|    if (warn) mr_json_warn_unknown(j, k_known, file);|    (void)warn, (void)k_known;|^cli_hall$
 help_research_not_apart|lib/core/cli.c|for (; o->name && o->name[0]; o++) print_row(o->name, o->arg, o->help);|for (; o->name; o++) if (o->name[0]) print_row(o->name, o->arg, o->help);|^cli_help$
+triangulate_sigma_over_sqrt3|lib/track/triangulate.c|out->sigma = sqrt(fmax(0, out->cov[0] + out->cov[4] + out->cov[8]));|out->sigma = sqrt(fmax(0, out->cov[0] + out->cov[4] + out->cov[8]) / 3);|^test_sigma$
+triangulate_line_sigma_over_sqrt3|lib/track/triangulate.c|*sigma = sqrt(fmax(v, 0));|*sigma = sqrt(fmax(v, 0) / 3);|^test_sigma$
+triangulate_point_sigma_not_per_axis|lib/track/triangulate.c|*sigma = sqrt((t->cov[0] + t->cov[4] + t->cov[8]) / 3);|*sigma = sqrt(t->cov[0] + t->cov[4] + t->cov[8]);|^test_sigma$
 LIST
 )
 
