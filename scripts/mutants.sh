@@ -98,6 +98,10 @@ study_overall_rotation|lib/study/run.c|answered = true, answer = (t->right + i) 
 gltf_sparse_values_at_index_offset|lib/scene/gltf_io.cc|        vp += sp.values.byteOffset;|        vp += sp.indices.byteOffset;|^test_gltf_ext$
 gltf_sparse_short_32768|lib/scene/gltf_io.cc|return norm ? std::max(v / 32767.0, -1.0) : (double)v;|return norm ? std::max(v / 32768.0, -1.0) : (double)v;|^test_gltf_ext$
 bcf_viewpoint_guid_is_topic|lib/export/findings.c|mr_bcf_guid(key, n, 2, f->viewpoint_guid);|mr_bcf_guid(key, n, 1, f->viewpoint_guid);|^test_export$
+bcf_fov_not_fitted|lib/export/bcf.c|double fit = fmin(fmax(fov, 45.0), 60.0);|double fit = fov;|^test_export$
+bcf_no_ifcguid|lib/export/bcf.c|if (mr_ifc_guid_valid(c->ifc_guid)) mr_xml_attr(x, "IfcGuid", c->ifc_guid);|(void)0;|^test_export$
+bcf_21_hints_missing|lib/export/bcf.c|if (!v3) setup_hints(x, v);|if (0) setup_hints(x, v);|^test_export$
+mark_element_guid_lost|lib/session/annotations.c|cJSON_AddStringToObject(e, "guid", a->element_guid);|cJSON_AddStringToObject(e, "guid", "");|^test_export$
 study_cmax_odd_even_formula|lib/study/stats.c|(t % 2) ? (td * td * td - td) / 24.0|(t % 2) ? (td * td * td - 4 * td) / 24.0|^test_study$
 map_huber_scale_unweighted|lib/track/map_ba.cc|ceres::HuberLoss loss2(loss_px * w);|ceres::HuberLoss loss2(loss_px);|^test_map$
 map_control_residual_sign|lib/track/map.c|cr->residual[1] = pr.y - p->controls[q].world.y;|cr->residual[1] = p->controls[q].world.y - pr.y;|^test_map$

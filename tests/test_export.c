@@ -138,6 +138,48 @@ static mr_dmat4 pose_at(double ex, double ey, double ez, double tx, double ty, d
 static const mr_measurement *g_mark_measure;
 static const mr_verdict *g_mark_verdict;     /* with g_mark_measure: its verdict */
 
+static const char k_pipe_guid[] = "2O2Fr$t4X7Zf8NOew3FLOH";
+
+/* The viewpoint's Components as buildingSMART's visinfo.xsd orders them:
+ * 2.1 ViewSetupHints, Selection, Visibility, Coloring (Color holds
+ * Component); 3.0 Selection, Visibility (holding ViewSetupHints), Coloring
+ * (Color holds Components). The marked element is the selected and
+ * coloured component: IfcGuid (22 chars of IFC's base64) where the model
+ * has one, else AuthoringToolId = its name. Colours are 6 or 8 hex digits. */
+static void check_components(const char *vp, mr_bcf_version v, int k) {
+    const char *comps = find_tag(vp, "Components");
+    CHECK_MSG(comps && comps < find_tag(vp, "PerspectiveCamera"), "Components before the camera");
+    if (!comps) return;
+    static const char *const o21[] = {"Components", "ViewSetupHints", "Selection", "Component", "Visibility",
+                                      "Coloring", "Color", "Component"};
+    static const char *const o30[] = {"Components", "Selection", "Component", "Visibility", "ViewSetupHints",
+                                      "Coloring", "Color", "Components", "Component"};
+    if (v == MR_BCF_3_0) CHECK(in_order(vp, NULL, o30, 9));
+    else CHECK(in_order(vp, NULL, o21, 8));
+    char dv[16] = "", col[16] = "", g[64] = "", tool[160] = "", sys[64] = "";
+    CHECK(attr(find_tag(vp, "Visibility"), "DefaultVisibility", dv, sizeof dv) && strcmp(dv, "true") == 0);
+    CHECK(attr(find_tag(vp, "Color"), "Color", col, sizeof col));
+    size_t cl = strlen(col);
+    CHECK_MSG(cl == 6 || cl == 8, "colour %s", col);
+    for (size_t i = 0; i < cl; i++) CHECK(strchr("0123456789ABCDEF", col[i]) != NULL);
+    const char *sel = find_tag(vp, "Selection");
+    const char *c = find_tag(sel, "Component");
+    bool has_guid = attr(c, "IfcGuid", g, sizeof g);
+    tag_text(c, "OriginatingSystem", sys, sizeof sys);
+    CHECK(strcmp(sys, "mrcheck") == 0);
+    if (k == 0) {
+        CHECK_MSG(has_guid && strcmp(g, k_pipe_guid) == 0, "IfcGuid %s", g);
+        CHECK(strlen(g) == 22 && strspn(g, "0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz_$") == 22);
+    } else {
+        CHECK(!has_guid);
+        CHECK(tag_text(c, "AuthoringToolId", tool, sizeof tool) && strcmp(tool, "Conveyor_2") == 0);
+    }
+    /* The coloured component is the selected one. */
+    const char *cc = find_tag(find_tag(vp, "Color"), "Component");
+    char g2[64] = "";
+    CHECK(cc && (attr(cc, "IfcGuid", g2, sizeof g2) == has_guid) && strcmp(g, g2) == 0);
+}
+
 static bool write_mark(const char *dir, int i, const char *note, const mr_dmat4 *pose, double dist, double unc) {
     mr_camera cam = test_camera();
     mr_image img;
@@ -163,6 +205,19 @@ static bool write_mark(const char *dir, int i, const char *note, const mr_dmat4 
     m.world[0] = 1, m.world[1] = 1, m.world[2] = 1;
     m.depth = 3.5;
     m.node_index = -1;
+    /* Mark 1 is on an IFC element, mark 2 on a part of a model without
+     * IFC identity. */
+    if (i == 1) {
+        snprintf(m.node, sizeof m.node, "Pipe_1");
+        m.node_index = 3;
+        snprintf(m.element_guid, sizeof m.element_guid, "%s", k_pipe_guid);
+        snprintf(m.element_class, sizeof m.element_class, "IfcPipeSegment");
+        snprintf(m.element_name, sizeof m.element_name, "Pipe_1");
+    } else if (i == 2) {
+        snprintf(m.node, sizeof m.node, "Conveyor_2");
+        m.node_index = 4;
+        snprintf(m.element_name, sizeof m.element_name, "Conveyor_2");
+    }
     m.has_pose = m.pose_valid = true;
     m.world_from_camera = *pose;
     m.pose_tags_seen = 3;
@@ -433,6 +488,11 @@ static void check_archive(const char *path, mr_bcf_version v, const mr_dmat4 *po
             const double *m = poses[k].m;
             double want_p[3] = {m[3], -m[11], m[7]};
             double want_d[3] = {m[2], -m[10], m[6]};
+            /* 2.1 allows 45..60 deg only: this camera's 77.3 deg horizontal
+             * view is 60 deg from further back along its axis, showing the
+             * same width at the marked point (3.5 m away). */
+            double back = v == MR_BCF_3_0 ? 0 : 3.5 * 0.8 / tan(M_PI / 6) - 3.5;
+            for (int a = 0; a < 3; a++) want_p[a] -= back * want_d[a];
             double p[3], d[3], u[3], fov = 0;
             CHECK(tag_xyz(vp, "CameraViewPoint", p) && tag_xyz(vp, "CameraDirection", d) &&
                   tag_xyz(vp, "CameraUpVector", u) && tag_num(vp, "FieldOfView", &fov));
@@ -444,8 +504,14 @@ static void check_archive(const char *path, mr_bcf_version v, const mr_dmat4 *po
             CHECK_MSG(ang < 0.01, "direction off by %g deg", ang);
             CHECK_NEAR(u[0] * d[0] + u[1] * d[1] + u[2] * d[2], 0, 1e-9);
             CHECK(u[2] > 0); /* these poses look upright */
-            double want_fov = 2 * atan(v == MR_BCF_3_0 ? 0.6 : 0.8) * 180 / M_PI;
+            double want_fov = v == MR_BCF_3_0 ? 2 * atan(0.6) * 180 / M_PI : 60;
             CHECK_NEAR(fov, want_fov, 1e-6);
+            CHECK(v == MR_BCF_3_0 || (fov >= 45 && fov <= 60)); /* 2.1's FieldOfView range */
+            CHECK(fov > 0 && fov < 180);
+            if (v == MR_BCF_2_1)
+                CHECK_MSG(strstr(desc, "BCF 2.1 allows 45 to 60 deg"), "the moved camera is noted: %s", desc);
+            if (descs) check_components(vp, v, k);
+            if (descs && k == 0) CHECK(strstr(desc, "IfcPipeSegment") && strstr(desc, k_pipe_guid));
             if (v == MR_BCF_3_0) {
                 double ar = 0;
                 CHECK(tag_num(vp, "AspectRatio", &ar));

@@ -233,6 +233,10 @@ static bool one_mark(const char *session, int i, const cJSON *d, const mr_bench_
         m.node_index = pick.node;
         snprintf(m.node, sizeof m.node, "%s", planned->nodes[pick.node].name);
         snprintf(m.layer, sizeof m.layer, "%s", pick.layer == MR_LAYER_HIDDEN ? "hidden" : "visible");
+        mr_element_words ew = mr_scene_element_words(planned, pick.node);
+        snprintf(m.element_guid, sizeof m.element_guid, "%s", ew.guid);
+        snprintf(m.element_class, sizeof m.element_class, "%s", ew.ifc_class);
+        snprintf(m.element_name, sizeof m.element_name, "%s", ew.name);
     }
     m.has_pose = m.pose_valid = true;
     m.world_from_camera = view.world_from_camera;

@@ -37,6 +37,15 @@ void mr_xml_raw(mr_xml *x, const char *fmt, ...)
 char *mr_xml_take(mr_xml *x, size_t *len);
 void mr_xml_free(mr_xml *x);
 
+/* ------------------------------------------------------------------ BCF */
+
+/* mrcheck's topic types (the mark categories in words, then "Issue" for a
+ * mark without one) and statuses. */
+#define MR_BCF_TOPIC_TYPE_COUNT 7
+#define MR_BCF_TOPIC_STATUS_COUNT 3
+extern const char *const mr_bcf_topic_types[MR_BCF_TOPIC_TYPE_COUNT];
+extern const char *const mr_bcf_topic_statuses[MR_BCF_TOPIC_STATUS_COUNT];
+
 /* --------------------------------------------------------------- findings */
 
 typedef struct mr_finding {

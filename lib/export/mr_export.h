@@ -93,6 +93,139 @@ bool mr_bcf_snapshot(const mr_image *src, const mr_camera *cam, const mr_bcf_fra
  * and salt. out needs 37 bytes. */
 void mr_bcf_guid(const void *data, size_t n, uint64_t salt, char out[37]);
 
+/* ------------------------------------------------------------ BCF topics
+ * A BCF archive as data: what the reader fills from BCF 2.0, 2.1 or 3.0
+ * (a .bcf/.bcfzip archive or its unzipped folder), what the writer writes
+ * as 2.1 or 3.0. The session's marks go out through it, and topics read
+ * from elsewhere go back out through it with their GUIDs kept. Strings are
+ * as the file gives them (truncated to the field's size); numbers in BCF's
+ * frame (Z up, metres). */
+#define MR_BCF_MAX_LABELS 16
+typedef struct mr_bcf_component {
+    char ifc_guid[24];          /* IfcGuid (22 chars), "" none */
+    char originating[64];       /* OriginatingSystem, "" none */
+    char authoring_id[128];     /* AuthoringToolId, "" none */
+} mr_bcf_component;
+
+typedef struct mr_bcf_coloring {
+    uint32_t argb;              /* 0xAARRGGBB; alpha 0xff when the file gives RRGGBB */
+    mr_bcf_component *items;
+    int count;
+} mr_bcf_coloring;
+
+typedef struct mr_bcf_plane {
+    double location[3];         /* a point of the plane, metres */
+    double direction[3];        /* its normal: what lies on this side is clipped away */
+} mr_bcf_plane;
+
+typedef enum mr_bcf_camera_kind {
+    MR_BCF_CAMERA_NONE = 0, MR_BCF_CAMERA_PERSPECTIVE, MR_BCF_CAMERA_ORTHOGONAL
+} mr_bcf_camera_kind;
+
+typedef struct mr_bcf_viewpoint {
+    char guid[37];
+    char file[128];             /* the .bcfv's name in the topic folder */
+    char snapshot_name[128];    /* "" none */
+    int index;                  /* -1 none */
+    int camera_kind;            /* mr_bcf_camera_kind */
+    mr_bcf_camera camera;       /* fov_deg as written (2.x horizontal-ish, 3.0 vertical);
+                                   aspect 0 when the file gives none */
+    double view_to_world_scale; /* orthogonal: the view's height in metres */
+    bool has_components;        /* a <Components> element was read / is to be written */
+    bool default_visibility;    /* BCF's default: false in 2.1/3.0 when absent, true in 2.0 */
+    bool spaces_visible, space_boundaries_visible, openings_visible;
+    mr_bcf_component *selection; int selection_count;
+    mr_bcf_component *exceptions; int exception_count; /* the visibility exceptions */
+    mr_bcf_coloring *colorings; int coloring_count;
+    mr_bcf_plane *clips; int clip_count;
+    unsigned char *snapshot;    /* the snapshot's bytes (PNG or JPEG), NULL none */
+    size_t snapshot_size;
+} mr_bcf_viewpoint;
+
+typedef struct mr_bcf_comment {
+    char guid[37];
+    char date[32], author[128], modified_date[32], modified_author[128];
+    char viewpoint_guid[37];    /* "" none */
+    char *text;                 /* malloc'd, never NULL once added */
+} mr_bcf_comment;
+
+typedef struct mr_bcf_topic {
+    char guid[37];
+    char type[64], status[64];  /* TopicType, TopicStatus; "" none */
+    char title[256], priority[64];
+    int index;                  /* -1 none */
+    char labels[MR_BCF_MAX_LABELS][64];
+    int label_count;
+    char creation_date[32], creation_author[128], modified_date[32], modified_author[128];
+    char due_date[32], assigned_to[128], stage[64];
+    char *description;          /* malloc'd, NULL none */
+    mr_bcf_comment *comments; int comment_count;
+    mr_bcf_viewpoint *viewpoints; int viewpoint_count;
+} mr_bcf_topic;
+
+typedef struct mr_bcf {
+    char version[16];           /* as read ("2.0", "2.1", "3.0"); "" built in memory */
+    mr_bcf_topic *topics; int topic_count;
+    /* What the reader skipped or could not use, one line each ("topic
+     * 1b2c...: viewpoint.bcfv names no camera"). */
+    char (*warnings)[256]; int warning_count;
+} mr_bcf;
+
+/* Limits the reader keeps to (bad input is refused, not followed). */
+#define MR_BCF_MAX_ENTRY_BYTES (64u << 20)   /* one entry, uncompressed */
+#define MR_BCF_MAX_TOTAL_BYTES (512u << 20)  /* all entries read, uncompressed */
+#define MR_BCF_MAX_ENTRIES 100000
+
+/* True for BCF's GUID form: 8-4-4-4-12 lowercase hex. */
+bool mr_bcf_guid_valid(const char *g);
+/* Growing the lists: a zeroed new item (index -1 where it has one), NULL
+ * when out of memory. */
+mr_bcf_topic *mr_bcf_add_topic(mr_bcf *b);
+mr_bcf_comment *mr_bcf_add_comment(mr_bcf_topic *t);
+mr_bcf_viewpoint *mr_bcf_add_viewpoint(mr_bcf_topic *t);
+bool mr_bcf_add_component(mr_bcf_component **list, int *count, const mr_bcf_component *c);
+mr_bcf_coloring *mr_bcf_add_coloring(mr_bcf_viewpoint *v, uint32_t argb);
+void mr_bcf_warn(mr_bcf *b, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+void mr_bcf_free(mr_bcf *b); /* zeroes it */
+
+/* Writes b as a BCF v archive to out_path (temp file + rename; on failure
+ * out_path is as it was): bcf.version, (3.0) extensions.xml declaring the
+ * values the topics use, and per topic a folder named by its GUID with
+ * markup.bcf and each viewpoint's .bcfv and snapshot, the first viewpoint
+ * as viewpoint.bcfv / snapshot.png. Elements in the schemas' order.
+ * Names inside the archive are made here, never taken from b. Fails for a
+ * topic, comment or viewpoint without a valid GUID. In 2.1 a perspective
+ * FieldOfView outside 45..60 is fitted (mr_bcf_fit_fov_21, 5 m) in the copy
+ * written; callers that know a better distance fit it first. */
+bool mr_bcf_write(const mr_bcf *b, mr_bcf_version v, const char *out_path, mr_error *err);
+/* The archive's bytes (caller frees) instead of a file. */
+bool mr_bcf_write_memory(const mr_bcf *b, mr_bcf_version v, void **out, size_t *out_size, mr_error *err);
+
+/* BCF 2.1's schema allows a FieldOfView of 45..60 degrees only. A camera
+ * outside is moved along its axis so that the region it shows at distance
+ * depth_m (> 0: the marked point; otherwise 5 m) stays the same at the
+ * nearest allowed angle; the fov is taken as horizontal. Returns how far it
+ * moved (metres, + backwards), 0 when it was inside. */
+double mr_bcf_fit_fov_21(mr_bcf_camera *c, double depth_m);
+
+/* Reads a BCF 2.0, 2.1 or 3.0 archive (zip) or unzipped folder. What is
+ * unusable inside (a topic without markup, a viewpoint without a camera,
+ * an entry too large, a name with "..", XML with a DOCTYPE) is skipped
+ * with a warning and the rest is read. Fails with one line when path
+ * cannot be opened, is neither zip nor folder, names no version it knows,
+ * or holds no topic at all. Nothing is written anywhere. */
+bool mr_bcf_read(const char *path, mr_bcf *out, mr_error *err);
+/* The same for a zip archive's bytes (tests, fuzzing). */
+bool mr_bcf_read_memory(const void *data, size_t size, mr_bcf *out, mr_error *err);
+
+/* The topic of b named by sel: a 1-based number, or a GUID (or its unique
+ * prefix); NULL with a message when none matches. */
+mr_bcf_topic *mr_bcf_find_topic(mr_bcf *b, const char *sel, mr_error *err);
+
 /* ------------------------------------------------------------ the exports */
 
 /* Writes the BCF archive of session_dir's marks to out_path (a temporary

@@ -68,6 +68,20 @@ int32_t mr_scene_storey(mr_scene *s, const char *name, const char *guid, double 
     return s->storey_count++;
 }
 
+mr_element_words mr_scene_element_words(const mr_scene *s, int32_t node) {
+    mr_element_words w;
+    memset(&w, 0, sizeof w);
+    if (!s || node < 0 || node >= s->node_count) return w;
+    const mr_element *e = mr_scene_element_of(s, node);
+    int32_t named = e ? e->node : node;
+    snprintf(w.name, sizeof w.name, "%s", s->nodes[named].name);
+    if (e) {
+        snprintf(w.guid, sizeof w.guid, "%s", e->guid);
+        snprintf(w.ifc_class, sizeof w.ifc_class, "%s", e->ifc_class);
+    }
+    return w;
+}
+
 const mr_element *mr_scene_element_of(const mr_scene *s, int32_t node) {
     if (!s || s->element_count == 0) return NULL;
     for (int guard = 0; node >= 0 && node < s->node_count && guard < 4096; guard++) {

@@ -151,6 +151,13 @@ bool mr_scene_add_element(mr_scene *s, mr_element *e);
 int32_t mr_scene_storey(mr_scene *s, const char *name, const char *guid, double elevation);
 /* The element of node (its own or its nearest ancestor's), or NULL. */
 const mr_element *mr_scene_element_of(const mr_scene *s, int32_t node);
+/* What a mark says about the element under node: the element's GlobalId
+ * and class ("" none) and its name (its node's name; without an element,
+ * node's own name). All "" for node < 0 or out of range. */
+typedef struct mr_element_words {
+    char guid[24], ifc_class[48], name[128];
+} mr_element_words;
+mr_element_words mr_scene_element_words(const mr_scene *s, int32_t node);
 /* The node whose element has this GlobalId, or -1. */
 int32_t mr_scene_node_of_guid(const mr_scene *s, const char *guid);
 /* True if text is 22 characters of IFC's base64 alphabet (0-9A-Za-z_$)

@@ -178,6 +178,12 @@ cJSON *mr_annotation_to_json(const mr_annotation *a) {
     } else {
         cJSON_AddNullToObject(line, "node");
     }
+    if (a->element_guid[0] || a->element_name[0]) {
+        cJSON *e = cJSON_AddObjectToObject(line, "element");
+        cJSON_AddStringToObject(e, "guid", a->element_guid);
+        cJSON_AddStringToObject(e, "class", a->element_class);
+        cJSON_AddStringToObject(e, "name", a->element_name);
+    }
     cJSON_AddItemToObject(line, "pose",
                           mr_sess_pose_json(a->pose_valid, &a->world_from_camera, a->pose_tags_seen, a->pose_rms_px));
     /* Absent, not null, when unknown: the exports read it as optional. */
@@ -257,6 +263,12 @@ static bool parse_annotation(const cJSON *o, mr_annotation *a) {
     double ni = -1;
     if (!get_num(o, "node_index", &ni) || !(ni == -1 || (ni >= 0 && ni < 2147483647.0 && ni == floor(ni)))) return false;
     a->node_index = (int32_t)ni;
+    const cJSON *el = cJSON_GetObjectItemCaseSensitive(o, "element");
+    if (el && !cJSON_IsNull(el) &&
+        (!cJSON_IsObject(el) || !get_str(el, "guid", a->element_guid, sizeof a->element_guid, false) ||
+         !get_str(el, "class", a->element_class, sizeof a->element_class, false) ||
+         !get_str(el, "name", a->element_name, sizeof a->element_name, false)))
+        return false;
     a->hit = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(o, "hit"));
     if (a->hit && !has_world) return false; /* a hit names its point */
     const cJSON *p = cJSON_GetObjectItemCaseSensitive(o, "pose");

@@ -337,6 +337,12 @@ typedef struct mr_annotation {
     char node[256];                 /* picked node name, "" none */
     int32_t node_index;             /* its index in the scene, -1 none */
     char layer[16];                 /* "visible" / "hidden" / "" */
+    /* The building element the mark is about (the picked node's element,
+     * see mr_scene_element_of): line field "element" {guid, class, name},
+     * absent when nothing was picked. */
+    char element_guid[24];          /* IFC GlobalId, "" none (a model without IFC identity) */
+    char element_class[48];         /* e.g. "IfcWall", "" unknown */
+    char element_name[128];         /* the element's name (its node's), "" none */
     bool has_pose;                  /* pose.world_from_camera present */
     bool pose_valid;
     mr_dmat4 world_from_camera;
@@ -358,7 +364,8 @@ typedef struct mr_annotation {
  * timestamp, id and revision (when set), category, note, title, status,
  * priority, assignee, labels (each when not empty), pixel, hit, world
  * (null when no hit), depth (hit only),
- * node (null when none; then node_index and layer), pose {valid,
+ * node (null when none; then node_index and layer), element {guid,
+ * class, name} (when element_name or element_guid is set), pose {valid,
  * world_from_camera, tags_seen, rms_px}, uncertainty_m (only when
  * has_uncertainty; older lines have none), and with has_measurement
  * (the view's Measure) measured_point [x,y,z], measured_covariance

@@ -131,6 +131,16 @@ cJSON *mr_view_mark_line(const mr_capture_frame *f, const mr_view_mark_words *w,
         snprintf(m.node, sizeof m.node, "%s", scene->nodes[pick->node].name);
         snprintf(m.layer, sizeof m.layer, "%s", pick->layer == MR_LAYER_HIDDEN ? "hidden" : "visible");
     }
+    /* The element the mark is about: the picked one, else the planned
+     * part a measurement was measured to. */
+    int32_t en = m.node_index;
+    if (en < 0 && measured && measured->planned_node[0] && scene)
+        for (int32_t i = 0; i < scene->node_count && en < 0; i++)
+            if (strcmp(scene->nodes[i].name, measured->planned_node) == 0) en = i;
+    mr_element_words ew = mr_scene_element_words(scene, en);
+    snprintf(m.element_guid, sizeof m.element_guid, "%s", ew.guid);
+    snprintf(m.element_class, sizeof m.element_class, "%s", ew.ifc_class);
+    snprintf(m.element_name, sizeof m.element_name, "%s", ew.name);
     /* The registration's sigma at the marked point (absent when
      * the pose has no covariance, e.g. an older recording, or nothing was
      * hit) */
