@@ -51,6 +51,7 @@ int cmd_synth(int argc, char **argv);
 int cmd_factory(int argc, char **argv);
 /* mrcheck export (cmd_export.c) */
 int cmd_export(int argc, char **argv);
+int cmd_bcf(int argc, char **argv); /* bcf list | answer */
 int cmd_hall(int argc, char **argv); /* cmd_hall.c */
 int bench_scene(int argc, char **argv);
 /* mrcheck bench map (bench_map.c). */

@@ -3,6 +3,9 @@
 #include "app.h"
 #include "mr_export.h"
 
+#include <stdlib.h>
+#include <string.h>
+
 int cmd_export(int argc, char **argv) {
     static const char *cmd = "export";
     mr_cli_opt opts[] = {
@@ -49,5 +52,63 @@ int cmd_export(int argc, char **argv) {
         else if (!mr_cli_flag(opts, "quiet")) printf("wrote %s/index.html\n", html);
     }
     mr_scene_destroy(&scene);
+    return rc;
+}
+
+/* mrcheck bcf list FILE [--scene S] | bcf answer FILE --topic N ... --out OUT.bcf */
+int cmd_bcf(int argc, char **argv) {
+    static const char *cmd = "bcf";
+    const char *sub = argc > 2 ? argv[2] : "";
+    bool answer = strcmp(sub, "answer") == 0;
+    if (!answer && strcmp(sub, "list") != 0)
+        return mr_cli_errorf(cmd, "usage: mrcheck bcf (list FILE [--scene S] | answer FILE --topic N "
+                                  "[--comment TEXT] [--status S] [--snapshot PNG] --out OUT.bcf)"), 2;
+    mr_cli_opt opts[] = {
+        {"scene", "S", "list: count the components the scene has", NULL},
+        {"topic", "N|GUID", "answer: the topic (number from list, or GUID)", NULL},
+        {"comment", "TEXT", "answer: a comment", NULL},
+        {"status", "S", "answer: the new TopicStatus (e.g. Closed)", NULL},
+        {"snapshot", "PNG", "answer: a new snapshot from site", NULL},
+        {"author", "NAME", "answer: the comment's author (an e-mail address for Procore)", NULL},
+        {"out", "OUT.bcf", "answer: where to write the topics", NULL},
+        {"quiet", NULL, "errors only", NULL},
+        {NULL, NULL, NULL, NULL},
+    };
+    mr_export_params p = MR_EXPORT_DEFAULTS;
+    mr_cli_table tables[] = {{.prefix = "bcf", .table = mr_export_opts, .params = &p}};
+    const char *pos[1];
+    int npos = 0;
+    bool help;
+    if (!mr_cli_parse_tables(argc, argv, 3, opts, tables, 1, pos, 1, &npos, "usage: mrcheck bcf list|answer FILE ...",
+                             &help))
+        return 2;
+    if (help) return 0;
+    if (npos != 1) return mr_cli_errorf(cmd, "needs a BCF file or folder (see --help)"), 2;
+    mr_error err = {0};
+    mr_bcf b;
+    if (!mr_bcf_read(pos[0], &b, &err)) return mr_cli_error(cmd, &err);
+    for (int i = 0; i < b.warning_count; i++) fprintf(stderr, "mrcheck bcf: warning: %s\n", b.warnings[i]);
+    int rc = 0;
+    if (!answer) {
+        mr_scene *scene = NULL;
+        if (mr_cli_get(opts, "scene") && !(scene = mr_scene_load(mr_cli_get(opts, "scene"), NULL, &err)))
+            rc = mr_cli_error(cmd, &err);
+        if (rc == 0) mr_bcf_print_list(&b, scene, stdout);
+        mr_scene_destroy(&scene);
+    } else {
+        const char *out = mr_cli_get(opts, "out"), *snap = mr_cli_get(opts, "snapshot");
+        mr_bcf_topic *t = mr_bcf_find_topic(&b, mr_cli_get(opts, "topic"), &err);
+        mr_bcf_answer_params a = {.comment = mr_cli_get(opts, "comment"), .status = mr_cli_get(opts, "status"),
+                                  .author = mr_cli_get(opts, "author")};
+        char *png = NULL;
+        if (!out) mr_fail(&err, MR_ERR_INVALID, "answer needs --out OUT.bcf");
+        else if (t && snap && !(png = mr_file_read(snap, &a.snapshot_size, 0, &err))) t = NULL;
+        a.snapshot = (const unsigned char *)png;
+        if (!out || !t || !mr_bcf_answer(t, &a, &err) || !mr_bcf_write(&b, (mr_bcf_version)p.bcf_version, out, &err))
+            rc = mr_cli_error(cmd, &err);
+        else if (!mr_cli_flag(opts, "quiet")) printf("wrote %s (BCF %s)\n", out, p.bcf_version ? "3.0" : "2.1");
+        free(png);
+    }
+    mr_bcf_free(&b);
     return rc;
 }

@@ -25,6 +25,7 @@ static const struct {
     {"measure", cmd_measure, "triangulate a feature tapped in several recorded frames; distance to the plan with sigma"},
     /* Findings as BCF and a report */
     {"export", cmd_export, "a session's marks as BCF 2.1/3.0 topics or a self-contained HTML report"},
+    {"bcf", cmd_bcf, "topics of a BCF made elsewhere: list them, answer one (comment, status, snapshot)"},
     {"hall", cmd_hall, "a hall folder: plan, camera, marker map, tolerances and sessions in one place"},
 };
 

@@ -102,6 +102,11 @@ bcf_fov_not_fitted|lib/export/bcf.c|double fit = fmin(fmax(fov, 45.0), 60.0);|do
 bcf_no_ifcguid|lib/export/bcf.c|if (mr_ifc_guid_valid(c->ifc_guid)) mr_xml_attr(x, "IfcGuid", c->ifc_guid);|(void)0;|^test_export$
 bcf_21_hints_missing|lib/export/bcf.c|if (!v3) setup_hints(x, v);|if (0) setup_hints(x, v);|^test_export$
 mark_element_guid_lost|lib/session/annotations.c|cJSON_AddStringToObject(e, "guid", a->element_guid);|cJSON_AddStringToObject(e, "guid", "");|^test_export$
+bcf_xml_doctype_read|lib/export/xml_read.c|starts(r, "<!DOCTYPE")|starts(r, "<!NOPE")|^test_bcf_read$
+bcf_dotdot_allowed|lib/export/bcf_read.c|p[0] == '.' && p[1] == '.')|p[0] == '.' && p[1] == 'X')|^test_bcf_read$
+bcf_entry_uncapped|lib/export/bcf_read.c|            if (n > cap) {|            if (0) {|^test_bcf_read$
+bcf_30_color_components|lib/export/bcf_read.c|if (!components_in(list ? list : e, &cc->items, &cc->count)) return false;|if (!components_in(e, &cc->items, &cc->count)) return false;|^test_bcf_read$
+bcf_answer_status_kept|lib/export/bcf_answer.c|if (a->status && a->status[0]) snprintf|if (0) snprintf|^test_bcf_read$
 study_cmax_odd_even_formula|lib/study/stats.c|(t % 2) ? (td * td * td - td) / 24.0|(t % 2) ? (td * td * td - 4 * td) / 24.0|^test_study$
 map_huber_scale_unweighted|lib/track/map_ba.cc|ceres::HuberLoss loss2(loss_px * w);|ceres::HuberLoss loss2(loss_px);|^test_map$
 map_control_residual_sign|lib/track/map.c|cr->residual[1] = pr.y - p->controls[q].world.y;|cr->residual[1] = p->controls[q].world.y - pr.y;|^test_map$

@@ -533,6 +533,42 @@ static void check_archive(const char *path, mr_bcf_version v, const mr_dmat4 *po
     zip_close(z);
 }
 
+/* What the reader gets back from an exported archive: the marked
+ * element's GUID, the camera (position within 1 mm, direction within
+ * 0.01 deg of the pose, after 2.1's field-of-view fit) and the comment. */
+static void check_read_back(const mr_bcf *b, mr_bcf_version v, const mr_dmat4 *poses, const char *const *titles) {
+    CHECK(b->topic_count == 2);
+    CHECK(strcmp(b->version, v == MR_BCF_3_0 ? "3.0" : "2.1") == 0);
+    CHECK_MSG(b->warning_count == 0, "%s", b->warning_count ? b->warnings[0] : "");
+    for (int i = 0; i < b->topic_count; i++) {
+        const mr_bcf_topic *t = &b->topics[i];
+        int k = strcmp(t->title, titles[0]) == 0 ? 0 : strcmp(t->title, titles[1]) == 0 ? 1 : -1;
+        CHECK_MSG(k >= 0, "title %s", t->title);
+        if (k < 0 || t->viewpoint_count != 1 || t->comment_count != 1) {
+            CHECK(false);
+            continue;
+        }
+        const mr_bcf_viewpoint *vp = &t->viewpoints[0];
+        if (k == 0) CHECK(vp->selection_count == 1 && strcmp(vp->selection[0].ifc_guid, k_pipe_guid) == 0);
+        else CHECK(vp->selection_count == 1 && strcmp(vp->selection[0].authoring_id, "Conveyor_2") == 0);
+        CHECK(t->description && strcmp(t->comments[0].text, t->description) == 0);
+        CHECK(strcmp(t->comments[0].viewpoint_guid, vp->guid) == 0);
+        const double *m = poses[k].m;
+        double want_p[3] = {m[3], -m[11], m[7]}, want_d[3] = {m[2], -m[10], m[6]};
+        double back = v == MR_BCF_3_0 ? 0 : 3.5 * 0.8 / tan(M_PI / 6) - 3.5;
+        for (int a = 0; a < 3; a++) want_p[a] -= back * want_d[a];
+        const mr_bcf_camera *c = &vp->camera;
+        CHECK(vp->camera_kind == MR_BCF_CAMERA_PERSPECTIVE);
+        double dp = sqrt(pow(c->view_point[0] - want_p[0], 2) + pow(c->view_point[1] - want_p[1], 2) +
+                         pow(c->view_point[2] - want_p[2], 2));
+        CHECK_MSG(dp < 1e-3, "read back: position off by %g m", dp);
+        double dot = (c->direction[0] * want_d[0] + c->direction[1] * want_d[1] + c->direction[2] * want_d[2]) /
+                     sqrt(c->direction[0] * c->direction[0] + c->direction[1] * c->direction[1] +
+                          c->direction[2] * c->direction[2]);
+        CHECK_MSG(acos(fmin(1, dot)) * 180 / M_PI < 0.01, "read back: direction off");
+    }
+}
+
 static void test_round_trip(void) {
     char dir[1200], out[1300];
     snprintf(dir, sizeof dir, "%s/session", g_tmp);
@@ -547,6 +583,10 @@ static void test_round_trip(void) {
         mr_error err = {0};
         CHECK_MSG(mr_export_bcf(dir, out, &p, &err), "export: %s", err.msg);
         check_archive(out, (mr_bcf_version)v, poses, titles, 2, true);
+        mr_bcf rb;
+        CHECK_MSG(mr_bcf_read(out, &rb, &err), "read back: %s", err.msg);
+        check_read_back(&rb, (mr_bcf_version)v, poses, titles);
+        mr_bcf_free(&rb);
         /* The same marks give the same archive (GUIDs from the marks). */
         char out2[1400];
         snprintf(out2, sizeof out2, "%s.again", out);

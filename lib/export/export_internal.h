@@ -37,6 +37,25 @@ void mr_xml_raw(mr_xml *x, const char *fmt, ...)
 char *mr_xml_take(mr_xml *x, size_t *len);
 void mr_xml_free(mr_xml *x);
 
+/* ------------------------------------------------------------- XML reader
+ * xml_read.c: a tree of elements (namespace prefixes dropped), their
+ * attributes and text (entities decoded, CDATA kept, surrounding white
+ * space kept). A DOCTYPE or an entity other than XML's five is refused, so
+ * nothing expands; depth and element count are capped. */
+typedef struct mr_xml_node {
+    char *name;
+    char **attrs;                /* name, value, name, value, ... */
+    int attr_count;
+    char *text;                  /* the element's own text, "" none */
+    struct mr_xml_node **children;
+    int child_count;
+} mr_xml_node;
+mr_xml_node *mr_xml_parse(const char *data, size_t size, mr_error *err);
+void mr_xml_node_free(mr_xml_node *n);
+const mr_xml_node *mr_xml_child(const mr_xml_node *n, const char *name);   /* the first, or NULL */
+const char *mr_xml_get_attr(const mr_xml_node *n, const char *name);       /* NULL if absent */
+const char *mr_xml_child_text(const mr_xml_node *n, const char *name);     /* NULL if no such child */
+
 /* ------------------------------------------------------------------ BCF */
 
 /* mrcheck's topic types (the mark categories in words, then "Issue" for a

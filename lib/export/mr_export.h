@@ -33,6 +33,8 @@
 #ifndef MR_EXPORT_H
 #define MR_EXPORT_H
 
+#include <stdio.h>
+
 #include "mr_core.h"
 #include "mr_scene.h"
 #include "mr_session.h"
@@ -225,6 +227,25 @@ bool mr_bcf_read_memory(const void *data, size_t size, mr_bcf *out, mr_error *er
 /* The topic of b named by sel: a 1-based number, or a GUID (or its unique
  * prefix); NULL with a message when none matches. */
 mr_bcf_topic *mr_bcf_find_topic(mr_bcf *b, const char *sel, mr_error *err);
+
+/* One line per topic on out: number, GUID, status, title, viewpoints (and
+ * how many have a camera), comments, distinct components, and with a
+ * scene how many of those it has (by IfcGuid, else by node name). */
+void mr_bcf_print_list(const mr_bcf *b, const mr_scene *scene, FILE *out);
+
+/* The planner's answer to a topic: a comment, a new status, a new
+ * snapshot (a viewpoint of its own with the first viewpoint's camera and
+ * selection, which the comment points at); each optional. The topic's
+ * ModifiedDate / ModifiedAuthor are set; its GUID and everything it had
+ * are kept, so the office's tool updates the topic it sent. */
+typedef struct mr_bcf_answer_params {
+    const char *comment;            /* NULL or "": none */
+    const char *status;             /* NULL or "": unchanged, e.g. "Closed" */
+    const unsigned char *snapshot;  /* PNG or JPEG bytes, NULL none */
+    size_t snapshot_size;
+    const char *author;             /* NULL: "mrcheck" */
+} mr_bcf_answer_params;
+bool mr_bcf_answer(mr_bcf_topic *t, const mr_bcf_answer_params *a, mr_error *err);
 
 /* ------------------------------------------------------------ the exports */
 
