@@ -59,10 +59,7 @@ int cmd_export(int argc, char **argv) {
 int cmd_bcf(int argc, char **argv) {
     static const char *cmd = "bcf";
     const char *sub = argc > 2 ? argv[2] : "";
-    bool answer = strcmp(sub, "answer") == 0;
-    if (!answer && strcmp(sub, "list") != 0)
-        return mr_cli_errorf(cmd, "usage: mrcheck bcf (list FILE [--scene S] | answer FILE --topic N "
-                                  "[--comment TEXT] [--status S] [--snapshot PNG] --out OUT.bcf)"), 2;
+    bool answer = strcmp(sub, "answer") == 0, list = strcmp(sub, "list") == 0;
     mr_cli_opt opts[] = {
         {"scene", "S", "list: count the components the scene has", NULL},
         {"topic", "N|GUID", "answer: the topic (number from list, or GUID)", NULL},
@@ -79,10 +76,13 @@ int cmd_bcf(int argc, char **argv) {
     const char *pos[1];
     int npos = 0;
     bool help;
-    if (!mr_cli_parse_tables(argc, argv, 3, opts, tables, 1, pos, 1, &npos, "usage: mrcheck bcf list|answer FILE ...",
+    if (!mr_cli_parse_tables(argc, argv, answer || list ? 3 : 2, opts, tables, 1, pos, 1, &npos,
+                             "usage: mrcheck bcf (list FILE [--scene S] | answer FILE --topic N [--comment TEXT] "
+                             "[--status S] [--snapshot PNG] [--author NAME] --out OUT.bcf [--bcf-version 2.1|3.0])",
                              &help))
         return 2;
     if (help) return 0;
+    if (!answer && !list) return mr_cli_errorf(cmd, "needs list or answer (see --help)"), 2;
     if (npos != 1) return mr_cli_errorf(cmd, "needs a BCF file or folder (see --help)"), 2;
     mr_error err = {0};
     mr_bcf b;
