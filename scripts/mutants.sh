@@ -107,6 +107,7 @@ bcf_dotdot_allowed|lib/export/bcf_read.c|p[0] == '.' && p[1] == '.')|p[0] == '.'
 bcf_entry_uncapped|lib/export/bcf_read.c|            if (n > cap) {|            if (0) {|^test_bcf_read$
 bcf_30_color_components|lib/export/bcf_read.c|if (!components_in(list ? list : e, &cc->items, &cc->count)) return false;|if (!components_in(e, &cc->items, &cc->count)) return false;|^test_bcf_read$
 bcf_answer_status_kept|lib/export/bcf_answer.c|if (a->status && a->status[0]) snprintf|if (0) snprintf|^test_bcf_read$
+element_describe_no_storey|lib/scene/element.c|if (e && e->storey >= 0 && e->storey < s->storey_count) ADD|if (0) ADD|^test_ifc$
 study_cmax_odd_even_formula|lib/study/stats.c|(t % 2) ? (td * td * td - td) / 24.0|(t % 2) ? (td * td * td - 4 * td) / 24.0|^test_study$
 map_huber_scale_unweighted|lib/track/map_ba.cc|ceres::HuberLoss loss2(loss_px * w);|ceres::HuberLoss loss2(loss_px);|^test_map$
 map_control_residual_sign|lib/track/map.c|cr->residual[1] = pr.y - p->controls[q].world.y;|cr->residual[1] = p->controls[q].world.y - pr.y;|^test_map$

@@ -99,6 +99,13 @@ int main(void) {
         CHECK(w->storey == 0 && b->storey == 0 && p->storey == 0);
         CHECK(strcmp(s->nodes[w->node].name, "Wall A") == 0);
         CHECK(w->props && strstr(w->props, "\"Pset_WallCommon\":{\"IsExternal\":true}"));
+        /* The view's tap says what the element is. */
+        char what[300];
+        mr_scene_element_describe(s, w->node, 3, what, sizeof what);
+        CHECK_MSG(strcmp(what, "Wall A \xc2\xb7 IfcWall \xc2\xb7 Level 1 \xc2\xb7 IsExternal=true") == 0, "%s", what);
+        mr_element_words ew = mr_scene_element_words(s, w->node);
+        CHECK(strcmp(ew.guid, "3cKYIHmn9FAgfuNu$zAIQL") == 0 && strcmp(ew.ifc_class, "IfcWall") == 0 &&
+              strcmp(ew.name, "Wall A") == 0);
         /* The pipe is a distribution element: the hidden layer by default. */
         CHECK(s->nodes[p->node].layer == MR_LAYER_HIDDEN);
         CHECK(s->nodes[w->node].layer == MR_LAYER_VISIBLE && s->nodes[b->node].layer == MR_LAYER_VISIBLE);

@@ -82,6 +82,37 @@ mr_element_words mr_scene_element_words(const mr_scene *s, int32_t node) {
     return w;
 }
 
+void mr_scene_element_describe(const mr_scene *s, int32_t node, int max_props, char *out, size_t n) {
+    if (!out || n == 0) return;
+    out[0] = 0;
+    mr_element_words w = mr_scene_element_words(s, node);
+    if (!w.name[0] && !w.guid[0]) return;
+    const mr_element *e = mr_scene_element_of(s, node);
+    size_t k = 0;
+#define ADD(...) do { int w_ = snprintf(out + k, n - k, __VA_ARGS__); if (w_ > 0) k = k + (size_t)w_ < n ? k + (size_t)w_ : n - 1; } while (0)
+    ADD("%s", w.name[0] ? w.name : w.guid);
+    if (w.ifc_class[0]) ADD(" \xc2\xb7 %s", w.ifc_class);
+    if (e && e->storey >= 0 && e->storey < s->storey_count) ADD(" \xc2\xb7 %s", s->storeys[e->storey].name);
+    cJSON *props = e && e->props ? cJSON_Parse(e->props) : NULL;
+    int shown = 0;
+    const cJSON *set;
+    cJSON_ArrayForEach(set, props) {
+        const cJSON *v;
+        cJSON_ArrayForEach(v, set) {
+            if (shown >= max_props) break;
+            char val[64];
+            if (cJSON_IsString(v)) snprintf(val, sizeof val, "%s", v->valuestring);
+            else if (cJSON_IsBool(v)) snprintf(val, sizeof val, "%s", cJSON_IsTrue(v) ? "true" : "false");
+            else if (cJSON_IsNumber(v)) snprintf(val, sizeof val, "%g", v->valuedouble);
+            else continue;
+            ADD("%s%s=%s", shown ? ", " : " \xc2\xb7 ", v->string ? v->string : "?", val);
+            shown++;
+        }
+    }
+#undef ADD
+    cJSON_Delete(props);
+}
+
 const mr_element *mr_scene_element_of(const mr_scene *s, int32_t node) {
     if (!s || s->element_count == 0) return NULL;
     for (int guard = 0; node >= 0 && node < s->node_count && guard < 4096; guard++) {

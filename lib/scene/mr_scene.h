@@ -158,6 +158,10 @@ typedef struct mr_element_words {
     char guid[24], ifc_class[48], name[128];
 } mr_element_words;
 mr_element_words mr_scene_element_words(const mr_scene *s, int32_t node);
+/* The element under node in one line for the view's tap: "Wall A ·
+ * IfcWall · Level 1 · IsExternal=true, ..." (name, class, storey, then up
+ * to max_props properties of its property sets). "" for no node. */
+void mr_scene_element_describe(const mr_scene *s, int32_t node, int max_props, char *out, size_t n);
 /* The node whose element has this GlobalId, or -1. */
 int32_t mr_scene_node_of_guid(const mr_scene *s, const char *guid);
 /* True if text is 22 characters of IFC's base64 alphabet (0-9A-Za-z_$)

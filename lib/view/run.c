@@ -260,6 +260,10 @@ static void begin_mark(view_app *a, double x, double y) {
         mr_viewer_toast(a->vc, "cannot mark: %s", err.msg);
         return;
     }
+    /* What the planner tapped, as the model names it. */
+    char what[300];
+    mr_scene_element_describe(a->scene, a->mark_pick.node, 3, what, sizeof what);
+    if (what[0]) mr_viewer_toast(a->vc, "%s", what);
     const mr_camera *cam = &a->src->camera;
     mr_view_image_to_camera(cam, a->rw, a->rh, u, v, &a->mark_px, &a->mark_py);
     a->mark_u = u;
