@@ -132,6 +132,7 @@ help_research_not_apart|lib/core/cli.c|for (; o->name && o->name[0]; o++) print_
 triangulate_sigma_over_sqrt3|lib/track/triangulate.c|out->sigma = sqrt(fmax(0, out->cov[0] + out->cov[4] + out->cov[8]));|out->sigma = sqrt(fmax(0, out->cov[0] + out->cov[4] + out->cov[8]) / 3);|^test_sigma$
 triangulate_line_sigma_over_sqrt3|lib/track/triangulate.c|*sigma = sqrt(fmax(v, 0));|*sigma = sqrt(fmax(v, 0) / 3);|^test_sigma$
 triangulate_point_sigma_not_per_axis|lib/track/triangulate.c|*sigma = sqrt((t->cov[0] + t->cov[4] + t->cov[8]) / 3);|*sigma = sqrt(t->cov[0] + t->cov[4] + t->cov[8]);|^test_sigma$
+map_lost_tag_not_replaced|lib/track/map.c|        bool used = false, posed = false;|        bool used = true, posed = false;|^test_bench$
 LIST
 )
 

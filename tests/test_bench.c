@@ -373,16 +373,17 @@ static void test_load_runner(const char *tmp) {
     read_svg(path, "bench_load.svg");
 }
 
-/* bench measure at its smallest (the base row and the distances, one map,
- * 2 points): the documented columns, a row each, and a map of the 30 x 20 m
- * hall from 100 phone photos that is good to centimetres (a map whose
- * initial photo poses dropped the far sightings was 0.7 m off). */
+/* bench measure at its smallest (the base row and the distances, two maps,
+ * 2 points): the documented columns, a row each, and maps of the 30 x 20 m
+ * hall from 100 phone photos that are good to centimetres (a map whose
+ * initial photo poses dropped the far sightings was 0.7 m off; the second
+ * seed's map kept a tag 4 m off whose sightings had all been rejected). */
 static void test_measure_runner(const char *tmp) {
     char out[4096], path[4096];
     mr_path_join(tmp, "measure", out, sizeof out);
     mr_bench_measure_params p = {MR_BENCH_MEASURE_DEFAULTS};
     p.out_dir = out;
-    p.maps = 1;
+    p.maps = 2;
     p.points = 2;
     p.quick = true;
     mr_error err = {0};
@@ -391,18 +392,23 @@ static void test_measure_runner(const char *tmp) {
     size_t n = 0;
     const char *csv = slurp(path, &n);
     const char *cols = "hall,tag_m,photos,map_res,track_res,dist_m,taps,samples,failed,map_err_rms_mm,map_sigma_med_mm,"
-                       "point_err_med_mm,dev_sigma_med_mm,point_sigma3d_med_mm,z_rms,coverage95,correct,undecided,wrong,"
+                       "map_z_rms,map_tags_share,point_err_med_mm,dev_sigma_med_mm,point_sigma3d_med_mm,z_rms,coverage95,correct,undecided,wrong,"
                        "correct_at_0,wrong_at_0,correct_at_50,wrong_at_50\n";
     CHECK_MSG(csv && strncmp(csv, cols, strlen(cols)) == 0, "bench_measure.csv must start with the documented header");
-    CHECK(csv && count(csv, "\n") == 5 && count(csv, ",") == 22 * 5);
+    CHECK(csv && count(csv, "\n") == 5 && count(csv, ",") == 24 * 5);
     const char *row = csv ? strchr(csv, '\n') : NULL;
-    double map_mm = NAN;
+    double map_mm = NAN, share = NAN;
     if (row) {
         const char *f = row + 1;
-        for (int k = 0; k < 9 && f; k++) f = strchr(f, ',') ? strchr(f, ',') + 1 : NULL;
-        if (f) map_mm = atof(f);
+        for (int k = 0; k < 12 && f; k++) {
+            f = strchr(f, ',') ? strchr(f, ',') + 1 : NULL;
+            if (f && k == 8) map_mm = atof(f);
+            if (f && k == 11) share = atof(f);
+        }
     }
     CHECK_MSG(map_mm < 20, "the 30 x 20 m hall's map is %.1f mm off (RMS)", map_mm);
+    /* Every tag mapped: a tag whose sightings all left is placed again. */
+    CHECK_MSG(share > 0.995, "%.3f of the hall's tags mapped", share);
     mr_path_join(out, "bench_measure.svg", path, sizeof path);
     read_svg(path, "bench_measure.svg");
 }

@@ -145,7 +145,8 @@ static int see_tags(const hall_t *h, const mr_camera *cam, const mr_dmat4 *wfc, 
 
 typedef struct built_map {
     mr_marker_map markers;
-    double err_rms_mm, sigma_med_mm;
+    double err_rms_mm, sigma_med_mm, z_rms; /* z: RMS of a tag's error / its sigma */
+    double tags;                            /* share of the seen tags mapped */
     bool ok;
 } built_map;
 
@@ -198,19 +199,25 @@ static bool build_map(const hall_t *h, const row_t *r, double noise_px, uint64_t
                e2.msg);
         return true;
     }
-    double ss = 0, *sg = malloc((size_t)res.tag_count * sizeof *sg);
-    int n = 0;
+    double ss = 0, zz = 0, *sg = malloc((size_t)res.tag_count * sizeof *sg);
+    int n = 0, nz = 0;
     for (int i = 0; i < res.tag_count; i++) {
         const mr_marker *t = NULL;
         for (int k = 0; k < h->count; k++)
             if (h->tags[k].id == res.tags[i].id) t = &h->tags[k];
         if (!t) continue;
         double d = mr_pose_dist(&res.tags[i].world_from_tag, &t->world_from_tag);
+        if (res.tags[i].sigma_pos > 0 && isfinite(res.tags[i].sigma_pos)) {
+            zz += d * d / (res.tags[i].sigma_pos * res.tags[i].sigma_pos);
+            nz++;
+        }
         ss += d * d;
         if (sg && isfinite(res.tags[i].sigma_pos)) sg[n++] = 1e3 * res.tags[i].sigma_pos;
     }
     bm->err_rms_mm = res.tag_count ? 1e3 * sqrt(ss / res.tag_count) : NAN;
     bm->sigma_med_mm = n ? mr_median(sg, n) : NAN;
+    bm->z_rms = nz ? sqrt(zz / nz) : NAN;
+    bm->tags = (double)res.tag_count / (res.tag_count + res.unplaced_count + res.unconnected_count);
     free(sg);
     bm->ok = mr_map_result_markers(&res, "tag36h11", h->tag_size, &bm->markers, err);
     mr_map_result_free(&res);
@@ -281,7 +288,7 @@ static int verdict(double dev_mm, double sigma_mm, double tol_mm) {
 typedef struct row_acc {
     sample_t *s;         /* maps x points x NDEV */
     int n, failed;
-    double map_err[16], map_sig[16];
+    double map_err[16], map_sig[16], map_z[16], map_tags[16];
     int nmaps;
 } row_acc;
 
@@ -291,7 +298,8 @@ static bool same_map(const row_t *a, const row_t *b) {
 }
 
 typedef struct row_stats {
-    double err_med, sig_med, sig3_med, z_rms, cover, share[3], correct_at[NDEV], wrong_at[NDEV], map_err, map_sig;
+    double err_med, sig_med, sig3_med, z_rms, cover, share[3], correct_at[NDEV], wrong_at[NDEV], map_err, map_sig,
+        map_z, map_tags;
     int n, failed;
 } row_stats;
 
@@ -333,6 +341,8 @@ static void row_summary(row_acc *a, double tol_mm, row_stats *st) {
     }
     st->map_err = a->nmaps ? mr_median(a->map_err, a->nmaps) : NAN;
     st->map_sig = a->nmaps ? mr_median(a->map_sig, a->nmaps) : NAN;
+    st->map_z = a->nmaps ? mr_median(a->map_z, a->nmaps) : NAN;
+    st->map_tags = a->nmaps ? mr_median(a->map_tags, a->nmaps) : NAN;
     free(v);
 }
 
@@ -362,7 +372,10 @@ static bool run_seed(const mr_bench_measure_params *p, int nrows, uint64_t seed,
             a->failed += p->points * NDEV;
             continue;
         }
-        if (a->nmaps < 16) a->map_err[a->nmaps] = bm.err_rms_mm, a->map_sig[a->nmaps++] = bm.sigma_med_mm;
+        if (a->nmaps < 16) {
+            a->map_err[a->nmaps] = bm.err_rms_mm, a->map_sig[a->nmaps] = bm.sigma_med_mm;
+            a->map_z[a->nmaps] = bm.z_rms, a->map_tags[a->nmaps++] = bm.tags;
+        }
         mr_rng rng;
         mr_rng_seed(&rng, seed * 7919 + (uint64_t)ri);
         for (int pi = 0; pi < p->points; pi++) {
@@ -404,6 +417,8 @@ static void csv_row(mr_csv *csv, const row_t *r, const char *hall, double tag_m,
     mr_csv_int(csv, st->failed);
     mr_csv_num(csv, "%.3f", st->map_err);
     mr_csv_num(csv, "%.3f", st->map_sig);
+    mr_csv_num(csv, "%.2f", st->map_z);
+    mr_csv_num(csv, "%.3f", st->map_tags);
     mr_csv_num(csv, "%.2f", st->err_med);
     mr_csv_num(csv, "%.2f", st->sig_med);
     mr_csv_num(csv, "%.2f", st->sig3_med);
@@ -465,11 +480,11 @@ bool mr_bench_measure(const mr_bench_measure_params *params, mr_error *err) {
     ok = ok && csv;
     if (ok) {
         mr_csv_header(csv, "hall,tag_m,photos,map_res,track_res,dist_m,taps,samples,failed,map_err_rms_mm,"
-                           "map_sigma_med_mm,point_err_med_mm,dev_sigma_med_mm,point_sigma3d_med_mm,z_rms,"
+                           "map_sigma_med_mm,map_z_rms,map_tags_share,point_err_med_mm,dev_sigma_med_mm,point_sigma3d_med_mm,z_rms,"
                            "coverage95,correct,undecided,wrong,correct_at_0,wrong_at_0,correct_at_50,wrong_at_50");
         if (p.out)
-            fprintf(p.out, "%-8s %5s %6s %10s %10s %5s %4s %5s %8s %8s %8s %8s %6s %6s %6s %6s %6s\n", "hall", "tag",
-                    "photos", "map", "track", "dist", "taps", "n", "map mm", "map sig", "err mm", "sig mm", "z rms",
+            fprintf(p.out, "%-8s %5s %6s %10s %10s %5s %4s %5s %8s %8s %6s %8s %8s %6s %6s %6s %6s %6s\n", "hall", "tag",
+                    "photos", "map", "track", "dist", "taps", "n", "map mm", "map sig", "map z", "err mm", "sig mm", "z rms",
                     "cover", "right", "undec", "wrong");
         for (int ri = 0; ri < nrows; ri++) {
             const row_t *r = &k_rows[ri];
@@ -481,10 +496,10 @@ bool mr_bench_measure(const mr_bench_measure_params *params, mr_error *err) {
             row_summary(&acc[ri], p.tolerance_mm, &st[ri]);
             csv_row(csv, r, h.name, h.tag_size, &st[ri]);
             if (p.out)
-                fprintf(p.out, "%-8s %5.2f %6d %5dx%-4d %5dx%-4d %5.1f %4d %5d %8.2f %8.2f %8.2f %8.2f %6.2f %6.3f %6.3f "
+                fprintf(p.out, "%-8s %5.2f %6d %5dx%-4d %5dx%-4d %5.1f %4d %5d %8.2f %8.2f %6.2f %8.2f %8.2f %6.2f %6.3f %6.3f "
                                "%6.3f %6.3f\n",
                         h.name, h.tag_size, r->photos, r->map_w, r->map_h, r->trk_w, r->trk_h, r->dist_m, r->taps,
-                        st[ri].n, st[ri].map_err, st[ri].map_sig, st[ri].err_med, st[ri].sig_med, st[ri].z_rms,
+                        st[ri].n, st[ri].map_err, st[ri].map_sig, st[ri].map_z, st[ri].err_med, st[ri].sig_med, st[ri].z_rms,
                         st[ri].cover, st[ri].share[0], st[ri].share[1], st[ri].share[2]);
         }
     }

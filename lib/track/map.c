@@ -179,6 +179,7 @@ void mr_map_result_free(mr_map_result *r) {
     if (!r) return;
     free(r->tags);
     free(r->unconnected);
+    free(r->unplaced);
     free(r->unsized);
     free(r->controls);
     memset(r, 0, sizeof *r);
@@ -1003,18 +1004,74 @@ static bool photo_poses(map_state *s) {
     return true;
 }
 
+/* A tag of the part none of whose sightings is in use: its initial place
+ * was wrong (a bad pair mean along its tree path), so every sighting
+ * disagreed with it and left. It is placed again from the adjusted photo
+ * poses: the candidate through each of its sightings and IPPE branches
+ * that explains most of them (capped errors, as best_candidate), and the
+ * sightings within lim px of it are used again. Each tag once (tried).
+ * Returns how many tags came back. */
+static int replace_lost_tags(map_state *s, bool *tried, double lim) {
+    ctx_t *c = &s->c;
+    int back = 0;
+    for (int i = 0; i < c->ntags; i++) {
+        int ti = s->tag_of[i];
+        if (ti < 0 || tried[i]) continue;
+        bool used = false, posed = false;
+        for (int x = 0; x < c->nobs && !used; x++) {
+            if (c->obs[x].tag != i) continue;
+            used = c->obs[x].use;
+            posed = posed || s->photo_slot[c->obs[x].photo] >= 0;
+        }
+        if (used || !posed) continue;
+        tried[i] = true;
+        double best_s = INFINITY, cap = 4 * (20 / c->cam->fx) * (20 / c->cam->fx);
+        mr_dmat4 best = s->wft[ti];
+        for (int x = 0; x < c->nobs; x++) {
+            const obs_t *o = &c->obs[x];
+            if (o->tag != i || s->photo_slot[o->photo] < 0) continue;
+            mr_dmat4 wfc = mr_m4_invert_rigid(&s->cfw[s->photo_slot[o->photo]]);
+            for (int k = 0; k < o->ns; k++) {
+                mr_dmat4 cand = mr_m4_mul(&wfc, &o->cft[k]);
+                double sum = 0;
+                for (int y = 0; y < c->nobs; y++)
+                    if (c->obs[y].tag == i && s->photo_slot[c->obs[y].photo] >= 0)
+                        sum += fmin(obs_sq(&c->obs[y], c->size[i], &s->cfw[s->photo_slot[c->obs[y].photo]], &cand), cap);
+                if (sum < best_s) best_s = sum, best = cand;
+            }
+        }
+        int n = 0;
+        for (int y = 0; y < c->nobs; y++) {
+            obs_t *o = &c->obs[y];
+            if (o->tag != i || s->photo_slot[o->photo] < 0) continue;
+            mr_dmat4 wfc = mr_m4_invert_rigid(&s->cfw[s->photo_slot[o->photo]]);
+            o->use = obs_rms_px(&s->cam_adj, o, c->size[i], &wfc, &best) < lim;
+            n += o->use;
+        }
+        if (n > 0) {
+            s->wft[ti] = best;
+            back++;
+            mr_log(MR_LOG_INFO, "map: tag %d placed again from %d sightings", c->ids[i], n);
+        }
+    }
+    return back;
+}
+
 /* Adjustments until no sighting is off by more than OBS_REJECT_SIGMA
- * estimated sigmas (at most 4 rounds): wrong ids, a lone tag's wrong
- * branch leave; then once more. */
+ * estimated sigmas and no lost tag comes back (at most 6 rounds): wrong
+ * ids, a lone tag's wrong branch leave; then once more. */
 static bool adjust_rounds(map_state *s) {
     ctx_t *c = &s->c;
     mr_map_result *out = s->out;
     ba_run r = {.wft = s->wft, .cfw = s->cfw, .cam = &s->cam_adj, .cov = s->cov,
                 .fixed = c->p->control_count > 0 ? -1 : s->tag_of[s->root]};
+    bool *tried = calloc((size_t)c->ntags + 1, sizeof *tried);
+    if (!tried) return nomem(s);
+    bool ok = true;
     for (int round = 0;; round++) {
-        if (!run_ba(s, &r, s->err)) return false;
+        if (!(ok = run_ba(s, &r, s->err))) break;
         out->rms_px = r.rms, out->sigma_px = r.sigma, out->iterations = r.iters;
-        if (round == 3) break;
+        if (round == 5) break;
         int rejected = 0;
         double lim = fmax(OBS_REJECT_MIN_PX, OBS_REJECT_SIGMA * out->sigma_px);
         for (int i = 0; i < c->nobs; i++) {
@@ -1026,11 +1083,13 @@ static bool adjust_rounds(map_state *s) {
                 rejected++;
             }
         }
-        if (!rejected) break;
-        mr_log(MR_LOG_INFO, "map: %d sightings off by more than %.1f px left out", rejected, lim);
+        int back = replace_lost_tags(s, tried, lim);
+        if (!rejected && !back) break;
+        if (rejected) mr_log(MR_LOG_INFO, "map: %d sightings off by more than %.1f px left out", rejected, lim);
     }
-    out->adjusted = true;
-    return true;
+    free(tried);
+    out->adjusted = ok;
+    return ok;
 }
 
 /* Control q left out: its prediction by the others (loo, loo_sigma) into
@@ -1183,24 +1242,17 @@ static bool fill_result(map_state *s) {
     const ctx_t *c = &s->c;
     const mr_map_params *p = c->p;
     mr_map_result *out = s->out;
-    out->tags = calloc((size_t)s->nt, sizeof *out->tags);
-    if (!out->tags) return nomem(s);
+    out->tags = calloc((size_t)s->nt + 1, sizeof *out->tags);
+    out->unplaced = malloc((size_t)s->nt * sizeof *out->unplaced + 1);
+    if (!out->tags || !out->unplaced) return nomem(s);
+    int nk = 0;
     for (int i = 0; i < c->ntags; i++) {
         int ti = s->tag_of[i];
         if (ti < 0) continue;
-        mr_map_tag *t = &out->tags[ti];
+        mr_map_tag *t = &out->tags[nk];
         t->id = c->ids[i];
         t->size = c->size[i];
         t->world_from_tag = s->wft[ti];
-        memcpy(t->cov, &s->cov[36 * ti], sizeof t->cov);
-        double tr = 0, rr = 0;
-        for (int a = 0; a < 3; a++) {
-            rr += t->cov[7 * a];
-            tr += t->cov[7 * (a + 3)];
-            t->sigma_xyz[a] = sqrt(t->cov[7 * (a + 3)]);
-        }
-        t->sigma_pos = sqrt(tr);
-        t->sigma_deg = sqrt(rr) * DEG;
         double ss = 0;
         int n = 0;
         for (int k = 0; k < c->nobs; k++) {
@@ -1211,11 +1263,28 @@ static bool fill_result(map_state *s) {
             ss += r * r;
             n++;
         }
+        /* Every sighting left and none came back: its place is a guess
+         * (the fixed tag of a tag-fixed gauge stays: it is given). */
+        if (n == 0 && !(c->p->control_count == 0 && i == s->root)) {
+            out->unplaced[out->unplaced_count++] = t->id;
+            memset(t, 0, sizeof *t);
+            continue;
+        }
+        nk++;
         t->photos = n;
         t->rms_px = n ? sqrt(ss / n) : NAN;
         out->observations += n;
+        memcpy(t->cov, &s->cov[36 * ti], sizeof t->cov);
+        double tr = 0, rr = 0;
+        for (int a = 0; a < 3; a++) {
+            rr += t->cov[7 * a];
+            tr += t->cov[7 * (a + 3)];
+            t->sigma_xyz[a] = sqrt(t->cov[7 * (a + 3)]);
+        }
+        t->sigma_pos = sqrt(tr);
+        t->sigma_deg = sqrt(rr) * DEG;
     }
-    out->tag_count = s->nt;
+    out->tag_count = nk;
     for (int q = 0; q < p->control_count; q++) {
         mr_map_control_result *cr = &out->controls[q];
         cr->used = s->ctl_use[q];

@@ -69,6 +69,8 @@ cJSON *mr_map_result_to_json(const mr_map_result *r, const mr_marker_map *marker
     }
     cJSON *u = cJSON_AddArrayToObject(mp, "unconnected");
     for (int i = 0; i < r->unconnected_count; i++) cJSON_AddItemToArray(u, cJSON_CreateNumber(r->unconnected[i]));
+    cJSON *up = cJSON_AddArrayToObject(mp, "unplaced");
+    for (int i = 0; i < r->unplaced_count; i++) cJSON_AddItemToArray(up, cJSON_CreateNumber(r->unplaced[i]));
     cJSON *us = cJSON_AddArrayToObject(mp, "unsized");
     for (int i = 0; i < r->unsized_count; i++) cJSON_AddItemToArray(us, cJSON_CreateNumber(r->unsized[i]));
     if (r->refined_intrinsics) cJSON_AddItemToObject(mp, "camera", mr_camera_to_json(&r->camera));
@@ -199,6 +201,9 @@ void mr_map_result_report(const mr_map_result *r, const mr_map_params *params, c
     for (int i = 0; i < r->unconnected_count; i++)
         fprintf(stderr, "mrcheck: map: warning: tag %d is not connected to the mapped part: no shared photo\n",
                 r->unconnected[i]);
+    for (int i = 0; i < r->unplaced_count; i++)
+        fprintf(stderr, "mrcheck: map: warning: tag %d: no sighting agrees with the adjusted map: not mapped\n",
+                r->unplaced[i]);
     fprintf(out, "mapped %d tags from %d of %d photos (%d sightings)%s; reprojection RMS %.3f px", r->tag_count,
            r->photos_used, r->photos_total, r->observations, r->adjusted ? "" : " by chaining (no adjustment)",
            r->rms_px);

@@ -209,6 +209,10 @@ typedef struct mr_map_result {
     int unconnected_count;
     int *unsized;             /* ids seen without a known size (skipped) */
     int unsized_count;
+    int *unplaced;            /* ids of the part none of whose sightings
+                                 agreed with the adjusted map, even after
+                                 placing it again from the photo poses */
+    int unplaced_count;
     mr_camera camera;         /* the intrinsics used (refined if asked) */
     int photos_used;          /* photos with a pose in the map */
     int photos_total;
@@ -238,11 +242,11 @@ bool mr_map_result_markers(const mr_map_result *r, const char *family, double ta
  * scene units taken as metres), "sigma_deg", "rms_px", "covariance" [36]
  * (rad, scene units), and a top-level "map" object: "rms_px", "sigma_px",
  * "photos_used", "photos_total", "observations", "gauge", "unconnected"
- * [ids], "unsized" [ids], "control_points" [{name, tag, corner,
+ * [ids], "unsized" [ids], "unplaced" [ids], "control_points" [{name, tag, corner,
  * residual_mm [3], loo_mm [3] or null, loo_sigma, used, outlier}]. */
 cJSON *mr_map_result_to_json(const mr_map_result *r, const mr_marker_map *markers, const mr_map_params *params);
-/* What `mrcheck map` prints: one warning line on stderr per unsized or
- * unconnected tag, then on out the summary (tags, photos, RMS, the file
+/* What `mrcheck map` prints: one warning line on stderr per unsized,
+ * unconnected or unplaced tag, then on out the summary (tags, photos, RMS, the file
  * written), the largest tag sigma, each tag at --verbose, and each control
  * point's residual and leave-one-out check. */
 void mr_map_result_report(const mr_map_result *r, const mr_map_params *params, const char *written, FILE *out);
