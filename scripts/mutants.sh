@@ -133,6 +133,9 @@ triangulate_sigma_over_sqrt3|lib/track/triangulate.c|out->sigma = sqrt(fmax(0, o
 triangulate_line_sigma_over_sqrt3|lib/track/triangulate.c|*sigma = sqrt(fmax(v, 0));|*sigma = sqrt(fmax(v, 0) / 3);|^test_sigma$
 triangulate_point_sigma_not_per_axis|lib/track/triangulate.c|*sigma = sqrt((t->cov[0] + t->cov[4] + t->cov[8]) / 3);|*sigma = sqrt(t->cov[0] + t->cov[4] + t->cov[8]);|^test_sigma$
 map_lost_tag_not_replaced|lib/track/map.c|        bool used = false, posed = false;|        bool used = true, posed = false;|^test_bench$
+cluster_key_positions_dropped|lib/render/cluster_cache.c|    h = mr_hash64(h, positions, (size_t)vertex_count * 12);|    h = mr_hash64(h, positions, 0);|^test_rules$
+cluster_key_index_quarter|lib/render/cluster_cache.c|return mr_hash64(h, indices, (size_t)count * 4);|return mr_hash64(h, indices, (size_t)count);|^test_rules$
+cluster_key_threshold_dropped|lib/render/cluster_cache.c|uint32_t threshold) {\n    uint64_t h|uint32_t threshold_) {\n    uint32_t threshold = 0 * threshold_;\n    uint64_t h|^test_rules$
 LIST
 )
 

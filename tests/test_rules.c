@@ -1,6 +1,7 @@
 /* test_rules.c — the renderer's decision rules as pure functions, on
  * injected inputs on both sides of each threshold (no GL): a rule that
  * only the fixtures' one scene reaches is otherwise never seen to switch. */
+#include "cluster_cache.h"
 #include "mr_render.h"
 #include "mr_test.h"
 
@@ -32,7 +33,42 @@ static void test_cascade_count(void) {
     CHECK(mr_shadow_cascade_count(0, S, T, 1, INFINITY) == 1);
 }
 
+/* The meshlet cache's key of a level changes with each input alone: one
+ * position's last bit, one index (an index-only edit of a cached mesh,
+ * last of all or first), the index count, the vertex count and the
+ * cluster threshold; copies of the same input give the same key. */
+static void test_cluster_key(void) {
+    enum { nv = 40, ni = 120 };
+    float pos[nv * 3], pos2[nv * 3];
+    uint32_t idx[ni], idx2[ni];
+    for (int i = 0; i < nv * 3; i++) pos[i] = (float)(i * 0.37 - 3);
+    for (int i = 0; i < ni; i++) idx[i] = (uint32_t)((i * 7) % nv);
+    memcpy(pos2, pos, sizeof pos);
+    memcpy(idx2, idx, sizeof idx);
+    const uint64_t k = clu_level_key(pos, nv, idx, ni, 4096);
+    CHECK(clu_level_key(pos2, nv, idx2, ni, 4096) == k);
+    uint32_t bits;
+    memcpy(&bits, &pos2[nv * 3 - 1], 4);
+    bits ^= 1;
+    memcpy(&pos2[nv * 3 - 1], &bits, 4);
+    CHECK_MSG(clu_level_key(pos2, nv, idx, ni, 4096) != k, "the last position's last bit is not in the key");
+    for (int at = 0; at < ni; at += ni - 1) {
+        memcpy(idx2, idx, sizeof idx);
+        idx2[at] = (idx2[at] + 1) % nv;
+        CHECK_MSG(clu_level_key(pos, nv, idx2, ni, 4096) != k, "index %d is not in the key", at);
+    }
+    /* two indices swapped: same multiset, other triangles */
+    memcpy(idx2, idx, sizeof idx);
+    uint32_t t = idx2[ni - 1];
+    idx2[ni - 1] = idx2[ni - 2], idx2[ni - 2] = t;
+    CHECK(clu_level_key(pos, nv, idx2, ni, 4096) != k);
+    CHECK(clu_level_key(pos, nv, idx, ni - 3, 4096) != k);
+    CHECK(clu_level_key(pos, nv - 1, idx, ni, 4096) != k);
+    CHECK(clu_level_key(pos, nv, idx, ni, 4097) != k);
+}
+
 int main(void) {
     test_cascade_count();
+    test_cluster_key();
     return mr_test_finish("test_rules");
 }
