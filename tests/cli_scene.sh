@@ -115,17 +115,17 @@ expect_fail factory_bad_unit "$tmp/cad/bad.glb" -- "$mr" factory --unique --unit
 expect_fail factory_unit_alone "$tmp/cad/bad.glb" -- "$mr" factory --unit 1000 --out "$tmp/cad/bad.glb"
 expect_fail factory_unique_halls "$tmp/cad/bad.glb" -- "$mr" factory --unique --halls 2 --out "$tmp/cad/bad.glb"
 expect_fail bench_bad_unit "" -- "$mr" bench scene --unique --unit -1 --out "$tmp/b"
-# issue 17 (lane bench): bench scene --unique at one part, twice into one
-# folder: the new columns at the end, each image against "none" (0 for
+# bench scene --unique at one part, twice into one folder: the
+# hierarchy's columns at the end (the hier row: 9 configs x 3 views), each image against "none" (0 for
 # itself), the first build's rate of LOD and meshlets, the Goal lines in the log and the CSV, the LOD cache removed
 # before each first build, --full-detail-frames for no-lod and none.
 bu() { "$mr" bench scene --unique --sizes 10k --frames 1 --size 64x48 --out "$tmp/bu" "$@"; }
 if bu >"$tmp/bu1.log" 2>&1 && bu --full-detail-frames 2 >"$tmp/bu.log" 2>&1; then
   csv=$tmp/bu/bench_scene_unique.csv
-  head -1 "$csv" | grep -q ',lod_cached_s,unit,image_diff_pct,image_edge_pct,open_first_s,open_cached_s,timed_frames,frame_cpu_ms,cluster_build_s,lod_cluster_mtris_s$' && ok ||
+  head -1 "$csv" | grep -q ',lod_cached_s,unit,image_diff_pct,image_edge_pct,open_first_s,open_cached_s,timed_frames,frame_cpu_ms,cluster_build_s,lod_cluster_mtris_s,hlod_s,hlod_cached_s,hlod_stored_triangles,hlod_proxies,hlod_triangles$' && ok ||
     bad "bench scene --unique columns: $(head -1 "$csv")"
-  [ "$(grep -vc '^#' "$csv")" = 25 ] && ok || bad "bench scene --unique: not 24 rows"
-  awk -F, '!/^#/ && NR > 1 && (NF != 34 || $32 < 0 || $33 < 0 || !($34 > 0) || $11 != 0 || ($14 == "none" && $27 != 0) || $31 != ($14 == "none" || $14 == "no-lod" ? 2 : 1)) { b = 1 }
+  [ "$(grep -vc '^#' "$csv")" = 28 ] && [ "$(grep -c ',hier,' "$csv")" = 3 ] && ok || bad "bench scene --unique: not 27 rows with 3 hier"
+  awk -F, '!/^#/ && NR > 1 && (NF != 39 || $35 < 0 || $36 < 0 || $37 < 0 || $38 < 0 || $39 < 0 || $32 < 0 || $33 < 0 || !($34 > 0) || $11 != 0 || ($14 == "none" && $27 != 0) || $31 != ($14 == "none" || $14 == "no-lod" ? 2 : 1)) { b = 1 }
            END { exit b }' "$csv" && ok || bad "bench scene --unique rows (fields, first build, none's diff, frames): $(cat "$csv")"
   [ "$(grep -c '^# Goal image 10k ' "$csv")" = 3 ] && grep -q '^Goal image 10k overview: all differs from none in ' "$tmp/bu.log" &&
     grep -q '^Goal floor: .*not measured' "$tmp/bu.log" && ok || bad "bench scene --unique Goal lines: $(cat "$tmp/bu.log")"
