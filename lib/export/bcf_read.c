@@ -541,7 +541,7 @@ static bool read_all(archive *a, mr_bcf *b, mr_error *err) {
     }
     /* A folder lists in no fixed order: by name, so runs agree; a zip's
      * folders may repeat when its entries are not grouped. */
-    qsort(names, (size_t)count, sizeof *names, by_name);
+    if (count > 1) qsort(names, (size_t)count, sizeof *names, by_name); /* names is NULL when empty */
     int kept = 0;
     for (int i = 0; i < count; i++) {
         if (kept > 0 && strcmp(names[kept - 1], names[i]) == 0) free(names[i]);
