@@ -10,8 +10,7 @@ int cmd_calibrate(int argc, char **argv) {
         {"images", "DIR", "folder of board images (png, jpg, ...)", NULL},
         {"board", "BOARD.json", "the board as a marker map: tag poses in the board frame (z = 0 plane)", NULL},
         {"out", "CAMERA.json", "camera file to write", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_board_calib_params bp = {.min_tags = 0};

@@ -14,8 +14,7 @@ int cmd_export(int argc, char **argv) {
         {"scene", "S", "report: the plan (glTF/GLB or scene config) for the plan-view map", NULL},
         {"author", "NAME", "CreationAuthor of the topics (default mrcheck)", NULL},
         {"title", "TEXT", "report title (default \"mrcheck findings\")", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_export_params p = MR_EXPORT_DEFAULTS;

@@ -28,8 +28,7 @@ int cmd_hall(int argc, char **argv) {
         {"tolerances", "T.json", "tolerance table (default DIN 18202 Table 1); copied in as tolerances.json", NULL},
         {"input", "DEV", "the live camera (default /dev/video0)", NULL},
         {"name", "TEXT", "the hall's name, for people", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     const char *pos[2];

@@ -28,8 +28,7 @@ int cmd_map(int argc, char **argv) {
         {"fix-pose", "P.json", "{\"world_from_tag\": [16]} for the --fix tag", NULL},
         {"control", "P.json", "gauge: >= 3 control points with plan coordinates and sigma", NULL},
         {"out", "MARKERS.json", "marker map to write (with sigma, RMS, control residuals)", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_map_params mp = MR_MAP_DEFAULTS;

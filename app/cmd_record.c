@@ -23,8 +23,7 @@ int cmd_record(int argc, char **argv) {
         {"rate", "FPS", "pace file inputs at this rate, as a live camera would deliver them", NULL},
         {"gray", NULL, "store grey frames (smaller)", NULL},
         {"png", NULL, "store lossless PNG frames instead of JPEG", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_detector_params dp = MR_DETECTOR_DEFAULTS;

@@ -13,8 +13,7 @@ int cmd_track(int argc, char **argv) {
         {"out", "POSES.jsonl", "write one pose line per frame there (written when the run ends)", NULL},
         {"print-detections", NULL, "print {\"frame\",\"detections\"} per frame on stdout", NULL},
         {"max-frames", "N", "stop after N frames", NULL},
-        {"verbose", NULL, "more output", NULL},
-        {"quiet", NULL, "errors only", NULL},
+        MR_CLI_LOG_OPTS,
         {NULL, NULL, NULL, NULL},
     };
     mr_detector_params dp = MR_DETECTOR_DEFAULTS;
