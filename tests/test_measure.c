@@ -27,7 +27,7 @@ static bool measure(mr_dvec3 built, int n, double spread_rad, uint64_t seed, mr_
     for (int i = 0; i < 24; i++) {
         double a = 2 * M_PI * (i % 12 + 0.5 * (i / 12)) / 12;
         mr_dvec3 c = mr_v3(built.x + 5 * cos(a), i < 12 ? 1.2 : 2.6, built.z + 5 * sin(a));
-        tags[i] = (mr_marker){i, mr_m4_look_at_cv(c, mr_v3(c.x + cos(a), c.y, c.z + sin(a)), mr_v3(0, 1, 0)), 0};
+        tags[i] = (mr_marker){.id = i, .world_from_tag = mr_m4_look_at_cv(c, mr_v3(c.x + cos(a), c.y, c.z + sin(a)), mr_v3(0, 1, 0))};
     }
     mr_marker_map map = {.family = "tag36h11", .tag_size = 0.6, .tags = tags, .count = 24};
     mr_rng rng;
@@ -58,7 +58,7 @@ static bool measure(mr_dvec3 built, int n, double spread_rad, uint64_t seed, mr_
         if (!mr_pose_solve(&cam, &map, det, nd, NULL, NULL, pose, err) || !pose->valid) continue;
         double u, v;
         if (!mr_project_point(&cam, &wfc, built, &u, &v)) continue;
-        taps[m] = (mr_tap){pose->world_from_camera, pose->cov, {u + mr_rng_normal(&rng), v + mr_rng_normal(&rng)}};
+        taps[m] = (mr_tap){pose->world_from_camera, pose->cov, {u + mr_rng_normal(&rng), v + mr_rng_normal(&rng)}, pose->cov_map};
         m++;
     }
     mr_triangulate_params tp = MR_TRIANGULATE_DEFAULTS;

@@ -14,7 +14,7 @@ static void run(int ntags, double noise, double *observed, double *predicted, do
     mr_camera cam = mr_demo_camera();
     mr_marker tags[4];
     for (int i = 0; i < ntags; i++) {
-        tags[i] = (mr_marker){i, facing(mr_v3(-0.6 + 0.4 * i, 0.2 * (i % 2), 2.0 + 0.3 * i)), 0};
+        tags[i] = (mr_marker){.id = i, .world_from_tag = facing(mr_v3(-0.6 + 0.4 * i, 0.2 * (i % 2), 2.0 + 0.3 * i))};
     }
     mr_marker_map map = {.family = "tag36h11", .tag_size = 0.2, .tags = tags, .count = ntags};
     mr_dmat4 wfc = mr_m4_look_at_cv(mr_v3(0, 0.1, 0), mr_v3(0, 0.1, 3), mr_v3(0, 1, 0));

@@ -66,8 +66,8 @@ static mr_dmat4 pose_of(int i) {
  * (PNG frames). */
 static mr_recorder_params rec_params(mr_camera *cam, mr_marker tags[2], mr_marker_map *map) {
     *cam = (mr_camera){64, 48, 50, 50, 31.5, 23.5, {0.01, 0, 0, 0, 0}};
-    tags[0] = (mr_marker){3, mr_m4_translate(0, 1, 0), 0};
-    tags[1] = (mr_marker){8, mr_m4_translate(1, 1, 0), 0};
+    tags[0] = (mr_marker){.id = 3, .world_from_tag = mr_m4_translate(0, 1, 0)};
+    tags[1] = (mr_marker){.id = 8, .world_from_tag = mr_m4_translate(1, 1, 0)};
     *map = (mr_marker_map){"tag36h11", 0.2, tags, 2};
     mr_recorder_params rp = MR_RECORDER_DEFAULTS;
     rp.camera = cam;

@@ -30,7 +30,7 @@ static void test_triangulated_sigma(void) {
             mr_dmat4 wfc = mr_m4_look_at_cv(eye, truth, mr_v3(0, 1, 0));
             double u, v;
             if (!mr_project_point(&cam, &wfc, truth, &u, &v)) continue;
-            taps[m++] = (mr_tap){wfc, NULL, {u + mr_rng_normal(&rng), v + mr_rng_normal(&rng)}};
+            taps[m++] = (mr_tap){.world_from_camera = wfc, .px = {u + mr_rng_normal(&rng), v + mr_rng_normal(&rng)}};
         }
         mr_triangulation t;
         mr_error err = {0};

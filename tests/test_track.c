@@ -211,9 +211,9 @@ static void test_tiny_frames(void) {
  * corners must match the projected ones and the pose the true one. */
 static void test_pose_rendered(void) {
     mr_marker tags[3] = {
-        {1, tag_facing(mr_v3(0.0, 1.6, 0.0), mr_v3(0, 0, 1)), 0},
-        {2, tag_facing(mr_v3(0.8, 1.2, 0.0), mr_v3(0, 0, 1)), 0},
-        {3, tag_facing(mr_v3(-0.7, 1.5, 0.7), mr_v3(1, 0, 0)), 0},
+        {.id = 1, .world_from_tag = tag_facing(mr_v3(0.0, 1.6, 0.0), mr_v3(0, 0, 1))},
+        {.id = 2, .world_from_tag = tag_facing(mr_v3(0.8, 1.2, 0.0), mr_v3(0, 0, 1))},
+        {.id = 3, .world_from_tag = tag_facing(mr_v3(-0.7, 1.5, 0.7), mr_v3(1, 0, 0))},
     };
     mr_marker_map map = {"tag36h11", 0.2, tags, 3};
     tag_bits bits[3];
@@ -287,7 +287,7 @@ static void test_pose_rendered(void) {
         tags[1].world_from_tag.m[3] -= shifts[s];
     }
     /* Nothing in the map: no pose, no error. */
-    mr_marker other = {42, mr_m4_identity(), 0};
+    mr_marker other = {.id = 42, .world_from_tag = mr_m4_identity()};
     mr_marker_map empty = {"tag36h11", 0.2, &other, 1};
     mr_pose p3;
     CHECK(mr_pose_solve(&cam, &empty, det, n, NULL, NULL, &p3, &err) && !p3.valid && p3.tags_seen == 0);
@@ -300,7 +300,7 @@ static void test_pose_rendered(void) {
  * error, and noise picks the wrong one now and then. With the previous
  * pose given, flips must (nearly) vanish. */
 static void test_single_tag_flip(void) {
-    mr_marker tag = {0, tag_facing(mr_v3(0, 2, 0), mr_v3(0, 0, 1)), 0};
+    mr_marker tag = {.id = 0, .world_from_tag = tag_facing(mr_v3(0, 2, 0), mr_v3(0, 0, 1))};
     mr_marker_map map = {"tag36h11", 0.3, &tag, 1};
     mr_camera cam = {640, 480, 500, 500, 319.5, 239.5, {0}};
     mr_rng rng;

@@ -44,7 +44,7 @@ static void project_tag(const mr_camera *cam, const mr_marker_map *map, const mr
 typedef struct flip_run { int frames, valid, ambiguous, flips, free_flips, first_flip; } flip_run;
 
 static flip_run lone_tag_run(double dist, double sigma, uint64_t seed) {
-    mr_marker tag = {7, {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}, 0}; /* faces -z, y down */
+    mr_marker tag = {.id = 7, .world_from_tag = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}}; /* faces -z, y down */
     mr_marker_map map = {"tag36h11", 0.3, &tag, 1};
     mr_camera cam = demo_camera();
     mr_rng rng;
@@ -137,10 +137,10 @@ static double reproj_cost(const mr_camera *cam, const mr_marker_map *map, const 
  * 7e-5 .. 1.8e-2. */
 static void test_multi_tag_refined(void) {
     mr_marker tags[4] = {
-        {1, {{1, 0, 0, -1.0, 0, 1, 0, 0.3, 0, 0, 1, 0, 0, 0, 0, 1}}, 0},
-        {2, {{1, 0, 0, 1.2, 0, 1, 0, -0.2, 0, 0, 1, 0, 0, 0, 0, 1}}, 0},
-        {3, {{0, 0, 1, 2.5, 0, 1, 0, 0.1, -1, 0, 0, -1.2, 0, 0, 0, 1}}, 0}, /* side wall, seen from -x */
-        {4, {{0, 0, 1, 2.5, 0, 1, 0, -0.4, -1, 0, 0, -2.4, 0, 0, 0, 1}}, 0},
+        {.id = 1, .world_from_tag = {{1, 0, 0, -1.0, 0, 1, 0, 0.3, 0, 0, 1, 0, 0, 0, 0, 1}}},
+        {.id = 2, .world_from_tag = {{1, 0, 0, 1.2, 0, 1, 0, -0.2, 0, 0, 1, 0, 0, 0, 0, 1}}},
+        {.id = 3, .world_from_tag = {{0, 0, 1, 2.5, 0, 1, 0, 0.1, -1, 0, 0, -1.2, 0, 0, 0, 1}}}, /* side wall, seen from -x */
+        {.id = 4, .world_from_tag = {{0, 0, 1, 2.5, 0, 1, 0, -0.4, -1, 0, 0, -2.4, 0, 0, 0, 1}}},
     };
     mr_marker_map map = {"tag36h11", 0.3, tags, 4};
     mr_camera cam = demo_camera();

@@ -55,7 +55,7 @@ static bool measure_edge(const mr_recording *rec, const int *frames, int nf, con
         /* A planner's tap is good to about half a pixel. */
         u += 0.5 * mr_rng_normal(&rng);
         v += 0.5 * mr_rng_normal(&rng);
-        taps[t] = (mr_tap){f->pose.world_from_camera, f->pose.cov, {u, v}};
+        taps[t] = (mr_tap){f->pose.world_from_camera, f->pose.cov, {u, v}, f->pose.cov_map};
         m->frames[t] = f->index;
         m->px[t][0] = u, m->px[t][1] = v;
     }

@@ -59,7 +59,7 @@ static const row_t k_rows[] = {
 
 /* A tag at c whose surface normal (out of the wall) is n. */
 static mr_marker tag_at(int id, mr_dvec3 c, mr_dvec3 n) {
-    return (mr_marker){id, mr_m4_look_at_cv(c, mr_v3_sub(c, n), mr_v3(0, 1, 0)), 0};
+    return (mr_marker){.id = id, .world_from_tag = mr_m4_look_at_cv(c, mr_v3_sub(c, n), mr_v3(0, 1, 0))};
 }
 
 /* 30 x 20 m, 15 columns (0.5 m) on a 6 x 6 m grid, a tag on each face at
@@ -89,7 +89,7 @@ static bool hall_demo(double tag_size, hall_t *h, mr_error *err) {
     h->tag_size = tag_size > 0 ? tag_size : d.tag_size;
     h->lo[0] = h->lo[1] = INFINITY, h->hi[0] = h->hi[1] = -INFINITY;
     for (int i = 0; i < d.tag_count && h->count < MAX_HALL_TAGS; i++) {
-        h->tags[h->count++] = (mr_marker){d.tags[i].id, d.tags[i].world_from_tag, 0};
+        h->tags[h->count++] = (mr_marker){.id = d.tags[i].id, .world_from_tag = d.tags[i].world_from_tag};
         const double *m = d.tags[i].world_from_tag.m;
         h->lo[0] = fmin(h->lo[0], m[3]), h->hi[0] = fmax(h->hi[0], m[3]);
         h->lo[1] = fmin(h->lo[1], m[11]), h->hi[1] = fmax(h->hi[1], m[11]);
@@ -257,7 +257,7 @@ static void measure_point(const hall_t *h, const built_map *bm, const row_t *r, 
             double u, v;
             if (!mr_project_point(&cam, &wfc, p, &u, &v)) break;
             taps[m] = (mr_tap){poses[m].world_from_camera, poses[m].cov,
-                               {u + tap_px * mr_rng_normal(rng), v + tap_px * mr_rng_normal(rng)}};
+                               {u + tap_px * mr_rng_normal(rng), v + tap_px * mr_rng_normal(rng)}, poses[m].cov_map};
             m++;
         }
         if (m < r->taps) continue;

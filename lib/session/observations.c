@@ -47,7 +47,7 @@ bool mr_observations_load(const char *path, const mr_recording *rec, mr_observat
         }
         bool cov = f->pose.corner_sigma_px > 0;
         o->no_cov += !cov;
-        o->taps[o->count++] = (mr_tap){f->pose.world_from_camera, cov ? f->pose.cov : NULL, {px[0], px[1]}};
+        o->taps[o->count++] = (mr_tap){f->pose.world_from_camera, cov ? f->pose.cov : NULL, {px[0], px[1]}, cov ? f->pose.cov_map : NULL};
     }
     ok = true;
 done:

@@ -18,6 +18,11 @@ bool mr_map_result_markers(const mr_map_result *r, const char *family, double ta
         out->tags[i].id = r->tags[i].id;
         out->tags[i].world_from_tag = r->tags[i].world_from_tag;
         out->tags[i].size = r->tags[i].size != out->tag_size ? r->tags[i].size : 0;
+        /* A covariance that could not be computed is unknown: the tag
+         * counts as exact (what the map said before it carried one). */
+        bool fin = true;
+        for (int k = 0; k < 36; k++) fin = fin && isfinite(r->tags[i].cov[k]);
+        if (fin) memcpy(out->tags[i].cov, r->tags[i].cov, sizeof out->tags[i].cov);
     }
     out->count = r->tag_count;
     return true;
@@ -51,6 +56,7 @@ cJSON *mr_map_result_to_json(const mr_map_result *r, const mr_marker_map *marker
         add_num(t, "rms_px", m->rms_px);
         bool fin = true;
         for (int k = 0; k < 36; k++) fin = fin && isfinite(m->cov[k]);
+        cJSON_DeleteItemFromObjectCaseSensitive(t, "covariance"); /* the marker's copy, if any */
         cJSON_AddItemToObject(t, "covariance", fin ? mr_json_from_doubles(m->cov, 36) : cJSON_CreateNull());
     }
     cJSON *mp = cJSON_AddObjectToObject(j, "map");

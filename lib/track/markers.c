@@ -71,6 +71,30 @@ bool mr_marker_map_from_json(const cJSON *obj, mr_marker_map *map, mr_error *err
             }
             m->size = ts;
         }
+        const cJSON *cv = cJSON_GetObjectItemCaseSensitive(t, "covariance");
+        if (cv && !cJSON_IsNull(cv)) {
+            bool good = cJSON_IsArray(cv) && cJSON_GetArraySize(cv) == 36;
+            int k = 0;
+            const cJSON *e;
+            if (good)
+                cJSON_ArrayForEach(e, cv) {
+                    good = good && cJSON_IsNumber(e) && isfinite(e->valuedouble);
+                    if (good) m->cov[k++] = e->valuedouble;
+                }
+            for (k = 0; good && k < 6; k++) {
+                good = m->cov[7 * k] >= 0;
+                for (int q = 0; q < k; q++)
+                    good = good && fabs(m->cov[6 * k + q] - m->cov[6 * q + k]) <=
+                                       1e-6 * (m->cov[7 * k] + m->cov[7 * q]) + 1e-300;
+            }
+            if (!good) {
+                mr_marker_map_free(map);
+                return mr_fail(err, MR_ERR_INVALID,
+                               "marker map: tag id %d: covariance must be 36 finite numbers, symmetric, with a "
+                               "diagonal >= 0",
+                               (int)id);
+            }
+        }
         if (!mr_m4_is_rigid(&m->world_from_tag, 1e-4)) {
             mr_marker_map_free(map);
             return mr_fail(err, MR_ERR_INVALID, "marker map: tag id %d: world_from_tag is not a rigid transform", (int)id);
@@ -116,6 +140,9 @@ cJSON *mr_marker_map_to_json(const mr_marker_map *map) {
         cJSON_AddItemToObject(t, "world_from_tag", mr_json_from_dmat4(&map->tags[i].world_from_tag));
         if (map->tags[i].size > 0 && map->tags[i].size != map->tag_size)
             cJSON_AddNumberToObject(t, "tag_size", map->tags[i].size);
+        bool any = false;
+        for (int k = 0; k < 36; k++) any = any || (map->tags[i].cov[k] != 0 && isfinite(map->tags[i].cov[k]));
+        if (any) cJSON_AddItemToObject(t, "covariance", mr_json_from_doubles(map->tags[i].cov, 36));
         cJSON_AddItemToArray(tags, t);
     }
     return j;

@@ -31,6 +31,11 @@ typedef struct mr_marker {
     mr_dmat4 world_from_tag; /* rigid */
     double size;             /* this tag's black-square edge (scene units) in a
                                 map of mixed sizes; 0 = the map's tag_size */
+    double cov[36];          /* the uncertainty of world_from_tag in a map
+                                built from photos (mr_map_tag.cov's convention:
+                                rotation about world x y z, radians, then the
+                                centre, scene units); all 0 = exact (a planned
+                                map), as is any non-finite entry */
 } mr_marker;
 
 typedef struct mr_marker_map {
@@ -42,8 +47,9 @@ typedef struct mr_marker_map {
 
 /* {"family": "tag36h11", "tag_size": 0.4, "tags": [{"id": 0,
  *   "world_from_tag": [16]}, ...]}; a tag may carry its own "tag_size"
- * (maps of mixed sizes). Other keys (e.g. the σ fields `mrcheck map`
- * writes) are ignored. Refuses duplicate ids, a tag size <= 0, non-rigid
+ * (maps of mixed sizes) and its "covariance" [36] (mr_marker.cov; null or
+ * absent: exact), which `mrcheck map` writes and the pose solve weighs.
+ * Other keys (the other σ fields `mrcheck map` writes) are ignored. Refuses duplicate ids, a tag size <= 0, non-rigid
  * transforms and unknown families. */
 bool mr_marker_map_from_json(const cJSON *obj, mr_marker_map *map, mr_error *err);
 bool mr_marker_map_parse(const char *text, size_t size, mr_marker_map *map, mr_error *err);
@@ -308,8 +314,18 @@ typedef struct mr_pose {
      * then tau (scene units). From the used corners' Jacobian, with the
      * corner noise estimated from the residuals (dof-corrected) and never
      * below MR_POSE_MIN_CORNER_SIGMA_PX. mr_pose_point_sigma turns it into
-     * "± N here". */
+     * "± N here". With map uncertainty (mr_marker.cov) each tag's corners
+     * are weighted by (corner noise)^2 I + B C B^T (B: the corners'
+     * pixels against the tag's pose, C: its map covariance), the solve is
+     * that weighted least squares, and cov is its covariance: the corner
+     * noise part plus the map part, cov_map. The corner noise is then the
+     * value that makes the weighted residuals' chi-square equal their
+     * degrees of freedom (the map explains part of the residuals). */
     double cov[36];
+    double cov_map[36];      /* the part of cov from the map's uncertainty
+                                (shared by every frame that sees the same
+                                tags, so it does not average out over frames;
+                                0 when the map is exact) */
     double corner_sigma_px;  /* the corner noise used, px */
 } mr_pose;
 /* Corner noise floor of the covariance (px): a lucky frame with near-exact
@@ -352,6 +368,9 @@ typedef struct mr_tap {
     mr_dmat4 world_from_camera;
     const double *pose_cov;  /* 36, mr_pose.cov's convention; NULL: none */
     double px[2];
+    const double *pose_cov_map; /* 36, mr_pose.cov_map: the part of pose_cov
+                                   shared between taps (the map's); NULL: the
+                                   whole pose_cov is this tap's own */
 } mr_tap;
 typedef struct mr_triangulate_params {
     double tap_sigma_px;     /* a tap's 1-σ per axis, px; 0 = 1.0 */
@@ -369,8 +388,11 @@ typedef struct mr_triangulation {
     double rms_px;           /* reprojection RMS of the taps */
 } mr_triangulation;
 /* Linear (closest point to all rays), then Gauss-Newton on the taps'
- * reprojection error, each weighted by its tap noise plus its pose's
- * covariance carried into the image. false + err: fewer than 2 taps, a tap
+ * reprojection error, each weighted by its tap noise plus its pose's own
+ * covariance (pose_cov less pose_cov_map) carried into the image. The
+ * shared map part moves every tap's ray alike, so it moves the point as a
+ * whole: the point's covariance adds the mean over the taps of the map
+ * part carried to the point (it does not shrink with more taps). false + err: fewer than 2 taps, a tap
  * that cannot be undistorted, rays nearly parallel ("baseline angle 0.4
  * deg < 2 deg": taken from nearly the same place), the point behind a
  * camera. */

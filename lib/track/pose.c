@@ -111,6 +111,9 @@ typedef struct tag_obs {
     int id;
     double world[4][3];  /* corners in the world */
     double norm[4][2];   /* undistorted normalised image points */
+    double centre[3];    /* the tag's centre in the world */
+    double C[36];        /* its map covariance (mr_marker.cov) */
+    bool has_cov;        /* C is not all 0 */
 } tag_obs;
 
 /* RMS reprojection error of one tag under camera_from_world x, in pixels
@@ -164,6 +167,7 @@ static bool refine(const tag_obs *obs, const bool *use, int n, rt *x) {
 }
 
 static void covariance(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, double outlier_px, mr_pose *out);
+static void weighted_refine(const mr_camera *cam, const tag_obs *obs, int n, double outlier_px, rt *x);
 
 bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_detection *dets, int count,
                    const mr_pose *prev, const mr_pose_params *params, mr_pose *out, mr_error *err) {
@@ -204,6 +208,14 @@ bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_dete
             o->world[k][2] = w[k].z;
             ok = mr_camera_undistort(cam, (dets[i].corners[k][0] - cam->cx) / cam->fx,
                                      (dets[i].corners[k][1] - cam->cy) / cam->fy, &o->norm[k][0], &o->norm[k][1]);
+        }
+        o->centre[0] = m->world_from_tag.m[3];
+        o->centre[1] = m->world_from_tag.m[7];
+        o->centre[2] = m->world_from_tag.m[11];
+        o->has_cov = false;
+        for (int k = 0; k < 36; k++) {
+            o->C[k] = isfinite(m->cov[k]) ? m->cov[k] : 0;
+            o->has_cov = o->has_cov || o->C[k] != 0;
         }
         if (ok) n++;
     }
@@ -300,6 +312,9 @@ bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_dete
         rt y = x;
         if (refine(obs, use, n, &y)) x = y;
     }
+    /* With map uncertainty the least-squares optimum above weighs a badly
+     * mapped tag like a good one: refine again under each tag's weight. */
+    if (!lone) weighted_refine(cam, obs, n, outlier_px, &x);
     double sse = 0;
     int used = 0;
     for (int i = 0; i < n; i++) {
@@ -319,10 +334,10 @@ bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_dete
     return true;
 }
 
-/* In-place inverse of a symmetric positive definite n x n matrix
+/* In-place inverse of a symmetric positive definite n x n matrix, n <= 8
  * (Gauss-Jordan with partial pivoting); false if singular. */
 static bool invert_n(double *a, int n) {
-    double inv[36];
+    double inv[64];
     for (int i = 0; i < n * n; i++) inv[i] = (i / n == i % n) ? 1 : 0;
     double scale = 0;
     for (int i = 0; i < n; i++) scale = fmax(scale, fabs(a[i * n + i]));
@@ -358,46 +373,212 @@ static bool invert_n(double *a, int n) {
     return true;
 }
 
-/* Covariance of the solved pose: J^T J over the inlier corners (pixel
- * residuals of the pinhole projection; the lens only rescales them
- * locally), scaled by the residual variance with its floor. */
-static void covariance(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, double outlier_px, mr_pose *out) {
-    double JtJ[36] = {0};
-    double sse = 0;
-    int m = 0;
-    for (int i = 0; i < n; i++) {
-        if (tag_rms(cam, x, &obs[i]) > outlier_px) continue;
-        for (int k = 0; k < 4; k++) {
-            const double *p = obs[i].world[k];
-            double q[3];
-            for (int r = 0; r < 3; r++)
-                q[r] = x->R[3 * r] * p[0] + x->R[3 * r + 1] * p[1] + x->R[3 * r + 2] * p[2] + x->t[r];
-            double iz = 1 / q[2], u = q[0] * iz, v = q[1] * iz;
-            double du = cam->fx * (u - obs[i].norm[k][0]), dv = cam->fy * (v - obs[i].norm[k][1]);
-            sse += du * du + dv * dv;
-            /* d(pixel)/dq, then dq/d(w, tau) = [-[q]x | I]. */
-            double Pu[3] = {cam->fx * iz, 0, -cam->fx * u * iz}, Pv[3] = {0, cam->fy * iz, -cam->fy * v * iz};
-            double J[2][6];
-            for (int row = 0; row < 2; row++) {
-                const double *P = row ? Pv : Pu;
-                /* P . (-[q]x w) = P . (w x q) = w . (q x P) */
-                J[row][0] = q[1] * P[2] - q[2] * P[1];
-                J[row][1] = q[2] * P[0] - q[0] * P[2];
-                J[row][2] = q[0] * P[1] - q[1] * P[0];
-                J[row][3] = P[0];
-                J[row][4] = P[1];
-                J[row][5] = P[2];
-            }
-            for (int a = 0; a < 6; a++)
-                for (int b = 0; b < 6; b++) JtJ[6 * a + b] += J[0][a] * J[0][b] + J[1][a] * J[1][b];
-            m++;
+/* One tag under camera_from_world x: its 8 pixel residuals e (projection
+ * minus detection; the lens only rescales them locally), their Jacobian J
+ * in the pose perturbation (mr_pose.cov's: X_cam -> exp([w]x) X_cam + tau)
+ * and B in the tag's map perturbation (mr_marker.cov's: corner X ->
+ * X + w_m x (X - centre) + dc). false if a corner is behind the camera. */
+static bool tag_jac(const mr_camera *cam, const rt *x, const tag_obs *o, double e[8], double J[8][6], double B[8][6]) {
+    for (int k = 0; k < 4; k++) {
+        const double *p = o->world[k];
+        double q[3];
+        for (int r = 0; r < 3; r++) q[r] = x->R[3 * r] * p[0] + x->R[3 * r + 1] * p[1] + x->R[3 * r + 2] * p[2] + x->t[r];
+        if (!(q[2] > 0)) return false;
+        double iz = 1 / q[2], u = q[0] * iz, v = q[1] * iz;
+        e[2 * k] = cam->fx * (u - o->norm[k][0]);
+        e[2 * k + 1] = cam->fy * (v - o->norm[k][1]);
+        /* d(pixel)/dq, then dq/d(w, tau) = [-[q]x | I]. */
+        double Pu[3] = {cam->fx * iz, 0, -cam->fx * u * iz}, Pv[3] = {0, cam->fy * iz, -cam->fy * v * iz};
+        double a[3] = {p[0] - o->centre[0], p[1] - o->centre[1], p[2] - o->centre[2]};
+        for (int row = 0; row < 2; row++) {
+            const double *P = row ? Pv : Pu;
+            double *Jr = J[2 * k + row], *Br = B[2 * k + row];
+            /* P . (-[q]x w) = P . (w x q) = w . (q x P) */
+            Jr[0] = q[1] * P[2] - q[2] * P[1];
+            Jr[1] = q[2] * P[0] - q[0] * P[2];
+            Jr[2] = q[0] * P[1] - q[1] * P[0];
+            Jr[3] = P[0];
+            Jr[4] = P[1];
+            Jr[5] = P[2];
+            /* The world displacement dX reaches the pixel through
+             * g = R^T P; g . (w_m x a) = w_m . (a x g). */
+            double g[3];
+            for (int c = 0; c < 3; c++) g[c] = P[0] * x->R[c] + P[1] * x->R[3 + c] + P[2] * x->R[6 + c];
+            Br[0] = a[1] * g[2] - a[2] * g[1];
+            Br[1] = a[2] * g[0] - a[0] * g[2];
+            Br[2] = a[0] * g[1] - a[1] * g[0];
+            Br[3] = g[0];
+            Br[4] = g[1];
+            Br[5] = g[2];
         }
     }
-    if (2 * m <= 6 || !invert_n(JtJ, 6)) return;
-    double s = sqrt(sse / (2 * m - 6));
-    if (!(s >= MR_POSE_MIN_CORNER_SIGMA_PX)) s = MR_POSE_MIN_CORNER_SIGMA_PX;
+    return true;
+}
+
+/* W = (s2 I + B C B^T)^-1, the tag's 8x8 weight. */
+static bool tag_weight(const tag_obs *o, const double B[8][6], double s2, double W[64]) {
+    for (int r = 0; r < 8; r++)
+        for (int c = 0; c < 8; c++) {
+            double v = r == c ? s2 : 0;
+            if (o->has_cov)
+                for (int a = 0; a < 6; a++) {
+                    if (B[r][a] == 0) continue;
+                    for (int b = 0; b < 6; b++) v += B[r][a] * o->C[6 * a + b] * B[c][b];
+                }
+            W[8 * r + c] = v;
+        }
+    return invert_n(W, 8);
+}
+
+/* The tags the covariance and the weighted solve use: the inliers. */
+static int inliers(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, double outlier_px, bool *use,
+                   bool *any_cov) {
+    int m = 0;
+    *any_cov = false;
+    for (int i = 0; i < n; i++) {
+        use[i] = tag_rms(cam, x, &obs[i]) <= outlier_px;
+        m += use[i];
+        *any_cov = *any_cov || (use[i] && obs[i].has_cov);
+    }
+    return m;
+}
+
+/* The weighted residuals' chi-square under corner noise s. */
+static double chi2(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, const bool *use, double s) {
+    double sum = 0, e[8], J[8][6], B[8][6], W[64];
+    for (int i = 0; i < n; i++) {
+        if (!use[i]) continue;
+        if (!tag_jac(cam, x, &obs[i], e, J, B) || !tag_weight(&obs[i], B, s * s, W)) return INFINITY;
+        for (int r = 0; r < 8; r++)
+            for (int c = 0; c < 8; c++) sum += e[r] * W[8 * r + c] * e[c];
+    }
+    return sum;
+}
+
+/* The corner noise: without map uncertainty the dof-corrected residual
+ * RMS; with it, the s whose chi-square equals the degrees of freedom
+ * (chi-square falls as s grows, and at the plain RMS it is at most the
+ * dof, so the root lies below it); never below the floor. */
+static double corner_sigma(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, const bool *use, int m,
+                           bool any_cov) {
+    double dof = 8.0 * m - 6, sse = 0, e[8], J[8][6], B[8][6];
+    for (int i = 0; i < n; i++) {
+        if (!use[i] || !tag_jac(cam, x, &obs[i], e, J, B)) continue;
+        for (int r = 0; r < 8; r++) sse += e[r] * e[r];
+    }
+    double s0 = sqrt(sse / dof), lo = MR_POSE_MIN_CORNER_SIGMA_PX;
+    if (!(s0 > lo)) return lo;
+    if (!any_cov) return s0;
+    if (chi2(cam, x, obs, n, use, lo) <= dof) return lo;
+    double hi = s0;
+    for (int it = 0; it < 40 && hi / lo > 1 + 1e-6; it++) {
+        double mid = sqrt(lo * hi);
+        if (chi2(cam, x, obs, n, use, mid) > dof)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return hi;
+}
+
+/* The normal matrix N = sum J^T W J (and, with g, the gradient J^T W e) of
+ * the weighted problem; with Mmap, the map part's sum K C K^T, K = J^T W B. */
+static bool normal(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, const bool *use, double s,
+                   double N[36], double g[6], double Mmap[36]) {
+    memset(N, 0, 36 * sizeof *N);
+    if (g) memset(g, 0, 6 * sizeof *g);
+    if (Mmap) memset(Mmap, 0, 36 * sizeof *Mmap);
+    double e[8], J[8][6], B[8][6], W[64];
+    for (int i = 0; i < n; i++) {
+        if (!use[i]) continue;
+        if (!tag_jac(cam, x, &obs[i], e, J, B) || !tag_weight(&obs[i], B, s * s, W)) return false;
+        double WJ[8][6];
+        for (int r = 0; r < 8; r++)
+            for (int a = 0; a < 6; a++) {
+                double v = 0;
+                for (int c = 0; c < 8; c++) v += W[8 * r + c] * J[c][a];
+                WJ[r][a] = v;
+            }
+        for (int a = 0; a < 6; a++) {
+            for (int b = 0; b < 6; b++)
+                for (int r = 0; r < 8; r++) N[6 * a + b] += J[r][a] * WJ[r][b];
+            if (g)
+                for (int r = 0; r < 8; r++) g[a] += WJ[r][a] * e[r];
+        }
+        if (Mmap && obs[i].has_cov) {
+            double K[6][6] = {{0}}, KC[6][6] = {{0}};
+            for (int a = 0; a < 6; a++)
+                for (int b = 0; b < 6; b++)
+                    for (int r = 0; r < 8; r++) K[a][b] += WJ[r][a] * B[r][b];
+            for (int a = 0; a < 6; a++)
+                for (int b = 0; b < 6; b++)
+                    for (int c = 0; c < 6; c++) KC[a][b] += K[a][c] * obs[i].C[6 * c + b];
+            for (int a = 0; a < 6; a++)
+                for (int b = 0; b < 6; b++)
+                    for (int c = 0; c < 6; c++) Mmap[6 * a + b] += KC[a][c] * K[b][c];
+        }
+    }
+    return true;
+}
+
+/* Gauss-Newton on the weighted problem from the plain optimum x (a few
+ * steps: the weights change the answer by a fraction of its sigma). Only
+ * with map uncertainty: otherwise the weights are uniform and x is it. */
+static void weighted_refine(const mr_camera *cam, const tag_obs *obs, int n, double outlier_px, rt *x) {
+    bool use[MAX_TAGS], any_cov;
+    int m = inliers(cam, x, obs, n, outlier_px, use, &any_cov);
+    if (!any_cov || m < 1) return;
+    for (int round = 0; round < 2; round++) {
+        double s = corner_sigma(cam, x, obs, n, use, m, any_cov);
+        for (int it = 0; it < 5; it++) {
+            double N[36], g[6];
+            if (!normal(cam, x, obs, n, use, s, N, g, NULL) || !invert_n(N, 6)) return;
+            double d[6] = {0};
+            for (int a = 0; a < 6; a++)
+                for (int b = 0; b < 6; b++) d[a] -= N[6 * a + b] * g[b];
+            double Rw[9];
+            mr_rotvec_to_mat(d, Rw);
+            rt y;
+            for (int r = 0; r < 3; r++) {
+                for (int c = 0; c < 3; c++)
+                    y.R[3 * r + c] = Rw[3 * r] * x->R[c] + Rw[3 * r + 1] * x->R[3 + c] + Rw[3 * r + 2] * x->R[6 + c];
+                y.t[r] = Rw[3 * r] * x->t[0] + Rw[3 * r + 1] * x->t[1] + Rw[3 * r + 2] * x->t[2] + d[3 + r];
+            }
+            bool fin = true;
+            for (int k = 0; k < 9; k++) fin = fin && isfinite(y.R[k]);
+            if (!fin) return;
+            *x = y;
+            double step = 0;
+            for (int a = 0; a < 6; a++) step += d[a] * d[a];
+            if (step < 1e-24) break;
+        }
+    }
+}
+
+/* Covariance of the solved pose: the weighted problem's N^-1 over the
+ * inlier tags (each tag weighed by its corner noise and its map
+ * covariance), with the corner noise estimated from the residuals; and the
+ * map's part of it, N^-1 (sum K C K^T) N^-1. */
+static void covariance(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, double outlier_px, mr_pose *out) {
+    bool use[MAX_TAGS], any_cov;
+    int m = inliers(cam, x, obs, n, outlier_px, use, &any_cov);
+    if (8 * m <= 6) return;
+    double s = corner_sigma(cam, x, obs, n, use, m, any_cov);
+    double N[36], Mmap[36];
+    if (!normal(cam, x, obs, n, use, s, N, NULL, Mmap) || !invert_n(N, 6)) return;
     out->corner_sigma_px = s;
-    for (int i = 0; i < 36; i++) out->cov[i] = s * s * JtJ[i];
+    memcpy(out->cov, N, sizeof out->cov);
+    if (!any_cov) return;
+    double T[36] = {0};
+    for (int a = 0; a < 6; a++)
+        for (int b = 0; b < 6; b++)
+            for (int c = 0; c < 6; c++) T[6 * a + b] += N[6 * a + c] * Mmap[6 * c + b];
+    for (int a = 0; a < 6; a++)
+        for (int b = 0; b < 6; b++) {
+            double v = 0;
+            for (int c = 0; c < 6; c++) v += T[6 * a + c] * N[6 * c + b];
+            out->cov_map[6 * a + b] = v;
+        }
 }
 
 bool mr_pose_point_sigma(const mr_pose *pose, mr_dvec3 world_point, double *sigma_3d, double *sigma_lateral) {

@@ -120,11 +120,13 @@ bool mr_triangulate(const mr_camera *cam, const mr_tap *taps, int n, const mr_tr
             if (!project(cam, &taps[i], P, uv, JX, JP))
                 return mr_fail(err, MR_ERR_INVALID, "triangulate: the point is behind the camera of tap %d", i + 1);
             double S[4] = {sig * sig, 0, 0, sig * sig};
-            if (taps[i].pose_cov)
+            const double *pc = taps[i].pose_cov, *pm = taps[i].pose_cov_map;
+            if (pc)
                 for (int r = 0; r < 2; r++)
                     for (int c = 0; c < 2; c++)
                         for (int a = 0; a < 6; a++)
-                            for (int e = 0; e < 6; e++) S[2 * r + c] += JP[r][a] * taps[i].pose_cov[6 * a + e] * JP[c][e];
+                            for (int e = 0; e < 6; e++)
+                                S[2 * r + c] += JP[r][a] * (pc[6 * a + e] - (pm ? pm[6 * a + e] : 0)) * JP[c][e];
             double det = S[0] * S[3] - S[1] * S[2];
             double W[4] = {S[3] / det, -S[1] / det, -S[2] / det, S[0] / det};
             double res[2] = {uv[0] - taps[i].px[0], uv[1] - taps[i].px[1]};
@@ -142,6 +144,26 @@ bool mr_triangulate(const mr_camera *cam, const mr_tap *taps, int n, const mr_tr
         if (sqrt(step[0] * step[0] + step[1] * step[1] + step[2] * step[2]) < 1e-12 * (1 + mr_v3_len(P))) break;
     }
     if (!inv3(H, out->cov)) return mr_fail(err, MR_ERR_INVALID, "triangulate: degenerate geometry");
+    /* The map's part: every ray moved by the same world displacement d
+     * moves the point by d, so its covariance is that of d, taken as the
+     * mean over the taps of their map part carried to the point (camera
+     * frame A = [-[q]x | I], then to the world by R^T). */
+    for (int i = 0; i < n; i++) {
+        const double *pm = taps[i].pose_cov_map;
+        if (!pm || !taps[i].pose_cov) continue;
+        mr_dmat4 cfw = mr_m4_invert_rigid(&taps[i].world_from_camera);
+        mr_dvec3 q = mr_m4_point(&cfw, P);
+        double Aq[3][6] = {{0, q.z, -q.y, 1, 0, 0}, {-q.z, 0, q.x, 0, 1, 0}, {q.y, -q.x, 0, 0, 0, 1}}, M[3][6];
+        for (int r = 0; r < 3; r++) /* world rows: R^T A */
+            for (int a = 0; a < 6; a++) M[r][a] = cfw.m[r] * Aq[0][a] + cfw.m[4 + r] * Aq[1][a] + cfw.m[8 + r] * Aq[2][a];
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++) {
+                double v = 0;
+                for (int a = 0; a < 6; a++)
+                    for (int e = 0; e < 6; e++) v += M[r][a] * pm[6 * a + e] * M[c][e];
+                out->cov[3 * r + c] += v / n;
+            }
+    }
     double ss = 0;
     for (int i = 0; i < n; i++) {
         double uv[2], JX[2][3], JP[2][6];

@@ -71,7 +71,7 @@ static void solve(mr_viewer *v, const mr_camera *camera) {
     mr_tap taps[MR_MEASURE_MAX_TAPS];
     for (int i = 0; i < m->taps; i++)
         taps[i] = (mr_tap){v->measure_pose[i], v->measure_has_cov[i] ? v->measure_cov[i] : NULL,
-                           {m->px[i][0], m->px[i][1]}};
+                           {m->px[i][0], m->px[i][1]}, NULL};
     mr_error err = {0};
     if (!mr_triangulate(&cam, taps, m->taps, NULL, &m->tri, &err)) {
         const char *msg = strncmp(err.msg, "triangulate: ", 13) == 0 ? err.msg + 13 : err.msg;
