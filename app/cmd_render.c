@@ -1,5 +1,6 @@
 /* mrcheck render: one headless frame. */
 #include "app.h"
+#include "mr_export.h"
 
 #include <stddef.h>
 #include <string.h>
@@ -8,7 +9,9 @@ int cmd_render(int argc, char **argv) {
     static const char *cmd = "render";
     mr_cli_opt opts[] = {
         {"scene", "FILE", "glTF/GLB file or scene config JSON (required)", NULL},
-        {"view", "VIEW.json", "camera + world_from_camera (required)", NULL},
+        {"view", "VIEW.json", "camera + world_from_camera (required without --bcf)", NULL},
+        {"bcf", "FILE", "render a BCF topic's viewpoint (camera, visibility, colours, clipping) instead of --view", NULL},
+        {"topic", "N|GUID", "the topic of --bcf (its number in `bcf list`, or its GUID)", NULL},
         {"out", "OUT.png", "output image (required)", NULL},
         {"size", "WxH", "output size (default: the camera's)", NULL},
         {"video", "IMG", "camera frame to overlay (raw, distorted)", NULL},
@@ -31,7 +34,7 @@ int cmd_render(int argc, char **argv) {
                              APP_SHADOW_TABLE(&fp.shadow), APP_RIG_TABLE(&rp), APP_DRAW_TABLE(&dp)};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 7, NULL, 0, NULL,
-                   "usage: mrcheck render --scene FILE --view VIEW.json --out OUT.png [--size WxH] "
+                   "usage: mrcheck render --scene FILE (--view VIEW.json | --bcf FILE --topic N) --out OUT.png [--size WxH] "
                    "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive] "
                    "[--shadows off|hard|pcf|pcss|bp|groundtruth ...] "
                    "[--views N --view-cone DEG [--focal-distance D] [--quilt SPEC]: --out is then a folder]",
@@ -40,7 +43,9 @@ int cmd_render(int argc, char **argv) {
     if (help) return 0;
     mr_cli_log_level(opts);
     const char *scene_path = mr_cli_get(opts, "scene"), *view_path = mr_cli_get(opts, "view"), *out = mr_cli_get(opts, "out");
-    if (!scene_path || !view_path || !out) return mr_cli_errorf(cmd, "--scene, --view and --out are required"), 2;
+    const char *bcf = mr_cli_get(opts, "bcf");
+    if (!scene_path || !out || !(view_path || bcf) || (bcf && (view_path || !mr_cli_get(opts, "topic"))))
+        return mr_cli_errorf(cmd, "--scene, --out and --view (or --bcf with --topic) are required"), 2;
 
     if (mr_cli_get(opts, "size") && !mr_cli_size("size", mr_cli_get(opts, "size"), &fp.width, &fp.height)) return 2;
     mr_error err = {0};
@@ -78,7 +83,7 @@ int cmd_render(int argc, char **argv) {
     /* Everything that can be checked without a GPU is checked first, so a
      * bad input never costs a context. */
     mr_view view;
-    if (!mr_view_load(view_path, &view, &err)) return mr_cli_error(cmd, &err);
+    if (!bcf && !mr_view_load(view_path, &view, &err)) return mr_cli_error(cmd, &err);
     mr_image video = {0};
     if (mr_cli_get(opts, "video")) {
         if (!mr_image_load(mr_cli_get(opts, "video"), 3, &video, &err)) return mr_cli_error(cmd, &err);
@@ -89,7 +94,9 @@ int cmd_render(int argc, char **argv) {
     sp.hidden_globs = globs;
     sp.hidden_glob_count = globs[0] ? 1 : 0;
     mr_scene *scene = mr_scene_load_logged(scene_path, &sp, &err);
-    if (!scene) {
+    if (!scene || (bcf && !mr_bcf_render_setup(bcf, mr_cli_get(opts, "topic"), scene,
+                                               &(mr_bcf_view_params){1.0, fp.width, fp.height, false}, &view, &err))) {
+        mr_scene_destroy(&scene);
         mr_image_free(&video);
         return mr_cli_error(cmd, &err);
     }
@@ -101,7 +108,8 @@ int cmd_render(int argc, char **argv) {
     }
     mr_lod *lod = NULL;
     dp.no_lod = !mr_lod_wanted(lod_mode, scene);
-    if (!dp.no_lod && !(lod = mr_lod_load_logged(scene, scene->source, !lod_cache || strcmp(lod_cache, "on") == 0, &err))) {
+    bool use_cache = (!lod_cache || strcmp(lod_cache, "on") == 0) && scene->source[0]; /* none for an edited scene */
+    if (!dp.no_lod && !(lod = mr_lod_load_logged(scene, scene->source, use_cache, &err))) {
         mr_scene_destroy(&scene);
         mr_image_free(&video);
         return mr_cli_error(cmd, &err);
@@ -115,8 +123,7 @@ int cmd_render(int argc, char **argv) {
     } else {
         /* Meshlets cached beside the file too */
         char clu[4096] = "";
-        if ((!lod_cache || strcmp(lod_cache, "on") == 0) && scene->source[0])
-            mr_cluster_cache_path(scene->source, clu, sizeof clu);
+        if (use_cache) mr_cluster_cache_path(scene->source, clu, sizeof clu);
         double t_up = mr_time_now();
         bool set = mr_renderer_set_cluster_cache(gfx.renderer, clu, &err) && mr_renderer_set_draw_params(gfx.renderer, &dp, &err) &&
                    mr_renderer_set_scene_lod(gfx.renderer, scene, lod, &err); /* one upload, levels included */

@@ -228,6 +228,66 @@ bool mr_bcf_read_memory(const void *data, size_t size, mr_bcf *out, mr_error *er
  * prefix); NULL with a message when none matches. */
 mr_bcf_topic *mr_bcf_find_topic(mr_bcf *b, const char *sel, mr_error *err);
 
+/* ------------------------------------------------- a viewpoint rendered
+ * (bcf_view.c) A topic's viewpoint as a view of the scene and as edits of
+ * the scene, so that any renderer draws what the viewpoint shows:
+ * - the camera: perspective with square pixels and the principal point at
+ *   the centre (FieldOfView vertical for 3.0, horizontal for 2.x as
+ *   mrcheck writes it); orthogonal as a pinhole far back along its axis
+ *   (MR_BCF_ORTHO_DISTANCE times the larger of the view's height and the
+ *   scene's depth from the scene's middle depth), ViewToWorldScale metres
+ *   over the image height there, so the scale differs by at most
+ *   1 / (2 MR_BCF_ORTHO_DISTANCE) across the scene;
+ * - visibility: DefaultVisibility with its exceptions; IfcSpace and
+ *   IfcOpeningElement elements hidden unless the hints show them; a hidden
+ *   node draws nothing;
+ * - colouring: the node's meshes copied with the colour (sRGB hex, alpha
+ *   ignored) as a flat material; selection: the colour blended
+ *   MR_BCF_HIGHLIGHT_MIX towards the highlight colour (linear RGB);
+ * - clipping planes: a node wholly on a plane's cut side is hidden, one
+ *   that straddles it is cut on the CPU (its triangles clipped in world
+ *   space, in double).
+ * Components match a node by IfcGuid (its element's GlobalId) or by
+ * AuthoringToolId (its name or an ancestor's). */
+typedef struct mr_bcf_view_params {
+    double unit_m;            /* metres per scene unit; 0 = 1 (glTF, IFC) */
+    int width, height;        /* output px; 0 = MR_BCF_VIEW_DEFAULT_WIDTH wide,
+                                 the other side from AspectRatio (else 4:3) */
+    bool fov_vertical;        /* FieldOfView is vertical (3.0); mr_bcf_topic_view sets it */
+} mr_bcf_view_params;
+#define MR_BCF_VIEW_DEFAULT_WIDTH 800
+#define MR_BCF_VIEW_DEFAULTS {.unit_m = 1.0}
+#define MR_BCF_ORTHO_DISTANCE 200.0
+#define MR_BCF_HIGHLIGHT_R 0.05f
+#define MR_BCF_HIGHLIGHT_G 0.45f
+#define MR_BCF_HIGHLIGHT_B 1.0f
+#define MR_BCF_HIGHLIGHT_MIX 0.6f
+
+typedef struct mr_bcf_view_info {
+    int viewpoint;            /* index of the viewpoint used in the topic */
+    int hidden_nodes;         /* drawing nodes left out (hidden or clipped away) */
+    int coloured_nodes, selected_nodes, clipped_nodes;
+    int unresolved;           /* component references that name nothing in the scene */
+    int bad_planes;           /* clipping planes without a usable normal, ignored */
+} mr_bcf_view_info;
+
+/* The view of vp's camera (s: the scene, for an orthogonal camera's depth;
+ * may be NULL). Fails with one line for a viewpoint without a camera or
+ * with an unusable one. */
+bool mr_bcf_viewpoint_view(const mr_bcf_viewpoint *vp, const mr_scene *s, const mr_bcf_view_params *p, mr_view *out,
+                           mr_error *err);
+/* Writes vp's visibility, colouring, selection and clipping into s (see
+ * above); s->source is cleared, since s is no longer its file's scene (no
+ * cache beside the file is used for it). info may be NULL. */
+bool mr_bcf_viewpoint_apply(mr_scene *s, const mr_bcf_viewpoint *vp, const mr_bcf_view_params *p,
+                            mr_bcf_view_info *info, mr_error *err);
+/* Both for topic t of b: its first viewpoint with a camera. */
+bool mr_bcf_topic_view(mr_scene *s, const mr_bcf *b, const mr_bcf_topic *t, const mr_bcf_view_params *p, mr_view *view,
+                       mr_bcf_view_info *info, mr_error *err);
+/* `render --bcf FILE --topic SEL`: reads the BCF (its warnings logged),
+ * finds the topic and does mr_bcf_topic_view, logging what it changed. */
+bool mr_bcf_render_setup(const char *bcf_path, const char *topic, mr_scene *s, const mr_bcf_view_params *p,
+                         mr_view *view, mr_error *err);
 /* One line per topic on out: number, GUID, status, title, viewpoints (and
  * how many have a camera), comments, distinct components, and with a
  * scene how many of those it has (by IfcGuid, else by node name). */
