@@ -207,8 +207,51 @@ static void test_json(void) {
     CHECK(strstr(err.msg, "covariance") != NULL);
 }
 
+/* A lone tag 3.5 m away, 12 degrees off its normal, solved without a
+ * previous pose: now and then noise makes the mirror pose fit better and
+ * it is kept. Its covariance must say so (the rival's likelihood times
+ * the step to it): over the draws, the RMS of a point's error over its
+ * predicted sigma stays near 1 (the branch's own covariance alone: the
+ * flipped draws are tens of sigmas off). */
+static double lone_tag_z(int draws, int *flips) {
+    mr_marker tag = {.id = 7, .world_from_tag = mr_m4_identity()};
+    mr_marker_map map = {.family = "tag36h11", .tag_size = 0.3, .tags = &tag, .count = 1};
+    mr_camera cam = mr_demo_camera();
+    mr_rng rng;
+    mr_rng_seed(&rng, 17);
+    mr_pose_params pp = MR_POSE_DEFAULTS;
+    pp.corner_sigma_px = 0.3;
+    double zz = 0;
+    int n = 0;
+    *flips = 0;
+    for (int d = 0; d < draws; d++) {
+        double th = 12 * M_PI / 180, phi = 2 * M_PI * d / draws;
+        mr_dvec3 eye = mr_v3(3.5 * sin(th) * cos(phi), 3.5 * sin(th) * sin(phi), -3.5 * cos(th));
+        mr_dmat4 wfc = mr_m4_look_at_cv(eye, mr_v3(0, 0, 0), mr_v3(0, -1, 0));
+        mr_detection det;
+        if (see(&cam, &map, &wfc, 0.3, &rng, &det) != 1) continue;
+        mr_pose pose;
+        mr_error err = {0};
+        if (!mr_pose_solve(&cam, &map, &det, 1, NULL, &pp, &pose, &err) || !pose.valid) continue;
+        mr_dvec3 point = mr_v3(0.5, 0.3, 1.0); /* behind the tag's wall, in view */
+        double s3;
+        if (!mr_pose_point_sigma(&pose, point, &s3, NULL)) continue;
+        mr_dmat4 a = mr_m4_invert_rigid(&pose.world_from_camera), b = mr_m4_invert_rigid(&wfc);
+        mr_dvec3 e = mr_v3_sub(mr_m4_point(&a, point), mr_m4_point(&b, point));
+        *flips += mr_pose_angle_deg(&pose.world_from_camera, &wfc) > 8;
+        zz += mr_v3_dot(e, e) / (s3 * s3);
+        n++;
+    }
+    return sqrt(zz / n);
+}
+
 int main(void) {
     test_json();
+    int flips;
+    double lz = lone_tag_z(300, &flips);
+    printf("lone tag, 300 draws: %d flipped, RMS of error / sigma %.3f\n", flips, lz);
+    CHECK(flips > 0);
+    CHECK_MSG(lz > 0.6 && lz < 1.6, "lone tag: RMS of error / sigma %.3f", lz);
     enum { DRAWS = 300 };
     stats w = pose_run(true, false, DRAWS), x = pose_run(false, false, DRAWS);
     printf("pose, map noise, %d draws: observed %.2f mm, predicted %.2f mm (map part %.2f), ratio %.3f; "

@@ -253,7 +253,11 @@ static void measure_point(const hall_t *h, const built_map *bm, const row_t *r, 
             mr_detection det[MAX_HALL_TAGS];
             int nd = see_tags(h, &cam, &wfc, track_noise, rng, det);
             mr_error e = {0};
-            if (!mr_pose_solve(&cam, &bm->markers, det, nd, NULL, NULL, &poses[m], &e) || !poses[m].valid) break;
+            /* Each place is solved alone; a tracker knows the corner
+             * noise from its multi-tag frames (mr_tracker learns it). */
+            mr_pose_params pp = MR_POSE_DEFAULTS;
+            pp.corner_sigma_px = track_noise;
+            if (!mr_pose_solve(&cam, &bm->markers, det, nd, NULL, &pp, &poses[m], &e) || !poses[m].valid) break;
             double u, v;
             if (!mr_project_point(&cam, &wfc, p, &u, &v)) break;
             taps[m] = (mr_tap){poses[m].world_from_camera, poses[m].cov,

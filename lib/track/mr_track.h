@@ -294,8 +294,15 @@ typedef struct mr_pose_params {
                                 nearest the previous pose wins), default 2.5 */
     double ambiguity_px;     /* ... or within this many px of it, default 0.1 */
     double min_tag_px;       /* tags with a shorter edge are ignored, default 8 px */
+    double corner_sigma_px;  /* the detector's corner noise where known, px:
+                                pooled with the residuals' estimate as
+                                MR_POSE_PRIOR_DOF more degrees of freedom, so
+                                that a lone tag (2 of its own) cannot claim a
+                                noise it has no way to know; 0 = none (the
+                                tracker learns it from its multi-tag frames) */
 } mr_pose_params;
-#define MR_POSE_DEFAULTS {0.0, 0.0, 0.0, 0.0, 0.0}
+#define MR_POSE_DEFAULTS {.outlier_px = 0.0, .max_rms_px = 0.0, .ambiguity_ratio = 0.0, .ambiguity_px = 0.0, .min_tag_px = 0.0, .corner_sigma_px = 0.0}
+#define MR_POSE_PRIOR_DOF 8
 
 #define MR_POSE_MAX_IDS 32
 

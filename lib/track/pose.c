@@ -166,8 +166,31 @@ static bool refine(const tag_obs *obs, const bool *use, int n, rt *x) {
     return m >= 4 && mr_cv_refine_lm(o, p, m, x->R, x->t);
 }
 
-static void covariance(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, double outlier_px, mr_pose *out);
-static void weighted_refine(const mr_camera *cam, const tag_obs *obs, int n, double outlier_px, rt *x);
+static void covariance(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, double outlier_px, double prior,
+                       mr_pose *out);
+
+/* A lone tag's two mirror poses: the one kept is wrong with the
+ * likelihood p of the other (its corner residuals' chi-square against the
+ * kept one's), so the kept pose's mean squared error is its covariance
+ * plus p d d^T, d the step from it to the other (mr_pose.cov's
+ * perturbation). Without it the covariance is that of one branch alone,
+ * and a flipped pose claims millimetres it is metres off. */
+static void mirror_spread(const rt *x, const cand *other, double sse_kept, mr_pose *out) {
+    double s2 = out->corner_sigma_px * out->corner_sigma_px;
+    double dchi = 4 * (other->sse - sse_kept) / s2; /* sse: squared per-tag RMS, 4 corners each */
+    double p = dchi > 80 ? 0 : 1 / (1 + exp(0.5 * dchi));
+    double Rd[9], d[6];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            Rd[3 * r + c] = other->x.R[3 * r] * x->R[3 * c] + other->x.R[3 * r + 1] * x->R[3 * c + 1] +
+                            other->x.R[3 * r + 2] * x->R[3 * c + 2];
+    mr_mat_to_rotvec(Rd, d);
+    for (int r = 0; r < 3; r++)
+        d[3 + r] = other->x.t[r] - (Rd[3 * r] * x->t[0] + Rd[3 * r + 1] * x->t[1] + Rd[3 * r + 2] * x->t[2]);
+    for (int a = 0; a < 6; a++)
+        for (int b = 0; b < 6; b++) out->cov[6 * a + b] += p * d[a] * d[b];
+}
+static void weighted_refine(const mr_camera *cam, const tag_obs *obs, int n, double outlier_px, double prior, rt *x);
 
 bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_detection *dets, int count,
                    const mr_pose *prev, const mr_pose_params *params, mr_pose *out, mr_error *err) {
@@ -297,6 +320,19 @@ bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_dete
             }
         }
     }
+    /* The picked pose's strongest rival: the best fitting plausible
+     * candidate turned 2 degrees or more from it. */
+    int alt = -1;
+    if (out->ambiguous) {
+        mr_dmat4 pm = rt_to_m4(&cands[pick].x);
+        for (int c = 0; c < nc; c++) {
+            if (c == pick || cands[c].inliers != cands[best].inliers ||
+                cands[c].rms > fmax(amb_ratio * cands[best].rms, cands[best].rms + amb_px))
+                continue;
+            mr_dmat4 cm = rt_to_m4(&cands[c].x);
+            if (mr_pose_angle_deg(&cm, &pm) >= 2.0 && (alt < 0 || cands[c].sse < cands[alt].sse)) alt = c;
+        }
+    }
     /* Refine over the inlier tags; drop tags that still do not fit and
      * refine once more. */
     rt x = cands[pick].x;
@@ -314,7 +350,7 @@ bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_dete
     }
     /* With map uncertainty the least-squares optimum above weighs a badly
      * mapped tag like a good one: refine again under each tag's weight. */
-    if (!lone) weighted_refine(cam, obs, n, outlier_px, &x);
+    if (!lone) weighted_refine(cam, obs, n, outlier_px, p.corner_sigma_px, &x);
     double sse = 0;
     int used = 0;
     for (int i = 0; i < n; i++) {
@@ -330,7 +366,8 @@ bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_dete
     mr_dmat4 cfw = rt_to_m4(&x);
     out->world_from_camera = mr_m4_invert_rigid(&cfw);
     out->valid = out->rms_px <= max_rms && mr_m4_is_finite(&out->world_from_camera);
-    if (out->valid) covariance(cam, &x, obs, n, outlier_px, out);
+    if (out->valid) covariance(cam, &x, obs, n, outlier_px, p.corner_sigma_px, out);
+    if (out->valid && lone && alt >= 0 && out->corner_sigma_px > 0) mirror_spread(&x, &cands[alt], cands[pick].sse, out);
     return true;
 }
 
@@ -459,8 +496,20 @@ static double chi2(const mr_camera *cam, const rt *x, const tag_obs *obs, int n,
  * RMS; with it, the s whose chi-square equals the degrees of freedom
  * (chi-square falls as s grows, and at the plain RMS it is at most the
  * dof, so the root lies below it); never below the floor. */
+static double corner_sigma_fit(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, const bool *use, int m,
+                               bool any_cov);
+/* ... pooled with the known noise `prior` (0: none) as MR_POSE_PRIOR_DOF
+ * more degrees of freedom. */
 static double corner_sigma(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, const bool *use, int m,
-                           bool any_cov) {
+                           bool any_cov, double prior) {
+    double s = corner_sigma_fit(cam, x, obs, n, use, m, any_cov), dof = 8.0 * m - 6;
+    if (!(prior > 0)) return s;
+    return fmax(sqrt((dof * s * s + MR_POSE_PRIOR_DOF * prior * prior) / (dof + MR_POSE_PRIOR_DOF)),
+                MR_POSE_MIN_CORNER_SIGMA_PX);
+}
+
+static double corner_sigma_fit(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, const bool *use, int m,
+                               bool any_cov) {
     double dof = 8.0 * m - 6, sse = 0, e[8], J[8][6], B[8][6];
     for (int i = 0; i < n; i++) {
         if (!use[i] || !tag_jac(cam, x, &obs[i], e, J, B)) continue;
@@ -524,12 +573,12 @@ static bool normal(const mr_camera *cam, const rt *x, const tag_obs *obs, int n,
 /* Gauss-Newton on the weighted problem from the plain optimum x (a few
  * steps: the weights change the answer by a fraction of its sigma). Only
  * with map uncertainty: otherwise the weights are uniform and x is it. */
-static void weighted_refine(const mr_camera *cam, const tag_obs *obs, int n, double outlier_px, rt *x) {
+static void weighted_refine(const mr_camera *cam, const tag_obs *obs, int n, double outlier_px, double prior, rt *x) {
     bool use[MAX_TAGS], any_cov;
     int m = inliers(cam, x, obs, n, outlier_px, use, &any_cov);
     if (!any_cov || m < 1) return;
     for (int round = 0; round < 2; round++) {
-        double s = corner_sigma(cam, x, obs, n, use, m, any_cov);
+        double s = corner_sigma(cam, x, obs, n, use, m, any_cov, prior);
         for (int it = 0; it < 5; it++) {
             double N[36], g[6];
             if (!normal(cam, x, obs, n, use, s, N, g, NULL) || !invert_n(N, 6)) return;
@@ -559,11 +608,12 @@ static void weighted_refine(const mr_camera *cam, const tag_obs *obs, int n, dou
  * inlier tags (each tag weighed by its corner noise and its map
  * covariance), with the corner noise estimated from the residuals; and the
  * map's part of it, N^-1 (sum K C K^T) N^-1. */
-static void covariance(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, double outlier_px, mr_pose *out) {
+static void covariance(const mr_camera *cam, const rt *x, const tag_obs *obs, int n, double outlier_px, double prior,
+                       mr_pose *out) {
     bool use[MAX_TAGS], any_cov;
     int m = inliers(cam, x, obs, n, outlier_px, use, &any_cov);
     if (8 * m <= 6) return;
-    double s = corner_sigma(cam, x, obs, n, use, m, any_cov);
+    double s = corner_sigma(cam, x, obs, n, use, m, any_cov, prior);
     double N[36], Mmap[36];
     if (!normal(cam, x, obs, n, use, s, N, NULL, Mmap) || !invert_n(N, 6)) return;
     out->corner_sigma_px = s;

@@ -22,6 +22,7 @@ struct mr_tracker {
     double next_dec;            /* picked from the last frame's tags; 0 = conservative */
     int since_probe;            /* frames since the last conservative one */
     int last_n;                 /* tags the last frame found */
+    double corner_var;          /* learnt corner noise^2 (px^2), 0 = none yet */
 };
 
 static bool copy_markers(const mr_marker_map *src, mr_marker_map *dst, mr_error *err) {
@@ -194,7 +195,15 @@ bool mr_tracker_detections(mr_tracker *t, const mr_detection *dets, int count, i
     double age = timestamp - t->prev_t;
     const mr_pose *prev = t->prev.valid && age >= 0 && age < t->prev_max_age_s ? &t->prev : NULL;
     out->prev_used = prev != NULL;
-    if (!mr_pose_solve(&cam, &t->markers, dets, count, prev, &t->pose_params, &out->pose, err)) return false;
+    /* The corner noise as the frames with 3 or more tags (18 degrees of
+     * freedom and up) tell it, for the frames with fewer. */
+    mr_pose_params pp = t->pose_params;
+    if (!(pp.corner_sigma_px > 0) && t->corner_var > 0) pp.corner_sigma_px = sqrt(t->corner_var);
+    if (!mr_pose_solve(&cam, &t->markers, dets, count, prev, &pp, &out->pose, err)) return false;
+    if (out->pose.valid && out->pose.tags_used >= 3 && out->pose.corner_sigma_px > 0) {
+        double v = out->pose.corner_sigma_px * out->pose.corner_sigma_px;
+        t->corner_var = t->corner_var > 0 ? 0.9 * t->corner_var + 0.1 * v : v;
+    }
     if (out->pose.valid) {
         t->prev = out->pose;
         t->prev_t = timestamp;
