@@ -34,7 +34,8 @@ int bench_ao(int argc, char **argv);
  * which decides whether levels are built or read at all. */
 #define APP_DRAW_TABLE(p) {.prefix = "", .table = mr_draw_opts, .params = (p), .research = true}
 #define APP_DRAW_OPTS                                                                                          \
-    {"lod", "auto|on|off", "simplified levels within the tolerance, cached next to the scene (default auto: on for scenes over 500k triangles)", NULL}
+    {"lod", "auto|on|off", "simplified levels within the tolerance, cached next to the scene (default auto: on for scenes over 500k triangles)", NULL}, \
+    {"hlod", "auto|on|off", "levels above the part: merged proxies of groups of parts, cut by --lod-pixels, cached in <scene>.mrhlod (default auto: scenes of 1M triangles in 16 parts)", NULL}
 
 /* mrcheck study {stimuli,plan,run,analyze} (cmd_study.c). */
 int cmd_study(int argc, char **argv);

@@ -54,6 +54,7 @@ int cmd_render(int argc, char **argv) {
     const char *lod_cache = mr_cli_get(opts, "lod-cache");
     if (lod_cache && strcmp(lod_cache, "on") != 0 && strcmp(lod_cache, "off") != 0)
         return mr_cli_errorf(cmd, "--lod-cache must be 'on' or 'off'"), 2;
+    if (!mr_hlod_mode_check(mr_cli_get(opts, "hlod"), &err)) return mr_cli_error(cmd, &err), 2;
     const char *aux = mr_cli_get(opts, "aux");
     fp.want_depth = fp.want_normals = aux != NULL;
     bool groundtruth = false;
@@ -107,9 +108,12 @@ int cmd_render(int argc, char **argv) {
         return 2;
     }
     mr_lod *lod = NULL;
+    mr_hlod *hlod = NULL; /* levels above the part where the scene wants them (--hlod) */
+    const bool use_cache = (!lod_cache || strcmp(lod_cache, "on") == 0) && scene->source[0]; /* none for an edited scene */
     dp.no_lod = !mr_lod_wanted(lod_mode, scene);
-    bool use_cache = (!lod_cache || strcmp(lod_cache, "on") == 0) && scene->source[0]; /* none for an edited scene */
-    if (!dp.no_lod && !(lod = mr_lod_load_logged(scene, scene->source, use_cache, &err))) {
+    if (!dp.no_lod && (!(lod = mr_lod_load_logged(scene, scene->source, use_cache, &err)) ||
+                       !mr_hlod_load_logged(scene, lod, scene->source, mr_cli_get(opts, "hlod"), use_cache, &hlod, &err))) {
+        mr_lod_destroy(&lod);
         mr_scene_destroy(&scene);
         mr_image_free(&video);
         return mr_cli_error(cmd, &err);
@@ -126,7 +130,8 @@ int cmd_render(int argc, char **argv) {
         if (use_cache) mr_cluster_cache_path(scene->source, clu, sizeof clu);
         double t_up = mr_time_now();
         bool set = mr_renderer_set_cluster_cache(gfx.renderer, clu, &err) && mr_renderer_set_draw_params(gfx.renderer, &dp, &err) &&
-                   mr_renderer_set_scene_lod(gfx.renderer, scene, lod, &err); /* one upload, levels included */
+                   mr_renderer_set_scene_lod(gfx.renderer, scene, lod, &err) && /* one upload, levels included */
+                   mr_renderer_set_hlod(gfx.renderer, hlod, &err);
         double t_upload = mr_time_now() - t_up;
         if (!set) {
             rc = mr_cli_error(cmd, &err);
@@ -154,6 +159,7 @@ int cmd_render(int argc, char **argv) {
         mr_frame_result_free(&res);
         mr_gfx_close(&gfx);
     }
+    mr_hlod_destroy(&hlod);
     mr_lod_destroy(&lod);
     mr_scene_destroy(&scene);
     mr_image_free(&video);

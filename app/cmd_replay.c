@@ -38,7 +38,8 @@ int cmd_replay(int argc, char **argv) {
     mr_cli_log_level(opts);
     mr_lod_mode lod_mode; /* --lod: whether levels are drawn */
     mr_error lerr = {0};
-    if (!mr_lod_mode_parse(mr_cli_get(opts, "lod"), &lod_mode, &lerr)) return mr_cli_error(cmd, &lerr), 2;
+    if (!mr_lod_mode_parse(mr_cli_get(opts, "lod"), &lod_mode, &lerr) || !mr_hlod_mode_check(mr_cli_get(opts, "hlod"), &lerr))
+        return mr_cli_error(cmd, &lerr), 2;
     if (npos != 1 || !mr_cli_get(opts, "scene") || !mr_cli_get(opts, "out"))
         return mr_cli_errorf(cmd, "needs a recording folder, --scene and --out (see --help)"), 2;
     bool groundtruth = false;
@@ -89,15 +90,20 @@ int cmd_replay(int argc, char **argv) {
      * from the cache next to the scene; where they cannot be had, the
      * frames are drawn in full detail. */
     mr_lod *lod = NULL;
+    mr_hlod *hlod = NULL;
     if (scene && mr_lod_wanted(lod_mode, scene)) {
         lod = mr_lod_load_logged(scene, scene->source, scene->source[0] != 0, &lerr);
         if (!lod) mr_log(MR_LOG_WARN, "%s: full detail (no levels of detail: %s)", cmd, lerr.msg);
+        else if (!mr_hlod_load_logged(scene, lod, scene->source, mr_cli_get(opts, "hlod"), scene->source[0] != 0, &hlod, &lerr))
+            mr_log(MR_LOG_WARN, "%s: no levels above the part: %s", cmd, lerr.msg);
     }
     p.lod = lod;
+    p.hlod = hlod;
     mr_gfx gfx = {0};
     mr_batch_replay_stats st;
     bool ok = scene && mr_gfx_open(&gfx, &err) && mr_batch_replay(&p, gfx.renderer, scene, &st, &err);
     mr_gfx_close(&gfx);
+    mr_hlod_destroy(&hlod);
     mr_lod_destroy(&lod);
     mr_scene_destroy(&scene);
     mr_recording_close(&rec);

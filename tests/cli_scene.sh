@@ -53,6 +53,28 @@ rl "$tmp/lod2.png" --verbose 2>"$tmp/lod2.err" && grep -q "read from the cache" 
 printf 'x' >>"$tmp/tri.gltf.mrlod"
 rl "$tmp/lod3.png" 2>"$tmp/lod3.err" && grep -q "ignored" "$tmp/lod3.err" && cmp -s "$tmp/lod1.png" "$tmp/lod3.png" \
   && ok || bad "damaged LOD cache: $(cat "$tmp/lod3.err")"
+# The levels above the part: --hlod auto leaves them out for the factory
+# (under 1M triangles: nothing read or built), --hlod on builds and caches
+# them in <scene>.mrhlod and draws proxies, the cache is reused for the same
+# image, a damaged one is ignored and rebuilt, --hlod off draws none.
+v2=$tmp/views/view_overview.json
+rh() { "$mr" render --scene "$tmp/plant/s.glb" --view "$v2" --size 120x90 --lod on --verbose "$@"; }
+rh --out "$tmp/h0.png" 2>"$tmp/h0.err" && ! grep -q "hierarchy" "$tmp/h0.err" && [ ! -e "$tmp/plant/s.glb.mrhlod" ] \
+  && ok || bad "--hlod auto loaded a hierarchy for a small scene: $(cat "$tmp/h0.err")"
+rh --out "$tmp/h1.png" --hlod on 2>"$tmp/h1.err" && grep -q "LOD hierarchy: .* built" "$tmp/h1.err" \
+  && grep -q "render: LOD hierarchy: [1-9][0-9]* proxies" "$tmp/h1.err" && [ -s "$tmp/plant/s.glb.mrhlod" ] \
+  && ok || bad "--hlod on built or drew no hierarchy: $(cat "$tmp/h1.err")"
+rh --out "$tmp/h2.png" --hlod on 2>"$tmp/h2.err" && grep -q "LOD hierarchy: .* read from the cache" "$tmp/h2.err" \
+  && cmp -s "$tmp/h1.png" "$tmp/h2.png" && ok || bad "hierarchy cache not reused: $(cat "$tmp/h2.err")"
+head -c 5000 "$tmp/plant/s.glb.mrhlod" >"$tmp/short" && mv "$tmp/short" "$tmp/plant/s.glb.mrhlod"
+rh --out "$tmp/h3.png" --hlod on 2>"$tmp/h3.err" && grep -q "mrhlod: ignored" "$tmp/h3.err" \
+  && grep -q "LOD hierarchy: .* built" "$tmp/h3.err" && cmp -s "$tmp/h1.png" "$tmp/h3.png" \
+  && ok || bad "truncated hierarchy cache: $(cat "$tmp/h3.err")"
+rh --out "$tmp/h4.png" --hlod off 2>"$tmp/h4.err" && ! grep -q "hierarchy" "$tmp/h4.err" \
+  && ok || bad "--hlod off: $(cat "$tmp/h4.err")"
+rh --out "$tmp/h5.png" --hlod maybe 2>"$tmp/h5.err"
+[ $? -eq 2 ] && [ "$(wc -l <"$tmp/h5.err")" -eq 1 ] && grep -q -- "--hlod must be" "$tmp/h5.err" \
+  && ok || bad "bad --hlod: $(cat "$tmp/h5.err")"
 # replay draws levels as render does: --lod on here (the demo hall, which
 # the demo recording sees, is under --lod auto's 500k triangles), through
 # the same cache next to the scene; --lod auto leaves them out for it.

@@ -1,12 +1,15 @@
 /* The LOD hierarchy drawn (lib/render/hlod_draw.c): proxies replace whole
  * groups of parts where their certified error projects under
  * --lod-pixels, yet a tap still names the real part (40 random taps
- * against the frame without the hierarchy), the hidden layer stays
- * hidden, the parts keep their colours, and far from the origin it draws
- * like at it. Skips (77) where no EGL device exists. */
+ * against the frame without the hierarchy: the same part and depth, at
+ * edges too, since a pick redraws its pixel at the part levels), the
+ * hidden layer stays hidden, each part keeps its own colour through the
+ * proxies, and far from the origin it draws like at it. Skips (77) where
+ * no EGL device exists. */
 #include "mr_render.h"
 #include "mr_test.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -21,9 +24,14 @@ static mr_scene *cad(double unit, double ox) {
     cp.origin[0] = ox;
     mr_error err = {0};
     mr_scene *s = mr_synth_cad_build(&cp, &err);
-    /* every third part in the hidden layer */
+    /* every third part in the hidden layer; every mesh a colour of its own */
     for (int32_t i = 0; s && i < s->node_count; i++)
         if (s->nodes[i].mesh_count > 0 && i % 3 == 1) s->nodes[i].layer = MR_LAYER_HIDDEN;
+    for (int32_t i = 0; s && i < s->mesh_count; i++) {
+        mr_material m = {.base_color = {(float)(i % 3 == 0), (float)(i % 3 == 1), (float)((i / 3) % 3) * 0.5f, 1},
+                         .base_color_texture = -1};
+        s->meshes[i].material = mr_scene_add_material(s, &m);
+    }
     CHECK_MSG(s != NULL, "%s", err.msg);
     return s;
 }
@@ -56,12 +64,31 @@ static double mismatch(const mr_image *a, const mr_image *b, int tol) {
     return (double)bad / (double)n;
 }
 
-/* node under (x, y) of the last frame, -1 for none */
-static int32_t pick_node(double x, double y) {
+/* node under (x, y) of the last frame, -1 for none; its depth (0: none) */
+static int32_t pick_depth(double x, double y, double *depth) {
     mr_pick pk;
     mr_error err = {0};
+    *depth = 0;
     if (!mr_renderer_pick(g_r, x, y, &pk, &err)) return -2;
+    *depth = pk.depth;
     return pk.hit ? pk.node : -1;
+}
+
+static int32_t pick_node(double x, double y) {
+    double d;
+    return pick_depth(x, y, &d);
+}
+
+/* largest channel difference of pixel (x, y) */
+static int pixel_diff(const mr_image *a, const mr_image *b, int x, int y) {
+    const unsigned char *pa = a->data, *pb = b->data;
+    size_t o = ((size_t)y * a->width + x) * a->channels;
+    int m = 0;
+    for (int c = 0; c < a->channels; c++) {
+        int d = abs((int)pa[o + c] - (int)pb[o + c]);
+        if (d > m) m = d;
+    }
+    return m;
 }
 
 static void check_case(double unit, double ox) {
@@ -89,9 +116,10 @@ static void check_case(double unit, double ox) {
     mr_draw_stats sw, so;
     memset(&with, 0, sizeof with);
     memset(&without, 0, sizeof without);
-    /* Taps: without first (ids of the 3x3 around each tap: the proxies move edges by under a pixel), then with. */
+    /* Taps: without first (and whether the 3x3 around each tap is one
+     * part: there the colour is compared), then with. */
     enum { TAPS = 40 };
-    double tx[TAPS], ty[TAPS];
+    double tx[TAPS], ty[TAPS], ref_depth[TAPS];
     int32_t ref[TAPS];
     bool interior[TAPS];
     mr_rng rng;
@@ -102,7 +130,7 @@ static void check_case(double unit, double ox) {
         do {
             tx[t] = 2 + mr_rng_uniform(&rng) * 315;
             ty[t] = 2 + mr_rng_uniform(&rng) * 235;
-            ref[t] = pick_node(tx[t], ty[t]);
+            ref[t] = pick_depth(tx[t], ty[t], &ref_depth[t]);
         } while (ref[t] < 0 && ++tries < 20000);
         interior[t] = true;
         for (int dy = -1; dy <= 1; dy++)
@@ -114,16 +142,25 @@ static void check_case(double unit, double ox) {
     CHECK(sw.triangles < so.triangles); /* the proxies are cheaper than the parts */
     int compared = 0, hits = 0;
     for (int t = 0; ok && t < TAPS; t++) {
-        int32_t n = pick_node(tx[t], ty[t]);
+        double d;
+        int32_t n = pick_depth(tx[t], ty[t], &d);
         CHECK(n >= -1 && n < s->node_count);
         if (n >= 0) CHECK(s->nodes[n].mesh_count > 0); /* a real part, never a proxy */
-        if (!interior[t]) continue;
-        compared++;
         hits += ref[t] >= 0;
-        CHECK_MSG(n == ref[t], "unit %g tap (%.1f, %.1f): node %d with the hierarchy, %d without", unit, tx[t], ty[t],
-                  (int)n, (int)ref[t]);
+        /* Every tap, edges included: the part and depth of the frame
+         * without the hierarchy */
+        CHECK_MSG(n == ref[t] && fabs(d - ref_depth[t]) <= 1e-5 * ref_depth[t],
+                  "unit %g tap (%.1f, %.1f): node %d at %.9g with the hierarchy, %d at %.9g without", unit, tx[t], ty[t],
+                  (int)n, d, (int)ref[t], ref_depth[t]);
+        if (!interior[t]) continue;
+        /* The part's own colour through the proxy */
+        int tap_x = (int)floor(tx[t] + 0.5), tap_y = (int)floor(ty[t] + 0.5);
+        compared++;
+        CHECK_MSG(pixel_diff(&with.color, &without.color, tap_x, tap_y) <= 40,
+                  "unit %g tap (%d, %d) on node %d: colour off by %d with the hierarchy", unit, tap_x, tap_y, (int)n,
+                  pixel_diff(&with.color, &without.color, tap_x, tap_y));
     }
-    CHECK_MSG(compared >= 20 && hits >= 20, "only %d taps inside a part's area (%d on parts)", compared, hits);
+    CHECK_MSG(compared >= 20 && hits >= 30, "only %d taps inside a part's area (%d on parts)", compared, hits);
     /* Colours survive: the same picture up to the proxies' sub-pixel error */
     if (ok) CHECK_MSG(mismatch(&with.color, &without.color, 48) < 0.03, "unit %g: %.4f of pixels differ", unit,
                       mismatch(&with.color, &without.color, 48));

@@ -62,6 +62,7 @@ typedef struct mr_batch_replay_params {
     const mr_rig_params *rig;
     const mr_quilt *quilt;      /* with rig */
     const mr_lod *lod;          /* the scene's levels of detail (built for it), or NULL: full detail */
+    const mr_hlod *hlod;        /* levels above the part, built from lod, or NULL: none */
 } mr_batch_replay_params;
 #define MR_BATCH_REPLAY_DEFAULTS                                                                   \
     {.frame = MR_FRAME_DEFAULTS, .every = 1, .from = 0, .to = -1}

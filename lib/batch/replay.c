@@ -119,7 +119,7 @@ bool mr_batch_replay(const mr_batch_replay_params *p, mr_renderer *r, const mr_s
     if (total == 0) return mr_fail(err, MR_ERR_INVALID, "no recorded frame in the selected range");
     mr_outdir od;
     if (!mr_outdir_create(&od, p->out_dir, p->force, err)) return false;
-    bool ok = mr_renderer_set_scene_lod(r, scene, p->lod, err);
+    bool ok = mr_renderer_set_scene_lod(r, scene, p->lod, err) && mr_renderer_set_hlod(r, p->lod ? p->hlod : NULL, err);
     mr_jsonl log = {0};
     mr_video_writer *vw = NULL;
     const double fps = recording_fps(rec, every);

@@ -1056,7 +1056,7 @@ static void submit_nodes(mr_renderer *r, const mr_geo_view *vw, mr_frame_result 
                          int32_t nvis) {
     struct mr_geo *g = r->geo;
     double t0 = mr_time_now();
-    double fmax_t = g->lod && !r->draw.no_lod ? mr_geometry_lod_fmax(&vw->cam) : 0;
+    double fmax_t = !g->lod || r->draw.no_lod ? 0 : vw->lod_fmax > 0 ? vw->lod_fmax : mr_geometry_lod_fmax(&vw->cam);
     size_t nrec = select_recs(r, vw, fmax_t, nodes, nvis, g->sorted);
     r->stats.cull_ms += (mr_time_now() - t0) * 1e3;
     emit_recs(r, vw, out, g->sorted, nrec, 0);

@@ -34,6 +34,9 @@ void mr_render_report(FILE *f, const mr_renderer *r, const mr_frame_result *res,
             "commands, %llu of %llu triangles, culling %.2f ms; peak RSS %.0f MB\n", ds.nodes_visible,
             ds.nodes_drawable, ds.instances, ds.lod_instances, ds.commands, (unsigned long long)ds.triangles,
             (unsigned long long)ds.triangles_full, ds.cull_ms, mr_peak_rss_bytes() / 1048576.0);
+    if (ds.hlod_proxies)
+        fprintf(f, "mrcheck: render: LOD hierarchy: %u proxies, %llu triangles\n", ds.hlod_proxies,
+                (unsigned long long)ds.hlod_triangles);
     if (ds.clusters_tested)
         fprintf(f, "mrcheck: render: clusters: %llu of %llu meshlets drawn (%llu occluded)\n",
                 (unsigned long long)ds.clusters_drawn, (unsigned long long)ds.clusters_tested,

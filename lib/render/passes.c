@@ -17,6 +17,7 @@ struct mr_base_state {
     target gbuf;           /* albedo (sRGB8), normal (RGBA16F), ids (RG32UI), positions (RGBA32F), depth (32F) */
     target shaded;         /* sRGB8: the virtual image */
     target composed;       /* sRGB8: virtual + video */
+    target pick;           /* 1x1: albedo, normal, ids, depth (mr_gbuffer_pick_pixel) */
     GLuint video_tex;
     int video_w, video_h;
 };
@@ -32,6 +33,7 @@ void mr_base_free(mr_renderer *r) {
     struct mr_base_state *b = r->base;
     if (!b) return;
     free_targets(b);
+    mr_gl_target_free(&b->pick);
     glDeleteTextures(1, &b->video_tex);
     glDeleteProgram(b->prog_gbuffer);
     glDeleteProgram(b->prog_shade);
@@ -165,7 +167,10 @@ static void mr_pass_gbuffer(frame *f) {
     if (f->p->display) {
         gbuffer_display(f, &v);
     } else {
+        uint32_t proxies = f->r->stats.hlod_proxies;
         mr_geometry_draw(f->r, &v, f->out);
+        f->r->last.hier = f->r->stats.hlod_proxies > proxies;
+        f->r->last.layers = mask;
     }
     glDisable(GL_DEPTH_TEST);
     frame_put(f, RES_DEPTH, b->gbuf.depth);
@@ -173,6 +178,65 @@ static void mr_pass_gbuffer(frame *f) {
     frame_put(f, RES_NORMAL, b->gbuf.color[MR_OUT_GBUFFER_NORMAL]);
     frame_put(f, RES_IDS, b->gbuf.color[MR_OUT_GBUFFER_IDS]);
     if (want_pos) frame_put(f, RES_POSITIONS, b->gbuf.color[MR_OUT_GBUFFER_POSITIONS]);
+}
+
+bool mr_gbuffer_pick_pixel(mr_renderer *r, int px, int py, float *depth, GLuint ids[2], mr_error *err) {
+    struct mr_base_state *b = r->base;
+    if (!b || !b->prog_gbuffer) return mr_fail(err, MR_ERR_INVALID, "no G-buffer to pick from");
+    static const GLenum gfmt[MR_OUT_GBUFFER_POSITIONS] = {GL_SRGB8_ALPHA8, GL_RGBA16F, GL_RG32UI};
+    if (!b->pick.fbo && !mr_gl_target_make(&b->pick, 1, 1, gfmt, MR_OUT_GBUFFER_POSITIONS, true, err)) return false;
+    /* The frame's camera shifted so that pixel (px, py) is the target's
+     * only one; its levels chosen with the whole image's pixel factor. */
+    mr_geo_view v;
+    memset(&v, 0, sizeof v);
+    v.cam = r->last.cam;
+    v.lod_fmax = mr_geometry_lod_fmax(&r->last.cam);
+    v.cam.width = v.cam.height = 1;
+    v.cam.cx -= px;
+    v.cam.cy -= py;
+    v.world_from_camera = r->last.world_from_camera;
+    v.cam_from_world = mr_m4_invert_rigid(&v.world_from_camera);
+    v.near_plane = r->last.near_plane;
+    v.program = b->prog_gbuffer;
+    v.layers = r->last.layers;
+    v.cull_back = true;
+    GLint fbo = 0, vp[4];
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fbo);
+    glGetIntegerv(GL_VIEWPORT, vp);
+    GLboolean depth_test = glIsEnabled(GL_DEPTH_TEST);
+    glBindFramebuffer(GL_FRAMEBUFFER, b->pick.fbo);
+    glViewport(0, 0, 1, 1);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    static const GLenum bufs[MR_OUT_GBUFFER_POSITIONS] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    glNamedFramebufferDrawBuffers(b->pick.fbo, MR_OUT_GBUFFER_POSITIONS, bufs);
+    static const GLuint zero_u[4] = {0, 0, 0, 0};
+    static const float depth0 = 0.0f;
+    glClearNamedFramebufferuiv(b->pick.fbo, GL_COLOR, MR_OUT_GBUFFER_IDS, zero_u);
+    glClearNamedFramebufferfv(b->pick.fbo, GL_DEPTH, 0, &depth0);
+    glProgramUniform3f(b->prog_gbuffer, MR_LOC_GBUFFER_POS_OFFSET, 0, 0, 0);
+    /* No hierarchy, no occlusion (nothing learnt from this draw), and the
+     * frame's statistics kept. */
+    const mr_draw_params saved = r->draw;
+    const mr_draw_stats st = r->stats;
+    r->draw.no_hlod = true;
+    r->draw.occlusion = false;
+    r->draw.occlusion_auto = false;
+    mr_geometry_draw(r, &v, NULL);
+    r->draw = saved;
+    r->stats = st;
+    if (!depth_test) glDisable(GL_DEPTH_TEST);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)fbo);
+    glViewport(vp[0], vp[1], vp[2], vp[3]);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glGetTextureSubImage(b->pick.depth, 0, 0, 0, 0, 1, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, sizeof *depth, depth);
+    glGetTextureSubImage(b->pick.color[MR_OUT_GBUFFER_IDS], 0, 0, 0, 0, 1, 1, 1, GL_RG_INTEGER, GL_UNSIGNED_INT,
+                         2 * sizeof *ids, ids);
+    GLenum e = glGetError();
+    return e == GL_NO_ERROR || mr_fail(err, MR_ERR_GL, "GL error 0x%x redrawing the pick pixel", e);
 }
 
 static void mr_pass_shade(frame *f) {

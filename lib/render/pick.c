@@ -21,6 +21,11 @@ bool mr_renderer_pick(mr_renderer *r, double x, double y, mr_pick *out, mr_error
     glGetTextureSubImage(r->last.ids, 0, px, py, 0, 1, 1, 1, GL_RG_INTEGER, GL_UNSIGNED_INT, sizeof ids, ids);
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) return mr_fail(err, MR_ERR_GL, "GL error 0x%x reading the pick pixel", e);
+    /* Proxies of the LOD hierarchy move edges and surfaces by up to their
+     * error: where the frame drew some, the pixel is drawn again at the
+     * part levels, so a tap names the part and the point that a frame
+     * without the hierarchy shows there. */
+    if (r->last.hier && !mr_gbuffer_pick_pixel(r, px, py, &d, ids, err)) return false;
     if (!(d > 0)) return true; /* reversed Z: 0 is infinity, nothing there */
     /* depth = near / z (see mr_gl_projection); the ray through (x, y)
      * itself, not the pixel centre, of the ideal pinhole camera the frame

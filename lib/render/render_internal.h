@@ -70,6 +70,11 @@ struct mr_renderer {
         mr_camera cam;         /* at the output size */
         mr_dmat4 world_from_camera;
         double near_plane;
+        /* Its G-buffer drew proxies of the LOD hierarchy (not through a
+         * display mapping), of these layers: a pick redraws the pixel at
+         * the part levels (mr_gbuffer_pick_pixel). */
+        bool hier;
+        uint32_t layers;
     } last;
     /* The state of each pass file, owned by it (created in its prepare,
      * freed by its destroy). */
@@ -133,6 +138,10 @@ typedef struct mr_geo_view {
      * materials (glTF doubleSided = false), as glTF says they look; only
      * then may back-facing meshlets be skipped. Set by the G-buffer. */
     bool cull_back;
+    /* The pixel factor of the LOD choice (mr_geometry_lod_fmax); 0: cam's.
+     * A draw of one pixel of a frame passes the frame camera's, so it
+     * chooses the frame's levels. */
+    double lod_fmax;
 } mr_geo_view;
 /* The frame's camera with a program and layers. */
 mr_geo_view mr_frame_view(const frame *f, GLuint program, uint32_t layers);
@@ -243,6 +252,11 @@ void mr_base_free(mr_renderer *r);
 void mr_gbuffer_begin(frame *f, const target *t);
 /* The G-buffer program (for drawing another layer into a G-buffer). */
 GLuint mr_gbuffer_program(const frame *f);
+/* The last frame's G-buffer at pixel (px, py) drawn again without the LOD
+ * hierarchy (the part levels the frame would have chosen, same camera and
+ * layers) into a 1x1 target: its depth and ids, exactly those of a frame
+ * drawn without the hierarchy. */
+bool mr_gbuffer_pick_pixel(mr_renderer *r, int px, int py, float *depth, GLuint ids[2], mr_error *err);
 /* Shades albedo + normal (+ ao, 0 = none) into dst's first colour target
  * with the scene's lights: the main image and the hidden layer D. */
 void mr_shade_draw(frame *f, GLuint albedo, GLuint normal, GLuint ao, const target *dst);

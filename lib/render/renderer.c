@@ -174,6 +174,7 @@ bool mr_render_frame(mr_renderer *r, const mr_view *view, const mr_frame_params 
                      mr_error *err) {
     memset(out, 0, sizeof *out);
     r->last.valid = false; /* targets may be reallocated below */
+    r->last.hier = false;
     mr_frame_params defaults = MR_FRAME_DEFAULTS;
     const mr_frame_params *p = params ? params : &defaults;
     if (!mr_camera_validate(&view->camera, err)) return false;

@@ -658,7 +658,7 @@ static mr_hlod *build(const mr_scene *s, const mr_lod *lod, const mr_hlod_params
     if (x.stop) {
         mr_hlod_destroy(&h);
         if (x.failed) mr_fail(err, MR_ERR_NOMEM, "out of memory building the LOD hierarchy");
-        else mr_fail(err, MR_ERR_INVALID, "LOD hierarchy build cancelled");
+        else mr_fail(err, MR_ERR_INTERRUPTED, "LOD hierarchy build interrupted");
         return NULL;
     }
     for (int32_t i = 0; i < h->node_count; i++) h->proxy_triangles += h->nodes[i].index_count / 3;

@@ -76,3 +76,56 @@ mr_lod *mr_lod_load_logged(const mr_scene *s, const char *scene_path, bool use_c
                mr_lod_kernel(&lp), info.cache_written ? " (cache written)" : "");
     return lod;
 }
+
+bool mr_hlod_mode_check(const char *mode, mr_error *err) {
+    if (!mode || strcmp(mode, "auto") == 0 || strcmp(mode, "on") == 0 || strcmp(mode, "off") == 0) return true;
+    return mr_fail(err, MR_ERR_INVALID, "--hlod must be 'on' or 'off' or 'auto', not '%s'", mode);
+}
+
+typedef struct hlod_progress {
+    double t0;
+    bool tty, shown;
+} hlod_progress;
+
+/* Progress on a terminal after a second; false (stop) once SIGINT or
+ * SIGTERM was caught. */
+static bool hlod_on_progress(void *user, double fraction) {
+    hlod_progress *p = user;
+    if (p->tty && mr_time_now() - p->t0 >= 1.0) {
+        fprintf(stderr, "\rLOD hierarchy: %3.0f%%   ", 100.0 * fraction);
+        fflush(stderr);
+        p->shown = true;
+    }
+    return !mr_stop_requested();
+}
+
+bool mr_hlod_wanted_scene(const char *mode, const mr_scene *s) {
+    int32_t drawn = 0;
+    for (int32_t i = 0; s && i < s->node_count; i++) drawn += s->nodes[i].mesh_count > 0 && !s->nodes[i].shadow_catcher;
+    return s && mr_hlod_wanted(mode, mr_scene_triangle_count(s), drawn);
+}
+
+bool mr_hlod_load_logged(const mr_scene *s, const mr_lod *lod, const char *scene_path, const char *mode, bool use_cache,
+                         mr_hlod **out, mr_error *err) {
+    *out = NULL;
+    if (!mr_hlod_mode_check(mode, err)) return false;
+    if (!lod || !mr_hlod_wanted_scene(mode, s)) return true;
+    char cache[4096];
+    mr_hlod_cache_path(scene_path, cache, sizeof cache);
+    hlod_progress pr = {mr_time_now(), isatty(2) != 0, false};
+    mr_hlod_params hp = MR_HLOD_DEFAULTS;
+    hp.on_progress = hlod_on_progress;
+    hp.progress_user = &pr;
+    mr_hlod_info info;
+    *out = mr_hlod_load_or_build(s, lod, use_cache && scene_path && scene_path[0] ? cache : NULL, &hp, &info, err);
+    if (pr.shown) fprintf(stderr, "\r%*s\r", 30, "");
+    if (!*out) return false;
+    if (info.from_cache)
+        mr_log(MR_LOG_INFO, "LOD hierarchy: %d tree nodes, %llu proxy triangles read from the cache", (int)(*out)->node_count,
+               (unsigned long long)(*out)->proxy_triangles);
+    else
+        mr_log(MR_LOG_INFO, "LOD hierarchy: %d tree nodes, %llu proxy triangles built in %.2f s (%.0f input triangles/s)%s",
+               (int)(*out)->node_count, (unsigned long long)(*out)->proxy_triangles, info.build_s,
+               info.build_s > 0 ? info.input_triangles / info.build_s : 0.0, info.cache_written ? " (cache written)" : "");
+    return true;
+}

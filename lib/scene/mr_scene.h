@@ -561,6 +561,14 @@ mr_lod_builder *mr_lod_build_async(const mr_scene *s, const char *cache_path, co
                                    mr_error *err);
 bool mr_lod_builder_poll(mr_lod_builder *b, double *fraction);
 mr_lod *mr_lod_builder_finish(mr_lod_builder **b, mr_lod_info *info, mr_error *err); /* NULLs *b */
+/* The same, and after the levels the hierarchy above the part where
+ * mr_hlod_wanted_scene(hlod_mode) says so (from hlod_cache_path or built;
+ * NULL: no cache), taken with finish_hlod (*hlod NULL: none; a failed
+ * hierarchy is a warning in the log, the levels still come). */
+typedef struct mr_hlod mr_hlod;
+mr_lod_builder *mr_lod_build_async_hlod(const mr_scene *s, const char *cache_path, const mr_lod_params *params,
+                                        const char *hlod_mode, const char *hlod_cache_path, mr_error *err);
+mr_lod *mr_lod_builder_finish_hlod(mr_lod_builder **b, mr_lod_info *info, mr_hlod **hlod, mr_error *err);
 void mr_lod_builder_cancel(mr_lod_builder **b); /* NULLs *b, accepts NULL */
 /* Scenes drawing at least this many triangles get levels by default (the
  * commands' --lod auto): below it, simplifying costs more than it saves. */
@@ -630,7 +638,7 @@ typedef struct mr_hlod_node {
     mr_hlod_run *runs;
 } mr_hlod_node;
 
-typedef struct mr_hlod {
+struct mr_hlod {
     int32_t node_count;
     mr_hlod_node *nodes;        /* breadth first: roots, then their children, ... */
     int32_t root[MR_LAYER_COUNT]; /* -1: the layer has no tree */
@@ -639,7 +647,7 @@ typedef struct mr_hlod {
     uint64_t proxy_triangles;   /* over all proxies */
     int32_t scene_node_count;
     int32_t scene_mesh_count;
-} mr_hlod;
+};
 
 typedef struct mr_hlod_params {
     /* Proxy triangles as a fraction of their input (the children's proxies
@@ -685,6 +693,20 @@ mr_hlod *mr_hlod_load_or_build(const mr_scene *s, const mr_lod *lod, const char 
                                const mr_hlod_params *params, mr_hlod_info *info, mr_error *err);
 /* "<scene>.mrhlod" */
 void mr_hlod_cache_path(const char *scene_path, char *out, size_t n);
+/* The commands' hierarchy (--hlod auto|on|off; NULL is auto), in
+ * load_report.c: where mr_hlod_wanted says so for the scene's drawn
+ * triangles and nodes, and lod is set (--lod off draws full detail
+ * everywhere), the hierarchy from <scene_path>.mrhlod (use_cache) or
+ * built, with progress on a terminal, stopping at SIGINT/SIGTERM
+ * (mr_stop_catch) and an info line. true with *out NULL where the scene
+ * does not want one: nothing is read or built then. A bad mode or a
+ * failed build: false + err. */
+/* mr_hlod_wanted for the scene's drawn triangles and nodes (shadow
+ * catchers excluded). */
+bool mr_hlod_wanted_scene(const char *mode, const mr_scene *s);
+bool mr_hlod_load_logged(const mr_scene *s, const mr_lod *lod, const char *scene_path, const char *mode, bool use_cache,
+                         mr_hlod **out, mr_error *err);
+bool mr_hlod_mode_check(const char *mode, mr_error *err);
 
 /* Where a view cuts the tree: a node's proxy is drawn where its error,
  * projected at the node's nearest depth (fmax / z pixels per unit, as the

@@ -104,6 +104,7 @@ typedef struct view_app {
      * full detail is drawn; the renderer holds lod until it is destroyed. */
     mr_lod_builder *lod_builder;
     mr_lod *lod;
+    mr_hlod *hlod; /* levels above the part (after lod, same thread; <scene>.mrhlod) where the scene wants them */
     bool upload_pending; /* the scene waits for its levels from the cache: one upload of both */
     double pending_since;
     /* frames */
@@ -594,6 +595,7 @@ static bool upload_scene(view_app *a, const mr_lod *lod) {
     mr_log(MR_LOG_ERROR, "view: %s", a->scene_msg);
     mr_lod_builder_cancel(&a->lod_builder);
     mr_renderer_set_scene(a->rend, NULL, &err);
+    mr_hlod_destroy(&a->hlod);
     mr_lod_destroy(&a->lod);
     mr_scene_destroy(&a->scene);
     return false;
@@ -621,12 +623,13 @@ static void poll_scene_load(view_app *a) {
         a->fail_err = err;
         return;
     }
-    char cache[4096];
+    char cache[4096], hcache[4096];
     mr_lod_cache_path(a->scene->source, cache, sizeof cache);
+    mr_hlod_cache_path(a->scene->source, hcache, sizeof hcache);
     const bool has_file = a->scene->source[0] != 0;
     if (mr_lod_wanted(MR_LOD_MODE_AUTO, a->scene)) {
         mr_lod_params lp = MR_LOD_DEFAULTS;
-        a->lod_builder = mr_lod_build_async(a->scene, has_file ? cache : NULL, &lp, &err);
+        a->lod_builder = mr_lod_build_async_hlod(a->scene, has_file ? cache : NULL, &lp, "auto", has_file ? hcache : NULL, &err);
         if (!a->lod_builder) mr_log(MR_LOG_WARN, "view: no levels of detail: %s", err.msg);
     }
     /* With a cache file the levels come in a fraction of the scene's load
@@ -658,14 +661,20 @@ static void poll_lod(view_app *a) {
     if (!a->lod_builder || !mr_lod_builder_poll(a->lod_builder, NULL)) return;
     mr_error err = {0};
     mr_lod_info info;
-    a->lod = mr_lod_builder_finish(&a->lod_builder, &info, &err);
+    a->lod = mr_lod_builder_finish_hlod(&a->lod_builder, &info, &a->hlod, &err);
     a->need_render = true;
     if (a->upload_pending) {
         a->upload_pending = false;
         a->scene_msg[0] = 0;
         if (!upload_scene(a, a->lod)) return;
     } else if (a->lod && !mr_renderer_set_lod(a->rend, a->lod, &err)) {
+        mr_hlod_destroy(&a->hlod);
         mr_lod_destroy(&a->lod);
+    }
+    mr_error herr = {0};
+    if (a->lod && a->hlod && !mr_renderer_set_hlod(a->rend, a->hlod, &herr)) {
+        mr_log(MR_LOG_WARN, "view: no levels above the part: %s", herr.msg);
+        mr_hlod_destroy(&a->hlod);
     }
     if (!a->lod) {
         mr_log(MR_LOG_WARN, "view: no levels of detail: %s", err.msg);
@@ -812,6 +821,7 @@ bool mr_view_run(const mr_view_run_params *p, mr_error *err) {
     free(a->tolerances);
     mr_draw2d_destroy(&a->d2);
     mr_renderer_destroy(&a->rend);
+    mr_hlod_destroy(&a->hlod);
     mr_lod_destroy(&a->lod);
     mr_window_destroy(&a->win);
     if (a->nearest && a->nearest_fns.destroy) a->nearest_fns.destroy(a->nearest_fns.user, a->nearest);
