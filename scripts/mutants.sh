@@ -145,6 +145,28 @@ restore() {
 trap 'restore; rm -rf "$backup"' EXIT
 trap 'exit 130' INT TERM
 
+# Each mutant's tests get a time limit: three times their slowest
+# unmutated run (ctest's cost data from the suite's run in build/) plus a
+# minute. A mutant that makes a test run that long (an ignored --frames,
+# a loop that no longer ends) is caught by the limit instead of costing
+# CI its time; without cost data ctest's default applies.
+declare -A cost=()
+if [ -f build/Testing/Temporary/CTestCostData.txt ]; then
+  while read -r t _ c; do
+    [ "$t" = "---" ] && break
+    [ -n "${c:-}" ] && cost[$t]=$c
+  done <build/Testing/Temporary/CTestCostData.txt
+fi
+all_tests=$(ctest --test-dir build -N 2>/dev/null | sed -n 's/^ *Test *#[0-9]*: //p')
+time_limit() {
+  local t slow=""
+  for t in $(grep -E -- "$1" <<<"$all_tests"); do
+    [ -n "${cost[$t]:-}" ] || continue
+    slow=$(awk -v a="${slow:-0}" -v b="${cost[$t]}" 'BEGIN { print (b > a ? b : a) }')
+  done
+  [ -n "$slow" ] && awk -v s="$slow" 'BEGIN { printf "%d", 3 * s + 60 }'
+}
+
 survived=0 caught=0 built=""
 start=$(date +%s)
 while IFS='|' read -r name file text repl tests; do
@@ -193,11 +215,12 @@ while IFS='|' read -r name file text repl tests; do
     survived=$((survived + 1))
     continue
   fi
-  if bash scripts/ctest-strict.sh build -R "$tests" >"$backup/test.log" 2>&1; then
+  limit=$(time_limit "$tests")
+  if bash scripts/ctest-strict.sh build -R "$tests" ${limit:+--timeout "$limit"} >"$backup/test.log" 2>&1; then
     echo "SURVIVED $name ($file): tests '$tests' still pass"
     survived=$((survived + 1))
   else
-    why=$(grep -E "CHECK failed|FAIL:|FAILED|SKIPPED" "$backup/test.log" | cut -c1-200 | head -n 3 | paste -sd "|" -)
+    why=$(grep -E "CHECK failed|FAIL:|FAILED|SKIPPED|\*\*\*Timeout" "$backup/test.log" | cut -c1-200 | head -n 3 | paste -sd "|" -)
     echo "caught   $name: $why"
     caught=$((caught + 1))
   fi
