@@ -4,7 +4,9 @@
 # options:"): the view's files and folders above its AO and ghosting
 # start modes and test script, render's and replay's files above the AO,
 # ghosting, shadow and draw tables, track's input above the detector's
-# tuning. A command that takes a hall says so.
+# tuning, map's photos and gauge above the adjustment's tuning, calibrate's
+# and measure's inputs above theirs, synth's output above its sensor model.
+# A command that takes a hall says so.
 # Usage: cli_help.sh MRCHECK TMPDIR.
 set -u
 mr=$1
@@ -41,6 +43,10 @@ order view "scene input camera markers replay out size paused" "ao ghost script 
 order render "scene view out size video" "ao ao-samples ghost ghost-opacity shadows shadows-taps lod cull views quilt aux"
 order replay "scene out video from to every" "ao ghost shadows lod views"
 order track "input camera markers out" "decimate threads"
+order map "images video camera tag-size tag-sizes fix control out" "loss refine-intrinsics chain"
+order calibrate "images board out" "min-tags"
+order measure "recording observations scene tolerances" "tap-sigma min-angle"
+order synth "out size frames" "noise motion-blur shutter exposure jpeg"
 for c in view replay map calibrate measure export render record track; do
   grep -q '^hall (`mrcheck '"$c"' HALL' "$tmp/$c.txt" && ok || bad "$c --help does not say it takes a hall"
 done

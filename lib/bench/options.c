@@ -118,11 +118,11 @@ const mr_opt mr_bench_load_opts[] = {
 const mr_opt mr_synth_recording_opts[] = {
     {"frames", MR_OPT_INT, SR(frames), 1, 100000, 0, NULL, "frames spread over the walking path (auto: one per path step, 217)",
      MR_OPT_ZERO_AUTO},
-    {"noise", MR_OPT_DOUBLE, SR(noise), 0, 100, 2.0, NULL, "sensor noise in grey levels", 0},
-    {"motion-blur", MR_OPT_INT, SR(motion_blur), 1, 16, 3, NULL, "sub-frames averaged over the shutter, 1 = none", 0},
-    {"shutter", MR_OPT_DOUBLE, SR(shutter), 1, 100000, 60, NULL, "exposure time 1/N s (motion blur over it)", 0},
-    {"exposure", MR_OPT_DOUBLE, SR(exposure), 0, 0.9, 0.25, NULL, "relative exposure swing along the path", 0},
-    {"jpeg", MR_OPT_INT, SR(jpeg_quality), 1, 100, 80, NULL, "JPEG quality of the stored frames", 0},
+    {"noise", MR_OPT_DOUBLE, SR(noise), 0, 100, 2.0, NULL, "sensor noise in grey levels", MR_OPT_RESEARCH},
+    {"motion-blur", MR_OPT_INT, SR(motion_blur), 1, 16, 3, NULL, "sub-frames averaged over the shutter, 1 = none", MR_OPT_RESEARCH},
+    {"shutter", MR_OPT_DOUBLE, SR(shutter), 1, 100000, 60, NULL, "exposure time 1/N s (motion blur over it)", MR_OPT_RESEARCH},
+    {"exposure", MR_OPT_DOUBLE, SR(exposure), 0, 0.9, 0.25, NULL, "relative exposure swing along the path", MR_OPT_RESEARCH},
+    {"jpeg", MR_OPT_INT, SR(jpeg_quality), 1, 100, 80, NULL, "JPEG quality of the stored frames", MR_OPT_RESEARCH},
     {"fps", MR_OPT_DOUBLE, SR(fps), 0.1, 1000, 10.0, NULL, "path steps per second (frame rate at one frame per step)", 0},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };

@@ -56,26 +56,26 @@ const mr_opt mr_map_opts[] = {
     {"tag-size", MR_OPT_DOUBLE, MP(tag_size), 1e-9, 1e9, 0, NULL,
      "black-square edge of the tags, scene units (auto: only --tag-sizes)", MR_OPT_ZERO_AUTO},
     {"loss", MR_OPT_DOUBLE, MP(loss_px), 1e-3, 1e3, MR_MAP_DEFAULT_LOSS_PX, NULL, "Huber scale of the corner residuals, px",
-     MR_OPT_ZERO_DEFAULT},
-    {"refine-intrinsics", MR_OPT_BOOL, MP(refine_intrinsics), 0, 1, 0, NULL, "also adjust fx fy cx cy k1 k2", 0},
+     MR_OPT_ZERO_DEFAULT | MR_OPT_RESEARCH},
+    {"refine-intrinsics", MR_OPT_BOOL, MP(refine_intrinsics), 0, 1, 0, NULL, "also adjust fx fy cx cy k1 k2", MR_OPT_RESEARCH},
     {"chain", MR_OPT_BOOL, MP(no_adjust), 0, 1, 0, NULL,
-     "no global adjustment: chain relative poses along the spanning tree (baseline)", 0},
+     "no global adjustment: chain relative poses along the spanning tree (baseline)", MR_OPT_RESEARCH},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef MP
 
 const mr_opt mr_board_calib_opts[] = {
     {"min-tags", MR_OPT_INT, offsetof(mr_board_calib_params, min_tags), 1, 10000, MR_BOARD_CALIB_DEFAULT_MIN_TAGS, NULL,
-     "images with fewer board tags are skipped", MR_OPT_ZERO_DEFAULT},
+     "images with fewer board tags are skipped", MR_OPT_ZERO_DEFAULT | MR_OPT_RESEARCH},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 
 #define TP(f) offsetof(mr_triangulate_params, f)
 const mr_opt mr_triangulate_opts[] = {
     {"tap-sigma", MR_OPT_DOUBLE, TP(tap_sigma_px), 1e-3, 100, MR_TRIANGULATE_DEFAULT_TAP_SIGMA_PX, NULL,
-     "1-sigma of a tap per axis, px", MR_OPT_ZERO_DEFAULT},
+     "1-sigma of a tap per axis, px", MR_OPT_ZERO_DEFAULT | MR_OPT_RESEARCH},
     {"min-angle", MR_OPT_DOUBLE, TP(min_angle_deg), 1e-3, 90, MR_TRIANGULATE_DEFAULT_MIN_ANGLE_DEG, NULL,
-     "refuse rays closer than this, degrees", MR_OPT_ZERO_DEFAULT},
+     "refuse rays closer than this, degrees", MR_OPT_ZERO_DEFAULT | MR_OPT_RESEARCH},
     {NULL, 0, 0, 0, 0, 0, NULL, NULL, 0},
 };
 #undef TP
