@@ -84,30 +84,14 @@ int cmd_bcf(int argc, char **argv) {
     if (!answer && !list) return mr_cli_errorf(cmd, "needs list or answer (see --help)"), 2;
     if (npos != 1) return mr_cli_errorf(cmd, "needs a BCF file or folder (see --help)"), 2;
     mr_error err = {0};
-    mr_bcf b;
-    if (!mr_bcf_read(pos[0], &b, &err)) return mr_cli_error(cmd, &err);
-    for (int i = 0; i < b.warning_count; i++) fprintf(stderr, "mrcheck bcf: warning: %s\n", b.warnings[i]);
-    int rc = 0;
-    if (!answer) {
-        mr_scene *scene = NULL;
-        if (mr_cli_get(opts, "scene") && !(scene = mr_scene_load(mr_cli_get(opts, "scene"), NULL, &err)))
-            rc = mr_cli_error(cmd, &err);
-        if (rc == 0) mr_bcf_print_list(&b, scene, stdout);
-        mr_scene_destroy(&scene);
-    } else {
-        const char *out = mr_cli_get(opts, "out"), *snap = mr_cli_get(opts, "snapshot");
-        mr_bcf_topic *t = mr_bcf_find_topic(&b, mr_cli_get(opts, "topic"), &err);
-        mr_bcf_answer_params a = {.comment = mr_cli_get(opts, "comment"), .status = mr_cli_get(opts, "status"),
-                                  .author = mr_cli_get(opts, "author")};
-        char *png = NULL;
-        if (!out) mr_fail(&err, MR_ERR_INVALID, "answer needs --out OUT.bcf");
-        else if (t && snap && !(png = mr_file_read(snap, &a.snapshot_size, 0, &err))) t = NULL;
-        a.snapshot = (const unsigned char *)png;
-        if (!out || !t || !mr_bcf_answer(t, &a, &err) || !mr_bcf_write(&b, (mr_bcf_version)p.bcf_version, out, &err))
-            rc = mr_cli_error(cmd, &err);
-        else if (!mr_cli_flag(opts, "quiet")) printf("wrote %s (BCF %s)\n", out, p.bcf_version ? "3.0" : "2.1");
-        free(png);
-    }
-    mr_bcf_free(&b);
-    return rc;
+    const char *out = mr_cli_get(opts, "out");
+    mr_bcf_answer_file_params a = {
+        .in = pos[0], .topic = mr_cli_get(opts, "topic"), .snapshot_path = mr_cli_get(opts, "snapshot"),
+        .answer = {.comment = mr_cli_get(opts, "comment"), .status = mr_cli_get(opts, "status"),
+                   .author = mr_cli_get(opts, "author")},
+        .version = (mr_bcf_version)p.bcf_version, .out = out, .warn = stderr};
+    if (!(answer ? mr_bcf_answer_file(&a, &err) : mr_bcf_list_file(pos[0], mr_cli_get(opts, "scene"), stdout, stderr, &err)))
+        return mr_cli_error(cmd, &err);
+    if (answer && !mr_cli_flag(opts, "quiet")) printf("wrote %s (BCF %s)\n", out, p.bcf_version ? "3.0" : "2.1");
+    return 0;
 }

@@ -1,9 +1,6 @@
 /* mrcheck track: detection and pose per frame. */
 #include "app_track.h"
-
-#include <stdlib.h>
-#include <string.h>
-#include <unistd.h>
+#include "mr_batch.h"
 
 int cmd_track(int argc, char **argv) {
     static const char *cmd = "track";
@@ -33,9 +30,6 @@ int cmd_track(int argc, char **argv) {
     long max_frames = -1;
     if (mr_cli_get(opts, "max-frames") && !mr_cli_int("max-frames", mr_cli_get(opts, "max-frames"), 1, 1L << 40, &max_frames))
         return 2;
-    const char *out = mr_cli_get(opts, "out");
-    bool print_det = mr_cli_flag(opts, "print-detections");
-
     mr_error err = {0};
     mr_recording *rec = NULL;
     mr_source *src = NULL;
@@ -44,90 +38,18 @@ int cmd_track(int argc, char **argv) {
     app_tracker t;
     bool ok = app_tracker_init(&t, cmd, opts, &dp, rec);
     mr_recording_close(&rec);
-    if (!ok) {
-        mr_source_close(&src);
-        return 1;
-    }
-    bool want_pose = t.has_camera && t.has_markers;
-    if (out && !want_pose) {
-        app_tracker_free(&t);
-        mr_source_close(&src);
-        return mr_cli_errorf(cmd, "--out needs --camera and --markers (or a recording as input)");
-    }
+    mr_batch_track_params p = MR_BATCH_TRACK_DEFAULTS;
+    p.source = src;
+    p.tracker = t.tracker;
+    p.input = input;
+    p.out = mr_cli_get(opts, "out");
+    p.print_detections = mr_cli_flag(opts, "print-detections");
+    p.max_frames = max_frames;
+    p.progress = p.summary = mr_log_get_level() >= MR_LOG_WARN;
+    p.lines = stdout;
+    mr_batch_track_stats st;
     mr_stop_catch();
-    mr_jsonl poses = {0};
-    long frames = 0, failed = 0, with_tags = 0, with_pose = 0;
-    int rc = 0;
-    /* The first bad frame's message is held back: if no frame at all can be
-     * processed (a single tiny image, say) it becomes the one error line. */
-    char held[600] = "";
-    const bool tty = isatty(2) && mr_log_get_level() >= MR_LOG_WARN;
-    double shown = mr_time_now();
-    while (!mr_stop_requested() && (max_frames < 0 || frames < max_frames)) {
-        mr_frame f;
-        mr_read_status st = mr_source_read(src, &f, &err);
-        if (st == MR_READ_END) break;
-        if (st == MR_READ_ERROR) {
-            rc = mr_cli_error(cmd, &err);
-            break;
-        }
-        frames++;
-        if (tty && mr_time_now() - shown > 0.25) {
-            fprintf(stderr, "\rtrack: frame %lld, %ld with a pose", (long long)f.index, with_pose);
-            shown = mr_time_now();
-        }
-        mr_tracker_result r;
-        mr_error fe = {0};
-        if (!mr_tracker_frame(t.tracker, &f.image, f.timestamp, &r, &fe)) {
-            /* One bad frame (too small, broken) does not end the run. */
-            if (failed == 0 && frames == 1) snprintf(held, sizeof held, "frame %lld: %s", (long long)f.index, fe.msg);
-            else fprintf(stderr, "mrcheck: track: warning: frame %lld: %s\n", (long long)f.index, fe.msg);
-            failed++;
-            continue;
-        }
-        if (held[0]) {
-            fprintf(stderr, "mrcheck: track: warning: %s\n", held);
-            held[0] = 0;
-        }
-        with_tags += r.detection_count > 0;
-        with_pose += r.pose.valid;
-        if (print_det) {
-            cJSON *o = cJSON_CreateObject();
-            cJSON_AddNumberToObject(o, "frame", (double)f.index);
-            cJSON_AddItemToObject(o, "detections", mr_detections_json(r.detections, r.detection_count, 1e-3));
-            /* with camera and markers the line also carries the pose */
-            if (want_pose) cJSON_AddItemToObject(o, "pose", mr_pose_line_json(f.index, f.timestamp, &r));
-            char *s = cJSON_PrintUnformatted(o);
-            cJSON_Delete(o);
-            if (s) puts(s);
-            free(s);
-        }
-        if (want_pose) {
-            cJSON *o = mr_pose_line_json(f.index, f.timestamp, &r);
-            char *s = out || print_det ? NULL : cJSON_PrintUnformatted(o);
-            bool added = !out || mr_jsonl_add(&poses, o);
-            cJSON_Delete(o);
-            if (!added || (!out && !print_det && !s)) {
-                free(s);
-                rc = mr_cli_errorf(cmd, "out of memory");
-                break;
-            }
-            if (s) puts(s);
-            free(s);
-        }
-        fflush(stdout);
-    }
-    if (rc == 0 && frames == 0) rc = mr_cli_errorf(cmd, "%s: no frames", input);
-    else if (rc == 0 && failed == frames)
-        rc = mr_cli_errorf(cmd, "no frame could be processed (%ld failed; %s)", failed, held[0] ? held : "see above");
-    if (tty) fprintf(stderr, "\r\033[K");
-    if (rc == 0 && out && !mr_jsonl_save(&poses, out, &err)) rc = mr_cli_error(cmd, &err);
-    if (rc == 0 && mr_log_get_level() >= MR_LOG_WARN) /* the summary, on stderr: stdout may be the poses */
-        fprintf(stderr, "track: %s%ld frames, %ld with tags, %ld with a pose, %ld failed%s%s\n",
-                mr_stop_requested() ? "interrupted after " : "", frames, with_tags, with_pose, failed,
-                out ? "; wrote " : "", out ? out : "");
-    if (rc == 0 && mr_stop_requested()) rc = 128 + mr_stop_signal();
-    mr_jsonl_free(&poses);
+    int rc = !ok ? 1 : !mr_batch_track(&p, &st, &err) ? mr_cli_error(cmd, &err) : st.interrupted ? 128 + mr_stop_signal() : 0;
     app_tracker_free(&t);
     mr_source_close(&src);
     return rc;

@@ -52,4 +52,19 @@ printf '{"type":"discrepancy","note":"tor' >>"$tmp/torn/annotations.jsonl"
 if "$mr" export "$tmp/torn" --bcf "$tmp/t.bcf" >"$tmp/t.out" 2>"$tmp/t.err"; then ok; else bad "torn: $(cat "$tmp/t.err")"; fi
 [ "$(wc -l <"$tmp/t.err")" -eq 1 ] && grep -q torn "$tmp/t.err" && ok || bad "torn: stderr $(cat "$tmp/t.err")"
 [ "$(unzip -l "$tmp/t.bcf" 2>/dev/null | grep -cE ' [0-9a-f-]{36}/$')" -eq 2 ] && ok || bad "torn: topics"
+# bcf list / bcf answer on the archive written above: the answer keeps the
+# topic and adds the comment and status; bad input fails with one line.
+if "$mr" bcf list "$tmp/a.bcf" >"$tmp/list.out" 2>"$tmp/list.err"; then ok; else bad "bcf list: $(cat "$tmp/list.err")"; fi
+[ "$(wc -l <"$tmp/list.out")" -eq 2 ] && grep -q $'^1\t[0-9a-f-]\{36\}\t' "$tmp/list.out" && ok || bad "bcf list: $(cat "$tmp/list.out")"
+"$mr" bcf answer "$tmp/a.bcf" --topic 1 --comment "fixed on site" --status Closed --out "$tmp/ans.bcf" \
+  >"$tmp/ans.log" 2>&1 && [ -s "$tmp/ans.bcf" ] && ok || bad "bcf answer: $(cat "$tmp/ans.log")"
+c0=$(head -1 "$tmp/list.out" | grep -o 'comments [0-9]*' | cut -d' ' -f2)
+"$mr" bcf list "$tmp/ans.bcf" >"$tmp/ans.list" 2>&1 && head -1 "$tmp/ans.list" | grep -q $'\tClosed\t.*comments '$((c0 + 1)) && ok ||
+  bad "answered topic: $(cat "$tmp/ans.list")"
+unzip -p "$tmp/ans.bcf" '*/markup.bcf' 2>/dev/null | grep -q 'fixed on site' && ok || bad "bcf answer: no comment in markup"
+[ "$(cut -f2 "$tmp/ans.list")" = "$(cut -f2 "$tmp/list.out")" ] && ok || bad "bcf answer changed the GUIDs"
+expect_fail answer_no_out "" -- "$mr" bcf answer "$tmp/a.bcf" --topic 1
+expect_fail answer_bad_topic "$tmp/bt.bcf" -- "$mr" bcf answer "$tmp/a.bcf" --topic 9 --out "$tmp/bt.bcf"
+expect_fail answer_no_snapshot "$tmp/ns.bcf" -- "$mr" bcf answer "$tmp/a.bcf" --topic 1 --snapshot "$tmp/none.png" --out "$tmp/ns.bcf"
+expect_fail list_missing "" -- "$mr" bcf list "$tmp/none.bcf"
 cli_finish cli_export

@@ -109,6 +109,33 @@ typedef struct mr_batch_measure_params {
 #define MR_BATCH_MEASURE_DEFAULTS {.nominal = -1, .triangulate = MR_TRIANGULATE_DEFAULTS}
 bool mr_batch_measure(const mr_batch_measure_params *p, mr_error *err);
 
+/* `mrcheck track` (track.c): the tracker over the source's frames. A frame
+ * the tracker refuses is skipped with a warning on stderr. With the
+ * tracker's camera and markers each frame has a pose line
+ * (mr_pose_line_json): on lines, or into out (written atomically when the
+ * run ends); print_detections puts {"frame","detections"[,"pose"]} per
+ * frame on lines instead. A stop (mr_stop_requested) ends the run at the
+ * next frame and returns true with stats->interrupted. False + one line:
+ * no frames, no frame processed, --out without camera and markers, a read
+ * or write failure. */
+typedef struct mr_batch_track_params {
+    mr_source *source;        /* required */
+    mr_tracker *tracker;      /* required */
+    const char *input;        /* its name, for messages */
+    const char *out;          /* poses.jsonl; NULL: pose lines on `lines` */
+    bool print_detections;
+    long max_frames;          /* < 0 (default): all */
+    bool progress;            /* "track: frame N" on a terminal */
+    bool summary;             /* the counts as one line on stderr at the end */
+    FILE *lines;              /* required (stdout) */
+} mr_batch_track_params;
+#define MR_BATCH_TRACK_DEFAULTS {.max_frames = -1}
+typedef struct mr_batch_track_stats {
+    long frames, failed, with_tags, with_pose;
+    bool interrupted;
+} mr_batch_track_stats;
+bool mr_batch_track(const mr_batch_track_params *p, mr_batch_track_stats *stats, mr_error *err);
+
 #ifdef __cplusplus
 }
 #endif

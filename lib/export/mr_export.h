@@ -307,6 +307,24 @@ typedef struct mr_bcf_answer_params {
 } mr_bcf_answer_params;
 bool mr_bcf_answer(mr_bcf_topic *t, const mr_bcf_answer_params *a, mr_error *err);
 
+/* `mrcheck bcf list`: reads the BCF at path (warnings, one line each, on
+ * warn unless NULL) and prints its topics on out (mr_bcf_print_list), with
+ * scene_path (NULL: none) loaded to count the components it has. */
+bool mr_bcf_list_file(const char *path, const char *scene_path, FILE *out, FILE *warn, mr_error *err);
+/* `mrcheck bcf answer`: reads in, answers the topic named by topic (as
+ * mr_bcf_find_topic) with answer (its snapshot read from snapshot_path,
+ * if given) and writes all topics as BCF version to out (atomic). */
+typedef struct mr_bcf_answer_file_params {
+    const char *in;             /* BCF archive or folder, required */
+    const char *topic;          /* 1-based number or GUID (prefix), required */
+    mr_bcf_answer_params answer; /* comment, status, author (its snapshot is read from snapshot_path) */
+    const char *snapshot_path;  /* PNG, NULL none */
+    mr_bcf_version version;     /* of the file written */
+    const char *out;            /* required */
+    FILE *warn;                 /* the reader's warnings; NULL: not shown */
+} mr_bcf_answer_file_params;
+bool mr_bcf_answer_file(const mr_bcf_answer_file_params *p, mr_error *err);
+
 /* ------------------------------------------------------------ the exports */
 
 /* Writes the BCF archive of session_dir's marks to out_path (a temporary
