@@ -35,16 +35,11 @@ static mr_frame_params ao_frame(int w, int h, double radius, mr_ao_noise noise, 
     return fp;
 }
 
+/* RMSE over the surface pixels (depth > 0); NAN where there are none. */
 static double rmse_over_surface(const mr_image *a, const mr_image *b, const mr_image *depth) {
-    const float *x = a->data, *y = b->data, *d = depth->data;
-    double se = 0;
-    long n = 0;
-    for (size_t i = 0; i < (size_t)a->width * a->height; i++)
-        if (d[i] > 0) {
-            se += (x[i] - y[i]) * (double)(x[i] - y[i]);
-            n++;
-        }
-    return n ? sqrt(se / n) : NAN;
+    mr_image_metrics m;
+    mr_error e = {0};
+    return mr_image_compare(a, b, depth, &m, &e) && m.count > 0 ? m.rmse : NAN;
 }
 
 /* AO of one frame against its ray-traced reference (the frame's own
@@ -307,208 +302,184 @@ typedef struct row {
     double ms_frame, ms_view, err_pin, err_disp, cons_world, cons_pixel, cons_world0, cons_pixel0, shared;
 } row;
 
-bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err) {
-    mr_bench_multiview_params p = {MR_BENCH_MULTIVIEW_DEFAULTS};
-    if (params) p = *params;
-    const mr_bench_multiview_params dflt = {MR_BENCH_MULTIVIEW_DEFAULTS};
-    if (!p.out_dir) p.out_dir = dflt.out_dir;
-    if (p.budget_w <= 0 || p.budget_h <= 0) p.budget_w = dflt.budget_w, p.budget_h = dflt.budget_h;
-    if (p.view_w <= 0 || p.view_h <= 0) p.view_w = dflt.view_w, p.view_h = dflt.view_h;
-    if (p.table_w <= 0 || p.table_h <= 0) p.table_w = dflt.table_w, p.table_h = dflt.table_h;
-    if (p.frames <= 0) p.frames = dflt.frames;
-    if (p.rays <= 0) p.rays = dflt.rays;
-    FILE *out = p.out;
-    if (!bench_gpu_check(&p.gfx, "bench multiview", err)) return false;
-    mr_renderer *r = p.gfx.renderer;
-    if (!mr_mkdirs(p.out_dir, err)) return false;
+static const int k_views[] = {1, 8, 24, 48};
+static const int k_bands[] = {1, 4, 16};
+static const char *const k_table_scenes[3] = {"demo hall (planned)", "demo hall (built)", "synthetic factory"};
 
-    static const int k_views[] = {1, 8, 24, 48};
-    int nviews = p.quick ? 2 : 4;
+/* One run's state: what is set up once, then the three tables in the
+ * order they are measured. */
+typedef struct mv_run {
+    mr_bench_multiview_params p;
+    mr_renderer *r;
     mr_demo_hall hall;
-    memset(&hall, 0, sizeof hall);
-    if (!mr_demo_build_tagged(NULL, 0, &hall, err)) return false;
-    mr_scene *scene = hall.planned;
-    mr_view centre = p.view ? *p.view : mr_demo_view(0);
-    memset(centre.camera.dist, 0, sizeof centre.camera.dist);
-    if (p.shared_only) {
-        /* The shared-work table alone. */
-        mr_synth_params sp = MR_SYNTH_DEFAULTS;
-        mr_scene *synth = mr_synth_build(&sp, err);
-        bool ok = synth != NULL;
-        if (ok) {
-            mr_scene *sc[2] = {scene, synth};
-            const char *nm[2] = {"demo hall (planned)", "synthetic factory"};
-            mr_view vs[2] = {centre, centre};
-            vs[1].world_from_camera = mr_synth_viewpoint(&sp, MR_SYNTH_VIEW_AISLE);
-            ok = bench_shared(&p, sc, nm, vs, err);
-        }
-        mr_scene_destroy(&synth);
-        mr_demo_free(&hall);
-        return ok;
-    }
-    double radius = mr_ao_default_radius(scene);
-    mr_eval_gt *gt = NULL;
-    bool ok = mr_renderer_set_scene(r, scene, err) && (gt = mr_eval_gt_create(scene, false, err)) != NULL;
-    /* The rig: the display defaults (35 degree cone) around the camera's own
-     * vertical field of view, focused where the centre view looks. */
-    double fov = 2 * atan(0.5 * centre.camera.height / centre.camera.fy) / DEG, focal = 0;
-    if (ok) {
-        mr_frame_params dp = MR_FRAME_DEFAULTS;
-        dp.want_depth = true;
-        dp.width = p.view_w;
-        dp.height = p.view_h;
-        mr_frame_result fr;
-        ok = mr_render_frame(r, &centre, &dp, &fr, err);
-        if (ok) focal = mr_rig_focal_from_depth(&fr.depth);
-        mr_frame_result_free(&fr);
-        if (ok && !(focal > 0)) ok = mr_fail(err, MR_ERR_INVALID, "bench multiview: the view sees nothing to focus on");
-    }
+    mr_view centre;
+    mr_eval_gt *gt;
+    double radius, fov, focal;
     row rows[8];
-    int nrows = 0;
-    for (int mode = 0; ok && mode < 2; mode++)
-        for (int k = 0; ok && k < nviews; k++) {
-            int n = k_views[k];
-            row *rw = &rows[nrows];
-            memset(rw, 0, sizeof *rw);
-            rw->mode = mode == 0 ? "budget" : "per_view";
-            rw->views = n;
-            if (mode == 0) {
-                rw->w = (int)lround(p.budget_w / sqrt((double)n));
-                rw->h = (int)lround(p.budget_h / sqrt((double)n));
-            } else {
-                rw->w = p.view_w;
-                rw->h = p.view_h;
-            }
-            mr_rig_params rp = MR_RIG_DEFAULTS;
-            rp.views = n;
-            rp.fov_deg = fov;
-            mr_rig rig;
-            ok = mr_rig_make(&rp, (double)rw->w / rw->h, focal, &rig, err);
-            mr_frame_params fw = ao_frame(rw->w, rw->h, radius, MR_AO_NOISE_WORLD, &centre, false);
-            mr_frame_params fpx = ao_frame(rw->w, rw->h, radius, MR_AO_NOISE_PIXEL, NULL, false);
-            mr_frame_params fw0 = ao_frame(rw->w, rw->h, radius, MR_AO_NOISE_WORLD, &centre, true);
-            mr_frame_params fpx0 = ao_frame(rw->w, rw->h, radius, MR_AO_NOISE_PIXEL, NULL, true);
-            ok = ok && time_rig(r, &rig, &centre, &fw, p.frames, &rw->ms_frame, err);
-            rw->ms_view = rw->ms_frame / n;
-            /* AO error against the reference on the outer and middle views. */
-            int probe[3] = {0, n / 2, n - 1}, np = n >= 3 ? 3 : 1;
-            double se = 0;
-            for (int j = 0; ok && j < np; j++) {
-                mr_view v = mr_rig_view(&rig, &centre, probe[j], rw->w, rw->h);
-                double e = 0;
-                ok = ao_error(r, gt, &v, &fw, NULL, radius, p.rays, &e, err);
-                se += e;
-            }
-            rw->err_pin = se / np;
-            /* The display mapping at the same size and cone (exact slices). */
-            mr_rig_params one = rp;
-            one.views = 1;
-            mr_rig crig;
-            ok = ok && mr_rig_make(&one, (double)rw->w / rw->h, focal, &crig, err);
-            crig.cone = rp.cone_deg * DEG;
-            mr_display_map m = mr_display_from_rig(&crig, 1);
-            mr_view cv = mr_rig_view(&crig, &centre, 0, rw->w, rw->h);
-            ok = ok && ao_error(r, gt, &cv, &fw, &m, radius, p.rays, &rw->err_disp, err);
-            rw->cons_world = rw->cons_pixel = rw->cons_world0 = rw->cons_pixel0 = rw->shared = NAN;
-            if (ok && n > 1) {
-                double f1, f2;
-                ok = consistency(r, &rig, &centre, &fw, &rw->cons_world, &f1, err) &&
-                     consistency(r, &rig, &centre, &fpx, &rw->cons_pixel, &f2, err) &&
-                     consistency(r, &rig, &centre, &fw0, &rw->cons_world0, &f2, err) &&
-                     consistency(r, &rig, &centre, &fpx0, &rw->cons_pixel0, &f2, err);
-                rw->shared = f1;
-            }
-            if (ok && p.progress) fprintf(stderr, "bench multiview: %s %d views done\n", rw->mode, n);
-            nrows++;
-        }
+    int nrows;
+    double band_ms[3], band_err_mean[3], band_err_max[3], band_ao[3];
+    double t_no[3], t_ao[3];
+    uint64_t t_tris[3];
+} mv_run;
 
-    /* The display mapping's slices at the per-view size. */
-    static const int k_bands[] = {1, 4, 16};
-    double band_ms[3] = {0}, band_err_mean[3] = {0}, band_err_max[3] = {0}, band_ao[3] = {0};
-    for (int b = 0; ok && b < 3; b++) {
-        mr_rig_params one = MR_RIG_DEFAULTS;
-        one.views = 1;
-        one.fov_deg = fov;
-        mr_rig crig;
-        ok = mr_rig_make(&one, (double)p.view_w / p.view_h, focal, &crig, err);
-        mr_display_map m = mr_display_from_rig(&crig, k_bands[b]);
-        mr_view cv = mr_rig_view(&crig, &centre, 0, p.view_w, p.view_h);
-        mr_frame_params fw = ao_frame(p.view_w, p.view_h, radius, MR_AO_NOISE_WORLD, &centre, false);
-        fw.display = &m;
-        ok = ok && time_frame(r, &cv, &fw, p.frames, &band_ms[b], err);
-        mr_frame_params fd = fw;
-        fd.want_depth = true;
-        mr_frame_result res;
-        if (ok && (ok = mr_render_frame(r, &cv, &fd, &res, err))) {
-            /* Where the exact mapping puts each pixel's surface point, from
-             * the depth the slices rendered. */
-            double sum = 0, mx = 0;
-            long cnt = 0;
-            const float *d = res.depth.data;
-            for (int y = 0; y < p.view_h; y++)
-                for (int x = 0; x < p.view_w; x++) {
-                    double z = d[(size_t)y * p.view_w + x];
-                    if (!(z > 0)) continue;
-                    double e = fabs(mr_display_column_error(&m, &cv.camera, x, z));
-                    if (!isfinite(e)) continue;
-                    sum += e;
-                    mx = fmax(mx, e);
-                    cnt++;
-                }
-            band_err_mean[b] = cnt ? sum / cnt : NAN;
-            band_err_max[b] = mx;
-            mr_frame_result_free(&res);
-        }
-        fw.display = NULL;
-        ok = ok && ao_error(r, gt, &cv, &fw, &m, radius, p.rays, &band_ao[b], err);
+/* The AO radius, the reference and the rig's cone (the display defaults'
+ * 35 degrees around the camera's own vertical field of view), focused
+ * where the centre view looks. */
+static bool mv_setup(mv_run *m, mr_error *err) {
+    mr_scene *scene = m->hall.planned;
+    m->radius = mr_ao_default_radius(scene);
+    m->fov = 2 * atan(0.5 * m->centre.camera.height / m->centre.camera.fy) / DEG;
+    if (!mr_renderer_set_scene(m->r, scene, err) || !(m->gt = mr_eval_gt_create(scene, false, err))) return false;
+    mr_frame_params dp = MR_FRAME_DEFAULTS;
+    dp.want_depth = true;
+    dp.width = m->p.view_w;
+    dp.height = m->p.view_h;
+    mr_frame_result fr;
+    bool ok = mr_render_frame(m->r, &m->centre, &dp, &fr, err);
+    if (ok) m->focal = mr_rig_focal_from_depth(&fr.depth);
+    mr_frame_result_free(&fr);
+    if (ok && !(m->focal > 0)) ok = mr_fail(err, MR_ERR_INVALID, "bench multiview: the view sees nothing to focus on");
+    return ok;
+}
+
+/* One row of the views table: n views at the total budget (mode 0) or at
+ * the fixed per-view size (mode 1). */
+static bool mv_rig_row(mv_run *m, int mode, int n, row *rw, mr_error *err) {
+    const mr_bench_multiview_params *p = &m->p;
+    memset(rw, 0, sizeof *rw);
+    rw->mode = mode == 0 ? "budget" : "per_view";
+    rw->views = n;
+    rw->w = mode == 0 ? (int)lround(p->budget_w / sqrt((double)n)) : p->view_w;
+    rw->h = mode == 0 ? (int)lround(p->budget_h / sqrt((double)n)) : p->view_h;
+    mr_rig_params rp = MR_RIG_DEFAULTS;
+    rp.views = n;
+    rp.fov_deg = m->fov;
+    mr_rig rig;
+    bool ok = mr_rig_make(&rp, (double)rw->w / rw->h, m->focal, &rig, err);
+    mr_frame_params fw = ao_frame(rw->w, rw->h, m->radius, MR_AO_NOISE_WORLD, &m->centre, false);
+    mr_frame_params fpx = ao_frame(rw->w, rw->h, m->radius, MR_AO_NOISE_PIXEL, NULL, false);
+    mr_frame_params fw0 = ao_frame(rw->w, rw->h, m->radius, MR_AO_NOISE_WORLD, &m->centre, true);
+    mr_frame_params fpx0 = ao_frame(rw->w, rw->h, m->radius, MR_AO_NOISE_PIXEL, NULL, true);
+    ok = ok && time_rig(m->r, &rig, &m->centre, &fw, p->frames, &rw->ms_frame, err);
+    rw->ms_view = rw->ms_frame / n;
+    /* AO error against the reference on the outer and middle views. */
+    int probe[3] = {0, n / 2, n - 1}, np = n >= 3 ? 3 : 1;
+    double se = 0;
+    for (int j = 0; ok && j < np; j++) {
+        mr_view v = mr_rig_view(&rig, &m->centre, probe[j], rw->w, rw->h);
+        double e = 0;
+        ok = ao_error(m->r, m->gt, &v, &fw, NULL, m->radius, p->rays, &e, err);
+        se += e;
     }
-    mr_eval_gt_destroy(&gt);
-    mr_renderer_set_scene(r, NULL, NULL);
+    rw->err_pin = se / np;
+    /* The display mapping at the same size and cone (exact slices). */
+    mr_rig_params one = rp;
+    one.views = 1;
+    mr_rig crig;
+    ok = ok && mr_rig_make(&one, (double)rw->w / rw->h, m->focal, &crig, err);
+    crig.cone = rp.cone_deg * DEG;
+    mr_display_map dm = mr_display_from_rig(&crig, 1);
+    mr_view cv = mr_rig_view(&crig, &m->centre, 0, rw->w, rw->h);
+    ok = ok && ao_error(m->r, m->gt, &cv, &fw, &dm, m->radius, p->rays, &rw->err_disp, err);
+    rw->cons_world = rw->cons_pixel = rw->cons_world0 = rw->cons_pixel0 = rw->shared = NAN;
+    if (ok && n > 1) {
+        double f1, f2;
+        ok = consistency(m->r, &rig, &m->centre, &fw, &rw->cons_world, &f1, err) &&
+             consistency(m->r, &rig, &m->centre, &fpx, &rw->cons_pixel, &f2, err) &&
+             consistency(m->r, &rig, &m->centre, &fw0, &rw->cons_world0, &f2, err) &&
+             consistency(m->r, &rig, &m->centre, &fpx0, &rw->cons_pixel0, &f2, err);
+        rw->shared = f1;
+    }
+    if (ok && p->progress) fprintf(stderr, "bench multiview: %s %d views done\n", rw->mode, n);
+    return ok;
+}
 
-    /* Table 1's shape: three scenes, per-view ms without and with SSAO. */
-    const char *tnames[3] = {"demo hall (planned)", "demo hall (built)", "synthetic factory"};
-    double t_no[3] = {0}, t_ao[3] = {0};
-    uint64_t t_tris[3] = {0};
+/* The display mapping's slices k_bands[b] columns wide at the per-view
+ * size: time, where the exact mapping puts each pixel's surface point
+ * (from the depth the slices rendered), AO error. */
+static bool mv_band(mv_run *m, int b, mr_error *err) {
+    const int w = m->p.view_w, h = m->p.view_h;
+    mr_rig_params one = MR_RIG_DEFAULTS;
+    one.views = 1;
+    one.fov_deg = m->fov;
+    mr_rig crig;
+    bool ok = mr_rig_make(&one, (double)w / h, m->focal, &crig, err);
+    mr_display_map dm = mr_display_from_rig(&crig, k_bands[b]);
+    mr_view cv = mr_rig_view(&crig, &m->centre, 0, w, h);
+    mr_frame_params fw = ao_frame(w, h, m->radius, MR_AO_NOISE_WORLD, &m->centre, false);
+    fw.display = &dm;
+    ok = ok && time_frame(m->r, &cv, &fw, m->p.frames, &m->band_ms[b], err);
+    mr_frame_params fd = fw;
+    fd.want_depth = true;
+    mr_frame_result res;
+    if (ok && (ok = mr_render_frame(m->r, &cv, &fd, &res, err))) {
+        double sum = 0, mx = 0;
+        long cnt = 0;
+        const float *d = res.depth.data;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                double z = d[(size_t)y * w + x];
+                if (!(z > 0)) continue;
+                double e = fabs(mr_display_column_error(&dm, &cv.camera, x, z));
+                if (!isfinite(e)) continue;
+                sum += e;
+                mx = fmax(mx, e);
+                cnt++;
+            }
+        m->band_err_mean[b] = cnt ? sum / cnt : NAN;
+        m->band_err_max[b] = mx;
+        mr_frame_result_free(&res);
+    }
+    fw.display = NULL;
+    return ok && ao_error(m->r, m->gt, &cv, &fw, &dm, m->radius, m->p.rays, &m->band_ao[b], err);
+}
+
+/* Table 1's shape: three scenes, per-view ms without and with SSAO. On
+ * the light-field path, as the paper times it: one optical module's image
+ * through the display mapping (4-column slices, the middle row of the band
+ * table), the AO reading the positions texture the G-buffer writes (the
+ * paper's G-buffer "position texture"). */
+static bool mv_table1(mv_run *m, mr_error *err) {
+    const mr_bench_multiview_params *p = &m->p;
     mr_synth_params sp = MR_SYNTH_DEFAULTS;
-    mr_scene *synth = ok ? mr_synth_build(&sp, err) : NULL;
-    if (ok && !synth) ok = false;
-    /* On the light-field path, as the paper times it: one optical module's
-     * image through the display mapping (4-column slices, the middle row
-     * of the band table), the AO reading the positions texture the
-     * G-buffer writes (the paper's G-buffer "position texture"). */
+    mr_scene *synth = mr_synth_build(&sp, err);
+    bool ok = synth != NULL;
     mr_rig_params trp = MR_RIG_DEFAULTS;
     trp.views = 1;
-    trp.fov_deg = fov;
+    trp.fov_deg = m->fov;
     mr_rig trig;
-    ok = ok && mr_rig_make(&trp, (double)p.table_w / p.table_h, focal, &trig, err);
+    ok = ok && mr_rig_make(&trp, (double)p->table_w / p->table_h, m->focal, &trig, err);
     mr_display_map tmap = mr_display_from_rig(&trig, 4);
     for (int s = 0; ok && s < 3; s++) {
-        mr_scene *sc = s == 0 ? hall.planned : s == 1 ? hall.built : synth;
-        mr_view vc = centre;
+        mr_scene *sc = s == 0 ? m->hall.planned : s == 1 ? m->hall.built : synth;
+        mr_view vc = m->centre;
         if (s == 2) vc.world_from_camera = mr_synth_viewpoint(&sp, MR_SYNTH_VIEW_AISLE);
-        mr_view v = mr_rig_view(&trig, &vc, 0, p.table_w, p.table_h);
-        ok = mr_renderer_set_scene(r, sc, err);
+        mr_view v = mr_rig_view(&trig, &vc, 0, p->table_w, p->table_h);
+        ok = mr_renderer_set_scene(m->r, sc, err);
         mr_frame_params f0 = MR_FRAME_DEFAULTS;
-        f0.width = p.table_w;
-        f0.height = p.table_h;
+        f0.width = p->table_w;
+        f0.height = p->table_h;
         f0.display = &tmap;
         mr_frame_params f1 = f0;
         f1.ao.method = MR_AO_CRYTEK; /* Mittring's, as the paper */
         f1.ao.positions = true;
         f1.ao.no_reuse = true;
-        ok = ok && time_frame(r, &v, &f0, p.frames, &t_no[s], err) && time_frame(r, &v, &f1, p.frames, &t_ao[s], err);
+        ok = ok && time_frame(m->r, &v, &f0, p->frames, &m->t_no[s], err) &&
+             time_frame(m->r, &v, &f1, p->frames, &m->t_ao[s], err);
         if (ok) {
             mr_frame_result res;
-            if ((ok = mr_render_frame(r, &v, &f0, &res, err))) t_tris[s] = res.triangles;
+            if ((ok = mr_render_frame(m->r, &v, &f0, &res, err))) m->t_tris[s] = res.triangles;
             mr_frame_result_free(&res);
         }
-        mr_renderer_set_scene(r, NULL, NULL);
+        mr_renderer_set_scene(m->r, NULL, NULL);
     }
     mr_scene_destroy(&synth);
-    mr_demo_free(&hall);
-    if (!ok) return false;
+    return ok;
+}
 
-    /* CSV, plot, markdown. */
+/* bench_multiview.csv, _display.csv and _table1.csv. */
+static bool mv_write_csvs(const mv_run *m, mr_error *err) {
+    const mr_bench_multiview_params *p = &m->p;
     char path[4096];
     mr_csv *csv = mr_csv_create(err);
     if (!csv) return false;
@@ -517,8 +488,8 @@ bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err) 
     mr_csv_header(csv, "mode,views,width,height,ms_frame,ms_per_view,ao_rmse_pinhole,ao_rmse_display,"
                        "consistency_rmse_world,consistency_rmse_pixel,consistency_rmse_world_noblur,"
                        "consistency_rmse_pixel_noblur,shared_fraction");
-    for (int i = 0; i < nrows; i++) {
-        const row *rw = &rows[i];
+    for (int i = 0; i < m->nrows; i++) {
+        const row *rw = &m->rows[i];
         mr_csv_text(csv, rw->mode);
         mr_csv_int(csv, rw->views);
         mr_csv_int(csv, rw->w);
@@ -534,65 +505,66 @@ bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err) 
         mr_csv_num(csv, "%.3f", rw->shared);
         mr_csv_end_row(csv);
     }
-    mr_path_join(p.out_dir, "bench_multiview.csv", path, sizeof path);
+    mr_path_join(p->out_dir, "bench_multiview.csv", path, sizeof path);
+    bool ok = mr_csv_save(csv, path, err);
+    mr_csv_destroy(&csv);
+    if (!ok || !(csv = mr_csv_create(err))) return false;
+    mr_csv_header(csv, "band,width,height,ms_frame,column_error_mean_px,column_error_max_px,ao_rmse_display");
+    for (int b = 0; b < 3; b++) {
+        mr_csv_int(csv, k_bands[b]);
+        mr_csv_int(csv, p->view_w);
+        mr_csv_int(csv, p->view_h);
+        mr_csv_num(csv, "%.2f", m->band_ms[b]);
+        mr_csv_num(csv, "%.4f", m->band_err_mean[b]);
+        mr_csv_num(csv, "%.4f", m->band_err_max[b]);
+        mr_csv_num(csv, "%.4f", m->band_ao[b]);
+        mr_csv_end_row(csv);
+    }
+    mr_path_join(p->out_dir, "bench_multiview_display.csv", path, sizeof path);
     ok = mr_csv_save(csv, path, err);
     mr_csv_destroy(&csv);
-    if (ok && (csv = mr_csv_create(err))) {
-        mr_csv_header(csv, "band,width,height,ms_frame,column_error_mean_px,column_error_max_px,ao_rmse_display");
-        for (int b = 0; b < 3; b++) {
-            mr_csv_int(csv, k_bands[b]);
-            mr_csv_int(csv, p.view_w);
-            mr_csv_int(csv, p.view_h);
-            mr_csv_num(csv, "%.2f", band_ms[b]);
-            mr_csv_num(csv, "%.4f", band_err_mean[b]);
-            mr_csv_num(csv, "%.4f", band_err_max[b]);
-            mr_csv_num(csv, "%.4f", band_ao[b]);
-            mr_csv_end_row(csv);
-        }
-        mr_path_join(p.out_dir, "bench_multiview_display.csv", path, sizeof path);
-        ok = mr_csv_save(csv, path, err);
-        mr_csv_destroy(&csv);
-    } else {
-        ok = false;
+    if (!ok || !(csv = mr_csv_create(err))) return false;
+    mr_csv_header(csv, "scene,triangles,width,height,ms_no_ssao,ms_ssao,ms_difference");
+    for (int s = 0; s < 3; s++) {
+        mr_csv_quoted(csv, k_table_scenes[s]);
+        mr_csv_int(csv, (long long)m->t_tris[s]);
+        mr_csv_int(csv, p->table_w);
+        mr_csv_int(csv, p->table_h);
+        mr_csv_num(csv, "%.2f", m->t_no[s]);
+        mr_csv_num(csv, "%.2f", m->t_ao[s]);
+        mr_csv_num(csv, "%.2f", m->t_ao[s] - m->t_no[s]);
+        mr_csv_end_row(csv);
     }
-    if (ok && (csv = mr_csv_create(err))) {
-        mr_csv_header(csv, "scene,triangles,width,height,ms_no_ssao,ms_ssao,ms_difference");
-        for (int s = 0; s < 3; s++) {
-            mr_csv_quoted(csv, tnames[s]);
-            mr_csv_int(csv, (long long)t_tris[s]);
-            mr_csv_int(csv, p.table_w);
-            mr_csv_int(csv, p.table_h);
-            mr_csv_num(csv, "%.2f", t_no[s]);
-            mr_csv_num(csv, "%.2f", t_ao[s]);
-            mr_csv_num(csv, "%.2f", t_ao[s] - t_no[s]);
-            mr_csv_end_row(csv);
-        }
-        mr_path_join(p.out_dir, "bench_multiview_table1.csv", path, sizeof path);
-        ok = mr_csv_save(csv, path, err);
-        mr_csv_destroy(&csv);
-    } else {
-        ok = false;
-    }
-    /* ms per view against the number of views, both ways. */
+    mr_path_join(p->out_dir, "bench_multiview_table1.csv", path, sizeof path);
+    ok = mr_csv_save(csv, path, err);
+    mr_csv_destroy(&csv);
+    return ok;
+}
+
+/* bench_multiview.svg: ms per view against the number of views, both ways. */
+static bool mv_write_plot(const mv_run *m, mr_error *err) {
     double xs[2][4], ys[2][4];
     int cnt[2] = {0, 0};
-    for (int i = 0; i < nrows; i++) {
-        int m = strcmp(rows[i].mode, "budget") == 0 ? 0 : 1;
-        xs[m][cnt[m]] = rows[i].views;
-        ys[m][cnt[m]] = rows[i].ms_view;
-        cnt[m]++;
+    for (int i = 0; i < m->nrows; i++) {
+        int k = strcmp(m->rows[i].mode, "budget") == 0 ? 0 : 1;
+        xs[k][cnt[k]] = m->rows[i].views;
+        ys[k][cnt[k]] = m->rows[i].ms_view;
+        cnt[k]++;
     }
-    char s0[96], s1[96];
-    snprintf(s0, sizeof s0, "total %dx%d px", p.budget_w, p.budget_h);
-    snprintf(s1, sizeof s1, "%dx%d px per view", p.view_w, p.view_h);
+    char s0[96], s1[96], path[4096];
+    snprintf(s0, sizeof s0, "total %dx%d px", m->p.budget_w, m->p.budget_h);
+    snprintf(s1, sizeof s1, "%dx%d px per view", m->p.view_w, m->p.view_h);
     mr_plot_series ser[2] = {{.name = s0, .x = xs[0], .y = ys[0], .count = cnt[0]},
                              {.name = s1, .x = xs[1], .y = ys[1], .count = cnt[1], .mark = MR_PLOT_MARK_SQUARE}};
     mr_plot_params pp = {.title = "mrcheck bench multiview: ms per view (median, crytek AO, llvmpipe)",
                          .xlabel = "views", .ylabel = "ms per view", .log_x = true, .log_y = true};
-    mr_path_join(p.out_dir, "bench_multiview.svg", path, sizeof path);
-    ok = ok && mr_plot_write(path, &pp, ser, 2, err);
+    mr_path_join(m->p.out_dir, "bench_multiview.svg", path, sizeof path);
+    return mr_plot_write(path, &pp, ser, 2, err);
+}
 
-    /* The tables, as markdown and on `out`. */
+/* bench_multiview.md, the three tables, also printed on p.out. */
+static bool mv_write_markdown(const mv_run *m, mr_error *err) {
+    const mr_bench_multiview_params *p = &m->p;
     size_t cap = 16384, len = 0;
     char *md = malloc(cap);
     if (!md) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
@@ -604,29 +576,88 @@ bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err) 
        "of view i's AO reprojected into view i+1 through the depth, mean over neighbouring pairs, with the "
        "default blur (what is shown) and without (the noise itself); world = the kernel rotation hashed from the "
        "position in the centre camera's pixel grid (4 px cells), pixel = hashed from the pixel.\n\n",
-       mr_gpu_description(p.gfx.gpu), radius, focal, p.frames, p.rays);
+       mr_gpu_description(p->gfx.gpu), m->radius, m->focal, p->frames, p->rays);
     MD("| mode | views | size | ms/frame | ms/view | AO RMSE pinhole | AO RMSE display | consistency world | "
        "consistency pixel | no blur: world | no blur: pixel |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
-    for (int i = 0; i < nrows; i++)
-        MD("| %s | %d | %dx%d | %.1f | %.2f | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f |\n", rows[i].mode, rows[i].views,
-           rows[i].w, rows[i].h, rows[i].ms_frame, rows[i].ms_view, rows[i].err_pin, rows[i].err_disp, rows[i].cons_world,
-           rows[i].cons_pixel, rows[i].cons_world0, rows[i].cons_pixel0);
+    for (int i = 0; i < m->nrows; i++) {
+        const row *rw = &m->rows[i];
+        MD("| %s | %d | %dx%d | %.1f | %.2f | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f |\n", rw->mode, rw->views, rw->w,
+           rw->h, rw->ms_frame, rw->ms_view, rw->err_pin, rw->err_disp, rw->cons_world, rw->cons_pixel, rw->cons_world0,
+           rw->cons_pixel0);
+    }
     MD("\n## The display mapping's slices (%dx%d)\n\n| band (columns) | ms/frame | column error mean px | max px | AO "
        "RMSE |\n|---|---|---|---|---|\n",
-       p.view_w, p.view_h);
+       p->view_w, p->view_h);
     for (int b = 0; b < 3; b++)
-        MD("| %d | %.1f | %.4f | %.3f | %.4f |\n", k_bands[b], band_ms[b], band_err_mean[b], band_err_max[b], band_ao[b]);
+        MD("| %d | %.1f | %.4f | %.3f | %.4f |\n", k_bands[b], m->band_ms[b], m->band_err_mean[b], m->band_err_max[b],
+           m->band_ao[b]);
     MD("\n## Doronin et al.'s Table 1 on this machine (%dx%d, one optical module through the display mapping, 4-column "
        "slices; crytek with the positions texture)\n\n| scene | triangles | no SSAO ms | SSAO ms | "
        "difference |\n|---|---|---|---|---|\n",
-       p.table_w, p.table_h);
+       p->table_w, p->table_h);
     for (int s = 0; s < 3; s++)
-        MD("| %s | %llu | %.1f | %.1f | %.1f |\n", tnames[s], (unsigned long long)t_tris[s], t_no[s], t_ao[s],
-           t_ao[s] - t_no[s]);
+        MD("| %s | %llu | %.1f | %.1f | %.1f |\n", k_table_scenes[s], (unsigned long long)m->t_tris[s], m->t_no[s],
+           m->t_ao[s], m->t_ao[s] - m->t_no[s]);
 #undef MD
-    mr_path_join(p.out_dir, "bench_multiview.md", path, sizeof path);
-    ok = ok && mr_file_write_atomic(path, md, len < cap ? len : cap - 1, err);
-    if (ok) BENCH_PRINT(out, "%.*s\nwrote %s/bench_multiview{.csv,.svg,.md,_display.csv,_table1.csv}\n", (int)len, md, p.out_dir);
+    char path[4096];
+    mr_path_join(p->out_dir, "bench_multiview.md", path, sizeof path);
+    bool ok = mr_file_write_atomic(path, md, len < cap ? len : cap - 1, err);
+    if (ok) BENCH_PRINT(p->out, "%.*s\nwrote %s/bench_multiview{.csv,.svg,.md,_display.csv,_table1.csv}\n", (int)len, md,
+                        p->out_dir);
     free(md);
+    return ok;
+}
+
+/* The shared-work table alone (--shared). */
+static bool mv_shared_only(mv_run *m, mr_error *err) {
+    mr_synth_params sp = MR_SYNTH_DEFAULTS;
+    mr_scene *synth = mr_synth_build(&sp, err);
+    bool ok = synth != NULL;
+    if (ok) {
+        mr_scene *sc[2] = {m->hall.planned, synth};
+        const char *nm[2] = {"demo hall (planned)", "synthetic factory"};
+        mr_view vs[2] = {m->centre, m->centre};
+        vs[1].world_from_camera = mr_synth_viewpoint(&sp, MR_SYNTH_VIEW_AISLE);
+        ok = bench_shared(&m->p, sc, nm, vs, err);
+    }
+    mr_scene_destroy(&synth);
+    return ok;
+}
+
+bool mr_bench_multiview(const mr_bench_multiview_params *params, mr_error *err) {
+    mv_run *m = calloc(1, sizeof *m);
+    if (!m) return mr_fail(err, MR_ERR_NOMEM, "out of memory");
+    mr_bench_multiview_params *p = &m->p;
+    *p = (mr_bench_multiview_params){MR_BENCH_MULTIVIEW_DEFAULTS};
+    if (params) *p = *params;
+    const mr_bench_multiview_params dflt = {MR_BENCH_MULTIVIEW_DEFAULTS};
+    if (!p->out_dir) p->out_dir = dflt.out_dir;
+    if (p->budget_w <= 0 || p->budget_h <= 0) p->budget_w = dflt.budget_w, p->budget_h = dflt.budget_h;
+    if (p->view_w <= 0 || p->view_h <= 0) p->view_w = dflt.view_w, p->view_h = dflt.view_h;
+    if (p->table_w <= 0 || p->table_h <= 0) p->table_w = dflt.table_w, p->table_h = dflt.table_h;
+    if (p->frames <= 0) p->frames = dflt.frames;
+    if (p->rays <= 0) p->rays = dflt.rays;
+    m->r = p->gfx.renderer;
+    bool ok = bench_gpu_check(&p->gfx, "bench multiview", err) && mr_mkdirs(p->out_dir, err) &&
+              mr_demo_build_tagged(NULL, 0, &m->hall, err);
+    if (ok) {
+        m->centre = p->view ? *p->view : mr_demo_view(0);
+        memset(m->centre.camera.dist, 0, sizeof m->centre.camera.dist);
+    }
+    if (ok && p->shared_only) {
+        ok = mv_shared_only(m, err);
+    } else if (ok) {
+        ok = mv_setup(m, err);
+        int nviews = p->quick ? 2 : 4;
+        for (int mode = 0; ok && mode < 2; mode++)
+            for (int k = 0; ok && k < nviews; k++) ok = mv_rig_row(m, mode, k_views[k], &m->rows[m->nrows++], err);
+        for (int b = 0; ok && b < 3; b++) ok = mv_band(m, b, err);
+        mr_eval_gt_destroy(&m->gt);
+        mr_renderer_set_scene(m->r, NULL, NULL);
+        ok = ok && mv_table1(m, err) && mv_write_csvs(m, err) && mv_write_plot(m, err) && mv_write_markdown(m, err);
+    }
+    mr_eval_gt_destroy(&m->gt);
+    mr_demo_free(&m->hall);
+    free(m);
     return ok;
 }
