@@ -18,14 +18,11 @@
 static mr_gpu *g_gpu;
 static mr_renderer *g_r;
 
-/* RMSE over geometry pixels (depth > 0). */
+/* RMSE over geometry pixels (depth > 0); 1e9 where there are none. */
 static double rmse_geo(const mr_image *a, const mr_image *b, const mr_image *depth) {
-    const float *x = a->data, *y = b->data, *d = depth->data;
-    double se = 0;
-    int n = 0;
-    for (int i = 0; i < a->width * a->height; i++)
-        if (d[i] > 0) se += ((double)x[i] - y[i]) * ((double)x[i] - y[i]), n++;
-    return n ? sqrt(se / n) : 1e9;
+    mr_image_metrics m;
+    mr_error e = {0};
+    return mr_image_compare(a, b, depth, &m, &e) && m.count > 0 ? m.rmse : 1e9;
 }
 
 static void test_pass_list(void) {
