@@ -279,6 +279,56 @@ static bool write_bytes(const char *path, const unsigned char *d, size_t n) {
     return fclose(f) == 0 && ok;
 }
 
+typedef struct progress_log {
+    int calls, stop_at;
+    double last;
+    bool monotone;
+} progress_log;
+
+static bool log_progress(void *user, double fraction) {
+    progress_log *p = user;
+    if (fraction < p->last || fraction > 1) p->monotone = false;
+    p->last = fraction;
+    return ++p->calls != p->stop_at;
+}
+
+/* A build stopped by its progress callback (as SIGINT stops the
+ * commands') ends with MR_ERR_INTERRUPTED and writes no cache; a whole
+ * build reports rising fractions up to 1. */
+static void test_interrupt(void) {
+    mr_scene *s = cad(1, 0, 8, 600);
+    CHECK(s != NULL);
+    if (!s) return;
+    mr_error err = {0};
+    mr_lod_params lp = MR_LOD_DEFAULTS;
+    mr_lod *lod = mr_lod_build(s, &lp, &err);
+    char path[4096];
+    snprintf(path, sizeof path, "%s/test_hlod_stop.mrhlod", tmp_dir());
+    remove(path);
+    progress_log pl = {0, 3, 0, true};
+    mr_hlod_params hp = MR_HLOD_DEFAULTS;
+    hp.on_progress = log_progress;
+    hp.progress_user = &pl;
+    hp.threads = 1;
+    mr_hlod_info info;
+    mr_hlod *h = mr_hlod_load_or_build(s, lod, path, &hp, &info, &err);
+    CHECK_MSG(!h && err.code == MR_ERR_INTERRUPTED, "stopped build: %p, error %d", (void *)h, (int)err.code);
+    CHECK(pl.calls == 3);
+    FILE *f = fopen(path, "rb");
+    CHECK(f == NULL); /* nothing half-written */
+    if (f) fclose(f);
+    mr_hlod_destroy(&h);
+    pl = (progress_log){0, -1, 0, true};
+    err = (mr_error){0};
+    h = mr_hlod_load_or_build(s, lod, path, &hp, &info, &err);
+    CHECK_MSG(h && info.cache_written, "%s", err.msg);
+    CHECK(pl.monotone && pl.calls > 3 && pl.last == 1.0);
+    mr_hlod_destroy(&h);
+    remove(path);
+    mr_lod_destroy(&lod);
+    mr_scene_destroy(&s);
+}
+
 static void test_cache(void) {
     mr_scene *s = cad(1, 0, 8, 600);
     CHECK(s != NULL);
@@ -354,5 +404,6 @@ int main(void) {
     test_bound(1, 1e7);
     test_units();
     test_cache();
+    test_interrupt();
     return mr_test_finish("test_hlod");
 }
