@@ -1240,6 +1240,97 @@ static void test_big_files(void) {
     unlink(path);
 }
 
+/* Non-tight strides out of EXT_meshopt_compression: (a) one ATTRIBUTES
+ * view of 24-byte elements holding float POSITION and NORMAL interleaved
+ * (accessor offsets 0 and 12); (b) with KHR_mesh_quantization, unsigned
+ * short positions in 8-byte elements and normalised byte normals in
+ * 4-byte elements, each padded with junk that a tight read would take for
+ * a component. Each vertex must come back as written. */
+static void test_meshopt_strides(void) {
+    float pos[48];
+    uint32_t idx[54];
+    grid(pos, idx);
+    float inter[16 * 6];
+    float nrm[48];
+    for (int i = 0; i < 16; i++) {
+        double a = 0.1 * i;
+        nrm[3 * i] = (float)sin(a), nrm[3 * i + 1] = 0, nrm[3 * i + 2] = (float)cos(a);
+        for (int k = 0; k < 3; k++) inter[6 * i + k] = pos[3 * i + k], inter[6 * i + 3 + k] = nrm[3 * i + k];
+    }
+    uint16_t qpos[16][4];
+    int8_t qnrm[16][4];
+    for (int i = 0; i < 16; i++) {
+        qpos[i][0] = (uint16_t)(i % 4 * 100), qpos[i][1] = (uint16_t)(i / 4 * 100), qpos[i][2] = (uint16_t)(i * 7);
+        qpos[i][3] = 0xBEEF;
+        qnrm[i][0] = (int8_t)(i % 2 ? 127 : 0), qnrm[i][1] = 0, qnrm[i][2] = (int8_t)(i % 2 ? 0 : 127), qnrm[i][3] = 0x55;
+    }
+    unsigned char ib[1024];
+    size_t in = meshopt_encodeIndexBuffer(ib, sizeof ib, idx, 54);
+    for (int variant = 0; variant < 2; variant++) {
+        unsigned char bin[4096], v0[2048], v1[2048];
+        size_t n0, n1 = 0;
+        if (variant == 0) n0 = meshopt_encodeVertexBuffer(v0, sizeof v0, inter, 16, 24);
+        else {
+            n0 = meshopt_encodeVertexBuffer(v0, sizeof v0, qpos, 16, 8);
+            n1 = meshopt_encodeVertexBuffer(v1, sizeof v1, qnrm, 16, 4);
+        }
+        CHECK(n0 > 0 && in > 0 && (variant == 0 || n1 > 0));
+        size_t p0 = (n0 + 3) & ~(size_t)3, p1 = (n1 + 3) & ~(size_t)3;
+        memset(bin, 0, sizeof bin);
+        memcpy(bin, v0, n0);
+        memcpy(bin + p0, v1, n1);
+        memcpy(bin + p0 + p1, ib, in);
+        size_t bn = p0 + p1 + in;
+        char json[4096];
+        if (variant == 0)
+            snprintf(json, sizeof json,
+                     "{%s\"extensionsUsed\":[\"EXT_meshopt_compression\"],\"extensionsRequired\":[\"EXT_meshopt_compression\"],"
+                     "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}],"
+                     "\"buffers\":[{\"byteLength\":%zu},{\"byteLength\":600,\"extensions\":{\"EXT_meshopt_compression\":{\"fallback\":true}}}],"
+                     "\"bufferViews\":[{\"buffer\":1,\"byteLength\":384,\"byteStride\":24,\"extensions\":{\"EXT_meshopt_compression\":"
+                     "{\"buffer\":0,\"byteLength\":%zu,\"byteStride\":24,\"count\":16,\"mode\":\"ATTRIBUTES\"}}},"
+                     "{\"buffer\":1,\"byteOffset\":384,\"byteLength\":108,\"extensions\":{\"EXT_meshopt_compression\":"
+                     "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":2,\"count\":54,\"mode\":\"TRIANGLES\"}}}],"
+                     "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":16,\"type\":\"VEC3\"},"
+                     "{\"bufferView\":0,\"byteOffset\":12,\"componentType\":5126,\"count\":16,\"type\":\"VEC3\"},"
+                     "{\"bufferView\":1,\"componentType\":5123,\"count\":54,\"type\":\"SCALAR\"}]}",
+                     k_head, bn, n0, p0 + p1, in);
+        else
+            snprintf(json, sizeof json,
+                     "{%s\"extensionsUsed\":[\"EXT_meshopt_compression\",\"KHR_mesh_quantization\"],"
+                     "\"extensionsRequired\":[\"EXT_meshopt_compression\",\"KHR_mesh_quantization\"],"
+                     "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}],"
+                     "\"buffers\":[{\"byteLength\":%zu},{\"byteLength\":600,\"extensions\":{\"EXT_meshopt_compression\":{\"fallback\":true}}}],"
+                     "\"bufferViews\":[{\"buffer\":1,\"byteLength\":128,\"byteStride\":8,\"extensions\":{\"EXT_meshopt_compression\":"
+                     "{\"buffer\":0,\"byteLength\":%zu,\"byteStride\":8,\"count\":16,\"mode\":\"ATTRIBUTES\"}}},"
+                     "{\"buffer\":1,\"byteOffset\":128,\"byteLength\":64,\"byteStride\":4,\"extensions\":{\"EXT_meshopt_compression\":"
+                     "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":4,\"count\":16,\"mode\":\"ATTRIBUTES\"}}},"
+                     "{\"buffer\":1,\"byteOffset\":192,\"byteLength\":108,\"extensions\":{\"EXT_meshopt_compression\":"
+                     "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"byteStride\":2,\"count\":54,\"mode\":\"TRIANGLES\"}}}],"
+                     "\"accessors\":[{\"bufferView\":0,\"componentType\":5123,\"count\":16,\"type\":\"VEC3\"},"
+                     "{\"bufferView\":1,\"componentType\":5120,\"normalized\":true,\"count\":16,\"type\":\"VEC3\"},"
+                     "{\"bufferView\":2,\"componentType\":5123,\"count\":54,\"type\":\"SCALAR\"}]}",
+                     k_head, bn, n0, p0, n1, p0 + p1, in);
+        mr_error err = {0};
+        mr_scene *s = load_glb(json, bin, bn, &err);
+        CHECK_MSG(s != NULL, "strides variant %d: %s", variant, err.msg);
+        if (!s) continue;
+        const mr_mesh *m = &s->meshes[0];
+        CHECK_MSG(m->vertex_count == 16 && m->index_count == 54 && m->normals, "strides variant %d: %u vertices",
+                  variant, m->vertex_count);
+        double wp = 0, wn = 0;
+        for (int i = 0; i < 16 && m->vertex_count == 16 && m->normals; i++)
+            for (int k = 0; k < 3; k++) {
+                double want_p = variant == 0 ? pos[3 * i + k] : qpos[i][k];
+                double want_n = variant == 0 ? nrm[3 * i + k] : qnrm[i][k] / 127.0;
+                wp = fmax(wp, fabs(m->positions[3 * i + k] + m->origin[k] - want_p));
+                wn = fmax(wn, fabs(m->normals[3 * i + k] - want_n));
+            }
+        CHECK_MSG(wp < 1e-5 && wn < 1e-6, "strides variant %d: positions off by %g, normals by %g", variant, wp, wn);
+        mr_scene_destroy(&s);
+    }
+}
+
 int main(void) {
     const char *tmp = getenv("MR_TEST_TMP");
     snprintf(g_tmp, sizeof g_tmp, "%s/gltf_ext", tmp && tmp[0] ? tmp : "/tmp/mrcheck_test");
@@ -1258,6 +1349,7 @@ int main(void) {
     test_meshopt_shared();
     test_meshopt_slices();
     test_meshopt_big();
+    test_meshopt_strides();
     test_pipeline();
     test_draco();
     test_texture_transform();

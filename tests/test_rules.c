@@ -3,6 +3,8 @@
  * only the fixtures' one scene reaches is otherwise never seen to switch. */
 #include "cluster_cache.h"
 #include "mr_render.h"
+#include "mr_scene.h"
+#include "occ_rule.h"
 #include "mr_test.h"
 
 /* Sun cascades: one more per factor 16 of far over near visible depth, at
@@ -67,8 +69,119 @@ static void test_cluster_key(void) {
     CHECK(clu_level_key(pos, nv, idx, ni, 4097) != k);
 }
 
+/* Automatic occlusion culling on injected timings: a read-back of 1 ms
+ * alone, 2 ms while 1000 occluder triangles are drawn (1 us each). */
+static void test_occlusion_rule(void) {
+    /* the gain: skipped x cost per triangle - read-back - CPU test */
+    CHECK(fabs(occ_auto_gain_ms(1, 2, 0.25, 1000, 3000) - (3 - 1 - 0.25)) < 1e-12);
+    CHECK(fabs(occ_auto_gain_ms(-1, 2, 0, 1000, 3000) - 6) < 1e-12); /* no read-back measured: 0 */
+    CHECK(occ_auto_gain_ms(1, 0.5, 0, 1000, 3000) == -1);            /* sync under the read-back: no cost per tri */
+    CHECK(occ_auto_gain_ms(1, 2, 0, 0, 3000) == -1);                 /* no occluders */
+    /* A new upload tests the first frame and keeps testing while it pays. */
+    occ_auto s;
+    occ_auto_reset(&s);
+    CHECK(occ_auto_frame(&s) && occ_auto_frame(&s));
+    occ_auto_learn(&s, 1, 2, 0, 1000, 5000);
+    CHECK(s.on && s.probe == -1 && fabs(s.gain_ms - 4) < 1e-12);
+    /* Both sides of the hysteresis: on while the gain is above -10 % of
+     * the read-back, off below (from a fresh measurement each). */
+    occ_auto_reset(&s);
+    occ_auto_learn(&s, 1, 2, 0, 1000, 910); /* gain -0.09 */
+    CHECK_MSG(s.on, "a gain of -0.09 ms against a 1 ms read-back turned the test off");
+    occ_auto_reset(&s);
+    occ_auto_learn(&s, 1, 2, 0, 1000, 890); /* gain -0.11 */
+    CHECK_MSG(!s.on && s.probe == OCC_PROBE_FRAMES, "a gain of -0.11 ms kept the test on");
+    /* While on, the gain is smoothed: one bad frame after a good one
+     * (4 then -1) averages to 1.5 and stays on; two more turn it off. */
+    occ_auto_reset(&s);
+    occ_auto_learn(&s, 1, 2, 0, 1000, 5000);
+    occ_auto_learn(&s, 1, 2, 0, 1000, 0);
+    CHECK(s.on && fabs(s.gain_ms - 1.5) < 1e-12);
+    occ_auto_learn(&s, 1, 2, 0, 1000, 0);
+    CHECK(s.on && fabs(s.gain_ms - 0.25) < 1e-12);
+    occ_auto_learn(&s, 1, 2, 0, 1000, 0);
+    CHECK(!s.on);
+    /* Off: no test for OCC_PROBE_FRAMES - 1 frames, then one trial. */
+    int quiet = 0;
+    while (!occ_auto_frame(&s) && quiet < 1000) quiet++;
+    CHECK_MSG(quiet == OCC_PROBE_FRAMES - 1, "%d frames without a trial", quiet);
+    /* A trial starts afresh: a paying trial turns it on at once, however
+     * bad the frames before it were. */
+    s.gain_ms = -100;
+    occ_auto_learn(&s, 1, 2, 0, 1000, 3000);
+    CHECK(s.on && fabs(s.gain_ms - 2) < 1e-12);
+    /* A failing trial turns it off for another round. */
+    occ_auto_learn(&s, 1, 2, 0, 1000, 0);
+    occ_auto_learn(&s, 1, 2, 0, 1000, 0);
+    occ_auto_learn(&s, 1, 2, 0, 1000, 0);
+    CHECK(!s.on);
+    quiet = 0;
+    while (!occ_auto_frame(&s) && quiet < 1000) quiet++;
+    occ_auto_learn(&s, 1, 2, 0, 1000, 500); /* gain -0.5 */
+    CHECK(!s.on && s.probe == OCC_PROBE_FRAMES);
+}
+
+/* Levels of detail at all (--lod auto|on|off): auto gives them to scenes
+ * drawing MR_LOD_AUTO_TRIANGLES or more, counted per drawn node (a mesh
+ * drawn twice counts twice), on and off whatever the scene. */
+static void test_lod_rule(void) {
+    mr_mesh meshes[2];
+    mr_node nodes[3];
+    memset(meshes, 0, sizeof meshes);
+    memset(nodes, 0, sizeof nodes);
+    mr_scene s;
+    memset(&s, 0, sizeof s);
+    s.meshes = meshes;
+    s.nodes = nodes;
+    s.mesh_count = 2;
+    const uint32_t T = MR_LOD_AUTO_TRIANGLES;
+    meshes[0].index_count = 3 * (T / 2);
+    meshes[1].index_count = 3;
+    nodes[0] = (mr_node){.mesh_first = 0, .mesh_count = 1, .parent = -1};
+    nodes[1] = (mr_node){.mesh_first = 0, .mesh_count = 1, .parent = -1};
+    nodes[2] = (mr_node){.mesh_first = 1, .mesh_count = 1, .parent = -1};
+    s.node_count = 2; /* T / 2 stored, T drawn */
+    CHECK(mr_scene_triangle_count(&s) == T);
+    CHECK_MSG(mr_lod_wanted(MR_LOD_MODE_AUTO, &s), "a scene drawing %u triangles got no levels", T);
+    meshes[0].index_count -= 3; /* T - 2 drawn */
+    CHECK(!mr_lod_wanted(MR_LOD_MODE_AUTO, &s));
+    s.node_count = 3; /* + 1 */
+    CHECK(!mr_lod_wanted(MR_LOD_MODE_AUTO, &s));
+    meshes[1].index_count = 6; /* + 2: T */
+    CHECK(mr_lod_wanted(MR_LOD_MODE_AUTO, &s));
+    CHECK(!mr_lod_wanted(MR_LOD_MODE_OFF, &s));
+    s.node_count = 0;
+    CHECK(!mr_lod_wanted(MR_LOD_MODE_AUTO, &s));
+    CHECK(mr_lod_wanted(MR_LOD_MODE_ON, &s));
+    mr_lod_mode m;
+    mr_error err = {0};
+    CHECK(mr_lod_mode_parse(NULL, &m, &err) && m == MR_LOD_MODE_AUTO);
+    CHECK(mr_lod_mode_parse("on", &m, &err) && m == MR_LOD_MODE_ON);
+    CHECK(mr_lod_mode_parse("off", &m, &err) && m == MR_LOD_MODE_OFF);
+    CHECK(!mr_lod_mode_parse("yes", &m, &err));
+}
+
+/* The hierarchy above the parts: auto needs both MR_HLOD_AUTO_TRIANGLES
+ * drawn and MR_HLOD_AUTO_NODES nodes; on needs two nodes; off never. */
+static void test_hlod_rule(void) {
+    const uint64_t T = MR_HLOD_AUTO_TRIANGLES;
+    const int32_t N = MR_HLOD_AUTO_NODES;
+    CHECK(mr_hlod_wanted("auto", T, N));
+    CHECK(mr_hlod_wanted(NULL, T, N));
+    CHECK_MSG(!mr_hlod_wanted("auto", T - 1, N), "one triangle under the threshold");
+    CHECK_MSG(!mr_hlod_wanted("auto", T, N - 1), "one node under the threshold");
+    CHECK(!mr_hlod_wanted(NULL, 100 * T, N - 1));
+    CHECK(!mr_hlod_wanted(NULL, T - 1, 100 * N));
+    CHECK(mr_hlod_wanted("on", 6, 2));
+    CHECK(!mr_hlod_wanted("on", 100 * T, 1));
+    CHECK(!mr_hlod_wanted("off", 100 * T, 100 * N));
+}
+
 int main(void) {
     test_cascade_count();
     test_cluster_key();
+    test_occlusion_rule();
+    test_lod_rule();
+    test_hlod_rule();
     return mr_test_finish("test_rules");
 }

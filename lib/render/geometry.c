@@ -18,6 +18,7 @@
  * on the GPU. */
 #include "geo_internal.h"
 #include "cluster_cache.h"
+#include "occ_rule.h"
 
 #include <math.h>
 #include <meshoptimizer.h>
@@ -82,10 +83,7 @@ struct mr_geo {
     float *depth, *hz;
     size_t depth_cap, hz_cap, hz_off[24];
     int hz_w[24], hz_h[24];
-    /* The automatic decision (see occlusion_wanted) */
-    bool occ_auto_on;              /* test this frame */
-    int occ_probe;                 /* frames until the next trial while off */
-    double occ_gain_ms;            /* smoothed measured gain (saved - cost) */
+    occ_auto occ;                  /* the automatic decision (occ_rule.h) */
     double occ_rb_ms;              /* read-back of a finished frame, ms (< 0: not measured) */
     int occ_rb_w, occ_rb_h;
     geo_cluster *clusters;
@@ -462,7 +460,7 @@ static bool upload(mr_renderer *r, const mr_scene *s, const mr_lod *lod, mr_erro
         int32_t thr = r->draw.cluster_triangles > 0 ? r->draw.cluster_triangles : MR_DRAW_DEFAULT_CLUSTER_TRIANGLES;
         if (g->cc) clu_cache_open(g->cc, r->cluster_cache, (uint32_t)thr);
     }
-    g->occ_auto_on = true; /* the first frames measure */
+    occ_auto_reset(&g->occ); /* the first frames measure */
     g->occ_rb_ms = -1;
     size_t nm = (size_t)s->mesh_count, nn = (size_t)s->node_count;
     g->mesh_count = s->mesh_count;
@@ -1249,41 +1247,12 @@ static const share_list *shared_list(mr_renderer *r, uint32_t mask) {
     return l;
 }
 
-/* Automatic occlusion culling: the test pays when the triangles
- * it skips cost more to draw than the test costs. Both are measured on the
- * frames that run it: the read-back waits for the occluders to be drawn, so
- * its time minus that of a read-back alone (measured once per size, after a
- * glFinish) is what drawing the occluders cost, hence a cost per triangle;
- * the gain is the skipped triangles (at the frame's LOD ratio) times that,
- * minus the read-back alone and the CPU test. Smoothed over frames, with
- * hysteresis: the test stays on while the gain is positive and goes off
- * when it turns negative by more than 10 % of the read-back; while off, one
- * frame in 32 tries it again (the view may have moved into a hall). */
-#define OCC_PROBE_FRAMES 32
-
-static void occlusion_learn(struct mr_geo *g, double sync_ms, double cpu_ms, uint64_t occluder_tris,
-                            uint64_t skipped_tris) {
-    double rb = g->occ_rb_ms > 0 ? g->occ_rb_ms : 0;
-    double per_tri = occluder_tris > 0 ? fmax(sync_ms - rb, 0) / (double)occluder_tris : 0;
-    double gain = (double)skipped_tris * per_tri - rb - cpu_ms;
-    g->occ_gain_ms = g->occ_probe >= 0 ? gain : 0.5 * g->occ_gain_ms + 0.5 * gain; /* a trial starts afresh */
-    if (g->occ_gain_ms < -0.1 * rb - 1e-3) {
-        g->occ_auto_on = false;
-        g->occ_probe = OCC_PROBE_FRAMES;
-    } else {
-        g->occ_auto_on = true;
-        g->occ_probe = -1; /* on: every frame measures */
-    }
-}
-
 /* The learnt state back to the upload's (see
  * upload): the next frame tests and measures. */
 void mr_renderer_reset_occlusion(mr_renderer *r) {
     struct mr_geo *g = r ? r->geo : NULL;
     if (!g) return;
-    g->occ_auto_on = true;
-    g->occ_probe = 0;
-    g->occ_gain_ms = 0;
+    occ_auto_reset(&g->occ);
 }
 
 void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *out) {
@@ -1331,8 +1300,7 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
     bool depth_ok = false;
     bool want = dp->occlusion;
     if (!want && dp->occlusion_auto && !dp->no_cull && nvis >= 64) {
-        if (g->occ_auto_on) want = true;
-        else if (--g->occ_probe <= 0) want = true; /* a trial frame */
+        want = occ_auto_frame(&g->occ);
     }
     if (want && !dp->no_cull && nvis >= 64 && w == vw->cam.width && h == vw->cam.height) {
         GLint fbo = 0, type = GL_NONE, func = 0;
@@ -1435,7 +1403,7 @@ void mr_geometry_draw(mr_renderer *r, const mr_geo_view *vw, mr_frame_result *ou
          * would overstate the gain where LOD engages); skipped meshlets are
          * counted at the level drawn. */
         double ratio = occluder_full > 0 ? (double)occluder_tris / (double)occluder_full : 1;
-        occlusion_learn(g, (t_sync - t0) * 1e3, (t_end - t_sync) * 1e3 + g->occ_cl_ms, occluder_tris,
+        occ_auto_learn(&g->occ, g->occ_rb_ms, (t_sync - t0) * 1e3, (t_end - t_sync) * 1e3 + g->occ_cl_ms, occluder_tris,
                         (uint64_t)(skipped_full * ratio) + g->occ_cl_tris);
     }
 }

@@ -35,7 +35,7 @@
 #include <meshoptimizer.h>
 
 #define HL_MAGIC "MRHLOD01"
-#define HL_VERSION 1u
+#define HL_VERSION 2u
 
 double mr_stretch_bound(const mr_dmat4 *w) {
     double mtm[3][3];
@@ -737,7 +737,25 @@ typedef struct disk_node {
     uint32_t layer, vertex_count, index_count, run_count, pad;
 } disk_node;
 
-static bool cache_write(const mr_hlod *h, double reduction, const char *path, mr_error *err) {
+/* Where the parts are drawn: the proxies are merged in world space, so a
+ * node moved, drawing other meshes or on another layer, or a mesh's origin
+ * moved, makes a cache stale although every mesh is the same. */
+static uint64_t placement_hash(const mr_scene *s) {
+    uint64_t h = 0x243f6a8885a308d3ull;
+    h = mr_hash64(h, &s->node_count, sizeof s->node_count);
+    for (int32_t i = 0; i < s->node_count; i++) {
+        const mr_node *n = &s->nodes[i];
+        uint8_t flags[2] = {n->layer, n->shadow_catcher};
+        h = mr_hash64(h, n->world.m, sizeof n->world.m);
+        h = mr_hash64(h, &n->mesh_first, sizeof n->mesh_first);
+        h = mr_hash64(h, &n->mesh_count, sizeof n->mesh_count);
+        h = mr_hash64(h, flags, sizeof flags);
+    }
+    for (int32_t i = 0; i < s->mesh_count; i++) h = mr_hash64(h, s->meshes[i].origin, sizeof s->meshes[i].origin);
+    return h;
+}
+
+static bool cache_write(const mr_scene *s, const mr_hlod *h, double reduction, const char *path, mr_error *err) {
     wbuf b = {0};
     uint32_t ver = HL_VERSION, nc = (uint32_t)h->node_count;
     put(&b, HL_MAGIC, 8);
@@ -746,6 +764,8 @@ static bool cache_write(const mr_hlod *h, double reduction, const char *path, mr
     put(&b, &h->scene_hash, 8);
     put(&b, &h->lod_hash, 8);
     put(&b, &reduction, 8);
+    uint64_t ph = placement_hash(s);
+    put(&b, &ph, 8);
     put(&b, &h->scene_node_count, 4);
     put(&b, &h->scene_mesh_count, 4);
     put(&b, h->root, sizeof h->root);
@@ -835,7 +855,7 @@ static mr_hlod *cache_read(const mr_scene *s, const mr_lod *lod, double reductio
     mr_hlod *h = NULL;
     char magic[8];
     uint32_t ver, nc;
-    uint64_t sum, sh, lh;
+    uint64_t sum, sh, lh, ph;
     double red;
     *why = "not a LOD hierarchy cache";
     if (size < 16 || !get(&r, magic, 8) || memcmp(magic, HL_MAGIC, 8) != 0) goto out;
@@ -845,7 +865,8 @@ static mr_hlod *cache_read(const mr_scene *s, const mr_lod *lod, double reductio
     r.n = size - 8;
     *why = "written for another scene or other levels";
     if (!get(&r, &ver, 4) || ver != HL_VERSION || !get(&r, &nc, 4) || !get(&r, &sh, 8) || sh != mr_lod_scene_hash(s) ||
-        !get(&r, &lh, 8) || lh != mr_hlod_lod_hash(lod) || !get(&r, &red, 8) || red != reduction)
+        !get(&r, &lh, 8) || lh != mr_hlod_lod_hash(lod) || !get(&r, &red, 8) || red != reduction ||
+        !get(&r, &ph, 8) || ph != placement_hash(s))
         goto out;
     *why = "malformed";
     if (nc == 0 || nc > (uint32_t)(2 * s->node_count + 2)) goto out;
@@ -921,7 +942,7 @@ mr_hlod *mr_hlod_load_or_build(const mr_scene *s, const mr_lod *lod, const char 
         hi.build_s = mr_time_now() - t0;
         if (cache_path) {
             mr_error we = {0};
-            hi.cache_written = cache_write(h, reduction, cache_path, &we);
+            hi.cache_written = cache_write(s, h, reduction, cache_path, &we);
             if (!hi.cache_written) mr_log(MR_LOG_WARN, "LOD hierarchy cache not written: %s", we.msg);
         }
     }

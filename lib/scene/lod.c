@@ -1469,6 +1469,9 @@ uint64_t mr_lod_scene_hash(const mr_scene *s) {
         h = mr_hash64(h, &m->index_count, sizeof m->index_count);
         h = mr_hash64(h, m->positions, (size_t)m->vertex_count * 12);
         h = mr_hash64(h, m->indices, (size_t)m->index_count * 4);
+        /* a level's corner is, among the vertices at its position, the one
+         * whose normal is nearest the face's (unweld): normals shape it too */
+        if (m->normals) h = mr_hash64(h, m->normals, (size_t)m->vertex_count * 12);
     }
     h ^= h >> 33;
     h *= 0xff51afd7ed558ccdull;
