@@ -203,7 +203,8 @@ bool mr_gbuffer_pick_pixel(mr_renderer *r, int px, int py, float *depth, GLuint 
     GLint fbo = 0, vp[4];
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fbo);
     glGetIntegerv(GL_VIEWPORT, vp);
-    GLboolean depth_test = glIsEnabled(GL_DEPTH_TEST);
+    GLboolean depth_test = glIsEnabled(GL_DEPTH_TEST), scissor = glIsEnabled(GL_SCISSOR_TEST);
+    glDisable(GL_SCISSOR_TEST); /* a caller's 2D layer may have left one */
     glBindFramebuffer(GL_FRAMEBUFFER, b->pick.fbo);
     glViewport(0, 0, 1, 1);
     glEnable(GL_DEPTH_TEST);
@@ -229,6 +230,7 @@ bool mr_gbuffer_pick_pixel(mr_renderer *r, int px, int py, float *depth, GLuint 
     r->draw = saved;
     r->stats = st;
     if (!depth_test) glDisable(GL_DEPTH_TEST);
+    if (scissor) glEnable(GL_SCISSOR_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)fbo);
     glViewport(vp[0], vp[1], vp[2], vp[3]);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
