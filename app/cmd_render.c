@@ -9,7 +9,7 @@ int cmd_render(int argc, char **argv) {
     static const char *cmd = "render";
     mr_cli_opt opts[] = {
         {"scene", "FILE", "glTF/GLB file or scene config JSON (required)", NULL},
-        {"view", "VIEW.json", "camera + world_from_camera (required without --bcf)", NULL},
+        {"view", "VIEW.json|auto", "camera + world_from_camera, or auto: the whole scene from a corner above", NULL},
         {"bcf", "FILE", "render a BCF topic's viewpoint (camera, visibility, colours, clipping) instead of --view", NULL},
         {"topic", "N|GUID", "the topic of --bcf (its number in `bcf list`, or its GUID)", NULL},
         {"out", "OUT.png", "output image (required)", NULL},
@@ -34,7 +34,7 @@ int cmd_render(int argc, char **argv) {
                              APP_SHADOW_TABLE(&fp.shadow), APP_RIG_TABLE(&rp), APP_DRAW_TABLE(&dp)};
     bool help;
     if (!mr_cli_parse_tables(argc, argv, 2, opts, tables, 7, NULL, 0, NULL,
-                   "usage: mrcheck render --scene FILE (--view VIEW.json | --bcf FILE --topic N) --out OUT.png [--size WxH] "
+                   "usage: mrcheck render --scene FILE (--view VIEW.json|auto | --bcf FILE --topic N) --out OUT.png [--size WxH] "
                    "[--video IMG --alpha A] [--aux DIR] [--ao METHOD ...] [--ghost off|alpha|g0|adaptive] "
                    "[--shadows off|hard|pcf|pcss|bp|groundtruth ...] "
                    "[--views N --view-cone DEG [--focal-distance D] [--quilt SPEC]: --out is then a folder]",
@@ -84,7 +84,8 @@ int cmd_render(int argc, char **argv) {
     /* Everything that can be checked without a GPU is checked first, so a
      * bad input never costs a context. */
     mr_view view;
-    if (!bcf && !mr_view_load(view_path, &view, &err)) return mr_cli_error(cmd, &err);
+    bool auto_view = view_path && strcmp(view_path, "auto") == 0;
+    if (!bcf && !auto_view && !mr_view_load(view_path, &view, &err)) return mr_cli_error(cmd, &err);
     mr_image video = {0};
     if (mr_cli_get(opts, "video")) {
         if (!mr_image_load(mr_cli_get(opts, "video"), 3, &video, &err)) return mr_cli_error(cmd, &err);
@@ -101,6 +102,7 @@ int cmd_render(int argc, char **argv) {
         mr_image_free(&video);
         return mr_cli_error(cmd, &err);
     }
+    if (auto_view) view = mr_scene_auto_view(scene, fp.width, fp.height);
     if (!mr_shadow_scene_default(&tables[4], scene, &fp.shadow, &err)) {
         mr_cli_error(cmd, &err);
         mr_scene_destroy(&scene);

@@ -215,6 +215,21 @@ uint64_t mr_scene_triangle_count(const mr_scene *s);
  * scale every scene-relative default is a fraction of. 0 for NULL, an empty
  * scene or bounds that are not finite; callers choose their own fallback. */
 double mr_scene_diagonal(const mr_scene *s);
+/* A view for any model (auto_view.c): the whole scene seen from the corner
+ * of its bounds at +x +z (Y up), MR_AUTO_VIEW_ELEVATION_DEG above the
+ * horizon, looking at the bounds' centre from the nearest distance at
+ * which every point of the bounds (so every vertex) projects inside the
+ * image with MR_AUTO_VIEW_MARGIN of each side left free. A pinhole without
+ * distortion, square pixels, vertical field of view MR_AUTO_VIEW_FOV_DEG,
+ * width x height px (0: MR_AUTO_VIEW_DEFAULT_WIDTH x ..._HEIGHT, or 3:4 of
+ * a given width). Double precision throughout: any scale, any offset. An
+ * empty scene gets a view of a unit box at the origin. */
+#define MR_AUTO_VIEW_DEFAULT_WIDTH 800
+#define MR_AUTO_VIEW_DEFAULT_HEIGHT 600
+#define MR_AUTO_VIEW_FOV_DEG 50.0
+#define MR_AUTO_VIEW_ELEVATION_DEG 30.0
+#define MR_AUTO_VIEW_MARGIN 0.05
+mr_view mr_scene_auto_view(const mr_scene *s, int width, int height);
 /* Area-weighted smooth normals for a triangle list (out: 3*vertex_count). */
 void mr_mesh_generate_normals(const float *positions, uint32_t vertex_count,
                               const uint32_t *indices, uint32_t index_count, float *normals);
