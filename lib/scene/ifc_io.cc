@@ -18,6 +18,13 @@
 #include <ifcpp/IFC4/include/IfcProduct.h>
 #include <ifcpp/IFC4/include/IfcPropertySet.h>
 #include <ifcpp/IFC4/include/IfcPropertySingleValue.h>
+#include <ifcpp/IFC4/include/IfcSimpleProperty.h>
+#include <ifcpp/IFC4/include/IfcProductRepresentation.h>
+#include <ifcpp/IFC4/include/IfcRepresentation.h>
+#include <ifcpp/IFC4/include/IfcRepresentationItem.h>
+#include <ifcpp/IFC4/include/IfcRelVoidsElement.h>
+#include <ifcpp/IFC4/include/IfcFeatureElementSubtraction.h>
+#include <algorithm>
 #include <ifcpp/IFC4/include/IfcRelAggregates.h>
 #include <ifcpp/IFC4/include/IfcRelContainedInSpatialStructure.h>
 #include <ifcpp/IFC4/include/IfcRelDefinesByProperties.h>
@@ -333,6 +340,27 @@ mr_scene *convert(const char *data, size_t size, const mr_scene_params *params) 
     content.clear();
     content.shrink_to_fit();
     if (model->getMapIfcEntities().empty()) throw Fail{MR_ERR_PARSE, "no IFC entities could be read"};
+    // IFC++'s geometry converter follows some references without a check:
+    // a simple property's Name (GeometryConverter::readAppearanceFromPropertySet)
+    // and the entries of a product's representation list and of a
+    // representation's items, an opening's placement (RepresentationConverter).
+    // A damaged entity leaves them empty (found by tests/fuzz/fuzz_ifc.c):
+    // they are given an empty name or dropped (an opening without a
+    // placement is not cut) before converting.
+    for (auto &kv : model->getMapIfcEntities()) {
+        if (shared_ptr<IfcSimpleProperty> sp = dynamic_pointer_cast<IfcSimpleProperty>(kv.second)) {
+            if (!sp->m_Name) sp->m_Name = shared_ptr<IfcIdentifier>(new IfcIdentifier(L""));
+        } else if (shared_ptr<IfcProductRepresentation> pr = dynamic_pointer_cast<IfcProductRepresentation>(kv.second)) {
+            auto &v = pr->m_Representations;
+            v.erase(std::remove(v.begin(), v.end(), nullptr), v.end());
+        } else if (shared_ptr<IfcRepresentation> r = dynamic_pointer_cast<IfcRepresentation>(kv.second)) {
+            auto &v = r->m_Items;
+            v.erase(std::remove(v.begin(), v.end(), nullptr), v.end());
+        } else if (shared_ptr<IfcRelVoidsElement> rv = dynamic_pointer_cast<IfcRelVoidsElement>(kv.second)) {
+            if (rv->m_RelatedOpeningElement && !rv->m_RelatedOpeningElement->m_ObjectPlacement)
+                rv->m_RelatedOpeningElement.reset();
+        }
+    }
 
     shared_ptr<GeometryConverter> gc(new GeometryConverter(model));
     gc->setMessageCallBack(&cv, &Convert::on_message);
