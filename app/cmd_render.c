@@ -92,9 +92,7 @@ int cmd_render(int argc, char **argv) {
         fp.video = &video;
     }
     const char *globs[1] = {mr_cli_get(opts, "hidden")};
-    mr_scene_params sp = MR_SCENE_DEFAULTS;
-    sp.hidden_globs = globs;
-    sp.hidden_glob_count = globs[0] ? 1 : 0;
+    mr_scene_params sp = {.hidden_globs = globs, .hidden_glob_count = globs[0] ? 1 : 0}; /* else MR_SCENE_DEFAULTS */
     mr_scene *scene = mr_scene_load_logged(scene_path, &sp, &err);
     if (!scene || (bcf && !mr_bcf_render_setup(bcf, mr_cli_get(opts, "topic"), scene,
                                                &(mr_bcf_view_params){1.0, fp.width, fp.height, false}, &view, &err))) {
