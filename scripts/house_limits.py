@@ -5,8 +5,8 @@
 - No function in lib/ or app/ is longer than 150 lines or takes more than
   8 parameters, except those named in scripts/house_limits.allow, each with
   its size now as its ceiling: an entry may only shrink or go (an entry
-  that no longer exceeds, or names a function that is gone, fails too, so
-  the list cannot keep stale rows). Tables of data (an initialiser, not a
+  that no longer exceeds, or is above its function's size, is printed as
+  a note to lower or remove it). Tables of data (an initialiser, not a
   function body) are not functions and are not counted.
 
 Usage: scripts/house_limits.py [SOURCE_DIR]       check; one line per finding
@@ -200,13 +200,19 @@ def main(argv):
                        '(named steps, a params struct)')
         elif v > allow[key]:
             bad.append(f'{rel}:{line}: {name} grew to {what} (scripts/house_limits.allow holds it at {allow[key]})')
+    # A row that is no longer needed, or higher than its function, is a
+    # note to lower or remove it, not a failure: work that shrinks a
+    # function must not turn the check red for everyone.
+    notes = []
     for key, v in sorted(allow.items()):
         if key not in offenders:
-            bad.append(f'scripts/house_limits.allow: "{" ".join(key)}" is within the limit now (or gone): '
+            notes.append(f'scripts/house_limits.allow: "{" ".join(key)}" is within the limit now (or gone): '
                        'remove the row')
         elif offenders[key][0] < v:
-            bad.append(f'scripts/house_limits.allow: "{" ".join(key)}" is {offenders[key][0]} now: lower the row '
+            notes.append(f'scripts/house_limits.allow: "{" ".join(key)}" is {offenders[key][0]} now: lower the row '
                        f'from {v}')
+    for b in notes:
+        print('note: ' + b)
     for b in bad:
         print(b)
     return 1 if bad else 0
