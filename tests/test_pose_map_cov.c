@@ -245,8 +245,105 @@ static double lone_tag_z(int draws, int *flips) {
     return sqrt(zz / n);
 }
 
+/* A still camera: per draw one map error (0.3 of the base covariance)
+ * and 16 frames of 0.3 px corner noise, fused. At 1, 4 and 16 frames the
+ * fused pose's predicted sigma of a point matches its observed spread,
+ * shrinks with the frames, and stays above the map's floor (the sigma of
+ * the map part alone), as does the error. */
+static void test_fusion(void) {
+    enum { DRAWS = 200, FRAMES = 16 };
+    static const int at[3] = {1, 4, 16};
+    mr_camera cam = mr_demo_camera();
+    mr_marker tags[NTAGS], bel[NTAGS];
+    double L[NTAGS][36];
+    for (int i = 0; i < NTAGS; i++) {
+        tags[i] = (mr_marker){.id = i, .world_from_tag = facing(mr_v3(-0.6 + 0.4 * i, 0.2 * (i % 2), 2.0 + 0.3 * i))};
+        map_factor(i, false, L[i]);
+        for (int k = 0; k < 36; k++) L[i][k] *= 0.3;
+    }
+    mr_marker_map truth = {.family = "tag36h11", .tag_size = 0.2, .tags = tags, .count = NTAGS};
+    mr_marker_map map = {.family = "tag36h11", .tag_size = 0.2, .tags = bel, .count = NTAGS};
+    mr_dmat4 wfc = mr_m4_look_at_cv(mr_v3(0, 0.1, 0), mr_v3(0, 0.1, 3), mr_v3(0, 1, 0));
+    mr_dmat4 cfw_true = mr_m4_invert_rigid(&wfc);
+    mr_dvec3 point = mr_v3(0.3, -0.2, 4.0), q0 = mr_m4_point(&cfw_true, point);
+    mr_rng rng;
+    mr_rng_seed(&rng, 19);
+    double ss[3] = {0}, pred[3] = {0}, floor2[3] = {0};
+    int n[3] = {0}, restarts = 0;
+    for (int d = 0; d < DRAWS; d++) {
+        for (int i = 0; i < NTAGS; i++) {
+            bel[i] = perturbed(&tags[i], L[i], &rng);
+            cov_of(L[i], bel[i].cov);
+        }
+        mr_pose_fusion fu = {0};
+        bool restarted = false;
+        for (int f = 1; f <= FRAMES; f++) {
+            mr_detection det[NTAGS];
+            int nd = see(&cam, &truth, &wfc, 0.3, &rng, det);
+            mr_pose pose;
+            mr_error err = {0};
+            if (!mr_pose_solve(&cam, &map, det, nd, NULL, NULL, &pose, &err) || !pose.valid) continue;
+            bool r = !mr_pose_fusion_add(&fu, &pose) && f > 1;
+            restarts += r;
+            restarted = restarted || r;
+            for (int k = 0; k < 3; k++) {
+                if (restarted || fu.frames != at[k] || f != at[k]) continue;
+                double s3, sm;
+                mr_pose only_map = fu.pose;
+                memcpy(only_map.cov, fu.pose.cov_map, sizeof only_map.cov);
+                if (!mr_pose_point_sigma(&fu.pose, point, &s3, NULL) || !mr_pose_point_sigma(&only_map, point, &sm, NULL))
+                    continue;
+                mr_dmat4 cfw = mr_m4_invert_rigid(&fu.pose.world_from_camera);
+                mr_dvec3 e = mr_v3_sub(mr_m4_point(&cfw, point), q0);
+                ss[k] += mr_v3_dot(e, e);
+                pred[k] += s3 * s3;
+                floor2[k] += sm * sm;
+                n[k]++;
+            }
+        }
+    }
+    double o[3], p[3], fl[3];
+    for (int k = 0; k < 3; k++) {
+        o[k] = sqrt(ss[k] / n[k]), p[k] = sqrt(pred[k] / n[k]), fl[k] = sqrt(floor2[k] / n[k]);
+        printf("still camera, %2d frames fused (%d draws): observed %.2f mm, predicted %.2f mm (map floor %.2f), "
+               "ratio %.3f\n",
+               at[k], n[k], 1e3 * o[k], 1e3 * p[k], 1e3 * fl[k], p[k] / o[k]);
+        CHECK(n[k] > DRAWS * 0.8);
+        CHECK_MSG(p[k] / o[k] > 0.75 && p[k] / o[k] < 1.25, "%d frames: ratio %.3f", at[k], p[k] / o[k]);
+    }
+    printf("still camera: %d restarts by the gate in %d frames\n", restarts, DRAWS * (FRAMES - 1));
+    CHECK(restarts < DRAWS * FRAMES / 100); /* p = 1e-4 per frame, more with estimated noise */
+    /* The own part (above the floor) shrinks as 1 / sqrt(frames). */
+    double own[3];
+    for (int k = 0; k < 3; k++) own[k] = sqrt(fmax(p[k] * p[k] - fl[k] * fl[k], 0));
+    printf("still camera: own part %.2f, %.2f, %.2f mm\n", 1e3 * own[0], 1e3 * own[1], 1e3 * own[2]);
+    CHECK(own[1] < 0.6 * own[0] && own[1] > 0.4 * own[0]);
+    CHECK(own[2] < 0.6 * own[1] && own[2] > 0.4 * own[1]);
+    CHECK(p[2] >= fl[2] && p[2] < 1.3 * fl[2]);    /* down to the map's floor */
+    CHECK(o[2] > 0.75 * fl[2]);                    /* which the error does not beat */
+
+    /* The camera moves 5 cm: the fusion restarts there. */
+    mr_pose_fusion fu = {0};
+    for (int i = 0; i < NTAGS; i++) bel[i] = tags[i];
+    for (int f = 0; f < 9; f++) {
+        mr_dmat4 w = f < 8 ? wfc : mr_m4_look_at_cv(mr_v3(0.05, 0.1, 0), mr_v3(0.05, 0.1, 3), mr_v3(0, 1, 0));
+        mr_detection det[NTAGS];
+        int nd = see(&cam, &truth, &w, 0.3, &rng, det);
+        mr_pose pose;
+        mr_error err = {0};
+        CHECK(mr_pose_solve(&cam, &map, det, nd, NULL, NULL, &pose, &err) && pose.valid);
+        bool fused = mr_pose_fusion_add(&fu, &pose);
+        CHECK(fused == (f < 8));
+        CHECK(fu.frames == (f < 8 ? f + 1 : 1));
+    }
+    CHECK(fabs(fu.pose.world_from_camera.m[3] - 0.05) < 0.01);
+    mr_pose none = {0};
+    CHECK(!mr_pose_fusion_add(&fu, &none) && fu.frames == 0);
+}
+
 int main(void) {
     test_json();
+    test_fusion();
     int flips;
     double lz = lone_tag_z(300, &flips);
     printf("lone tag, 300 draws: %d flipped, RMS of error / sigma %.3f\n", flips, lz);

@@ -354,6 +354,31 @@ bool mr_pose_point_sigma(const mr_pose *pose, mr_dvec3 world_point, double *sigm
 bool mr_pose_solve(const mr_camera *cam, const mr_marker_map *map, const mr_detection *dets, int count,
                    const mr_pose *prev, const mr_pose_params *params, mr_pose *out, mr_error *err);
 
+/* Still-camera fusion: the poses of a camera that stands still (or a
+ * frozen view), fused over the frames, so the σ shrinks with the frames
+ * down to the map's floor. Each pose's own part (cov - cov_map) is
+ * independent from frame to frame and is fused by its information; the
+ * map part is the same tags' error in every frame and stays as it is (its
+ * mean). A frame further from the fused pose than MR_POSE_FUSION_GATE
+ * (chi-square, 6 degrees of freedom, p = 1e-4) means the camera moved:
+ * the fusion restarts at that frame. Corner noise that repeats from frame
+ * to frame (the same pixels of a truly static image) is not independent;
+ * fused poses of such frames claim too much. Zero-initialise, or reset. */
+typedef struct mr_pose_fusion {
+    mr_pose pose;            /* the fused pose (valid once a frame was added):
+                                world_from_camera, cov (own + map), cov_map;
+                                the quality fields of the latest frame */
+    int frames;              /* frames fused since the camera last moved */
+    mr_dmat4 ref;            /* internal: the first frame's camera_from_world */
+    double info[36], info_d[6], map_sum[36]; /* internal sums */
+} mr_pose_fusion;
+#define MR_POSE_FUSION_GATE 27.86
+void mr_pose_fusion_reset(mr_pose_fusion *f);
+/* Adds a frame's pose. true: fused (or the first); false: the camera moved
+ * (the fusion restarted at this pose, frames = 1), or the pose is invalid
+ * or has no covariance (the fusion is reset, frames = 0). */
+bool mr_pose_fusion_add(mr_pose_fusion *f, const mr_pose *pose);
+
 /* Projects a world point with the camera model; false if behind the camera. */
 bool mr_project_point(const mr_camera *cam, const mr_dmat4 *world_from_camera, mr_dvec3 p, double *u, double *v);
 
@@ -552,6 +577,10 @@ typedef struct mr_tracker_result {
                                        (mr_tracker_frame; 0 from mr_tracker_detections) */
     bool redetected;                /* adaptive decimation lost the last frame's tags
                                        and the frame was detected again at 2 */
+    mr_pose fused;                  /* the raw poses fused since the camera last
+                                       moved (mr_pose_fusion); its σ shrinks while
+                                       the camera stands still */
+    int fused_frames;               /* frames in fused; 0: none (no pose) */
 } mr_tracker_result;
 /* Adaptive decimation (above): the probe interval, and the rule. */
 #define MR_TRACKER_PROBE_FRAMES 8

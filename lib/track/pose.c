@@ -655,3 +655,110 @@ bool mr_pose_point_sigma(const mr_pose *pose, mr_dvec3 world_point, double *sigm
     if (sigma_lateral) *sigma_lateral = sqrt(fmax(tr - along, 0));
     return isfinite(tr);
 }
+
+void mr_pose_fusion_reset(mr_pose_fusion *f) { memset(f, 0, sizeof *f); }
+
+/* The step from camera_from_world a to b as mr_pose.cov's perturbation:
+ * b = exp([w]x) a + tau. */
+static void pose_step(const mr_dmat4 *a, const mr_dmat4 *b, double d[6]) {
+    rt x = m4_to_rt(a), y = m4_to_rt(b);
+    double Rd[9];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            Rd[3 * r + c] = y.R[3 * r] * x.R[3 * c] + y.R[3 * r + 1] * x.R[3 * c + 1] + y.R[3 * r + 2] * x.R[3 * c + 2];
+    mr_mat_to_rotvec(Rd, d);
+    for (int r = 0; r < 3; r++) d[3 + r] = y.t[r] - (Rd[3 * r] * x.t[0] + Rd[3 * r + 1] * x.t[1] + Rd[3 * r + 2] * x.t[2]);
+}
+
+/* A pose's own part of its covariance as information; false if singular. */
+static bool own_info(const mr_pose *p, double I[36]) {
+    for (int a = 0; a < 6; a++)
+        for (int b = 0; b < 6; b++) {
+            double v = 0.5 * (p->cov[6 * a + b] + p->cov[6 * b + a] - p->cov_map[6 * a + b] - p->cov_map[6 * b + a]);
+            I[6 * a + b] = v;
+        }
+    return invert_n(I, 6);
+}
+
+static bool fusion_start(mr_pose_fusion *f, const mr_pose *p) {
+    mr_pose_fusion_reset(f);
+    if (!own_info(p, f->info)) return false;
+    f->ref = mr_m4_invert_rigid(&p->world_from_camera);
+    memcpy(f->map_sum, p->cov_map, sizeof f->map_sum);
+    f->pose = *p;
+    f->frames = 1;
+    return true;
+}
+
+bool mr_pose_fusion_add(mr_pose_fusion *f, const mr_pose *p) {
+    if (!p || !p->valid || !(p->corner_sigma_px > 0)) {
+        mr_pose_fusion_reset(f);
+        return false;
+    }
+    if (f->frames < 1) return fusion_start(f, p);
+    double Ii[36], d[6], C[36], e[6];
+    mr_dmat4 cfw = mr_m4_invert_rigid(&p->world_from_camera);
+    pose_step(&f->ref, &cfw, d);
+    /* The gate: this frame against the fused estimate, own parts only (the
+     * map part is common to both). */
+    memcpy(C, f->info, sizeof C);
+    if (!own_info(p, Ii) || !invert_n(C, 6)) {
+        fusion_start(f, p);
+        return false;
+    }
+    double est[6] = {0};
+    for (int a = 0; a < 6; a++)
+        for (int b = 0; b < 6; b++) est[a] += C[6 * a + b] * f->info_d[b];
+    double S[36];
+    for (int a = 0; a < 6; a++) {
+        e[a] = d[a] - est[a];
+        for (int b = 0; b < 6; b++)
+            S[6 * a + b] = C[6 * a + b] + 0.5 * (p->cov[6 * a + b] + p->cov[6 * b + a] - p->cov_map[6 * a + b] -
+                                                 p->cov_map[6 * b + a]);
+    }
+    if (!invert_n(S, 6)) {
+        fusion_start(f, p);
+        return false;
+    }
+    double m2 = 0;
+    for (int a = 0; a < 6; a++)
+        for (int b = 0; b < 6; b++) m2 += e[a] * S[6 * a + b] * e[b];
+    if (!(m2 <= MR_POSE_FUSION_GATE)) {
+        fusion_start(f, p);
+        return false;
+    }
+    for (int a = 0; a < 6; a++) {
+        for (int b = 0; b < 6; b++) {
+            f->info[6 * a + b] += Ii[6 * a + b];
+            f->info_d[a] += Ii[6 * a + b] * d[b];
+        }
+    }
+    for (int k = 0; k < 36; k++) f->map_sum[k] += p->cov_map[k];
+    f->frames++;
+    /* The fused pose: the information-weighted step from the reference. */
+    memcpy(C, f->info, sizeof C);
+    if (!invert_n(C, 6)) {
+        fusion_start(f, p);
+        return false;
+    }
+    double dh[6] = {0};
+    for (int a = 0; a < 6; a++)
+        for (int b = 0; b < 6; b++) dh[a] += C[6 * a + b] * f->info_d[b];
+    double Rw[9];
+    mr_rotvec_to_mat(dh, Rw);
+    rt x = m4_to_rt(&f->ref), y;
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 3; c++)
+            y.R[3 * r + c] = Rw[3 * r] * x.R[c] + Rw[3 * r + 1] * x.R[3 + c] + Rw[3 * r + 2] * x.R[6 + c];
+        y.t[r] = Rw[3 * r] * x.t[0] + Rw[3 * r + 1] * x.t[1] + Rw[3 * r + 2] * x.t[2] + dh[3 + r];
+    }
+    mr_pose fused = *p;
+    mr_dmat4 cfw_f = rt_to_m4(&y);
+    fused.world_from_camera = mr_m4_invert_rigid(&cfw_f);
+    for (int k = 0; k < 36; k++) {
+        fused.cov_map[k] = f->map_sum[k] / f->frames;
+        fused.cov[k] = C[k] + fused.cov_map[k];
+    }
+    f->pose = fused;
+    return true;
+}

@@ -23,6 +23,7 @@ struct mr_tracker {
     int since_probe;            /* frames since the last conservative one */
     int last_n;                 /* tags the last frame found */
     double corner_var;          /* learnt corner noise^2 (px^2), 0 = none yet */
+    mr_pose_fusion fusion;      /* the still camera's poses */
 };
 
 static bool copy_markers(const mr_marker_map *src, mr_marker_map *dst, mr_error *err) {
@@ -85,6 +86,7 @@ void mr_tracker_destroy(mr_tracker **t) {
 
 void mr_tracker_reset(mr_tracker *t) {
     memset(&t->prev, 0, sizeof t->prev);
+    mr_pose_fusion_reset(&t->fusion);
     t->prev_t = 0;
     t->next_dec = 0;
     t->since_probe = 0;
@@ -203,6 +205,13 @@ bool mr_tracker_detections(mr_tracker *t, const mr_detection *dets, int count, i
     if (out->pose.valid && out->pose.tags_used >= 3 && out->pose.corner_sigma_px > 0) {
         double v = out->pose.corner_sigma_px * out->pose.corner_sigma_px;
         t->corner_var = t->corner_var > 0 ? 0.9 * t->corner_var + 0.1 * v : v;
+    }
+    /* A frame without a pose leaves the fusion as it was: the camera may
+     * still stand where it stood. */
+    if (out->pose.valid) mr_pose_fusion_add(&t->fusion, &out->pose);
+    if (t->fusion.frames > 0) {
+        out->fused = t->fusion.pose;
+        out->fused_frames = t->fusion.frames;
     }
     if (out->pose.valid) {
         t->prev = out->pose;
