@@ -10,7 +10,7 @@ pkgs=(
   libembree-dev
   libopencv-dev libopencv-contrib-dev
   libceres-dev libzip-dev
-  unzip
+  unzip poppler-utils
   python3
   gltfpack libdraco-dev
   libifcplusplus-dev

@@ -136,6 +136,97 @@ typedef struct mr_batch_track_stats {
 } mr_batch_track_stats;
 bool mr_batch_track(const mr_batch_track_params *p, mr_batch_track_stats *stats, mr_error *err);
 
+/* ------------------------------------------------------ printable pages */
+
+/* A page as filled black rectangles and lines of text (page.c), written
+ * as PDF 1.4 (vector rectangles, text in the standard Helvetica font) or
+ * rasterised to a grey PNG at a given dpi (a pixel is black when its
+ * centre lies in a rectangle; text in a built-in 5x7 pixel font scaled to
+ * Helvetica's cap height). Lengths in mm from the page's top-left corner,
+ * y down. */
+typedef enum mr_page_item_kind { MR_PAGE_RECT, MR_PAGE_TEXT } mr_page_item_kind;
+typedef struct mr_page_item {
+    mr_page_item_kind kind;
+    double x, y;              /* mm; rect: top-left corner; text: left end of the baseline */
+    double w, h;              /* rect: size, mm; text: w unused, h the font size in points */
+    char text[128];           /* printable ASCII */
+} mr_page_item;
+typedef struct mr_page {
+    double width_mm, height_mm;
+    mr_page_item *items;
+    int count, cap;
+    bool failed;              /* an allocation failed: saving reports it */
+} mr_page;
+void mr_page_rect(mr_page *p, double x, double y, double w, double h);
+void mr_page_text(mr_page *p, double x, double y, double size_pt, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+void mr_page_free(mr_page *p); /* zeroes it */
+/* n pages as one PDF 1.4 file, written atomically. */
+bool mr_pdf_save(const char *path, const mr_page *pages, int n, mr_error *err);
+/* The page as an 8-bit grey image at dpi (white paper, black ink). */
+bool mr_page_raster(const mr_page *p, double dpi, mr_image *out, mr_error *err);
+/* The image as PNG, written atomically, with a pHYs chunk stating dpi so
+ * that a viewer prints it at its size. */
+bool mr_page_png_save(const char *path, const mr_image *img, double dpi, mr_error *err);
+/* Paper sizes (portrait, mm): "a4", "a3", "letter" (any case). */
+bool mr_paper_size(const char *name, double *width_mm, double *height_mm);
+
+
+/* `mrcheck tags` and `mrcheck board` (sheets.c): printable AprilTags at a
+ * chosen physical size. Each tag's cells come from the family's own code
+ * (mr_tag_pattern_make); size_mm is the edge of the square the detector
+ * finds, the marker map's tag_size (tag36h11: the black square). The
+ * files go into out_dir, which must be new or empty unless force, and
+ * is removed again if the run fails before writing. */
+typedef struct mr_sheet_params {
+    const char *out_dir;      /* required */
+    const char *family;       /* NULL: tag36h11 */
+    double size_mm;           /* detected square's edge, mm; tags: required;
+                                 board: 0 = MR_SHEET_BOARD_DEFAULT_SIZE_MM */
+    const char *paper;        /* "a4" (default), "a3", "letter" */
+    double dpi;               /* the PNGs' resolution, default 300 */
+    bool force;               /* write into a folder that holds files */
+    bool progress;            /* "tags: page i/n" on stderr */
+    /* tags: */
+    const int *ids;           /* id_count ids to print, in this order */
+    int id_count;
+    /* board: */
+    int cols, rows;           /* tags across and down; 0 = as many as fit */
+    int first_id;             /* ids first_id, first_id+1, ... row by row */
+    double gap_mm;            /* between neighbouring tags' squares; 0 = size_mm / 4 */
+} mr_sheet_params;
+#define MR_SHEET_DEFAULTS {.family = NULL, .paper = "a4", .dpi = 300.0, .first_id = 100}
+#define MR_SHEET_BOARD_DEFAULT_SIZE_MM 30.0
+/* size-mm, dpi, cols, rows, first-id, gap-mm. */
+extern const mr_opt mr_sheet_opts[];
+/* The length of the scale bar printed beside each tag and on the board. */
+#define MR_SHEET_SCALE_BAR_MM 100.0
+
+typedef struct mr_sheet_result {
+    int pages;
+    int tags;                 /* tags printed */
+    int per_page;
+    int cols, rows;           /* board: its grid */
+    double pitch_mm;          /* board: centre to centre */
+    char pdf[4096];           /* the files written */
+    char json[4096];          /* tags: the marker-map template; board: board.json */
+} mr_sheet_result;
+
+/* tags.pdf (every page), tags-N.png (page N at dpi) and
+ * markers_template.json: the marker map's format with the family, the
+ * size (m) and the ids filled in, each world_from_tag null until
+ * surveyed (so no command takes it for a map by mistake). Each tag has
+ * its id, family and size printed under it and a 10 cm scale bar. */
+bool mr_sheet_tags(const mr_sheet_params *p, mr_sheet_result *res, mr_error *err);
+/* A planar calibration board for `mrcheck calibrate`: board.pdf,
+ * board.png and board.json (a marker map in the board frame: origin at the
+ * first tag's centre, x along a row, y down the page, z into the paper,
+ * lengths in metres) with a scale bar. */
+bool mr_sheet_board(const mr_sheet_params *p, mr_sheet_result *res, mr_error *err);
+/* "0-11", "3,5,7-9": ids >= 0 in order, each once; a malloc'd array.
+ * false on a bad list (nothing allocated). */
+bool mr_sheet_ids_parse(const char *s, int **ids, int *n);
+
 #ifdef __cplusplus
 }
 #endif

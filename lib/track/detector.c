@@ -204,3 +204,50 @@ const mr_detection *mr_detector_detect(mr_detector *d, const mr_image *img, int 
     *count = k;
     return d->dets;
 }
+
+/* The printed cells, as apriltag's decoder expects them: the family's
+ * one-cell white ring just outside the detected square (inside it for the
+ * reversed-border families, whose outside is black), every cell else black
+ * unless the code sets its bit. Bit i (most significant first) sits at
+ * (bit_x[i], bit_y[i]) cells from the detected square's top-left corner;
+ * the reversed families place some bits outside it (negative offsets,
+ * stored wrapped in the unsigned fields). */
+bool mr_tag_pattern_make(const char *family, int id, mr_tag_pattern *out, mr_error *err) {
+    memset(out, 0, sizeof *out);
+    const family_entry *e = NULL;
+    for (size_t i = 0; family && i < sizeof k_family_table / sizeof k_family_table[0]; i++)
+        if (strcmp(k_family_table[i].name, family) == 0) e = &k_family_table[i];
+    if (!e) return mr_fail(err, MR_ERR_UNSUPPORTED, "unknown tag family '%.40s'", family ? family : "");
+    apriltag_family_t *fam = e->create();
+    if (!fam) return mr_fail(err, MR_ERR_NOMEM, "cannot create the %s family", family);
+    const int tw = fam->total_width, wb = fam->width_at_border;
+    bool ok = true;
+    if (tw < 1 || tw > MR_TAG_MAX_CELLS || wb < 1 || wb > tw)
+        ok = mr_fail(err, MR_ERR_UNSUPPORTED, "%s: %d cells per side is more than %d", family, tw, MR_TAG_MAX_CELLS);
+    else if (id < 0 || (uint32_t)id >= fam->ncodes)
+        ok = mr_fail(err, MR_ERR_INVALID, "%s has ids 0..%u; %d is not one", family, fam->ncodes - 1, id);
+    if (ok) {
+        out->total_width = tw;
+        out->width_at_border = wb;
+        out->codes = (int)fam->ncodes;
+        memset(out->cells, 1, sizeof out->cells);
+        const int ring = wb + (fam->reversed_border ? 0 : 2), r0 = (tw - ring) / 2, r1 = r0 + ring - 1;
+        for (int y = 0; y < tw; y++)
+            for (int x = 0; x < tw; x++) {
+                bool on_ring = ((x == r0 || x == r1) && y >= r0 && y <= r1) || ((y == r0 || y == r1) && x >= r0 && x <= r1);
+                if (on_ring) out->cells[y * MR_TAG_MAX_CELLS + x] = 0;
+            }
+        const int b0 = (tw - wb) / 2;
+        const uint64_t code = fam->codes[id];
+        for (uint32_t i = 0; i < fam->nbits; i++) {
+            int x = (int32_t)fam->bit_x[i] + b0, y = (int32_t)fam->bit_y[i] + b0;
+            if (x < 0 || y < 0 || x >= tw || y >= tw) {
+                ok = mr_fail(err, MR_ERR_UNSUPPORTED, "%s: bit %u lies outside the tag", family, i);
+                break;
+            }
+            if ((code >> (fam->nbits - 1 - i)) & 1u) out->cells[y * MR_TAG_MAX_CELLS + x] = 0;
+        }
+    }
+    e->destroy(fam);
+    return ok;
+}

@@ -70,6 +70,22 @@ bool mr_camera_parse(const char *text, size_t size, mr_camera *cam, mr_error *er
 /* Is `name` a tag family the detector knows? */
 bool mr_tag_family_known(const char *name);
 
+/* A tag as printed: total_width x total_width cells, cell (x, y) at
+ * cells[y * MR_TAG_MAX_CELLS + x], 1 = black, 0 = white; rendered from the
+ * family's own code (apriltag's codes, nbits, bit_x, bit_y) the way the
+ * detector reads it. The detector's quad, whose edge is a marker map's
+ * tag_size, spans the middle width_at_border cells (tag36h11: the black
+ * square, 8 of its 10 cells; the outer ring is the white quiet zone). */
+#define MR_TAG_MAX_CELLS 16
+typedef struct mr_tag_pattern {
+    int total_width;          /* cells per side, quiet zone included */
+    int width_at_border;      /* cells per side of the detected square */
+    int codes;                /* ids in the family: 0 .. codes-1 */
+    unsigned char cells[MR_TAG_MAX_CELLS * MR_TAG_MAX_CELLS];
+} mr_tag_pattern;
+/* false + err: unknown family, id outside the family. */
+bool mr_tag_pattern_make(const char *family, int id, mr_tag_pattern *out, mr_error *err);
+
 /* ------------------------------------------------------------- detection */
 
 typedef struct mr_detection {
