@@ -54,8 +54,7 @@ int cmd_factory(int argc, char **argv);
 int cmd_export(int argc, char **argv);
 int cmd_bcf(int argc, char **argv); /* bcf list | answer */
 int cmd_hall(int argc, char **argv); /* cmd_hall.c */
-int cmd_tags(int argc, char **argv);  /* cmd_sheets.c */
-int cmd_board(int argc, char **argv);
+int cmd_sheets(int argc, char **argv); /* tags | board: cmd_sheets.c */
 int bench_scene(int argc, char **argv);
 /* mrcheck bench map (bench_map.c). */
 int bench_map(int argc, char **argv);

@@ -3,12 +3,11 @@
 #include "app.h"
 #include "mr_batch.h"
 
-#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-static int sheets(int argc, char **argv, bool board) {
-    const char *cmd = board ? "board" : "tags";
+int cmd_sheets(int argc, char **argv) {
+    const bool board = strcmp(argv[1], "board") == 0;
     mr_cli_opt opts[] = {
         {"out", "DIR", "folder to write (new or empty)", NULL},
         {"ids", "LIST", "tags: ids to print, e.g. 0-11 or 0,3,7-9 (default 0-11)", NULL},
@@ -31,32 +30,16 @@ static int sheets(int argc, char **argv, bool board) {
         return 2;
     if (help) return 0;
     mr_cli_log_level(opts);
-    sp.out_dir = mr_cli_get(opts, "out");
+    if (!(sp.out_dir = mr_cli_get(opts, "out"))) return mr_cli_errorf(argv[1], "--out is required (see --help)"), 2;
     sp.family = mr_cli_get(opts, "family");
-    if (mr_cli_get(opts, "paper")) sp.paper = mr_cli_get(opts, "paper");
+    sp.paper = mr_cli_get(opts, "paper") ? mr_cli_get(opts, "paper") : sp.paper;
+    sp.ids_text = mr_cli_get(opts, "ids");
     sp.force = mr_cli_flag(opts, "force");
     sp.progress = isatty(2) && mr_log_get_level() >= MR_LOG_WARN;
-    if (!sp.out_dir) return mr_cli_errorf(cmd, "--out is required (see --help)"), 2;
-    if (!board && !(sp.size_mm > 0)) return mr_cli_errorf(cmd, "--size-mm is required: the printed edge of the black square"), 2;
-    int *ids = NULL;
-    const char *list = mr_cli_get(opts, "ids") ? mr_cli_get(opts, "ids") : "0-11";
-    if (!board && !mr_sheet_ids_parse(list, &ids, &sp.id_count))
-        return mr_cli_errorf(cmd, "--ids: expected ids like 0-11 or 0,3,7-9 (each once), got '%s'", list), 2;
-    sp.ids = ids;
     mr_stop_catch();
     mr_error err = {0};
     mr_sheet_result r;
-    bool ok = board ? mr_sheet_board(&sp, &r, &err) : mr_sheet_tags(&sp, &r, &err);
-    free(ids);
-    if (!ok) return mr_cli_error(cmd, &err);
-    if (board)
-        printf("board: %dx%d tags, pitch %g mm; wrote %s, %s/board.png at %g dpi and %s\n", r.cols, r.rows, r.pitch_mm,
-               r.pdf, sp.out_dir, sp.dpi, r.json);
-    else
-        printf("tags: %d tags on %d page%s (%d a page); wrote %s, %d PNG%s at %g dpi and %s\n", r.tags, r.pages,
-               r.pages == 1 ? "" : "s", r.per_page, r.pdf, r.pages, r.pages == 1 ? "" : "s", sp.dpi, r.json);
+    if (!(board ? mr_sheet_board(&sp, &r, &err) : mr_sheet_tags(&sp, &r, &err))) return mr_cli_error(argv[1], &err);
+    puts(r.summary);
     return 0;
 }
-
-int cmd_tags(int argc, char **argv) { return sheets(argc, argv, false); }
-int cmd_board(int argc, char **argv) { return sheets(argc, argv, true); }

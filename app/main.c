@@ -26,8 +26,8 @@ static const struct {
     /* Findings as BCF and a report */
     {"export", cmd_export, "a session's marks as BCF 2.1/3.0 topics or a self-contained HTML report"},
     {"bcf", cmd_bcf, "topics of a BCF made elsewhere: list them, answer one (comment, status, snapshot)"},
-    {"tags", cmd_tags, "printable AprilTag sheets (PDF, PNG at a stated dpi) and the marker-map template"},
-    {"board", cmd_board, "a printable calibration board for calibrate (PDF, PNG) and its board.json"},
+    {"tags", cmd_sheets, "printable AprilTag sheets (PDF, PNG at a stated dpi) and the marker-map template"},
+    {"board", cmd_sheets, "a printable calibration board for calibrate (PDF, PNG) and its board.json"},
     {"hall", cmd_hall, "a hall folder: plan, camera, marker map, tolerances and sessions in one place"},
 };
 

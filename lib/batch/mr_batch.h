@@ -188,8 +188,9 @@ typedef struct mr_sheet_params {
     bool force;               /* write into a folder that holds files */
     bool progress;            /* "tags: page i/n" on stderr */
     /* tags: */
-    const int *ids;           /* id_count ids to print, in this order */
+    const int *ids;           /* id_count ids to print, in this order; none: */
     int id_count;
+    const char *ids_text;     /* ... these, as mr_sheet_ids_parse reads them; NULL: "0-11" */
     /* board: */
     int cols, rows;           /* tags across and down; 0 = as many as fit */
     int first_id;             /* ids first_id, first_id+1, ... row by row */
@@ -210,6 +211,7 @@ typedef struct mr_sheet_result {
     double pitch_mm;          /* board: centre to centre */
     char pdf[4096];           /* the files written */
     char json[4096];          /* tags: the marker-map template; board: board.json */
+    char summary[4096];       /* what was written, one line for people */
 } mr_sheet_result;
 
 /* tags.pdf (every page), tags-N.png (page N at dpi) and

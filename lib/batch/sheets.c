@@ -160,10 +160,24 @@ static void free_pages(mr_page *pages, int n) {
     free(pages);
 }
 
+static bool sheet_tags(const mr_sheet_params *p, mr_sheet_result *res, mr_error *err);
+
 bool mr_sheet_tags(const mr_sheet_params *p, mr_sheet_result *res, mr_error *err) {
     memset(res, 0, sizeof *res);
     if (!p->out_dir) return mr_fail(err, MR_ERR_INVALID, "no output folder given");
-    if (!p->ids || p->id_count < 1) return mr_fail(err, MR_ERR_INVALID, "no tag ids given");
+    if (!(p->size_mm > 0)) return mr_fail(err, MR_ERR_INVALID, "the tag size (--size-mm) is required: the printed edge of the black square");
+    int *parsed = NULL, nparsed = 0;
+    const char *text = p->ids_text ? p->ids_text : "0-11";
+    if ((!p->ids || p->id_count < 1) && !mr_sheet_ids_parse(text, &parsed, &nparsed))
+        return mr_fail(err, MR_ERR_INVALID, "--ids: expected ids like 0-11 or 0,3,7-9 (each once), got '%.40s'", text);
+    mr_sheet_params pp = *p;
+    if (parsed) pp.ids = parsed, pp.id_count = nparsed;
+    bool ok = sheet_tags(&pp, res, err);
+    free(parsed);
+    return ok;
+}
+
+static bool sheet_tags(const mr_sheet_params *p, mr_sheet_result *res, mr_error *err) {
     sheet s;
     if (!sheet_setup(p, &s, p->ids[0], err)) return false;
     mr_tag_pattern t;
@@ -228,6 +242,8 @@ bool mr_sheet_tags(const mr_sheet_params *p, mr_sheet_result *res, mr_error *err
         snprintf(res->json, sizeof res->json, "%s/markers_template.json", p->out_dir);
         ok = mr_json_save(res->json, j, err);
         cJSON_Delete(j);
+        snprintf(res->summary, sizeof res->summary, "tags: %d tags on %d page%s (%d a page); wrote %.1500s, %d PNG%s at %g dpi and %.1500s",
+                 res->tags, npages, npages == 1 ? "" : "s", per, res->pdf, npages, npages == 1 ? "" : "s", s.dpi, res->json);
     }
     if (!ok && !mr_dir_has_entries(p->out_dir)) mr_outdir_abandon(&od);
     return ok;
@@ -303,6 +319,8 @@ bool mr_sheet_board(const mr_sheet_params *p, mr_sheet_result *res, mr_error *er
         snprintf(res->json, sizeof res->json, "%s/board.json", p->out_dir);
         ok = mr_json_save(res->json, j, err);
         cJSON_Delete(j);
+        snprintf(res->summary, sizeof res->summary, "board: %dx%d tags, pitch %g mm; wrote %.1500s, board.png at %g dpi and %.1500s",
+                 cols, rows, pitch, res->pdf, s.dpi, res->json);
     }
     free(map.tags);
     if (!ok && !mr_dir_has_entries(p->out_dir)) mr_outdir_abandon(&od);
