@@ -3,6 +3,7 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 int cmd_calibrate(int argc, char **argv) {
     static const char *cmd = "calibrate";
@@ -31,6 +32,8 @@ int cmd_calibrate(int argc, char **argv) {
     mr_marker_map map;
     if (!mr_marker_map_load(board, &map, &err)) return mr_cli_error(cmd, &err);
     bp.images = dir;
+    bp.progress = isatty(2) && mr_log_get_level() >= MR_LOG_WARN;
+    mr_stop_catch();
     bp.board = &map;
     bp.board_name = board;
     mr_board_calib c;

@@ -93,7 +93,11 @@ int cmd_map(int argc, char **argv) {
     }
 
     bool tty = isatty(2) && mr_log_get_level() >= MR_LOG_WARN;
-    if (!mr_map_photos_detect(in, family, cmd, &cam, tty ? photo_progress : NULL, NULL, &ps, &err)) goto fail;
+    mr_stop_catch();
+    if (!mr_map_photos_detect(in, family, cmd, &cam, tty ? photo_progress : NULL, NULL, &ps, &err)) {
+        if (tty) fprintf(stderr, "\n");
+        goto fail;
+    }
     if (tty) {
         fprintf(stderr, "\n");
         mp.progress = progress;

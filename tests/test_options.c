@@ -309,6 +309,8 @@ static void test_tables(void) {
     walk_table("mr_export_opts", mr_export_opts, sizeof exp, &exp);
     const mr_batch_replay_params rp = MR_BATCH_REPLAY_DEFAULTS;
     walk_table("mr_batch_replay_opts", mr_batch_replay_opts, sizeof rp, &rp);
+    const mr_sheet_params shp = MR_SHEET_DEFAULTS;
+    walk_table("mr_sheet_opts", mr_sheet_opts, sizeof shp, &shp);
 
 #define E(t, k, f, names) {k, offsetof(t, f), 0, 0, names}
 #define N(t, k, f, lo, hi) {k, offsetof(t, f), lo, hi, NULL}

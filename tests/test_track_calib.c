@@ -19,7 +19,7 @@ int main(void) {
     mr_marker_map map;
     CHECK_MSG(mr_marker_map_load(board, &map, &err), "%s", err.msg);
 
-    mr_board_calib_params p = {images, &map, "board.json", 0};
+    mr_board_calib_params p = {images, &map, "board.json", 0, false};
     mr_board_calib c;
     CHECK_MSG(mr_calibrate_board(&p, &c, &err), "%s", err.msg);
     CHECK_MSG(fabs(c.camera.fx - 500) < 5 && fabs(c.camera.fy - 500) < 5, "fx %g fy %g, expected 500 +- 1%%",

@@ -265,6 +265,9 @@ typedef struct mr_synth_recording_params {
 #define MR_SYNTH_RECORDING_DEFAULTS \
     .frames = 0, .width = 640, .height = 480, .noise = 2.0, .motion_blur = 3, .shutter = 60, .exposure = 0.25, \
     .jpeg_quality = 80, .seed = 1, .fps = 10.0
+/* A stop (SIGINT/SIGTERM, mr_stop_requested) ends it before the next
+ * frame: the recording holds every frame made so far; false with
+ * MR_ERR_INTERRUPTED and the summary in err. */
 bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params, const mr_bench_gpu *gfx, mr_error *err);
 /* Steps of the walking path (pauses and walks), the default frame count. */
 int mr_synth_path_frames(void);

@@ -154,8 +154,12 @@ bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params
     mr_rng_seed(&rng, p.seed);
     const int total = mr_synth_path_frames();
     const int frames = p.frames > 0 ? p.frames : total;
-    int with_pose = 0;
+    int with_pose = 0, stopped = -1;
     for (int i = 0; ok && i < frames; i++) {
+        if (mr_stop_requested()) {
+            stopped = i;
+            break;
+        }
         /* Spread the frames over the whole path; the timestamps are the
          * path's clock (one step per 1/fps), so fewer frames are further
          * apart in time, never a faster walk. */
@@ -201,6 +205,11 @@ bool mr_synth_recording(const char *dir, const mr_synth_recording_params *params
     for (int k = 0; k < 16; k++) mr_image_free(&ideal[k]);
     if (ok) mr_log(MR_LOG_INFO, "synth: %d frames, %d with a pose", frames, with_pose);
     mr_recorder_close(&rec);
+    /* Every frame appended so far is whole in the recording (frames.jsonl,
+     * groundtruth.jsonl and the images are append-only). */
+    if (ok && stopped >= 0)
+        ok = mr_fail(err, MR_ERR_INTERRUPTED, "interrupted after frame %d: %d of %d frames in %s", stopped - 1, stopped,
+                     frames, dir);
     mr_tracker_destroy(&trk);
     mr_renderer_set_scene(gfx->renderer, NULL, NULL); /* the caller's renderer keeps no scene of ours */
     mr_marker_map_free(&map);
@@ -243,6 +252,11 @@ bool mr_synth_calibration(const char *dir, int images, mr_error *err) {
     mr_rng_seed(&rng, 77);
     double cxb = 0.5 * (MR_DEMO_BOARD_COLS - 1) * MR_DEMO_BOARD_PITCH, cyb = 0.5 * (MR_DEMO_BOARD_ROWS - 1) * MR_DEMO_BOARD_PITCH;
     for (int i = 0; ok && i < images; i++) {
+        if (mr_stop_requested()) {
+            ok = mr_fail(err, MR_ERR_INTERRUPTED, "interrupted after image %d: board.json and %d of %d images in %s", i - 1,
+                         i, images, dir);
+            break;
+        }
         /* Views from around the board: tilts up to ~35 degrees, the board
          * filling different parts of the image. */
         double a = 2 * M_PI * i / images;

@@ -50,11 +50,13 @@ typedef struct gather {
     mr_board_calib *out;
     mr_calib_view *views;
     int cap, width, height;
+    bool progress;
 } gather;
 
 static bool take_photo(void *user, const mr_frame *f, const mr_detection *d, int n, mr_error *err) {
     gather *g = user;
     mr_board_calib *out = g->out;
+    if (g->progress) fprintf(stderr, "\rcalibrate: image %d (%d used)   ", out->views + out->skipped + 1, out->views);
     int used = 0;
     for (int i = 0; i < n; i++) used += mr_marker_map_find(g->map, d[i].id) != NULL;
     if (used < g->min_tags) {
@@ -85,9 +87,10 @@ bool mr_calibrate_board(const mr_board_calib_params *p, mr_board_calib *out, mr_
     if (!board_is_planar(map))
         return mr_fail(err, MR_ERR_INVALID, "%s: the board must be planar (all tags in the z = 0 plane)",
                        p->board_name ? p->board_name : "board");
-    gather g = {map, p->min_tags > 0 ? p->min_tags : MR_BOARD_CALIB_DEFAULT_MIN_TAGS, out, NULL, 0, 0, 0};
+    gather g = {map, p->min_tags > 0 ? p->min_tags : MR_BOARD_CALIB_DEFAULT_MIN_TAGS, out, NULL, 0, 0, 0, p->progress};
     int skipped = 0;
     bool ok = mr_detect_each(p->images, map->family, "calibrate", take_photo, &g, &skipped, err);
+    if (p->progress && (out->views || out->skipped)) fprintf(stderr, "\n");
     out->skipped += skipped;
     const int nv = out->views;
     out->view_rms_px = nv ? calloc((size_t)nv, sizeof *out->view_rms_px) : NULL;

@@ -13,8 +13,12 @@ bool mr_detect_each(const char *input, const char *family, const char *who, mr_d
     dp.decimate = 1; /* full resolution: corner accuracy is what is measured */
     mr_detector *det = src ? mr_detector_create(&dp, err) : NULL;
     bool ok = det != NULL;
-    int width = 0, height = 0;
+    int width = 0, height = 0, done = 0;
     while (ok) {
+        if (mr_stop_requested()) {
+            ok = mr_fail(err, MR_ERR_INTERRUPTED, "interrupted after %d image%s; nothing written", done, done == 1 ? "" : "s");
+            break;
+        }
         mr_frame f;
         mr_read_status st = mr_source_read(src, &f, err);
         if (st == MR_READ_END) break;
@@ -40,6 +44,7 @@ bool mr_detect_each(const char *input, const char *family, const char *who, mr_d
             continue;
         }
         ok = fn(user, &f, d, n, err);
+        done++;
     }
     mr_detector_destroy(&det);
     mr_source_close(&src);

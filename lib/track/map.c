@@ -495,7 +495,7 @@ static bool run_ba(const map_state *s, ba_run *r, mr_error *err) {
         };
         char msg[256] = "";
         ok = mr_ba_solve(&b, msg, sizeof msg);
-        if (!ok) mr_fail(err, MR_ERR_INVALID, "map: %s", msg);
+        if (!ok) mr_fail(err, mr_stop_requested() ? MR_ERR_INTERRUPTED : MR_ERR_INVALID, "map: %s", msg);
         if (ok) {
             cam->fx = b.intr[0], cam->fy = b.intr[1], cam->cx = b.intr[2], cam->cy = b.intr[3];
             for (int i = 0; i < 5; i++) cam->dist[i] = b.intr[4 + i];
@@ -1308,6 +1308,10 @@ bool mr_map_build(const mr_camera *cam, const mr_map_photo *photos, int photo_co
     bool ok = collect_tags(&s) && collect_sightings(&s) && connect_tags(&s) && choose_part(&s) && spanning_tree(&s) &&
               (params->no_adjust || average_poses(&s)) && apply_gauge(&s) && photo_poses(&s) && adjust(&s) &&
               fill_result(&s);
+    /* A stop (SIGINT/SIGTERM) ends the adjustment at its next iteration;
+     * whatever step noticed it, the map is not finished. */
+    if (mr_stop_requested() && (ok || !err || err->code != MR_ERR_INTERRUPTED))
+        ok = mr_fail(err, MR_ERR_INTERRUPTED, "interrupted while building the map; nothing written");
     map_state_free(&s);
     if (!ok) mr_map_result_free(out);
     return ok;

@@ -21,6 +21,14 @@
 
 namespace {
 
+/* SIGINT/SIGTERM (mr_stop_requested) end the solve after the iteration
+ * in progress. */
+struct StopOnSignal : public ceres::IterationCallback {
+    ceres::CallbackReturnType operator()(const ceres::IterationSummary &) override {
+        return mr_stop_requested() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+    }
+};
+
 /* Quaternion (w x y z) and translation of a row-major rigid 4x4. */
 void split_pose(const double *m, double q[4], double t[3]) {
     Eigen::Matrix3d R;
@@ -181,6 +189,8 @@ extern "C" bool mr_ba_solve(mr_ba_problem *p, char *msg, size_t msg_size) {
         so.function_tolerance = 1e-10;
         so.parameter_tolerance = 1e-10;
         so.logging_type = ceres::SILENT;
+        StopOnSignal stop;
+        so.callbacks.push_back(&stop);
         ceres::Solver::Summary sum;
         /* Pass 1: corners at 1 px. Their sigma is then estimated from the
          * residuals (floored: synthetic corners can be near exact) and pass
@@ -194,6 +204,11 @@ extern "C" bool mr_ba_solve(mr_ba_problem *p, char *msg, size_t msg_size) {
             return false;
         }
         ceres::Solve(so, problem.get(), &sum);
+        if (sum.termination_type == ceres::USER_FAILURE && mr_stop_requested()) {
+            snprintf(msg, msg_size, "bundle adjustment interrupted at iteration %d; nothing written",
+                     (int)sum.iterations.size());
+            return false;
+        }
         if (!sum.IsSolutionUsable()) {
             snprintf(msg, msg_size, "bundle adjustment failed: %s", sum.message.c_str());
             return false;
@@ -233,6 +248,11 @@ extern "C" bool mr_ba_solve(mr_ba_problem *p, char *msg, size_t msg_size) {
         problem.reset(new ceres::Problem(po));
         build(*problem, w, &loss2);
         ceres::Solve(so, problem.get(), &sum);
+        if (sum.termination_type == ceres::USER_FAILURE && mr_stop_requested()) {
+            snprintf(msg, msg_size, "bundle adjustment interrupted at iteration %d; nothing written",
+                     (int)sum.iterations.size());
+            return false;
+        }
         if (!sum.IsSolutionUsable()) {
             snprintf(msg, msg_size, "bundle adjustment failed: %s", sum.message.c_str());
             return false;

@@ -708,6 +708,8 @@ const char *mr_aruco_refine_name(mr_aruco_refine refine);
  * other frame and its detections (valid during the call); false from fn
  * stops the run and fails it. */
 typedef bool (*mr_detect_each_fn)(void *user, const mr_frame *f, const mr_detection *d, int count, mr_error *err);
+/* A stop (SIGINT/SIGTERM, mr_stop_requested) ends it before the next frame:
+ * false with MR_ERR_INTERRUPTED. */
 bool mr_detect_each(const char *input, const char *family, const char *who, mr_detect_each_fn fn, void *user,
                     int *skipped, mr_error *err);
 
@@ -737,6 +739,7 @@ typedef struct mr_board_calib_params {
     const mr_marker_map *board;   /* required */
     const char *board_name;       /* for messages (its file), or NULL */
     int min_tags;                 /* 0 = 4 */
+    bool progress;                /* "calibrate: image N" on stderr */
 } mr_board_calib_params;
 #define MR_BOARD_CALIB_DEFAULT_MIN_TAGS 4
 extern const mr_opt mr_board_calib_opts[]; /* min-tags */
