@@ -29,6 +29,20 @@ struct StopOnSignal : public ceres::IterationCallback {
     }
 };
 
+/* A solve's outcome: false with msg when a stop ended it (its callback
+ * above) or its solution is not usable. */
+bool solved(const ceres::Solver::Summary &sum, char *msg, size_t msg_size) {
+    if (sum.termination_type == ceres::USER_FAILURE && mr_stop_requested()) {
+        snprintf(msg, msg_size, "bundle adjustment interrupted at iteration %d; nothing written", (int)sum.iterations.size());
+        return false;
+    }
+    if (!sum.IsSolutionUsable()) {
+        snprintf(msg, msg_size, "bundle adjustment failed: %s", sum.message.c_str());
+        return false;
+    }
+    return true;
+}
+
 /* Quaternion (w x y z) and translation of a row-major rigid 4x4. */
 void split_pose(const double *m, double q[4], double t[3]) {
     Eigen::Matrix3d R;
@@ -204,15 +218,7 @@ extern "C" bool mr_ba_solve(mr_ba_problem *p, char *msg, size_t msg_size) {
             return false;
         }
         ceres::Solve(so, problem.get(), &sum);
-        if (sum.termination_type == ceres::USER_FAILURE && mr_stop_requested()) {
-            snprintf(msg, msg_size, "bundle adjustment interrupted at iteration %d; nothing written",
-                     (int)sum.iterations.size());
-            return false;
-        }
-        if (!sum.IsSolutionUsable()) {
-            snprintf(msg, msg_size, "bundle adjustment failed: %s", sum.message.c_str());
-            return false;
-        }
+        if (!solved(sum, msg, msg_size)) return false;
         int iters = (int)sum.iterations.size();
         auto corner_ss = [&](int *count) {
             double ss = 0;
@@ -248,15 +254,7 @@ extern "C" bool mr_ba_solve(mr_ba_problem *p, char *msg, size_t msg_size) {
         problem.reset(new ceres::Problem(po));
         build(*problem, w, &loss2);
         ceres::Solve(so, problem.get(), &sum);
-        if (sum.termination_type == ceres::USER_FAILURE && mr_stop_requested()) {
-            snprintf(msg, msg_size, "bundle adjustment interrupted at iteration %d; nothing written",
-                     (int)sum.iterations.size());
-            return false;
-        }
-        if (!sum.IsSolutionUsable()) {
-            snprintf(msg, msg_size, "bundle adjustment failed: %s", sum.message.c_str());
-            return false;
-        }
+        if (!solved(sum, msg, msg_size)) return false;
         p->iterations = iters + (int)sum.iterations.size();
         ss = corner_ss(&nc);
         p->rms_px = std::sqrt(ss / (2.0 * nc));
